@@ -1,0 +1,502 @@
+"""The robot model: plain, frozen data shared by every stage of eomgen.
+
+Conventions (URDF's, whatever the input format):
+
+* Every link has a frame. A joint connects a parent link to a child link; its ``origin`` is the
+  pose of the joint frame in the parent link frame, and the child link frame *is* the joint
+  frame moved by the joint variable: ``T_parent_child(q) = origin · motion(axis, q)``.
+* ``axis`` is a unit vector in the joint (= child link) frame. A revolute joint rotates by ``q``
+  radians about it (right hand rule); a prismatic joint translates by ``q`` metres along it.
+* A link's inertial data: mass [kg], centre of mass [m] in the link frame, and the 3×3
+  rotational inertia [kg m²] about the centre of mass, expressed in the link frame axes (a
+  URDF ``<inertial><origin rpy>`` is already applied by the parser).
+* ``gravity`` is the gravitational acceleration [m/s²] in the root link frame, e.g.
+  ``(0, 0, -9.81)`` for URDF input.
+
+Every geometric and inertial quantity is a SymPy expression: a number (exact integers are kept
+exact so that structural zeros stay zeros) or an expression in the model's parameter symbols.
+``RobotModel.parameters`` lists those symbols with their default numeric values.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+from typing import Iterable, Mapping
+
+import sympy as sp
+
+from .errors import DescriptionError, warn_physical
+
+Scalar = sp.Expr
+Vec3 = tuple[sp.Expr, sp.Expr, sp.Expr]
+Mat3 = tuple[Vec3, Vec3, Vec3]
+
+#: Rotation entries read from floats that lie within this distance of 0 or ±1 are made exact,
+#: so that ``rpy="1.57079632679 0 0"`` keeps its structural zeros. The change to the model is
+#: below the precision such descriptions are written with.
+SNAP_TOLERANCE = 1e-11
+
+
+def parameter_symbol(name: str) -> sp.Symbol:
+    """The one way eomgen makes a parameter symbol (real-valued), so that equal names give
+    equal symbols everywhere."""
+    return sp.Symbol(name, real=True)
+
+
+def scalar(value) -> sp.Expr:
+    """Convert a number or SymPy expression to the model's scalar type.
+
+    Integral floats become exact SymPy Integers (``0.0`` → ``0``) so that they propagate as
+    structural zeros and ones; other floats become SymPy Floats at double precision.
+    """
+    if isinstance(value, sp.Basic):
+        if value.is_Float and float(value).is_integer():
+            return sp.Integer(int(float(value)))
+        return value
+    if isinstance(value, bool):
+        raise TypeError("booleans are not scalars")
+    if isinstance(value, int):
+        return sp.Integer(value)
+    value = float(value)
+    if value.is_integer():
+        return sp.Integer(int(value))
+    return sp.Float(value, 17)
+
+
+def _snap(value: float) -> sp.Expr:
+    for target in (0.0, 1.0, -1.0):
+        if abs(value - target) <= SNAP_TOLERANCE:
+            return sp.Integer(int(target))
+    return scalar(value)
+
+
+def vec3(values: Iterable) -> Vec3:
+    out = tuple(scalar(v) for v in values)
+    if len(out) != 3:
+        raise ValueError("a 3-vector needs three components")
+    return out  # type: ignore[return-value]
+
+
+def mat3(rows: Iterable[Iterable]) -> Mat3:
+    out = tuple(vec3(r) for r in rows)
+    if len(out) != 3:
+        raise ValueError("a 3×3 matrix needs three rows")
+    return out  # type: ignore[return-value]
+
+
+IDENTITY3: Mat3 = mat3([[1, 0, 0], [0, 1, 0], [0, 0, 1]])
+ZERO3: Vec3 = vec3([0, 0, 0])
+
+
+def _matmul3(a: Mat3, b: Mat3) -> Mat3:
+    return tuple(
+        tuple(sp.Add(*[a[i][k] * b[k][j] for k in range(3)]) for j in range(3)) for i in range(3)
+    )  # type: ignore[return-value]
+
+
+def _matvec3(a: Mat3, v: Vec3) -> Vec3:
+    return tuple(sp.Add(*[a[i][k] * v[k] for k in range(3)]) for i in range(3))  # type: ignore
+
+
+def rotation_about_axis(axis: Vec3, angle) -> Mat3:
+    """Rotation matrix of ``angle`` (rad, right hand rule) about the unit vector ``axis``."""
+    if isinstance(angle, sp.Basic) and not angle.is_number:
+        c, s = sp.cos(angle), sp.sin(angle)
+    else:
+        c, s = _snap(math.cos(float(angle))), _snap(math.sin(float(angle)))
+    x, y, z = axis
+    t = 1 - c
+    return mat3(
+        [
+            [t * x * x + c, t * x * y - s * z, t * x * z + s * y],
+            [t * x * y + s * z, t * y * y + c, t * y * z - s * x],
+            [t * x * z - s * y, t * y * z + s * x, t * z * z + c],
+        ]
+    )
+
+
+def rotation_from_rpy(rpy: Vec3) -> Mat3:
+    """URDF fixed-axis roll-pitch-yaw: ``R = Rz(yaw) · Ry(pitch) · Rx(roll)``."""
+    roll, pitch, yaw = rpy
+    rx = rotation_about_axis(vec3([1, 0, 0]), roll)
+    ry = rotation_about_axis(vec3([0, 1, 0]), pitch)
+    rz = rotation_about_axis(vec3([0, 0, 1]), yaw)
+    return _matmul3(rz, _matmul3(ry, rx))
+
+
+@dataclass(frozen=True)
+class Transform:
+    """A rigid transform: ``p_parent = rotation · p_child + translation``."""
+
+    rotation: Mat3 = IDENTITY3
+    translation: Vec3 = ZERO3
+
+    @staticmethod
+    def from_xyz_rpy(xyz: Iterable = (0, 0, 0), rpy: Iterable = (0, 0, 0)) -> "Transform":
+        return Transform(rotation_from_rpy(vec3(rpy)), vec3(xyz))
+
+    def __matmul__(self, other: "Transform") -> "Transform":
+        rotation = _matmul3(self.rotation, other.rotation)
+        moved = _matvec3(self.rotation, other.translation)
+        translation = tuple(moved[i] + self.translation[i] for i in range(3))
+        return Transform(rotation, translation)  # type: ignore[arg-type]
+
+    def apply(self, point: Vec3) -> Vec3:
+        moved = _matvec3(self.rotation, point)
+        return tuple(moved[i] + self.translation[i] for i in range(3))  # type: ignore
+
+
+class JointType(enum.Enum):
+    """Joint types eomgen models. Mimic and floating joints are refused by the parsers."""
+
+    REVOLUTE = "revolute"
+    CONTINUOUS = "continuous"
+    PRISMATIC = "prismatic"
+    FIXED = "fixed"
+
+    @property
+    def is_movable(self) -> bool:
+        return self is not JointType.FIXED
+
+    @property
+    def is_revolute(self) -> bool:
+        return self in (JointType.REVOLUTE, JointType.CONTINUOUS)
+
+
+@dataclass(frozen=True)
+class Inertial:
+    """Mass [kg], centre of mass [m] in the link frame, inertia [kg m²] about the centre of mass
+    in the link frame axes."""
+
+    mass: Scalar
+    com: Vec3 = ZERO3
+    inertia: Mat3 = field(default_factory=lambda: mat3([[0, 0, 0], [0, 0, 0], [0, 0, 0]]))
+
+
+@dataclass(frozen=True)
+class Link:
+    """A rigid body. ``inertial`` is None for a massless link (valid: frames, sensors)."""
+
+    name: str
+    inertial: Inertial | None = None
+
+
+@dataclass(frozen=True)
+class Joint:
+    """A joint from ``parent`` link to ``child`` link; see the module docstring for frames."""
+
+    name: str
+    type: JointType
+    parent: str
+    child: str
+    origin: Transform = Transform()
+    axis: Vec3 = vec3([0, 0, 1])
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A symbol the model keeps symbolic, with the numeric value used where numbers are needed
+    (verification, defaults of generated keyword arguments). ``value`` is None when unknown."""
+
+    symbol: sp.Symbol
+    value: float | None = None
+    description: str = ""
+
+    @property
+    def name(self) -> str:
+        return self.symbol.name
+
+
+@dataclass(frozen=True)
+class RobotModel:
+    """A robot: links, joints (in description order), gravity and parameters.
+
+    The kinematic structure is a tree rooted at ``root``. ``joints`` keeps the order of the
+    description; ``movable_joints`` (and hence the joint vector ``q``) follows it.
+    ``info`` carries format-specific extras for display (e.g. the DH table) and never changes the
+    dynamics.
+    """
+
+    name: str
+    links: tuple[Link, ...]
+    joints: tuple[Joint, ...]
+    root: str
+    gravity: Vec3 = vec3([0, 0, -9.81])
+    parameters: tuple[Parameter, ...] = ()
+    source: str = "<memory>"
+    info: tuple[tuple[str, object], ...] = ()
+
+    @cached_property
+    def link_by_name(self) -> dict[str, Link]:
+        return {link.name: link for link in self.links}
+
+    @cached_property
+    def parent_joint(self) -> dict[str, Joint]:
+        """The joint whose child is the given link (absent for the root)."""
+        return {joint.child: joint for joint in self.joints}
+
+    @cached_property
+    def movable_joints(self) -> tuple[Joint, ...]:
+        return tuple(j for j in self.joints if j.type.is_movable)
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        return tuple(j.name for j in self.movable_joints)
+
+    @property
+    def dof(self) -> int:
+        return len(self.movable_joints)
+
+    @cached_property
+    def topological_joints(self) -> tuple[Joint, ...]:
+        """Joints ordered so that every joint comes after the joint of its parent link."""
+        children: dict[str, list[Joint]] = {}
+        for joint in self.joints:
+            children.setdefault(joint.parent, []).append(joint)
+        order: list[Joint] = []
+        stack = [self.root]
+        while stack:
+            link = stack.pop()
+            for joint in reversed(children.get(link, [])):
+                order.append(joint)
+                stack.append(joint.child)
+        # depth-first order; re-sort children visit so that description order is kept per level
+        return tuple(order)
+
+    @property
+    def parameter_values(self) -> dict[sp.Symbol, float]:
+        """Default numeric value of every parameter that has one."""
+        return {p.symbol: p.value for p in self.parameters if p.value is not None}
+
+    @property
+    def free_symbols(self) -> set[sp.Symbol]:
+        """Every symbol appearing anywhere in the model's numbers."""
+        found: set[sp.Symbol] = set()
+        for value in _all_scalars(self):
+            found |= value.free_symbols
+        return found
+
+    def substitute(self, values: Mapping[sp.Symbol, object]) -> "RobotModel":
+        """A copy with the given symbols replaced by numbers or expressions; parameters that
+        became numbers are dropped from ``parameters``."""
+        subs = {k: scalar(v) if not isinstance(v, sp.Basic) else v for k, v in values.items()}
+
+        def s(x):
+            return scalar(x.xreplace(subs)) if isinstance(x, sp.Basic) else x
+
+        def sv(v):
+            return tuple(s(x) for x in v)
+
+        links = tuple(
+            replace(
+                link,
+                inertial=None
+                if link.inertial is None
+                else Inertial(
+                    s(link.inertial.mass),
+                    sv(link.inertial.com),
+                    tuple(sv(r) for r in link.inertial.inertia),
+                ),
+            )
+            for link in self.links
+        )
+        joints = tuple(
+            replace(
+                j,
+                origin=Transform(
+                    tuple(sv(r) for r in j.origin.rotation), sv(j.origin.translation)
+                ),
+                axis=sv(j.axis),
+            )
+            for j in self.joints
+        )
+        params = tuple(p for p in self.parameters if p.symbol not in subs)
+        return replace(self, links=links, joints=joints, gravity=sv(self.gravity),
+                       parameters=params)
+
+    def with_numeric_parameters(self, values: Mapping[sp.Symbol, float] | None = None) -> "RobotModel":
+        """A copy with every parameter replaced by a number (``values`` over the defaults).
+
+        Raises
+        ------
+        DescriptionError
+            When a parameter has neither a default nor a given value.
+        """
+        merged = dict(self.parameter_values)
+        merged.update(values or {})
+        missing = sorted(s.name for s in self.free_symbols if s not in merged)
+        if missing:
+            raise DescriptionError(self.source, "parameters",
+                                   "no numeric value for " + ", ".join(missing))
+        return self.substitute(merged)
+
+
+def _all_scalars(model: RobotModel) -> Iterable[sp.Expr]:
+    yield from model.gravity
+    for link in model.links:
+        if link.inertial is not None:
+            yield link.inertial.mass
+            yield from link.inertial.com
+            for row in link.inertial.inertia:
+                yield from row
+    for joint in model.joints:
+        yield from joint.axis
+        yield from joint.origin.translation
+        for row in joint.origin.rotation:
+            yield from row
+
+
+# ----------------------------------------------------------------------------------------------
+# Validation, shared by every parser: one place for each rule.
+# ----------------------------------------------------------------------------------------------
+
+def _number(x: sp.Expr) -> float | None:
+    """The float value of x when it is a plain number, else None (symbolic)."""
+    if isinstance(x, sp.Basic) and x.is_number:
+        try:
+            return float(x)
+        except TypeError:  # complex numbers
+            return float("nan")
+    return None
+
+
+def check_inertial(source: str, link: str, inertial: Inertial, strict: bool = False) -> None:
+    """Check a link's inertial data: finite non-negative mass, finite symmetric PSD inertia,
+    and (warning, or error under ``strict``) the triangle inequality of principal moments."""
+    where = f"link '{link}' inertial"
+    m = _number(inertial.mass)
+    if m is not None:
+        if not math.isfinite(m):
+            raise DescriptionError(source, where, f"mass is {m}, not a finite number")
+        if m < 0:
+            raise DescriptionError(source, where, f"mass {m} is negative")
+    for v in inertial.com:
+        c = _number(v)
+        if c is not None and not math.isfinite(c):
+            raise DescriptionError(source, where, "centre of mass is not finite")
+    values = [[_number(v) for v in row] for row in inertial.inertia]
+    if any(v is None for row in values for v in row):
+        return  # symbolic inertia: checked at the numeric values by verification
+    import numpy as np
+
+    I = np.array(values, dtype=float)
+    if not np.all(np.isfinite(I)):
+        raise DescriptionError(source, where, "inertia has a non-finite entry")
+    if not np.allclose(I, I.T, rtol=0, atol=1e-12 * max(1.0, np.abs(I).max())):
+        raise DescriptionError(source, where, "inertia is not symmetric")
+    eig = np.linalg.eigvalsh(I)
+    scale = max(1.0, float(np.abs(eig).max()))
+    if eig.min() < -1e-12 * scale:
+        raise DescriptionError(
+            source, where, f"inertia has a negative eigenvalue ({eig.min():.6g})"
+        )
+    a, b, c = sorted(eig)
+    if a + b < c - 1e-9 * scale:
+        warn_physical(
+            source,
+            where,
+            f"principal moments {a:.6g}, {b:.6g}, {c:.6g} break the triangle inequality "
+            "(not a physical rigid body)",
+            strict,
+        )
+
+
+def check_tree(source: str, links: Iterable[str], joints: Iterable[Joint]) -> str:
+    """Check that links and joints form one tree; return the root link's name.
+
+    Errors: duplicate link or joint names, a joint naming an unknown link, a link with two
+    parents, a cycle, more than one root (disconnected links).
+    """
+    links = list(links)
+    joints = list(joints)
+    seen: set[str] = set()
+    for name in links:
+        if name in seen:
+            raise DescriptionError(source, f"link '{name}'", "duplicate link name")
+        seen.add(name)
+    joint_names: set[str] = set()
+    parent_of: dict[str, str] = {}
+    for j in joints:
+        if j.name in joint_names:
+            raise DescriptionError(source, f"joint '{j.name}'", "duplicate joint name")
+        joint_names.add(j.name)
+        for role, link in (("parent", j.parent), ("child", j.child)):
+            if link not in seen:
+                raise DescriptionError(source, f"joint '{j.name}'",
+                                       f"{role} link '{link}' is not defined")
+        if j.child in parent_of:
+            raise DescriptionError(source, f"joint '{j.name}'",
+                                   f"link '{j.child}' already has a parent joint")
+        if j.parent == j.child:
+            raise DescriptionError(source, f"joint '{j.name}'", "joint connects a link to itself")
+        parent_of[j.child] = j.parent
+    for name in links:  # cycle detection by walking up
+        visited = {name}
+        node = name
+        while node in parent_of:
+            node = parent_of[node]
+            if node in visited:
+                raise DescriptionError(source, f"link '{name}'", "kinematic loop (cycle)")
+            visited.add(node)
+    roots = [name for name in links if name not in parent_of]
+    if not roots:
+        raise DescriptionError(source, "robot", "no root link")
+    if len(roots) > 1:
+        raise DescriptionError(
+            source, f"link '{roots[1]}'",
+            f"not connected to the tree rooted at '{roots[0]}' (no parent joint)")
+    return roots[0]
+
+
+def check_axis(source: str, joint: str, axis: Vec3) -> Vec3:
+    """Return the unit axis; refuse zero, NaN or infinite axes."""
+    values = [_number(v) for v in axis]
+    if any(v is None for v in values):
+        return axis  # symbolic axis: the user's responsibility to keep it unit
+    if not all(math.isfinite(v) for v in values):
+        raise DescriptionError(source, f"joint '{joint}' axis", "axis is not finite")
+    norm = math.sqrt(sum(v * v for v in values))
+    if norm < 1e-12:
+        raise DescriptionError(source, f"joint '{joint}' axis", "axis is zero")
+    if abs(norm - 1.0) < 1e-12:
+        return axis
+    return vec3([_snap(v / norm) for v in values])
+
+
+def build_model(
+    source: str,
+    name: str,
+    links: Iterable[Link],
+    joints: Iterable[Joint],
+    gravity: Iterable = (0, 0, -9.81),
+    parameters: Iterable[Parameter] = (),
+    strict: bool = False,
+    info: Mapping[str, object] | None = None,
+) -> RobotModel:
+    """Validate parsed parts and assemble a :class:`RobotModel`. Every parser ends here."""
+    links = tuple(links)
+    joints = tuple(replace(j, axis=check_axis(source, j.name, j.axis)) for j in joints)
+    root = check_tree(source, (l.name for l in links), joints)
+    for link in links:
+        if link.inertial is not None:
+            check_inertial(source, link.name, link.inertial, strict)
+    gravity = vec3(gravity)
+    for v in gravity:
+        g = _number(v)
+        if g is not None and not math.isfinite(g):
+            raise DescriptionError(source, "gravity", "gravity is not finite")
+    params = tuple(parameters)
+    names = [p.name for p in params]
+    for p in params:
+        if names.count(p.name) > 1:
+            raise DescriptionError(source, f"parameter '{p.name}'", "duplicate parameter")
+    model = RobotModel(name=name, links=links, joints=joints, root=root, gravity=gravity,
+                       parameters=params, source=str(source),
+                       info=tuple((info or {}).items()))
+    undeclared = sorted((s for s in model.free_symbols if s.name not in names), key=str)
+    if undeclared:
+        model = replace(model, parameters=params + tuple(Parameter(s) for s in undeclared))
+    return model

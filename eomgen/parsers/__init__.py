@@ -1,0 +1,84 @@
+"""Parsers: one ``load(path, strict) -> RobotModel`` per input format, in a registry.
+
+A format registers itself with :func:`register`, naming the file suffixes it reads and, for
+YAML files shared by several formats, a ``sniff`` function that recognises its content. Adding a
+format touches no other module.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+from ..errors import DescriptionError
+from ..model import RobotModel
+
+Loader = Callable[[Path, bool], RobotModel]
+
+
+@dataclass(frozen=True)
+class Format:
+    name: str
+    suffixes: tuple[str, ...]
+    load: Loader
+    sniff: Callable[[str], bool] | None = None
+
+
+FORMATS: list[Format] = []
+
+
+def register(name: str, suffixes: tuple[str, ...], sniff: Callable[[str], bool] | None = None):
+    """Decorator registering ``load(path, strict)`` for files with the given suffixes."""
+
+    def decorate(load: Loader) -> Loader:
+        FORMATS.append(Format(name, suffixes, load, sniff))
+        return load
+
+    return decorate
+
+
+MAX_FILE_BYTES = 50 * 1024 * 1024
+
+
+def load(path, strict: bool = False) -> RobotModel:
+    """Read a robot description: URDF (``.urdf``), DH table (``.yaml`` with ``dh:``) or eomgen
+    YAML (``.yaml`` with ``links:``/``joints:``).
+
+    Parameters
+    ----------
+    path:
+        The description file.
+    strict:
+        Refuse (rather than warn about) inertias that break the triangle inequality.
+
+    Raises
+    ------
+    DescriptionError
+        Naming the file, the element and what is wrong.
+    """
+    from . import dh, urdf, yaml_format  # noqa: F401  (registration side effect)
+
+    path = Path(path)
+    if not path.is_file():
+        raise DescriptionError(str(path), "", "no such file")
+    if path.stat().st_size > MAX_FILE_BYTES:
+        raise DescriptionError(str(path), "", f"file larger than {MAX_FILE_BYTES} bytes")
+    suffix = path.suffix.lower()
+    candidates = [f for f in FORMATS if suffix in f.suffixes]
+    if not candidates:
+        known = sorted({s for f in FORMATS for s in f.suffixes})
+        raise DescriptionError(str(path), "", f"unknown file type '{suffix}' (known: {', '.join(known)})")
+    if len(candidates) > 1:
+        try:
+            text = path.read_text(encoding="utf-8")
+        except UnicodeDecodeError as exc:
+            raise DescriptionError(str(path), "", f"not UTF-8 text ({exc.reason})") from None
+        sniffed = [f for f in candidates if f.sniff is None or f.sniff(text)]
+        if len(sniffed) != 1:
+            raise DescriptionError(
+                str(path), "",
+                "cannot tell which format this is (" + " or ".join(f.name for f in candidates)
+                + "): a DH table needs a top-level 'dh' list, an eomgen robot 'links' and 'joints'")
+        candidates = sniffed
+    return candidates[0].load(path, strict)
