@@ -1,0 +1,218 @@
+"""Symbolic equations of motion ``M(q) q̈ + C(q, q̇) q̇ + g(q) = τ``: :func:`derive` and its result.
+
+Joint order is ``JOINT_NAMES``: the movable joints in the order the description lists them.
+Symbols: ``q1 … qn`` [rad or m], ``qd1 … qdn`` [rad/s or m/s], ``qdd1 … qddn``; parameters keep
+the names the description gave them. ``g`` is ∂P/∂q with ``P = −Σ m_l g_vecᵀ c_l`` (so a
+gravity vector (0, 0, −9.81) makes height cost energy). ``C`` is the Coriolis matrix built from
+the Christoffel symbols of the first kind, ``C_ij = Σ_k c_ijk q̇_k`` with
+``c_ijk = ½(∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i)``, which makes ``Ṁ − 2C`` skew-symmetric.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Iterable
+
+import sympy as sp
+
+from .bodies import body_tree
+from .model import Parameter, RobotModel
+from .symbolic.composite import derive_program
+from .symbolic.program import Program, ProgramBuilder
+
+ALL_OUTPUTS = ("M", "C", "g")
+
+
+def joint_symbols(n: int) -> tuple[tuple[sp.Symbol, ...], tuple[sp.Symbol, ...], tuple[sp.Symbol, ...]]:
+    """Symbols ``q1…qn``, ``qd1…qdn``, ``qdd1…qddn`` (real)."""
+    def make(prefix):
+        return tuple(sp.Symbol(f"{prefix}{k + 1}", real=True) for k in range(n))
+
+    return make("q"), make("qd"), make("qdd")
+
+
+@dataclass(frozen=True)
+class Step:
+    """One step of a derivation: a title, a sentence on what it computes, and named results."""
+
+    key: str
+    title: str
+    explanation: str
+    results: tuple[tuple[str, sp.Expr], ...]
+
+
+@dataclass(frozen=True)
+class Dynamics:
+    """The derived equations of motion of one model. Immutable.
+
+    Attributes
+    ----------
+    model:
+        The model they were derived from.
+    q, qd, qdd:
+        Joint position, velocity and acceleration symbols, in ``joint_names`` order.
+    program:
+        The straight-line program: intermediates and the outputs ``M``, ``C``, ``g``, ``P`` in
+        terms of them (what printers turn into code).
+    steps:
+        The ordered derivation steps (for LaTeX and notebook export).
+    timings:
+        Seconds spent in each stage.
+    """
+
+    model: RobotModel
+    q: tuple[sp.Symbol, ...]
+    qd: tuple[sp.Symbol, ...]
+    qdd: tuple[sp.Symbol, ...]
+    program: Program
+    steps: tuple[Step, ...]
+    timings: tuple[tuple[str, float], ...] = ()
+    simplified: bool = False
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        return self.model.joint_names
+
+    @property
+    def parameters(self) -> tuple[Parameter, ...]:
+        return self.model.parameters
+
+    @property
+    def outputs(self) -> tuple[str, ...]:
+        return tuple(name for name, _ in self.program.outputs)
+
+    @cached_property
+    def _full(self) -> dict:
+        return self.program.expanded()
+
+    def _expanded(self, name: str) -> sp.Matrix:
+        if name not in self.outputs:
+            raise KeyError(f"{name} was not derived (outputs: {', '.join(self.outputs)})")
+        matrix = self.program.expand(self.program.output(name), self._full)
+        if self.simplified:
+            matrix = matrix.applyfunc(lambda e: sp.factor_terms(sp.trigsimp(sp.expand(e))))
+        return matrix
+
+    @cached_property
+    def M(self) -> sp.Matrix:
+        """Mass matrix M(q), n×n, symmetric positive definite [kg m², kg m, kg]."""
+        return self._expanded("M")
+
+    @cached_property
+    def C(self) -> sp.Matrix:
+        """Coriolis matrix C(q, q̇), n×n, from Christoffel symbols of the first kind."""
+        return self._expanded("C")
+
+    @cached_property
+    def g(self) -> sp.Matrix:
+        """Gravity vector g(q) = ∂P/∂q, n×1 [N m or N]."""
+        return self._expanded("g")
+
+    @cached_property
+    def P(self) -> sp.Expr:
+        """Potential energy P(q) = −Σ m_l g_vecᵀ c_l [J] (zero at the world origin)."""
+        return self._expanded("P")[0, 0]
+
+    @cached_property
+    def K(self) -> sp.Expr:
+        """Kinetic energy K = ½ q̇ᵀ M(q) q̇ [J]."""
+        qd = sp.Matrix(self.qd)
+        value = (qd.T * self.M * qd)[0, 0] / 2
+        return sp.factor_terms(sp.expand(value)) if self.simplified else value
+
+    @property
+    def tau(self) -> sp.Matrix:
+        """Inverse dynamics M q̈ + C q̇ + g, n×1."""
+        return self.M * sp.Matrix(self.qdd) + self.C * sp.Matrix(self.qd) + self.g
+
+    def operation_count(self, names: Iterable[str] | None = None) -> int:
+        """Arithmetic operations of the straight-line program for the given outputs."""
+        return self.program.operation_count(names)
+
+    def _repr_latex_(self) -> str:  # rich display in notebooks
+        parts = [f"\\text{{{self.model.name}: }}"]
+        for name in ("M", "C", "g"):
+            if name in self.outputs and self.model.dof <= 3:
+                parts.append(f"{name} = {sp.latex(getattr(self, name))}")
+        return "$" + r",\quad ".join(parts) + "$"
+
+
+def derive(model: RobotModel, outputs: Iterable[str] = ALL_OUTPUTS, simplify: bool | None = None) -> Dynamics:
+    """Derive the equations of motion of ``model`` symbolically (Lagrangian method).
+
+    Parameters
+    ----------
+    model:
+        A robot model (see :func:`eomgen.load`).
+    outputs:
+        Which of ``"M"``, ``"C"``, ``"g"`` to derive; what is not asked is not computed.
+    simplify:
+        Trig-simplify the expanded expressions (``dynamics.M`` etc.). ``None`` (default) does it
+        for teaching-sized models (at most 3 joints) only: it is exponential in the model size.
+
+    Returns
+    -------
+    Dynamics
+        With ``M``, ``C``, ``g`` as SymPy matrices in ``q``, ``qd`` and the parameters.
+
+    Examples
+    --------
+    >>> import eomgen
+    >>> arm = eomgen.load(eomgen.example_path("planar_2link"))
+    >>> dyn = eomgen.derive(arm)
+    >>> dyn.joint_names
+    ('joint1', 'joint2')
+    """
+    outputs = set(outputs)
+    unknown = outputs - set(ALL_OUTPUTS)
+    if unknown:
+        raise ValueError(f"unknown outputs {sorted(unknown)}; choose from {ALL_OUTPUTS}")
+    timings = []
+    start = time.perf_counter()
+    tree = body_tree(model)
+    q, qd, qdd = joint_symbols(model.dof)
+    reserved = {s.name for s in q + qd + qdd} | {p.name for p in model.parameters}
+    builder = ProgramBuilder(reserved)
+    timings.append(("bodies", time.perf_counter() - start))
+    start = time.perf_counter()
+    result = derive_program(tree, q, qd, model.gravity, outputs, builder)
+    timings.append(("program", time.perf_counter() - start))
+    names = [name for name in ("M", "C", "g", "P") if name in result]
+    program = Program(tuple(builder.assignments), tuple((n, result[n]) for n in names)).pruned(names)
+    steps = _steps(program, result)
+    if simplify is None:
+        simplify = model.dof <= 3
+    return Dynamics(model, q, qd, qdd, program, steps, tuple(timings), bool(simplify))
+
+
+def _steps(program: Program, result: dict) -> tuple[Step, ...]:
+    defined = dict(program.assignments)
+
+    def named(prefix: str) -> tuple[tuple[str, sp.Expr], ...]:
+        return tuple((s.name, e) for s, e in program.assignments if s.name.startswith(prefix))
+
+    steps = [
+        Step("kinematics", "Forward kinematics",
+             "World rotation R_i, origin p_i and motion axis S_i of every body.",
+             named("R") + named("o") + named("p") + named("z") + named("v")),
+        Step("inertia", "Composite inertias",
+             "Mass m, first moment h and rotational inertia about the world origin of each subtree.",
+             named("mc") + named("hc") + named("Ic")),
+    ]
+    if "M" in result:
+        steps.append(Step("M", "Mass matrix", "M_ij = S_iᵀ I^c_j S_j for i an ancestor of j.",
+                          tuple((f"M[{i},{j}]", result["M"][i, j]) for i in range(result["M"].rows)
+                                for j in range(i, result["M"].cols))))
+    if "C" in result:
+        steps.append(Step("christoffel", "Christoffel symbols",
+                          "c_ijk = ½(∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i).", named("Gamma")))
+        steps.append(Step("C", "Coriolis matrix", "C_ij = Σ_k c_ijk q̇_k.",
+                          tuple((f"C[{i},{j}]", result["C"][i, j]) for i in range(result["C"].rows)
+                                for j in range(result["C"].cols))))
+    if "g" in result:
+        steps.append(Step("g", "Gravity vector", "g_i = ∂P/∂q_i.",
+                          tuple((f"g[{i}]", result["g"][i, 0]) for i in range(result["g"].rows))))
+    del defined
+    return tuple(steps)

@@ -1,0 +1,128 @@
+"""Straight-line programs: symbolic expressions with named intermediate quantities.
+
+Expression swell is what makes naive symbolic dynamics unusable past a few joints. eomgen never
+builds one big expression: every non-trivial quantity (a sine, an entry of a rotation matrix, a
+composite inertia, a Christoffel symbol) is *defined once* as a named intermediate symbol, and
+later expressions refer to it by name. The result is a straight-line program
+``x_k = f_k(q, qd, parameters, x_0 … x_{k-1})`` whose outputs (M, C, g, …) are small
+expressions in the intermediates. Identical definitions are shared (hash-consing), numbers fold,
+and zeros never get a name, so structural zeros propagate for free.
+
+Printers turn a program into code directly; :meth:`Program.expand` substitutes the intermediates
+back when full expressions in ``q`` are wanted (small teaching models, exact checks).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Iterable, Mapping, Sequence
+
+import sympy as sp
+
+
+def _is_trivial(expr: sp.Expr) -> bool:
+    """Atoms, and a number times an atom, are used inline rather than named."""
+    if expr.is_Atom:
+        return True
+    if expr.is_Mul and len(expr.args) == 2 and expr.args[0].is_Number and expr.args[1].is_Atom:
+        return True
+    return False
+
+
+class ProgramBuilder:
+    """Builds a straight-line program. Not thread-safe; one builder per derivation.
+
+    Parameters
+    ----------
+    reserved:
+        Names already in use (joint and parameter symbols); intermediates never take them.
+    """
+
+    def __init__(self, reserved: Iterable[str] = ()):
+        self._reserved = set(reserved)
+        self._names: set[str] = set()
+        self._by_value: dict[sp.Expr, sp.Symbol] = {}
+        self.assignments: list[tuple[sp.Symbol, sp.Expr]] = []
+
+    def _fresh(self, hint: str) -> sp.Symbol:
+        name = hint
+        while name in self._names or name in self._reserved:
+            name += "_"
+        self._names.add(name)
+        return sp.Symbol(name, real=True)
+
+    def define(self, expr, hint: str = "x") -> sp.Expr:
+        """Name ``expr`` unless it is trivial or already named; return what to use in its place."""
+        expr = sp.sympify(expr) if not isinstance(expr, sp.Basic) else expr
+        if _is_trivial(expr):
+            return expr
+        if expr.is_Mul and expr.args[0] == -1 and len(expr.args) == 2 and expr.args[1].is_Atom:
+            return expr
+        known = self._by_value.get(expr)
+        if known is not None:
+            return known
+        neg = self._by_value.get(-expr)
+        if neg is not None:
+            return -neg
+        symbol = self._fresh(hint)
+        self._by_value[expr] = symbol
+        self.assignments.append((symbol, expr))
+        return symbol
+
+    def define_all(self, exprs: Sequence, hint: str) -> tuple:
+        """Define each entry of a vector, hinting names ``hint0, hint1, …``."""
+        return tuple(self.define(e, f"{hint}{k}") for k, e in enumerate(exprs))
+
+
+@dataclass(frozen=True)
+class Program:
+    """An immutable straight-line program with named outputs.
+
+    Attributes
+    ----------
+    assignments:
+        ``(symbol, expression)`` pairs in evaluation order; each expression uses only inputs and
+        earlier symbols.
+    outputs:
+        Output name → SymPy Matrix in terms of inputs and intermediates.
+    """
+
+    assignments: tuple[tuple[sp.Symbol, sp.Expr], ...]
+    outputs: tuple[tuple[str, sp.Matrix], ...]
+
+    def output(self, name: str) -> sp.Matrix:
+        return dict(self.outputs)[name]
+
+    def pruned(self, names: Iterable[str]) -> "Program":
+        """The program computing only the named outputs, with unused assignments removed."""
+        names = list(names)
+        outs = tuple((n, m) for n, m in self.outputs if n in names)
+        needed: set[sp.Symbol] = set()
+        for _, matrix in outs:
+            needed |= matrix.free_symbols
+        kept = []
+        for symbol, expr in reversed(self.assignments):
+            if symbol in needed:
+                kept.append((symbol, expr))
+                needed |= expr.free_symbols
+        return Program(tuple(reversed(kept)), outs)
+
+    def expanded(self) -> dict[sp.Symbol, sp.Expr]:
+        """Map every intermediate to its full expression in the inputs (shared sub-trees)."""
+        full: dict[sp.Symbol, sp.Expr] = {}
+        for symbol, expr in self.assignments:
+            full[symbol] = expr.xreplace(full) if expr.free_symbols & full.keys() else expr
+        return full
+
+    def expand(self, matrix: sp.Matrix, full: Mapping | None = None) -> sp.Matrix:
+        full = self.expanded() if full is None else full
+        return matrix.xreplace(dict(full))
+
+    def operation_count(self, names: Iterable[str] | None = None) -> int:
+        """Arithmetic operations (SymPy ``count_ops``) of the assignments and outputs needed for
+        the named outputs (all by default)."""
+        program = self if names is None else self.pruned(names)
+        total = sum(sp.count_ops(expr) for _, expr in program.assignments)
+        for _, matrix in program.outputs:
+            total += sum(sp.count_ops(e) for e in matrix)
+        return int(total)
