@@ -10,6 +10,12 @@ from __future__ import annotations
 import warnings
 
 
+def one_line(text: str) -> str:
+    """``text`` with line breaks and other non-printable characters escaped (``\\n``,
+    ``\\u2028``), so that a message built from file content (names, paths) stays on one line."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+
+
 class EomgenError(Exception):
     """Base class of every error eomgen raises on bad input or impossible requests."""
 
@@ -33,7 +39,7 @@ class DescriptionError(EomgenError):
         self.element = element
         self.problem = problem
         where = f"{self.source}: {element}: " if element else f"{self.source}: "
-        super().__init__(where + problem)
+        super().__init__(one_line(where + problem))
 
 
 class UnsupportedError(DescriptionError):
@@ -52,4 +58,5 @@ def warn_physical(source: str, element: str, problem: str, strict: bool) -> None
     """Warn about a non-physical but usable value, or raise under ``strict``."""
     if strict:
         raise DescriptionError(source, element, problem + " (refused under --strict)")
-    warnings.warn(f"{source}: {element}: {problem}", PhysicalConsistencyWarning, stacklevel=3)
+    warnings.warn(one_line(f"{source}: {element}: {problem}"), PhysicalConsistencyWarning,
+                  stacklevel=3)

@@ -65,9 +65,12 @@ def parse_scalar(text) -> sp.Expr:
     if len(text) > MAX_LENGTH:
         raise ValueError(f"expression longer than {MAX_LENGTH} characters")
     try:
-        return scalar(float(text)) if _is_float(text) else _convert(ast.parse(text, mode="eval").body)
+        value = scalar(float(text)) if _is_float(text) else _convert(ast.parse(text, mode="eval").body)
     except (SyntaxError, RecursionError, MemoryError) as exc:
         raise ValueError(f"cannot parse {text!r} as a number or expression") from exc
+    if value.has(sp.I, sp.zoo, sp.oo, sp.nan):  # sqrt(-1), 0**-1, ...
+        raise ValueError(f"{text!r} is not a finite real number")
+    return value
 
 
 def _is_float(text: str) -> bool:

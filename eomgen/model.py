@@ -252,18 +252,18 @@ class RobotModel:
 
     @cached_property
     def topological_joints(self) -> tuple[Joint, ...]:
-        """Joints ordered so that every joint comes after the joint of its parent link."""
+        """Joints in depth-first preorder from the root: every joint comes after the joint of
+        its parent link, each subtree's joints are contiguous, and siblings keep description
+        order."""
         children: dict[str, list[Joint]] = {}
         for joint in self.joints:
             children.setdefault(joint.parent, []).append(joint)
         order: list[Joint] = []
-        stack = [self.root]
+        stack = list(reversed(children.get(self.root, [])))
         while stack:
-            link = stack.pop()
-            for joint in reversed(children.get(link, [])):
-                order.append(joint)
-                stack.append(joint.child)
-        # depth-first order; re-sort children visit so that description order is kept per level
+            joint = stack.pop()
+            order.append(joint)
+            stack.extend(reversed(children.get(joint.child, [])))
         return tuple(order)
 
     @property

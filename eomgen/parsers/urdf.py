@@ -1,0 +1,353 @@
+"""Read a URDF robot description into a :class:`~eomgen.model.RobotModel`.
+
+What is read
+------------
+* ``<robot name>``: the model name. The root link of the link tree is the fixed base (as
+  Pinocchio's ``buildModelFromUrdf`` without a root joint); gravity is ``(0, 0, -9.81)`` m/s²
+  in the root link frame (URDF convention: base z axis up).
+* ``<link name>`` with an optional ``<inertial>``: ``<origin xyz rpy>`` (default zeros) is the
+  centre-of-mass frame in the link frame, ``<mass value>`` [kg] and
+  ``<inertia ixx ixy ixz iyy iyz izz>`` [kg m²] about the centre of mass in the axes of that
+  frame. The model stores the inertia in the *link* frame axes, ``I_link = R · I · Rᵀ`` with
+  ``R = Rz(yaw) · Ry(pitch) · Rx(roll)`` from the origin's ``rpy``. A link without
+  ``<inertial>`` is massless (``Link.inertial is None``).
+* ``<joint name type>`` of type ``revolute``, ``continuous``, ``prismatic`` or ``fixed``, with
+  ``<parent link>``, ``<child link>``, ``<origin xyz rpy>`` (the joint frame in the parent link
+  frame; metres and radians; default zeros) and ``<axis xyz>`` (in the joint frame; default
+  ``1 0 0`` as the URDF specification says; not read for fixed joints). Joints keep document
+  order, so the joint vector ``q`` lists the movable joints in the order the file does.
+
+Everything else (visual, collision, limit, dynamics, transmission, gazebo, material, sensors)
+is ignored: it does not enter the rigid-body equations of motion.
+
+Decisions
+---------
+* An ``<inertial>`` must hold ``<mass>`` and ``<inertia>`` with all six attributes, as urdfdom
+  (ROS, Pinocchio) requires; a point mass is written with zero moments of inertia. A missing
+  ``<inertia>`` is more often an authoring slip than a deliberate point mass.
+* ``floating`` and ``planar`` joints and joints with ``<mimic>`` raise
+  :class:`~eomgen.errors.UnsupportedError`. ``mimic_as_independent=True`` instead reads a mimic
+  joint as an ordinary independent joint (what Pinocchio does by default), for descriptions
+  such as the Franka Panda whose gripper fingers are coupled by ``<mimic>``.
+* Numbers are plain decimal numbers read with :func:`float` (URDF has no expressions); they
+  must be finite. Exact integers stay exact (see :func:`eomgen.model.scalar`).
+* A singleton element (``<inertial>``, ``<origin>``, ``<axis>``, ...) given twice is an error
+  rather than a silent choice of one of them.
+* ``<limit>`` is not required for revolute and prismatic joints (urdfdom requires it): limits
+  do not enter the equations of motion.
+
+Safety
+------
+XML is parsed with :mod:`defusedxml`: entity declarations (billion laughs) and external
+entities or DTDs are refused before anything is expanded or fetched. Names are data: they are
+never evaluated, and error messages escape line breaks in them.
+
+Validation of the assembled tree and of masses and inertias (negative mass, indefinite inertia,
+triangle inequality, zero axis, cycles, duplicate or missing links) is done once, for every
+format, by :func:`eomgen.model.build_model`.
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from pathlib import Path
+from typing import Iterable
+from xml.parsers import expat
+
+import defusedxml
+import defusedxml.ElementTree as SafeET
+import sympy as sp
+
+from ..errors import DescriptionError, UnsupportedError
+from ..model import (
+    Inertial,
+    Joint,
+    JointType,
+    Link,
+    Mat3,
+    RobotModel,
+    Transform,
+    build_model,
+    mat3,
+    rotation_from_rpy,
+    scalar,
+    vec3,
+)
+from . import register
+
+#: Gravitational acceleration [m/s²] in the root link frame (URDF: z up).
+GRAVITY = (0, 0, -9.81)
+#: The joint axis when ``<axis>`` is absent (URDF specification).
+DEFAULT_AXIS = (1.0, 0.0, 0.0)
+ZEROS = (0.0, 0.0, 0.0)
+
+_JOINT_TYPES = {t.value: t for t in JointType}
+_UNSUPPORTED_JOINT_TYPES = ("floating", "planar")
+_INERTIA_ATTRIBUTES = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+_SHOWN_CHARACTERS = 40
+
+
+@register("URDF", (".urdf",))
+def load_urdf(path: Path, strict: bool = False, *, mimic_as_independent: bool = False
+              ) -> RobotModel:
+    """Read the URDF file ``path`` (see the module docstring for what is read and how).
+
+    Parameters
+    ----------
+    path:
+        The ``.urdf`` file.
+    strict:
+        Refuse (rather than warn about) inertias that break the triangle inequality.
+    mimic_as_independent:
+        Read ``<mimic>`` joints as independent joints instead of refusing them.
+
+    Returns
+    -------
+    RobotModel
+        Links and joints in document order, gravity ``(0, 0, -9.81)`` m/s².
+
+    Raises
+    ------
+    DescriptionError
+        One line naming the file, the element and the problem.
+    UnsupportedError
+        For floating, planar and (by default) mimic joints.
+    """
+    source = str(path)
+    try:
+        data = Path(path).read_bytes()
+    except OSError as exc:
+        raise DescriptionError(source, "", f"cannot read the file ({exc.strerror})") from None
+    return _read_robot(data, source, strict, mimic_as_independent)
+
+
+def parse_urdf_string(text: str | bytes, source: str = "<string>", strict: bool = False, *,
+                      mimic_as_independent: bool = False) -> RobotModel:
+    """Read URDF from a string; ``source`` names it in error messages. See :func:`load_urdf`.
+
+    >>> model = parse_urdf_string('''<robot name="r">
+    ...   <link name="base"/>
+    ...   <link name="arm"><inertial><mass value="2"/>
+    ...     <inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+    ...   <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/>
+    ...     <axis xyz="0 0 1"/></joint>
+    ... </robot>''')
+    >>> model.joint_names, model.link_by_name["arm"].inertial.mass
+    (('j1',), 2)
+    """
+    return _read_robot(text, source, strict, mimic_as_independent)
+
+
+# ----------------------------------------------------------------------------------------------
+# Document
+# ----------------------------------------------------------------------------------------------
+
+def _read_robot(data: str | bytes, source: str, strict: bool, mimic_as_independent: bool
+                ) -> RobotModel:
+    root = _parse_xml(data, source)
+    if root.tag != "robot":
+        raise DescriptionError(source, f"root element <{root.tag}>", "expected <robot>")
+    name = _required_name(root, source, "<robot>")
+    links = [_read_link(element, index, source)
+             for index, element in enumerate(root.findall("link"), start=1)]
+    joints = [_read_joint(element, index, source, mimic_as_independent)
+              for index, element in enumerate(root.findall("joint"), start=1)]
+    return build_model(source, name, links, joints, gravity=GRAVITY, strict=strict)
+
+
+def _parse_xml(data: str | bytes, source: str) -> ET.Element:
+    """The document's root element; no entity is expanded and nothing external is read."""
+    try:
+        return SafeET.fromstring(data, forbid_dtd=False, forbid_entities=True,
+                                 forbid_external=True)
+    except ET.ParseError as exc:
+        line, column = getattr(exc, "position", (0, -1))
+        where = f"line {line}, column {column + 1}" if line else ""
+        raise DescriptionError(source, where,
+                               f"malformed XML ({expat.ErrorString(exc.code)})") from None
+    except defusedxml.EntitiesForbidden as exc:
+        raise DescriptionError(source, f"<!ENTITY {exc.name}>",
+                               "entity declarations are not allowed in a URDF") from None
+    except defusedxml.DefusedXmlException as exc:  # external references, DTD tricks
+        raise DescriptionError(source, "XML", f"refused: {exc}") from None
+
+
+# ----------------------------------------------------------------------------------------------
+# Links
+# ----------------------------------------------------------------------------------------------
+
+def _read_link(element: ET.Element, index: int, source: str) -> Link:
+    name = _required_name(element, source, f"<link> number {index}")
+    where = f"link '{name}'"
+    inertial = _single_child(element, "inertial", source, where)
+    if inertial is None:
+        return Link(name)
+    return Link(name, _read_inertial(inertial, source, f"{where} <inertial>"))
+
+
+def _read_inertial(element: ET.Element, source: str, where: str) -> Inertial:
+    """Mass [kg], centre of mass [m] in the link frame and inertia [kg m²] about it in the
+    link frame axes (the origin's rpy applied)."""
+    xyz, rpy = _read_origin(_single_child(element, "origin", source, where), source,
+                            f"{where}<origin>")
+    mass_element = _single_child(element, "mass", source, where)
+    if mass_element is None:
+        raise DescriptionError(source, where, "no <mass> element")
+    mass = _number_attribute(mass_element, "value", source, f"{where}<mass>")
+    inertia_element = _single_child(element, "inertia", source, where)
+    if inertia_element is None:
+        raise DescriptionError(
+            source, where,
+            "no <inertia> element (a point mass has ixx=ixy=ixz=iyy=iyz=izz=\"0\")")
+    inertia = _read_inertia(inertia_element, source, f"{where}<inertia>")
+    return Inertial(scalar(mass), vec3(xyz), rotate_inertia(inertia, rpy))
+
+
+def _read_inertia(element: ET.Element, source: str, where: str) -> list[list[float]]:
+    """The symmetric 3×3 matrix of ``<inertia ixx ixy ixz iyy iyz izz>``."""
+    xx, xy, xz, yy, yz, zz = (_number_attribute(element, attribute, source, where)
+                              for attribute in _INERTIA_ATTRIBUTES)
+    return [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]
+
+
+def rotate_inertia(inertia: list[list[float]], rpy: Iterable[float]) -> Mat3:
+    """Express an inertia given in a frame rotated by ``rpy`` in the outer frame's axes.
+
+    ``I_outer = R · I · Rᵀ`` with ``R = Rz(yaw) · Ry(pitch) · Rx(roll)``. When ``rpy`` is zero
+    the values are kept exactly (structural zeros stay exact zeros); otherwise the result is
+    made exactly symmetric by computing the upper triangle only.
+
+    >>> rotate_inertia([[1, 0, 0], [0, 2, 0], [0, 0, 3]], (0, 0, math.pi / 2))[0]
+    (2, 0, 0)
+    """
+    rpy = tuple(rpy)
+    if not any(rpy):
+        return mat3(inertia)
+    R = rotation_from_rpy(vec3(rpy))
+    I = mat3(inertia)
+    upper = {
+        (i, j): scalar(sp.Add(*[R[i][k] * I[k][l] * R[j][l] for k in range(3) for l in range(3)]))
+        for i in range(3) for j in range(i, 3)
+    }
+    return mat3([[upper[min(i, j), max(i, j)] for j in range(3)] for i in range(3)])
+
+
+# ----------------------------------------------------------------------------------------------
+# Joints
+# ----------------------------------------------------------------------------------------------
+
+def _read_joint(element: ET.Element, index: int, source: str, mimic_as_independent: bool
+                ) -> Joint:
+    name = _required_name(element, source, f"<joint> number {index}")
+    where = f"joint '{name}'"
+    joint_type = _read_joint_type(element, source, where)
+    if _single_child(element, "mimic", source, where) is not None and not mimic_as_independent:
+        raise UnsupportedError(source, f"{where} <mimic>",
+                               "mimic joints are not supported (eomgen needs independent joints)")
+    parent = _link_reference(element, "parent", source, where)
+    child = _link_reference(element, "child", source, where)
+    xyz, rpy = _read_origin(_single_child(element, "origin", source, where), source,
+                            f"{where} <origin>")
+    axis = DEFAULT_AXIS
+    axis_element = _single_child(element, "axis", source, where)
+    if joint_type.is_movable and axis_element is not None:
+        axis = _vector_attribute(axis_element, "xyz", 3, source, f"{where} <axis>")
+    return Joint(name, joint_type, parent, child, Transform.from_xyz_rpy(xyz, rpy), vec3(axis))
+
+
+def _read_joint_type(element: ET.Element, source: str, where: str) -> JointType:
+    text = element.get("type")
+    if text is None:
+        raise DescriptionError(source, where, "no 'type' attribute")
+    if text in _UNSUPPORTED_JOINT_TYPES:
+        raise UnsupportedError(
+            source, where,
+            f"{text} joints are not supported (eomgen models fixed-base robots; "
+            "the root link is the fixed base)")
+    try:
+        return _JOINT_TYPES[text]
+    except KeyError:
+        known = ", ".join(sorted(_JOINT_TYPES) + list(_UNSUPPORTED_JOINT_TYPES))
+        raise DescriptionError(source, where,
+                               f"unknown joint type {_show(text)} (URDF knows {known})") from None
+
+
+def _link_reference(element: ET.Element, role: str, source: str, where: str) -> str:
+    """The link named by the joint's ``<parent link>`` or ``<child link>``."""
+    reference = _single_child(element, role, source, where)
+    if reference is None:
+        raise DescriptionError(source, where, f"no <{role}> element")
+    link = reference.get("link")
+    if not link:
+        raise DescriptionError(source, f"{where} <{role}>", "no 'link' attribute")
+    return link
+
+
+# ----------------------------------------------------------------------------------------------
+# Attributes
+# ----------------------------------------------------------------------------------------------
+
+def _required_name(element: ET.Element, source: str, where: str) -> str:
+    name = element.get("name")
+    if not name:
+        raise DescriptionError(source, where, "no 'name' attribute (or it is empty)")
+    return name
+
+
+def _single_child(element: ET.Element, tag: str, source: str, where: str) -> ET.Element | None:
+    """The one ``<tag>`` child of ``element``, or None; two or more are an error."""
+    found = element.findall(tag)
+    if len(found) > 1:
+        raise DescriptionError(source, where, f"{len(found)} <{tag}> elements, expected one")
+    return found[0] if found else None
+
+
+def _read_origin(element: ET.Element | None, source: str, where: str
+                 ) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """``(xyz [m], rpy [rad])`` of an ``<origin>``; zeros when absent."""
+    if element is None:
+        return ZEROS, ZEROS
+    return (_vector_attribute(element, "xyz", 3, source, where, ZEROS),
+            _vector_attribute(element, "rpy", 3, source, where, ZEROS))
+
+
+def _vector_attribute(element: ET.Element, attribute: str, count: int, source: str, where: str,
+                      default: tuple[float, ...] | None = None) -> tuple[float, ...]:
+    """``count`` whitespace-separated finite numbers; ``default`` (if not None) when absent."""
+    text = element.get(attribute)
+    if text is None:
+        if default is None:
+            raise DescriptionError(source, where, f"no '{attribute}' attribute")
+        return default
+    parts = text.split()
+    if len(parts) != count:
+        raise DescriptionError(
+            source, where,
+            f"{attribute}={_show(text)} has {len(parts)} numbers, expected {count}")
+    return tuple(_finite(part, f"{attribute} component", source, where) for part in parts)
+
+
+def _number_attribute(element: ET.Element, attribute: str, source: str, where: str) -> float:
+    text = element.get(attribute)
+    if text is None:
+        raise DescriptionError(source, where, f"no '{attribute}' attribute")
+    return _finite(text, attribute, source, where)
+
+
+def _finite(text: str, label: str, source: str, where: str) -> float:
+    """``float(text)``, refusing text that is not a number or not finite (nan, inf)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise DescriptionError(source, where, f"{label} {_show(text)} is not a number") from None
+    if not math.isfinite(value):
+        raise DescriptionError(source, where, f"{label} {_show(text)} is not a finite number")
+    return value
+
+
+def _show(text: str) -> str:
+    """A short quoted rendering of file text for an error message."""
+    if len(text) > _SHOWN_CHARACTERS:
+        text = text[:_SHOWN_CHARACTERS] + "..."
+    return repr(text)

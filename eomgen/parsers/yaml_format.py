@@ -1,0 +1,126 @@
+"""eomgen's own YAML robot format: URDF's model, written to be read on a slide.
+
+.. code-block:: yaml
+
+    name: planar_2link
+    gravity: [0, -g, 0]
+    parameters:
+      m1: {value: 1.0, description: "mass of link 1 [kg]"}
+      lc1: 0.5                     # shorthand for {value: 0.5}
+      I1: {value: 1/12}
+      g: 9.81
+    links:
+      - name: base                 # no mass: a massless link
+      - name: link1
+        mass: m1
+        com: [lc1, 0, 0]           # [m], in the link frame
+        inertia: {izz: I1}         # about the COM, link-frame axes; missing entries are 0
+    joints:
+      - name: joint1
+        type: revolute             # revolute | continuous | prismatic | fixed
+        parent: base
+        child: link1
+        origin: {xyz: [0, 0, 0], rpy: [0, 0, 0]}   # optional, default identity
+        axis: [0, 0, 1]                            # optional, default [0, 0, 1]
+
+Frames and units follow :mod:`eomgen.model` (URDF's conventions). Values are numbers or
+expressions read by :func:`eomgen.expressions.parse_scalar`; every symbol must be declared under
+``parameters``. Unknown keys are errors. The full reference is ``docs/formats.md``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import UnsupportedError
+from ..model import Inertial, Joint, JointType, Link, RobotModel, Transform, build_model, vec3
+from . import register
+from ._yaml import Reader, read_document, top_level_key
+
+TOP_KEYS = ("name", "description", "gravity", "parameters", "links", "joints")
+LINK_KEYS = ("name", "mass", "com", "inertia")
+JOINT_KEYS = ("name", "type", "parent", "child", "origin", "axis")
+ORIGIN_KEYS = ("xyz", "rpy")
+JOINT_TYPES = {t.value: t for t in JointType}
+UNSUPPORTED_TYPES = ("floating", "planar", "spherical", "mimic")
+
+
+def sniff(text: str) -> bool:
+    """An eomgen robot has top-level ``links:`` and ``joints:`` keys."""
+    return top_level_key(text, "links") and top_level_key(text, "joints")
+
+
+@register("eomgen YAML", (".yaml", ".yml"), sniff)
+def load(path, strict: bool = False) -> RobotModel:
+    """Read an eomgen YAML robot file.
+
+    Parameters
+    ----------
+    path:
+        The ``.yaml`` file.
+    strict:
+        Refuse (rather than warn about) inertias that break the triangle inequality.
+
+    Raises
+    ------
+    DescriptionError
+        One line naming the file and the element, e.g. ``links[2] 'link2' inertia``.
+    """
+    path = Path(path)
+    return parse(read_document(path), str(path), strict, default_name=path.stem)
+
+
+def parse(data: dict, source: str, strict: bool = False, default_name: str = "robot") -> RobotModel:
+    """Build the model from an already loaded document (see :func:`load`)."""
+    r = Reader(source)
+    r.mapping(data, "robot", required=("links", "joints"), optional=TOP_KEYS)
+    name = r.text(data["name"], "name") if "name" in data else default_name
+    r.read_parameters(data.get("parameters"))
+    gravity = r.vector(data["gravity"], "gravity") if "gravity" in data else vec3([0, 0, -9.81])
+
+    links = []
+    for i, entry in enumerate(r.sequence(data["links"], "links")):
+        r.mapping(entry, r.named(entry, f"links[{i}]"), required=("name",), optional=LINK_KEYS)
+        link_name = r.name(entry["name"], f"links[{i}] name")
+        where = f"links[{i}] '{link_name}'"
+        links.append(Link(link_name, _inertial(r, entry, where)))
+
+    joints = []
+    for i, entry in enumerate(r.sequence(data["joints"], "joints", allow_empty=True)):
+        r.mapping(entry, r.named(entry, f"joints[{i}]"),
+                  required=("name", "type", "parent", "child"), optional=JOINT_KEYS)
+        joint_name = r.name(entry["name"], f"joints[{i}] name")
+        where = f"joints[{i}] '{joint_name}'"
+        kind = entry["type"]
+        if kind in UNSUPPORTED_TYPES:
+            raise UnsupportedError(source, f"{where} type", f"{kind} joints are not supported")
+        kind = JOINT_TYPES[r.choice(kind, f"{where} type", JOINT_TYPES)]
+        origin = Transform()
+        if "origin" in entry:
+            o = r.mapping(entry["origin"], f"{where} origin", optional=ORIGIN_KEYS)
+            xyz = r.vector(o["xyz"], f"{where} origin xyz") if "xyz" in o else (0, 0, 0)
+            rpy = r.vector(o["rpy"], f"{where} origin rpy") if "rpy" in o else (0, 0, 0)
+            origin = Transform.from_xyz_rpy(xyz, rpy)
+        axis = r.vector(entry["axis"], f"{where} axis") if "axis" in entry else vec3([0, 0, 1])
+        joints.append(Joint(
+            joint_name, kind,
+            r.name(entry["parent"], f"{where} parent"),
+            r.name(entry["child"], f"{where} child"),
+            origin, axis))
+
+    info = {"description": r.text(data["description"], "description")} \
+        if "description" in data else {}
+    return build_model(source, name, links, joints, gravity, r.used_parameters(), strict, info)
+
+
+def _inertial(r: Reader, entry: dict, where: str) -> Inertial | None:
+    if "mass" not in entry:
+        for key in ("com", "inertia"):
+            if key in entry:
+                raise r.error(where, f"'{key}' given without 'mass'")
+        return None
+    mass = r.scalar(entry["mass"], f"{where} mass")
+    com = r.vector(entry["com"], f"{where} com") if "com" in entry else vec3([0, 0, 0])
+    if "inertia" in entry:
+        return Inertial(mass, com, r.inertia(entry["inertia"], f"{where} inertia"))
+    return Inertial(mass, com)
