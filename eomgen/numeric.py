@@ -1,0 +1,496 @@
+"""Numeric rigid-body dynamics in NumPy: the independent reference for the symbolic engine.
+
+The design follows Pinocchio's Model/Data split. :func:`numeric_model` turns a
+:class:`~eomgen.model.RobotModel` into a :class:`NumericModel` once: every parameter replaced
+by its number, every quantity stored as a read-only float64 array. The algorithms are free
+functions of ``(nm, q, ...)``; their working storage is local to each call, so a
+``NumericModel`` can be shared freely (threads included) and nothing depends on call order.
+
+Conventions
+-----------
+Frames are those of :mod:`eomgen.model` (URDF's):
+
+* Body ``i`` is link ``i``; its frame is the link frame. Body 0 is the root link, fixed in the
+  world; the *world* frame of this module is the root link frame.
+* ``T_parent_child(q) = origin · motion(axis, q)``: the joint frame sits at ``origin`` in the
+  parent frame, and the child frame is the joint frame rotated by ``q`` [rad] about ``axis``
+  (revolute, right hand rule) or translated by ``q`` [m] along it (prismatic). ``axis`` is a
+  unit vector in the child frame.
+* Fixed joints are bodies whose joint has no motion: the recursion passes through them, so
+  links rigidly attached to others keep their own frame and inertia (no merging).
+* Generalised coordinates: ``q[k]`` belongs to ``model.movable_joints[k]``, i.e. description
+  order (``JOINT_NAMES`` order), which may differ from the tree order the recursions use.
+* Units: SI. ``tau[k]`` is a torque [N m] for a revolute joint and a force [N] for a
+  prismatic one; it is the generalised force the joint actuator applies to the child body
+  (and, reacting, to the parent), positive along ``+axis``.
+* ``gravity`` is the gravitational acceleration [m/s²] in the root frame, e.g. ``(0, 0,
+  -9.81)``; the equations of motion are ``M(q) q̈ + C(q, q̇) q̇ + g(q) = tau``.
+
+Examples
+--------
+A point mass ``m = 2`` kg hanging ``l = 0.5`` m below a joint about ``y`` (gravity ``-z``):
+
+>>> from eomgen.model import (Inertial, Joint, JointType, Link, Transform, build_model,
+...                           scalar, vec3)
+>>> bob = Inertial(scalar(2.0), vec3([0, 0, -0.5]))
+>>> pendulum = build_model(
+...     "<doc>", "pendulum", [Link("base"), Link("bob", bob)],
+...     [Joint("swing", JointType.REVOLUTE, "base", "bob", Transform(), vec3([0, 1, 0]))])
+>>> nm = numeric_model(pendulum)
+>>> round(float(gravity_torques(nm, [np.pi / 2])[0]), 12)  # m g l sin q, bob held sideways
+9.81
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Mapping
+
+import numpy as np
+
+from .model import JointType, RobotModel, parameter_symbol
+
+#: Joint type codes stored in :attr:`NumericModel.joint_type`.
+FIXED, REVOLUTE, PRISMATIC = 0, 1, 2
+
+_TYPE_CODE = {
+    JointType.FIXED: FIXED,
+    JointType.REVOLUTE: REVOLUTE,
+    JointType.CONTINUOUS: REVOLUTE,
+    JointType.PRISMATIC: PRISMATIC,
+}
+
+
+@dataclass(frozen=True, eq=False)
+class NumericModel:
+    """A robot with every quantity a number: the fixed description the algorithms read.
+
+    Bodies are the links in topological order (every body after its parent); body 0 is the
+    root. Arrays are float64 (indices int64) and read-only. ``nb`` is the number of bodies
+    (links), ``n`` the number of degrees of freedom.
+
+    Attributes
+    ----------
+    name : str
+        The robot's name.
+    body_names : tuple of str, (nb,)
+        Link name of each body.
+    joint_of_body : tuple of str, (nb,)
+        Name of the joint whose child is the body (``""`` for the root).
+    joint_names : tuple of str, (n,)
+        Movable joints in description order: the order of ``q``, ``qd``, ``qdd``, ``tau``.
+    parent : (nb,) int array
+        Parent body index; ``-1`` for the root.
+    joint_type : (nb,) int array
+        :data:`FIXED`, :data:`REVOLUTE` or :data:`PRISMATIC` (the root counts as fixed).
+    q_index : (nb,) int array
+        Index into ``q`` of the body's joint; ``-1`` for fixed joints and the root.
+    axis : (nb, 3) array
+        Joint axis, a unit vector in the body (child link) frame.
+    origin_rotation : (nb, 3, 3) array
+        Rotation of the joint frame in the parent frame (identity for the root).
+    origin_translation : (nb, 3) array
+        Position [m] of the joint frame origin in the parent frame (zero for the root).
+    mass : (nb,) array
+        Body mass [kg]; zero for massless links.
+    com : (nb, 3) array
+        Centre of mass [m] in the body frame.
+    inertia : (nb, 3, 3) array
+        Rotational inertia [kg m²] about the centre of mass, in body frame axes.
+    gravity : (3,) array
+        Gravitational acceleration [m/s²] in the root frame.
+    """
+
+    name: str
+    body_names: tuple[str, ...]
+    joint_of_body: tuple[str, ...]
+    joint_names: tuple[str, ...]
+    parent: np.ndarray
+    joint_type: np.ndarray
+    q_index: np.ndarray
+    axis: np.ndarray
+    origin_rotation: np.ndarray
+    origin_translation: np.ndarray
+    mass: np.ndarray
+    com: np.ndarray
+    inertia: np.ndarray
+    gravity: np.ndarray
+
+    @property
+    def n(self) -> int:
+        """Number of degrees of freedom (length of ``q``)."""
+        return len(self.joint_names)
+
+    @property
+    def nb(self) -> int:
+        """Number of bodies (links, root included)."""
+        return len(self.body_names)
+
+
+def _float(x, what: str) -> float:
+    try:
+        return float(x)
+    except TypeError:
+        raise ValueError(f"{what} is not a number after substitution: {x}") from None
+
+
+def _vec(v, what: str) -> np.ndarray:
+    return np.array([_float(x, what) for x in v], dtype=float)
+
+
+def _mat(m, what: str) -> np.ndarray:
+    return np.array([[_float(x, what) for x in row] for row in m], dtype=float)
+
+
+def numeric_model(model: RobotModel, values: Mapping | None = None) -> NumericModel:
+    """Build the numeric description of ``model``.
+
+    Parameters
+    ----------
+    model : RobotModel
+        The robot; its expressions may contain parameter symbols.
+    values : mapping, optional
+        Parameter values overriding the model's defaults, keyed by SymPy symbol or by
+        parameter name.
+
+    Returns
+    -------
+    NumericModel
+
+    Raises
+    ------
+    eomgen.DescriptionError
+        When a parameter has neither a default nor a given value.
+    ValueError
+        When a quantity is still not a real number after substitution.
+    """
+    values = {
+        (parameter_symbol(k) if isinstance(k, str) else k): v for k, v in (values or {}).items()
+    }
+    model = model.with_numeric_parameters(values)
+    order = model.topological_joints
+    names = (model.root,) + tuple(j.child for j in order)
+    index = {name: i for i, name in enumerate(names)}
+    q_of_joint = {j.name: k for k, j in enumerate(model.movable_joints)}
+    nb = len(names)
+
+    parent = np.full(nb, -1, dtype=np.int64)
+    joint_type = np.full(nb, FIXED, dtype=np.int64)
+    q_index = np.full(nb, -1, dtype=np.int64)
+    axis = np.zeros((nb, 3))
+    axis[:, 2] = 1.0
+    rot = np.tile(np.eye(3), (nb, 1, 1))
+    trans = np.zeros((nb, 3))
+    for i, joint in enumerate(order, start=1):
+        where = f"joint '{joint.name}'"
+        parent[i] = index[joint.parent]
+        joint_type[i] = _TYPE_CODE[joint.type]
+        q_index[i] = q_of_joint.get(joint.name, -1)
+        axis[i] = _vec(joint.axis, where + " axis")
+        rot[i] = _mat(joint.origin.rotation, where + " origin")
+        trans[i] = _vec(joint.origin.translation, where + " origin")
+
+    mass = np.zeros(nb)
+    com = np.zeros((nb, 3))
+    inertia = np.zeros((nb, 3, 3))
+    for i, name in enumerate(names):
+        inertial = model.link_by_name[name].inertial
+        if inertial is None:
+            continue
+        where = f"link '{name}' inertial"
+        mass[i] = _float(inertial.mass, where)
+        com[i] = _vec(inertial.com, where)
+        inertia[i] = _mat(inertial.inertia, where)
+
+    arrays = dict(parent=parent, joint_type=joint_type, q_index=q_index, axis=axis,
+                  origin_rotation=rot, origin_translation=trans, mass=mass, com=com,
+                  inertia=inertia, gravity=_vec(model.gravity, "gravity"))
+    for a in arrays.values():
+        if not np.all(np.isfinite(a)):
+            raise ValueError(f"model '{model.name}' has a non-finite quantity")
+        a.flags.writeable = False
+    return NumericModel(
+        name=model.name,
+        body_names=names,
+        joint_of_body=("",) + tuple(j.name for j in order),
+        joint_names=model.joint_names,
+        **arrays,
+    )
+
+
+# ----------------------------------------------------------------------------------------------
+# Kinematics shared by the algorithms
+# ----------------------------------------------------------------------------------------------
+
+def _check(nm: NumericModel, name: str, x) -> np.ndarray:
+    """``x`` as a float (n,) array, or a ValueError naming the argument."""
+    if not isinstance(nm, NumericModel):
+        raise ValueError(f"expected a NumericModel (see numeric_model), got {type(nm).__name__}")
+    a = np.asarray(x, dtype=float)
+    if a.shape != (nm.n,):
+        raise ValueError(
+            f"{name} must have shape ({nm.n},) (joints {', '.join(nm.joint_names) or 'none'}), "
+            f"got shape {a.shape}"
+        )
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} has a non-finite entry")
+    return a
+
+
+def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
+    """Rodrigues: rotation by ``angle`` [rad] about the unit vector ``axis``."""
+    x, y, z = axis
+    K = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    return np.eye(3) + np.sin(angle) * K + (1.0 - np.cos(angle)) * (K @ K)
+
+
+def _parent_transforms(nm: NumericModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Pose of every body frame in its parent's frame at ``q``.
+
+    Returns
+    -------
+    R : (nb, 3, 3) array
+        ``R[i]`` rotates body-``i`` coordinates into parent coordinates (``ᵖR_i``).
+    p : (nb, 3) array
+        ``p[i]`` is the body-``i`` origin in parent coordinates [m] (``ᵖp_i``).
+    """
+    R = nm.origin_rotation.copy()
+    p = nm.origin_translation.copy()
+    for i in range(1, nm.nb):
+        k = nm.q_index[i]
+        if k < 0:
+            continue
+        if nm.joint_type[i] == REVOLUTE:
+            R[i] = R[i] @ _rotation(nm.axis[i], q[k])
+        else:  # prismatic: the child frame moves along the axis, without rotating
+            p[i] = p[i] + R[i] @ (nm.axis[i] * q[k])
+    return R, p
+
+
+def _velocities(nm: NumericModel, R: np.ndarray, p: np.ndarray, qd: np.ndarray):
+    """Angular velocity ``ω_i`` [rad/s] and origin velocity ``v_i`` [m/s] of every body,
+    in body-``i`` coordinates (outward recursion)."""
+    w = np.zeros((nm.nb, 3))
+    v = np.zeros((nm.nb, 3))
+    for i in range(1, nm.nb):
+        j = nm.parent[i]
+        Rt = R[i].T
+        w[i] = Rt @ w[j]
+        v[i] = Rt @ (v[j] + np.cross(w[j], p[i]))
+        k = nm.q_index[i]
+        if k >= 0:
+            if nm.joint_type[i] == REVOLUTE:
+                w[i] += qd[k] * nm.axis[i]
+            else:
+                v[i] += qd[k] * nm.axis[i]
+    return w, v
+
+
+# ----------------------------------------------------------------------------------------------
+# Algorithms
+# ----------------------------------------------------------------------------------------------
+
+def rnea(nm: NumericModel, q, qd, qdd) -> np.ndarray:
+    """Inverse dynamics by the recursive Newton–Euler algorithm: ``tau = M q̈ + C q̇ + g``.
+
+    Outward recursion (root to tips), every quantity of body ``i`` in body-``i`` coordinates,
+    with ``R = ᵖR_i``, ``p = ᵖp_i`` the pose of body ``i`` in its parent ``p``, ``z`` the
+    joint axis and ``q̇, q̈`` the joint rate and acceleration::
+
+        ω_i  = Rᵀ ω_p                    (+ q̇ z                     revolute)
+        ω̇_i  = Rᵀ ω̇_p                    (+ Rᵀω_p × q̇ z + q̈ z       revolute)
+        v̇_i  = Rᵀ (v̇_p + ω̇_p × p + ω_p × (ω_p × p))
+                                         (+ 2 ω_i × q̇ z + q̈ z        prismatic)
+        v̇_ci = v̇_i + ω̇_i × c_i + ω_i × (ω_i × c_i)
+        F_i  = m_i v̇_ci,     N_i = I_ci ω̇_i + ω_i × I_ci ω_i
+
+    starting from the root at rest with ``v̇_0 = -gravity`` (gravity enters as an upward
+    acceleration of the base). Here ``v̇_i`` is the acceleration of the body-``i`` origin,
+    ``c_i`` the centre of mass and ``I_ci`` the inertia about it. Inward recursion (tips to
+    root), ``f_i`` and ``n_i`` being the force [N] and moment [N m] about the body origin that
+    the parent exerts on body ``i`` through the joint::
+
+        f_i = F_i + Σ_children ⁱR_c f_c
+        n_i = N_i + c_i × F_i + Σ_children (ⁱR_c n_c + ⁱp_c × ⁱR_c f_c)
+        tau = n_i · z  (revolute)   or   f_i · z  (prismatic)
+
+    Fixed joints are bodies with no joint motion; the root's forces are not returned.
+
+    Parameters
+    ----------
+    nm : NumericModel
+    q : (n,) array_like
+        Joint positions [rad or m] in ``nm.joint_names`` order.
+    qd : (n,) array_like
+        Joint velocities [rad/s or m/s], same order.
+    qdd : (n,) array_like
+        Joint accelerations [rad/s² or m/s²], same order.
+
+    Returns
+    -------
+    tau : (n,) ndarray
+        Joint torques [N m] / forces [N], same order, positive along ``+axis``.
+
+    Raises
+    ------
+    ValueError
+        When an argument does not have shape (n,) or is not finite.
+    """
+    q = _check(nm, "q", q)
+    qd = _check(nm, "qd", qd)
+    qdd = _check(nm, "qdd", qdd)
+    nb = nm.nb
+    R, p = _parent_transforms(nm, q)
+
+    w = np.zeros((nb, 3))
+    wd = np.zeros((nb, 3))
+    vd = np.zeros((nb, 3))
+    vd[0] = -nm.gravity
+    F = np.zeros((nb, 3))
+    N = np.zeros((nb, 3))
+    for i in range(1, nb):
+        j = nm.parent[i]
+        Rt = R[i].T
+        w[i] = Rt @ w[j]
+        wd[i] = Rt @ wd[j]
+        vd[i] = Rt @ (vd[j] + np.cross(wd[j], p[i]) + np.cross(w[j], np.cross(w[j], p[i])))
+        k = nm.q_index[i]
+        if k >= 0:
+            z = nm.axis[i]
+            if nm.joint_type[i] == REVOLUTE:
+                wd[i] += np.cross(w[i], qd[k] * z) + qdd[k] * z
+                w[i] += qd[k] * z
+            else:
+                vd[i] += 2.0 * np.cross(w[i], qd[k] * z) + qdd[k] * z
+        c = nm.com[i]
+        vdc = vd[i] + np.cross(wd[i], c) + np.cross(w[i], np.cross(w[i], c))
+        I = nm.inertia[i]
+        F[i] = nm.mass[i] * vdc
+        N[i] = I @ wd[i] + np.cross(w[i], I @ w[i])
+
+    f = F.copy()
+    n = N + np.cross(nm.com, F)
+    tau = np.zeros(nm.n)
+    for i in range(nb - 1, 0, -1):
+        k = nm.q_index[i]
+        if k >= 0:
+            s = n[i] if nm.joint_type[i] == REVOLUTE else f[i]
+            tau[k] = s @ nm.axis[i]
+        j = nm.parent[i]
+        fj = R[i] @ f[i]
+        f[j] += fj
+        n[j] += R[i] @ n[i] + np.cross(p[i], fj)
+    return tau
+
+
+def gravity_torques(nm: NumericModel, q) -> np.ndarray:
+    """Gravity vector ``g(q) = rnea(q, 0, 0)``: the (n,) torques/forces that hold the robot
+    still at ``q`` (``q`` in ``nm.joint_names`` order)."""
+    zero = np.zeros(nm.n)
+    return rnea(nm, q, zero, zero)
+
+
+def mass_matrix_rnea(nm: NumericModel, q) -> np.ndarray:
+    """Joint-space mass matrix ``M(q)``, (n, n), rows and columns in ``nm.joint_names`` order.
+
+    Column ``i`` is ``rnea(q, 0, e_i) - rnea(q, 0, 0)`` (n + 1 RNEA calls, O(n²) overall).
+    """
+    q = _check(nm, "q", q)
+    zero = np.zeros(nm.n)
+    g = rnea(nm, q, zero, zero)
+    M = np.empty((nm.n, nm.n))
+    for i in range(nm.n):
+        e = np.zeros(nm.n)
+        e[i] = 1.0
+        M[:, i] = rnea(nm, q, zero, e) - g
+    return M
+
+
+def coriolis_times_qd(nm: NumericModel, q, qd) -> np.ndarray:
+    """Velocity product ``C(q, q̇) q̇ = rnea(q, q̇, 0) - rnea(q, 0, 0)``, shape (n,), in
+    ``nm.joint_names`` order (centrifugal and Coriolis torques/forces)."""
+    q = _check(nm, "q", q)
+    zero = np.zeros(nm.n)
+    return rnea(nm, q, qd, zero) - rnea(nm, q, zero, zero)
+
+
+def kinetic_energy(nm: NumericModel, q, qd) -> float:
+    """Kinetic energy [J]: ``K = Σ_i ½ m_i |v_ci|² + ½ ω_iᵀ I_ci ω_i`` (= ½ q̇ᵀ M(q) q̇).
+
+    Parameters
+    ----------
+    q, qd : (n,) array_like
+        Joint positions and velocities in ``nm.joint_names`` order.
+    """
+    q = _check(nm, "q", q)
+    qd = _check(nm, "qd", qd)
+    R, p = _parent_transforms(nm, q)
+    w, v = _velocities(nm, R, p, qd)
+    vc = v + np.cross(w, nm.com)
+    Iw = np.einsum("ijk,ik->ij", nm.inertia, w)
+    return float(0.5 * (nm.mass @ np.einsum("ij,ij->i", vc, vc)) + 0.5 * np.sum(w * Iw))
+
+
+def _world_poses(nm: NumericModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    R, p = _parent_transforms(nm, q)
+    Rw = np.empty_like(R)
+    pw = np.empty_like(p)
+    Rw[0] = np.eye(3)
+    pw[0] = 0.0
+    for i in range(1, nm.nb):
+        j = nm.parent[i]
+        Rw[i] = Rw[j] @ R[i]
+        pw[i] = pw[j] + Rw[j] @ p[i]
+    return Rw, pw
+
+
+def potential_energy(nm: NumericModel, q) -> float:
+    """Gravitational potential energy [J]: ``P = -Σ_i m_i gravityᵀ p_ci``, with ``p_ci`` the
+    centre of mass of body ``i`` in the root frame (zero when every centre of mass is at the
+    root origin; with gravity ``(0, 0, -9.81)``, raising a mass raises P). ``g(q) = ∂P/∂q``.
+
+    Parameters
+    ----------
+    q : (n,) array_like
+        Joint positions in ``nm.joint_names`` order.
+    """
+    q = _check(nm, "q", q)
+    Rw, pw = _world_poses(nm, q)
+    pc = pw + np.einsum("ijk,ik->ij", Rw, nm.com)
+    return float(-(nm.mass @ (pc @ nm.gravity)))
+
+
+def link_poses(nm: NumericModel, q) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Forward kinematics: pose of every link frame in the root frame.
+
+    Parameters
+    ----------
+    q : (n,) array_like
+        Joint positions in ``nm.joint_names`` order.
+
+    Returns
+    -------
+    dict
+        ``{link name: (R, p)}`` with ``R`` (3, 3) the rotation taking link coordinates to root
+        coordinates and ``p`` (3,) the link origin [m] in the root frame; the root maps to
+        ``(I, 0)``. Every link is present, massless and fixed-joint links included.
+    """
+    q = _check(nm, "q", q)
+    Rw, pw = _world_poses(nm, q)
+    return {name: (Rw[i], pw[i]) for i, name in enumerate(nm.body_names)}
+
+
+__all__ = [
+    "NumericModel",
+    "numeric_model",
+    "rnea",
+    "gravity_torques",
+    "mass_matrix_rnea",
+    "coriolis_times_qd",
+    "kinetic_energy",
+    "potential_energy",
+    "link_poses",
+    "FIXED",
+    "REVOLUTE",
+    "PRISMATIC",
+]
