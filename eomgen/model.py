@@ -175,6 +175,11 @@ class Inertial:
     com: Vec3 = ZERO3
     inertia: Mat3 = field(default_factory=lambda: mat3([[0, 0, 0], [0, 0, 0], [0, 0, 0]]))
 
+    def __post_init__(self):  # accept plain numbers from Python callers
+        object.__setattr__(self, "mass", scalar(self.mass))
+        object.__setattr__(self, "com", vec3(self.com))
+        object.__setattr__(self, "inertia", mat3(self.inertia))
+
 
 @dataclass(frozen=True)
 class Link:
@@ -500,3 +505,34 @@ def build_model(
     if undeclared:
         model = replace(model, parameters=params + tuple(Parameter(s) for s in undeclared))
     return model
+
+
+def joint_motion(joint: Joint, value) -> Transform:
+    """The transform a joint applies at position ``value`` (rad or m): child frame in joint frame."""
+    value = scalar(value) if not isinstance(value, sp.Basic) else value
+    if joint.type.is_revolute:
+        return Transform(rotation_about_axis(joint.axis, value), ZERO3)
+    if joint.type is JointType.PRISMATIC:
+        return Transform(IDENTITY3, tuple(a * value for a in joint.axis))  # type: ignore[arg-type]
+    return Transform()
+
+
+def lock_joints(model: RobotModel, positions: Mapping[str, object]) -> RobotModel:
+    """A copy of ``model`` with the named movable joints made fixed at the given positions.
+
+    Raises
+    ------
+    DescriptionError
+        When a name is not a movable joint of the model.
+    """
+    movable = {j.name for j in model.movable_joints}
+    for name in positions:
+        if name not in movable:
+            raise DescriptionError(model.source, f"joint '{name}'",
+                                   "cannot lock: not a movable joint of this model")
+    joints = tuple(
+        replace(j, type=JointType.FIXED, origin=j.origin @ joint_motion(j, positions[j.name]))
+        if j.name in positions else j
+        for j in model.joints
+    )
+    return replace(model, joints=joints)

@@ -281,21 +281,30 @@ def _coriolis(tree, S, F, comp, qd, idx, b: ProgramBuilder) -> sp.Matrix:
         if anc[i][k] and i != k and anc[k][j]:
             value = _dot(S[i], SxF(k, j))
         elif anc[j][k] and j != k:
-            value = -_dot(SxS(k, i), IS(k, j)) - _dot(IS(k, i), SxS(k, j))
+            a, b_, c, d = SxS(k, i), IS(k, j), IS(k, i), SxS(k, j)
+            value = sp.Add(*[-x * y for x, y in zip(a, b_) if x != 0 and y != 0],
+                           *[-x * y for x, y in zip(c, d) if x != 0 and y != 0])
         else:
             value = sp.Integer(0)
         value = b.define(value, f"dM{idx[i] + 1}_{idx[j] + 1}_{idx[k] + 1}")
         dM_cache[key] = value
         return value
 
+    half = sp.Rational(1, 2)
+    christoffel: dict = {}
     C = sp.zeros(n, n)
     for i in range(n):
         for j in range(n):
             terms = []
             for k in range(n):
-                c_ijk = (dM(i, j, k) + dM(i, k, j) - dM(j, k, i)) / 2
+                if (i, k, j) in christoffel:  # c_ijk = c_ikj
+                    c_ijk = christoffel[(i, k, j)]
+                else:
+                    parts = [x for x in (dM(i, j, k), dM(i, k, j), -dM(j, k, i)) if x != 0]
+                    c_ijk = b.define(sp.Add(*[half * x for x in parts]),
+                                     f"Gamma{idx[i] + 1}_{idx[j] + 1}_{idx[k] + 1}") if parts else 0
+                    christoffel[(i, j, k)] = c_ijk
                 if c_ijk != 0:
-                    terms.append(b.define(c_ijk, f"Gamma{idx[i] + 1}_{idx[j] + 1}_{idx[k] + 1}")
-                                 * qd[idx[k]])
+                    terms.append(c_ijk * qd[idx[k]])
             C[idx[i], idx[j]] = b.define(sp.Add(*terms), f"C{idx[i] + 1}_{idx[j] + 1}")
     return C

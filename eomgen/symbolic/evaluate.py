@@ -1,7 +1,7 @@
 """Numeric evaluation of a straight-line program, for verification and notebooks.
 
 The program is printed once, with SymPy's Python printer, into a plain Python function over
-floats (``math`` functions); no expression is ever expanded. Generated modules for users come
+floats or complex numbers (NumPy's scalar functions); no expression is ever expanded. Generated modules for users come
 from the code generation backends instead; this evaluator exists so that verification does not
 depend on them.
 """
@@ -45,13 +45,15 @@ def compile_program(program: Program, inputs: Sequence[sp.Symbol]) -> Callable[.
         results.append(f"{name!r}: [" + ", ".join("[" + ", ".join(r) + "]" for r in rows) + "]")
     lines.append("    return {" + ", ".join(results) + "}")
     namespace: dict = {}
+    functions = {f: getattr(np, f) for f in ("sin", "cos", "tan", "sqrt", "pi")}
     exec(compile("\n".join(lines), "<eomgen program>", "exec"),  # noqa: S102 - our own printed code
-         {"math": __import__("math"), **{f: getattr(__import__("math"), f) for f in
-                                         ("sin", "cos", "tan", "sqrt", "pi")}}, namespace)
+         functions, namespace)
     raw = namespace["_program"]
 
     def evaluate(*values) -> dict:
-        out = raw(*[float(v) for v in values])
-        return {k: np.array(v, dtype=float) for k, v in out.items()}
+        """Values may be floats or complex numbers (complex-step differentiation)."""
+        out = raw(*values)
+        dtype = complex if any(isinstance(v, complex) for v in values) else float
+        return {k: np.array(v, dtype=dtype) for k, v in out.items()}
 
     return evaluate

@@ -108,15 +108,34 @@ class Program:
         return Program(tuple(reversed(kept)), outs)
 
     def expanded(self) -> dict[sp.Symbol, sp.Expr]:
-        """Map every intermediate to its full expression in the inputs (shared sub-trees)."""
+        """Map every intermediate to its full expression in the inputs.
+
+        Sub-trees are shared, not copied, and the substituted expressions are not re-flattened
+        or re-evaluated (``evaluate=False``): they keep the structure of the program, which is
+        what keeps this linear in the program size.
+        """
         full: dict[sp.Symbol, sp.Expr] = {}
+
+        def rebuild(expr):
+            if expr.is_Symbol:
+                return full.get(expr, expr)
+            if expr.is_Atom:
+                return expr
+            args = tuple(rebuild(a) for a in expr.args)
+            if all(a is b for a, b in zip(args, expr.args)):
+                return expr
+            if expr.is_Add or expr.is_Mul or expr.is_Pow:
+                return expr.func(*args, evaluate=False)
+            return expr.func(*args)
+
         for symbol, expr in self.assignments:
-            full[symbol] = expr.xreplace(full) if expr.free_symbols & full.keys() else expr
+            full[symbol] = rebuild(expr)
         return full
 
     def expand(self, matrix: sp.Matrix, full: Mapping | None = None) -> sp.Matrix:
+        """``matrix`` with every intermediate replaced by its full expression in the inputs."""
         full = self.expanded() if full is None else full
-        return matrix.xreplace(dict(full))
+        return matrix.applyfunc(lambda e: e.xreplace(dict(full)) if e.free_symbols & full.keys() else e)
 
     def operation_count(self, names: Iterable[str] | None = None) -> int:
         """Arithmetic operations (SymPy ``count_ops``) of the assignments and outputs needed for
