@@ -49,7 +49,7 @@ def parse_scalar(text) -> sp.Expr:
     >>> parse_scalar("l1/2")
     l1/2
     >>> parse_scalar(0.25)
-    0.250000000000000
+    0.25000000000000000
     """
     if isinstance(text, bool):
         raise ValueError(f"{text!r} is not a number")

@@ -1,0 +1,1 @@
+"""Symbolic derivation: straight-line programs and the algorithms that build them."""
