@@ -48,7 +48,8 @@ description_argument = click.argument(
     "description", required=False, type=click.Path(dir_okay=False, path_type=Path))
 strict_option = click.option(
     "--strict", is_flag=True,
-    help="Refuse inertias that break the triangle inequality instead of warning.")
+    help="Refuse inertias that break the triangle inequality and URDF <mimic> joints "
+         "instead of warning.")
 
 
 def _load(description: Path | None, strict: bool):
@@ -88,12 +89,12 @@ def verify(description, samples, seed, tolerance, strict):
       eomgen verify
       eomgen verify ur5.urdf --samples 100 --seed 3
     """
-    from .dynamics import derive
+    from .dynamics import ALL_OUTPUTS, derive
     from .verify import verify as run_verify
 
     model = _load(description, strict)
     start = time.perf_counter()
-    dynamics = derive(model)
+    dynamics = derive(model, outputs=ALL_OUTPUTS)
     click.echo(f"derived {model.name} ({model.dof} joints: {', '.join(model.joint_names)}) "
                f"in {time.perf_counter() - start:.2f} s")
     report = run_verify(dynamics, samples=samples, seed=seed, tolerance=tolerance)

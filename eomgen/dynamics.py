@@ -20,9 +20,13 @@ import sympy as sp
 from .bodies import body_tree
 from .model import Parameter, RobotModel
 from .symbolic.composite import derive_program
+from .symbolic.newton_euler import inverse_dynamics_program
 from .symbolic.program import Program, ProgramBuilder
 
-ALL_OUTPUTS = ("M", "C", "g")
+#: What :func:`derive` can build: the mass matrix, Coriolis matrix, gravity vector and the
+#: inverse dynamics τ(q, q̇, q̈) (by a symbolic Newton–Euler pass; cheaper to evaluate).
+ALL_OUTPUTS = ("M", "C", "g", "tau")
+DEFAULT_OUTPUTS = ("M", "C", "g")
 
 
 def joint_symbols(n: int) -> tuple[tuple[sp.Symbol, ...], tuple[sp.Symbol, ...], tuple[sp.Symbol, ...]]:
@@ -122,9 +126,12 @@ class Dynamics:
         value = (qd.T * self.M * qd)[0, 0] / 2
         return sp.factor_terms(sp.expand(value)) if self.simplified else value
 
-    @property
+    @cached_property
     def tau(self) -> sp.Matrix:
-        """Inverse dynamics M q̈ + C q̇ + g, n×1."""
+        """Inverse dynamics τ = M q̈ + C q̇ + g, n×1: from the Newton–Euler program when it was
+        derived (``outputs`` with ``"tau"``), else formed from M, C and g."""
+        if "tau" in self.outputs:
+            return self._expanded("tau")
         return self.M * sp.Matrix(self.qdd) + self.C * sp.Matrix(self.qd) + self.g
 
     def operation_count(self, names: Iterable[str] | None = None) -> int:
@@ -139,7 +146,7 @@ class Dynamics:
         return "$" + r",\quad ".join(parts) + "$"
 
 
-def derive(model: RobotModel, outputs: Iterable[str] = ALL_OUTPUTS, simplify: bool | None = None) -> Dynamics:
+def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify: bool | None = None) -> Dynamics:
     """Derive the equations of motion of ``model`` symbolically (Lagrangian method).
 
     Parameters
@@ -147,7 +154,8 @@ def derive(model: RobotModel, outputs: Iterable[str] = ALL_OUTPUTS, simplify: bo
     model:
         A robot model (see :func:`eomgen.load`).
     outputs:
-        Which of ``"M"``, ``"C"``, ``"g"`` to derive; what is not asked is not computed.
+        Which of ``"M"``, ``"C"``, ``"g"``, ``"tau"`` to derive; what is not asked is not
+        computed.
     simplify:
         Trig-simplify the expanded expressions (``dynamics.M`` etc.). ``None`` (default) does it
         for teaching-sized models (at most 3 joints) only: it is exponential in the model size.
@@ -178,8 +186,10 @@ def derive(model: RobotModel, outputs: Iterable[str] = ALL_OUTPUTS, simplify: bo
     timings.append(("bodies", time.perf_counter() - start))
     start = time.perf_counter()
     result = derive_program(tree, q, qd, model.gravity, outputs, builder)
+    if "tau" in outputs:
+        result["tau"] = inverse_dynamics_program(tree, q, qd, qdd, model.gravity, builder)
     timings.append(("program", time.perf_counter() - start))
-    names = [name for name in ("M", "C", "g", "P") if name in result]
+    names = [name for name in ("M", "C", "g", "P", "tau") if name in result]
     program = Program(tuple(builder.assignments), tuple((n, result[n]) for n in names)).pruned(names)
     steps = _steps(program, result)
     if simplify is None:

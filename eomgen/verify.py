@@ -12,6 +12,7 @@ Checks, in the order reported:
 ``g = RNEA(q,0,0)``       the gravity vector against the numeric recursive Newton–Euler.
 ``M e_i = RNEA(q,0,e_i) - RNEA(q,0,0)``  every column of M.
 ``M qdd + C qd + g = RNEA(q,qd,qdd)``  the whole equation at random states.
+``symbolic Newton-Euler tau``  when derived, the O(n) inverse dynamics equals M q̈ + C q̇ + g.
 
 The RNEA is :mod:`eomgen.numeric`, an independent O(n) algorithm on the same model. Parameters
 kept symbolic are given their default values. Errors are relative to the size of the reference
@@ -138,7 +139,15 @@ def verify(dynamics: Dynamics, samples: int = 20, seed: int = 0,
         raise DescriptionError(model.source, "parameters",
                                "verification needs a value for " + ", ".join(missing))
     n = model.dof
-    evaluate = compile_program(dynamics.program, list(dynamics.q) + list(dynamics.qd) + params)
+    evaluate_all = compile_program(dynamics.program, list(dynamics.q) + list(dynamics.qd)
+                                   + list(dynamics.qdd) + params)
+    zero_qdd = [0.0] * len(dynamics.q)
+
+    def evaluate(*values, qdd=None):
+        n_q = len(dynamics.q)
+        return evaluate_all(*values[:2 * n_q], *(zero_qdd if qdd is None else qdd),
+                            *values[2 * n_q:])
+
     pvals = [values[s] for s in params]
     nm = numeric_model(model)
     rng = np.random.default_rng(seed)
@@ -152,7 +161,7 @@ def verify(dynamics: Dynamics, samples: int = 20, seed: int = 0,
         rel_err = max((_rel(a, b)[1] for a, b in pairs), default=0.0)
         checks.append(CheckResult(name, abs_err, rel_err, rel_err <= tolerance and extra_ok, how))
 
-    results = [evaluate(*q, *qd, *pvals) for q, qd, _ in states]
+    results = [evaluate(*q, *qd, *pvals, qdd=qdd) for q, qd, qdd in states]
 
     if exact:
         M_exact = _exact(dynamics, "M")
@@ -207,4 +216,8 @@ def verify(dynamics: Dynamics, samples: int = 20, seed: int = 0,
     record("M qdd + C qd + g = RNEA(q,qd,qdd)",
            [(r["M"] @ qdd + r["C"] @ qd + r["g"][:, 0], rnea(nm, q, qd, qdd))
             for (q, qd, qdd), r in zip(states, results)])
+    if "tau" in dynamics.outputs:
+        record("symbolic Newton-Euler tau = M qdd + C qd + g",
+               [(r["tau"][:, 0], r["M"] @ qdd + r["C"] @ qd + r["g"][:, 0])
+                for (q, qd, qdd), r in zip(states, results)])
     return VerificationReport(model.name, tuple(checks))
