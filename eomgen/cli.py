@@ -65,7 +65,9 @@ def main():
 
     \b
     Examples:
-      eomgen verify                          # the bundled planar 2-link arm
+      eomgen generate                        # code for the bundled planar 2-link arm
+      eomgen generate ur5.urdf --backend numpy,casadi -o build/ur5
+      eomgen verify                          # check the bundled arm against Newton-Euler
       eomgen verify robot.urdf --samples 50
     """
 
@@ -100,6 +102,48 @@ def verify(description, samples, seed, tolerance, strict):
     report = run_verify(dynamics, samples=samples, seed=seed, tolerance=tolerance)
     click.echo(report.format())
     sys.exit(0 if report.passed else 1)
+
+
+@main.command()
+@description_argument
+@click.option("--backend", "backends", default="all", show_default=True,
+              help="Comma-separated backends among numpy, casadi, c, latex; or all.")
+@click.option("-o", "--output", "outdir", default="eomgen_output", show_default=True,
+              type=click.Path(file_okay=False, path_type=Path), help="Output folder.")
+@click.option("--symbolic", default=None,
+              help="Comma-separated parameters to keep symbolic (default: all the description "
+                   "declares; 'none' for none). The others take their values.")
+@click.option("--quiet", is_flag=True, help="No progress lines.")
+@strict_option
+@_handle_errors
+def generate(description, backends, outdir, symbolic, quiet, strict):
+    """Generate code and a derivation for DESCRIPTION (default: the bundled planar 2-link arm).
+
+    Writes <robot>_numpy.py (NumPy, single states and batches), <robot>_casadi.py (CasADi
+    functions), <robot>_casadi.c/.h (C through CasADi, plus a .so when a C compiler is found) and
+    <robot>.tex (the derivation) into OUTPUT, all files or none.
+
+    \b
+    Examples:
+      eomgen generate
+      eomgen generate robot.urdf --backend numpy -o build/
+      eomgen generate eomgen/robots/planar_2link.yaml --symbolic m2,g
+    """
+    from .codegen.generate import generate as run_generate
+
+    model = _load(description, strict)
+    names = None
+    if symbolic is not None:
+        names = [] if symbolic.strip().lower() == "none" else [
+            n.strip() for n in symbolic.split(",") if n.strip()]
+
+    def progress(line: str) -> None:
+        if not quiet:
+            click.echo(f"eomgen: {line}", err=True)
+
+    paths = run_generate(model, outdir, backends, names, progress)
+    for path in paths:
+        click.echo(str(path))
 
 
 if __name__ == "__main__":  # pragma: no cover

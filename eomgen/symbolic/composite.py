@@ -215,7 +215,7 @@ def derive_program(tree: BodyTree, q, qd, gravity: Vec3, outputs: set[str], b: P
     idx = [body.q_index for body in tree.bodies]
     result: dict = {"kinematics": kin, "composite": comp}
 
-    if "M" in outputs or "C" in outputs:
+    if "M" in outputs:
         M = sp.zeros(n, n)
         for j in range(n):
             for i in [j] + tree.ancestors(j):

@@ -1,0 +1,133 @@
+"""CasADi backend: ``<robot>_casadi.py`` building ``casadi.Function`` objects (SX), and the C
+backend: C source from CasADi's code generator plus, where a C compiler is found, a shared library
+that ``casadi.external`` loads.
+
+Printer: SymPy's Python printer with CasADi's math functions (``ca.sin`` …). Templates:
+``templates/casadi/module.py.jinja``.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import sympy as sp
+from sympy.printing.pycode import PythonCodePrinter
+
+from .. import GeneratedFile, Job, register
+from ..render import render
+from .common import parameter_renames, print_function, python_literal
+
+_FUNCTIONS = ("sin", "cos", "tan", "sqrt", "exp", "log", "asin", "acos", "atan", "atan2")
+
+
+class CasADiPrinter(PythonCodePrinter):
+    """Python code over CasADi SX symbols: ``ca.sin(x)``, exact float literals."""
+
+    def _print_Function(self, expr):
+        name = expr.func.__name__
+        if name in _FUNCTIONS:
+            return f"ca.{name}(" + ", ".join(self._print(a) for a in expr.args) + ")"
+        raise ValueError(f"the CasADi backend cannot print function {name}")
+
+    _print_sin = _print_cos = _print_tan = _print_Function
+
+    def _print_Pow(self, expr, rational=False):
+        base, exponent = expr.args
+        if exponent == sp.Rational(1, 2):
+            return f"ca.sqrt({self._print(base)})"
+        return super()._print_Pow(expr, rational)
+
+    def _print_Float(self, expr):
+        return repr(float(expr))
+
+    def _print_Rational(self, expr):
+        return f"({int(expr.p)}/{int(expr.q)})"
+
+    def _print_Pi(self, expr):
+        return "ca.pi"
+
+
+@dataclass(frozen=True)
+class CasADiConfig:
+    template: str = "casadi/module.py.jinja"
+    suffix: str = "_casadi.py"
+
+
+def _render_module(job: Job, config: CasADiConfig) -> str:
+    printer = CasADiPrinter({"standard": "python3"})
+    renames = parameter_renames(job)
+
+    def doprint(expr: sp.Expr) -> str:
+        return printer.doprint(expr.xreplace(renames) if renames else expr)
+
+    functions = [print_function(spec, job, doprint, None) for spec in job.specs]
+    return render(
+        config.template,
+        header=job.header_lines(config.template),
+        robot=python_literal(job.model.name),
+        joint_names=[python_literal(n) for n in job.dynamics.joint_names],
+        nq=job.model.dof,
+        parameters=[(p.identifier, repr(float(p.default)) if p.default is not None else None,
+                     python_literal(p.doc)) for p in job.parameters],
+        functions=functions,
+    )
+
+
+@register("casadi", "CasADi module: casadi.Function objects (SX) with named inputs and outputs")
+def generate_casadi(job: Job, config: CasADiConfig = CasADiConfig()) -> list[GeneratedFile]:
+    return [GeneratedFile(job.stem + config.suffix, _render_module(job, config))]
+
+
+def load_module_source(source: str, name: str) -> dict:
+    """Execute a generated CasADi module's source in a fresh namespace (our own printed code)."""
+    namespace: dict = {"__name__": name}
+    exec(compile(source, f"<{name}>", "exec"), namespace)  # noqa: S102
+    return namespace
+
+
+FUNCTION_NAMES = ("mass_matrix", "coriolis_matrix", "gravity_vector", "inverse_dynamics",
+                  "forward_dynamics")
+
+
+def c_compiler() -> str | None:
+    """The C compiler to use: $CC, else cc or gcc on PATH, else None."""
+    for candidate in (os.environ.get("CC"), "cc", "gcc", "clang"):
+        if candidate and shutil.which(candidate):
+            return candidate
+    return None
+
+
+@register("c", "C source through CasADi's code generator, and a shared library when a C compiler is found")
+def generate_c(job: Job, config: CasADiConfig = CasADiConfig()) -> list[GeneratedFile]:
+    import casadi as ca
+
+    namespace = load_module_source(_render_module(job, config), job.stem + "_casadi")
+    stem = job.stem + "_casadi"
+    generator = ca.CodeGenerator(stem + ".c", {"with_header": True, "with_mem": False})
+    for name in FUNCTION_NAMES:
+        generator.add(namespace[name])
+    with tempfile.TemporaryDirectory() as tmp:
+        generator.generate(tmp + os.sep)
+        c_source = Path(tmp, stem + ".c").read_text()
+        h_source = Path(tmp, stem + ".h").read_text()
+        header = "".join(f"/* {line.replace('*/', '* /')} */\n"
+                         for line in job.header_lines("CasADi CodeGenerator via casadi/module.py.jinja"))
+        files = [GeneratedFile(stem + ".c", header + c_source),
+                 GeneratedFile(stem + ".h", header + h_source)]
+        compiler = c_compiler()
+        if compiler is not None:
+            c_path = Path(tmp, stem + ".c")
+            c_path.write_text(header + c_source)
+            library = Path(tmp, stem + ".so")
+            result = subprocess.run(
+                [compiler, "-O3", "-fPIC", "-shared", "-o", str(library), str(c_path), "-lm"],
+                capture_output=True, text=True)
+            if result.returncode != 0:
+                raise RuntimeError(f"compiling {stem}.c failed: {result.stderr.strip()[:500]}")
+            files.append(GeneratedFile(stem + ".so", library.read_bytes(), golden=False))
+    return files

@@ -1,0 +1,79 @@
+"""Pieces shared by the Python-source backends (NumPy, CasADi): naming of inputs and printing of
+a straight-line program into ``(lhs, rhs)`` pairs for the templates."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+
+from .. import Job
+from ..functions import FunctionSpec
+
+
+@dataclass(frozen=True)
+class PrintedFunction:
+    """A function ready for a template: everything is a string or a list of strings."""
+
+    name: str
+    summary: str
+    arguments: list[tuple[str, str]]      # (name, doc) of the vector inputs
+    unpack: list[tuple[str, str, int]]     # (element name, vector name, index)
+    assignments: list[tuple[str, str]]     # (lhs, rhs)
+    output_name: str
+    output_shape: tuple[int, ...]
+    output_entries: list[tuple[tuple[int, ...], str]]  # (index, rhs) of non-zero entries
+    operation_count: int
+    units: str
+
+
+def print_function(spec: FunctionSpec, job: Job, doprint, element_name) -> PrintedFunction:
+    """Print ``spec`` with ``doprint(expr) -> str``; ``element_name(vector, index) -> str`` names
+    the scalar unpacked from an input vector."""
+    unpack = []
+    for argument in spec.arguments:
+        for k, symbol in enumerate(argument.symbols):
+            unpack.append((symbol.name, argument.name, k))
+    used = set()
+    for _, expr in spec.program.assignments:
+        used |= expr.free_symbols
+    for e in spec.output:
+        used |= e.free_symbols
+    unpack = [u for u in unpack if sp.Symbol(u[0], real=True) in used]
+    assignments = [(symbol.name, doprint(expr)) for symbol, expr in spec.program.assignments]
+    rows, cols = spec.output.shape
+    entries = []
+    if spec.is_vector:
+        shape: tuple[int, ...] = (rows,)
+        for r in range(rows):
+            if spec.output[r, 0] != 0:
+                entries.append(((r,), doprint(spec.output[r, 0])))
+    else:
+        shape = (rows, cols)
+        for r in range(rows):
+            for c in range(cols):
+                if spec.output[r, c] != 0:
+                    entries.append(((r, c), doprint(spec.output[r, c])))
+    return PrintedFunction(
+        name=spec.name,
+        summary=spec.summary,
+        arguments=[(a.name, a.doc) for a in spec.arguments],
+        unpack=unpack,
+        assignments=assignments,
+        output_name=spec.output_name,
+        output_shape=shape,
+        output_entries=entries,
+        operation_count=spec.operation_count,
+        units=spec.units,
+    )
+
+
+def parameter_renames(job: Job) -> dict[sp.Symbol, sp.Symbol]:
+    """Parameter symbols → symbols named by their safe Python identifiers."""
+    return {p.symbol: sp.Symbol(p.identifier, real=True) for p in job.parameters
+            if p.identifier != p.symbol.name}
+
+
+def python_literal(text: str) -> str:
+    """A Python string literal for ``text`` that cannot break out of its quotes."""
+    return repr(str(text))
