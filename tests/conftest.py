@@ -57,3 +57,8 @@ def _erd_robots_dir_fixture() -> Path:
     if found is None:
         pytest.skip("example-robot-data is not installed")
     return found
+
+
+def pytest_addoption(parser):
+    parser.addoption("--update-golden", action="store_true", default=False,
+                     help="Rewrite generated/ from the current code instead of comparing.")
