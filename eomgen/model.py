@@ -200,6 +200,9 @@ class Joint:
     origin: Transform = Transform()
     axis: Vec3 = vec3([0, 0, 1])
 
+    def __post_init__(self):  # accept plain numbers from Python callers
+        object.__setattr__(self, "axis", vec3(self.axis))
+
 
 @dataclass(frozen=True)
 class Parameter:

@@ -76,8 +76,8 @@ _IDENTIFIER = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 def safe_identifier(name: str, taken: set[str]) -> str:
     """A valid, unused Python/C identifier derived from ``name`` (ASCII letters, digits, _)."""
     candidate = re.sub(r"[^A-Za-z0-9_]", "_", name.encode("ascii", "replace").decode("ascii"))
-    if not candidate or not _IDENTIFIER.match(candidate):
-        candidate = "p_" + candidate
+    if not candidate or not _IDENTIFIER.match(candidate) or candidate.startswith("_"):
+        candidate = "p" + candidate if candidate.startswith("_") else "p_" + candidate
     while candidate in taken or candidate in RESERVED_IDENTIFIERS:
         candidate += "_"
     taken.add(candidate)

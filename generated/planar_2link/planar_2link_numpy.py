@@ -5,7 +5,8 @@
 
 Joint order: JOINT_NAMES (the movable joints in the order the description lists them).
 Every function takes one state, arrays of shape (NQ,), or a batch, arrays of shape (N, NQ),
-and returns the matching shape. Units are SI (rad, m, kg, s, N, N m).
+and returns the matching shape: a single result only when every input is a single state, and a
+ValueError when the inputs hold different numbers of states. Units are SI (rad, m, kg, s, N, N m).
 Parameters kept symbolic are keyword arguments; their defaults are the description's values
 (see PARAMETERS). They may be scalars or arrays of shape (N,).
 """
@@ -43,6 +44,20 @@ def _batch(x, name):
     raise ValueError(f"{name} must have shape ({NQ},) or (N, {NQ}), got {x.shape}")
 
 
+def _states(*named):
+    """The (array, name) inputs as float arrays of shape (N, NQ), then whether all of them were
+    single states."""
+    arrays, singles = [], []
+    for x, name in named:
+        x, one = _batch(x, name)
+        arrays.append(x)
+        singles.append(one)
+    if len({x.shape[0] for x in arrays}) != 1:
+        got = ", ".join(f"{x.shape[0]} ({name})" for x, (_, name) in zip(arrays, named))
+        raise ValueError(f"the inputs must hold the same number of states, got {got}")
+    return (*arrays, all(singles))
+
+
 def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
     """Mass matrix M(q), symmetric positive definite.
 
@@ -58,7 +73,7 @@ def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l
 
     52 arithmetic operations per state.
     """
-    q, single = _batch(q, "q")
+    q, single = _states((q, "q"))
     batch = q.shape[0]
     q1 = q[:, 0]
     q2 = q[:, 1]
@@ -106,10 +121,7 @@ def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_
 
     43 arithmetic operations per state.
     """
-    q, single = _batch(q, "q")
-    qd, single = _batch(qd, "qd")
-    if len({ q.shape[0], qd.shape[0] }) != 1:
-        raise ValueError("the inputs must hold the same number of states")
+    q, qd, single = _states((q, "q"), (qd, "qd"))
     batch = q.shape[0]
     q1 = q[:, 0]
     q2 = q[:, 1]
@@ -156,7 +168,7 @@ def gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81
 
     19 arithmetic operations per state.
     """
-    q, single = _batch(q, "q")
+    q, single = _states((q, "q"))
     batch = q.shape[0]
     q1 = q[:, 0]
     q2 = q[:, 1]
@@ -198,11 +210,7 @@ def inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.083333333333333
 
     48 arithmetic operations per state.
     """
-    q, single = _batch(q, "q")
-    qd, single = _batch(qd, "qd")
-    qdd, single = _batch(qdd, "qdd")
-    if len({ q.shape[0], qd.shape[0], qdd.shape[0] }) != 1:
-        raise ValueError("the inputs must hold the same number of states")
+    q, qd, qdd, single = _states((q, "q"), (qd, "qd"), (qdd, "qdd"))
     batch = q.shape[0]
     q1 = q[:, 0]
     q2 = q[:, 1]
@@ -255,9 +263,7 @@ def forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.083333333333333
     numpy.linalg.LinAlgError
         When M is not positive definite at some state.
     """
-    q_batch, single = _batch(q, "q")
-    qd_batch, _ = _batch(qd, "qd")
-    tau_batch, _ = _batch(tau, "tau")
+    q_batch, qd_batch, tau_batch, single = _states((q, "q"), (qd, "qd"), (tau, "tau"))
     M = mass_matrix(q_batch, I1=I1, I2=I2, g_=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
     bias = inverse_dynamics(q_batch, qd_batch, np.zeros_like(q_batch), I1=I1, I2=I2, g_=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
     L = np.linalg.cholesky(M)

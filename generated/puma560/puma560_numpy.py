@@ -5,7 +5,8 @@
 
 Joint order: JOINT_NAMES (the movable joints in the order the description lists them).
 Every function takes one state, arrays of shape (NQ,), or a batch, arrays of shape (N, NQ),
-and returns the matching shape. Units are SI (rad, m, kg, s, N, N m).
+and returns the matching shape: a single result only when every input is a single state, and a
+ValueError when the inputs hold different numbers of states. Units are SI (rad, m, kg, s, N, N m).
 """
 
 import numpy as np
@@ -36,6 +37,20 @@ def _batch(x, name):
     raise ValueError(f"{name} must have shape ({NQ},) or (N, {NQ}), got {x.shape}")
 
 
+def _states(*named):
+    """The (array, name) inputs as float arrays of shape (N, NQ), then whether all of them were
+    single states."""
+    arrays, singles = [], []
+    for x, name in named:
+        x, one = _batch(x, name)
+        arrays.append(x)
+        singles.append(one)
+    if len({x.shape[0] for x in arrays}) != 1:
+        got = ", ".join(f"{x.shape[0]} ({name})" for x, (_, name) in zip(arrays, named))
+        raise ValueError(f"the inputs must hold the same number of states, got {got}")
+    return (*arrays, all(singles))
+
+
 def mass_matrix(q):
     """Mass matrix M(q), symmetric positive definite.
 
@@ -51,7 +66,7 @@ def mass_matrix(q):
 
     1004 arithmetic operations per state.
     """
-    q, single = _batch(q, "q")
+    q, single = _states((q, "q"))
     batch = q.shape[0]
     q1 = q[:, 0]
     q2 = q[:, 1]
@@ -290,10 +305,7 @@ def coriolis_matrix(q, qd):
 
     2832 arithmetic operations per state.
     """
-    q, single = _batch(q, "q")
-    qd, single = _batch(qd, "qd")
-    if len({ q.shape[0], qd.shape[0] }) != 1:
-        raise ValueError("the inputs must hold the same number of states")
+    q, qd, single = _states((q, "q"), (qd, "qd"))
     batch = q.shape[0]
     q1 = q[:, 0]
     q2 = q[:, 1]
@@ -804,7 +816,7 @@ def gravity_vector(q):
 
     144 arithmetic operations per state.
     """
-    q, single = _batch(q, "q")
+    q, single = _states((q, "q"))
     batch = q.shape[0]
     q1 = q[:, 0]
     q2 = q[:, 1]
@@ -894,11 +906,7 @@ def inverse_dynamics(q, qd, qdd):
 
     488 arithmetic operations per state.
     """
-    q, single = _batch(q, "q")
-    qd, single = _batch(qd, "qd")
-    qdd, single = _batch(qdd, "qdd")
-    if len({ q.shape[0], qd.shape[0], qdd.shape[0] }) != 1:
-        raise ValueError("the inputs must hold the same number of states")
+    q, qd, qdd, single = _states((q, "q"), (qd, "qd"), (qdd, "qdd"))
     batch = q.shape[0]
     q2 = q[:, 1]
     q3 = q[:, 2]
@@ -1036,9 +1044,7 @@ def forward_dynamics(q, qd, tau):
     numpy.linalg.LinAlgError
         When M is not positive definite at some state.
     """
-    q_batch, single = _batch(q, "q")
-    qd_batch, _ = _batch(qd, "qd")
-    tau_batch, _ = _batch(tau, "tau")
+    q_batch, qd_batch, tau_batch, single = _states((q, "q"), (qd, "qd"), (tau, "tau"))
     M = mass_matrix(q_batch)
     bias = inverse_dynamics(q_batch, qd_batch, np.zeros_like(q_batch))
     L = np.linalg.cholesky(M)

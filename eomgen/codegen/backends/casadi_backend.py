@@ -9,6 +9,7 @@ Printer: SymPy's Python printer with CasADi's math functions (``ca.sin`` …). T
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 import tempfile
@@ -20,7 +21,7 @@ from sympy.printing.pycode import PythonCodePrinter
 
 from .. import GeneratedFile, Job, register
 from ..render import render
-from .common import parameter_renames, print_function, python_literal
+from .common import docstring_literal, parameter_renames, print_function, python_literal
 
 _FUNCTIONS = ("sin", "cos", "tan", "sqrt", "exp", "log", "asin", "acos", "atan", "atan2")
 
@@ -69,7 +70,7 @@ def _render_module(job: Job, config: CasADiConfig) -> str:
     return render(
         config.template,
         header=job.header_lines(config.template),
-        robot=python_literal(job.model.name),
+        robot=docstring_literal(job.model.name),
         joint_names=[python_literal(n) for n in job.dynamics.joint_names],
         nq=job.model.dof,
         parameters=[(p.identifier, repr(float(p.default)) if p.default is not None else None,
@@ -108,13 +109,17 @@ def generate_c(job: Job, config: CasADiConfig = CasADiConfig()) -> list[Generate
 
     namespace = load_module_source(_render_module(job, config), job.stem + "_casadi")
     stem = job.stem + "_casadi"
-    generator = ca.CodeGenerator(stem + ".c", {"with_header": True, "with_mem": False})
+    # The generator's name prefixes every C symbol; CasADi refuses names holding "__" (a robot
+    # named "arm  2" has the stem "arm__2"), so the prefix has runs of "_" merged. File names
+    # keep the stem.
+    prefix = re.sub(r"__+", "_", stem)
+    generator = ca.CodeGenerator(prefix + ".c", {"with_header": True, "with_mem": False})
     for name in FUNCTION_NAMES:
         generator.add(namespace[name])
     with tempfile.TemporaryDirectory() as tmp:
         generator.generate(tmp + os.sep)
-        c_source = Path(tmp, stem + ".c").read_text()
-        h_source = Path(tmp, stem + ".h").read_text()
+        c_source = Path(tmp, prefix + ".c").read_text()
+        h_source = Path(tmp, prefix + ".h").read_text()
         header = "".join(f"/* {line.replace('*/', '* /')} */\n"
                          for line in job.header_lines("CasADi CodeGenerator via casadi/module.py.jinja"))
         files = [GeneratedFile(stem + ".c", header + c_source),

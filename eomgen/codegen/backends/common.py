@@ -77,3 +77,14 @@ def parameter_renames(job: Job) -> dict[sp.Symbol, sp.Symbol]:
 def python_literal(text: str) -> str:
     """A Python string literal for ``text`` that cannot break out of its quotes."""
     return repr(str(text))
+
+
+def docstring_literal(text: str) -> str:
+    """``text`` quoted for the inside of a triple-double-quoted docstring, which then reads as
+    :func:`python_literal` of ``text``.
+
+    The literal's backslashes and double quotes are escaped once more, so that no three double
+    quotes in a robot's name can end the docstring early (and let the rest of the name run as
+    code when the module is imported), and no backslash can start an escape sequence.
+    """
+    return python_literal(text).replace("\\", "\\\\").replace('"', '\\"')

@@ -13,7 +13,7 @@ from sympy.printing.numpy import NumPyPrinter
 
 from .. import GeneratedFile, Job, register
 from ..render import render
-from .common import parameter_renames, print_function, python_literal
+from .common import docstring_literal, parameter_renames, print_function, python_literal
 
 
 class NumPyModulePrinter(NumPyPrinter):
@@ -50,7 +50,7 @@ def generate_numpy(job: Job, config: NumPyConfig = NumPyConfig()) -> list[Genera
     text = render(
         config.template,
         header=job.header_lines(config.template),
-        robot=python_literal(job.model.name),
+        robot=docstring_literal(job.model.name),
         joint_names=[python_literal(n) for n in job.dynamics.joint_names],
         nq=job.model.dof,
         parameters=[(p.identifier, repr(float(p.default)) if p.default is not None else None,

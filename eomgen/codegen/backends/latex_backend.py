@@ -1,0 +1,434 @@
+"""LaTeX backend: ``<robot>.tex``, a standalone document of the derivation (plain pdflatex with
+amsmath, geometry and longtable; all three are in TeX Live's ``latex-base``).
+
+Two kinds of document, chosen by :func:`is_teaching_sized`:
+
+* **teaching-sized** models (at most :data:`~eomgen.symbolic.textbook.TEXTBOOK_MAX_DOF` joints
+  and a small program): the textbook derivation of :mod:`eomgen.symbolic.textbook`, body by
+  body: centre-of-mass positions, Jacobians, K_i and P_i, then M, the Christoffel symbols, C, g
+  and the equations of motion written out, in compact trigonometric notation (s_1, c_12);
+* **large** models: the description, then the straight-line program of named subexpressions
+  that computes M, g and C (grouped by the output that first needs them), the entries of M, C,
+  g in terms of those names and the equations of motion per joint. At most
+  :attr:`LatexConfig.max_program_lines` subexpressions are printed, so that pdflatex stays fast.
+
+Printer: :class:`~eomgen.codegen.backends.latex_printer.DerivationLatexPrinter`. Template:
+``templates/latex/document.tex.jinja``. Every string that comes from the description (robot,
+link, joint and file names, descriptions) is escaped with
+:func:`~eomgen.codegen.backends.latex_printer.latex_escape`.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+
+import sympy as sp
+
+from ... import __version__
+from ...model import IDENTITY3, RobotModel
+from ...symbolic.textbook import TEXTBOOK_MAX_DOF, TextbookDerivation, textbook_derivation
+from .. import GeneratedFile, Job, register
+from ..render import render
+from .latex_printer import DerivationLatexPrinter, index_latex, latex_comment, latex_escape
+
+#: Parameter names that would print like the document's own quantities (K_{1}, M_{1,2},
+#: \Gamma_{1,1,2}, s_{12}, …); such parameters print as upright text instead.
+_NOTATION_NAMES = re.compile(
+    r"^(?:(?:K|P|g|R|pc|Jv|Ic|tau)[0-9]+|(?:M|C)[0-9]+_[0-9]+|Gamma[0-9]+_[0-9]+_[0-9]+"
+    r"|[sc][0-9]+(?:_[0-9]+)*)$"
+)
+
+#: The families of named subexpressions of eomgen's straight-line program (the name prefixes of
+#: :mod:`eomgen.symbolic.composite`), for the legend of large documents. Vectors and matrices
+#: are in world coordinates; spatial 6-vectors are [angular; linear] about the world origin.
+PROGRAM_NAMES = {
+    "s": "sine of the joint position of joint i",
+    "c": "cosine of the joint position of joint i",
+    "A": "rotation of joint frame i before the joint moves, entry (r, c)",
+    "R": "rotation of body i, entry (r, c)",
+    "o": "origin of joint frame i",
+    "p": "origin of body i (after a prismatic joint moved it)",
+    "z": "axis of joint i",
+    "v": "linear part of the motion axis S_i of joint i (origin × axis)",
+    "Rh": "first moment of body i rotated into world axes",
+    "Iw": "rotational inertia of body i about the world origin, entry (r, c)",
+    "hw": "first moment of body i about the world origin",
+    "mc": "mass of the subtree of body i (composite body)",
+    "hc": "first moment of the composite body i",
+    "Ic": "rotational inertia of the composite body i about the world origin, entry (r, c)",
+    "F": "momentum of composite body i for a unit rate of joint i: F_i = I^c_i S_i",
+    "M": "entry of the mass matrix",
+    "g": "entry of the gravity vector",
+    "X": "motion cross product S_k × S_j",
+    "G": "momentum of composite body k for a unit rate of joint j: I^c_k S_j",
+    "Y": "force cross product S_k ×* F_j",
+    "dM": "derivative of M_ij with respect to q_k",
+    "Gamma": "Christoffel symbol of the first kind c_ijk",
+    "C": "entry of the Coriolis matrix",
+}
+
+_PROGRAM_GROUPS = (
+    ("M", "Subexpressions of the mass matrix"),
+    ("g", "Further subexpressions of the gravity vector"),
+    ("C", "Further subexpressions of the Coriolis matrix"),
+)
+
+
+@dataclass(frozen=True)
+class LatexConfig:
+    """Options of the LaTeX backend.
+
+    Attributes
+    ----------
+    template:
+        The document template, below ``templates/``.
+    suffix:
+        Appended to the job's stem to name the file.
+    float_digits:
+        Significant digits of printed numbers (the generated code keeps all of them).
+    line_width:
+        About how many glyphs a display line holds before a sum is broken.
+    block_size:
+        Equations per ``align*`` environment (each may break across pages).
+    textbook_max_dof, textbook_max_operations:
+        The largest model given the textbook derivation: number of joints, and operations of
+        the straight-line program of M, C and g.
+    max_program_lines:
+        At most this many named subexpressions are printed for large models.
+    """
+
+    template: str = "latex/document.tex.jinja"
+    suffix: str = ".tex"
+    float_digits: int = 6
+    line_width: int = 72
+    block_size: int = 24
+    textbook_max_dof: int = TEXTBOOK_MAX_DOF
+    textbook_max_operations: int = 600
+    max_program_lines: int = 2500
+
+
+@dataclass(frozen=True)
+class Equation:
+    """One displayed equation: ``lhs = lines[0]``, continued on ``lines[1:]``."""
+
+    lhs: str
+    lines: list[str]
+
+
+@dataclass(frozen=True)
+class Block:
+    """Equations typeset together (one ``align*``), after an optional sentence of text."""
+
+    equations: list[Equation]
+    text: str = ""
+
+
+@dataclass
+class _Printing:
+    """The printers and sizes one document uses."""
+
+    printer: DerivationLatexPrinter
+    width: int
+    block_size: int
+    blocks: list[Block] = field(default_factory=list)
+
+    def tex(self, expr) -> str:
+        return self.printer.doprint(sp.sympify(expr))
+
+    def equation(self, lhs: str, expr) -> Equation:
+        return Equation(lhs, self.printer.print_lines(expr, self.width))
+
+    def chunks(self, equations: list[Equation], text: str = "") -> list[Block]:
+        """``equations`` in blocks of at most ``block_size``; ``text`` before the first."""
+        size = self.block_size
+        out = [Block(equations[k:k + size], text if k == 0 else "")
+               for k in range(0, len(equations), size)]
+        return out or ([Block([], text)] if text else [])
+
+
+def is_teaching_sized(job: Job, config: LatexConfig = LatexConfig()) -> bool:
+    """Whether ``job``'s model gets the textbook derivation (else the program is printed)."""
+    return (job.model.dof <= config.textbook_max_dof
+            and job.dynamics.operation_count(["M", "C", "g"]) <= config.textbook_max_operations)
+
+
+def symbol_names(job: Job) -> dict[sp.Symbol, str]:
+    """Explicit LaTeX for the joint symbols, and for parameters whose name would print like one
+    of the document's own quantities."""
+    dyn = job.dynamics
+    names: dict[sp.Symbol, str] = {}
+    for k, (q, qd, qdd) in enumerate(zip(dyn.q, dyn.qd, dyn.qdd), start=1):
+        names[q] = f"q_{{{k}}}"
+        names[qd] = rf"\dot{{q}}_{{{k}}}"
+        names[qdd] = rf"\ddot{{q}}_{{{k}}}"
+    for p in job.model.parameters:
+        if _NOTATION_NAMES.match(p.name):
+            names[p.symbol] = r"\textrm{" + latex_escape(p.name) + "}"
+    return names
+
+
+def _printing(job: Job, config: LatexConfig, compact_trig: bool) -> _Printing:
+    printer = DerivationLatexPrinter({
+        "joint_positions": job.dynamics.q,
+        "symbol_names": symbol_names(job),
+        "compact_trig": compact_trig,
+        "float_digits": config.float_digits,
+        "mat_str": "pmatrix",
+        "mat_delim": "",
+    })
+    return _Printing(printer, config.line_width, config.block_size)
+
+
+def _vector(p: _Printing, values) -> str:
+    return r"\left(" + ", ".join(p.tex(v) for v in values) + r"\right)"
+
+
+# -- the description ------------------------------------------------------------------------
+
+def _rpy(rotation) -> list[sp.Expr] | None:
+    """URDF roll, pitch, yaw of a numeric rotation matrix, None when it is symbolic."""
+    try:
+        R = [[float(v) for v in row] for row in rotation]
+    except TypeError:
+        return None
+    pitch = math.asin(max(-1.0, min(1.0, -R[2][0])))
+    roll = math.atan2(R[2][1], R[2][2])
+    yaw = math.atan2(R[1][0], R[0][0])
+    return [sp.Float(a, 15) if abs(a) > 1e-12 else sp.Integer(0) for a in (roll, pitch, yaw)]
+
+
+def _joint_rows(model: RobotModel, p: _Printing) -> list[list[str]]:
+    rows = []
+    index = {j.name: k for k, j in enumerate(model.movable_joints, start=1)}
+    for joint in model.joints:
+        rotation = joint.origin.rotation
+        if rotation == IDENTITY3:
+            rpy = "0"
+        else:
+            angles = _rpy(rotation)
+            rpy = "$" + _vector(p, angles) + "$" if angles is not None else "symbolic"
+        rows.append([
+            f"$q_{{{index[joint.name]}}}$" if joint.name in index else "",
+            latex_escape(joint.name),
+            joint.type.value,
+            latex_escape(joint.parent),
+            latex_escape(joint.child),
+            "$" + _vector(p, joint.axis) + "$" if joint.type.is_movable else "",
+            "$" + _vector(p, joint.origin.translation) + "$",
+            rpy,
+        ])
+    return rows
+
+
+_DH_HEADINGS = {"joint": "joint", "type": "type", "a": "$a$", "alpha": r"$\alpha$",
+                "d": "$d$", "theta": r"$\theta$"}
+
+
+def _dh_table(model: RobotModel, p: _Printing) -> dict | None:
+    info = dict(model.info)
+    if "dh" not in info:
+        return None
+    columns = list(info.get("dh_columns", ("joint", "type", "a", "alpha", "d", "theta")))
+    rows = []
+    for row in info["dh"]:
+        cells = []
+        for value in row:
+            if isinstance(value, sp.Basic):
+                cells.append("$" + p.tex(value) + "$")
+            else:
+                cells.append(latex_escape(str(value)))
+        rows.append(cells)
+    return {
+        "convention": latex_escape(str(info.get("convention", ""))),
+        "headings": [_DH_HEADINGS.get(c, latex_escape(c)) for c in columns],
+        "rows": rows,
+    }
+
+
+def _link_rows(model: RobotModel, p: _Printing) -> list[list[str]]:
+    rows = []
+    for link in model.links:
+        if link.inertial is None:
+            rows.append([latex_escape(link.name), "--", "", ""])
+            continue
+        inertia = link.inertial.inertia
+        rows.append([
+            latex_escape(link.name),
+            "$" + p.tex(link.inertial.mass) + "$",
+            "$" + _vector(p, link.inertial.com) + "$",
+            "$" + _vector(p, [inertia[0][0], inertia[1][1], inertia[2][2],
+                              inertia[0][1], inertia[0][2], inertia[1][2]]) + "$",
+        ])
+    return rows
+
+
+def _parameter_rows(model: RobotModel, p: _Printing) -> list[list[str]]:
+    return [["$" + p.tex(par.symbol) + "$",
+             "$" + p.tex(sp.Float(par.value, 15)) + "$" if par.value is not None else "--",
+             latex_escape(par.description)]
+            for par in sorted(model.parameters, key=lambda par: par.name)]
+
+
+# -- the textbook derivation ----------------------------------------------------------------
+
+def _matrix_equations(p: _Printing, lhs: str, matrix: sp.Matrix) -> list[Equation]:
+    """``lhs = (matrix)`` on one line when it fits, else one line per non-zero entry."""
+    widths = [max(len(p.tex(matrix[r, c])) for r in range(matrix.rows))
+              for c in range(matrix.cols)]
+    entries = [p.tex(e) for e in matrix]
+    if sum(min(w, p.width) for w in widths) <= p.width:
+        rows = [" & ".join(entries[r * matrix.cols:(r + 1) * matrix.cols])
+                for r in range(matrix.rows)]
+        return [Equation(lhs, [r"\begin{pmatrix} " + r" \\ ".join(rows) + r" \end{pmatrix}")]]
+    out = []
+    for r in range(matrix.rows):
+        for c in range(matrix.cols):
+            if matrix[r, c] != 0:
+                out.append(p.equation(rf"\bigl[{lhs}\bigr]_{{{r + 1},{c + 1}}}", matrix[r, c]))
+    return out
+
+
+def _textbook_sections(job: Job, book: TextbookDerivation, p: _Printing) -> dict:
+    n = job.model.dof
+    bodies = []
+    for body in book.bodies:
+        k = job.model.joint_names.index(body.joint) + 1
+        kinematics = [p.equation(f"m_{{({k})}}", body.mass)]
+        kinematics += _matrix_equations(p, f"I_{{c{k}}}", body.inertia)
+        kinematics += _matrix_equations(p, f"R_{{{k}}}", body.rotation)
+        kinematics += _matrix_equations(p, f"p_{{c{k}}}", body.com)
+        kinematics += _matrix_equations(p, f"J_{{v{k}}}", body.J_v)
+        kinematics += _matrix_equations(p, rf"J_{{\omega {k}}}", body.J_w)
+        energies = [p.equation(f"K_{{{k}}}", body.K), p.equation(f"P_{{{k}}}", body.P)]
+        bodies.append({
+            "index": k,
+            "joint": latex_escape(body.joint),
+            "links": ", ".join(latex_escape(name) for name in body.links),
+            "kinematics": p.chunks(kinematics),
+            "energies": p.chunks(energies),
+        })
+    M = [p.equation(f"M_{{{i + 1},{j + 1}}}", book.M[i, j]) for i in range(n) for j in range(i, n)]
+    christoffel = []
+    for (i, j, k), value in book.christoffel:
+        lhs = rf"\Gamma_{{{i + 1},{j + 1},{k + 1}}}"
+        if j != k:
+            lhs += rf" = \Gamma_{{{i + 1},{k + 1},{j + 1}}}"
+        christoffel.append(p.equation(lhs, value))
+    C = [p.equation(f"C_{{{i + 1},{j + 1}}}", book.C[i, j]) for i in range(n) for j in range(n)]
+    g = [p.equation(f"g_{{{i + 1}}}", book.g[i]) for i in range(n)]
+    dyn = job.dynamics
+    equations = []
+    for i in range(n):
+        terms = [book.M[i, j] * dyn.qdd[j] for j in range(n) if book.M[i, j] != 0]
+        terms += [book.C[i, j] * dyn.qd[j] for j in range(n) if book.C[i, j] != 0]
+        terms += [book.g[i]] if book.g[i] != 0 else []
+        lines = p.printer.print_sum_lines([sp.Mul(t, evaluate=False) for t in terms], p.width)
+        equations.append(Equation(rf"\tau_{{{i + 1}}}", lines))
+    return {
+        "bodies": bodies,
+        "energies": p.chunks([p.equation("K", book.K), p.equation("P", book.P)]),
+        "mass_matrix": p.chunks(M),
+        "christoffel": p.chunks(christoffel),
+        "coriolis": p.chunks(C),
+        "gravity_vector": p.chunks(g),
+        "equations": p.chunks(equations),
+    }
+
+
+# -- the straight-line program --------------------------------------------------------------
+
+def _entry_symbol(name: str, *indices: int) -> sp.Symbol:
+    return sp.Symbol(name + "_".join(str(i + 1) for i in indices), real=True)
+
+
+def _program_sections(job: Job, config: LatexConfig, p: _Printing) -> dict:
+    program = job.dynamics.program
+    n = job.model.dof
+    shown: set[sp.Symbol] = set()
+    groups, omitted = [], []
+    legend: dict[str, str] = {}
+    budget = config.max_program_lines
+    for output, title in _PROGRAM_GROUPS:
+        assignments = [(s, e) for s, e in program.pruned([output]).assignments if s not in shown]
+        if len(assignments) > budget:
+            omitted.append(output)
+            continue
+        budget -= len(assignments)
+        shown |= {s for s, _ in assignments}
+        for symbol, _ in assignments:
+            family = re.match(r"[A-Za-z]+", symbol.name)
+            if family and family[0] in PROGRAM_NAMES and family[0] not in legend:
+                legend[family[0]] = p.tex(symbol)
+        equations = [p.equation(p.tex(symbol), expr) for symbol, expr in assignments]
+        groups.append({"title": title, "count": len(assignments), "blocks": p.chunks(equations)})
+
+    M, C, g = (program.output(name) for name in ("M", "C", "g"))
+    outputs = []
+    if "M" not in omitted:
+        outputs += p.chunks([p.equation(p.tex(_entry_symbol("M", i, j)), M[i, j])
+                             for i in range(n) for j in range(i, n) if M[i, j] != 0],
+                            r"Mass matrix (upper triangle; $M_{j,i} = M_{i,j}$):")
+    if "g" not in omitted:
+        outputs += p.chunks([p.equation(p.tex(_entry_symbol("g", i)), g[i])
+                             for i in range(n) if g[i] != 0], "Gravity vector:")
+    if "C" not in omitted:
+        outputs += p.chunks([p.equation(p.tex(_entry_symbol("C", i, j)), C[i, j])
+                             for i in range(n) for j in range(n) if C[i, j] != 0],
+                            "Coriolis matrix:")
+    dyn = job.dynamics
+    equations = []
+    for i in range(n):
+        terms = [_entry_symbol("M", min(i, j), max(i, j)) * dyn.qdd[j] for j in range(n)
+                 if M[i, j] != 0]
+        terms += [_entry_symbol("C", i, j) * dyn.qd[j] for j in range(n) if C[i, j] != 0]
+        terms += [_entry_symbol("g", i)] if g[i] != 0 else []
+        equations.append(Equation(rf"\tau_{{{i + 1}}}",
+                                  p.printer.print_sum_lines(terms or [sp.Integer(0)], p.width)))
+    return {
+        "legend": [(tex, latex_escape(PROGRAM_NAMES[family])) for family, tex in legend.items()],
+        "groups": groups,
+        "omitted": [{"M": "mass matrix", "g": "gravity vector", "C": "Coriolis matrix"}[o]
+                    for o in omitted],
+        "total": len(program.pruned(["M", "C", "g"]).assignments),
+        "outputs": outputs,
+        "equations": p.chunks(equations),
+    }
+
+
+def render_document(job: Job, config: LatexConfig = LatexConfig()) -> str:
+    """The text of the ``.tex`` document for ``job`` (see the module docstring)."""
+    model = job.model
+    teaching = is_teaching_sized(job, config)
+    p = _printing(job, config, compact_trig=teaching)
+    context = {
+        "header": [latex_comment(line) for line in job.header_lines(config.template)],
+        "robot": latex_escape(model.name),
+        "source": latex_escape(job.source_name),
+        "version": latex_escape(__version__),
+        "description": latex_escape(str(dict(model.info).get("description", ""))),
+        "dof": model.dof,
+        "gravity": _vector(p, model.gravity),
+        "joints": _joint_rows(model, p),
+        "dh": _dh_table(model, p),
+        "links": _link_rows(model, p),
+        "parameters": _parameter_rows(model, p),
+        "float_digits": config.float_digits,
+        "teaching": teaching,
+        "max_dof": config.textbook_max_dof,
+        "max_operations": config.textbook_max_operations,
+        "operations": job.dynamics.operation_count(["M", "C", "g"]),
+    }
+    if teaching:
+        book = textbook_derivation(model, max_dof=config.textbook_max_dof)
+        context.update(_textbook_sections(job, book, p))
+    else:
+        context.update(_program_sections(job, config, p))
+    return render(config.template, **context)
+
+
+@register("latex", "LaTeX document of the derivation: textbook steps for small models, the "
+                   "program of named subexpressions for large ones (pdflatex)")
+def generate_latex(job: Job, config: LatexConfig = LatexConfig()) -> list[GeneratedFile]:
+    return [GeneratedFile(job.stem + config.suffix, render_document(job, config))]
