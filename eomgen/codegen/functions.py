@@ -15,11 +15,15 @@ inverse_dynamics    tau (n,)             q, qd, qdd
 
 ``forward_dynamics(q, qd, tau)`` is composed by each backend from ``mass_matrix`` and
 ``inverse_dynamics`` (a Cholesky solve of M q̈ = τ − (C q̇ + g)).
+
+A module may export a subset of these functions (:func:`select_functions`, e.g. from a scene's
+``outputs``); only the outputs they need are derived (:func:`derived_outputs`).
 """
 
 from __future__ import annotations
 
 import builtins
+import difflib
 import keyword
 import re
 from dataclasses import dataclass
@@ -67,7 +71,8 @@ RESERVED_IDENTIFIERS = frozenset(
     {"np", "ca", "casadi", "math", "q", "qd", "qdd", "tau", "out", "single", "batch", "n",
      "JOINT_NAMES", "NQ", "PARAMETERS", "mass_matrix", "coriolis_matrix", "gravity_vector",
      "inverse_dynamics", "forward_dynamics", "self", "cls", "M", "C", "g", "L", "x", "y", "d",
-     "rhs", "bias", "args", "names", "vectors", "functions", "parameters"}
+     "rhs", "bias", "args", "names", "vectors", "functions", "parameters", "q_columns",
+     "qd_columns", "qdd_columns"}
 ) | frozenset(keyword.kwlist) | frozenset(keyword.softkwlist) | frozenset(dir(builtins))
 
 _IDENTIFIER = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
@@ -120,12 +125,88 @@ _ARG_DOCS = {
 }
 
 
-def function_specs(dynamics: Dynamics) -> tuple[FunctionSpec, ...]:
-    """The specs of every function a backend generates, from dynamics derived with M, C, g and
-    tau as outputs."""
+#: Every function a generated module can export, in module order, with the derived outputs
+#: (see :data:`eomgen.dynamics.ALL_OUTPUTS`) it needs.
+FUNCTION_OUTPUTS: dict[str, tuple[str, ...]] = {
+    "mass_matrix": ("M",),
+    "coriolis_matrix": ("C",),
+    "gravity_vector": ("g",),
+    "inverse_dynamics": ("tau",),
+    "forward_dynamics": ("M", "tau"),
+}
+FUNCTION_NAMES: tuple[str, ...] = tuple(FUNCTION_OUTPUTS)
+
+#: Functions a function is composed from, and so generated with it.
+FUNCTION_REQUIRES: dict[str, tuple[str, ...]] = {
+    "forward_dynamics": ("mass_matrix", "inverse_dynamics"),
+}
+
+#: Short names accepted for functions: the symbol of what they return.
+FUNCTION_ALIASES: dict[str, str] = {
+    "M": "mass_matrix", "C": "coriolis_matrix", "g": "gravity_vector", "tau": "inverse_dynamics",
+}
+
+
+def select_functions(names=None) -> tuple[str, ...]:
+    """The functions to generate for the requested ``names``, in module order.
+
+    Parameters
+    ----------
+    names:
+        Function names (``mass_matrix`` …) or their short names (``M``, ``C``, ``g``, ``tau``);
+        ``None`` for all of :data:`FUNCTION_NAMES`. A function composed from others brings them
+        along (``forward_dynamics`` needs ``mass_matrix`` and ``inverse_dynamics``).
+
+    Raises
+    ------
+    ValueError
+        For an unknown name, or no name at all.
+
+    Examples
+    --------
+    >>> select_functions(["g", "forward_dynamics"])
+    ('mass_matrix', 'gravity_vector', 'inverse_dynamics', 'forward_dynamics')
+    """
+    if names is None:
+        return FUNCTION_NAMES
+    wanted: set[str] = set()
+    for name in names:
+        function = FUNCTION_ALIASES.get(name, name)
+        if function not in FUNCTION_OUTPUTS:
+            known = list(FUNCTION_ALIASES) + list(FUNCTION_NAMES)
+            hint = difflib.get_close_matches(str(name), known, n=1)
+            raise ValueError(f"unknown output {name!r} (known: {', '.join(known)})"
+                             + (f"; did you mean '{hint[0]}'?" if hint else ""))
+        wanted.add(function)
+        wanted.update(FUNCTION_REQUIRES.get(function, ()))
+    if not wanted:
+        raise ValueError("no output asked for")
+    return tuple(f for f in FUNCTION_NAMES if f in wanted)
+
+
+def derived_outputs(functions=None) -> tuple[str, ...]:
+    """The outputs :func:`eomgen.derive` must build for ``functions`` (default: all), in
+    ``ALL_OUTPUTS`` order.
+
+    >>> derived_outputs(["gravity_vector"])
+    ('g',)
+    """
+    from ..dynamics import ALL_OUTPUTS
+
+    needed = {o for f in select_functions(functions) for o in FUNCTION_OUTPUTS[f]}
+    return tuple(o for o in ALL_OUTPUTS if o in needed)
+
+
+def function_specs(dynamics: Dynamics, functions=None) -> tuple[FunctionSpec, ...]:
+    """The specs of the printed functions among ``functions`` (default: all; see
+    :func:`select_functions`), from dynamics derived with the outputs they need.
+    ``forward_dynamics`` has no spec: backends compose it."""
     vectors = {"q": dynamics.q, "qd": dynamics.qd, "qdd": dynamics.qdd}
+    chosen = select_functions(functions)
     specs = []
     for name, output, summary, args, is_vector, units in _SPECS:
+        if name not in chosen:
+            continue
         if output not in dynamics.outputs:
             raise ValueError(f"code generation needs '{output}' among the derived outputs")
         program = dynamics.program.pruned([output])

@@ -39,8 +39,26 @@ def _transpose_apply(R, v) -> tuple:
     return tuple(sp.Add(*[R[k][r] * v[k] for k in range(3)]) for r in range(3))
 
 
-def _is_z(axis) -> bool:
-    return tuple(axis) == (0, 0, 1)
+def _aligned(axis) -> tuple[int, int] | None:
+    """``(k, sign)`` when ``axis`` is ``sign`` times the k-th unit vector, else None."""
+    values = tuple(axis)
+    for k in range(3):
+        for sign in (1, -1):
+            if values == tuple(sign if j == k else 0 for j in range(3)):
+                return k, sign
+    return None
+
+
+def _rotate_aligned(k: int, c, s, v, transpose: bool) -> tuple:
+    """Rot(e_k, q) v, or its transpose, touching only the two components that change."""
+    i, j = (k + 1) % 3, (k + 2) % 3
+    if transpose:
+        s = -s
+    w = [None, None, None]
+    w[i] = c * v[i] - s * v[j]
+    w[j] = s * v[i] + c * v[j]
+    w[k] = v[k]
+    return tuple(w)
 
 
 def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: ProgramBuilder) -> sp.Matrix:
@@ -55,8 +73,9 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
         w = _transpose_apply(body.placement.rotation, v)
         if body.joint.type.is_revolute:
             s, c = sincos[i]
-            if _is_z(body.joint.axis):
-                w = (c * w[0] + s * w[1], -s * w[0] + c * w[1], w[2])
+            aligned = _aligned(body.joint.axis)
+            if aligned is not None:
+                w = _rotate_aligned(aligned[0], c, aligned[1] * s, w, transpose=True)
             else:
                 w = _rotate_back(body.joint.axis, c, s, w)
         return w
@@ -67,8 +86,9 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
         w = v
         if body.joint.type.is_revolute:
             s, c = sincos[i]
-            if _is_z(body.joint.axis):
-                w = (c * v[0] - s * v[1], s * v[0] + c * v[1], v[2])
+            aligned = _aligned(body.joint.axis)
+            if aligned is not None:
+                w = _rotate_aligned(aligned[0], c, aligned[1] * s, v, transpose=False)
             else:
                 w = _rotate_back(body.joint.axis, c, -s, v)
         return _matvec(body.placement.rotation, w)
@@ -119,7 +139,7 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
         m, h, I = par.mass, par.first_moment, par.inertia
         w, dw, a = omega[i], domega[i], acc[i]
         f = tuple(m * a[j] + x + y for j, (x, y) in enumerate(zip(_cross(dw, h), _cross(w, _cross(w, h)))))
-        Iw = _matvec(I, w)
+        Iw = b.define_all(_matvec(I, w), f"Iw{tag}_")
         nn = tuple(x + y + z_ for x, y, z_ in zip(_matvec(I, dw), _cross(w, Iw), _cross(h, a)))
         force[i] = list(f)
         moment[i] = list(nn)

@@ -75,8 +75,9 @@ def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l
     """
     q, single = _states((q, "q"))
     batch = q.shape[0]
-    q1 = q[:, 0]
-    q2 = q[:, 1]
+    q_columns = np.ascontiguousarray(q.T)
+    q1 = q_columns[0]
+    q2 = q_columns[1]
     s1 = np.sin(q1)
     c1 = np.cos(q1)
     o2_0 = c1*l1
@@ -85,17 +86,27 @@ def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l
     c2 = np.cos(q2)
     R2_00 = c1*c2 - s1*s2
     R2_01 = -c1*s2 - c2*s1
+    del c1, c2, s1, s2
     Iw1_22 = I1 + lc1**2*m1
     Rh2_0 = R2_00*lc2*m2
+    del R2_00
     Rh2_1 = -R2_01*lc2*m2
+    del R2_01
     Iw2_22 = I2 + 2*Rh2_0*o2_0 + 2*Rh2_1*o2_1 + lc2**2*m2 + m2*(o2_0**2 + o2_1**2)
     hw2_0 = Rh2_0 + m2*o2_0
+    del Rh2_0
     hw2_1 = Rh2_1 + m2*o2_1
+    del Rh2_1
     Ic1_22 = Iw1_22 + Iw2_22
+    del Iw1_22
     F2_2 = Iw2_22 - hw2_0*o2_0 - hw2_1*o2_1
+    del Iw2_22
     F2_3 = -hw2_1 + m2*o2_1
+    del hw2_1
     F2_4 = hw2_0 - m2*o2_0
+    del hw2_0
     M2_2 = F2_2 + F2_3*o2_1 - F2_4*o2_0
+    del F2_3, F2_4, o2_0, o2_1
     out = np.zeros((batch,) + (2, 2))
     out[:, 0, 0] = Ic1_22
     out[:, 0, 1] = F2_2
@@ -123,10 +134,12 @@ def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_
     """
     q, qd, single = _states((q, "q"), (qd, "qd"))
     batch = q.shape[0]
-    q1 = q[:, 0]
-    q2 = q[:, 1]
-    qd1 = qd[:, 0]
-    qd2 = qd[:, 1]
+    q_columns = np.ascontiguousarray(q.T)
+    qd_columns = np.ascontiguousarray(qd.T)
+    q1 = q_columns[0]
+    q2 = q_columns[1]
+    qd1 = qd_columns[0]
+    qd2 = qd_columns[1]
     s1 = np.sin(q1)
     c1 = np.cos(q1)
     o2_0 = c1*l1
@@ -135,17 +148,26 @@ def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_
     c2 = np.cos(q2)
     R2_00 = c1*c2 - s1*s2
     R2_01 = -c1*s2 - c2*s1
+    del c1, c2, s1, s2
     Rh2_0 = R2_00*lc2*m2
+    del R2_00
     Rh2_1 = -R2_01*lc2*m2
+    del R2_01
     hw2_0 = Rh2_0 + m2*o2_0
+    del Rh2_0
     hw2_1 = Rh2_1 + m2*o2_1
+    del Rh2_1
     F2_3 = -hw2_1 + m2*o2_1
     F2_4 = hw2_0 - m2*o2_0
     dM1_1_2 = 2*hw2_0*o2_1 - 2*hw2_1*o2_0
+    del hw2_0, hw2_1
     C1_1 = ((1/2))*dM1_1_2*qd2
     Y2_2_2 = F2_3*o2_0 + F2_4*o2_1
+    del F2_3, F2_4, o2_0, o2_1
     C1_2 = Y2_2_2*qd2 + ((1/2))*dM1_1_2*qd1
+    del Y2_2_2
     C2_1 = -(1/2)*dM1_1_2*qd1
+    del dM1_1_2
     out = np.zeros((batch,) + (2, 2))
     out[:, 0, 0] = C1_1
     out[:, 0, 1] = C1_2
@@ -170,21 +192,30 @@ def gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81
     """
     q, single = _states((q, "q"))
     batch = q.shape[0]
-    q1 = q[:, 0]
-    q2 = q[:, 1]
+    q_columns = np.ascontiguousarray(q.T)
+    q1 = q_columns[0]
+    q2 = q_columns[1]
     s1 = np.sin(q1)
     c1 = np.cos(q1)
     o2_0 = c1*l1
     s2 = np.sin(q2)
     c2 = np.cos(q2)
     R2_00 = c1*c2 - s1*s2
+    del c2, s1, s2
     Rh1_0 = c1*lc1*m1
+    del c1
     Rh2_0 = R2_00*lc2*m2
+    del R2_00
     hw2_0 = Rh2_0 + m2*o2_0
+    del Rh2_0
     hc1_0 = Rh1_0 + hw2_0
+    del Rh1_0
     F2_4 = hw2_0 - m2*o2_0
+    del hw2_0, o2_0
     g1 = g_*hc1_0
+    del hc1_0
     g2 = F2_4*g_
+    del F2_4
     out = np.zeros((batch,) + (2,))
     out[:, 0] = g1
     out[:, 1] = g2
@@ -212,29 +243,40 @@ def inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.083333333333333
     """
     q, qd, qdd, single = _states((q, "q"), (qd, "qd"), (qdd, "qdd"))
     batch = q.shape[0]
-    q1 = q[:, 0]
-    q2 = q[:, 1]
-    qd1 = qd[:, 0]
-    qd2 = qd[:, 1]
-    qdd1 = qdd[:, 0]
-    qdd2 = qdd[:, 1]
+    q_columns = np.ascontiguousarray(q.T)
+    qd_columns = np.ascontiguousarray(qd.T)
+    qdd_columns = np.ascontiguousarray(qdd.T)
+    q1 = q_columns[0]
+    q2 = q_columns[1]
+    qd1 = qd_columns[0]
+    qd2 = qd_columns[1]
+    qdd1 = qdd_columns[0]
+    qdd2 = qdd_columns[1]
     s1 = np.sin(q1)
     c1 = np.cos(q1)
     s2 = np.sin(q2)
     c2 = np.cos(q2)
     a1_0 = g_*s1
+    del s1
     a1_1 = c1*g_
+    del c1
     ap2_0 = a1_0 - l1*qd1**2
+    del a1_0
     ap2_1 = a1_1 + l1*qdd1
     a2_0 = ap2_0*c2 + ap2_1*s2
     a2_1 = -ap2_0*s2 + ap2_1*c2
+    del ap2_0, ap2_1
     w2_2 = qd1 + qd2
     dw2_2 = qdd1 + qdd2
     f2_0 = a2_0*m2 - lc2*m2*w2_2**2
+    del a2_0, w2_2
     f2_1 = a2_1*m2 + dw2_2*lc2*m2
     n2_2 = a2_1*lc2*m2 + dw2_2*(I2 + lc2**2*m2)
+    del a2_1, dw2_2
     fp2_1 = c2*f2_1 + f2_0*s2
+    del c2, f2_0, f2_1, s2
     n1_2 = a1_1*lc1*m1 + fp2_1*l1 + n2_2 + qdd1*(I1 + lc1**2*m1)
+    del a1_1, fp2_1
     out = np.zeros((batch,) + (2,))
     out[:, 0] = n1_2
     out[:, 1] = n2_2

@@ -25,6 +25,24 @@ class PrintedFunction:
     output_entries: list[tuple[tuple[int, ...], str]]  # (index, rhs) of non-zero entries
     operation_count: int
     units: str
+    releases: list[list[str]]  # names no longer needed after each assignment
+
+
+def last_uses(assignments, outputs) -> list[list[str]]:
+    """For each assignment, the intermediates whose last use it is (never those the outputs
+    use): a backend may free them there (NumPy batches hold one array per intermediate)."""
+    kept = set()
+    for e in outputs:
+        kept |= e.free_symbols
+    defined = {symbol for symbol, _ in assignments}
+    seen: set = set()
+    releases: list[list[str]] = []
+    for symbol, expr in reversed(assignments):
+        free = [x for x in expr.free_symbols if x in defined and x not in kept and x not in seen]
+        seen.update(free)
+        releases.append(sorted(x.name for x in free))
+    releases.reverse()
+    return releases
 
 
 def print_function(spec: FunctionSpec, job: Job, doprint, element_name) -> PrintedFunction:
@@ -65,6 +83,7 @@ def print_function(spec: FunctionSpec, job: Job, doprint, element_name) -> Print
         output_entries=entries,
         operation_count=spec.operation_count,
         units=spec.units,
+        releases=last_uses(spec.program.assignments, list(spec.output)),
     )
 
 
@@ -88,3 +107,22 @@ def docstring_literal(text: str) -> str:
     code when the module is imported), and no backslash can start an escape sequence.
     """
     return python_literal(text).replace("\\", "\\\\").replace('"', '\\"')
+
+
+def dunder_all_lines(names, width: int = 79) -> list[str]:
+    """The lines of ``__all__ = [...]`` listing ``names``, filled up to ``width`` characters.
+
+    >>> dunder_all_lines(["NQ", "mass_matrix"])
+    ['__all__ = ["NQ", "mass_matrix"]']
+    """
+    prefix = "__all__ = ["
+    items = [f'"{name}"' for name in names]
+    lines, current = [], prefix
+    for k, item in enumerate(items):
+        text = item + ("]" if k == len(items) - 1 else ",")
+        if current not in (prefix, " " * len(prefix)) and len(current) + 1 + len(text) > width:
+            lines.append(current)
+            current = " " * len(prefix)
+        current += ("" if current in (prefix, " " * len(prefix)) else " ") + text
+    lines.append(current if items else prefix + "]")
+    return lines
