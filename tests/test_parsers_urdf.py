@@ -21,7 +21,12 @@ import pytest
 import sympy as sp
 
 import eomgen
-from eomgen.errors import DescriptionError, PhysicalConsistencyWarning, UnsupportedError
+from eomgen.errors import (
+    DescriptionError,
+    PhysicalConsistencyWarning,
+    UnsupportedError,
+    UnsupportedFeatureWarning,
+)
 from eomgen.model import JointType, RobotModel, Transform
 from eomgen.parsers.urdf import load_urdf, parse_urdf_string, rotate_inertia
 
@@ -41,7 +46,8 @@ ARMS = [
 ]
 #: Branched robots (no floating joint in the file; the root link is the fixed base).
 TREES = [
-    ("talos_data/robots/talos_reduced.urdf", True),
+    ("talos_data/robots/talos_reduced.urdf", False),  # <mimic> on fixed joints only
+    ("talos_data/robots/talos_full_v2.urdf", True),
     ("simple_humanoid_description/urdf/simple_humanoid.urdf", False),
 ]
 TOL = 1e-10
@@ -159,11 +165,20 @@ def document_joint_order(path: Path) -> list[str]:
 # example-robot-data against Pinocchio
 # ----------------------------------------------------------------------------------------------
 
+def load_expecting_mimic_warnings(path: Path, has_mimic: bool) -> RobotModel:
+    """``eomgen.load(path)``, checking that warnings come exactly when the file has mimics."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        model = eomgen.load(path)
+    mimics = [w for w in caught if issubclass(w.category, UnsupportedFeatureWarning)]
+    assert bool(mimics) == has_mimic, [str(w.message) for w in caught]
+    return model
+
+
 @pytest.mark.parametrize("relative, has_mimic", ARMS, ids=[Path(a).stem for a, _ in ARMS])
 def test_arm_matches_pinocchio(erd_robots_dir, pin, relative, has_mimic):
     path = erd_robots_dir / relative
-    model = (load_urdf(path, False, mimic_as_independent=True) if has_mimic
-             else eomgen.load(path))
+    model = load_expecting_mimic_warnings(path, has_mimic)
     pmodel = pin.buildModelFromUrdf(str(path))
     assert list(model.joint_names) == document_joint_order(path)
     assert list(model.joint_names) == list(pmodel.names[1:])  # a chain: same order as Pinocchio
@@ -174,21 +189,49 @@ def test_arm_matches_pinocchio(erd_robots_dir, pin, relative, has_mimic):
 @pytest.mark.parametrize("relative, has_mimic", TREES, ids=[Path(a).stem for a, _ in TREES])
 def test_tree_matches_pinocchio(erd_robots_dir, pin, relative, has_mimic):
     path = erd_robots_dir / relative
-    model = load_urdf(path, False, mimic_as_independent=has_mimic)
+    model = load_expecting_mimic_warnings(path, has_mimic)
     assert list(model.joint_names) == document_joint_order(path)
     compare_with_pinocchio(pin, model, pin.buildModelFromUrdf(str(path)))
 
 
-@pytest.mark.parametrize("relative, joint", [
-    ("panda_description/urdf/panda.urdf", "panda_finger_joint2"),
-    ("talos_data/robots/talos_reduced.urdf", "gripper_left_inner_double_joint"),
-])
-def test_mimic_joints_are_refused_by_default(erd_robots_dir, relative, joint):
+MIMICS = [
+    ("panda_description/urdf/panda.urdf", "panda_finger_joint2", "panda_finger_joint1"),
+    ("talos_data/robots/talos_full_v2.urdf", "gripper_left_inner_double_joint",
+     "gripper_left_joint"),
+]
+
+
+@pytest.mark.parametrize("relative, joint, mimicked", MIMICS, ids=["panda", "talos"])
+def test_mimic_joints_are_independent_with_a_warning(erd_robots_dir, pin, relative, joint,
+                                                     mimicked):
+    """By default a mimic joint is an ordinary joint (as in Pinocchio) and each one warns, on
+    one line naming the file and the joint."""
     path = erd_robots_dir / relative
-    with pytest.raises(UnsupportedError) as caught:
-        eomgen.load(path)
-    assert str(caught.value) == (f"{path}: joint '{joint}' <mimic>: mimic joints are not "
-                                 "supported (eomgen needs independent joints)")
+    with pytest.warns(UnsupportedFeatureWarning) as record:
+        model = eomgen.load(path)
+    messages = [str(w.message) for w in record
+                if issubclass(w.category, UnsupportedFeatureWarning)]
+    expected = (f"{path}: joint '{joint}' <mimic>: the coupling to joint '{mimicked}' is not "
+                "modelled; read as an independent joint")
+    assert expected in messages
+    assert all(len(m.splitlines()) == 1 and m.startswith(f"{path}: joint '") for m in messages)
+    mimic_joints = [j.get("name") for j in ET.parse(path).getroot().iter("joint")
+                    if j.find("mimic") is not None and j.get("type") != "fixed"]
+    assert len(messages) == len(mimic_joints)  # one warning per mimic joint
+    assert set(mimic_joints) <= set(model.joint_names)
+    assert model.dof == pin.buildModelFromUrdf(str(path)).nv
+
+
+@pytest.mark.parametrize("relative, joint, mimicked", MIMICS, ids=["panda", "talos"])
+def test_mimic_joints_are_refused_under_strict(erd_robots_dir, relative, joint, mimicked):
+    path = erd_robots_dir / relative
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UnsupportedFeatureWarning)
+        with pytest.raises(UnsupportedError) as caught:
+            eomgen.load(path, strict=True)
+    message = str(caught.value)
+    assert message.startswith(f"{path}: joint '") and "<mimic>" in message
+    assert "refused under --strict" in message and len(message.splitlines()) == 1
 
 
 def test_robot_name_and_massless_links(erd_robots_dir):
@@ -314,12 +357,51 @@ def test_document_order_defines_q():
     assert parse_urdf_string(text).joint_names == ("r", "l2", "l")
 
 
-def test_mimic_as_independent_reads_an_ordinary_joint():
-    text = robot(link("a"), link("b"), link("c"), joint("j1", "a", "b"),
-                 joint("j2", "a", "c", body='<axis xyz="0 1 0"/><mimic joint="j1"/>'))
-    model = parse_urdf_string(text, mimic_as_independent=True)
+MIMIC = robot(link("a"), link("b"), link("c"), joint("j1", "a", "b"),
+              joint("j2", "a", "c", body='<axis xyz="0 1 0"/><mimic joint="j1" multiplier="2"/>'))
+
+
+def test_mimic_joint_is_read_as_an_ordinary_joint_with_a_warning():
+    with pytest.warns(UnsupportedFeatureWarning) as record:
+        model = parse_urdf_string(MIMIC, source="m.urdf")
+    assert [str(w.message) for w in record] == [
+        "m.urdf: joint 'j2' <mimic>: the coupling to joint 'j1' is not modelled; "
+        "read as an independent joint"]
     assert model.joint_names == ("j1", "j2")
     assert model.joints[1].axis == (0, 1, 0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UnsupportedFeatureWarning)
+        plain = parse_urdf_string(MIMIC.replace('<mimic joint="j1" multiplier="2"/>', ""),
+                                  source="m.urdf")
+    assert model == plain  # the mimic element changes nothing else
+
+
+def test_mimic_joint_is_refused_under_strict():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(UnsupportedError) as caught:
+            parse_urdf_string(MIMIC, source="m.urdf", strict=True)
+    assert str(caught.value) == ("m.urdf: joint 'j2' <mimic>: the coupling to joint 'j1' is "
+                                 "not modelled (refused under --strict)")
+
+
+def test_mimic_on_a_fixed_joint_is_ignored_silently(erd_robots_dir):
+    """Talos' reduced model fixes its gripper joints but keeps their <mimic>: nothing to couple."""
+    text = MIMIC.replace('joint name="j2" type="revolute"', 'joint name="j2" type="fixed"')
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert parse_urdf_string(text, strict=True).joint_names == ("j1",)
+        model = eomgen.load(erd_robots_dir / "talos_data/robots/talos_reduced.urdf", strict=True)
+    assert "gripper_left_inner_double_joint" not in model.joint_names
+
+
+def test_mimic_warning_only_for_valid_files():
+    """A file with an error raises it, without a mimic warning first."""
+    broken = MIMIC.replace('<link name="c">', '<link name="c2">')
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(DescriptionError, match="child link 'c' is not defined"):
+            parse_urdf_string(broken)
 
 
 def test_ignored_elements_do_not_matter():
@@ -452,9 +534,12 @@ BAD = {
                                  '<child link="b"/></joint>'), D, "joint 'j'", "'type'"),
     "floating joint": (chain("", "floating"), U, "joint 'j2'", "floating joints"),
     "planar joint": (chain("", "planar"), U, "joint 'j2'", "planar joints"),
-    "mimic joint": (robot(link("a"), link("b"), link("c"), joint("j1", "a", "b"),
-                          joint("j2", "a", "c", body='<mimic joint="j1" multiplier="2"/>')),
-                    U, "joint 'j2' <mimic>", "mimic joints are not supported"),
+    "mimic without joint": (robot(link("a"), link("b"), link("c"), joint("j1", "a", "b"),
+                                  joint("j2", "a", "c", body='<mimic multiplier="2"/>')),
+                            D, "joint 'j2' <mimic>", "no 'joint' attribute"),
+    "mimic of unknown joint": (robot(link("a"), link("b"), link("c"), joint("j1", "a", "b"),
+                                     joint("j2", "a", "c", body='<mimic joint="ghost"/>')),
+                               D, "joint 'j2' <mimic>", "joint 'ghost' is not defined"),
     "no parent element": (robot(link("a"), '<joint name="j2" type="fixed"><child link="a"/>'
                                 "</joint>"), D, "joint 'j2'", "no <parent>"),
     "cycle": (robot(link("a"), link("b"), link("c"), joint("j1", "b", "c"),

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from ..errors import DescriptionError
+from ..errors import TooLargeError, UnknownFormatError, UnreadableFileError
 from ..model import RobotModel
 
 Loader = Callable[[Path, bool], RobotModel]
@@ -50,33 +50,40 @@ def load(path, strict: bool = False) -> RobotModel:
     path:
         The description file.
     strict:
-        Refuse (rather than warn about) inertias that break the triangle inequality.
+        Refuse (rather than warn about) inertias that break the triangle inequality and
+        features read in a simpler way than described (URDF ``<mimic>`` joints).
 
     Raises
     ------
     DescriptionError
-        Naming the file, the element and what is wrong.
+        Naming the file, the element and what is wrong; a subclass for each kind of problem
+        (see :mod:`eomgen.errors`): here :class:`~eomgen.errors.UnreadableFileError`,
+        :class:`~eomgen.errors.UnknownFormatError` and :class:`~eomgen.errors.TooLargeError`
+        (files above :data:`MAX_FILE_BYTES`), the others from the format's parser.
     """
     from . import dh, urdf, yaml_format  # noqa: F401  (registration side effect)
 
     path = Path(path)
     if not path.is_file():
-        raise DescriptionError(str(path), "", "no such file")
+        raise UnreadableFileError(str(path), "", "no such file")
     if path.stat().st_size > MAX_FILE_BYTES:
-        raise DescriptionError(str(path), "", f"file larger than {MAX_FILE_BYTES} bytes")
+        raise TooLargeError(str(path), "", f"file larger than {MAX_FILE_BYTES} bytes")
     suffix = path.suffix.lower()
     candidates = [f for f in FORMATS if suffix in f.suffixes]
     if not candidates:
         known = sorted({s for f in FORMATS for s in f.suffixes})
-        raise DescriptionError(str(path), "", f"unknown file type '{suffix}' (known: {', '.join(known)})")
+        raise UnknownFormatError(str(path), "", f"unknown file type '{suffix}' (known: {', '.join(known)})")
     if len(candidates) > 1:
         try:
             text = path.read_text(encoding="utf-8")
         except UnicodeDecodeError as exc:
-            raise DescriptionError(str(path), "", f"not UTF-8 text ({exc.reason})") from None
+            raise UnreadableFileError(str(path), "", f"not UTF-8 text ({exc.reason})") from None
+        except OSError as exc:
+            raise UnreadableFileError(str(path), "",
+                                      f"cannot read the file ({exc.strerror})") from None
         sniffed = [f for f in candidates if f.sniff is None or f.sniff(text)]
         if len(sniffed) != 1:
-            raise DescriptionError(
+            raise UnknownFormatError(
                 str(path), "",
                 "cannot tell which format this is (" + " or ".join(f.name for f in candidates)
                 + "): a DH table needs a top-level 'dh' list, an eomgen robot 'links' and 'joints'")

@@ -25,10 +25,17 @@ Decisions
 * An ``<inertial>`` must hold ``<mass>`` and ``<inertia>`` with all six attributes, as urdfdom
   (ROS, Pinocchio) requires; a point mass is written with zero moments of inertia. A missing
   ``<inertia>`` is more often an authoring slip than a deliberate point mass.
-* ``floating`` and ``planar`` joints and joints with ``<mimic>`` raise
-  :class:`~eomgen.errors.UnsupportedError`. ``mimic_as_independent=True`` instead reads a mimic
-  joint as an ordinary independent joint (what Pinocchio does by default), for descriptions
-  such as the Franka Panda whose gripper fingers are coupled by ``<mimic>``.
+* ``floating`` and ``planar`` joints raise :class:`~eomgen.errors.UnsupportedError`.
+* A joint with ``<mimic joint="...">`` is read as an ordinary independent joint with its own
+  coordinate, as Pinocchio's ``buildModelFromUrdf`` does by default, so that descriptions such
+  as the Franka Panda and Talos (gripper fingers coupled by ``<mimic>``) load unchanged. The
+  coupling ``q = multiplier · q_other + offset`` is *not* modelled: each such joint issues one
+  :class:`~eomgen.errors.UnsupportedFeatureWarning` naming the file and the joint, and
+  ``strict=True`` raises :class:`~eomgen.errors.UnsupportedError` instead. To remove the extra
+  coordinates, lock the joints (:func:`eomgen.model.lock_joints`). The ``joint`` attribute is
+  required (as urdfdom requires it) and must name a joint of the file; ``multiplier`` and
+  ``offset`` are not read. A ``<mimic>`` on a *fixed* joint (Talos' reduced models) couples
+  nothing and is ignored without a warning.
 * Numbers are plain decimal numbers read with :func:`float` (URDF has no expressions); they
   must be finite. Exact integers stay exact (see :func:`eomgen.model.scalar`).
 * A singleton element (``<inertial>``, ``<origin>``, ``<axis>``, ...) given twice is an error
@@ -59,7 +66,17 @@ import defusedxml
 import defusedxml.ElementTree as SafeET
 import sympy as sp
 
-from ..errors import DescriptionError, UnsupportedError
+from ..errors import (
+    ForbiddenXMLError,
+    InvalidNumberError,
+    KinematicTreeError,
+    SchemaError,
+    UnreadableFileError,
+    UnsupportedError,
+    XMLSyntaxError,
+    warn_unsupported,
+)
+from ..expressions import MAX_MAGNITUDE
 from ..model import (
     Inertial,
     Joint,
@@ -69,6 +86,7 @@ from ..model import (
     RobotModel,
     Transform,
     build_model,
+    check_size,
     mat3,
     rotation_from_rpy,
     scalar,
@@ -89,8 +107,7 @@ _SHOWN_CHARACTERS = 40
 
 
 @register("URDF", (".urdf",))
-def load_urdf(path: Path, strict: bool = False, *, mimic_as_independent: bool = False
-              ) -> RobotModel:
+def load_urdf(path: Path, strict: bool = False) -> RobotModel:
     """Read the URDF file ``path`` (see the module docstring for what is read and how).
 
     Parameters
@@ -98,9 +115,8 @@ def load_urdf(path: Path, strict: bool = False, *, mimic_as_independent: bool = 
     path:
         The ``.urdf`` file.
     strict:
-        Refuse (rather than warn about) inertias that break the triangle inequality.
-    mimic_as_independent:
-        Read ``<mimic>`` joints as independent joints instead of refusing them.
+        Refuse (rather than warn about) inertias that break the triangle inequality and
+        ``<mimic>`` joints.
 
     Returns
     -------
@@ -110,20 +126,30 @@ def load_urdf(path: Path, strict: bool = False, *, mimic_as_independent: bool = 
     Raises
     ------
     DescriptionError
-        One line naming the file, the element and the problem.
+        One line naming the file, the element and the problem; the subclass tells the kind
+        (:class:`~eomgen.errors.XMLSyntaxError`, :class:`~eomgen.errors.ForbiddenXMLError`,
+        :class:`~eomgen.errors.SchemaError`, :class:`~eomgen.errors.InvalidNumberError`, and
+        those of :func:`eomgen.model.build_model`).
     UnsupportedError
-        For floating, planar and (by default) mimic joints.
+        For floating and planar joints, and for mimic joints under ``strict``.
+
+    Warns
+    -----
+    UnsupportedFeatureWarning
+        For each ``<mimic>`` joint (read as an independent joint), unless ``strict``.
+    PhysicalConsistencyWarning
+        For inertias that break the triangle inequality, unless ``strict``.
     """
     source = str(path)
     try:
         data = Path(path).read_bytes()
     except OSError as exc:
-        raise DescriptionError(source, "", f"cannot read the file ({exc.strerror})") from None
-    return _read_robot(data, source, strict, mimic_as_independent)
+        raise UnreadableFileError(source, "", f"cannot read the file ({exc.strerror})") from None
+    return _read_robot(data, source, strict)
 
 
-def parse_urdf_string(text: str | bytes, source: str = "<string>", strict: bool = False, *,
-                      mimic_as_independent: bool = False) -> RobotModel:
+def parse_urdf_string(text: str | bytes, source: str = "<string>", strict: bool = False
+                      ) -> RobotModel:
     """Read URDF from a string; ``source`` names it in error messages. See :func:`load_urdf`.
 
     >>> model = parse_urdf_string('''<robot name="r">
@@ -136,24 +162,38 @@ def parse_urdf_string(text: str | bytes, source: str = "<string>", strict: bool 
     >>> model.joint_names, model.link_by_name["arm"].inertial.mass
     (('j1',), 2)
     """
-    return _read_robot(text, source, strict, mimic_as_independent)
+    return _read_robot(text, source, strict)
 
 
 # ----------------------------------------------------------------------------------------------
 # Document
 # ----------------------------------------------------------------------------------------------
 
-def _read_robot(data: str | bytes, source: str, strict: bool, mimic_as_independent: bool
-                ) -> RobotModel:
+def _read_robot(data: str | bytes, source: str, strict: bool) -> RobotModel:
     root = _parse_xml(data, source)
     if root.tag != "robot":
-        raise DescriptionError(source, f"root element <{root.tag}>", "expected <robot>")
+        raise SchemaError(source, f"root element <{root.tag}>", "expected <robot>")
     name = _required_name(root, source, "<robot>")
+    check_size(source, len(root.findall("link")), len(root.findall("joint")))
     links = [_read_link(element, index, source)
              for index, element in enumerate(root.findall("link"), start=1)]
-    joints = [_read_joint(element, index, source, mimic_as_independent)
-              for index, element in enumerate(root.findall("joint"), start=1)]
-    return build_model(source, name, links, joints, gravity=GRAVITY, strict=strict)
+    joints, mimics = [], []
+    for index, element in enumerate(root.findall("joint"), start=1):
+        joint, mimicked = _read_joint(element, index, source)
+        joints.append(joint)
+        if mimicked is not None and joint.type.is_movable:  # a fixed joint has nothing to couple
+            mimics.append((joint.name, mimicked))
+    model = build_model(source, name, links, joints, gravity=GRAVITY, strict=strict)
+    names = {joint.name for joint in joints}
+    for joint_name, mimicked in mimics:
+        if mimicked not in names:
+            raise KinematicTreeError(source, f"joint '{joint_name}' <mimic>",
+                                   f"joint '{mimicked}' is not defined")
+    for joint_name, mimicked in mimics:  # only once the file is known to be valid
+        warn_unsupported(source, f"joint '{joint_name}' <mimic>",
+                         f"the coupling to joint '{mimicked}' is not modelled",
+                         "read as an independent joint", strict)
+    return model
 
 
 def _parse_xml(data: str | bytes, source: str) -> ET.Element:
@@ -164,13 +204,13 @@ def _parse_xml(data: str | bytes, source: str) -> ET.Element:
     except ET.ParseError as exc:
         line, column = getattr(exc, "position", (0, -1))
         where = f"line {line}, column {column + 1}" if line else ""
-        raise DescriptionError(source, where,
-                               f"malformed XML ({expat.ErrorString(exc.code)})") from None
+        raise XMLSyntaxError(source, where,
+                             f"malformed XML ({expat.ErrorString(exc.code)})") from None
     except defusedxml.EntitiesForbidden as exc:
-        raise DescriptionError(source, f"<!ENTITY {exc.name}>",
-                               "entity declarations are not allowed in a URDF") from None
+        raise ForbiddenXMLError(source, f"<!ENTITY {exc.name}>",
+                                "entity declarations are not allowed in a URDF") from None
     except defusedxml.DefusedXmlException as exc:  # external references, DTD tricks
-        raise DescriptionError(source, "XML", f"refused: {exc}") from None
+        raise ForbiddenXMLError(source, "XML", f"refused: {exc}") from None
 
 
 # ----------------------------------------------------------------------------------------------
@@ -193,11 +233,11 @@ def _read_inertial(element: ET.Element, source: str, where: str) -> Inertial:
                             f"{where}<origin>")
     mass_element = _single_child(element, "mass", source, where)
     if mass_element is None:
-        raise DescriptionError(source, where, "no <mass> element")
+        raise SchemaError(source, where, "no <mass> element")
     mass = _number_attribute(mass_element, "value", source, f"{where}<mass>")
     inertia_element = _single_child(element, "inertia", source, where)
     if inertia_element is None:
-        raise DescriptionError(
+        raise SchemaError(
             source, where,
             "no <inertia> element (a point mass has ixx=ixy=ixz=iyy=iyz=izz=\"0\")")
     inertia = _read_inertia(inertia_element, source, f"{where}<inertia>")
@@ -237,14 +277,17 @@ def rotate_inertia(inertia: list[list[float]], rpy: Iterable[float]) -> Mat3:
 # Joints
 # ----------------------------------------------------------------------------------------------
 
-def _read_joint(element: ET.Element, index: int, source: str, mimic_as_independent: bool
-                ) -> Joint:
+def _read_joint(element: ET.Element, index: int, source: str) -> tuple[Joint, str | None]:
+    """The joint, and the name of the joint it mimics (None without ``<mimic>``)."""
     name = _required_name(element, source, f"<joint> number {index}")
     where = f"joint '{name}'"
     joint_type = _read_joint_type(element, source, where)
-    if _single_child(element, "mimic", source, where) is not None and not mimic_as_independent:
-        raise UnsupportedError(source, f"{where} <mimic>",
-                               "mimic joints are not supported (eomgen needs independent joints)")
+    mimic = _single_child(element, "mimic", source, where)
+    mimicked = None
+    if mimic is not None:
+        mimicked = mimic.get("joint")
+        if not mimicked:
+            raise SchemaError(source, f"{where} <mimic>", "no 'joint' attribute")
     parent = _link_reference(element, "parent", source, where)
     child = _link_reference(element, "child", source, where)
     xyz, rpy = _read_origin(_single_child(element, "origin", source, where), source,
@@ -253,13 +296,14 @@ def _read_joint(element: ET.Element, index: int, source: str, mimic_as_independe
     axis_element = _single_child(element, "axis", source, where)
     if joint_type.is_movable and axis_element is not None:
         axis = _vector_attribute(axis_element, "xyz", 3, source, f"{where} <axis>")
-    return Joint(name, joint_type, parent, child, Transform.from_xyz_rpy(xyz, rpy), vec3(axis))
+    return (Joint(name, joint_type, parent, child, Transform.from_xyz_rpy(xyz, rpy), vec3(axis)),
+            mimicked)
 
 
 def _read_joint_type(element: ET.Element, source: str, where: str) -> JointType:
     text = element.get("type")
     if text is None:
-        raise DescriptionError(source, where, "no 'type' attribute")
+        raise SchemaError(source, where, "no 'type' attribute")
     if text in _UNSUPPORTED_JOINT_TYPES:
         raise UnsupportedError(
             source, where,
@@ -269,18 +313,18 @@ def _read_joint_type(element: ET.Element, source: str, where: str) -> JointType:
         return _JOINT_TYPES[text]
     except KeyError:
         known = ", ".join(sorted(_JOINT_TYPES) + list(_UNSUPPORTED_JOINT_TYPES))
-        raise DescriptionError(source, where,
-                               f"unknown joint type {_show(text)} (URDF knows {known})") from None
+        raise SchemaError(source, where,
+                          f"unknown joint type {_show(text)} (URDF knows {known})") from None
 
 
 def _link_reference(element: ET.Element, role: str, source: str, where: str) -> str:
     """The link named by the joint's ``<parent link>`` or ``<child link>``."""
     reference = _single_child(element, role, source, where)
     if reference is None:
-        raise DescriptionError(source, where, f"no <{role}> element")
+        raise SchemaError(source, where, f"no <{role}> element")
     link = reference.get("link")
     if not link:
-        raise DescriptionError(source, f"{where} <{role}>", "no 'link' attribute")
+        raise SchemaError(source, f"{where} <{role}>", "no 'link' attribute")
     return link
 
 
@@ -291,7 +335,7 @@ def _link_reference(element: ET.Element, role: str, source: str, where: str) -> 
 def _required_name(element: ET.Element, source: str, where: str) -> str:
     name = element.get("name")
     if not name:
-        raise DescriptionError(source, where, "no 'name' attribute (or it is empty)")
+        raise SchemaError(source, where, "no 'name' attribute (or it is empty)")
     return name
 
 
@@ -299,7 +343,7 @@ def _single_child(element: ET.Element, tag: str, source: str, where: str) -> ET.
     """The one ``<tag>`` child of ``element``, or None; two or more are an error."""
     found = element.findall(tag)
     if len(found) > 1:
-        raise DescriptionError(source, where, f"{len(found)} <{tag}> elements, expected one")
+        raise SchemaError(source, where, f"{len(found)} <{tag}> elements, expected one")
     return found[0] if found else None
 
 
@@ -318,11 +362,11 @@ def _vector_attribute(element: ET.Element, attribute: str, count: int, source: s
     text = element.get(attribute)
     if text is None:
         if default is None:
-            raise DescriptionError(source, where, f"no '{attribute}' attribute")
+            raise SchemaError(source, where, f"no '{attribute}' attribute")
         return default
     parts = text.split()
     if len(parts) != count:
-        raise DescriptionError(
+        raise SchemaError(
             source, where,
             f"{attribute}={_show(text)} has {len(parts)} numbers, expected {count}")
     return tuple(_finite(part, f"{attribute} component", source, where) for part in parts)
@@ -331,18 +375,23 @@ def _vector_attribute(element: ET.Element, attribute: str, count: int, source: s
 def _number_attribute(element: ET.Element, attribute: str, source: str, where: str) -> float:
     text = element.get(attribute)
     if text is None:
-        raise DescriptionError(source, where, f"no '{attribute}' attribute")
+        raise SchemaError(source, where, f"no '{attribute}' attribute")
     return _finite(text, attribute, source, where)
 
 
 def _finite(text: str, label: str, source: str, where: str) -> float:
-    """``float(text)``, refusing text that is not a number or not finite (nan, inf)."""
+    """``float(text)``, refusing text that is not a number, not finite (nan, inf) or of a
+    magnitude above :data:`~eomgen.expressions.MAX_MAGNITUDE`."""
     try:
         value = float(text)
     except ValueError:
-        raise DescriptionError(source, where, f"{label} {_show(text)} is not a number") from None
+        raise InvalidNumberError(source, where,
+                                 f"{label} {_show(text)} is not a number") from None
     if not math.isfinite(value):
-        raise DescriptionError(source, where, f"{label} {_show(text)} is not a finite number")
+        raise InvalidNumberError(source, where, f"{label} {_show(text)} is not a finite number")
+    if abs(value) > MAX_MAGNITUDE:
+        raise InvalidNumberError(source, where, f"{label} {_show(text)} is out of range "
+                                 f"(magnitude above {MAX_MAGNITUDE:g})")
     return value
 
 
