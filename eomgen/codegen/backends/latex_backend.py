@@ -1,12 +1,13 @@
 """LaTeX backend: ``<robot>.tex``, a standalone document of the derivation (plain pdflatex with
 amsmath, geometry and longtable; all three are in TeX Live's ``latex-base``).
 
-Two kinds of document, chosen by :func:`is_teaching_sized`:
+Two kinds of document, chosen by :func:`textbook_for`:
 
 * **teaching-sized** models (at most :data:`~eomgen.symbolic.textbook.TEXTBOOK_MAX_DOF` joints
-  and a small program): the textbook derivation of :mod:`eomgen.symbolic.textbook`, body by
-  body: centre-of-mass positions, Jacobians, K_i and P_i, then M, the Christoffel symbols, C, g
-  and the equations of motion written out, in compact trigonometric notation (s_1, c_12);
+  and expressions of moderate size): the textbook derivation of :mod:`eomgen.symbolic.textbook`,
+  body by body: centre-of-mass positions, Jacobians, K_i and P_i, then M, the Christoffel
+  symbols, C, g and the equations of motion written out, in compact trigonometric notation
+  (s_1, c_12);
 * **large** models: the description, then the straight-line program of named subexpressions
   that computes M, g and C (grouped by the output that first needs them), the entries of M, C,
   g in terms of those names and the equations of motion per joint. At most
@@ -22,7 +23,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import sympy as sp
 
@@ -31,7 +32,7 @@ from ...model import IDENTITY3, RobotModel
 from ...symbolic.textbook import TEXTBOOK_MAX_DOF, TextbookDerivation, textbook_derivation
 from .. import GeneratedFile, Job, register
 from ..render import render
-from .latex_printer import DerivationLatexPrinter, index_latex, latex_comment, latex_escape
+from .latex_printer import DerivationLatexPrinter, display_width, latex_comment, latex_escape
 
 #: Parameter names that would print like the document's own quantities (K_{1}, M_{1,2},
 #: \Gamma_{1,1,2}, s_{12}, …); such parameters print as upright text instead.
@@ -41,32 +42,34 @@ _NOTATION_NAMES = re.compile(
 )
 
 #: The families of named subexpressions of eomgen's straight-line program (the name prefixes of
-#: :mod:`eomgen.symbolic.composite`), for the legend of large documents. Vectors and matrices
-#: are in world coordinates; spatial 6-vectors are [angular; linear] about the world origin.
+#: :mod:`eomgen.symbolic.composite`) and what they are, in LaTeX, for the legend of large
+#: documents. Vectors and matrices are in world coordinates; spatial 6-vectors are
+#: [angular; linear] about the world origin.
 PROGRAM_NAMES = {
-    "s": "sine of the joint position of joint i",
-    "c": "cosine of the joint position of joint i",
-    "A": "rotation of joint frame i before the joint moves, entry (r, c)",
-    "R": "rotation of body i, entry (r, c)",
-    "o": "origin of joint frame i",
-    "p": "origin of body i (after a prismatic joint moved it)",
-    "z": "axis of joint i",
-    "v": "linear part of the motion axis S_i of joint i (origin × axis)",
-    "Rh": "first moment of body i rotated into world axes",
-    "Iw": "rotational inertia of body i about the world origin, entry (r, c)",
-    "hw": "first moment of body i about the world origin",
-    "mc": "mass of the subtree of body i (composite body)",
-    "hc": "first moment of the composite body i",
-    "Ic": "rotational inertia of the composite body i about the world origin, entry (r, c)",
-    "F": "momentum of composite body i for a unit rate of joint i: F_i = I^c_i S_i",
-    "M": "entry of the mass matrix",
-    "g": "entry of the gravity vector",
-    "X": "motion cross product S_k × S_j",
-    "G": "momentum of composite body k for a unit rate of joint j: I^c_k S_j",
-    "Y": "force cross product S_k ×* F_j",
-    "dM": "derivative of M_ij with respect to q_k",
-    "Gamma": "Christoffel symbol of the first kind c_ijk",
-    "C": "entry of the Coriolis matrix",
+    "s": r"$\sin q_{i}$",
+    "c": r"$\cos q_{i}$",
+    "A": r"rotation of joint frame $i$ before the joint moves, entry $(r, c)$",
+    "R": r"rotation of body $i$, entry $(r, c)$",
+    "o": r"origin of joint frame $i$",
+    "p": r"origin of body $i$ (moved by its prismatic joint)",
+    "z": r"axis of joint $i$",
+    "v": r"linear part $o_{i} \times z_{i}$ of the motion axis $S_{i}$ of joint $i$",
+    "Rh": r"first moment of body $i$ in world axes",
+    "Iw": r"rotational inertia of body $i$ about the world origin, entry $(r, c)$",
+    "hw": r"first moment of body $i$ about the world origin",
+    "mc": r"mass of the subtree of body $i$ (composite body)",
+    "hc": r"first moment of composite body $i$",
+    "Ic": r"rotational inertia $I^{c}_{i}$ of composite body $i$ about the world origin, "
+          r"entry $(r, c)$",
+    "F": r"momentum $F_{i} = I^{c}_{i} S_{i}$ of composite body $i$ for a unit rate of joint $i$",
+    "M": r"entry $(i, j)$ of the mass matrix, $S_{i}^{T} F_{j}$",
+    "g": r"entry $i$ of the gravity vector",
+    "X": r"motion cross product $S_{k} \times S_{j}$",
+    "G": r"momentum $I^{c}_{k} S_{j}$ of composite body $k$ for a unit rate of joint $j$",
+    "Y": r"force cross product $S_{k} \times^{*} F_{j}$",
+    "dM": r"$\partial M_{i,j} / \partial q_{k}$",
+    "Gamma": r"Christoffel symbol of the first kind $\Gamma_{i,j,k}$",
+    "C": r"entry $(i, j)$ of the Coriolis matrix",
 }
 
 _PROGRAM_GROUPS = (
@@ -92,9 +95,10 @@ class LatexConfig:
         About how many glyphs a display line holds before a sum is broken.
     block_size:
         Equations per ``align*`` environment (each may break across pages).
-    textbook_max_dof, textbook_max_operations:
-        The largest model given the textbook derivation: number of joints, and operations of
-        the straight-line program of M, C and g.
+    textbook_max_dof, textbook_max_operations, textbook_max_size:
+        The largest model given the textbook derivation: number of joints, operations of the
+        straight-line program of M, C and g (checked first, it costs nothing), and operations
+        of the expanded M, C and g of the textbook derivation (checked after computing it).
     max_program_lines:
         At most this many named subexpressions are printed for large models.
     """
@@ -102,10 +106,11 @@ class LatexConfig:
     template: str = "latex/document.tex.jinja"
     suffix: str = ".tex"
     float_digits: int = 6
-    line_width: int = 72
+    line_width: int = 80
     block_size: int = 24
     textbook_max_dof: int = TEXTBOOK_MAX_DOF
-    textbook_max_operations: int = 600
+    textbook_max_operations: int = 2000
+    textbook_max_size: int = 4000
     max_program_lines: int = 2500
 
 
@@ -119,10 +124,9 @@ class Equation:
 
 @dataclass(frozen=True)
 class Block:
-    """Equations typeset together (one ``align*``), after an optional sentence of text."""
+    """Equations typeset together (one ``align*``)."""
 
     equations: list[Equation]
-    text: str = ""
 
 
 @dataclass
@@ -132,7 +136,6 @@ class _Printing:
     printer: DerivationLatexPrinter
     width: int
     block_size: int
-    blocks: list[Block] = field(default_factory=list)
 
     def tex(self, expr) -> str:
         return self.printer.doprint(sp.sympify(expr))
@@ -140,18 +143,25 @@ class _Printing:
     def equation(self, lhs: str, expr) -> Equation:
         return Equation(lhs, self.printer.print_lines(expr, self.width))
 
-    def chunks(self, equations: list[Equation], text: str = "") -> list[Block]:
-        """``equations`` in blocks of at most ``block_size``; ``text`` before the first."""
+    def chunks(self, equations: list[Equation]) -> list[Block]:
+        """``equations`` in blocks of at most ``block_size``."""
         size = self.block_size
-        out = [Block(equations[k:k + size], text if k == 0 else "")
-               for k in range(0, len(equations), size)]
-        return out or ([Block([], text)] if text else [])
+        return [Block(equations[k:k + size]) for k in range(0, len(equations), size)]
 
 
-def is_teaching_sized(job: Job, config: LatexConfig = LatexConfig()) -> bool:
-    """Whether ``job``'s model gets the textbook derivation (else the program is printed)."""
-    return (job.model.dof <= config.textbook_max_dof
-            and job.dynamics.operation_count(["M", "C", "g"]) <= config.textbook_max_operations)
+def expanded_size(book: TextbookDerivation) -> int:
+    """Operations (SymPy ``count_ops``) of the expanded M, C and g of ``book``."""
+    return int(sum(sp.count_ops(e) for matrix in (book.M, book.C, book.g) for e in matrix))
+
+
+def textbook_for(job: Job, config: LatexConfig = LatexConfig()) -> TextbookDerivation | None:
+    """The textbook derivation of ``job``'s model when it is teaching-sized (see
+    :class:`LatexConfig`), else None: the document then prints the straight-line program."""
+    if (job.model.dof > config.textbook_max_dof
+            or job.dynamics.operation_count(["M", "C", "g"]) > config.textbook_max_operations):
+        return None
+    book = textbook_derivation(job.model, max_dof=config.textbook_max_dof)
+    return book if expanded_size(book) <= config.textbook_max_size else None
 
 
 def symbol_names(job: Job) -> dict[sp.Symbol, str]:
@@ -187,6 +197,15 @@ def _vector(p: _Printing, values) -> str:
 
 # -- the description ------------------------------------------------------------------------
 
+def _angle(value: float) -> sp.Expr:
+    """An angle [rad] for display: a multiple of π/12 as such (``\\frac{\\pi}{2}``), else the
+    number."""
+    twelfths = value / math.pi * 12
+    if abs(twelfths - round(twelfths)) < 1e-9:
+        return sp.Rational(round(twelfths), 12) * sp.pi
+    return sp.Float(value, 15)
+
+
 def _rpy(rotation) -> list[sp.Expr] | None:
     """URDF roll, pitch, yaw of a numeric rotation matrix, None when it is symbolic."""
     try:
@@ -196,7 +215,7 @@ def _rpy(rotation) -> list[sp.Expr] | None:
     pitch = math.asin(max(-1.0, min(1.0, -R[2][0])))
     roll = math.atan2(R[2][1], R[2][2])
     yaw = math.atan2(R[1][0], R[0][0])
-    return [sp.Float(a, 15) if abs(a) > 1e-12 else sp.Integer(0) for a in (roll, pitch, yaw)]
+    return [_angle(a) for a in (roll, pitch, yaw)]
 
 
 def _joint_rows(model: RobotModel, p: _Printing) -> list[list[str]]:
@@ -275,13 +294,13 @@ def _parameter_rows(model: RobotModel, p: _Printing) -> list[list[str]]:
 
 def _matrix_equations(p: _Printing, lhs: str, matrix: sp.Matrix) -> list[Equation]:
     """``lhs = (matrix)`` on one line when it fits, else one line per non-zero entry."""
-    widths = [max(len(p.tex(matrix[r, c])) for r in range(matrix.rows))
-              for c in range(matrix.cols)]
     entries = [p.tex(e) for e in matrix]
-    if sum(min(w, p.width) for w in widths) <= p.width:
+    widths = [max(display_width(entries[r * matrix.cols + c]) for r in range(matrix.rows))
+              for c in range(matrix.cols)]
+    if sum(widths) + 2 * matrix.cols <= p.width:
         rows = [" & ".join(entries[r * matrix.cols:(r + 1) * matrix.cols])
                 for r in range(matrix.rows)]
-        return [Equation(lhs, [r"\begin{pmatrix} " + r" \\ ".join(rows) + r" \end{pmatrix}")]]
+        return [Equation(lhs, [r"\begin{pmatrix} " + r" \\ ".join(rows) + r" \end{pmatrix}"])]
     out = []
     for r in range(matrix.rows):
         for c in range(matrix.cols):
@@ -295,8 +314,7 @@ def _textbook_sections(job: Job, book: TextbookDerivation, p: _Printing) -> dict
     bodies = []
     for body in book.bodies:
         k = job.model.joint_names.index(body.joint) + 1
-        kinematics = [p.equation(f"m_{{({k})}}", body.mass)]
-        kinematics += _matrix_equations(p, f"I_{{c{k}}}", body.inertia)
+        kinematics = _matrix_equations(p, f"I_{{c{k}}}", body.inertia)
         kinematics += _matrix_equations(p, f"R_{{{k}}}", body.rotation)
         kinematics += _matrix_equations(p, f"p_{{c{k}}}", body.com)
         kinematics += _matrix_equations(p, f"J_{{v{k}}}", body.J_v)
@@ -306,6 +324,7 @@ def _textbook_sections(job: Job, book: TextbookDerivation, p: _Printing) -> dict
             "index": k,
             "joint": latex_escape(body.joint),
             "links": ", ".join(latex_escape(name) for name in body.links),
+            "mass": p.tex(body.mass),
             "kinematics": p.chunks(kinematics),
             "energies": p.chunks(energies),
         })
@@ -324,7 +343,7 @@ def _textbook_sections(job: Job, book: TextbookDerivation, p: _Printing) -> dict
         terms = [book.M[i, j] * dyn.qdd[j] for j in range(n) if book.M[i, j] != 0]
         terms += [book.C[i, j] * dyn.qd[j] for j in range(n) if book.C[i, j] != 0]
         terms += [book.g[i]] if book.g[i] != 0 else []
-        lines = p.printer.print_sum_lines([sp.Mul(t, evaluate=False) for t in terms], p.width)
+        lines = p.printer.print_sum_lines(terms or [sp.Integer(0)], p.width)
         equations.append(Equation(rf"\tau_{{{i + 1}}}", lines))
     return {
         "bodies": bodies,
@@ -340,7 +359,20 @@ def _textbook_sections(job: Job, book: TextbookDerivation, p: _Printing) -> dict
 # -- the straight-line program --------------------------------------------------------------
 
 def _entry_symbol(name: str, *indices: int) -> sp.Symbol:
+    """The symbol printing as an entry of M, C or g: ``M1_2`` → ``M_{1,2}`` (0-based indices)."""
     return sp.Symbol(name + "_".join(str(i + 1) for i in indices), real=True)
+
+
+def _entries(p: _Printing, name: str, matrix: sp.Matrix, upper: bool = False) -> list[Equation]:
+    """``name_{i,j} = value`` for the non-zero entries, except those already named so."""
+    out = []
+    for i in range(matrix.rows):
+        for j in range(i if upper else 0, matrix.cols):
+            value = matrix[i, j]
+            entry = _entry_symbol(name, i, j) if matrix.cols > 1 else _entry_symbol(name, i)
+            if value != 0 and value != entry:
+                out.append(p.equation(p.tex(entry), value))
+    return out
 
 
 def _program_sections(job: Job, config: LatexConfig, p: _Printing) -> dict:
@@ -365,18 +397,11 @@ def _program_sections(job: Job, config: LatexConfig, p: _Printing) -> dict:
         groups.append({"title": title, "count": len(assignments), "blocks": p.chunks(equations)})
 
     M, C, g = (program.output(name) for name in ("M", "C", "g"))
-    outputs = []
-    if "M" not in omitted:
-        outputs += p.chunks([p.equation(p.tex(_entry_symbol("M", i, j)), M[i, j])
-                             for i in range(n) for j in range(i, n) if M[i, j] != 0],
-                            r"Mass matrix (upper triangle; $M_{j,i} = M_{i,j}$):")
-    if "g" not in omitted:
-        outputs += p.chunks([p.equation(p.tex(_entry_symbol("g", i)), g[i])
-                             for i in range(n) if g[i] != 0], "Gravity vector:")
-    if "C" not in omitted:
-        outputs += p.chunks([p.equation(p.tex(_entry_symbol("C", i, j)), C[i, j])
-                             for i in range(n) for j in range(n) if C[i, j] != 0],
-                            "Coriolis matrix:")
+    outputs = {
+        "M": [] if "M" in omitted else p.chunks(_entries(p, "M", M, upper=True)),
+        "g": [] if "g" in omitted else p.chunks(_entries(p, "g", g)),
+        "C": [] if "C" in omitted else p.chunks(_entries(p, "C", C)),
+    }
     dyn = job.dynamics
     equations = []
     for i in range(n):
@@ -387,7 +412,7 @@ def _program_sections(job: Job, config: LatexConfig, p: _Printing) -> dict:
         equations.append(Equation(rf"\tau_{{{i + 1}}}",
                                   p.printer.print_sum_lines(terms or [sp.Integer(0)], p.width)))
     return {
-        "legend": [(tex, latex_escape(PROGRAM_NAMES[family])) for family, tex in legend.items()],
+        "legend": [(tex, PROGRAM_NAMES[family]) for family, tex in legend.items()],
         "groups": groups,
         "omitted": [{"M": "mass matrix", "g": "gravity vector", "C": "Coriolis matrix"}[o]
                     for o in omitted],
@@ -400,8 +425,8 @@ def _program_sections(job: Job, config: LatexConfig, p: _Printing) -> dict:
 def render_document(job: Job, config: LatexConfig = LatexConfig()) -> str:
     """The text of the ``.tex`` document for ``job`` (see the module docstring)."""
     model = job.model
-    teaching = is_teaching_sized(job, config)
-    p = _printing(job, config, compact_trig=teaching)
+    book = textbook_for(job, config)
+    p = _printing(job, config, compact_trig=book is not None)
     context = {
         "header": [latex_comment(line) for line in job.header_lines(config.template)],
         "robot": latex_escape(model.name),
@@ -409,19 +434,21 @@ def render_document(job: Job, config: LatexConfig = LatexConfig()) -> str:
         "version": latex_escape(__version__),
         "description": latex_escape(str(dict(model.info).get("description", ""))),
         "dof": model.dof,
+        "joint_vector": {0: "()", 1: "q_{1}"}.get(model.dof,
+                                                  rf"(q_{{1}}, \dots, q_{{{model.dof}}})"),
         "gravity": _vector(p, model.gravity),
         "joints": _joint_rows(model, p),
         "dh": _dh_table(model, p),
         "links": _link_rows(model, p),
         "parameters": _parameter_rows(model, p),
         "float_digits": config.float_digits,
-        "teaching": teaching,
+        "teaching": book is not None,
         "max_dof": config.textbook_max_dof,
         "max_operations": config.textbook_max_operations,
+        "max_size": config.textbook_max_size,
         "operations": job.dynamics.operation_count(["M", "C", "g"]),
     }
-    if teaching:
-        book = textbook_derivation(model, max_dof=config.textbook_max_dof)
+    if book is not None:
         context.update(_textbook_sections(job, book, p))
     else:
         context.update(_program_sections(job, config, p))
@@ -429,6 +456,7 @@ def render_document(job: Job, config: LatexConfig = LatexConfig()) -> str:
 
 
 @register("latex", "LaTeX document of the derivation: textbook steps for small models, the "
-                   "program of named subexpressions for large ones (pdflatex)")
+                   "program of named subexpressions for large ones (pdflatex)",
+          needs=("M", "C", "g"))
 def generate_latex(job: Job, config: LatexConfig = LatexConfig()) -> list[GeneratedFile]:
     return [GeneratedFile(job.stem + config.suffix, render_document(job, config))]

@@ -31,7 +31,7 @@ TEXT_ESCAPES = {
     "\\": r"\textbackslash{}",
     "{": r"\{",
     "}": r"\}",
-    "$": r"\$",
+    "$": r"{\char36}",  # not \$: that is the TS1 dollar, a bitmap font without cm-super
     "&": r"\&",
     "#": r"\#",
     "%": r"\%",
@@ -155,7 +155,6 @@ class DerivationLatexPrinter(LatexPrinter):
         would collide with the document's notation); all others go through :func:`symbol_latex`.
     """
 
-    printmethod = "_eomgen_latex"
     _default_settings = {
         **LatexPrinter._default_settings,
         "joint_positions": (),
@@ -218,11 +217,15 @@ class DerivationLatexPrinter(LatexPrinter):
     def _sum_tokens(self, terms: list, width: int) -> list[str]:
         tokens: list[str] = []
         for index, term in enumerate(terms):
-            negative = term.could_extract_minus_sign()
-            part = self._tokens(-term if negative else term, width)
-            if term.is_Add and len(part) == 1:
-                part = [r"\left(" + part[0] + r"\right)"]
-            sign = "- " if negative else ("+ " if index else "")
+            if term.is_Add:  # a sum within the sum: in parentheses, or flattened when broken
+                part = self._tokens(term, width)
+                if len(part) == 1:
+                    part = [r"\left(" + part[0] + r"\right)"]
+                sign = "" if part[0].startswith("- ") or not index else "+ "
+            else:
+                negative = term.could_extract_minus_sign()
+                part = self._tokens(-term if negative else term, width)
+                sign = "- " if negative else ("+ " if index else "")
             tokens += [sign + part[0]] + part[1:]
         return tokens
 

@@ -1,0 +1,492 @@
+"""The textbook Lagrangian derivation, body by body, for teaching-sized models.
+
+For each moving body i (a movable joint's child link with its fixed descendants merged, see
+:mod:`eomgen.bodies`), in the world (root link) frame:
+
+* ``p_ci(q)``: position of the centre of mass [m];
+* ``J_vi = ∂p_ci/∂q`` (3×n) and ``J_ωi`` (3×n): column k is the world axis ``z_k`` of joint k
+  when k is a revolute joint at or before body i, else 0; so ``v_ci = J_vi q̇``, ``ω_i = J_ωi q̇``;
+* ``K_i = ½ m_i v_ciᵀ v_ci + ½ ω_iᵀ R_i I_ci R_iᵀ ω_i`` with ``I_ci`` the rotational inertia about
+  the centre of mass in body axes and ``R_i`` the body's world rotation [J];
+* ``P_i = −m_i g_vecᵀ p_ci`` with ``g_vec`` the gravitational acceleration [J];
+* ``M = Σ_i m_i J_viᵀ J_vi + J_ωiᵀ R_i I_ci R_iᵀ J_ωi`` (n×n), so that ``K = ½ q̇ᵀ M q̇``;
+* the Christoffel symbols of the first kind
+  ``c_ijk = ½ (∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i)``, with ``C_ij = Σ_k c_ijk q̇_k``;
+* ``g_i = ∂P/∂q_i`` with ``P = Σ_i P_i``.
+
+Everything is expanded and written as sums of harmonics of the joint angles
+(:func:`simplify_trig`): the derivation as printed in textbooks. Expanded expressions grow
+exponentially with the number of joints, so this is for models of at most
+:data:`TEXTBOOK_MAX_DOF` joints. :func:`eomgen.derive` computes the same M, C, g without
+expression swell; the tests check that the two agree.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from fractions import Fraction
+
+import sympy as sp
+
+from ..bodies import body_tree
+from ..model import IDENTITY3, RobotModel, Transform, ZERO3, joint_motion
+
+#: Largest number of joints for which the textbook derivation is computed by default.
+TEXTBOOK_MAX_DOF = 3
+
+#: In a sum with floating-point coefficients, terms whose coefficient is smaller than this
+#: fraction of the largest coefficient are rounding noise of the description's numbers (e.g.
+#: ``2e-19*cos(2*q3)`` next to ``2.5``) and are dropped before simplifying.
+FLOAT_NOISE_RTOL = 1e-12
+
+
+def largest_coefficient(exprs) -> float:
+    """The largest magnitude of the numeric coefficients of the terms of ``exprs`` (sums)."""
+    return max((abs(float(term.as_coeff_Mul()[0])) for expr in exprs
+                for term in sp.Add.make_args(sp.sympify(expr))), default=0.0)
+
+
+def drop_float_noise(expr: sp.Expr, rtol: float = FLOAT_NOISE_RTOL,
+                     reference: float = 0.0) -> sp.Expr:
+    """``expr`` (a sum) without the terms whose Float coefficient is below ``rtol`` times the
+    largest numeric coefficient of the sum, or of ``reference`` when that is larger (for a sum
+    that is all noise, e.g. a Christoffel symbol of a matrix whose entries are of order
+    ``reference``). Exact (integer, rational) terms are always kept.
+
+    >>> x, y = sp.symbols("x y")
+    >>> drop_float_noise(2.5*x + 1e-19*y + sp.Rational(1, 3)*y**2)
+    2.5*x + y**2/3
+    """
+    if not expr.is_Add and reference == 0:
+        return expr
+    terms = sp.Add.make_args(expr)
+    coefficients = [term.as_coeff_Mul()[0] for term in terms]
+    largest = max([reference] + [abs(float(c)) for c in coefficients])
+    kept = [term for term, c in zip(terms, coefficients)
+            if not (c.is_Float and abs(float(c)) < rtol * largest)]
+    return sp.Add(*kept) if len(kept) < len(terms) else expr
+
+
+Spectrum = dict  # frequency vector (tuple of ints) → complex rational (re, im) of e^{i k·q}
+
+
+def _integer_combination(arg: sp.Expr, index: dict) -> tuple[int, ...] | None:
+    """``k`` when ``arg`` is ``Σ k_j q_j`` with integer ``k_j`` over the given angles."""
+    k = [0] * len(index)
+    for term in sp.Add.make_args(arg):
+        factor, angle = term.as_coeff_Mul()
+        if angle not in index or not factor.is_Integer:
+            return None
+        k[index[angle]] += int(factor)
+    return tuple(k)
+
+
+def _multiply(a: Spectrum, b: Spectrum) -> Spectrum:
+    out: Spectrum = {}
+    for ka, (ra, ia) in a.items():
+        for kb, (rb, ib) in b.items():
+            k = tuple(x + y for x, y in zip(ka, kb))
+            r, i = out.get(k, (Fraction(0), Fraction(0)))
+            out[k] = (r + ra * rb - ia * ib, i + ra * ib + ia * rb)
+    return {k: v for k, v in out.items() if v != (0, 0)}
+
+
+@functools.lru_cache(maxsize=4096)
+def _product_spectrum(trig: tuple, n: int) -> Spectrum:
+    """The spectrum of a product of ``(sin|cos, k)`` factors (sorted), built on the spectrum of
+    the product without its last factor (cached, so shared prefixes are computed once)."""
+    if not trig:
+        return {(0,) * n: (Fraction(1), Fraction(0))}
+    name, k = trig[-1]
+    return _multiply(_product_spectrum(trig[:-1], n), _spectrum(getattr(sp, name), k))
+
+
+def _spectrum(function, k: tuple[int, ...]) -> Spectrum:
+    """``cos(k·q) = (e^{ik·q} + e^{-ik·q})/2``, ``sin(k·q) = (e^{ik·q} − e^{-ik·q})/(2i)``."""
+    minus = tuple(-x for x in k)  # k ≠ 0: SymPy evaluates sin(0) and cos(0)
+    half = Fraction(1, 2)
+    if function is sp.cos:
+        return {k: (half, Fraction(0)), minus: (half, Fraction(0))}
+    return {k: (Fraction(0), -half), minus: (Fraction(0), half)}
+
+
+def fourier_form(expr: sp.Expr, angles) -> sp.Expr:
+    """``expr`` (a polynomial in sines and cosines of integer combinations of ``angles``) as the
+    sum of harmonics ``A_0 + Σ_k A_k cos(k·q) + B_k sin(k·q)``, fully expanded.
+
+    Products become sums of angles (``c1 c2 − s1 s2`` → ``cos(q1 + q2)``, ``s2²`` →
+    ``1/2 − cos(2 q2)/2``); the form is unique, so whatever cancels does cancel. The expansion
+    runs in SymPy's sparse polynomial rings (``sring``), with every other factor (parameters,
+    ``sin`` of anything else, ``1/m``) a further generator: exact, and fast where SymPy's
+    ``trigsimp`` takes minutes (a 2-joint arm with general axes).
+
+    >>> q1, q2 = sp.symbols("q1 q2")
+    >>> fourier_form(sp.cos(q1)*sp.cos(q2) - sp.sin(q1)*sp.sin(q2) + 2*sp.sin(q2)**2, (q1, q2))
+    -cos(2*q2) + cos(q1 + q2) + 1
+    """
+    expr = sp.sympify(expr)
+    if not expr.has(sp.sin, sp.cos):
+        return sp.expand(expr)
+    _, poly = sp.sring(expr)
+    return harmonics(poly, angles)
+
+
+def harmonics(poly, angles) -> sp.Expr:
+    """The element ``poly`` of a SymPy polynomial ring (generators: sines and cosines of integer
+    combinations of ``angles``, and anything else) in the form of :func:`fourier_form`."""
+    ring = poly.ring
+    domain = ring.domain if ring.domain.is_Field else ring.domain.get_field()
+    index = {angle: j for j, angle in enumerate(angles)}
+    zero = (0,) * len(index)
+    waves: list[tuple[str, tuple[int, ...]] | None] = []  # per generator: (sin|cos, k) or None
+    for generator in ring.symbols:
+        k = (_integer_combination(generator.args[0], index)
+             if generator.func in (sp.sin, sp.cos) else None)
+        waves.append(None if k is None else (generator.func.__name__, k))
+    scales: dict[Fraction, object] = {}
+    found: dict[tuple[str, tuple[int, ...]], dict[tuple[int, ...], object]] = {}
+    for monomial, coefficient in poly.terms():
+        coefficient = domain.convert_from(coefficient, ring.domain)
+        trig = tuple(wave for wave, e in zip(waves, monomial) if wave is not None for _ in range(e))
+        rest = tuple(0 if wave is not None else e for wave, e in zip(waves, monomial))
+        for k, (re, im) in _product_spectrum(trig, len(zero)).items():
+            if k != zero and next(x for x in k if x != 0) < 0:
+                continue  # paired with -k: c e^{ikq} + conj(c) e^{-ikq} = 2 Re c cos − 2 Im c sin
+            scale = 1 if k == zero else 2
+            for name, value in (("cos", scale * re), ("sin", -scale * im)):
+                if value:
+                    if value not in scales:
+                        scales[value] = domain.from_sympy(
+                            sp.Rational(value.numerator, value.denominator))
+                    terms = found.setdefault((name, k), {})
+                    terms[rest] = terms.get(rest, domain.zero) + scales[value] * coefficient
+    out = []
+    powers: dict[tuple[int, ...], list[sp.Expr]] = {}
+    for (name, k), terms in found.items():
+        wave = sp.Integer(1) if k == zero else getattr(sp, name)(
+            sp.Add(*[x * angle for x, angle in zip(k, angles)]))
+        for rest, value in terms.items():
+            if value:
+                if rest not in powers:
+                    powers[rest] = [g ** e for g, e in zip(ring.symbols, rest) if e]
+                out.append(sp.Mul(domain.to_sympy(value), wave, *powers[rest]))
+    return sp.Add(*out)
+
+
+def simplify_trig(expr: sp.Expr, angles, reference: float = 0.0) -> sp.Expr:
+    """The form eomgen prints for small models: :func:`fourier_form` in the joint ``angles``,
+    float rounding noise dropped (:func:`drop_float_noise` with ``reference``), common factors
+    pulled out:
+    ``l1*cos(q1) + lc2*cos(q1 + q2)`` rather than products of sines and cosines.
+
+    >>> q1, q2, l1, lc2 = sp.symbols("q1 q2 l1 lc2")
+    >>> simplify_trig(l1*sp.cos(q1) + lc2*(sp.cos(q1)*sp.cos(q2) - sp.sin(q1)*sp.sin(q2)), (q1, q2))
+    l1*cos(q1) + lc2*cos(q1 + q2)
+    """
+    return sp.factor_terms(drop_float_noise(fourier_form(expr, angles), reference=reference))
+
+
+@dataclass(frozen=True)
+class BodyTerms:
+    """The textbook quantities of one moving body (n = number of joints).
+
+    Attributes
+    ----------
+    joint:
+        Name of the body's movable joint.
+    links:
+        Links merged into the body, the joint's child first.
+    mass:
+        m_i [kg].
+    com:
+        p_ci, the centre of mass in the world frame (3×1) [m].
+    rotation:
+        R_i, the world rotation of the body frame (3×3).
+    inertia:
+        I_ci, rotational inertia about the centre of mass in body axes (3×3) [kg m²].
+    J_v, J_w:
+        Linear and angular velocity Jacobians of the centre of mass (3×n).
+    M:
+        The body's share of the mass matrix, ``m J_vᵀ J_v + J_ωᵀ R I_c Rᵀ J_ω`` (n×n).
+    K:
+        Kinetic energy ``K_i = ½ m v_cᵀ v_c + ½ ωᵀ R I_c Rᵀ ω = ½ q̇ᵀ M_i q̇`` [J], as a sum over
+        the products ``q̇_j q̇_k`` (j ≤ k) with simplified coefficients.
+    P:
+        Potential energy P_i(q) [J].
+    """
+
+    joint: str
+    links: tuple[str, ...]
+    mass: sp.Expr
+    com: sp.Matrix
+    rotation: sp.Matrix
+    inertia: sp.Matrix
+    J_v: sp.Matrix
+    J_w: sp.Matrix
+    M: sp.Matrix
+    K: sp.Expr
+    P: sp.Expr
+
+
+@dataclass(frozen=True)
+class TextbookDerivation:
+    """The body-by-body Lagrangian derivation of a small model (see the module docstring).
+
+    Attributes
+    ----------
+    q, qd:
+        Joint position and velocity symbols (``q1…qn``, ``qd1…qdn``), in joint order.
+    gravity:
+        g_vec, the gravitational acceleration in the world frame [m/s²].
+    bodies:
+        One :class:`BodyTerms` per moving body, a parent before its children.
+    K, P:
+        Total kinetic and potential energy, ``Σ K_i = ½ q̇ᵀ M q̇`` (as a sum over ``q̇_j q̇_k``)
+        and ``Σ P_i``, simplified [J].
+    M:
+        The mass matrix ``Σ_i m_i J_viᵀ J_vi + J_ωiᵀ R_i I_ci R_iᵀ J_ωi`` (n×n), simplified.
+    christoffel:
+        The non-zero Christoffel symbols ``((i, j, k), c_ijk)`` of M with ``j ≤ k``, 0-based (see
+        :func:`christoffel_symbols`; written Γ_ijk in the LaTeX document).
+    C:
+        The Coriolis matrix ``C_ij = Σ_k c_ijk q̇_k`` (n×n), simplified.
+    g:
+        The gravity vector ``g_i = ∂P/∂q_i`` (n×1), simplified.
+    """
+
+    q: tuple[sp.Symbol, ...]
+    qd: tuple[sp.Symbol, ...]
+    gravity: tuple[sp.Expr, sp.Expr, sp.Expr]
+    bodies: tuple[BodyTerms, ...]
+    K: sp.Expr
+    P: sp.Expr
+    M: sp.Matrix
+    christoffel: tuple[tuple[tuple[int, int, int], sp.Expr], ...]
+    C: sp.Matrix
+    g: sp.Matrix
+
+
+def textbook_derivation(model: RobotModel, max_dof: int = TEXTBOOK_MAX_DOF) -> TextbookDerivation:
+    """The textbook quantities of every moving body of ``model`` (see the module docstring).
+
+    Parameters
+    ----------
+    model:
+        A robot model; joint symbols are those of :func:`eomgen.derive` (``q1…qn``, ``qd1…qdn``).
+    max_dof:
+        Refuse larger models: expanded expressions grow exponentially with the number of joints.
+
+    Raises
+    ------
+    ValueError
+        When the model has more than ``max_dof`` movable joints.
+
+    Examples
+    --------
+    >>> import eomgen
+    >>> arm = eomgen.load(eomgen.example_path("planar_2link"))
+    >>> book = textbook_derivation(arm)
+    >>> book.bodies[1].com.T
+    Matrix([[l1*cos(q1) + lc2*cos(q1 + q2), l1*sin(q1) + lc2*sin(q1 + q2), 0]])
+    >>> book.bodies[0].P
+    g*lc1*m1*sin(q1)
+    """
+    from ..dynamics import joint_symbols  # the one place joint symbols are made
+
+    n = model.dof
+    if n > max_dof:
+        raise ValueError(f"the textbook derivation is for models of at most {max_dof} joints "
+                         f"({model.name!r} has {n})")
+    q, qd, _ = joint_symbols(n)
+    tree = body_tree(model)
+
+    # The inputs, as SymPy expressions: world pose of every body, centre of mass and inertia.
+    poses: list[Transform] = []
+    inputs = []
+    for body in tree.bodies:
+        parent = poses[body.parent] if body.parent >= 0 else Transform(IDENTITY3, ZERO3)
+        poses.append(parent @ body.placement @ joint_motion(body.joint, q[body.q_index]))
+        par = body.inertial
+        m = par.mass
+        if m == 0:
+            c, I_c = sp.zeros(3, 1), sp.Matrix(par.inertia)
+        else:
+            c = sp.Matrix(par.first_moment).applyfunc(lambda h: sp.cancel(h / m))
+            I_c = sp.Matrix(par.inertia) - m * ((c.T * c)[0, 0] * sp.eye(3) - c * c.T)
+        inputs.append((m, c, I_c))
+    scalars = [x for pose in poses for row in pose.rotation for x in row]
+    scalars += [x for pose in poses for x in pose.translation]
+    scalars += [x for m, c, I_c in inputs for x in [m, *c, *I_c]]
+    scalars += [x for body in tree.bodies for x in body.joint.axis] + list(model.gravity)
+    A = _TrigAlgebra(scalars, q, qd)
+
+    # The textbook quantities, computed in the polynomial ring.
+    gravity = [A(x) for x in model.gravity]
+    axes = []   # world axis of each body's joint (zero for prismatic)
+    bodies = []
+    shares = []
+    potentials = []
+    for i, (body, pose, (m, c, I_c)) in enumerate(zip(tree.bodies, poses, inputs)):
+        R = [[A(x) for x in row] for row in pose.rotation]
+        axis = [A(x) for x in body.joint.axis]
+        zero = A.ring.zero
+        axes.append([sum((R[r][k] * axis[k] for k in range(3)), zero) for r in range(3)]
+                    if body.joint.type.is_revolute else [zero] * 3)
+        mass = A(m)
+        com = [A(c[r]) for r in range(3)]
+        p_c = [A(pose.translation[r]) + sum((R[r][k] * com[k] for k in range(3)), zero)
+               for r in range(3)]
+        J_v = [[A.derivative(p_c[r], k) for k in range(n)] for r in range(3)]
+        J_w = [[zero] * n for _ in range(3)]
+        for a in [i] + tree.ancestors(i):
+            for r in range(3):
+                J_w[r][tree.bodies[a].q_index] = axes[a][r]
+        inertia = [[A(I_c[r, k]) for k in range(3)] for r in range(3)]
+        I_w = [[A.reduce(x) for x in row] for row in _matmul(_matmul(R, inertia), _transpose(R))]
+        share = [[A.reduce(x) for x in row] for row in
+                 _add(_scale(mass, _matmul(_transpose(J_v), J_v)),
+                      _matmul(_transpose(J_w), _matmul(I_w, J_w)))]
+        P = -mass * sum((gravity[r] * p_c[r] for r in range(3)), zero)
+        shares.append(share)
+        potentials.append(P)
+        M_i = A.matrix(share)
+        bodies.append(BodyTerms(
+            body.joint.name, body.links, A.expr(mass), A.matrix([[x] for x in p_c]),
+            A.matrix(R, reference=1.0), A.matrix(inertia), A.matrix(J_v),
+            A.matrix(J_w, reference=1.0), M_i, quadratic_form(M_i, qd), A.expr(P)))
+
+    M = [[A.ring.zero] * n for _ in range(n)]
+    for share in shares:
+        M = _add(M, share)
+    P = sum(potentials, A.ring.zero)
+    half = A.ring.domain.convert(sp.Rational(1, 2))
+    dM = [[[A.reduce(A.derivative(M[i][j], k)) for j in range(n)] for i in range(n)]
+          for k in range(n)]
+    christoffel_ring = {(i, j, k): (dM[k][i][j] + dM[j][i][k] - dM[i][j][k]) * half
+                        for i in range(n) for j in range(n) for k in range(j, n)}
+    C = [[sum((christoffel_ring[i, min(j, k), max(j, k)] * A.qd[k] for k in range(n)),
+              A.ring.zero) for j in range(n)] for i in range(n)]
+    g = [[A.derivative(P, i)] for i in range(n)]
+    M_expr = A.matrix(M)
+    scale = A.largest(M)  # Christoffel symbols and C: noise is noise next to M
+    christoffel = tuple((key, value) for key, value in
+                        ((key, A.expr(v, scale)) for key, v in christoffel_ring.items())
+                        if value != 0)
+    return TextbookDerivation(
+        q, qd, tuple(model.gravity), tuple(bodies), quadratic_form(M_expr, qd), A.expr(P),
+        M_expr, christoffel, A.matrix(C, reference=scale),
+        A.matrix(g, reference=A.largest([[P]])))
+
+
+class _TrigAlgebra:
+    """Polynomials in the sines and cosines of the joint positions (and in the joint positions,
+    velocities and everything else of the model as further generators), in one SymPy sparse
+    polynomial ring over a field: products and derivatives without SymPy's ``expand``.
+
+    ``scalars`` are all the model's expressions the derivation starts from; :meth:`__call__`
+    returns the ring element of one of them.
+    """
+
+    def __init__(self, scalars, q, qd):
+        trig = [f(x) for x in q for f in (sp.sin, sp.cos)]
+        everything = [sp.sympify(x) for x in scalars] + trig + list(q) + list(qd)
+        ring, elements = sp.sring(everything)
+        if not ring.domain.is_Field:
+            field = ring.clone(domain=ring.domain.get_field())
+            elements = [e.set_ring(field) for e in elements]
+            ring = field
+        self.ring = ring
+        self.q = q
+        self._element = dict(zip(everything, elements))
+        n = len(q)
+        at = len(scalars)
+        self.s = elements[at:at + 2 * n:2]
+        self.c = elements[at + 1:at + 2 * n:2]
+        self.q_gen = elements[at + 2 * n:at + 3 * n]
+        self.qd = elements[at + 3 * n:]
+        self._pythagoras = [s * s + c * c - 1 for s, c in zip(self.s, self.c)]
+
+    def reduce(self, f):
+        """``f`` modulo ``sin² q_k + cos² q_k = 1``: a canonical form of degree at most one in
+        one of the two, which keeps products small."""
+        return f.rem(self._pythagoras) if self._pythagoras else f
+
+    def __call__(self, expr):
+        return self._element[sp.sympify(expr)]
+
+    def derivative(self, f, k: int):
+        """``∂f/∂q_k``, with ``∂s_k/∂q_k = c_k`` and ``∂c_k/∂q_k = −s_k``."""
+        s, c, x = self.s[k], self.c[k], self.q_gen[k]
+        return f.diff(x) + c * f.diff(s) - s * f.diff(c)
+
+    def largest(self, matrix) -> float:
+        """The largest magnitude of a numeric coefficient among the entries of ``matrix``
+        (0 over exact domains, where there is no rounding noise)."""
+        if not self.ring.domain.is_RR:
+            return 0.0
+        return max((abs(float(v)) for row in matrix for f in row for v in f.coeffs()),
+                   default=0.0)
+
+    def expr(self, f, reference: float = 0.0) -> sp.Expr:
+        """``f`` as a SymPy expression in the form of :func:`simplify_trig`."""
+        return sp.factor_terms(drop_float_noise(harmonics(self.reduce(f), self.q),
+                                                reference=reference))
+
+    def matrix(self, rows, reference: float | None = None) -> sp.Matrix:
+        """A SymPy matrix of ring elements; float noise is judged against the largest
+        coefficient of the whole matrix unless ``reference`` is given."""
+        reference = self.largest(rows) if reference is None else reference
+        return sp.Matrix([[self.expr(f, reference) for f in row] for row in rows])
+
+
+def _transpose(A):
+    return [list(column) for column in zip(*A)]
+
+
+def _matmul(A, B):
+    zero = A[0][0].ring.zero
+    return [[sum((A[i][k] * B[k][j] for k in range(len(B)) if A[i][k] and B[k][j]), zero)
+             for j in range(len(B[0]))] for i in range(len(A))]
+
+
+def _add(A, B):
+    return [[a + b for a, b in zip(ra, rb)] for ra, rb in zip(A, B)]
+
+
+def _scale(x, A):
+    return [[x * a for a in row] for row in A]
+
+
+def quadratic_form(A: sp.Matrix, x) -> sp.Expr:
+    """``½ xᵀ A x`` for a symmetric ``A``, as ``Σ_j ½ A_jj x_j² + Σ_{j<k} A_jk x_j x_k`` with the
+    coefficients kept as they are (not expanded into the products)."""
+    n = len(x)
+    terms = [A[j, j] * x[j] ** 2 / 2 for j in range(n)]
+    terms += [A[j, k] * x[j] * x[k] for j in range(n) for k in range(j + 1, n)]
+    return sp.Add(*terms)
+
+
+def christoffel_symbols(M: sp.Matrix, q) -> tuple[tuple[tuple[int, int, int], sp.Expr], ...]:
+    """The non-zero Christoffel symbols of the first kind of the mass matrix ``M(q)``.
+
+    ``c_ijk = ½ (∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i)`` (0-based ``i, j, k``), simplified; since
+    ``c_ijk = c_ikj`` only ``j ≤ k`` is returned, in the order ``i, j, k``.
+
+    Examples
+    --------
+    >>> q1, q2 = sp.symbols("q1 q2")
+    >>> christoffel_symbols(sp.Matrix([[3 + 2 * sp.cos(q2), 1], [1, 1]]), (q1, q2))
+    (((0, 0, 1), -sin(q2)), ((1, 0, 0), sin(q2)))
+    """
+    n = len(q)
+    dM = [M.diff(qk) for qk in q]
+    scale = largest_coefficient(sp.expand(e) for e in M)  # what is noise next to M
+    out = []
+    for i in range(n):
+        for j in range(n):
+            for k in range(j, n):
+                value = simplify_trig((dM[k][i, j] + dM[j][i, k] - dM[i][j, k]) / 2, q, scale)
+                if value != 0:
+                    out.append(((i, j, k), value))
+    return tuple(out)
