@@ -18,6 +18,7 @@ from typing import Iterable
 import sympy as sp
 
 from .bodies import body_tree
+from .errors import TooLargeError
 from .model import Parameter, RobotModel
 from .symbolic.composite import derive_program
 from .symbolic.newton_euler import inverse_dynamics_program
@@ -27,6 +28,10 @@ from .symbolic.program import Program, ProgramBuilder
 #: inverse dynamics τ(q, q̇, q̈) (by a symbolic Newton–Euler pass; cheaper to evaluate).
 ALL_OUTPUTS = ("M", "C", "g", "tau")
 DEFAULT_OUTPUTS = ("M", "C", "g")
+#: ``derive(model, simplify=True)`` refuses models with more movable joints: trigonometric
+#: simplification of the expanded expressions grows exponentially with the number of joints
+#: (hours beyond this size), while the unsimplified program stays linear.
+MAX_SIMPLIFY_JOINTS = 6
 
 
 def joint_symbols(n: int) -> tuple[tuple[sp.Symbol, ...], tuple[sp.Symbol, ...], tuple[sp.Symbol, ...]]:
@@ -159,11 +164,17 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     simplify:
         Trig-simplify the expanded expressions (``dynamics.M`` etc.). ``None`` (default) does it
         for teaching-sized models (at most 3 joints) only: it is exponential in the model size.
+        ``True`` is refused above :data:`MAX_SIMPLIFY_JOINTS` joints.
 
     Returns
     -------
     Dynamics
         With ``M``, ``C``, ``g`` as SymPy matrices in ``q``, ``qd`` and the parameters.
+
+    Raises
+    ------
+    TooLargeError
+        For ``simplify=True`` on a model with more than :data:`MAX_SIMPLIFY_JOINTS` joints.
 
     Examples
     --------
@@ -177,6 +188,11 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     unknown = outputs - set(ALL_OUTPUTS)
     if unknown:
         raise ValueError(f"unknown outputs {sorted(unknown)}; choose from {ALL_OUTPUTS}")
+    if simplify and model.dof > MAX_SIMPLIFY_JOINTS:
+        raise TooLargeError(
+            model.source, "derive(simplify=True)",
+            f"{model.dof} joints: simplify is limited to {MAX_SIMPLIFY_JOINTS} joints; use "
+            "simplify=False (the default for large models)")
     timings = []
     start = time.perf_counter()
     tree = body_tree(model)

@@ -2,7 +2,8 @@
 
 User text is never passed to ``eval`` or ``sympify``. This module accepts exactly: decimal
 numbers, parameter names (identifiers), the constant ``pi``, the operators ``+ - * / **`` with
-parentheses, and the functions ``sin cos tan sqrt``. Anything else is refused with a
+parentheses, and the functions ``sin cos tan sqrt``; numbers must be finite and of magnitude
+at most :data:`MAX_MAGNITUDE`. Anything else is refused with a
 :class:`ValueError` whose message says what was not understood; parsers turn it into a
 :class:`~eomgen.errors.DescriptionError` naming file and element.
 """
@@ -20,6 +21,9 @@ from .model import parameter_symbol, scalar
 
 MAX_LENGTH = 200
 MAX_EXPONENT = 16
+#: Numbers of larger magnitude are refused: no robot needs them, and products of a few of them
+#: overflow double precision in the generated code (1e100³ = 1e300 < 1.8e308).
+MAX_MAGNITUDE = 1e100
 
 _FUNCTIONS = {"sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "sqrt": sp.sqrt}
 _CONSTANTS = {"pi": sp.pi}
@@ -36,6 +40,8 @@ def check_parameter_name(name: str) -> str:
         )
     if keyword.iskeyword(name) or name in _FUNCTIONS or name in _CONSTANTS:
         raise ValueError(f"parameter name {name!r} is a reserved word")
+    if _is_number_text(name):  # nan, inf, infinity: a value of that name would read as a number
+        raise ValueError(f"parameter name {name!r} reads as a number")
     if RESERVED.match(name):
         raise ValueError(f"parameter name {name!r} is reserved for joint variables")
     if len(name) > 64:
@@ -54,8 +60,9 @@ def parse_scalar(text) -> sp.Expr:
     if isinstance(text, bool):
         raise ValueError(f"{text!r} is not a number")
     if isinstance(text, (int, float)):
-        if not math.isfinite(float(text)):
+        if isinstance(text, float) and not math.isfinite(text):
             raise ValueError(f"{text!r} is not a finite number")
+        _check_magnitude(text, _shorten(repr(text)))
         return scalar(text)
     if not isinstance(text, str):
         raise ValueError(f"expected a number or expression, got {type(text).__name__}")
@@ -70,7 +77,31 @@ def parse_scalar(text) -> sp.Expr:
         raise ValueError(f"cannot parse {text!r} as a number or expression") from exc
     if value.has(sp.I, sp.zoo, sp.oo, sp.nan):  # sqrt(-1), 0**-1, ...
         raise ValueError(f"{text!r} is not a finite real number")
+    for number in value.atoms(sp.Number) | ({value} if value.is_number else set()):
+        _check_magnitude(number, repr(text))
     return value
+
+
+def _check_magnitude(value, shown: str) -> None:
+    """Refuse a number (int, float or SymPy number) of magnitude above :data:`MAX_MAGNITUDE`."""
+    try:
+        magnitude = abs(float(value))
+    except OverflowError:  # an integer beyond the float range
+        magnitude = math.inf
+    if not magnitude <= MAX_MAGNITUDE:
+        raise ValueError(f"{shown} is out of range (magnitude above {MAX_MAGNITUDE:g})")
+
+
+def _shorten(text: str, length: int = 24) -> str:
+    return text if len(text) <= length else text[:length] + "..."
+
+
+def _is_number_text(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def _is_float(text: str) -> bool:
@@ -80,6 +111,7 @@ def _is_float(text: str) -> bool:
         return False
     if not math.isfinite(value):
         raise ValueError(f"{text!r} is not a finite number")
+    _check_magnitude(value, repr(text))
     return True
 
 
@@ -95,8 +127,9 @@ def _convert(node: ast.AST) -> sp.Expr:
     if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)) and not isinstance(
         node.value, bool
     ):
-        if not math.isfinite(float(node.value)):
+        if isinstance(node.value, float) and not math.isfinite(node.value):
             raise ValueError("number is not finite")
+        _check_magnitude(node.value, _shorten(ast.unparse(node)))
         return scalar(node.value)
     if isinstance(node, ast.Name):
         if node.id in _CONSTANTS:

@@ -28,7 +28,15 @@ from typing import Iterable, Mapping
 
 import sympy as sp
 
-from .errors import DescriptionError, warn_physical
+from .errors import (
+    InvalidAxisError,
+    InvalidInertiaError,
+    InvalidNumberError,
+    KinematicTreeError,
+    ParameterError,
+    TooLargeError,
+    warn_physical,
+)
 
 Scalar = sp.Expr
 Vec3 = tuple[sp.Expr, sp.Expr, sp.Expr]
@@ -38,6 +46,10 @@ Mat3 = tuple[Vec3, Vec3, Vec3]
 #: so that ``rpy="1.57079632679 0 0"`` keeps its structural zeros. The change to the model is
 #: below the precision such descriptions are written with.
 SNAP_TOLERANCE = 1e-11
+
+#: At most this many joints (and one more link) in a model: beyond, a symbolic derivation is
+#: out of reach anyway, and the checks stay linear in practice.
+MAX_JOINTS = 500
 
 
 def parameter_symbol(name: str) -> sp.Symbol:
@@ -150,7 +162,8 @@ class Transform:
 
 
 class JointType(enum.Enum):
-    """Joint types eomgen models. Mimic and floating joints are refused by the parsers."""
+    """Joint types eomgen models. Floating and planar joints are refused by the parsers; a URDF
+    ``<mimic>`` joint is read as an independent joint (see :mod:`eomgen.parsers.urdf`)."""
 
     REVOLUTE = "revolute"
     CONTINUOUS = "continuous"
@@ -330,14 +343,14 @@ class RobotModel:
 
         Raises
         ------
-        DescriptionError
+        ParameterError
             When a parameter has neither a default nor a given value.
         """
         merged = dict(self.parameter_values)
         merged.update(values or {})
         missing = sorted(s.name for s in self.free_symbols if s not in merged)
         if missing:
-            raise DescriptionError(self.source, "parameters",
+            raise ParameterError(self.source, "parameters",
                                    "no numeric value for " + ", ".join(missing))
         return self.substitute(merged)
 
@@ -371,20 +384,27 @@ def _number(x: sp.Expr) -> float | None:
     return None
 
 
-def check_inertial(source: str, link: str, inertial: Inertial, strict: bool = False) -> None:
+def check_inertial(source: str, link: str, inertial: Inertial, strict: bool = False,
+                   at_defaults: bool = False) -> None:
     """Check a link's inertial data: finite non-negative mass, finite symmetric PSD inertia,
-    and (warning, or error under ``strict``) the triangle inequality of principal moments."""
-    where = f"link '{link}' inertial"
+    and (warning, or error under ``strict``) the triangle inequality of principal moments.
+
+    ``at_defaults``: ``inertial`` is a symbolic one with the parameters' default values put in;
+    the messages say so, and the triangle inequality is not checked (planar models describe
+    thin rods, with a moment of inertia about one axis only, on purpose).
+    """
+    where = f"link '{link}' inertial" + (" at the parameters' default values" if at_defaults
+                                         else "")
     m = _number(inertial.mass)
     if m is not None:
         if not math.isfinite(m):
-            raise DescriptionError(source, where, f"mass is {m}, not a finite number")
+            raise InvalidInertiaError(source, where, f"mass is {m}, not a finite number")
         if m < 0:
-            raise DescriptionError(source, where, f"mass {m} is negative")
+            raise InvalidInertiaError(source, where, f"mass {m} is negative")
     for v in inertial.com:
         c = _number(v)
         if c is not None and not math.isfinite(c):
-            raise DescriptionError(source, where, "centre of mass is not finite")
+            raise InvalidInertiaError(source, where, "centre of mass is not finite")
     values = [[_number(v) for v in row] for row in inertial.inertia]
     if any(v is None for row in values for v in row):
         return  # symbolic inertia: checked at the numeric values by verification
@@ -392,54 +412,56 @@ def check_inertial(source: str, link: str, inertial: Inertial, strict: bool = Fa
 
     I = np.array(values, dtype=float)
     if not np.all(np.isfinite(I)):
-        raise DescriptionError(source, where, "inertia has a non-finite entry")
+        raise InvalidInertiaError(source, where, "inertia has a non-finite entry")
     if not np.allclose(I, I.T, rtol=0, atol=1e-12 * max(1.0, np.abs(I).max())):
-        raise DescriptionError(source, where, "inertia is not symmetric")
+        raise InvalidInertiaError(source, where, "inertia is not symmetric")
     eig = np.linalg.eigvalsh(I)
     scale = max(1.0, float(np.abs(eig).max()))
     if eig.min() < -1e-12 * scale:
-        raise DescriptionError(
+        raise InvalidInertiaError(
             source, where, f"inertia has a negative eigenvalue ({eig.min():.6g})"
         )
     a, b, c = sorted(eig)
-    if a + b < c - 1e-9 * scale:
+    if a + b < c - 1e-9 * scale and not at_defaults:
         warn_physical(
             source,
             where,
             f"principal moments {a:.6g}, {b:.6g}, {c:.6g} break the triangle inequality "
             "(not a physical rigid body)",
             strict,
+            InvalidInertiaError,
         )
 
 
 def check_tree(source: str, links: Iterable[str], joints: Iterable[Joint]) -> str:
     """Check that links and joints form one tree; return the root link's name.
 
-    Errors: duplicate link or joint names, a joint naming an unknown link, a link with two
-    parents, a cycle, more than one root (disconnected links).
+    Raises :class:`~eomgen.errors.KinematicTreeError` for duplicate link or joint names, a
+    joint naming an unknown link, a link with two parents, a cycle, more than one root
+    (disconnected links).
     """
     links = list(links)
     joints = list(joints)
     seen: set[str] = set()
     for name in links:
         if name in seen:
-            raise DescriptionError(source, f"link '{name}'", "duplicate link name")
+            raise KinematicTreeError(source, f"link '{name}'", "duplicate link name")
         seen.add(name)
     joint_names: set[str] = set()
     parent_of: dict[str, str] = {}
     for j in joints:
         if j.name in joint_names:
-            raise DescriptionError(source, f"joint '{j.name}'", "duplicate joint name")
+            raise KinematicTreeError(source, f"joint '{j.name}'", "duplicate joint name")
         joint_names.add(j.name)
         for role, link in (("parent", j.parent), ("child", j.child)):
             if link not in seen:
-                raise DescriptionError(source, f"joint '{j.name}'",
+                raise KinematicTreeError(source, f"joint '{j.name}'",
                                        f"{role} link '{link}' is not defined")
         if j.child in parent_of:
-            raise DescriptionError(source, f"joint '{j.name}'",
+            raise KinematicTreeError(source, f"joint '{j.name}'",
                                    f"link '{j.child}' already has a parent joint")
         if j.parent == j.child:
-            raise DescriptionError(source, f"joint '{j.name}'", "joint connects a link to itself")
+            raise KinematicTreeError(source, f"joint '{j.name}'", "joint connects a link to itself")
         parent_of[j.child] = j.parent
     for name in links:  # cycle detection by walking up
         visited = {name}
@@ -447,13 +469,13 @@ def check_tree(source: str, links: Iterable[str], joints: Iterable[Joint]) -> st
         while node in parent_of:
             node = parent_of[node]
             if node in visited:
-                raise DescriptionError(source, f"link '{name}'", "kinematic loop (cycle)")
+                raise KinematicTreeError(source, f"link '{name}'", "kinematic loop (cycle)")
             visited.add(node)
     roots = [name for name in links if name not in parent_of]
     if not roots:
-        raise DescriptionError(source, "robot", "no root link")
+        raise KinematicTreeError(source, "robot", "no root link")
     if len(roots) > 1:
-        raise DescriptionError(
+        raise KinematicTreeError(
             source, f"link '{roots[1]}'",
             f"not connected to the tree rooted at '{roots[0]}' (no parent joint)")
     return roots[0]
@@ -465,13 +487,35 @@ def check_axis(source: str, joint: str, axis: Vec3) -> Vec3:
     if any(v is None for v in values):
         return axis  # symbolic axis: the user's responsibility to keep it unit
     if not all(math.isfinite(v) for v in values):
-        raise DescriptionError(source, f"joint '{joint}' axis", "axis is not finite")
+        raise InvalidAxisError(source, f"joint '{joint}' axis", "axis is not finite")
     norm = math.sqrt(sum(v * v for v in values))
     if norm < 1e-12:
-        raise DescriptionError(source, f"joint '{joint}' axis", "axis is zero")
+        raise InvalidAxisError(source, f"joint '{joint}' axis", "axis is zero")
     if abs(norm - 1.0) < 1e-12:
         return axis
     return vec3([_snap(v / norm) for v in values])
+
+
+def _is_symbolic(inertial: Inertial) -> bool:
+    return any(isinstance(v, sp.Basic) and v.free_symbols
+               for v in (inertial.mass, *inertial.com, *sum(inertial.inertia, ())))
+
+
+def _substituted(inertial: Inertial, values: Mapping[sp.Symbol, sp.Expr]) -> Inertial:
+    return Inertial(inertial.mass.xreplace(values),
+                    tuple(v.xreplace(values) for v in inertial.com),
+                    tuple(tuple(v.xreplace(values) for v in row) for row in inertial.inertia))
+
+
+def check_size(source: str, links: int, joints: int) -> None:
+    """Refuse models with more than :data:`MAX_JOINTS` joints (or ``MAX_JOINTS + 1`` links);
+    parsers call it as soon as they have counted, before reading the elements."""
+    if joints > MAX_JOINTS:
+        raise TooLargeError(source, "robot",
+                            f"{joints} joints; eomgen handles at most {MAX_JOINTS}")
+    if links > MAX_JOINTS + 1:
+        raise TooLargeError(source, "robot",
+                            f"{links} links; eomgen handles at most {MAX_JOINTS + 1}")
 
 
 def build_model(
@@ -484,23 +528,37 @@ def build_model(
     strict: bool = False,
     info: Mapping[str, object] | None = None,
 ) -> RobotModel:
-    """Validate parsed parts and assemble a :class:`RobotModel`. Every parser ends here."""
+    """Validate parsed parts and assemble a :class:`RobotModel`. Every parser ends here.
+
+    Raises a subclass of :class:`~eomgen.errors.DescriptionError` naming ``source`` and the
+    element at fault: :class:`~eomgen.errors.TooLargeError` (more than :data:`MAX_JOINTS`
+    joints), :class:`~eomgen.errors.InvalidAxisError`,
+    :class:`~eomgen.errors.KinematicTreeError`, :class:`~eomgen.errors.InvalidInertiaError`,
+    :class:`~eomgen.errors.InvalidNumberError` (gravity) or
+    :class:`~eomgen.errors.ParameterError` (duplicate parameters).
+    """
     links = tuple(links)
+    joints = tuple(joints)
+    check_size(source, len(links), len(joints))
     joints = tuple(replace(j, axis=check_axis(source, j.name, j.axis)) for j in joints)
     root = check_tree(source, (l.name for l in links), joints)
+    params = tuple(parameters)
+    defaults = {p.symbol: scalar(p.value) for p in params if p.value is not None}
     for link in links:
         if link.inertial is not None:
             check_inertial(source, link.name, link.inertial, strict)
+            if defaults and _is_symbolic(link.inertial):
+                check_inertial(source, link.name, _substituted(link.inertial, defaults), strict,
+                               at_defaults=True)
     gravity = vec3(gravity)
     for v in gravity:
         g = _number(v)
         if g is not None and not math.isfinite(g):
-            raise DescriptionError(source, "gravity", "gravity is not finite")
-    params = tuple(parameters)
+            raise InvalidNumberError(source, "gravity", "gravity is not finite")
     names = [p.name for p in params]
     for p in params:
         if names.count(p.name) > 1:
-            raise DescriptionError(source, f"parameter '{p.name}'", "duplicate parameter")
+            raise ParameterError(source, f"parameter '{p.name}'", "duplicate parameter")
     model = RobotModel(name=name, links=links, joints=joints, root=root, gravity=gravity,
                        parameters=params, source=str(source),
                        info=tuple((info or {}).items()))
@@ -525,13 +583,13 @@ def lock_joints(model: RobotModel, positions: Mapping[str, object]) -> RobotMode
 
     Raises
     ------
-    DescriptionError
+    KinematicTreeError
         When a name is not a movable joint of the model.
     """
     movable = {j.name for j in model.movable_joints}
     for name in positions:
         if name not in movable:
-            raise DescriptionError(model.source, f"joint '{name}'",
+            raise KinematicTreeError(model.source, f"joint '{name}'",
                                    "cannot lock: not a movable joint of this model")
     joints = tuple(
         replace(j, type=JointType.FIXED, origin=j.origin @ joint_motion(j, positions[j.name]))

@@ -27,7 +27,7 @@ import numpy as np
 import sympy as sp
 
 from .dynamics import Dynamics
-from .errors import DescriptionError
+from .errors import ParameterError
 from .numeric import numeric_model, rnea
 from .symbolic.evaluate import compile_program
 
@@ -136,8 +136,8 @@ def verify(dynamics: Dynamics, samples: int = 20, seed: int = 0,
     params = [p.symbol for p in model.parameters]
     missing = [p.name for p in model.parameters if p.symbol not in values]
     if missing:
-        raise DescriptionError(model.source, "parameters",
-                               "verification needs a value for " + ", ".join(missing))
+        raise ParameterError(model.source, "parameters",
+                             "verification needs a value for " + ", ".join(missing))
     n = model.dof
     evaluate_all = compile_program(dynamics.program, list(dynamics.q) + list(dynamics.qd)
                                    + list(dynamics.qdd) + params)

@@ -62,3 +62,24 @@ def _erd_robots_dir_fixture() -> Path:
 def pytest_addoption(parser):
     parser.addoption("--update-golden", action="store_true", default=False,
                      help="Rewrite generated/ from the current code instead of comparing.")
+
+
+# ----------------------------------------------------------------------------------------------
+# The derivation cache: never the user's. Every test module gets a fresh cache folder (set
+# before the module's own fixtures run, so that `eomgen generate` processes they start inherit
+# it), and the whole session one besides; nothing is ever written to ~/.cache/eomgen.
+# ----------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _session_cache_dir(tmp_path_factory):
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("EOMGEN_CACHE_DIR", str(tmp_path_factory.mktemp("eomgen_cache")))
+        yield
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _module_cache_dir(_session_cache_dir, tmp_path_factory):
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("EOMGEN_CACHE_DIR", str(tmp_path_factory.mktemp("eomgen_cache")))
+        yield

@@ -154,7 +154,7 @@ def test_debug_shows_a_traceback(tmp_path):
     debug = run_process("verify", path, "--debug")
     assert debug.returncode != 0
     assert "Traceback (most recent call last)" in debug.stderr
-    assert "eomgen.errors.DescriptionError" in debug.stderr and "is negative" in debug.stderr
+    assert "eomgen.errors.InvalidInertiaError" in debug.stderr and "is negative" in debug.stderr
     assert ERROR not in debug.stderr
 
 

@@ -10,7 +10,9 @@ Python objects are ever constructed) that additionally refuses
 
 Values are checked by :class:`Reader`, which turns every problem into a one-line
 :class:`~eomgen.errors.DescriptionError` naming the file and the element
-(``links[2] 'link2' inertia``). Numbers and expressions go through
+(``links[2] 'link2' inertia``): a :class:`~eomgen.errors.SchemaError` for the document's
+structure, an :class:`~eomgen.errors.InvalidNumberError` for values and a
+:class:`~eomgen.errors.ParameterError` for parameter names and undeclared symbols. Numbers and expressions go through
 :func:`eomgen.expressions.parse_scalar` only; every symbol must be declared under
 ``parameters``.
 """
@@ -26,7 +28,16 @@ from typing import Iterable
 import sympy as sp
 import yaml
 
-from ..errors import DescriptionError
+from ..errors import (
+    DescriptionError,
+    InvalidNumberError,
+    ParameterError,
+    SchemaError,
+    TooLargeError,
+    UnreadableFileError,
+    YAMLFormatError,
+    one_line,
+)
 from ..expressions import check_parameter_name, parse_scalar
 from ..model import Mat3, Parameter, Vec3, parameter_symbol, scalar
 
@@ -47,6 +58,10 @@ def _one_line(text: str) -> str:
     return " ".join(str(text).split())
 
 
+class _LimitError(yaml.composer.ComposerError):
+    """A document beyond :data:`MAX_NODES` or :data:`MAX_DEPTH`."""
+
+
 class _Loader(yaml.SafeLoader):
     """``yaml.SafeLoader`` refusing aliases, duplicate keys, deep nesting and huge documents."""
 
@@ -63,12 +78,12 @@ class _Loader(yaml.SafeLoader):
                 event.start_mark)
         self._nodes += 1
         if self._nodes > MAX_NODES:
-            raise yaml.composer.ComposerError(
+            raise _LimitError(
                 None, None, f"document has more than {MAX_NODES} nodes", self.peek_event().start_mark)
         self._depth += 1
         try:
             if self._depth > MAX_DEPTH:
-                raise yaml.composer.ComposerError(
+                raise _LimitError(
                     None, None, f"document is nested deeper than {MAX_DEPTH} levels",
                     self.peek_event().start_mark)
             return super().compose_node(parent, index)
@@ -98,9 +113,17 @@ def read_document(path: Path | str, text: str | None = None) -> dict:
 
     Raises
     ------
-    DescriptionError
-        When the file is too large, not UTF-8, not valid YAML, uses aliases or duplicate keys,
-        or its top level is not a mapping.
+    UnreadableFileError
+        When the file cannot be read or is not UTF-8.
+    TooLargeError
+        When the file is larger than :data:`MAX_BYTES`, or the document has more than
+        :data:`MAX_NODES` nodes or is nested deeper than :data:`MAX_DEPTH`.
+    YAMLFormatError
+        When it is not valid YAML, or uses aliases, duplicate keys or Python tags.
+    InvalidNumberError
+        For an integer too long to read.
+    SchemaError
+        When the document is empty or its top level is not a mapping.
     """
     source = str(path)
     if text is None:
@@ -108,32 +131,36 @@ def read_document(path: Path | str, text: str | None = None) -> dict:
         try:
             size = path.stat().st_size
         except OSError as exc:
-            raise DescriptionError(source, "", f"cannot read file ({exc.strerror})") from None
+            raise UnreadableFileError(source, "", f"cannot read file ({exc.strerror})") from None
         if size > MAX_BYTES:
-            raise DescriptionError(source, "", f"file larger than {MAX_BYTES} bytes")
+            raise TooLargeError(source, "", f"file larger than {MAX_BYTES} bytes")
         try:
             text = path.read_bytes().decode("utf-8")
         except UnicodeDecodeError as exc:
-            raise DescriptionError(source, "", f"not UTF-8 text ({exc.reason})") from None
+            raise UnreadableFileError(source, "", f"not UTF-8 text ({exc.reason})") from None
         except OSError as exc:
-            raise DescriptionError(source, "", f"cannot read file ({exc.strerror})") from None
+            raise UnreadableFileError(source, "", f"cannot read file ({exc.strerror})") from None
     elif len(text.encode("utf-8")) > MAX_BYTES:
-        raise DescriptionError(source, "", f"text larger than {MAX_BYTES} bytes")
+        raise TooLargeError(source, "", f"text larger than {MAX_BYTES} bytes")
     try:
         data = yaml.load(text, Loader=_Loader)  # noqa: S506 (a SafeLoader subclass)
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         problem = exc.problem or exc.context or "syntax error"
-        raise DescriptionError(source, "", _one_line(f"not valid YAML: {problem}{where}")) from None
+        kind = TooLargeError if isinstance(exc, _LimitError) else YAMLFormatError
+        raise kind(source, "", _one_line(f"not valid YAML: {problem}{where}")) from None
     except yaml.YAMLError as exc:
-        raise DescriptionError(source, "", _one_line(f"not valid YAML: {exc}")) from None
+        raise YAMLFormatError(source, "", _one_line(f"not valid YAML: {exc}")) from None
     except RecursionError:
-        raise DescriptionError(source, "", "not valid YAML: nested too deeply") from None
+        raise TooLargeError(source, "", "not valid YAML: nested too deeply") from None
+    except ValueError as exc:  # an integer beyond Python's digit limit for int("...")
+        raise InvalidNumberError(source, "", one_line(f"a number is too long to read ({exc})")
+                                 ) from None
     if data is None:
-        raise DescriptionError(source, "", "empty document")
+        raise SchemaError(source, "", "empty document")
     if not isinstance(data, dict):
-        raise DescriptionError(
+        raise SchemaError(
             source, "", f"the document must be a mapping of keys, not a {_kind(data)}")
     return data
 
@@ -175,8 +202,11 @@ class Reader:
         self.declared: dict[str, Parameter] = {}
         self.used: set[str] = set()
 
-    def error(self, where: str, problem: str) -> DescriptionError:
-        return DescriptionError(self.source, _one_line(where), _one_line(problem))
+    def error(self, where: str, problem: str, kind: type[DescriptionError] = SchemaError
+              ) -> DescriptionError:
+        """The exception to raise: ``kind`` (a structural problem by default) naming the file
+        and ``where``."""
+        return kind(self.source, _one_line(where), _one_line(problem))
 
     # -- structure ------------------------------------------------------------------------------
 
@@ -250,11 +280,11 @@ class Reader:
         for key, entry in value.items():
             here = f"{where} '{key}'"
             if not isinstance(key, str):
-                raise self.error(where, f"parameter name {key!r} is not text")
+                raise self.error(where, f"parameter name {key!r} is not text", ParameterError)
             try:
                 check_parameter_name(key)
             except ValueError as exc:
-                raise self.error(here, str(exc)) from None
+                raise self.error(here, str(exc), ParameterError) from None
             description = ""
             if isinstance(entry, dict):
                 self.mapping(entry, here, optional=("value", "description"))
@@ -271,12 +301,13 @@ class Reader:
         try:
             expr = parse_scalar(value)
         except ValueError as exc:
-            raise self.error(where, str(exc)) from None
+            raise self.error(where, str(exc), InvalidNumberError) from None
         if expr.free_symbols:
-            raise self.error(where, f"expected a number, got {value!r} which uses symbols")
+            raise self.error(where, f"expected a number, got {value!r} which uses symbols",
+                             InvalidNumberError)
         out = float(expr)
         if not math.isfinite(out):
-            raise self.error(where, "not a finite number")
+            raise self.error(where, "not a finite number", InvalidNumberError)
         return out
 
     def scalar(self, value, where: str) -> sp.Expr:
@@ -284,12 +315,12 @@ class Reader:
         try:
             expr = parse_scalar(value)
         except ValueError as exc:
-            raise self.error(where, str(exc)) from None
+            raise self.error(where, str(exc), InvalidNumberError) from None
         for symbol in sorted(expr.free_symbols, key=str):
             if symbol.name not in self.declared:
                 raise self.error(
                     where, f"symbol '{symbol.name}' is not declared under 'parameters' "
-                    f"(add e.g. '{symbol.name}: {{value: 1.0}}')")
+                    f"(add e.g. '{symbol.name}: {{value: 1.0}}')", ParameterError)
             self.used.add(symbol.name)
         return scalar(expr)
 

@@ -49,8 +49,8 @@ from pathlib import Path
 import sympy as sp
 
 from ..model import (
-    IDENTITY3, Inertial, Joint, JointType, Link, Mat3, RobotModel, Transform, build_model, mat3,
-    rotation_about_axis, vec3,
+    IDENTITY3, Inertial, Joint, JointType, Link, Mat3, RobotModel, Transform, build_model,
+    check_size, mat3, rotation_about_axis, vec3,
 )
 from . import register
 from ._yaml import Reader, read_document, top_level_key
@@ -85,7 +85,8 @@ def load(path, strict: bool = False) -> RobotModel:
     Raises
     ------
     DescriptionError
-        One line naming the file and the element, e.g. ``dh[2] 'joint3' alpha``.
+        One line naming the file and the element, e.g. ``dh[2] 'joint3' alpha``; the subclass
+        tells the kind of problem (see :mod:`eomgen.errors`).
     """
     path = Path(path)
     return parse(read_document(path), str(path), strict, default_name=path.stem)
@@ -119,8 +120,10 @@ def parse(data: dict, source: str, strict: bool = False, default_name: str = "ro
     r.read_parameters(data.get("parameters"))
     gravity = r.vector(data["gravity"], "gravity") if "gravity" in data else vec3([0, 0, -9.81])
 
+    entries = r.sequence(data["dh"], "dh")
+    check_size(source, len(entries) + 1, len(entries))  # one link more: the base
     rows = []
-    for i, entry in enumerate(r.sequence(data["dh"], "dh"), start=1):
+    for i, entry in enumerate(entries, start=1):
         where = f"dh[{i - 1}]"
         label = where
         if isinstance(entry, dict):

@@ -33,7 +33,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import UnsupportedError
-from ..model import Inertial, Joint, JointType, Link, RobotModel, Transform, build_model, vec3
+from ..model import (
+    Inertial, Joint, JointType, Link, RobotModel, Transform, build_model, check_size, vec3,
+)
 from . import register
 from ._yaml import Reader, read_document, top_level_key
 
@@ -64,7 +66,8 @@ def load(path, strict: bool = False) -> RobotModel:
     Raises
     ------
     DescriptionError
-        One line naming the file and the element, e.g. ``links[2] 'link2' inertia``.
+        One line naming the file and the element, e.g. ``links[2] 'link2' inertia``; the
+        subclass tells the kind of problem (see :mod:`eomgen.errors`).
     """
     path = Path(path)
     return parse(read_document(path), str(path), strict, default_name=path.stem)
@@ -78,15 +81,18 @@ def parse(data: dict, source: str, strict: bool = False, default_name: str = "ro
     r.read_parameters(data.get("parameters"))
     gravity = r.vector(data["gravity"], "gravity") if "gravity" in data else vec3([0, 0, -9.81])
 
+    link_entries = r.sequence(data["links"], "links")
+    joint_entries = r.sequence(data["joints"], "joints", allow_empty=True)
+    check_size(source, len(link_entries), len(joint_entries))
     links = []
-    for i, entry in enumerate(r.sequence(data["links"], "links")):
+    for i, entry in enumerate(link_entries):
         r.mapping(entry, r.named(entry, f"links[{i}]"), required=("name",), optional=LINK_KEYS)
         link_name = r.name(entry["name"], f"links[{i}] name")
         where = f"links[{i}] '{link_name}'"
         links.append(Link(link_name, _inertial(r, entry, where)))
 
     joints = []
-    for i, entry in enumerate(r.sequence(data["joints"], "joints", allow_empty=True)):
+    for i, entry in enumerate(joint_entries):
         r.mapping(entry, r.named(entry, f"joints[{i}]"),
                   required=("name", "type", "parent", "child"), optional=JOINT_KEYS)
         joint_name = r.name(entry["name"], f"joints[{i}] name")
