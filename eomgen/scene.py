@@ -1,0 +1,294 @@
+"""Scenes: what of a robot to model, read from a small YAML file.
+
+A robot description says what the robot *is*; a scene says what a task *uses* of it: the part
+that moves (a ``base`` link and ``tips``), joints held still (``locked``), loads carried
+(``payloads``), the ``gravity`` it works in, the parameters kept ``symbolic`` and the
+``outputs`` wanted. :func:`eomgen.reduction.apply_scene` turns a robot and a scene into the
+smaller model the scene needs, and a report of what it did.
+
+Version 1 of the format (every key but ``version`` is optional)::
+
+    version: 1                    # required: the scene format version
+    robot: talos                  # the robot's name; another robot is an error
+    description: Left arm, the rest of the robot held still.
+    base: torso_2_link            # the link the moving part hangs from (default: the root)
+    tips: [arm_left_7_link]       # its ends (default: everything below base)
+    locked:                       # joint: position [rad or m]; other joints outside the
+      torso_2_joint: 0.1          #   moving part are locked at 0
+    payloads:                     # rigid loads fixed to links
+      - link: arm_left_7_link
+        name: tool
+        mass: 1.5                 # kg
+        com: [0, 0, -0.1]         # m, in the link frame
+        inertia: {ixx: 0.01, iyy: 0.01, izz: 0.002}   # kg m², about com, link axes
+    gravity: [0, 0, -9.81]        # m/s² in the root link frame; none for no gravity
+    parameters: {m_load: 1.5}     # new symbols for payload values (name: default value)
+    symbolic: [m_load]            # parameters kept symbolic (default: all; none for none)
+    outputs: [M, C, g]            # M, C, g, tau / inverse_dynamics, forward_dynamics
+
+The file is read like eomgen's robot YAML (:mod:`eomgen.parsers._yaml`): safe loading, no
+aliases, size and depth limits, and an unknown key is an error that lists the known ones. Keys
+planned for later versions (:data:`PLANNED_KEYS`) are refused by name until they exist.
+
+Examples
+--------
+>>> scene = load_scene("s.yaml", text="version: 1\\nlocked: {joint2: 0.5}\\noutputs: [g]")
+>>> scene.locked_positions, scene.outputs
+({'joint2': 0.5}, ('gravity_vector',))
+"""
+
+from __future__ import annotations
+
+import difflib
+import functools
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterable
+
+from .codegen.functions import select_functions
+from .errors import DescriptionError, SceneError, one_line
+from .model import Inertial, Parameter, Vec3, check_inertial, mat3, vec3
+from .parsers._yaml import Reader, read_document
+
+#: The scene format version this eomgen reads.
+SCENE_VERSION = 1
+
+#: Top-level keys of a version-1 scene, in documentation order.
+SCENE_KEYS = ("version", "robot", "description", "base", "tips", "locked", "payloads",
+              "gravity", "parameters", "symbolic", "outputs")
+
+#: Keys reserved for later versions of the format; refused with a message saying so.
+PLANNED_KEYS = ("friction", "armature", "contacts", "flexible_joints", "joint_limits")
+
+PAYLOAD_KEYS = ("link", "name", "mass", "com", "inertia")
+
+
+@dataclass(frozen=True)
+class Payload:
+    """A rigid load fixed to ``link``: mass [kg], centre of mass [m] in the link frame and
+    inertia [kg m²] about the centre of mass in the link frame axes (``inertial``)."""
+
+    link: str
+    inertial: Inertial
+    name: str
+
+
+@dataclass(frozen=True)
+class Scene:
+    """What of a robot to model (see the module docstring for the file format).
+
+    Attributes
+    ----------
+    source:
+        The scene file (or a label), named by every error about the scene.
+    base, tips:
+        The moving part is every movable joint on a path from ``base`` (default: the root) to
+        one of ``tips`` (default: every joint below ``base``).
+    locked:
+        ``(joint, position)`` pairs [rad or m], in file order.
+    payloads:
+        Loads fixed to links.
+    gravity:
+        Gravitational acceleration [m/s²] in the root link frame; None keeps the description's.
+    parameters:
+        Parameters the scene declares (for payload values).
+    symbolic:
+        Names of the parameters kept symbolic; None keeps every parameter symbolic.
+    outputs:
+        The functions wanted (:func:`eomgen.codegen.functions.select_functions` names); None
+        for all.
+    """
+
+    source: str = "<scene>"
+    version: int = SCENE_VERSION
+    robot: str | None = None
+    description: str = ""
+    base: str | None = None
+    tips: tuple[str, ...] = ()
+    locked: tuple[tuple[str, float], ...] = ()
+    payloads: tuple[Payload, ...] = ()
+    gravity: Vec3 | None = None
+    parameters: tuple[Parameter, ...] = ()
+    symbolic: tuple[str, ...] | None = None
+    outputs: tuple[str, ...] | None = None
+
+    @property
+    def locked_positions(self) -> dict[str, float]:
+        return dict(self.locked)
+
+    def error(self, element: str, problem: str) -> SceneError:
+        """A :class:`SceneError` naming this scene's file and ``element``."""
+        return SceneError(self.source, element, problem)
+
+
+@functools.cache
+def scene_error(kind: type[DescriptionError] = DescriptionError) -> type[SceneError]:
+    """The class of a scene problem of ``kind``: :class:`SceneError` and ``kind`` both, so that
+    a payload mass of ``nan`` in a scene is caught as a ``SceneError`` and as an
+    ``InvalidNumberError`` alike."""
+    if issubclass(kind, SceneError):
+        return kind
+    if kind is DescriptionError:
+        return SceneError
+    return type(f"Scene{kind.__name__}", (SceneError, kind),
+                {"__module__": __name__, "__doc__": f"{kind.__name__} in a scene file."})
+
+
+def _as_scene_error(exc: DescriptionError) -> SceneError:
+    return scene_error(type(exc))(exc.source, exc.element, exc.problem)
+
+
+class _SceneReader(Reader):
+    """The robot-YAML reader, raising :class:`SceneError` (of the reader's kind)."""
+
+    def error(self, where: str, problem: str, *args, **kwargs) -> SceneError:
+        return _as_scene_error(super().error(where, problem, *args, **kwargs))
+
+
+def did_you_mean(name: str, known: Iterable[str]) -> str:
+    """``"; did you mean 'x'?"`` for the closest of ``known``, or an empty string."""
+    hint = difflib.get_close_matches(name, list(known), n=1)
+    return f"; did you mean '{hint[0]}'?" if hint else ""
+
+
+def load_scene(path, text: str | None = None, strict: bool = False) -> Scene:
+    """Read a scene file (see the module docstring).
+
+    Parameters
+    ----------
+    path:
+        The scene file; with ``text``, only the label errors name.
+    text:
+        The document itself, instead of reading ``path``.
+    strict:
+        Refuse payload inertias that break the triangle inequality instead of warning.
+
+    Returns
+    -------
+    Scene
+        Checked on its own; whether its links and joints exist is checked when it is applied to
+        a robot (:func:`eomgen.reduction.apply_scene`).
+
+    Raises
+    ------
+    SceneError
+        One line naming the file, the entry and the problem.
+    """
+    source = str(path)
+    try:
+        data = read_document(Path(path) if text is None else source, text)
+        return _read(data, source, strict)
+    except SceneError:
+        raise
+    except DescriptionError as exc:  # from the shared YAML reader: the same fields
+        raise _as_scene_error(exc) from None
+
+
+def _read(data: dict, source: str, strict: bool) -> Scene:
+    r = _SceneReader(source)
+    for key in data:
+        if key in PLANNED_KEYS:
+            raise r.error(str(key), f"'{key}' is planned for a later scene version; version "
+                          f"{SCENE_VERSION} knows: {', '.join(SCENE_KEYS)}")
+    r.mapping(data, "scene", required=("version",), optional=SCENE_KEYS)
+    version = data["version"]
+    if isinstance(version, bool) or not isinstance(version, int):
+        raise r.error("version", f"expected the integer {SCENE_VERSION}, got {version!r}")
+    if version != SCENE_VERSION:
+        raise r.error("version", f"scene version {version} is not supported (this eomgen reads "
+                      f"version {SCENE_VERSION})")
+    r.read_parameters(data.get("parameters"), "parameters")
+    robot = r.text(data["robot"], "robot") if "robot" in data else None
+    description = r.text(data["description"], "description") if "description" in data else ""
+    base = r.name(data["base"], "base") if data.get("base") is not None else None
+    tips: list[str] = []
+    if data.get("tips") is not None:
+        for k, tip in enumerate(r.sequence(data["tips"], "tips")):
+            name = r.name(tip, f"tips[{k}]")
+            if name in tips:
+                raise r.error(f"tips[{k}] '{name}'", "listed twice")
+            tips.append(name)
+    locked: list[tuple[str, float]] = []
+    if data.get("locked") is not None:
+        if not isinstance(data["locked"], dict):
+            raise r.error("locked", "expected a mapping of joint: position [rad or m]")
+        for joint, value in data["locked"].items():
+            name = r.name(joint, "locked")
+            locked.append((name, r.number(value, f"locked '{name}'")))
+    payloads = []
+    if data.get("payloads") is not None:
+        for k, entry in enumerate(r.sequence(data["payloads"], "payloads")):
+            payloads.append(_payload(r, entry, k, source, strict))
+        names = [p.name for p in payloads]
+        for p in payloads:
+            if names.count(p.name) > 1:
+                raise r.error(f"payloads '{p.name}'", "two payloads have this name")
+    gravity = _gravity(r, data["gravity"]) if "gravity" in data else None
+    symbolic = _symbolic(r, data["symbolic"]) if "symbolic" in data else None
+    outputs = _outputs(r, data["outputs"]) if data.get("outputs") is not None else None
+    declared = tuple(r.declared.values())
+    return Scene(source=source, version=version, robot=robot, description=description,
+                 base=base, tips=tuple(tips), locked=tuple(locked), payloads=tuple(payloads),
+                 gravity=gravity, parameters=declared, symbolic=symbolic, outputs=outputs)
+
+
+def _payload(r: _SceneReader, entry, k: int, source: str, strict: bool) -> Payload:
+    where = f"payloads[{k}]"
+    r.mapping(entry, where, required=("link", "mass"), optional=PAYLOAD_KEYS)
+    link = r.name(entry["link"], f"{where} link")
+    name = r.name(entry["name"], f"{where} name") if "name" in entry else f"payload{k}"
+    where = f"{where} '{name}'"
+    mass = r.scalar(entry["mass"], f"{where} mass")
+    com = r.vector(entry["com"], f"{where} com") if "com" in entry else vec3([0, 0, 0])
+    inertia = (r.inertia(entry["inertia"], f"{where} inertia") if "inertia" in entry
+               else mat3([[0, 0, 0]] * 3))
+    inertial = Inertial(mass, com, inertia)
+    values = {p.symbol: p.value for p in r.declared.values() if p.value is not None}
+    numeric = Inertial(*(_at(x, values) for x in (inertial.mass, inertial.com, inertial.inertia)))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            check_inertial(source, name, numeric, strict)
+        except DescriptionError as exc:
+            raise scene_error(type(exc))(source, where, exc.problem) from None
+    for warning in caught:  # re-issued naming the payload rather than a link
+        problem = str(warning.message).rsplit(" inertial: ", 1)[-1]
+        warnings.warn(one_line(f"{source}: {where}: {problem}"), warning.category, stacklevel=4)
+    return Payload(link, inertial, name)
+
+
+def _at(value, values: dict):
+    """``value`` (a scalar, vector or matrix of SymPy scalars) at the parameter values."""
+    if isinstance(value, tuple):
+        return tuple(_at(v, values) for v in value)
+    return value.xreplace(values) if values else value
+
+
+def _gravity(r: _SceneReader, value) -> Vec3:
+    if value is None or (isinstance(value, str) and value.strip().lower() == "none"):
+        return vec3([0, 0, 0])
+    return r.vector(value, "gravity")
+
+
+def _symbolic(r: _SceneReader, value) -> tuple[str, ...]:
+    if value is None or (isinstance(value, str) and value.strip().lower() == "none"):
+        return ()
+    names = []
+    for k, entry in enumerate(r.sequence(value, "symbolic", allow_empty=True)):
+        if not isinstance(entry, str):
+            raise r.error(f"symbolic[{k}]", "expected a parameter name")
+        names.append(entry)
+    return tuple(names)
+
+
+def _outputs(r: _SceneReader, value) -> tuple[str, ...]:
+    names = []
+    for k, entry in enumerate(r.sequence(value, "outputs")):
+        if not isinstance(entry, str):
+            raise r.error(f"outputs[{k}]", "expected an output name (M, C, g, tau, ...)")
+        names.append(entry)
+    try:
+        return select_functions(names)
+    except ValueError as exc:
+        raise r.error("outputs", str(exc)) from None
