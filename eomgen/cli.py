@@ -1,13 +1,18 @@
 """Command line interface: ``eomgen verify``, ``eomgen generate``.
 
 Exit codes: 0 success, 1 a verification check failed, 2 bad input (one line on stderr naming the
-file, the element and the problem; a traceback only with ``--debug``).
+file, the element and the problem; a traceback only with ``--debug``), 130 interrupted (SIGINT,
+Ctrl-C) and 143 terminated (SIGTERM), each with the one line ``eomgen: interrupted``.
 """
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
 import functools
+import signal
 import sys
+import threading
 import time
 import warnings
 from pathlib import Path
@@ -15,7 +20,7 @@ from pathlib import Path
 import click
 
 from . import __version__
-from .errors import EomgenError
+from .errors import EomgenError, one_line
 
 
 def _default_description() -> Path:
@@ -24,8 +29,31 @@ def _default_description() -> Path:
     return example_path("planar_2link")
 
 
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, raised wherever the program is (as SIGINT raises KeyboardInterrupt), so that
+    the same cleanups run: a generation in progress leaves the previous output untouched."""
+
+
+def _raise_terminated(signum, frame):
+    raise _Terminated()
+
+
+@contextlib.contextmanager
+def _sigterm_raises():
+    """Within the block, SIGTERM raises :class:`_Terminated` (main thread only)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def _handle_errors(command):
-    """Turn EomgenError into one line on stderr and exit code 2 (traceback with --debug)."""
+    """Turn EomgenError into one line on stderr and exit code 2 (traceback with --debug), and
+    an interrupt (SIGINT, SIGTERM) into ``eomgen: interrupted`` and exit code 130 or 143."""
 
     @functools.wraps(command)
     def wrapper(*args, debug: bool = False, **kwargs):
@@ -34,14 +62,56 @@ def _handle_errors(command):
 
         warnings.showwarning = show_warning
         try:
-            return command(*args, **kwargs)
+            with _sigterm_raises():
+                return command(*args, **kwargs)
         except EomgenError as exc:
             if debug:
                 raise
             click.echo(f"eomgen: error: {exc}", err=True)
             sys.exit(2)
+        except KeyboardInterrupt as exc:
+            if debug:
+                raise
+            click.echo("eomgen: interrupted", err=True)
+            sys.exit(128 + (signal.SIGTERM if isinstance(exc, _Terminated) else signal.SIGINT))
 
     return click.option("--debug", is_flag=True, help="Show a traceback on errors.")(wrapper)
+
+
+@contextlib.contextmanager
+def _recorded_warnings():
+    """Within the block, warnings are shown as usual and their messages collected in the list
+    yielded (a cached run prints them again)."""
+    notices: list[str] = []
+    shown = warnings.showwarning
+
+    def record(message, *args, **kwargs):
+        notices.append(one_line(str(message)))
+        shown(message, *args, **kwargs)
+
+    warnings.showwarning = record
+    try:
+        yield notices
+    finally:
+        warnings.showwarning = shown
+
+
+def _answer_from_cache(request, outdir: Path, quiet: bool, cache_dir: Path | None) -> bool:
+    """Write the files of a cached ``eomgen generate`` run and list them, as the run did;
+    False when the cache holds no (valid) entry. Imports neither SymPy nor the parsers."""
+    from .cache import Cache
+    from .output import write_atomically
+
+    entry = Cache(cache_dir).get(request.key)
+    if entry is None:
+        return False
+    for notice in entry.notices:
+        click.echo(f"eomgen: warning: {notice}", err=True)
+    if not quiet:
+        click.echo(f"eomgen: using cached result (key {request.key[:16]}…)", err=True)
+    for path in write_atomically(entry.files, outdir):
+        click.echo(str(path))
+    return True
 
 
 description_argument = click.argument(
@@ -114,24 +184,49 @@ def verify(description, samples, seed, tolerance, strict):
               help="Comma-separated parameters to keep symbolic (default: all the description "
                    "declares; 'none' for none). The others take their values.")
 @click.option("--quiet", is_flag=True, help="No progress lines.")
+@click.option("--scene", "scene_path", default=None,
+              type=click.Path(dir_okay=False, path_type=Path),
+              help="Scene file (YAML, docs/scenes.md): the part that moves, locked joints, "
+                   "payloads, gravity, outputs. Writes <robot>_scene_report.md too.")
+@click.option("--explain", is_flag=True,
+              help="Print what was merged, locked and dropped, and derive the whole "
+                   "description too to compare operation counts and times.")
+@click.option("--no-cache", is_flag=True,
+              help="Derive afresh: neither read nor write the derivation cache.")
+@click.option("--cache-dir", default=None, type=click.Path(file_okay=False, path_type=Path),
+              help="Derivation cache folder (default: $EOMGEN_CACHE_DIR, else "
+                   "$XDG_CACHE_HOME/eomgen, else ~/.cache/eomgen).")
 @strict_option
 @_handle_errors
-def generate(description, backends, outdir, symbolic, quiet, strict):
+def generate(description, backends, outdir, symbolic, quiet, scene_path, explain, no_cache,
+             cache_dir, strict):
     """Generate code and a derivation for DESCRIPTION (default: the bundled planar 2-link arm).
 
     Writes <robot>_numpy.py (NumPy, single states and batches), <robot>_casadi.py (CasADi
     functions), <robot>_casadi.c/.h (C through CasADi, plus a .so when a C compiler is found) and
-    <robot>.tex (the derivation) into OUTPUT, all files or none.
+    <robot>.tex (the derivation) into OUTPUT, all files or none. A request made before (same
+    file bytes, options and eomgen) is answered from the derivation cache.
 
     \b
     Examples:
       eomgen generate
       eomgen generate robot.urdf --backend numpy -o build/
       eomgen generate eomgen/robots/planar_2link.yaml --symbolic m2,g
+      eomgen generate talos_reduced.urdf --scene examples/scenes/talos_left_arm.yaml --explain
     """
+    request = None
+    if not no_cache:
+        from .cache import command_request
+
+        request = command_request(description or _default_description(),
+                                  click.get_current_context().params)
+        if request is not None and _answer_from_cache(request, outdir, quiet, cache_dir):
+            return
     from .codegen.generate import generate as run_generate
 
-    model = _load(description, strict)
+    with _recorded_warnings() as notices:
+        model = _load(description, strict)
+    cache = dataclasses.replace(request, notices=notices) if request else not no_cache
     names = None
     if symbolic is not None:
         names = [] if symbolic.strip().lower() == "none" else [
@@ -141,9 +236,27 @@ def generate(description, backends, outdir, symbolic, quiet, strict):
         if not quiet:
             click.echo(f"eomgen: {line}", err=True)
 
-    paths = run_generate(model, outdir, backends, names, progress)
+    if scene_path is not None or explain:
+        from .codegen.scene_generate import generate_scene
+        from .scene import load_scene
+
+        scene = load_scene(scene_path, strict=strict) if scene_path is not None else None
+        paths, produced = generate_scene(model, scene, outdir, backends, names, progress,
+                                         explain)
+        if explain:
+            click.echo(produced.markdown)
+    else:
+        paths = run_generate(model, outdir, backends, names, progress, cache=cache,
+                             cache_dir=cache_dir)
     for path in paths:
         click.echo(str(path))
+
+
+# ``eomgen bench`` and ``eomgen simulate`` (eomgen/analysis/commands.py), with this module's
+# error handling, DESCRIPTION argument, --strict and loading.
+from .analysis.commands import add_commands as _add_analysis_commands  # noqa: E402
+
+_add_analysis_commands(main, _handle_errors, description_argument, strict_option, _load)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -72,7 +72,8 @@ RESERVED_IDENTIFIERS = frozenset(
      "JOINT_NAMES", "NQ", "PARAMETERS", "mass_matrix", "coriolis_matrix", "gravity_vector",
      "inverse_dynamics", "forward_dynamics", "self", "cls", "M", "C", "g", "L", "x", "y", "d",
      "rhs", "bias", "args", "names", "vectors", "functions", "parameters", "q_columns",
-     "qd_columns", "qdd_columns"}
+     "qd_columns", "qdd_columns", "k", "finite", "condition", "return_condition",
+     "close", "eigenvalues", "IllConditionedWarning"}
 ) | frozenset(keyword.kwlist) | frozenset(keyword.softkwlist) | frozenset(dir(builtins))
 
 _IDENTIFIER = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")

@@ -7,24 +7,19 @@ leaves either the previous output or the complete new one, never a mixture.
 
 from __future__ import annotations
 
-import os
-import shutil
-import signal
-import tempfile
 import time
 from pathlib import Path
 from typing import Callable, Iterable, Sequence
 
-from ..dynamics import ALL_OUTPUTS, derive
-from ..errors import EomgenError
+from ..dynamics import derive
+from ..cache import CacheRequest, render_cached
+from ..errors import GenerationError
 from ..model import RobotModel
+from ..output import write_atomically  # noqa: F401  (re-exported)
 from . import GeneratedFile, available_backends, make_job
+from .functions import derived_outputs, select_functions
 
 Progress = Callable[[str], None]
-
-
-class GenerationError(EomgenError):
-    """A generation request that cannot be carried out (unknown backend, unknown parameter)."""
 
 
 def select_backends(names: str | Sequence[str]) -> list[str]:
@@ -64,17 +59,54 @@ def keep_symbolic(model: RobotModel, names: Iterable[str] | None) -> RobotModel:
     return model.substitute(fixed)
 
 
-def render_files(model: RobotModel, backends: Sequence[str], progress: Progress = lambda _: None
+def render_files(model: RobotModel, backends: Sequence[str], progress: Progress = lambda _: None,
+                 functions: Iterable[str] | None = None, notes: Sequence[str] = ()
                  ) -> list[GeneratedFile]:
-    """Derive ``model`` once and run each backend; nothing is written."""
+    """Derive ``model`` once and run each backend; nothing is written.
+
+    ``functions`` (default: all, see :func:`~eomgen.codegen.functions.select_functions`) are the
+    functions the modules export; only the outputs they need are derived. ``notes`` are extra
+    header lines of every file.
+    """
     start = time.perf_counter()
-    progress(f"deriving M, C, g and tau of {model.name} ({model.dof} joints)")
-    dynamics = derive(model, outputs=ALL_OUTPUTS, simplify=False)
-    job = make_job(dynamics)
+    outputs = derived_outputs(functions)
+    progress(f"deriving {', '.join(outputs)} of {model.name} ({model.dof} joints)")
+    dynamics = derive(model, outputs=outputs, simplify=False)
+    job = make_job(dynamics, functions, notes)
     progress(f"derived in {time.perf_counter() - start:.2f} s; "
              + ", ".join(f"{s.name} {s.operation_count} ops" for s in job.specs))
+    return render_job(job, backends, progress)
+
+
+def usable_backends(names: Sequence[str], functions: Iterable[str] | None = None
+                    ) -> tuple[list[str], list[str]]:
+    """Split backend ``names`` into those that can serve ``functions`` and those that cannot
+    (a backend whose ``needs`` are not all derived for them, e.g. the LaTeX derivation, which
+    documents M, C and g, when only g is asked)."""
+    outputs = set(derived_outputs(functions))
+    registry = available_backends()
+    usable = [n for n in names if set(registry[n].needs) <= outputs]
+    return usable, [n for n in names if n not in usable]
+
+
+def render_job(job, backends: Sequence[str], progress: Progress = lambda _: None
+               ) -> list[GeneratedFile]:
+    """Run each backend on ``job`` (see :func:`eomgen.codegen.make_job`); nothing is written.
+
+    Raises
+    ------
+    GenerationError
+        When a backend needs outputs the job's dynamics lack (see :func:`usable_backends`).
+    """
     files: list[GeneratedFile] = []
     registry = available_backends()
+    for name in backends:
+        missing = [o for o in registry[name].needs if o not in job.dynamics.outputs]
+        if missing:
+            raise GenerationError(
+                f"the {name} backend needs {', '.join(registry[name].needs)} derived, but the "
+                f"functions asked for ({', '.join(job.functions)}) do not need "
+                f"{', '.join(missing)}; ask for more outputs or choose other backends")
     for name in backends:
         start = time.perf_counter()
         produced = registry[name].generate(job)
@@ -88,38 +120,10 @@ def render_files(model: RobotModel, backends: Sequence[str], progress: Progress 
     return files
 
 
-def write_atomically(files: Sequence[GeneratedFile], outdir: Path) -> list[Path]:
-    """Write ``files`` into ``outdir``: all of them or, on any failure, none.
-
-    Files are first written into a staging folder beside ``outdir``; then they are moved in with
-    ``os.replace`` while SIGINT and SIGTERM are held back, and the staging folder is removed.
-    """
-    outdir = Path(outdir)
-    outdir.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=f".{outdir.name}.staging-", dir=outdir.parent))
-    try:
-        for f in files:
-            target = staging / f.name
-            if isinstance(f.content, bytes):
-                target.write_bytes(f.content)
-            else:
-                target.write_text(f.content, encoding="utf-8", newline="\n")
-        blocked = {signal.SIGINT, signal.SIGTERM}
-        previous = signal.pthread_sigmask(signal.SIG_BLOCK, blocked)
-        try:
-            outdir.mkdir(exist_ok=True)
-            for f in files:
-                os.replace(staging / f.name, outdir / f.name)
-        finally:
-            signal.pthread_sigmask(signal.SIG_SETMASK, previous)
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
-    return [outdir / f.name for f in files]
-
-
 def generate(model: RobotModel, outdir: Path, backends: str | Sequence[str] = "all",
-             symbolic: Iterable[str] | None = None, progress: Progress = lambda _: None
-             ) -> list[Path]:
+             symbolic: Iterable[str] | None = None, progress: Progress = lambda _: None,
+             functions: Iterable[str] | None = None, cache: bool | CacheRequest = True,
+             cache_dir: Path | None = None) -> list[Path]:
     """Generate the chosen backends' files for ``model`` into ``outdir``; returns their paths.
 
     Parameters
@@ -135,8 +139,28 @@ def generate(model: RobotModel, outdir: Path, backends: str | Sequence[str] = "a
         are replaced by their values. ``None`` keeps all of the description's parameters.
     progress:
         Called with a line of text at each stage.
+    functions:
+        The functions to generate (default: all; names or short names ``M``, ``C``, ``g``,
+        ``tau``, see :func:`~eomgen.codegen.functions.select_functions`). With ``"all"``
+        backends, a backend that cannot serve them (the LaTeX derivation needs M, C and g) is
+        left out, with a progress line; a backend named explicitly is an error.
+    cache:
+        Take the files of an identical earlier request from the derivation cache and store new
+        ones there (:mod:`eomgen.cache`); ``False`` derives afresh and stores nothing.
+    cache_dir:
+        The cache folder (default: :func:`eomgen.cache.default_cache_dir`).
     """
     chosen = select_backends(backends)
+    if functions is not None:
+        try:
+            functions = select_functions(functions)
+        except ValueError as exc:
+            raise GenerationError(str(exc)) from None
+        if backends == "all" or list(backends) == ["all"]:
+            chosen, skipped = usable_backends(chosen, functions)
+            for name in skipped:
+                progress(f"{name}: skipped (needs {', '.join(available_backends()[name].needs)})")
     model = keep_symbolic(model, symbolic)
-    files = render_files(model, chosen, progress)
+    files = render_cached(render_files, model, chosen, progress, cache=cache,
+                          cache_dir=cache_dir, functions=functions)
     return write_atomically(files, Path(outdir))

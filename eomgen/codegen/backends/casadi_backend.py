@@ -20,8 +20,10 @@ import sympy as sp
 from sympy.printing.pycode import PythonCodePrinter
 
 from .. import GeneratedFile, Job, register
+from ..functions import FUNCTION_NAMES as ALL_FUNCTIONS
 from ..render import render
-from .common import docstring_literal, parameter_renames, print_function, python_literal
+from .common import (docstring_literal, dunder_all_lines, parameter_renames, print_function,
+                     python_literal)
 
 _FUNCTIONS = ("sin", "cos", "tan", "sqrt", "exp", "log", "asin", "acos", "atan", "atan2")
 
@@ -76,6 +78,9 @@ def _render_module(job: Job, config: CasADiConfig) -> str:
         parameters=[(p.identifier, repr(float(p.default)) if p.default is not None else None,
                      python_literal(p.doc)) for p in job.parameters],
         functions=functions,
+        dunder_all=dunder_all_lines(["JOINT_NAMES", "NQ", "PARAMETERS", *job.functions]),
+        exports=list(job.functions),
+        forward_dynamics="forward_dynamics" in job.functions,
     )
 
 
@@ -91,8 +96,7 @@ def load_module_source(source: str, name: str) -> dict:
     return namespace
 
 
-FUNCTION_NAMES = ("mass_matrix", "coriolis_matrix", "gravity_vector", "inverse_dynamics",
-                  "forward_dynamics")
+FUNCTION_NAMES = ALL_FUNCTIONS  # every function a module can export (a job may ask fewer)
 
 
 def c_compiler() -> str | None:
@@ -114,7 +118,7 @@ def generate_c(job: Job, config: CasADiConfig = CasADiConfig()) -> list[Generate
     # keep the stem.
     prefix = re.sub(r"__+", "_", stem)
     generator = ca.CodeGenerator(prefix + ".c", {"with_header": True, "with_mem": False})
-    for name in FUNCTION_NAMES:
+    for name in job.functions:
         generator.add(namespace[name])
     with tempfile.TemporaryDirectory() as tmp:
         generator.generate(tmp + os.sep)

@@ -13,7 +13,8 @@ from sympy.printing.numpy import NumPyPrinter
 
 from .. import GeneratedFile, Job, register
 from ..render import render
-from .common import docstring_literal, parameter_renames, print_function, python_literal
+from .common import (docstring_literal, dunder_all_lines, parameter_renames, print_function,
+                     python_literal)
 
 
 class NumPyModulePrinter(NumPyPrinter):
@@ -56,5 +57,10 @@ def generate_numpy(job: Job, config: NumPyConfig = NumPyConfig()) -> list[Genera
         parameters=[(p.identifier, repr(float(p.default)) if p.default is not None else None,
                      python_literal(p.doc)) for p in job.parameters],
         functions=functions,
+        dunder_all=dunder_all_lines(["JOINT_NAMES", "NQ", "PARAMETERS", *job.functions]
+                                    + (["IllConditionedWarning"]
+                                       if "forward_dynamics" in job.functions else [])),
+        exports=list(job.functions),
+        forward_dynamics="forward_dynamics" in job.functions,
     )
     return [GeneratedFile(job.stem + config.suffix, text)]

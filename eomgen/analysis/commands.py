@@ -1,0 +1,205 @@
+"""``eomgen bench`` and ``eomgen simulate``: the command-line side of :mod:`eomgen.analysis`.
+
+:func:`add_commands` registers both on the ``eomgen`` group; ``eomgen/cli.py`` calls it with its
+own helpers (error handling, the DESCRIPTION argument, ``--strict``, loading), so this module
+imports nothing from the CLI and nothing heavy until a command runs.
+
+``--scene`` is offered when eomgen's scenes (``eomgen.scene`` and ``eomgen.reduction``) are
+installed: the model is reduced by the scene before anything is measured.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+
+import click
+
+from ..errors import EomgenError
+
+
+class AnalysisError(EomgenError):
+    """A bench or simulation request that cannot be carried out (a missing optional
+    dependency, a malformed list of numbers)."""
+
+
+def _scenes_available() -> bool:
+    return all(importlib.util.find_spec(name) is not None
+               for name in ("eomgen.scene", "eomgen.reduction"))
+
+
+def _scene_option(command):
+    if not _scenes_available():
+        return command
+    return click.option(
+        "--scene", "scene_path", default=None, type=click.Path(dir_okay=False, path_type=Path),
+        help="Scene file (YAML): reduce the robot to what the scene moves first "
+             "(e.g. examples/scenes/panda_fingers_locked.yaml).")(command)
+
+
+def _require(*modules: str) -> None:
+    missing = [m for m in modules if importlib.util.find_spec(m) is None]
+    if missing:
+        raise AnalysisError(f"this command needs {', '.join(missing)}: "
+                            "pip install 'eomgen[analysis]'")
+
+
+def _floats(text: str | None, option: str) -> list[float] | None:
+    if text is None:
+        return None
+    try:
+        values = [float(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise AnalysisError(f"{option}: expected comma-separated numbers, got {text!r}") from None
+    if not values or not all(v == v and abs(v) != float("inf") for v in values):
+        raise AnalysisError(f"{option}: expected finite comma-separated numbers, got {text!r}")
+    return values
+
+
+def _model(load, description, strict, scene_path):
+    model = load(description, strict)
+    if scene_path is not None:
+        from ..reduction import apply_scene
+        from ..scene import load_scene
+
+        model = apply_scene(model, load_scene(scene_path, strict=strict)).model
+    return model
+
+
+def _stem(model) -> str:
+    from ..codegen.functions import module_name
+
+    return module_name(model.name)
+
+
+def add_commands(main: click.Group, handle_errors, description_argument, strict_option,
+                 load) -> None:
+    """Register ``bench`` and ``simulate`` on ``main`` with the CLI's helpers."""
+
+    @main.command()
+    @description_argument
+    @click.option("-o", "--output", "outdir", default="eomgen_bench", show_default=True,
+                  type=click.Path(file_okay=False, path_type=Path), help="Output folder.")
+    @click.option("--samples", default=50, show_default=True,
+                  help="Sampled states (errors are the largest over them).")
+    @click.option("--seed", default=0, show_default=True, help="Seed of the sampled states.")
+    @click.option("--repeats", default=7, show_default=True, help="Timing repeats per route.")
+    @click.option("--batch-size", default=1000, show_default=True,
+                  help="States per call of the batch routes.")
+    @click.option("--quiet", is_flag=True, help="No progress bar.")
+    @_scene_option
+    @strict_option
+    @handle_errors
+    def bench(description, outdir, samples, seed, repeats, batch_size, quiet, strict,
+              scene_path=None):
+        """Time and accuracy of every evaluation route for DESCRIPTION.
+
+        Routes: the generated NumPy module (one state, batch), the same program in float32 and
+        over Python floats, the CasADi functions (SX, and the compiled C when a compiler is
+        found), eomgen's numeric Newton-Euler and Pinocchio when installed. Each evaluates
+        inverse dynamics and the mass matrix on sampled states; errors are against a 40-digit
+        mpmath reference. Writes bench_<robot>.md, .csv and .png (speed against error, Pareto
+        front marked) into OUTPUT.
+
+        \b
+        Examples:
+          eomgen bench
+          eomgen bench ur5_robot.urdf --samples 100 -o build/bench
+        """
+        _require("matplotlib", "mpmath")
+        from .bench import prepare_bench, write_outputs
+
+        model = _model(load, description, strict, scene_path)
+        if samples < 1 or repeats < 1 or batch_size < 1:
+            raise AnalysisError("--samples, --repeats and --batch-size must be positive")
+
+        def log(line: str) -> None:
+            if not quiet:
+                click.echo(f"eomgen: {line}", err=True)
+
+        plan = prepare_bench(model, samples=samples, seed=seed, batch_size=batch_size,
+                             repeats=repeats, log=log)
+        if quiet:
+            result = plan.run()
+        else:
+            with click.progressbar(length=plan.steps, label="eomgen: measuring",
+                                   file=sys.stderr) as bar:
+                result = plan.run(bar)
+        paths = write_outputs(result, outdir, _stem(model))
+        click.echo(result.markdown())
+        for path in paths:
+            click.echo(str(path))
+
+    @main.command()
+    @description_argument
+    @click.option("-o", "--output", "outdir", default="eomgen_simulate", show_default=True,
+                  type=click.Path(file_okay=False, path_type=Path), help="Output folder.")
+    @click.option("--duration", default=5.0, show_default=True, help="Simulated time [s].")
+    @click.option("--dt", "dts", default="1e-2,3e-3,1e-3", show_default=True,
+                  help="Steps of the fixed-step integrators [s], comma-separated.")
+    @click.option("--rtol", "rtols", default="1e-4,1e-6,1e-8", show_default=True,
+                  help="Relative tolerances of the adaptive integrators, comma-separated.")
+    @click.option("--integrators", "names", default="all", show_default=True,
+                  help="Comma-separated among euler, semi-implicit-euler, rk4, "
+                       "implicit-midpoint, rk45, dop853; or all.")
+    @click.option("--q0", default=None, help="Initial joint positions, comma-separated "
+                                             "(default: 1 rad or m per joint).")
+    @click.option("--qd0", default=None, help="Initial joint velocities (default: zero).")
+    @click.option("--quiet", is_flag=True, help="No progress bar.")
+    @_scene_option
+    @strict_option
+    @handle_errors
+    def simulate(description, outdir, duration, dts, rtols, names, q0, qd0, quiet, strict,
+                 scene_path=None):
+        """Integrate DESCRIPTION's dynamics (zero torque, no damping) with several integrators.
+
+        Explicit Euler, semi-implicit Euler, RK4 and the implicit midpoint rule at every --dt;
+        SciPy's RK45 and DOP853 at every --rtol. Reports wall time against energy drift and
+        against the error of q versus a DOP853 reference at rtol = atol = 1e-12. Writes
+        simulate_<robot>.md, .csv and .png into OUTPUT.
+
+        \b
+        Examples:
+          eomgen simulate --q0 2,2.5
+          eomgen simulate panda.urdf --scene examples/scenes/panda_fingers_locked.yaml
+        """
+        _require("matplotlib", "scipy")
+        from .simulate import integrators_named, run_study, write_outputs
+
+        if not duration > 0 or duration == float("inf"):
+            raise AnalysisError(f"--duration must be a positive number of seconds, got {duration}")
+        step_list = _floats(dts, "--dt")
+        rtol_list = _floats(rtols, "--rtol")
+        if min(step_list) <= 0 or min(rtol_list) <= 0:
+            raise AnalysisError("--dt and --rtol must be positive")
+        try:
+            integrators = integrators_named([n.strip() for n in names.split(",") if n.strip()],
+                                            step_list, rtol_list)
+        except ValueError as exc:
+            raise AnalysisError(f"--integrators: {exc}") from None
+        model = _model(load, description, strict, scene_path)
+        start = _floats(q0, "--q0")
+        velocity = _floats(qd0, "--qd0")
+        for values, option in ((start, "--q0"), (velocity, "--qd0")):
+            if values is not None and len(values) != model.dof:
+                raise AnalysisError(f"{option}: {model.name} has {model.dof} joints "
+                                    f"({', '.join(model.joint_names)}), got {len(values)} values")
+        if not quiet:
+            click.echo(f"eomgen: deriving M, C, g and tau of {model.name} ({model.dof} joints)",
+                       err=True)
+        from .simulate import System
+
+        system = System(model)
+        if quiet:
+            study = run_study(model, integrators, duration, start, velocity, system=system)
+        else:
+            with click.progressbar(length=len(integrators) + 1, label="eomgen: integrating",
+                                   file=sys.stderr) as bar:
+                study = run_study(model, integrators, duration, start, velocity,
+                                  progress=lambda _: bar.update(1), system=system)
+        paths = write_outputs([study], outdir, f"simulate_{_stem(model)}")
+        click.echo(study.describe())
+        click.echo(study.markdown_table())
+        for path in paths:
+            click.echo(str(path))

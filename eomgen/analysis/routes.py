@@ -1,0 +1,395 @@
+"""Every way eomgen's dynamics can be evaluated, behind one interface: :class:`Route`.
+
+A route evaluates inverse dynamics ``tau(q, qd, qdd)`` and the mass matrix ``M(q)`` for a
+batch of states (arrays of shape (N, n), results (N, n) and (N, n, n)); a route that takes one
+state per call loops over the batch, so that its time per state includes the call overhead a
+user pays.
+
+=========================  =======  ====================================================
+route                      dtype    what is called
+=========================  =======  ====================================================
+NumPy, one state           float64  ``<robot>_numpy.py``, once per state
+NumPy, batch               float64  ``<robot>_numpy.py`` on the whole (N, n) batch
+NumPy float32, batch       float32  the same program printed over float32 arrays
+                                    (:func:`compile_batch`; constants rounded to float32)
+Python floats, one state   float64  the program printed over Python floats with ``math``
+                                    (:func:`compile_scalar`; what ``eomgen simulate`` uses)
+CasADi SX, one state       float64  ``<robot>_casadi.py``'s ``casadi.Function``
+CasADi SX, map             float64  the same, ``Function.map(N)`` over the batch
+C (CasADi), one state      float64  the compiled ``<robot>_casadi.so`` via ``casadi.external``
+C (CasADi), map            float64  the same, mapped over the batch
+C (ctypes), one state      float64  the same library's C functions called through ctypes
+                                    (no CasADi call layer: the speed of the C code itself
+                                    plus about a microsecond of ctypes overhead)
+RNEA (eomgen.numeric)      float64  :func:`eomgen.numeric.rnea` and ``mass_matrix_rnea``
+Pinocchio                  float64  ``pinocchio.rnea`` and ``pinocchio.crba`` on the model
+                                    built by :mod:`~eomgen.analysis.pinocchio_bridge`
+=========================  =======  ====================================================
+
+The C routes exist when a C compiler is found, Pinocchio when it is installed. Only the
+program routes offer float32: the generated NumPy module casts its inputs to float64, and
+CasADi and Pinocchio (from Python) compute in double precision.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import importlib.util
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Iterable, Sequence
+
+import numpy as np
+import sympy as sp
+from sympy.printing.numpy import NumPyPrinter
+from sympy.printing.pycode import PythonCodePrinter
+
+from ..codegen import available_backends, make_job
+from ..codegen.backends.casadi_backend import c_compiler
+from ..dynamics import Dynamics, derive
+from ..model import RobotModel
+from ..numeric import mass_matrix_rnea, numeric_model, rnea
+from ..symbolic.program import Program
+
+# ----------------------------------------------------------------------------------------------
+# Printing a program for scalars and for batches of a given dtype
+# ----------------------------------------------------------------------------------------------
+
+
+class _ScalarPrinter(PythonCodePrinter):
+    """Python code over floats: ``sin(x)`` (``math``), floats with all 17 digits."""
+
+    def _print_Float(self, expr):
+        return repr(float(expr))
+
+    def _print_Rational(self, expr):
+        return f"({int(expr.p)}/{int(expr.q)})"
+
+
+class _BatchPrinter(NumPyPrinter):
+    """NumPy code over arrays of one dtype: every literal wrapped in ``_F`` (that dtype)."""
+
+    def _module_format(self, fqn, register=True):
+        text = super()._module_format(fqn, register)
+        return "np." + text[len("numpy."):] if text.startswith("numpy.") else text
+
+    def _print_Float(self, expr):
+        return f"_F({float(expr)!r})"
+
+    def _print_Rational(self, expr):
+        return f"(_F({int(expr.p)})/_F({int(expr.q)}))"
+
+    def _print_Pi(self, expr):
+        return "_F(np.pi)"
+
+
+def _source(program: Program, arguments: Sequence[str], printer, outputs: Sequence[str],
+            flat: bool) -> str:
+    lines = ["def _program(" + ", ".join(arguments) + "):"]
+    for symbol, expr in program.assignments:
+        lines.append(f"    {symbol.name} = {printer.doprint(expr)}")
+    parts = []
+    for name in outputs:
+        matrix = program.output(name)
+        entries = [printer.doprint(e) for e in matrix]
+        parts.append("[" + ", ".join(entries) + "]" if flat else
+                     "[" + ", ".join("[" + ", ".join(entries[r * matrix.cols:(r + 1) * matrix.cols])
+                                     + "]" for r in range(matrix.rows)) + "]")
+    lines.append("    return (" + ", ".join(parts) + ("," if len(parts) == 1 else "") + ")")
+    return "\n".join(lines)
+
+
+def _prepared(program: Program, inputs: Sequence[sp.Symbol], outputs: Sequence[str],
+              fixed: dict | None):
+    program = program.pruned(outputs)
+    names = [f"_a{k}" for k in range(len(inputs))]
+    rename = {s: sp.Symbol(a, real=True) for s, a in zip(inputs, names)}
+    if fixed:
+        rename.update({s: sp.sympify(v) for s, v in fixed.items()})
+    assignments = tuple((s, e.xreplace(rename)) for s, e in program.assignments)
+    outs = tuple((n, program.output(n).xreplace(rename)) for n in outputs)
+    return Program(assignments, outs), names
+
+
+def compile_scalar(program: Program, inputs: Sequence[sp.Symbol], outputs: Sequence[str],
+                   fixed: dict | None = None) -> Callable[..., tuple[list[float], ...]]:
+    """``f(*floats) -> (flat list of output 1, …)``: the program over Python floats.
+
+    ``fixed`` maps symbols to constants substituted before printing (e.g. ``qdd = 0`` for the
+    bias forces, which shortens the program). Outputs are flat row-major lists. The printed code
+    is our own program, executed in a namespace holding ``math``'s functions only.
+    """
+    program, names = _prepared(program, inputs, outputs, fixed)
+    printer = _ScalarPrinter({"fully_qualified_modules": False, "standard": "python3"})
+    namespace: dict = {}
+    functions = {f: getattr(math, f) for f in ("sin", "cos", "tan", "sqrt", "pi")}
+    exec(compile(_source(program, names, printer, outputs, flat=True),  # noqa: S102 - ours
+                 "<eomgen scalar program>", "exec"), functions, namespace)
+    return namespace["_program"]
+
+
+def compile_batch(program: Program, inputs: Sequence[sp.Symbol], outputs: Sequence[str],
+                  dtype=np.float64) -> Callable[..., tuple[np.ndarray, ...]]:
+    """``f(*columns) -> (array (N, rows, cols) per output)``: the program over arrays of
+    ``dtype`` (each input a column of shape (N,)), every literal rounded to ``dtype``. With
+    float32 this is the float32 evaluation of exactly the program the generators print."""
+    program, names = _prepared(program, inputs, outputs, None)
+    printer = _BatchPrinter({"fully_qualified_modules": True, "standard": "python3"})
+    namespace: dict = {}
+    exec(compile(_source(program, names, printer, outputs, flat=False),  # noqa: S102 - ours
+                 "<eomgen batch program>", "exec"), {"np": np, "_F": np.dtype(dtype).type},
+         namespace)
+    raw = namespace["_program"]
+    shapes = [program.output(n).shape for n in outputs]
+
+    def evaluate(*columns) -> tuple[np.ndarray, ...]:
+        columns = [np.asarray(c, dtype=dtype) for c in columns]
+        size = columns[0].shape[0] if columns else 1
+        results = []
+        for value, shape in zip(raw(*columns), shapes):
+            out = np.empty((size,) + shape, dtype=dtype)
+            for r in range(shape[0]):
+                for c in range(shape[1]):
+                    out[:, r, c] = value[r][c]
+            results.append(out)
+        return tuple(results)
+
+    return evaluate
+
+
+# ----------------------------------------------------------------------------------------------
+# Routes
+# ----------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Route:
+    """One way of evaluating the dynamics.
+
+    ``tau(q, qd, qdd)`` takes (N, n) arrays and returns (N, n); ``M(q)`` takes (N, n) and
+    returns (N, n, n); results are in the route's ``dtype``.
+    """
+
+    name: str
+    dtype: str
+    batch: bool
+    tau: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+    M: Callable[[np.ndarray], np.ndarray]
+    note: str = ""
+
+
+def _per_state(function, n_out_shape):
+    def run(*arrays):
+        size = arrays[0].shape[0]
+        out = np.empty((size,) + n_out_shape)
+        for k in range(size):
+            out[k] = function(*(a[k] for a in arrays))
+        return out
+
+    return run
+
+
+def _import(path: Path, name: str):
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)  # our own generated module
+    return module
+
+
+def numeric_only(model: RobotModel) -> RobotModel:
+    """``model`` with every parameter replaced by its value."""
+    return model.with_numeric_parameters() if model.parameters else model
+
+
+def build_routes(model: RobotModel, workdir: Path, dynamics: Dynamics | None = None,
+                 progress: Callable[[str], None] = lambda _: None,
+                 skip: Iterable[str] = ()) -> list[Route]:
+    """Every available route for ``model`` (parameters at their values).
+
+    Parameters
+    ----------
+    model:
+        The robot.
+    workdir:
+        Folder for the generated modules and the compiled library; must outlive the routes.
+    dynamics:
+        ``derive(model, outputs=("M", "tau"))`` when already at hand.
+    skip:
+        Route names to leave out.
+    """
+    model = numeric_only(model)
+    if dynamics is None:
+        progress(f"deriving M and tau of {model.name} ({model.dof} joints)")
+        dynamics = derive(model, outputs=("M", "tau"), simplify=False)
+    n = model.dof
+    skip = set(skip)
+    job = make_job(dynamics, ("mass_matrix", "inverse_dynamics"))
+    registry = available_backends()
+    chosen = ["numpy", "casadi"] + (["c"] if c_compiler() else [])
+    files = []
+    for backend in chosen:
+        progress(f"generating the {backend} code")
+        files += registry[backend].generate(job)
+    workdir = Path(workdir)
+    workdir.mkdir(parents=True, exist_ok=True)
+    paths = {}
+    for f in files:
+        path = workdir / f.name
+        if isinstance(f.content, bytes):
+            path.write_bytes(f.content)
+        else:
+            path.write_text(f.content, encoding="utf-8")
+        paths[f.name] = path
+    routes: list[Route] = []
+
+    numpy_module = _import(paths[job.stem + "_numpy.py"], f"_eomgen_bench_{job.stem}_numpy")
+    routes.append(Route("NumPy, one state", "float64", False,
+                        _per_state(numpy_module.inverse_dynamics, (n,)),
+                        _per_state(numpy_module.mass_matrix, (n, n)),
+                        "generated <robot>_numpy.py, called per state"))
+    routes.append(Route("NumPy, batch", "float64", True,
+                        numpy_module.inverse_dynamics, numpy_module.mass_matrix,
+                        "generated <robot>_numpy.py on the (N, n) batch"))
+
+    d = dynamics
+    tau32 = compile_batch(d.program, d.q + d.qd + d.qdd, ["tau"], np.float32)
+    M32 = compile_batch(d.program, d.q, ["M"], np.float32)
+    routes.append(Route(
+        "NumPy float32, batch", "float32", True,
+        lambda q, qd, qdd: tau32(*np.asarray(q, np.float32).T, *np.asarray(qd, np.float32).T,
+                                 *np.asarray(qdd, np.float32).T)[0][:, :, 0],
+        lambda q: M32(*np.asarray(q, np.float32).T)[0],
+        "the same program over float32 arrays"))
+
+    tau_scalar = compile_scalar(d.program, d.q + d.qd + d.qdd, ["tau"])
+    M_scalar = compile_scalar(d.program, d.q, ["M"])
+    routes.append(Route(
+        "Python floats, one state", "float64", False,
+        _per_state(lambda q, qd, qdd: tau_scalar(*q.tolist(), *qd.tolist(), *qdd.tolist())[0],
+                   (n,)),
+        _per_state(lambda q: np.reshape(M_scalar(*q.tolist())[0], (n, n)), (n, n)),
+        "the program printed over Python floats (math)"))
+
+    casadi_module = _import(paths[job.stem + "_casadi.py"], f"_eomgen_bench_{job.stem}_casadi")
+    routes += _casadi_routes("CasADi SX", casadi_module.inverse_dynamics,
+                             casadi_module.mass_matrix, n, "casadi.Function (SX virtual machine)")
+    library = paths.get(job.stem + "_casadi.so")
+    if library is not None:
+        import casadi as ca
+
+        routes += _casadi_routes("C (CasADi)", ca.external("inverse_dynamics", str(library)),
+                                 ca.external("mass_matrix", str(library)), n,
+                                 "compiled <robot>_casadi.so via casadi.external")
+        shared = ctypes.CDLL(str(library))
+        tau_c = CFunction(shared, "inverse_dynamics")
+        M_c = CFunction(shared, "mass_matrix")
+        routes.append(Route("C (ctypes), one state", "float64", False,
+                            _per_state(tau_c, (n,)),
+                            _per_state(lambda q: M_c(q).reshape(n, n), (n, n)),
+                            "compiled <robot>_casadi.so called through ctypes"))
+
+    nm = numeric_model(model)
+    routes.append(Route("RNEA (eomgen.numeric)", "float64", False,
+                        _per_state(lambda q, qd, qdd: rnea(nm, q, qd, qdd), (n,)),
+                        _per_state(lambda q: mass_matrix_rnea(nm, q), (n, n)),
+                        "eomgen.numeric.rnea; M by n + 1 RNEA calls"))
+    try:
+        from .pinocchio_bridge import to_pinocchio
+
+        pm = to_pinocchio(model)
+    except ImportError:
+        progress("Pinocchio is not installed: no Pinocchio route")
+    else:
+        routes.append(Route("Pinocchio", "float64", False,
+                            _per_state(pm.rnea, (n,)), _per_state(pm.crba, (n, n)),
+                            "pinocchio.rnea and pinocchio.crba"))
+    return [r for r in routes if r.name not in skip]
+
+
+class CFunction:
+    """A function of a CasADi-generated C library, called through ctypes.
+
+    Uses the C API CasADi generates: ``name(arg, res, iw, w, mem)``, ``name_work`` for the work
+    sizes and ``name_sparsity_in/out`` (compressed column storage) for the shapes. Inputs are
+    the function's vector inputs in order; the output is returned dense (row-major, flat).
+    """
+
+    def __init__(self, library: ctypes.CDLL, name: str):
+        c_int, c_ll, c_double = ctypes.c_int, ctypes.c_longlong, ctypes.c_double
+        self._f = getattr(library, name)
+        self._f.restype = c_int
+        sizes = [c_ll() for _ in range(4)]
+        work = getattr(library, name + "_work")
+        work.restype = c_int
+        work(*(ctypes.byref(s) for s in sizes))
+        sz_arg, sz_res, sz_iw, sz_w = (s.value for s in sizes)
+        n_in = getattr(library, name + "_n_in")
+        n_in.restype = c_ll
+        sparsity_in = getattr(library, name + "_sparsity_in")
+        sparsity_out = getattr(library, name + "_sparsity_out")
+        for f in (sparsity_in, sparsity_out):
+            f.restype = ctypes.POINTER(c_ll)
+            f.argtypes = [c_ll]
+        self._inputs = []
+        for i in range(n_in()):
+            rows, cols = sparsity_in(i)[0], sparsity_in(i)[1]
+            self._inputs.append(np.zeros(rows * cols))
+        sp_out = sparsity_out(0)
+        rows, cols = sp_out[0], sp_out[1]
+        if sp_out[2] == 1:  # compact form {rows, cols, 1}: dense, column-major
+            colind = [c * rows for c in range(cols + 1)]
+            row = [r for _ in range(cols) for r in range(rows)]
+        else:  # {rows, cols, colind[0..cols], row[0..nnz-1]}
+            colind = [sp_out[2 + c] for c in range(cols + 1)]
+            row = [sp_out[3 + cols + k] for k in range(colind[-1])]
+        nnz = colind[-1]
+        self._scatter = np.array([row[k] * cols + c for c in range(cols)
+                                  for k in range(colind[c], colind[c + 1])], dtype=int)
+        self._shape = rows * cols
+        self._buffer = np.zeros(max(nnz, 1))
+        pointer = ctypes.POINTER(c_double)
+        self._arg = (pointer * max(sz_arg, 1))(*[a.ctypes.data_as(pointer) for a in self._inputs])
+        self._res = (pointer * max(sz_res, 1))(self._buffer.ctypes.data_as(pointer))
+        self._iw = (c_ll * max(sz_iw, 1))()
+        self._w = (c_double * max(sz_w, 1))()
+        self._name = name
+
+    def __call__(self, *vectors) -> np.ndarray:
+        for buffer, v in zip(self._inputs, vectors):
+            buffer[:] = v
+        if self._f(self._arg, self._res, self._iw, self._w, 0):
+            raise RuntimeError(f"{self._name} failed")
+        out = np.zeros(self._shape)
+        out[self._scatter] = self._buffer[:len(self._scatter)]
+        return out
+
+
+def _casadi_routes(label: str, tau_f, M_f, n: int, note: str) -> list[Route]:
+    def tau_one(q, qd, qdd):
+        return np.asarray(tau_f(q, qd, qdd)).ravel()
+
+    def M_one(q):
+        return np.asarray(M_f(q))
+
+    maps: dict = {}
+
+    def mapped(function, size):
+        key = (id(function), size)
+        if key not in maps:
+            maps[key] = function.map(size)
+        return maps[key]
+
+    def tau_map(q, qd, qdd):
+        out = mapped(tau_f, q.shape[0])(q.T, qd.T, qdd.T)
+        return np.asarray(out).T
+
+    def M_map(q):
+        out = np.asarray(mapped(M_f, q.shape[0])(q.T))  # (n, n N): the N matrices side by side
+        return out.reshape(n, q.shape[0], n).transpose(1, 0, 2)
+
+    return [Route(f"{label}, one state", "float64", False, _per_state(tau_one, (n,)),
+                  _per_state(M_one, (n, n)), note),
+            Route(f"{label}, map", "float64", True, tau_map, M_map, note + ", Function.map(N)")]
+
+
+__all__ = ["Route", "build_routes", "compile_scalar", "compile_batch", "numeric_only"]
