@@ -22,8 +22,7 @@ from sympy.printing.pycode import PythonCodePrinter
 from .. import GeneratedFile, Job, register
 from ..functions import FUNCTION_NAMES as ALL_FUNCTIONS
 from ..render import render
-from .common import (docstring_literal, dunder_all_lines, parameter_renames, print_function,
-                     python_literal)
+from .common import python_module_context
 
 _FUNCTIONS = ("sin", "cos", "tan", "sqrt", "exp", "log", "asin", "acos", "atan", "atan2")
 
@@ -63,25 +62,7 @@ class CasADiConfig:
 
 def _render_module(job: Job, config: CasADiConfig) -> str:
     printer = CasADiPrinter({"standard": "python3"})
-    renames = parameter_renames(job)
-
-    def doprint(expr: sp.Expr) -> str:
-        return printer.doprint(expr.xreplace(renames) if renames else expr)
-
-    functions = [print_function(spec, job, doprint, None) for spec in job.specs]
-    return render(
-        config.template,
-        header=job.header_lines(config.template),
-        robot=docstring_literal(job.model.name),
-        joint_names=[python_literal(n) for n in job.dynamics.joint_names],
-        nq=job.model.dof,
-        parameters=[(p.identifier, repr(float(p.default)) if p.default is not None else None,
-                     python_literal(p.doc)) for p in job.parameters],
-        functions=functions,
-        dunder_all=dunder_all_lines(["JOINT_NAMES", "NQ", "PARAMETERS", *job.functions]),
-        exports=list(job.functions),
-        forward_dynamics="forward_dynamics" in job.functions,
-    )
+    return render(config.template, **python_module_context(job, printer, config.template))
 
 
 @register("casadi", "CasADi module: casadi.Function objects (SX) with named inputs and outputs")

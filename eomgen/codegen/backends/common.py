@@ -126,3 +126,26 @@ def dunder_all_lines(names, width: int = 79) -> list[str]:
         current += ("" if current in (prefix, " " * len(prefix)) else " ") + text
     lines.append(current if items else prefix + "]")
     return lines
+
+
+def python_module_context(job: Job, printer, template: str, extra_exports=()) -> dict:
+    """What the Python-source templates (NumPy, CasADi) receive: the printed functions and the
+    escaped module metadata. ``printer`` prints one SymPy expression (``printer.doprint``)."""
+    renames = parameter_renames(job)
+
+    def doprint(expr: sp.Expr) -> str:
+        return printer.doprint(expr.xreplace(renames) if renames else expr)
+
+    return dict(
+        header=job.header_lines(template),
+        robot=docstring_literal(job.model.name),
+        joint_names=[python_literal(n) for n in job.dynamics.joint_names],
+        nq=job.model.dof,
+        parameters=[(p.identifier, repr(float(p.default)) if p.default is not None else None,
+                     python_literal(p.doc)) for p in job.parameters],
+        functions=[print_function(spec, job, doprint, None) for spec in job.specs],
+        dunder_all=dunder_all_lines(["JOINT_NAMES", "NQ", "PARAMETERS", *job.functions,
+                                     *extra_exports]),
+        exports=list(job.functions),
+        forward_dynamics="forward_dynamics" in job.functions,
+    )

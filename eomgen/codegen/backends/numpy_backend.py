@@ -8,13 +8,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 
 from .. import GeneratedFile, Job, register
 from ..render import render
-from .common import (docstring_literal, dunder_all_lines, parameter_renames, print_function,
-                     python_literal)
+from .common import python_module_context
 
 
 class NumPyModulePrinter(NumPyPrinter):
@@ -42,25 +40,6 @@ class NumPyConfig:
 @register("numpy", "NumPy module: single states (n,) and batches (N, n), NumPy only")
 def generate_numpy(job: Job, config: NumPyConfig = NumPyConfig()) -> list[GeneratedFile]:
     printer = NumPyModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
-    renames = parameter_renames(job)
-
-    def doprint(expr: sp.Expr) -> str:
-        return printer.doprint(expr.xreplace(renames) if renames else expr)
-
-    functions = [print_function(spec, job, doprint, None) for spec in job.specs]
-    text = render(
-        config.template,
-        header=job.header_lines(config.template),
-        robot=docstring_literal(job.model.name),
-        joint_names=[python_literal(n) for n in job.dynamics.joint_names],
-        nq=job.model.dof,
-        parameters=[(p.identifier, repr(float(p.default)) if p.default is not None else None,
-                     python_literal(p.doc)) for p in job.parameters],
-        functions=functions,
-        dunder_all=dunder_all_lines(["JOINT_NAMES", "NQ", "PARAMETERS", *job.functions]
-                                    + (["IllConditionedWarning"]
-                                       if "forward_dynamics" in job.functions else [])),
-        exports=list(job.functions),
-        forward_dynamics="forward_dynamics" in job.functions,
-    )
+    extra = ["IllConditionedWarning"] if "forward_dynamics" in job.functions else []
+    text = render(config.template, **python_module_context(job, printer, config.template, extra))
     return [GeneratedFile(job.stem + config.suffix, text)]
