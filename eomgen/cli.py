@@ -252,6 +252,31 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
         click.echo(str(path))
 
 
+@main.command()
+@description_argument
+@click.option("-o", "--output", "output", default=None, type=click.Path(dir_okay=False, path_type=Path),
+              help="Notebook file to write (default: <robot>_derivation.ipynb).")
+@strict_option
+@_handle_errors
+def notebook(description, output, strict):
+    """Write a Jupyter notebook deriving DESCRIPTION's equations of motion step by step.
+
+    The notebook (saved without outputs) loads the robot, derives positions, Jacobians,
+    energies, M, the Christoffel symbols, C and g (textbook form for at most 3 joints), checks
+    them, compares them with Newton–Euler and simulates the robot.
+
+    \b
+    Examples:
+      eomgen notebook                        # the bundled planar 2-link arm
+      eomgen notebook ur5.urdf -o ur5.ipynb
+    """
+    from .notebook import build_notebook, write_notebook
+
+    model = _load(description, strict)
+    path = output or Path(f"{model.name}_derivation.ipynb")
+    click.echo(str(write_notebook(build_notebook(model, description), path)))
+
+
 # ``eomgen bench`` and ``eomgen simulate`` (eomgen/analysis/commands.py), with this module's
 # error handling, DESCRIPTION argument, --strict and loading.
 from .analysis.commands import add_commands as _add_analysis_commands  # noqa: E402

@@ -143,12 +143,10 @@ class Dynamics:
         """Arithmetic operations of the straight-line program for the given outputs."""
         return self.program.operation_count(names)
 
-    def _repr_latex_(self) -> str:  # rich display in notebooks
-        parts = [f"\\text{{{self.model.name}: }}"]
-        for name in ("M", "C", "g"):
-            if name in self.outputs and self.model.dof <= 3:
-                parts.append(f"{name} = {sp.latex(getattr(self, name))}")
-        return "$" + r",\quad ".join(parts) + "$"
+    def _repr_latex_(self) -> str:  # rich display in notebooks: see eomgen.display
+        from .display import dynamics_latex
+
+        return dynamics_latex(self)
 
 
 def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify: bool | None = None) -> Dynamics:

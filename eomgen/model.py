@@ -287,6 +287,11 @@ class RobotModel:
             stack.extend(reversed(children.get(joint.child, [])))
         return tuple(order)
 
+    def _repr_html_(self) -> str:  # rich display in notebooks: see eomgen.display
+        from .display import model_html
+
+        return model_html(self)
+
     @property
     def parameter_values(self) -> dict[sp.Symbol, float]:
         """Default numeric value of every parameter that has one."""

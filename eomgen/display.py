@@ -1,0 +1,105 @@
+"""Rich display in Jupyter: :meth:`RobotModel._repr_html_` and :meth:`Dynamics._repr_latex_`.
+
+* a model shows as an HTML table of its joints (name, type, parent, child, axis), every piece of
+  user text escaped with :func:`html.escape`;
+* equations of motion show as LaTeX: ``M``, ``C`` and ``g`` in the notation of eomgen's
+  derivation documents (``s_{1}``, ``c_{12}``, ``\\dot{q}_{1}``) for models of at most
+  :data:`DISPLAY_MAX_DOF` joints; larger models show a short summary (joints, operation counts)
+  instead of pages of algebra.
+"""
+
+from __future__ import annotations
+
+import html
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .dynamics import Dynamics
+    from .model import RobotModel
+
+#: Models with more joints display a summary instead of M, C and g.
+DISPLAY_MAX_DOF = 3
+
+
+def _number(value) -> str:
+    try:
+        return f"{float(value):.6g}"
+    except TypeError:  # a symbolic parameter
+        return str(value)
+
+
+def model_html(model: RobotModel) -> str:
+    """An HTML table of ``model``'s joints, every name escaped.
+
+    >>> import eomgen
+    >>> print(model_html(eomgen.load(eomgen.example_path("planar_2link"))).splitlines()[0])
+    <div class="eomgen-model"><p><b>planar_2link</b>: 2 movable joints (joint1, joint2)</p>
+    """
+    e = html.escape
+    movable = model.dof
+    rows = []
+    for joint in model.joints:
+        axis = ", ".join(_number(x) for x in joint.axis) if joint.type.is_movable else ""
+        rows.append("<tr>" + "".join(f"<td>{e(str(x))}</td>" for x in (
+            joint.name, joint.type.name.lower(), joint.parent, joint.child,
+            f"({axis})" if axis else "")) + "</tr>")
+    header = "".join(f"<th>{h}</th>" for h in ("joint", "type", "parent", "child", "axis"))
+    names = ", ".join(e(n) for n in model.joint_names)
+    return (f'<div class="eomgen-model"><p><b>{e(model.name)}</b>: {movable} movable joint'
+            f'{"" if movable == 1 else "s"} ({names})</p>\n'
+            f"<table>\n<thead><tr>{header}</tr></thead>\n<tbody>\n" + "\n".join(rows)
+            + "\n</tbody>\n</table></div>")
+
+
+def _printer(dynamics: Dynamics):
+    from .codegen.backends.latex_printer import DerivationLatexPrinter
+
+    names = {}
+    for k, (q, qd, qdd) in enumerate(zip(dynamics.q, dynamics.qd, dynamics.qdd), start=1):
+        names[q] = f"q_{{{k}}}"
+        names[qd] = rf"\dot{{q}}_{{{k}}}"
+        names[qdd] = rf"\ddot{{q}}_{{{k}}}"
+    return DerivationLatexPrinter({"joint_positions": dynamics.q, "symbol_names": names,
+                                   "mat_str": "pmatrix", "mat_delim": ""})
+
+
+def _text(value: str) -> str:
+    from .codegen.backends.latex_printer import latex_escape
+
+    return r"\text{" + latex_escape(value) + "}"
+
+
+def dynamics_latex(dynamics: Dynamics, max_dof: int = DISPLAY_MAX_DOF) -> str:
+    """LaTeX (one ``$$…$$`` display) of ``dynamics``: M, C, g for small models, else a summary.
+
+    >>> import eomgen
+    >>> tex = dynamics_latex(eomgen.derive(eomgen.load(eomgen.example_path("planar_2link"))))
+    >>> "c_{2}" in tex and tex.startswith("$$")
+    True
+    """
+    model = dynamics.model
+    title = _text(f"{model.name}: {model.dof} joints ({', '.join(model.joint_names)})")
+    if model.dof > max_dof:
+        counts = ",\\ ".join(
+            _text(f"{name}: {dynamics.operation_count([name])} operations")
+            for name in dynamics.outputs)
+        return ("$$\\begin{array}{l}" + title + r"\\ " + counts + r"\\ "
+                + _text("(M, C, g are shown for models of at most "
+                        f"{max_dof} joints; see dynamics.M, .C, .g)") + r"\end{array}$$")
+    printer = _printer(dynamics)
+    lines = [title]
+    for name in ("M", "C", "g"):
+        if name in dynamics.outputs:
+            lines.append(f"{name} = {printer.doprint(getattr(dynamics, name))}")
+    return "$$\\begin{array}{l}" + r"\\[1ex] ".join(lines) + r"\end{array}$$"
+
+
+def expression_latex(dynamics: Dynamics, expr) -> str:
+    """LaTeX of one expression or matrix in the notation of :func:`dynamics_latex`.
+
+    >>> import eomgen
+    >>> dyn = eomgen.derive(eomgen.load(eomgen.example_path("planar_2link")))
+    >>> expression_latex(dyn, dyn.g[1])
+    'g l_{c2} m_{2} c_{12}'
+    """
+    return _printer(dynamics).doprint(expr)

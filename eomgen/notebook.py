@@ -1,0 +1,258 @@
+"""A Jupyter notebook walking through the derivation of one robot's equations of motion
+(``eomgen notebook``).
+
+Sections, each a short explanation followed by a code cell using eomgen's API: loading the
+robot; for models of at most :data:`~eomgen.symbolic.textbook.TEXTBOOK_MAX_DOF` joints the
+textbook derivation (centre-of-mass positions, Jacobians, kinetic and potential energy per link,
+M, Christoffel symbols, C, g); the equations of motion; the property checks of
+:func:`eomgen.verify`; a comparison with the numeric Newton–Euler algorithm at a sample state;
+and a short simulation (SciPy's ``solve_ivp``) with a plot.
+
+The notebook is saved without outputs and holds no timestamp: the same description gives the
+same file, byte for byte.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from pathlib import Path
+
+import nbformat
+from nbformat import v4
+
+from .model import RobotModel
+from .symbolic.textbook import TEXTBOOK_MAX_DOF
+
+
+def _load_code(description: Path | None) -> str:
+    if description is None:
+        return 'model = eomgen.load(eomgen.example_path("planar_2link"))'
+    return f"model = eomgen.load({str(Path(description).resolve())!r})"
+
+
+def build_notebook(model: RobotModel, description: Path | None = None) -> nbformat.NotebookNode:
+    """The derivation notebook of ``model``, loaded from ``description`` (None: the bundled
+    planar 2-link arm)."""
+    small = model.dof <= TEXTBOOK_MAX_DOF
+    cells = []
+
+    def md(text: str) -> None:
+        cells.append(v4.new_markdown_cell(text.strip()))
+
+    def code(text: str) -> None:
+        cells.append(v4.new_code_cell(text.strip()))
+
+    md(f"""
+# Equations of motion of `{model.name}`
+
+This notebook derives the equations of motion
+
+$$M(q)\\,\\ddot q + C(q, \\dot q)\\,\\dot q + g(q) = \\tau$$
+
+of the robot with the Lagrangian method, step by step, with eomgen, then checks them and
+simulates the robot.
+Compact notation: $s_{{1}} = \\sin q_1$, $c_{{12}} = \\cos(q_1 + q_2)$.
+""")
+    md("## The robot\n\nThe description is loaded into a `RobotModel`: links, joints, "
+       "gravity and parameters.")
+    code(f"""
+import numpy as np
+import sympy as sp
+from IPython.display import Math, display
+
+import eomgen
+from eomgen.display import expression_latex
+
+{_load_code(description)}
+dyn = eomgen.derive(model)
+
+
+def show(name, expr):
+    display(Math(name + " = " + expression_latex(dyn, expr)))
+
+
+model
+""")
+    if small:
+        md("""
+## Positions of the centres of mass and Jacobians
+
+For each moving body $i$, the position $p_{c_i}(q)$ of its centre of mass in the world frame,
+the linear velocity Jacobian $J_{v_i} = \\partial p_{c_i} / \\partial q$ and the angular velocity
+Jacobian $J_{\\omega_i}$ (column $k$ is the world axis of joint $k$ when it is a revolute joint
+at or before body $i$), so that $v_{c_i} = J_{v_i} \\dot q$ and $\\omega_i = J_{\\omega_i} \\dot q$.
+""")
+        code("""
+from eomgen.symbolic.textbook import textbook_derivation
+
+book = textbook_derivation(model)
+for i, body in enumerate(book.bodies, start=1):
+    print(f"body {i}: joint {body.joint}, links {', '.join(body.links)}")
+    show(f"p_{{c{i}}}", body.com)
+    show(f"J_{{v{i}}}", body.J_v)
+    show(f"J_{{\\\\omega{i}}}", body.J_w)
+""")
+        md("""
+## Kinetic and potential energy of each link
+
+$K_i = \\tfrac12 m_i v_{c_i}^T v_{c_i} + \\tfrac12 \\omega_i^T R_i I_{c_i} R_i^T \\omega_i$ and
+$P_i = -m_i\\, g_{vec}^T p_{c_i}$; the totals are $K = \\sum_i K_i$ and $P = \\sum_i P_i$.
+""")
+        code("""
+for i, body in enumerate(book.bodies, start=1):
+    show(f"K_{{{i}}}", body.K)
+    show(f"P_{{{i}}}", body.P)
+show("K", book.K)
+show("P", book.P)
+""")
+        md("""
+## Mass matrix
+
+$M = \\sum_i m_i J_{v_i}^T J_{v_i} + J_{\\omega_i}^T R_i I_{c_i} R_i^T J_{\\omega_i}$, so that
+$K = \\tfrac12 \\dot q^T M \\dot q$: the same matrix as `dyn.M`, which `eomgen.derive`
+computes without expanding the intermediate expressions.
+""")
+        code("""
+show("M", book.M)
+""")
+        md("""
+## Christoffel symbols
+
+$\\Gamma_{ijk} = \\tfrac12 \\left(\\frac{\\partial M_{ij}}{\\partial q_k}
++ \\frac{\\partial M_{ik}}{\\partial q_j} - \\frac{\\partial M_{jk}}{\\partial q_i}\\right)$;
+the non-zero ones with $j \\le k$ ($\\Gamma_{ijk} = \\Gamma_{ikj}$), indices from 1 (written
+$c_{ijk}$ in many textbooks; here $c$ is a cosine).
+""")
+        code("""
+for (i, j, k), value in book.christoffel:
+    show(f"\\\\Gamma_{{{i + 1}{j + 1}{k + 1}}}", value)
+""")
+        md("## Coriolis matrix\n\n$C_{ij} = \\sum_k \\Gamma_{ijk} \\dot q_k$: with this choice "
+           "$\\dot M - 2C$ is skew-symmetric.")
+        code('show("C", book.C)')
+        md("## Gravity vector\n\n$g_i = \\partial P / \\partial q_i$.")
+        code('show("g", book.g)')
+    else:
+        md(f"""
+## Derivation
+
+`{model.name}` has {model.dof} joints: the body-by-body textbook derivation (expanded
+expressions, exponential in the number of joints) is shown for models of at most
+{TEXTBOOK_MAX_DOF} joints. `eomgen.derive` computes M, C and g as a straight-line program
+without expression swell; its size:
+""")
+        code('{name: dyn.operation_count([name]) for name in dyn.outputs}')
+    md("## The equations of motion\n\n$M(q)\\,\\ddot q + C(q, \\dot q)\\,\\dot q + g(q) = "
+       "\\tau$, in joint order:")
+    code("print(dyn.joint_names)\ndyn")
+    md("""
+## Property checks
+
+`eomgen.verify` checks that M is symmetric positive definite, that $\\dot M - 2C$ is
+skew-symmetric, and M, C, g and the whole equation against an independent numeric recursive
+Newton–Euler computation at random states.
+""")
+    code("""
+report = eomgen.verify(eomgen.derive(model, outputs=("M", "C", "g", "tau")), samples=5)
+print(report.format())
+assert report.passed
+""")
+    md("""
+## Comparison with Newton–Euler at a sample state
+
+The torques $\\tau = M \\ddot q + C \\dot q + g$ from the derived program against
+`eomgen.numeric.rnea`, the numeric recursive Newton–Euler algorithm.
+""")
+    code("""
+from eomgen.numeric import numeric_model, rnea
+from eomgen.symbolic.evaluate import compile_program
+
+params = [p.symbol for p in model.parameters]
+values = [model.parameter_values[p] for p in params]
+evaluate = compile_program(dyn.program, list(dyn.q) + list(dyn.qd) + params)
+nm = numeric_model(model)
+
+n = model.dof
+q0 = np.linspace(0.3, 0.9, n)
+qd0 = np.linspace(-0.5, 0.7, n)
+qdd0 = np.linspace(1.0, -1.0, n)
+out = evaluate(*q0, *qd0, *values)
+tau = out["M"] @ qdd0 + out["C"] @ qd0 + out["g"][:, 0]
+tau_rnea = rnea(nm, q0, qd0, qdd0)
+print("tau (derived):", tau)
+print("tau (RNEA):   ", tau_rnea)
+print("largest difference:", np.max(np.abs(tau - tau_rnea)))
+assert np.allclose(tau, tau_rnea, rtol=1e-9, atol=1e-9)
+""")
+    md("""
+## A short simulation
+
+Forward dynamics $\\ddot q = M^{-1}(\\tau - C \\dot q - g)$ with $\\tau = 0$ (the robot falls
+under gravity), integrated with SciPy's `solve_ivp`.
+""")
+    code("""
+import io
+
+import matplotlib
+from IPython.display import Image
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+from scipy.integrate import solve_ivp
+
+
+def rhs(t, state):
+    q, qd = state[:n], state[n:]
+    out = evaluate(*q, *qd, *values)
+    qdd = np.linalg.solve(out["M"], -out["C"] @ qd - out["g"][:, 0])
+    return np.concatenate([qd, qdd])
+
+
+times = np.linspace(0.0, 2.0, 201)
+solution = solve_ivp(rhs, (times[0], times[-1]), np.concatenate([q0, np.zeros(n)]),
+                     t_eval=times, rtol=1e-8, atol=1e-10)
+assert solution.success, solution.message
+fig, ax = plt.subplots(figsize=(7, 3.5))
+for k, name in enumerate(dyn.joint_names):
+    ax.plot(solution.t, solution.y[k], label=name)
+ax.set_xlabel("time [s]")
+ax.set_ylabel("joint position")
+ax.legend()
+ax.set_title(f"{model.name}: free motion from rest")
+fig.tight_layout()
+buffer = io.BytesIO()
+fig.savefig(buffer, format="png", dpi=100)
+plt.close(fig)
+display(Image(buffer.getvalue()))
+""")
+    nb = v4.new_notebook(cells=cells, metadata={
+        "kernelspec": {"display_name": "Python 3", "language": "python", "name": "python3"},
+        "language_info": {"name": "python"},
+    })
+    for k, cell in enumerate(nb.cells):  # deterministic ids (nbformat makes random ones)
+        cell["id"] = f"cell-{k:02d}"
+    return nb
+
+
+def write_notebook(nb: nbformat.NotebookNode, path: Path) -> Path:
+    """Write ``nb`` to ``path`` atomically (a temporary file in the same folder, then
+    :func:`os.replace`): a reader never sees half a notebook."""
+    path = Path(path)
+    nbformat.validate(nb)
+    text = nbformat.writes(nb)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
+        with os.fdopen(fd, "w", encoding="utf-8") as handle:
+            handle.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+    return path

@@ -1,0 +1,80 @@
+"""Rich display in Jupyter (eomgen/display.py) and ``eomgen notebook`` (eomgen/notebook.py): the
+generated notebook for the bundled arm runs in a real kernel without a cell error."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import nbformat
+import pytest
+from click.testing import CliRunner
+
+import eomgen
+from eomgen.cli import main
+from eomgen.display import dynamics_latex
+from eomgen.notebook import build_notebook
+
+
+def run(*args):
+    return CliRunner().invoke(main, [str(a) for a in args], prog_name="eomgen")
+
+
+@pytest.fixture(scope="module")
+def arm():
+    return eomgen.load(eomgen.example_path("planar_2link"))
+
+
+def test_model_html_lists_joints_escaped(arm):
+    text = arm._repr_html_()
+    for joint in arm.joints:
+        assert f"<td>{joint.name}</td>" in text
+    hostile = dataclasses.replace(arm, name="<script>x</script>", joints=tuple(
+        dataclasses.replace(j, name=f"<b>{j.name}&</b>") if j.type.is_movable else j
+        for j in arm.joints))
+    text = hostile._repr_html_()
+    assert "<script>" not in text and "<b>joint1" not in text
+    assert "&lt;script&gt;" in text and "&lt;b&gt;joint1&amp;&lt;/b&gt;" in text
+
+
+def test_dynamics_latex_compact_and_summary(arm):
+    dyn = eomgen.derive(arm)
+    tex = dyn._repr_latex_()
+    assert "c_{2}" in tex and r"\dot{q}_{1}" in tex and "M = " in tex and "g = " in tex
+    assert r"\cos" not in tex
+    summary = dynamics_latex(dyn, max_dof=1)  # what a larger model shows
+    assert "M = " not in summary and "operations" in summary and "joint1" in summary
+
+
+def test_notebook_is_deterministic_without_outputs(arm):
+    first = nbformat.writes(build_notebook(arm))
+    assert first == nbformat.writes(build_notebook(arm))
+    nb = nbformat.reads(first, as_version=4)
+    assert all(not cell.get("outputs") for cell in nb.cells if cell.cell_type == "code")
+    text = "\n".join(cell.source for cell in nb.cells)
+    for needle in ("textbook_derivation", "Christoffel", "eomgen.verify", "rnea", "solve_ivp"):
+        assert needle in text
+
+
+def test_cli_notebook_runs_without_errors(tmp_path):
+    nbclient = pytest.importorskip("nbclient")
+    pytest.importorskip("ipykernel")
+    path = tmp_path / "arm.ipynb"
+    result = run("notebook", "-o", path)
+    assert result.exit_code == 0, result.output
+    assert path.is_file() and not list(tmp_path.glob(".*.tmp"))
+    nb = nbformat.read(path, as_version=4)
+    nbclient.NotebookClient(nb, timeout=120, kernel_name="python3",
+                            resources={"metadata": {"path": str(tmp_path)}}).execute()
+    outputs = [o for cell in nb.cells if cell.cell_type == "code" for o in cell.outputs]
+    assert not [o for o in outputs if o.output_type == "error"]
+    assert any("image/png" in o.get("data", {}) for o in outputs)  # the simulation plot
+
+
+def test_cli_notebook_bad_description(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("robot: [unclosed\n")
+    out = tmp_path / "bad.ipynb"
+    for description in (bad, tmp_path / "missing.urdf"):
+        result = run("notebook", description, "-o", out)
+        assert result.exit_code == 2, result.output
+        assert not out.exists()
