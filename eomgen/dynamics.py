@@ -212,7 +212,6 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
 
 
 def _steps(program: Program, result: dict) -> tuple[Step, ...]:
-    defined = dict(program.assignments)
 
     def named(prefix: str) -> tuple[tuple[str, sp.Expr], ...]:
         return tuple((s.name, e) for s, e in program.assignments if s.name.startswith(prefix))
@@ -238,5 +237,4 @@ def _steps(program: Program, result: dict) -> tuple[Step, ...]:
     if "g" in result:
         steps.append(Step("g", "Gravity vector", "g_i = ∂P/∂q_i.",
                           tuple((f"g[{i}]", result["g"][i, 0]) for i in range(result["g"].rows))))
-    del defined
     return tuple(steps)
