@@ -255,7 +255,7 @@ def test_parameters_named_like_the_notation_print_as_text():
     model = build_model("<test>", "clash", links, joints,
                         parameters=[Parameter(parameter_symbol(n), 1.0) for n in ("K1", "c12", "M1_2")])
     job = make_job(eomgen.derive(model, outputs=ALL))
-    names = symbol_names(job)
+    names = symbol_names(job.dynamics)
     assert names[parameter_symbol("K1")] == r"\textrm{K1}"
     assert names[parameter_symbol("c12")] == r"\textrm{c12}"
     assert names[parameter_symbol("M1_2")] == r"\textrm{M1\_2}"
@@ -350,7 +350,7 @@ def test_planar_document_has_the_textbook_entries_in_compact_form():
 
 def test_dh_document_has_the_table_and_the_program():
     tex = document("puma560_dh")
-    assert textbook_for(make_job(dynamics("puma560_dh"))) is None
+    assert textbook_for(dynamics("puma560_dh")) is None
     assert r"\subsection*{Denavit--Hartenberg table}" in tex and "Convention: standard." in tex
     assert r"joint2 & revolute & $0.4318$ & $0$ & $0$ & $0$ \\" in tex
     assert r"$\frac{\pi}{2}$" in tex

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ... import __version__
+from ...dynamics import Dynamics
 from ...model import IDENTITY3, RobotModel
 from ...symbolic.textbook import TEXTBOOK_MAX_DOF, TextbookDerivation, textbook_derivation
 from .. import GeneratedFile, Job, register
@@ -130,7 +131,7 @@ class Block:
 
 
 @dataclass
-class _Printing:
+class Printing:
     """The printers and sizes one document uses."""
 
     printer: DerivationLatexPrinter
@@ -154,44 +155,47 @@ def expanded_size(book: TextbookDerivation) -> int:
     return int(sum(sp.count_ops(e) for matrix in (book.M, book.C, book.g) for e in matrix))
 
 
-def textbook_for(job: Job, config: LatexConfig = LatexConfig()) -> TextbookDerivation | None:
-    """The textbook derivation of ``job``'s model when it is teaching-sized (see
-    :class:`LatexConfig`), else None: the document then prints the straight-line program."""
-    if (job.model.dof > config.textbook_max_dof
-            or job.dynamics.operation_count(["M", "C", "g"]) > config.textbook_max_operations):
+def textbook_for(dynamics: Dynamics,
+                 config: LatexConfig = LatexConfig()) -> TextbookDerivation | None:
+    """The textbook derivation of ``dynamics``' model when it is teaching-sized (see
+    :class:`LatexConfig`), else None: documents then print the straight-line program."""
+    if (dynamics.model.dof > config.textbook_max_dof
+            or dynamics.operation_count(["M", "C", "g"]) > config.textbook_max_operations):
         return None
-    book = textbook_derivation(job.model, max_dof=config.textbook_max_dof)
+    book = textbook_derivation(dynamics.model, max_dof=config.textbook_max_dof)
     return book if expanded_size(book) <= config.textbook_max_size else None
 
 
-def symbol_names(job: Job) -> dict[sp.Symbol, str]:
+def symbol_names(dyn: Dynamics) -> dict[sp.Symbol, str]:
     """Explicit LaTeX for the joint symbols, and for parameters whose name would print like one
     of the document's own quantities."""
-    dyn = job.dynamics
     names: dict[sp.Symbol, str] = {}
     for k, (q, qd, qdd) in enumerate(zip(dyn.q, dyn.qd, dyn.qdd), start=1):
         names[q] = f"q_{{{k}}}"
         names[qd] = rf"\dot{{q}}_{{{k}}}"
         names[qdd] = rf"\ddot{{q}}_{{{k}}}"
-    for p in job.model.parameters:
+    for p in dyn.model.parameters:
         if _NOTATION_NAMES.match(p.name):
             names[p.symbol] = r"\textrm{" + latex_escape(p.name) + "}"
     return names
 
 
-def _printing(job: Job, config: LatexConfig, compact_trig: bool) -> _Printing:
+def printing(dynamics: Dynamics, config: LatexConfig, compact_trig: bool,
+             extra_names: dict | None = None) -> Printing:
+    """The printers and sizes of a derivation document of ``dynamics``; ``extra_names`` gives
+    the LaTeX of further symbols (a document's own abbreviations)."""
     printer = DerivationLatexPrinter({
-        "joint_positions": job.dynamics.q,
-        "symbol_names": symbol_names(job),
+        "joint_positions": dynamics.q,
+        "symbol_names": {**symbol_names(dynamics), **(extra_names or {})},
         "compact_trig": compact_trig,
         "float_digits": config.float_digits,
         "mat_str": "pmatrix",
         "mat_delim": "",
     })
-    return _Printing(printer, config.line_width, config.block_size)
+    return Printing(printer, config.line_width, config.block_size)
 
 
-def _vector(p: _Printing, values) -> str:
+def vector(p: Printing, values) -> str:
     return r"\left(" + ", ".join(p.tex(v) for v in values) + r"\right)"
 
 
@@ -206,7 +210,7 @@ def _angle(value: float) -> sp.Expr:
     return sp.Float(value, 15)
 
 
-def _rpy(rotation) -> list[sp.Expr] | None:
+def rpy(rotation) -> list[sp.Expr] | None:
     """URDF roll, pitch, yaw of a numeric rotation matrix, None when it is symbolic."""
     try:
         R = [[float(v) for v in row] for row in rotation]
@@ -218,25 +222,25 @@ def _rpy(rotation) -> list[sp.Expr] | None:
     return [_angle(a) for a in (roll, pitch, yaw)]
 
 
-def _joint_rows(model: RobotModel, p: _Printing) -> list[list[str]]:
+def _joint_rows(model: RobotModel, p: Printing) -> list[list[str]]:
     rows = []
     index = {j.name: k for k, j in enumerate(model.movable_joints, start=1)}
     for joint in model.joints:
         rotation = joint.origin.rotation
         if rotation == IDENTITY3:
-            rpy = "0"
+            angles_tex = "0"
         else:
-            angles = _rpy(rotation)
-            rpy = "$" + _vector(p, angles) + "$" if angles is not None else "symbolic"
+            angles = rpy(rotation)
+            angles_tex = "$" + vector(p, angles) + "$" if angles is not None else "symbolic"
         rows.append([
             f"$q_{{{index[joint.name]}}}$" if joint.name in index else "",
             latex_escape(joint.name),
             joint.type.value,
             latex_escape(joint.parent),
             latex_escape(joint.child),
-            "$" + _vector(p, joint.axis) + "$" if joint.type.is_movable else "",
-            "$" + _vector(p, joint.origin.translation) + "$",
-            rpy,
+            "$" + vector(p, joint.axis) + "$" if joint.type.is_movable else "",
+            "$" + vector(p, joint.origin.translation) + "$",
+            angles_tex,
         ])
     return rows
 
@@ -245,7 +249,7 @@ _DH_HEADINGS = {"joint": "joint", "type": "type", "a": "$a$", "alpha": r"$\alpha
                 "d": "$d$", "theta": r"$\theta$"}
 
 
-def _dh_table(model: RobotModel, p: _Printing) -> dict | None:
+def _dh_table(model: RobotModel, p: Printing) -> dict | None:
     info = dict(model.info)
     if "dh" not in info:
         return None
@@ -266,7 +270,7 @@ def _dh_table(model: RobotModel, p: _Printing) -> dict | None:
     }
 
 
-def _link_rows(model: RobotModel, p: _Printing) -> list[list[str]]:
+def _link_rows(model: RobotModel, p: Printing) -> list[list[str]]:
     rows = []
     for link in model.links:
         if link.inertial is None:
@@ -276,14 +280,14 @@ def _link_rows(model: RobotModel, p: _Printing) -> list[list[str]]:
         rows.append([
             latex_escape(link.name),
             "$" + p.tex(link.inertial.mass) + "$",
-            "$" + _vector(p, link.inertial.com) + "$",
-            "$" + _vector(p, [inertia[0][0], inertia[1][1], inertia[2][2],
+            "$" + vector(p, link.inertial.com) + "$",
+            "$" + vector(p, [inertia[0][0], inertia[1][1], inertia[2][2],
                               inertia[0][1], inertia[0][2], inertia[1][2]]) + "$",
         ])
     return rows
 
 
-def _parameter_rows(model: RobotModel, p: _Printing) -> list[list[str]]:
+def _parameter_rows(model: RobotModel, p: Printing) -> list[list[str]]:
     return [["$" + p.tex(par.symbol) + "$",
              "$" + p.tex(sp.Float(par.value, 15)) + "$" if par.value is not None else "--",
              latex_escape(par.description)]
@@ -292,7 +296,7 @@ def _parameter_rows(model: RobotModel, p: _Printing) -> list[list[str]]:
 
 # -- the textbook derivation ----------------------------------------------------------------
 
-def _matrix_equations(p: _Printing, lhs: str, matrix: sp.Matrix) -> list[Equation]:
+def matrix_equations(p: Printing, lhs: str, matrix: sp.Matrix) -> list[Equation]:
     """``lhs = (matrix)`` on one line when it fits, else one line per non-zero entry."""
     entries = [p.tex(e) for e in matrix]
     widths = [max(display_width(entries[r * matrix.cols + c]) for r in range(matrix.rows))
@@ -309,16 +313,16 @@ def _matrix_equations(p: _Printing, lhs: str, matrix: sp.Matrix) -> list[Equatio
     return out
 
 
-def _textbook_sections(job: Job, book: TextbookDerivation, p: _Printing) -> dict:
+def _textbook_sections(job: Job, book: TextbookDerivation, p: Printing) -> dict:
     n = job.model.dof
     bodies = []
     for body in book.bodies:
         k = job.model.joint_names.index(body.joint) + 1
-        kinematics = _matrix_equations(p, f"I_{{c{k}}}", body.inertia)
-        kinematics += _matrix_equations(p, f"R_{{{k}}}", body.rotation)
-        kinematics += _matrix_equations(p, f"p_{{c{k}}}", body.com)
-        kinematics += _matrix_equations(p, f"J_{{v{k}}}", body.J_v)
-        kinematics += _matrix_equations(p, rf"J_{{\omega {k}}}", body.J_w)
+        kinematics = matrix_equations(p, f"I_{{c{k}}}", body.inertia)
+        kinematics += matrix_equations(p, f"R_{{{k}}}", body.rotation)
+        kinematics += matrix_equations(p, f"p_{{c{k}}}", body.com)
+        kinematics += matrix_equations(p, f"J_{{v{k}}}", body.J_v)
+        kinematics += matrix_equations(p, rf"J_{{\omega {k}}}", body.J_w)
         energies = [p.equation(f"K_{{{k}}}", body.K), p.equation(f"P_{{{k}}}", body.P)]
         bodies.append({
             "index": k,
@@ -363,7 +367,7 @@ def _entry_symbol(name: str, *indices: int) -> sp.Symbol:
     return sp.Symbol(name + "_".join(str(i + 1) for i in indices), real=True)
 
 
-def _entries(p: _Printing, name: str, matrix: sp.Matrix, upper: bool = False) -> list[Equation]:
+def _entries(p: Printing, name: str, matrix: sp.Matrix, upper: bool = False) -> list[Equation]:
     """``name_{i,j} = value`` for the non-zero entries, except those already named so."""
     out = []
     for i in range(matrix.rows):
@@ -375,9 +379,12 @@ def _entries(p: _Printing, name: str, matrix: sp.Matrix, upper: bool = False) ->
     return out
 
 
-def _program_sections(job: Job, config: LatexConfig, p: _Printing) -> dict:
-    program = job.dynamics.program
-    n = job.model.dof
+def program_sections(dyn: Dynamics, config: LatexConfig, p: Printing) -> dict:
+    """The named subexpressions of ``dyn``'s program, grouped by the output that first needs
+    them (at most ``config.max_program_lines``), the entries of M, g, C and the equations of
+    motion in terms of them."""
+    program = dyn.program
+    n = dyn.model.dof
     shown: set[sp.Symbol] = set()
     groups, omitted = [], []
     legend: dict[str, str] = {}
@@ -402,7 +409,6 @@ def _program_sections(job: Job, config: LatexConfig, p: _Printing) -> dict:
         "g": [] if "g" in omitted else p.chunks(_entries(p, "g", g)),
         "C": [] if "C" in omitted else p.chunks(_entries(p, "C", C)),
     }
-    dyn = job.dynamics
     equations = []
     for i in range(n):
         terms = [_entry_symbol("M", min(i, j), max(i, j)) * dyn.qdd[j] for j in range(n)
@@ -425,8 +431,8 @@ def _program_sections(job: Job, config: LatexConfig, p: _Printing) -> dict:
 def render_document(job: Job, config: LatexConfig = LatexConfig()) -> str:
     """The text of the ``.tex`` document for ``job`` (see the module docstring)."""
     model = job.model
-    book = textbook_for(job, config)
-    p = _printing(job, config, compact_trig=book is not None)
+    book = textbook_for(job.dynamics, config)
+    p = printing(job.dynamics, config, compact_trig=book is not None)
     context = {
         "header": [latex_comment(line) for line in job.header_lines(config.template)],
         "robot": latex_escape(model.name),
@@ -436,7 +442,7 @@ def render_document(job: Job, config: LatexConfig = LatexConfig()) -> str:
         "dof": model.dof,
         "joint_vector": {0: "()", 1: "q_{1}"}.get(model.dof,
                                                   rf"(q_{{1}}, \dots, q_{{{model.dof}}})"),
-        "gravity": _vector(p, model.gravity),
+        "gravity": vector(p, model.gravity),
         "joints": _joint_rows(model, p),
         "dh": _dh_table(model, p),
         "links": _link_rows(model, p),
@@ -451,7 +457,7 @@ def render_document(job: Job, config: LatexConfig = LatexConfig()) -> str:
     if book is not None:
         context.update(_textbook_sections(job, book, p))
     else:
-        context.update(_program_sections(job, config, p))
+        context.update(program_sections(job.dynamics, config, p))
     return render(config.template, **context)
 
 
