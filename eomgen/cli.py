@@ -277,6 +277,45 @@ def notebook(description, output, strict):
     click.echo(str(write_notebook(build_notebook(model, description), path)))
 
 
+@main.command()
+@description_argument
+@click.option("--format", "formats", default="pdf", show_default=True,
+              help="Comma-separated handout formats among pdf, html, md, tex; or all.")
+@click.option("-o", "--output", "outdir", default="eomgen_handout", show_default=True,
+              type=click.Path(file_okay=False, path_type=Path), help="Output folder.")
+@click.option("--no-check", is_flag=True,
+              help="Leave out the numeric verification (the handout says so).")
+@click.option("--quiet", is_flag=True, help="No progress lines.")
+@strict_option
+@_handle_errors
+def teach(description, formats, outdir, no_check, quiet, strict):
+    """Write a handout deriving DESCRIPTION's equations of motion for students.
+
+    The robot (tables and a kinematic sketch), the Lagrangian derivation step by step
+    (positions, velocities, kinetic and potential energy, M, Christoffel symbols and C, g,
+    the equations of motion; named subexpressions for models too large to print expanded) and
+    the verified properties with their numbers. Formats: pdf (through pdflatex), html (one
+    self-contained file, math as MathML), md (Markdown with $...$ math, plus the sketch as SVG),
+    tex (LaTeX source, plus the sketch as PDF). All files or none are written.
+
+    \b
+    Examples:
+      eomgen teach                                  # the bundled planar 2-link arm, PDF
+      eomgen teach robot.urdf --format html,md -o handouts/
+    """
+    from .teach import parse_formats, write_handout
+
+    chosen = parse_formats(formats)
+    model = _load(description, strict)
+
+    def progress(line: str) -> None:
+        if not quiet:
+            click.echo(f"eomgen: {line}", err=True)
+
+    for path in write_handout(model, outdir, chosen, progress, check=not no_check):
+        click.echo(str(path))
+
+
 # ``eomgen bench`` and ``eomgen simulate`` (eomgen/analysis/commands.py), with this module's
 # error handling, DESCRIPTION argument, --strict and loading.
 from .analysis.commands import add_commands as _add_analysis_commands  # noqa: E402
