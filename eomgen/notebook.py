@@ -22,6 +22,7 @@ from pathlib import Path
 import nbformat
 from nbformat import v4
 
+from .errors import ParameterError
 from .model import RobotModel
 from .symbolic.textbook import TEXTBOOK_MAX_DOF
 
@@ -34,7 +35,19 @@ def _load_code(description: Path | None) -> str:
 
 def build_notebook(model: RobotModel, description: Path | None = None) -> nbformat.NotebookNode:
     """The derivation notebook of ``model``, loaded from ``description`` (None: the bundled
-    planar 2-link arm)."""
+    planar 2-link arm).
+
+    Raises
+    ------
+    ParameterError
+        When a parameter has no value: the notebook's checks, comparison with Newton–Euler and
+        simulation are numeric, and would fail cell by cell.
+    """
+    missing = [p.name for p in model.parameters if p.value is None]
+    if missing:
+        raise ParameterError(model.source, "parameters",
+                             "the notebook's numeric cells need a value for "
+                             + ", ".join(missing))
     small = model.dof <= TEXTBOOK_MAX_DOF
     cells = []
 

@@ -78,3 +78,17 @@ def test_cli_notebook_bad_description(tmp_path):
         result = run("notebook", description, "-o", out)
         assert result.exit_code == 2, result.output
         assert not out.exists()
+
+
+def test_cli_notebook_refuses_parameters_without_values(tmp_path):
+    """The notebook's checks and simulation are numeric: a parameter without a value would make
+    them fail cell by cell, so the command refuses up front and names the parameter."""
+    text = eomgen.example_path("planar_2link").read_text().replace(
+        "  m2:  {value: 1.0,  description", "  m2:  {description")
+    description = tmp_path / "arm.yaml"
+    description.write_text(text)
+    out = tmp_path / "arm.ipynb"
+    result = run("notebook", description, "-o", out)
+    assert result.exit_code == 2
+    assert "arm.yaml: parameters: the notebook's numeric cells need a value for m2" in result.output
+    assert not out.exists()
