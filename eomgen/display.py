@@ -52,14 +52,11 @@ def model_html(model: RobotModel) -> str:
 
 
 def _printer(dynamics: Dynamics):
+    from .codegen.backends.latex_backend import symbol_names
     from .codegen.backends.latex_printer import DerivationLatexPrinter
 
-    names = {}
-    for k, (q, qd, qdd) in enumerate(zip(dynamics.q, dynamics.qd, dynamics.qdd), start=1):
-        names[q] = f"q_{{{k}}}"
-        names[qd] = rf"\dot{{q}}_{{{k}}}"
-        names[qdd] = rf"\ddot{{q}}_{{{k}}}"
-    return DerivationLatexPrinter({"joint_positions": dynamics.q, "symbol_names": names,
+    return DerivationLatexPrinter({"joint_positions": dynamics.q,
+                                   "symbol_names": symbol_names(dynamics),
                                    "mat_str": "pmatrix", "mat_delim": ""})
 
 

@@ -55,11 +55,14 @@ def test_notebook_is_deterministic_without_outputs(arm):
         assert needle in text
 
 
-def test_cli_notebook_runs_without_errors(tmp_path):
+@pytest.mark.parametrize("example", ["planar_2link", "puma560_dh"])
+def test_cli_notebook_runs_without_errors(tmp_path, example):
+    """The notebooks of the bundled examples execute without a cell error (the 6-joint PUMA
+    takes the large-model path: no textbook cells, summaries instead)."""
     nbclient = pytest.importorskip("nbclient")
     pytest.importorskip("ipykernel")
     path = tmp_path / "arm.ipynb"
-    result = run("notebook", "-o", path)
+    result = run("notebook", eomgen.example_path(example), "-o", path)
     assert result.exit_code == 0, result.output
     assert path.is_file() and not list(tmp_path.glob(".*.tmp"))
     nb = nbformat.read(path, as_version=4)

@@ -90,6 +90,16 @@ class _Format:
         raise NotImplementedError
 
 
+def _aligned_rows(block: Equations) -> str:
+    """The body of an ``align*`` / ``aligned`` environment: one row per line, aligned at the
+    relation sign, continuation lines indented."""
+    rows = []
+    for eq in block.equations:
+        rows.append(f"{eq.lhs} &{eq.relation} {eq.lines[0]}")
+        rows += [f"&\\quad {{}}{line}" for line in eq.lines[1:]]
+    return " \\\\\n".join(rows)
+
+
 #: Typographic characters of eomgen's own sentences, as pdflatex writes them (other non-ASCII
 #: characters, from user text, are shown by :func:`latex_escape` as code points).
 _TEX_TYPOGRAPHY = {"\u2013": "--", "\u2014": "---", "\u2019": "'", "\u00a0": "~"}
@@ -109,12 +119,7 @@ class TexFormat(_Format):
         return r"\texttt{" + latex_escape(value) + "}"
 
     def equations(self, block):
-        rows = []
-        for eq in block.equations:
-            row = f"{eq.lhs} &{eq.relation} {eq.lines[0]}"
-            row += "".join(f"\n\\\\ &\\quad {{}}{line}" for line in eq.lines[1:])
-            rows.append(row)
-        return "\\begin{align*}\n" + "\n\\\\\n".join(rows) + "\n\\end{align*}"
+        return "\\begin{align*}\n" + _aligned_rows(block) + "\n\\end{align*}"
 
     def figure_file(self, handout, figure):
         return f"{handout.stem}_{figure.name}.pdf"
@@ -145,12 +150,7 @@ class MarkdownFormat(_Format):
         return self.inline(content).replace("|", r"\|")
 
     def equations(self, block):
-        rows = []
-        for eq in block.equations:
-            row = f"{eq.lhs} &{eq.relation} {eq.lines[0]}"
-            row += "".join(f" \\\\\n&\\quad {{}}{line}" for line in eq.lines[1:])
-            rows.append(row)
-        return "$$\n\\begin{aligned}\n" + " \\\\\n".join(rows) + "\n\\end{aligned}\n$$"
+        return "$$\n\\begin{aligned}\n" + _aligned_rows(block) + "\n\\end{aligned}\n$$"
 
     def figure_file(self, handout, figure):
         return f"{handout.stem}_{figure.name}.svg"
