@@ -320,6 +320,8 @@ def test_html_is_self_contained(arm_handout):
     assert not re.search(r"(?:href|src)\s*=\s*[\"']?https?:", text)
     assert text.count("<math") > 50 and "<svg" in text
     assert 'encoding="application/x-tex"' in text  # the TeX rides along as text
+    # capital Greek upright as in TeX (MathML would slant a one-letter <mi>)
+    assert '<mi mathvariant="normal">&#x00393;</mi>' in text and "<mi>&#x00393;</mi>" not in text
 
 
 @pytest.mark.parametrize("fmt", sorted(FORMATS))

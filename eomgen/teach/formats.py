@@ -161,6 +161,10 @@ class MarkdownFormat(_Format):
 
 _MATH_ELEMENT = re.compile(r"^<math[^>]*>(.*)</math>$", re.S)
 
+#: A capital Greek letter as latex2mathml writes it (``\Gamma`` → ``<mi>&#x00393;</mi>``):
+#: upright in TeX, but MathML makes a one-letter ``<mi>`` italic unless told otherwise.
+_CAPITAL_GREEK = re.compile(r"<mi>(&#x00(?:39[1-9A-F]|3A[0-9]);)</mi>")
+
 
 class HtmlFormat(_Format):
     """HTML with MathML made by latex2mathml (see the module docstring)."""
@@ -180,7 +184,8 @@ class HtmlFormat(_Format):
         except Exception as exc:  # latex2mathml raises assorted exceptions on unknown input
             raise GenerationError(f"cannot convert {tex!r} to MathML: {exc}") from exc
         match = _MATH_ELEMENT.match(out.strip())
-        return match.group(1) if match else out
+        content = match.group(1) if match else out
+        return _CAPITAL_GREEK.sub(r'<mi mathvariant="normal">\1</mi>', content)
 
     @staticmethod
     def _wrap(content: str, tex: str, display: str) -> str:
