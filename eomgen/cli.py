@@ -283,12 +283,16 @@ def notebook(description, output, strict):
               help="Comma-separated handout formats among pdf, html, md, tex; or all.")
 @click.option("-o", "--output", "outdir", default="eomgen_handout", show_default=True,
               type=click.Path(file_okay=False, path_type=Path), help="Output folder.")
+@click.option("--scene", "scene_path", default=None,
+              type=click.Path(dir_okay=False, path_type=Path),
+              help="Scene file (YAML, docs/scenes.md): derive only what it moves, e.g. two "
+                   "joints of a real arm (examples/scenes/panda_two_joints.yaml).")
 @click.option("--no-check", is_flag=True,
               help="Leave out the numeric verification (the handout says so).")
 @click.option("--quiet", is_flag=True, help="No progress lines.")
 @strict_option
 @_handle_errors
-def teach(description, formats, outdir, no_check, quiet, strict):
+def teach(description, formats, outdir, scene_path, no_check, quiet, strict):
     """Write a handout deriving DESCRIPTION's equations of motion for students.
 
     The robot (tables and a kinematic sketch), the Lagrangian derivation step by step
@@ -302,17 +306,25 @@ def teach(description, formats, outdir, no_check, quiet, strict):
     Examples:
       eomgen teach                                  # the bundled planar 2-link arm, PDF
       eomgen teach robot.urdf --format html,md -o handouts/
+      eomgen teach panda.urdf --scene examples/scenes/panda_two_joints.yaml
     """
     from .teach import parse_formats, write_handout
 
     chosen = parse_formats(formats)
     model = _load(description, strict)
+    report = None
+    if scene_path is not None:
+        from .reduction import apply_scene
+        from .scene import load_scene
+
+        model, report = apply_scene(model, load_scene(scene_path, strict=strict))
 
     def progress(line: str) -> None:
         if not quiet:
             click.echo(f"eomgen: {line}", err=True)
 
-    for path in write_handout(model, outdir, chosen, progress, check=not no_check):
+    for path in write_handout(model, outdir, chosen, progress, check=not no_check,
+                              scene=report):
         click.echo(str(path))
 
 

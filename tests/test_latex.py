@@ -507,3 +507,13 @@ def test_hostile_document_compiles_and_shows_the_names(tmp_path):
     if text is not None:
         assert r"\input{/etc/passwd} $x$ % #" in text
         assert 'a”); import os #' in text or 'a"); import os #' in text
+
+
+def test_float_one_coefficients_are_not_printed():
+    """Rotation matrices from numeric descriptions carry 1.0 and -1.0 factors: they print as
+    nothing and as a minus sign, not as '1 \\cos' (values equal, so no information is lost)."""
+    q1, q2, a, b = sp.symbols("q1 q2 a b")
+    p = DerivationLatexPrinter({"joint_positions": (q1, q2)})
+    assert p.doprint(1.0 * sp.cos(q1 - q2)) == r"\cos{\left(q_{1} - q_{2} \right)}"
+    assert p.doprint(-1.0 * sp.sin(q1) * a) == r"- a s_{1}"
+    assert p.doprint(2.5 * a) == "2.5 a"

@@ -425,3 +425,36 @@ def test_hostile_descriptions_give_safe_handouts(name, tmp_path):
     assert "<script" not in html_page
     if PDFLATEX:
         assert next(v for k, v in files.items() if k.endswith(".pdf")).startswith(b"%PDF")
+
+
+def test_scene_turns_a_real_arm_into_a_teaching_example(tmp_path):
+    """The Panda with all but its shoulder and elbow locked (examples/scenes): a two-joint
+    handout in the textbook sequence, saying which joints the scene locked, whose M, C, g pass
+    every check against Newton–Euler on the reduced model. (That reduction equals Pinocchio's
+    buildReducedModel is tests/test_scenes.py's business.)"""
+    from conftest import erd_robots_dir
+
+    robots = erd_robots_dir()
+    if robots is None:
+        pytest.skip("example-robot-data is not installed")
+    scene = Path(__file__).parent.parent / "examples" / "scenes" / "panda_two_joints.yaml"
+    out = tmp_path / "out"
+    result = CliRunner().invoke(main, [
+        "teach", str(robots / "panda_description" / "urdf" / "panda.urdf"),
+        "--scene", str(scene), "--format", "md", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    md = (out / "panda_handout.md").read_text()
+    assert "## Step 6: Christoffel symbols and the Coriolis matrix" in md
+    assert "panda_two_joints.yaml" in md and "Moving: 2 of 9 joints" in md
+    assert "` panda_joint6 ` = 1.5708" in md
+    assert "| $M$ positive definite |" in md and "FAILED" not in md
+    assert md.count("| passed |") == 6
+
+
+def test_numbers_lead_their_groups():
+    """Numeric descriptions: 8.08 c_1 (the number first), and K takes the ½ into the number."""
+    q1 = sp.Symbol("q1")
+    qd1 = sp.Symbol("qd1")
+    assert rd.by_trig(8.08 * sp.cos(q1) - 0.85 * sp.sin(q1), [q1]) == [
+        8.08 * sp.cos(q1), -0.85 * sp.sin(q1)]
+    assert _quadratic_terms(sp.Matrix([[0.5]]), [qd1], []) == [0.25 * qd1 ** 2]

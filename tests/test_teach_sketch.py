@@ -283,3 +283,20 @@ def test_hostile_robot_name_is_drawn_literally(tmp_path):
         assert render_sketch(model, fmt)
     fig = sketch_figure(model)
     assert fig.get_suptitle().splitlines()[0] == hostile
+
+
+@pytest.mark.parametrize("gravity", ["[0, -g, 0]", "[0, g, 0]", "[g, 0, 0]"])
+def test_planar_view_turns_gravity_down_the_page(tmp_path, gravity):
+    """Whatever the root frame, the planar view has gravity pointing down the page: the
+    hatched ground sits below the root joint, and the robot's vertical extent is unchanged."""
+    from matplotlib.patches import Polygon
+
+    text = eomgen.example_path("planar_2link").read_text().replace(
+        "gravity: [0, -g, 0]", f"gravity: {gravity}")
+    path = tmp_path / "arm.yaml"
+    path.write_text(text)
+    fig = sketch_figure(eomgen.load(path))
+    ax = fig.axes[0]
+    ground = next(p for p in ax.patches if isinstance(p, Polygon))
+    xy = ground.get_xy()[:4]  # the closed polygon repeats its first corner
+    assert xy[:, 1].max() < 0 and abs(xy[:, 0].mean()) < 1e-9  # straight below the root

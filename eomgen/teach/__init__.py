@@ -42,9 +42,10 @@ def parse_formats(text: str) -> list[str]:
 
 def handout_files(model: RobotModel, formats: Sequence[str],
                   progress: Callable[[str], None] = lambda message: None,
-                  check: bool = True) -> list[GeneratedFile]:
-    """The files of ``model``'s handout in ``formats`` (names of :data:`FORMATS`), in memory."""
-    handout = build_handout(model, progress, check=check)
+                  check: bool = True, scene=None) -> list[GeneratedFile]:
+    """The files of ``model``'s handout in ``formats`` (names of :data:`FORMATS`), in memory;
+    ``scene``: the reduction report when ``model`` comes from a scene."""
+    handout = build_handout(model, progress, check=check, scene=scene)
     files: dict[str, GeneratedFile] = {}
     for name in formats:
         progress(f"writing the {name} handout" + (" (pdflatex)" if name == "pdf" else ""))
@@ -55,6 +56,6 @@ def handout_files(model: RobotModel, formats: Sequence[str],
 
 def write_handout(model: RobotModel, outdir: Path, formats: Sequence[str] = ("pdf",),
                   progress: Callable[[str], None] = lambda message: None,
-                  check: bool = True) -> list[Path]:
+                  check: bool = True, scene=None) -> list[Path]:
     """Write ``model``'s handout into ``outdir``: every file of every format, or none."""
-    return write_atomically(handout_files(model, formats, progress, check), Path(outdir))
+    return write_atomically(handout_files(model, formats, progress, check, scene), Path(outdir))

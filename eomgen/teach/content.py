@@ -78,11 +78,28 @@ def _vector(w: _Writer, values) -> Span:
 
 # -- the robot ------------------------------------------------------------------------------
 
-def _robot_section(model: RobotModel, w: _Writer, sketch_caption: tuple) -> Section:
+def _scene_paragraph(report) -> Paragraph:
+    """What a scene (:mod:`eomgen.scene`) did to the description, in one paragraph."""
+    parts: list = ["This handout models ", code(report.robot), " as the scene ",
+                   code(Path(report.scene).name), " reduces it"]
+    parts += [": ", plain(report.description)] if report.description else []
+    parts.append(f". Moving: {len(report.moving)} of {report.before.dof} joints")
+    if report.locked:
+        parts.append("; locked (rad or m): ")
+        for k, lock in enumerate(report.locked):
+            parts += ([", "] if k else []) + [code(lock.name), f" = {lock.position:g}"]
+    parts.append("; links rigidly attached to a moving body are merged into it.")
+    return Paragraph(prose(*parts))
+
+
+def _robot_section(model: RobotModel, w: _Writer, sketch_caption: tuple,
+                   scene=None) -> Section:
     blocks: list = []
     info = dict(model.info)
     if info.get("description"):
         blocks.append(Paragraph((plain(str(info["description"])),)))
+    if scene is not None:
+        blocks.append(_scene_paragraph(scene))
     movable = {j.name: k for k, j in enumerate(model.movable_joints, start=1)}
     blocks.append(Paragraph(prose(
         code(model.name), f" has {model.dof} movable joint{'s' if model.dof != 1 else ''}; "
@@ -290,6 +307,9 @@ def _quadratic_terms(M: sp.Matrix, qd, masses) -> list[sp.Expr]:
             grouped = rd.by_mass(M[j, k], masses)
             inner = grouped[0] if len(grouped) == 1 else sp.Add(*grouped, evaluate=False)
             velocity = qd[j] ** 2 if j == k else qd[j] * qd[k]
+            if inner.is_Number:  # a number takes the ½ in: 0.133 q̇_1², not ½ · 0.266 q̇_1²
+                terms.append((inner / 2 if j == k else inner) * velocity)
+                continue
             factors = [HALF] if j == k else []
             terms.append(sp.Mul(*factors, inner, velocity, evaluate=False))
     return terms
@@ -477,11 +497,13 @@ _CHECK_NAMES = {
 # -- the handout ----------------------------------------------------------------------------
 
 def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda message: None,
-                  check: bool = True) -> Handout:
+                  check: bool = True, scene=None) -> Handout:
     """The handout deriving ``model``'s equations of motion (see the module docstring).
 
     ``progress`` receives one line per stage (deriving, checking…); ``check=False`` leaves out
-    the numeric verification (the section then says so).
+    the numeric verification (the section then says so); ``scene`` is the
+    :class:`~eomgen.reduction.ReductionReport` when ``model`` comes from a scene (a paragraph
+    says what was locked).
 
     >>> import eomgen
     >>> handout = build_handout(eomgen.load(eomgen.example_path("planar_2link")), check=False)
@@ -503,7 +525,7 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
     if geometry.placeholder_parameters:
         caption += prose(" Drawn with 1 for the parameters without a value: ",
                          *_names(geometry.placeholder_parameters), ".")
-    sections = [_robot_section(model, w, caption), _method_section(model, book is not None)]
+    sections = [_robot_section(model, w, caption, scene), _method_section(model, book is not None)]
     if book is not None:
         sections += _textbook_sections(dyn, book, w)
     else:

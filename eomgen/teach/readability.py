@@ -69,6 +69,8 @@ def group_by_factor(expr: sp.Expr, key: Callable[[sp.Expr], sp.Expr | None],
         inner = -inner if negative else inner
         if inner == 1:
             term = k
+        elif inner.is_Number:  # a number goes first, as usual: 8.08 c_1, 2 m_2
+            term = inner * k
         elif inner.is_Add or factor:
             term = sp.Mul(k, inner, evaluate=False)
         else:

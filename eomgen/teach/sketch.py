@@ -438,8 +438,17 @@ def _draw_planar(fig, model: RobotModel, geo: SketchGeometry, scale: float, grav
     ax = fig.add_axes(rect)
     ax.set_axis_off()
 
+    # The view is turned in its plane so that gravity points down the page, as a student would
+    # draw it (a turn keeps the handedness, so the angle arcs keep their sense).
+    turn_view = np.eye(2)
+    if gravity is not None and math.hypot(gravity[i], gravity[j]) > _TOL:
+        phi = -math.pi / 2 - math.atan2(gravity[j], gravity[i])
+        if abs(phi) > 1e-12:
+            turn_view = np.array([[math.cos(phi), -math.sin(phi)],
+                                  [math.sin(phi), math.cos(phi)]])
+
     def v(p):
-        return np.array([p[i], p[j]], dtype=float)
+        return turn_view @ np.array([p[i], p[j]], dtype=float)
 
     joint_at = {name: v(p) for name, p in geo.joints}
     com_at = {name: v(p) for name, p in geo.coms}
@@ -463,8 +472,7 @@ def _draw_planar(fig, model: RobotModel, geo: SketchGeometry, scale: float, grav
                 solid_capstyle="round", zorder=3)
 
     # Root frame axes, along the view's axes.
-    for e, name in ((np.array([1.0, 0.0]), _AXIS_NAMES[i]), (np.array([0.0, 1.0]),
-                                                             _AXIS_NAMES[j])):
+    for e, name in ((turn_view[:, 0], _AXIS_NAMES[i]), (turn_view[:, 1], _AXIS_NAMES[j])):
         end = 0.2 * scale * e
         _arrow(ax, (0.0, 0.0), end, _Style.thin, 8, zorder=6)
         _label(ax, end, f"${name}_0$", e, zorder=6)

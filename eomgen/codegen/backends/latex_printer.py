@@ -196,6 +196,14 @@ class DerivationLatexPrinter(LatexPrinter):
         return self._compact("c", expr, exp)
 
     # -- numbers -------------------------------------------------------------------------------
+    def _print_Mul(self, expr):
+        """As LatexPrinter, without a coefficient of exactly ±1.0 (a float from a rotation
+        matrix): ``\\cos(q_1 - q_2)``, not ``1 \\cos(q_1 - q_2)``."""
+        coefficient, rest = expr.as_coeff_Mul()
+        if coefficient.is_Float and abs(float(coefficient)) == 1.0 and rest != 1:
+            return self._print(rest if coefficient > 0 else sp.Mul(-1, rest))
+        return super()._print_Mul(expr)
+
     def _print_Float(self, expr):
         text = f"{float(expr):.{self._settings['float_digits']}g}"
         if "e" not in text:
