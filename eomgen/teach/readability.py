@@ -65,12 +65,13 @@ def group_by_factor(expr: sp.Expr, key: Callable[[sp.Expr], sp.Expr | None],
     for k, parts in groups.items():
         inner = sp.Add(*parts)
         inner = sp.factor_terms(inner) if factor else inner
+        if inner.is_Number:  # a number goes first, as usual: 8.08 c_1, -2 m_2
+            out.append(inner * k)
+            continue
         negative = inner.could_extract_minus_sign() and not inner.is_Add
         inner = -inner if negative else inner
         if inner == 1:
             term = k
-        elif inner.is_Number:  # a number goes first, as usual: 8.08 c_1, 2 m_2
-            term = inner * k
         elif inner.is_Add or factor:
             term = sp.Mul(k, inner, evaluate=False)
         else:
