@@ -45,6 +45,7 @@ EXAMPLES = {
     "panda_fingers_locked": "panda_description/urdf/panda.urdf",
     "ur5_payload": "ur_description/urdf/ur5_robot.urdf",
     "talos_left_arm": "talos_data/robots/talos_reduced.urdf",
+    "panda_two_joints": "panda_description/urdf/panda.urdf",
 }
 
 
@@ -175,6 +176,14 @@ def test_panda_with_fingers_locked_equals_pinocchio_reduced_model():
     hand = {b.link: b for b in report.merged}["panda_link7"]
     assert {"panda_link8", "panda_hand", "panda_leftfinger", "panda_rightfinger"} <= set(hand.links)
     assert (report.before.dof, report.after.dof) == (9, 7)
+
+
+def test_panda_shoulder_and_elbow_teaching_scene_equals_pinocchio_reduced_model():
+    """The scene eomgen teach uses to make a two-link arm of the Panda: planar, two joints."""
+    reduction = compare_example("panda_two_joints", seed=4)
+    assert reduction.model.joint_names == ("panda_joint2", "panda_joint4")
+    assert reduction.report.planar is not None and reduction.report.planar.gravity == "in the plane"
+    assert (reduction.report.before.dof, reduction.report.after.dof) == (9, 2)
 
 
 def test_one_arm_of_talos_equals_pinocchio_with_every_other_joint_locked():
