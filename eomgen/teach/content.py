@@ -57,8 +57,7 @@ class _Writer:
         return self.p.tex(expr)
 
     def eq(self, lhs: str, expr) -> Equation:
-        e = self.p.equation(lhs, expr)
-        return Equation(e.lhs, tuple(e.lines))
+        return self.convert([self.p.equation(lhs, expr)])[0]
 
     def terms(self, lhs: str, terms: list) -> Equation:
         """``lhs =`` the sum of ``terms`` in the given order."""
@@ -66,9 +65,11 @@ class _Writer:
         return Equation(lhs, tuple(lines))
 
     def matrix(self, lhs: str, matrix: sp.Matrix) -> tuple[Equation, ...]:
-        return tuple(Equation(e.lhs, tuple(e.lines)) for e in lb.matrix_equations(self.p, lhs, matrix))
+        return self.convert(lb.matrix_equations(self.p, lhs, matrix))
 
-    def convert(self, equations) -> tuple[Equation, ...]:
+    @staticmethod
+    def convert(equations) -> tuple[Equation, ...]:
+        """The LaTeX backend's equations as the handout's."""
         return tuple(Equation(e.lhs, tuple(e.lines)) for e in equations)
 
 
@@ -129,17 +130,16 @@ def _robot_section(model: RobotModel, w: _Writer, sketch_caption: tuple,
     blocks.append(Table(tuple(prose(h) for h in (
         "variable", "joint", "type", "parent", "child", "axis", "origin xyz", "origin rpy")),
         tuple(rows), small=True))
-    dh = lb._dh_table(model, w.p) if "dh" in info else None
-    if dh is not None:
+    if "dh" in info:
         columns = list(info.get("dh_columns", ("joint", "type", "a", "alpha", "d", "theta")))
-        heads = {"a": "$a$", "alpha": "$\\alpha$", "d": "$d$", "theta": "$\\theta$"}
         dh_rows = [tuple((math(w.tex(v)),) if isinstance(v, sp.Basic) else (code(str(v)),)
                          for v in row) for row in info["dh"]]
         blocks.append(Paragraph(prose(
             "Denavit–Hartenberg table (", plain(str(info.get("convention", ""))),
             " convention); the joint variable is added to $\\theta$ (revolute) or $d$ "
             "(prismatic).")))
-        blocks.append(Table(tuple(prose(heads.get(c, c)) for c in columns), tuple(dh_rows),
+        blocks.append(Table(tuple(prose(lb.DH_HEADINGS.get(c, c)) for c in columns),
+                            tuple(dh_rows),
                             small=True))
     link_rows = []
     for link in model.links:
@@ -274,13 +274,14 @@ def _textbook_sections(dyn: Dynamics, book: TextbookDerivation, w: _Writer) -> l
             "($M_{j,i} = M_{i,j}$).")),
         Equations(M_eqs))))
 
-    sections.append(_coriolis_section(dyn, book, w))
+    coriolis = named_coriolis(dyn, book)
+    sections.append(_coriolis_section(book, coriolis, w))
 
     sections.append(Section("Step 7: the gravity vector", (
         Paragraph(prose("$g_{i} = \\partial P / \\partial q_{i}$ (N m or N):")),
         Equations(tuple(trig_sum(f"g_{{{i + 1}}}", book.g[i]) for i in range(n))))))
 
-    sections.append(_equations_section(dyn, book, w))
+    sections.append(_equations_section(dyn, book, coriolis, w))
     return sections
 
 
@@ -295,6 +296,12 @@ def _names(names) -> list:
 HALF = sp.Symbol("eomgen_one_half", positive=True)
 
 
+def _mass_grouped(expr: sp.Expr, masses) -> sp.Expr:
+    """``expr`` as one (unevaluated) sum of its terms grouped by mass, to print in a product."""
+    grouped = rd.by_mass(expr, masses)
+    return grouped[0] if len(grouped) == 1 else sp.Add(*grouped, evaluate=False)
+
+
 def _quadratic_terms(M: sp.Matrix, qd, masses) -> list[sp.Expr]:
     """``½ q̇ᵀ M q̇`` as the terms ``½ M_jj q̇_j²`` and ``M_jk q̇_j q̇_k`` (j < k), each entry
     grouped by mass (``HALF`` stands for ½: ``.subs(HALF, 1/2)`` computes with them)."""
@@ -304,8 +311,7 @@ def _quadratic_terms(M: sp.Matrix, qd, masses) -> list[sp.Expr]:
         for k in range(j, n):
             if M[j, k] == 0:
                 continue
-            grouped = rd.by_mass(M[j, k], masses)
-            inner = grouped[0] if len(grouped) == 1 else sp.Add(*grouped, evaluate=False)
+            inner = _mass_grouped(M[j, k], masses)
             velocity = qd[j] ** 2 if j == k else qd[j] * qd[k]
             if inner.is_Number:  # a number takes the ½ in: 0.133 q̇_1², not ½ · 0.266 q̇_1²
                 terms.append((inner / 2 if j == k else inner) * velocity)
@@ -337,8 +343,8 @@ def named_coriolis(dyn: Dynamics, book: TextbookDerivation):
     return names, christoffel, C
 
 
-def _coriolis_section(dyn: Dynamics, book: TextbookDerivation, w: _Writer) -> Section:
-    names, christoffel, C = named_coriolis(dyn, book)
+def _coriolis_section(book: TextbookDerivation, coriolis, w: _Writer) -> Section:
+    names, christoffel, C = coriolis
     blocks = [Paragraph(prose(
         "The Christoffel symbols of the first kind are "
         "$\\Gamma_{i,j,k} = \\tfrac{1}{2} \\bigl(\\partial M_{i,j} / \\partial q_{k} + "
@@ -366,19 +372,18 @@ def _coriolis_section(dyn: Dynamics, book: TextbookDerivation, w: _Writer) -> Se
     return Section("Step 6: Christoffel symbols and the Coriolis matrix", tuple(blocks))
 
 
-def _equations_section(dyn: Dynamics, book: TextbookDerivation, w: _Writer) -> Section:
+def _equations_section(dyn: Dynamics, book: TextbookDerivation, coriolis,
+                       w: _Writer) -> Section:
     n = dyn.model.dof
-    names, _, C = named_coriolis(dyn, book)
+    names, _, C = coriolis
     masses = _masses(book)
     qd, qdd = dyn.qd, dyn.qdd
     symbols = [nf.symbol for nf in names]
     compact, full = [], []
     for i in range(n):
         Cqd = sp.expand(sum((C[i, j] * qd[j] for j in range(n)), sp.Integer(0)))
-        velocity_terms = []
-        for term in rd.group_by_factor(Cqd, lambda t: next((h for h in symbols if t.has(h)),
-                                                             None)):
-            velocity_terms.append(term)
+        velocity_terms = rd.group_by_factor(
+            Cqd, lambda t: next((h for h in symbols if t.has(h)), None))
         entry = [sp.Symbol(f"M{min(i, j) + 1}_{max(i, j) + 1}") * qdd[j]
                  for j in range(n) if book.M[i, j] != 0]
         gi = [sp.Symbol(f"g{i + 1}")] if book.g[i] != 0 else []
@@ -386,9 +391,8 @@ def _equations_section(dyn: Dynamics, book: TextbookDerivation, w: _Writer) -> S
         written = []
         for j in range(n):
             if book.M[i, j] != 0:
-                grouped = rd.by_mass(book.M[i, j], masses)
-                inner = grouped[0] if len(grouped) == 1 else sp.Add(*grouped, evaluate=False)
-                written.append(sp.Mul(inner, qdd[j], evaluate=False))
+                written.append(sp.Mul(_mass_grouped(book.M[i, j], masses), qdd[j],
+                                      evaluate=False))
         written += velocity_terms + rd.by_trig(book.g[i], list(dyn.q))
         full.append(w.terms(rf"\tau_{{{i + 1}}}", written))
     blocks = [Paragraph(prose(

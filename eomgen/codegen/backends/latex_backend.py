@@ -245,7 +245,7 @@ def _joint_rows(model: RobotModel, p: Printing) -> list[list[str]]:
     return rows
 
 
-_DH_HEADINGS = {"joint": "joint", "type": "type", "a": "$a$", "alpha": r"$\alpha$",
+DH_HEADINGS = {"joint": "joint", "type": "type", "a": "$a$", "alpha": r"$\alpha$",
                 "d": "$d$", "theta": r"$\theta$"}
 
 
@@ -265,7 +265,7 @@ def _dh_table(model: RobotModel, p: Printing) -> dict | None:
         rows.append(cells)
     return {
         "convention": latex_escape(str(info.get("convention", ""))),
-        "headings": [_DH_HEADINGS.get(c, latex_escape(c)) for c in columns],
+        "headings": [DH_HEADINGS.get(c, latex_escape(c)) for c in columns],
         "rows": rows,
     }
 
