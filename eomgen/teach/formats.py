@@ -225,16 +225,13 @@ class HtmlFormat(_Format):
         return "<!-- " + html.escape(line.replace("--", "- -"), quote=False) + " -->"
 
 
-def _tex_files(handout: Handout) -> list[GeneratedFile]:
+def write_tex(handout: Handout) -> list[GeneratedFile]:
+    """The LaTeX source and the sketch (PDF) it includes."""
     files = [GeneratedFile(f"{handout.stem}_handout.tex", TexFormat().render(handout))]
     for name in FIGURE_NAMES:
         if name in handout.figures:
             files.append(GeneratedFile(f"{handout.stem}_{name}.pdf", handout.figures[name]("pdf")))
     return files
-
-
-def write_tex(handout: Handout) -> list[GeneratedFile]:
-    return _tex_files(handout)
 
 
 def write_pdf(handout: Handout, pdflatex: str | None = None, timeout: float = 600) -> list[GeneratedFile]:
@@ -245,13 +242,15 @@ def write_pdf(handout: Handout, pdflatex: str | None = None, timeout: float = 60
         raise GenerationError("the pdf format needs pdflatex, which is not installed (Debian: "
                               "apt install texlive-latex-base); --format tex, html or md "
                               "need nothing more")
-    files = _tex_files(handout)
+    files = write_tex(handout)
     env = dict(os.environ, SOURCE_DATE_EPOCH="0", FORCE_SOURCE_DATE="1")
     with tempfile.TemporaryDirectory(prefix="eomgen-teach-") as tmp:
         for f in files:
             path = Path(tmp) / f.name
-            path.write_bytes(f.content) if isinstance(f.content, bytes) else path.write_text(
-                f.content, encoding="utf-8")
+            if isinstance(f.content, bytes):
+                path.write_bytes(f.content)
+            else:
+                path.write_text(f.content, encoding="utf-8")
         tex = files[0].name
         for _ in range(2):
             try:

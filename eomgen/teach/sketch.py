@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model import JointType, RobotModel
+from ..model import RobotModel
 from ..numeric import link_poses, numeric_model
 
 Point = tuple[float, float, float]
@@ -190,31 +190,28 @@ def sketch_geometry(model: RobotModel, q=None) -> SketchGeometry:
     lines += [(origin(name), com(name)) for name, _ in coms if name not in parents]
     segments = tuple((_point(a), _point(b)) for a, b in lines if np.linalg.norm(b - a) > _TOL)
 
-    # World direction of each movable joint's axis (the axis is given in the child frame).
-    axes = [(j.type, poses[j.child][0] @ nm.axis[body[j.child]]) for j in model.movable_joints]
     return SketchGeometry(
         q=q,
         joints=joints,
         coms=coms,
         segments=segments,
-        plane=_motion_plane(axes),
+        plane=_motion_plane(model),
         placeholder_parameters=placeholders,
     )
 
 
-def _motion_plane(axes) -> tuple[int, int] | None:
-    """The ``(i, j)`` plane of a planar robot from its joints' world axes, else None."""
-    turning = [a for t, a in axes if t.is_revolute]
-    if not turning:
+def _motion_plane(model: RobotModel) -> tuple[int, int] | None:
+    """The ``(i, j)`` root-frame plane of a planar robot: the plane of
+    :func:`eomgen.reduction.planar_motion` when its normal is a root axis (the view is drawn in
+    root coordinates), else None."""
+    from ..reduction import planar_motion
+
+    planar = planar_motion(model)
+    if planar is None:
         return None
-    k = int(np.argmax(np.abs(turning[0])))
-    normal = np.eye(3)[k]
-    for t, a in axes:
-        along = abs(float(a @ normal))
-        if (t.is_revolute and abs(along - 1.0) > _TOL) or (
-            t is JointType.PRISMATIC and along > _TOL
-        ):
-            return None
+    k = int(np.argmax(np.abs(planar.normal)))
+    if abs(abs(planar.normal[k]) - 1.0) > _TOL:
+        return None
     return {0: (1, 2), 1: (0, 2), 2: (0, 1)}[k]
 
 
