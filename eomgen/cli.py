@@ -118,14 +118,17 @@ description_argument = click.argument(
     "description", required=False, type=click.Path(dir_okay=False, path_type=Path))
 strict_option = click.option(
     "--strict", is_flag=True,
-    help="Refuse inertias that break the triangle inequality and URDF <mimic> joints "
-         "instead of warning.")
+    help="Refuse inertias that break the triangle inequality, URDF <mimic> joints and a URDF "
+         "root that looks like a floating base, instead of warning (only about what a "
+         "--scene keeps).")
 
 
-def _load(description: Path | None, strict: bool):
-    from .parsers import load
+def _load(description: Path | None, strict: bool, scene=None):
+    """The whole model; warns (refuses under ``strict``) only about what ``scene`` (a loaded
+    :class:`eomgen.scene.Scene`, applied by the caller) keeps."""
+    from .reduction import load_for_scene
 
-    return load(description or _default_description(), strict=strict)
+    return load_for_scene(description or _default_description(), scene, strict)
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -224,8 +227,13 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
             return
     from .codegen.generate import generate as run_generate
 
+    scene = None
+    if scene_path is not None:
+        from .scene import load_scene
+
+        scene = load_scene(scene_path, strict=strict)
     with _recorded_warnings() as notices:
-        model = _load(description, strict)
+        model = _load(description, strict, scene)
     cache = dataclasses.replace(request, notices=notices) if request else not no_cache
     names = None
     if symbolic is not None:
@@ -238,9 +246,7 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
 
     if scene_path is not None or explain:
         from .codegen.scene_generate import generate_scene
-        from .scene import load_scene
 
-        scene = load_scene(scene_path, strict=strict) if scene_path is not None else None
         paths, produced = generate_scene(model, scene, outdir, backends, names, progress,
                                          explain)
         if explain:
@@ -311,13 +317,16 @@ def teach(description, formats, outdir, scene_path, no_check, quiet, strict):
     from .teach import parse_formats, write_handout
 
     chosen = parse_formats(formats)
-    model = _load(description, strict)
-    report = None
+    scene = report = None
     if scene_path is not None:
-        from .reduction import apply_scene
         from .scene import load_scene
 
-        model, report = apply_scene(model, load_scene(scene_path, strict=strict))
+        scene = load_scene(scene_path, strict=strict)
+    model = _load(description, strict, scene)
+    if scene is not None:
+        from .reduction import apply_scene
+
+        model, report = apply_scene(model, scene)
 
     def progress(line: str) -> None:
         if not quiet:

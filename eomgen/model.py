@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import enum
 import math
+import warnings
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Iterable, Mapping
@@ -29,13 +30,17 @@ from typing import Iterable, Mapping
 import sympy as sp
 
 from .errors import (
+    DescriptionError,
     InvalidAxisError,
     InvalidInertiaError,
     InvalidNumberError,
     KinematicTreeError,
     ParameterError,
+    PhysicalConsistencyWarning,
     TooLargeError,
-    warn_physical,
+    UnsupportedError,
+    UnsupportedFeatureWarning,
+    one_line,
 )
 
 Scalar = sp.Expr
@@ -231,6 +236,79 @@ class Parameter:
         return self.symbol.name
 
 
+class NoticeKind(enum.Enum):
+    """What a :class:`Notice` is about."""
+
+    TRIANGLE_INEQUALITY = "triangle inequality"  # a link inertia that is not physical
+    MIMIC = "mimic"                              # a URDF <mimic> coupling read as independent
+    FLOATING_BASE = "floating base"              # a root that looks free, read as fixed
+
+
+@dataclass(frozen=True)
+class Notice:
+    """A finding about a description that does not stop it from loading: a warning, or an error
+    under ``strict`` (``--strict``).
+
+    Parsers record notices on the model (:attr:`RobotModel.notices`) instead of warning at
+    once when asked to (``defer_notices=True``), so that a scene can first say which of them
+    still matter: a notice is moot when none of the ``joints`` it concerns moves, or every one
+    of the ``links`` it concerns is dropped (see :func:`eomgen.reduction.apply_scene`).
+
+    Attributes
+    ----------
+    kind:
+        What it is about.
+    source, element, problem:
+        The file, the element and the finding, as in :class:`~eomgen.errors.DescriptionError`.
+    fallback:
+        How eomgen reads the description anyway (e.g. "read as an independent joint"); empty
+        for values used as they are (a non-physical inertia).
+    links, joints:
+        The links and joints the finding concerns.
+    """
+
+    kind: NoticeKind
+    source: str
+    element: str
+    problem: str
+    fallback: str = ""
+    links: tuple[str, ...] = ()
+    joints: tuple[str, ...] = ()
+
+    @property
+    def category(self) -> type[Warning]:
+        """The warning class issued without ``strict``."""
+        if self.kind is NoticeKind.TRIANGLE_INEQUALITY:
+            return PhysicalConsistencyWarning
+        return UnsupportedFeatureWarning
+
+    @property
+    def error(self) -> type[DescriptionError]:
+        """The error class raised under ``strict``."""
+        if self.kind is NoticeKind.TRIANGLE_INEQUALITY:
+            return InvalidInertiaError
+        return UnsupportedError
+
+    @property
+    def message(self) -> str:
+        """The warning's text: one line naming the file, the element and the finding."""
+        tail = f"; {self.fallback}" if self.fallback else ""
+        return one_line(f"{self.source}: {self.element}: {self.problem}{tail}")
+
+    def emit(self, strict: bool = False, stacklevel: int = 2) -> None:
+        """Warn (``category``), or under ``strict`` raise ``error`` saying it was refused."""
+        if strict:
+            raise self.error(self.source, self.element,
+                             self.problem + " (refused under --strict)")
+        warnings.warn(self.message, self.category, stacklevel=stacklevel + 1)
+
+
+def emit_notices(notices: Iterable[Notice], strict: bool = False) -> None:
+    """Warn about each notice in order, or under ``strict`` raise the first one's error."""
+    for notice in notices:
+        notice.emit(strict, stacklevel=3)
+
+
 @dataclass(frozen=True)
 class RobotModel:
     """A robot: links, joints (in description order), gravity and parameters.
@@ -238,7 +316,8 @@ class RobotModel:
     The kinematic structure is a tree rooted at ``root``. ``joints`` keeps the order of the
     description; ``movable_joints`` (and hence the joint vector ``q``) follows it.
     ``info`` carries format-specific extras for display (e.g. the DH table) and never changes the
-    dynamics.
+    dynamics. ``notices`` are the parser's findings that warn (or, under ``strict``, refuse):
+    see :class:`Notice`; they take no part in comparing models.
     """
 
     name: str
@@ -249,6 +328,7 @@ class RobotModel:
     parameters: tuple[Parameter, ...] = ()
     source: str = "<memory>"
     info: tuple[tuple[str, object], ...] = ()
+    notices: tuple[Notice, ...] = field(default=(), compare=False, repr=False)
 
     @cached_property
     def link_by_name(self) -> dict[str, Link]:
@@ -389,10 +469,11 @@ def _number(x: sp.Expr) -> float | None:
     return None
 
 
-def check_inertial(source: str, link: str, inertial: Inertial, strict: bool = False,
-                   at_defaults: bool = False) -> None:
-    """Check a link's inertial data: finite non-negative mass, finite symmetric PSD inertia,
-    and (warning, or error under ``strict``) the triangle inequality of principal moments.
+def check_inertial(source: str, link: str, inertial: Inertial,
+                   at_defaults: bool = False) -> tuple[Notice, ...]:
+    """Check a link's inertial data: finite non-negative mass, finite symmetric PSD inertia;
+    return a :class:`Notice` (to warn about, or refuse under ``strict``) when the principal
+    moments break the triangle inequality.
 
     ``at_defaults``: ``inertial`` is a symbolic one with the parameters' default values put in;
     the messages say so, and the triangle inequality is not checked (planar models describe
@@ -412,7 +493,7 @@ def check_inertial(source: str, link: str, inertial: Inertial, strict: bool = Fa
             raise InvalidInertiaError(source, where, "centre of mass is not finite")
     values = [[_number(v) for v in row] for row in inertial.inertia]
     if any(v is None for row in values for v in row):
-        return  # symbolic inertia: checked at the numeric values by verification
+        return ()  # symbolic inertia: checked at the numeric values by verification
     import numpy as np
 
     I = np.array(values, dtype=float)
@@ -428,14 +509,10 @@ def check_inertial(source: str, link: str, inertial: Inertial, strict: bool = Fa
         )
     a, b, c = sorted(eig)
     if a + b < c - 1e-9 * scale and not at_defaults:
-        warn_physical(
-            source,
-            where,
-            f"principal moments {a:.6g}, {b:.6g}, {c:.6g} break the triangle inequality "
-            "(not a physical rigid body)",
-            strict,
-            InvalidInertiaError,
-        )
+        return (Notice(NoticeKind.TRIANGLE_INEQUALITY, source, where,
+                       f"principal moments {a:.6g}, {b:.6g}, {c:.6g} break the triangle "
+                       "inequality (not a physical rigid body)", links=(link,)),)
+    return ()
 
 
 def check_tree(source: str, links: Iterable[str], joints: Iterable[Joint]) -> str:
@@ -532,8 +609,13 @@ def build_model(
     parameters: Iterable[Parameter] = (),
     strict: bool = False,
     info: Mapping[str, object] | None = None,
+    defer_notices: bool = False,
 ) -> RobotModel:
     """Validate parsed parts and assemble a :class:`RobotModel`. Every parser ends here.
+
+    Findings that do not stop the model from loading (inertias that break the triangle
+    inequality) are recorded in :attr:`RobotModel.notices` and, unless ``defer_notices``,
+    warned about at once (raised under ``strict``) by :func:`emit_notices`.
 
     Raises a subclass of :class:`~eomgen.errors.DescriptionError` naming ``source`` and the
     element at fault: :class:`~eomgen.errors.TooLargeError` (more than :data:`MAX_JOINTS`
@@ -549,12 +631,13 @@ def build_model(
     root = check_tree(source, (l.name for l in links), joints)
     params = tuple(parameters)
     defaults = {p.symbol: scalar(p.value) for p in params if p.value is not None}
+    notices: list[Notice] = []
     for link in links:
         if link.inertial is not None:
-            check_inertial(source, link.name, link.inertial, strict)
+            notices += check_inertial(source, link.name, link.inertial)
             if defaults and _is_symbolic(link.inertial):
-                check_inertial(source, link.name, _substituted(link.inertial, defaults), strict,
-                               at_defaults=True)
+                notices += check_inertial(source, link.name,
+                                          _substituted(link.inertial, defaults), at_defaults=True)
     gravity = vec3(gravity)
     for v in gravity:
         g = _number(v)
@@ -566,10 +649,12 @@ def build_model(
             raise ParameterError(source, f"parameter '{p.name}'", "duplicate parameter")
     model = RobotModel(name=name, links=links, joints=joints, root=root, gravity=gravity,
                        parameters=params, source=str(source),
-                       info=tuple((info or {}).items()))
+                       info=tuple((info or {}).items()), notices=tuple(notices))
     undeclared = sorted((s for s in model.free_symbols if s.name not in names), key=str)
     if undeclared:
         model = replace(model, parameters=params + tuple(Parameter(s) for s in undeclared))
+    if not defer_notices:
+        emit_notices(model.notices, strict)
     return model
 
 

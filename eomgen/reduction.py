@@ -24,7 +24,13 @@ with a :class:`ReductionReport` of every step:
    its joint frame at q = 0 (:func:`_reroot`): no constant rotation or offset multiplies every
    later quantity; gravity is re-expressed in that frame. Joint-space M, C, g and τ are the same
    in any fixed frame.
-7. **Planar motion** is recognised (every moving revolute axis parallel to one normal n,
+7. **Notices**: of the description's findings that warn (or refuse under ``--strict``,
+   :class:`~eomgen.model.Notice`), the reduced model keeps those that still matter: not those
+   about joints none of which moves (a ``<mimic>`` finger the scene locks) nor those about links
+   the scene drops; the floating-base notice only when the scene does not say
+   ``fixed_base: true``. The report's notes list the others. :func:`load_for_scene` loads a
+   description and warns only about what a scene keeps.
+8. **Planar motion** is recognised (every moving revolute axis parallel to one normal n,
    prismatic axes perpendicular to it, in the root frame at q = 0): the report says so, and
    the component of gravity along n, which does no work in such motion, is dropped, so gravity
    along n gives g ≡ 0 exactly. Out-of-plane inertia terms are not removed from the model
@@ -64,8 +70,11 @@ from .model import (
     Inertial,
     Joint,
     Link,
+    Notice,
+    NoticeKind,
     RobotModel,
     Transform,
+    emit_notices,
     lock_joints,
     scalar,
     vec3,
@@ -347,6 +356,9 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
         notes.append("parameters that no longer appear in the reduced model (dropped): "
                      + ", ".join(unused))
     notes += _massless_notes(reduced)
+    kept, moot = _split_notices(model.notices, scene, set(reduced.joint_names), set(dropped))
+    reduced = replace(reduced, notices=kept)
+    notes += _moot_notes(moot)
     report = ReductionReport(
         robot=model.name, scene=scene.source, description=scene.description, before=before,
         after=ModelSize.of(reduced), base=base, tips=scene.tips,
@@ -355,6 +367,70 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
         dropped_payloads=dropped_payloads, planar=planar, notes=tuple(notes),
         outputs=select_functions(scene.outputs))
     return Reduction(reduced, report)
+
+
+def _split_notices(notices: Sequence[Notice], scene: Scene, moving: set[str],
+                   dropped: set[str]) -> tuple[tuple[Notice, ...], tuple[Notice, ...]]:
+    """``(kept, moot)``: the notices that still concern the reduced model, and the others."""
+    kept, moot = [], []
+    for notice in notices:
+        if notice.kind is NoticeKind.FLOATING_BASE:
+            matters = not scene.fixed_base
+        else:
+            matters = ((not notice.joints or any(j in moving for j in notice.joints))
+                       and (not notice.links or any(l not in dropped for l in notice.links)))
+        (kept if matters else moot).append(notice)
+    return tuple(kept), tuple(moot)
+
+
+def _moot_notes(moot: Sequence[Notice]) -> list[str]:
+    """Report notes naming the notices the scene made moot."""
+    notes = [f"{n.element} taken as bolted to the world (the scene says fixed_base: true): "
+             "the floating-base warning is left out"
+             for n in moot if n.kind is NoticeKind.FLOATING_BASE]
+    others = [n.element for n in moot if n.kind is not NoticeKind.FLOATING_BASE]
+    if others:
+        notes.append(f"warnings left out, about what the scene locks or drops ({len(others)}): "
+                     + ", ".join(others))
+    return notes
+
+
+def load_for_scene(path, scene: Scene | None = None, strict: bool = False) -> RobotModel:
+    """Read a description and warn (or, under ``strict``, refuse) only about what ``scene``
+    keeps; without a scene, about everything, as :func:`eomgen.load` does.
+
+    The findings that warn (:class:`~eomgen.model.Notice`: a ``<mimic>`` joint, an inertia
+    that breaks the triangle inequality, a root that looks like a floating base) are emitted
+    once the scene is applied, for what remains: a mimic finger the scene locks, a link it
+    drops, a floating base it declares fixed (``fixed_base: true``) say nothing.
+
+    Parameters
+    ----------
+    path:
+        The description file (see :func:`eomgen.load`).
+    scene:
+        The scene the caller will apply (:func:`eomgen.scene.load_scene`), or None.
+    strict:
+        Raise the first remaining finding's error (``--strict``) instead of warning.
+
+    Returns
+    -------
+    RobotModel
+        The *whole* model, the scene not applied (apply it with :func:`apply_scene`).
+
+    Raises
+    ------
+    DescriptionError
+        As :func:`eomgen.load`; :class:`~eomgen.errors.SceneError` when the scene does not
+        fit the robot; under ``strict``, the error of the first finding that remains.
+    """
+    from .parsers import load
+
+    if scene is None:
+        return load(path, strict=strict)
+    model = load(path, strict=strict, defer_notices=True)
+    emit_notices(apply_scene(model, scene).model.notices, strict)
+    return model
 
 
 def _parameters(model: RobotModel, scene: Scene):

@@ -11,6 +11,7 @@ Version 1 of the format (every key but ``version`` is optional)::
     version: 1                    # required: the scene format version
     robot: talos                  # the robot's name; another robot is an error
     description: Left arm, the rest of the robot held still.
+    fixed_base: true              # the root link is bolted to the world, on purpose
     base: torso_2_link            # the link the moving part hangs from (default: the root)
     tips: [arm_left_7_link]       # its ends (default: everything below base)
     locked:                       # joint: position [rad or m]; other joints outside the
@@ -42,12 +43,12 @@ from __future__ import annotations
 import difflib
 import functools
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Iterable
 
 from .codegen.functions import select_functions
-from .errors import DescriptionError, SceneError, one_line
+from .errors import DescriptionError, SceneError
 from .model import Inertial, Parameter, Vec3, check_inertial, mat3, vec3
 from .parsers._yaml import Reader, read_document
 
@@ -55,8 +56,8 @@ from .parsers._yaml import Reader, read_document
 SCENE_VERSION = 1
 
 #: Top-level keys of a version-1 scene, in documentation order.
-SCENE_KEYS = ("version", "robot", "description", "base", "tips", "locked", "payloads",
-              "gravity", "parameters", "symbolic", "outputs")
+SCENE_KEYS = ("version", "robot", "description", "fixed_base", "base", "tips", "locked",
+              "payloads", "gravity", "parameters", "symbolic", "outputs")
 
 #: Keys reserved for later versions of the format; refused with a message saying so.
 PLANNED_KEYS = ("friction", "armature", "contacts", "flexible_joints", "joint_limits")
@@ -82,6 +83,10 @@ class Scene:
     ----------
     source:
         The scene file (or a label), named by every error about the scene.
+    fixed_base:
+        The robot's root link is meant to be bolted to the world: silences the warning about a
+        root that looks like a floating base (:mod:`eomgen.parsers.urdf`), as the task holds
+        the robot still (an arm of a humanoid on a fixed torso, a legged robot on a stand).
     base, tips:
         The moving part is every movable joint on a path from ``base`` (default: the root) to
         one of ``tips`` (default: every joint below ``base``).
@@ -104,6 +109,7 @@ class Scene:
     version: int = SCENE_VERSION
     robot: str | None = None
     description: str = ""
+    fixed_base: bool = False
     base: str | None = None
     tips: tuple[str, ...] = ()
     locked: tuple[tuple[str, float], ...] = ()
@@ -201,6 +207,9 @@ def _read(data: dict, source: str, strict: bool) -> Scene:
     r.read_parameters(data.get("parameters"), "parameters")
     robot = r.text(data["robot"], "robot") if "robot" in data else None
     description = r.text(data["description"], "description") if "description" in data else ""
+    fixed_base = data.get("fixed_base", False)
+    if not isinstance(fixed_base, bool):
+        raise r.error("fixed_base", f"expected true or false, got {fixed_base!r}")
     base = r.name(data["base"], "base") if data.get("base") is not None else None
     tips: list[str] = []
     if data.get("tips") is not None:
@@ -229,7 +238,8 @@ def _read(data: dict, source: str, strict: bool) -> Scene:
     outputs = _outputs(r, data["outputs"]) if data.get("outputs") is not None else None
     declared = tuple(r.declared.values())
     return Scene(source=source, version=version, robot=robot, description=description,
-                 base=base, tips=tuple(tips), locked=tuple(locked), payloads=tuple(payloads),
+                 fixed_base=fixed_base, base=base, tips=tuple(tips), locked=tuple(locked),
+                 payloads=tuple(payloads),
                  gravity=gravity, parameters=declared, symbolic=symbolic, outputs=outputs)
 
 
@@ -246,15 +256,15 @@ def _payload(r: _SceneReader, entry, k: int, source: str, strict: bool) -> Paylo
     inertial = Inertial(mass, com, inertia)
     values = {p.symbol: p.value for p in r.declared.values() if p.value is not None}
     numeric = Inertial(*(_at(x, values) for x in (inertial.mass, inertial.com, inertial.inertia)))
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        try:
-            check_inertial(source, name, numeric, strict)
-        except DescriptionError as exc:
-            raise scene_error(type(exc))(source, where, exc.problem) from None
-    for warning in caught:  # re-issued naming the payload rather than a link
-        problem = str(warning.message).rsplit(" inertial: ", 1)[-1]
-        warnings.warn(one_line(f"{source}: {where}: {problem}"), warning.category, stacklevel=4)
+    try:
+        found = check_inertial(source, name, numeric)
+    except DescriptionError as exc:
+        raise scene_error(type(exc))(source, where, exc.problem) from None
+    for notice in found:  # named after the payload rather than a link
+        if strict:
+            raise scene_error(notice.error)(source, where,
+                                            notice.problem + " (refused under --strict)")
+        warnings.warn(replace(notice, element=where).message, notice.category, stacklevel=4)
     return Payload(link, inertial, name)
 
 

@@ -58,13 +58,13 @@ def _floats(text: str | None, option: str) -> list[float] | None:
 
 
 def _model(load, description, strict, scene_path):
-    model = load(description, strict)
-    if scene_path is not None:
-        from ..reduction import apply_scene
-        from ..scene import load_scene
+    if scene_path is None:
+        return load(description, strict)
+    from ..reduction import apply_scene
+    from ..scene import load_scene
 
-        model = apply_scene(model, load_scene(scene_path, strict=strict)).model
-    return model
+    scene = load_scene(scene_path, strict=strict)
+    return apply_scene(load(description, strict, scene), scene).model
 
 
 def _stem(model) -> str:

@@ -1,4 +1,5 @@
-"""Parsers: one ``load(path, strict) -> RobotModel`` per input format, in a registry.
+"""Parsers: one ``load(path, strict, defer_notices) -> RobotModel`` per input format, in a
+registry.
 
 A format registers itself with :func:`register`, naming the file suffixes it reads and, for
 YAML files shared by several formats, a ``sniff`` function that recognises its content. Adding a
@@ -14,7 +15,8 @@ from typing import Callable
 from ..errors import TooLargeError, UnknownFormatError, UnreadableFileError
 from ..model import RobotModel
 
-Loader = Callable[[Path, bool], RobotModel]
+#: ``load(path, strict, defer_notices=False)``.
+Loader = Callable[..., RobotModel]
 
 
 @dataclass(frozen=True)
@@ -29,7 +31,8 @@ FORMATS: list[Format] = []
 
 
 def register(name: str, suffixes: tuple[str, ...], sniff: Callable[[str], bool] | None = None):
-    """Decorator registering ``load(path, strict)`` for files with the given suffixes."""
+    """Decorator registering ``load(path, strict, defer_notices=False)`` for files with the
+    given suffixes."""
 
     def decorate(load: Loader) -> Loader:
         FORMATS.append(Format(name, suffixes, load, sniff))
@@ -41,7 +44,7 @@ def register(name: str, suffixes: tuple[str, ...], sniff: Callable[[str], bool] 
 MAX_FILE_BYTES = 50 * 1024 * 1024
 
 
-def load(path, strict: bool = False) -> RobotModel:
+def load(path, strict: bool = False, defer_notices: bool = False) -> RobotModel:
     """Read a robot description: URDF (``.urdf``), DH table (``.yaml`` with ``dh:``) or eomgen
     YAML (``.yaml`` with ``links:``/``joints:``).
 
@@ -51,7 +54,12 @@ def load(path, strict: bool = False) -> RobotModel:
         The description file.
     strict:
         Refuse (rather than warn about) inertias that break the triangle inequality and
-        features read in a simpler way than described (URDF ``<mimic>`` joints).
+        features read in a simpler way than described (URDF ``<mimic>`` joints, a URDF root
+        that looks like a floating base).
+    defer_notices:
+        Neither warn nor refuse yet: record these findings in the model's ``notices``
+        (:class:`~eomgen.model.Notice`) for the caller to emit once it knows which still
+        matter, e.g. after a scene (:func:`eomgen.reduction.load_for_scene`).
 
     Raises
     ------
@@ -88,4 +96,4 @@ def load(path, strict: bool = False) -> RobotModel:
                 "cannot tell which format this is (" + " or ".join(f.name for f in candidates)
                 + "): a DH table needs a top-level 'dh' list, an eomgen robot 'links' and 'joints'")
         candidates = sniffed
-    return candidates[0].load(path, strict)
+    return candidates[0].load(path, strict, defer_notices=defer_notices)

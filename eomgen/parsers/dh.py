@@ -72,7 +72,7 @@ def sniff(text: str) -> bool:
 
 
 @register("DH table", (".yaml", ".yml"), sniff)
-def load(path, strict: bool = False) -> RobotModel:
+def load(path, strict: bool = False, defer_notices: bool = False) -> RobotModel:
     """Read a DH table (see the module docstring for the conventions).
 
     Parameters
@@ -81,6 +81,9 @@ def load(path, strict: bool = False) -> RobotModel:
         The ``.yaml`` file with a top-level ``dh`` list.
     strict:
         Refuse (rather than warn about) inertias that break the triangle inequality.
+    defer_notices:
+        Record such findings in ``RobotModel.notices`` without warning or refusing yet
+        (see :func:`eomgen.parsers.load`).
 
     Raises
     ------
@@ -89,7 +92,8 @@ def load(path, strict: bool = False) -> RobotModel:
         tells the kind of problem (see :mod:`eomgen.errors`).
     """
     path = Path(path)
-    return parse(read_document(path), str(path), strict, default_name=path.stem)
+    return parse(read_document(path), str(path), strict, default_name=path.stem,
+                 defer_notices=defer_notices)
 
 
 def x_transform(a, alpha) -> Transform:
@@ -111,7 +115,8 @@ def rotate_inertia(rotation: Mat3, inertia: Mat3) -> Mat3:
                  for row in rows)  # type: ignore[return-value]
 
 
-def parse(data: dict, source: str, strict: bool = False, default_name: str = "robot") -> RobotModel:
+def parse(data: dict, source: str, strict: bool = False, default_name: str = "robot",
+          defer_notices: bool = False) -> RobotModel:
     """Build the model from an already loaded document (see :func:`load`)."""
     r = Reader(source)
     r.mapping(data, "robot", required=("convention", "dh"), optional=TOP_KEYS)
@@ -174,4 +179,5 @@ def parse(data: dict, source: str, strict: bool = False, default_name: str = "ro
     }
     if "description" in data:
         info["description"] = r.text(data["description"], "description")
-    return build_model(source, name, links, joints, gravity, r.used_parameters(), strict, info)
+    return build_model(source, name, links, joints, gravity, r.used_parameters(), strict, info,
+                       defer_notices=defer_notices)

@@ -58,12 +58,14 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
+from dataclasses import replace
 from pathlib import Path
 from typing import Iterable
 from xml.parsers import expat
 
 import defusedxml
 import defusedxml.ElementTree as SafeET
+import numpy as np
 import sympy as sp
 
 from ..errors import (
@@ -74,7 +76,6 @@ from ..errors import (
     UnreadableFileError,
     UnsupportedError,
     XMLSyntaxError,
-    warn_unsupported,
 )
 from ..expressions import MAX_MAGNITUDE
 from ..model import (
@@ -83,10 +84,13 @@ from ..model import (
     JointType,
     Link,
     Mat3,
+    Notice,
+    NoticeKind,
     RobotModel,
     Transform,
     build_model,
     check_size,
+    emit_notices,
     mat3,
     rotation_from_rpy,
     scalar,
@@ -107,7 +111,7 @@ _SHOWN_CHARACTERS = 40
 
 
 @register("URDF", (".urdf",))
-def load_urdf(path: Path, strict: bool = False) -> RobotModel:
+def load_urdf(path: Path, strict: bool = False, defer_notices: bool = False) -> RobotModel:
     """Read the URDF file ``path`` (see the module docstring for what is read and how).
 
     Parameters
@@ -115,8 +119,11 @@ def load_urdf(path: Path, strict: bool = False) -> RobotModel:
     path:
         The ``.urdf`` file.
     strict:
-        Refuse (rather than warn about) inertias that break the triangle inequality and
-        ``<mimic>`` joints.
+        Refuse (rather than warn about) inertias that break the triangle inequality,
+        ``<mimic>`` joints and a root that looks like a floating base.
+    defer_notices:
+        Neither warn nor refuse: record these findings in ``RobotModel.notices`` (see
+        :func:`eomgen.parsers.load`).
 
     Returns
     -------
@@ -131,12 +138,15 @@ def load_urdf(path: Path, strict: bool = False) -> RobotModel:
         :class:`~eomgen.errors.SchemaError`, :class:`~eomgen.errors.InvalidNumberError`, and
         those of :func:`eomgen.model.build_model`).
     UnsupportedError
-        For floating and planar joints, and for mimic joints under ``strict``.
+        For floating and planar joints, and under ``strict`` for mimic joints and a root that
+        looks like a floating base.
 
     Warns
     -----
     UnsupportedFeatureWarning
-        For each ``<mimic>`` joint (read as an independent joint), unless ``strict``.
+        For each ``<mimic>`` joint (read as an independent joint) and for a root link that
+        looks like a floating base (:func:`floating_base_notice`; read as fixed), unless
+        ``strict``.
     PhysicalConsistencyWarning
         For inertias that break the triangle inequality, unless ``strict``.
     """
@@ -145,11 +155,11 @@ def load_urdf(path: Path, strict: bool = False) -> RobotModel:
         data = Path(path).read_bytes()
     except OSError as exc:
         raise UnreadableFileError(source, "", f"cannot read the file ({exc.strerror})") from None
-    return _read_robot(data, source, strict)
+    return _read_robot(data, source, strict, defer_notices)
 
 
-def parse_urdf_string(text: str | bytes, source: str = "<string>", strict: bool = False
-                      ) -> RobotModel:
+def parse_urdf_string(text: str | bytes, source: str = "<string>", strict: bool = False,
+                      defer_notices: bool = False) -> RobotModel:
     """Read URDF from a string; ``source`` names it in error messages. See :func:`load_urdf`.
 
     >>> model = parse_urdf_string('''<robot name="r">
@@ -162,14 +172,15 @@ def parse_urdf_string(text: str | bytes, source: str = "<string>", strict: bool 
     >>> model.joint_names, model.link_by_name["arm"].inertial.mass
     (('j1',), 2)
     """
-    return _read_robot(text, source, strict)
+    return _read_robot(text, source, strict, defer_notices)
 
 
 # ----------------------------------------------------------------------------------------------
 # Document
 # ----------------------------------------------------------------------------------------------
 
-def _read_robot(data: str | bytes, source: str, strict: bool) -> RobotModel:
+def _read_robot(data: str | bytes, source: str, strict: bool, defer_notices: bool = False
+                ) -> RobotModel:
     root = _parse_xml(data, source)
     if root.tag != "robot":
         raise SchemaError(source, f"root element <{root.tag}>", "expected <robot>")
@@ -183,17 +194,115 @@ def _read_robot(data: str | bytes, source: str, strict: bool) -> RobotModel:
         joints.append(joint)
         if mimicked is not None and joint.type.is_movable:  # a fixed joint has nothing to couple
             mimics.append((joint.name, mimicked))
-    model = build_model(source, name, links, joints, gravity=GRAVITY, strict=strict)
+    model = build_model(source, name, links, joints, gravity=GRAVITY, defer_notices=True)
     names = {joint.name for joint in joints}
     for joint_name, mimicked in mimics:
         if mimicked not in names:
             raise KinematicTreeError(source, f"joint '{joint_name}' <mimic>",
                                    f"joint '{mimicked}' is not defined")
-    for joint_name, mimicked in mimics:  # only once the file is known to be valid
-        warn_unsupported(source, f"joint '{joint_name}' <mimic>",
-                         f"the coupling to joint '{mimicked}' is not modelled",
-                         "read as an independent joint", strict)
+    # only once the file is known to be valid: the whole model first, then links, then joints
+    floating = floating_base_notice(model)
+    notices = ([floating] if floating is not None else []) + list(model.notices) + [
+        Notice(NoticeKind.MIMIC, source, f"joint '{joint_name}' <mimic>",
+               f"the coupling to joint '{mimicked}' is not modelled",
+               "read as an independent joint", joints=(joint_name, mimicked))
+        for joint_name, mimicked in mimics]
+    model = replace(model, notices=tuple(notices))
+    if not defer_notices:
+        emit_notices(model.notices, strict)
     return model
+
+
+# ----------------------------------------------------------------------------------------------
+# Floating bases
+# ----------------------------------------------------------------------------------------------
+
+#: The root link name by which ROS and Gazebo bolt a model to the world (a massless ``world``
+#: link and a fixed joint to the robot's base): such a root is never taken for a floating base.
+WORLD_LINK = "world"
+
+#: A branch leaving the root body counts as a leg when, at q = 0, one of its link frames lies
+#: below the root link origin (along gravity) by at least this fraction of the model's extent.
+LEG_REACH = 0.5
+
+#: At most this many legs are named in the warning.
+_SHOWN_LEGS = 6
+
+
+def floating_base_notice(model: RobotModel) -> Notice | None:
+    """A :class:`~eomgen.model.Notice` when the root link looks like the floating base of a
+    legged robot, None otherwise.
+
+    URDF has no way to say that a robot's base is free (the ``floating`` joint is not part of
+    the specification that robot descriptions follow), so a quadruped or a humanoid reads like
+    an arm bolted to the world at its trunk or pelvis. The rule (see docs/formats.md for its
+    survey over example-robot-data and its limits):
+
+    * the root link is not named ``world`` (:data:`WORLD_LINK`), and
+    * at q = 0, at least two movable joints leaving the *root body* (the root link and the
+      links fixed to it) start branches that reach below the root link origin, along gravity,
+      by at least :data:`LEG_REACH` times the model's extent (the largest distance of a link
+      frame from the root link origin): legs standing on the ground.
+
+    Arms reach up or sideways from their base and hang one chain from it; a hand's fingers and
+    a dual-arm torso's arms do not reach far down; legged robots are described with their legs
+    straight down at q = 0.
+
+    Parameters
+    ----------
+    model:
+        A model with numeric geometry (as URDF gives).
+
+    Returns
+    -------
+    Notice or None
+        Kind :attr:`~eomgen.model.NoticeKind.FLOATING_BASE`, naming the root link and the legs.
+    """
+    if model.root == WORLD_LINK:
+        return None
+    try:
+        down = np.array([float(g) for g in model.gravity])
+        frames = {model.root: (np.eye(3), np.zeros(3))}
+        for joint in model.topological_joints:
+            R, p = frames[joint.parent]
+            R_j = np.array([[float(v) for v in row] for row in joint.origin.rotation])
+            p_j = np.array([float(v) for v in joint.origin.translation])
+            frames[joint.child] = (R @ R_j, p + R @ p_j)
+    except TypeError:  # symbolic geometry: not from a URDF
+        return None
+    norm = float(np.linalg.norm(down))
+    extent = max(float(np.linalg.norm(p)) for _, p in frames.values())
+    if norm == 0 or extent == 0:
+        return None
+    down /= norm
+    children: dict[str, list[Joint]] = {}
+    for joint in model.joints:
+        children.setdefault(joint.parent, []).append(joint)
+    body = {model.root}
+    legs = []
+    for joint in model.topological_joints:
+        if joint.parent not in body:
+            continue
+        if not joint.type.is_movable:
+            body.add(joint.child)
+            continue
+        stack, depth = [joint.child], -math.inf
+        while stack:
+            link = stack.pop()
+            depth = max(depth, float(frames[link][1] @ down))
+            stack.extend(j.child for j in children.get(link, ()))
+        if depth >= LEG_REACH * extent:
+            legs.append(joint.name)
+    if len(legs) < 2:
+        return None
+    shown = ", ".join(f"'{name}'" for name in legs[:_SHOWN_LEGS]) + \
+        (", ..." if len(legs) > _SHOWN_LEGS else "")
+    return Notice(
+        NoticeKind.FLOATING_BASE, model.source, f"root link '{model.root}'",
+        f"looks like a floating base ({len(legs)} branches reach down from it like legs at "
+        f"q = 0: {shown}), but eomgen models fixed-base robots only",
+        f"read as bolted to the world at '{model.root}' (a scene with 'fixed_base: true' says "
+        "this is meant and silences this warning)")
 
 
 def _parse_xml(data: str | bytes, source: str) -> ET.Element:
@@ -304,11 +413,17 @@ def _read_joint_type(element: ET.Element, source: str, where: str) -> JointType:
     text = element.get("type")
     if text is None:
         raise SchemaError(source, where, "no 'type' attribute")
-    if text in _UNSUPPORTED_JOINT_TYPES:
+    if text == "floating":
+        child = _link_reference(element, "child", source, where)
         raise UnsupportedError(
             source, where,
-            f"{text} joints are not supported (eomgen models fixed-base robots; "
-            "the root link is the fixed base)")
+            f"floating joints are not supported: eomgen models fixed-base robots only; make "
+            f"it a fixed joint to model link '{child}' bolted to the world")
+    if text == "planar":
+        raise UnsupportedError(
+            source, where,
+            "planar joints are not supported (eomgen models revolute, continuous, prismatic "
+            "and fixed joints)")
     try:
         return _JOINT_TYPES[text]
     except KeyError:

@@ -53,7 +53,7 @@ def sniff(text: str) -> bool:
 
 
 @register("eomgen YAML", (".yaml", ".yml"), sniff)
-def load(path, strict: bool = False) -> RobotModel:
+def load(path, strict: bool = False, defer_notices: bool = False) -> RobotModel:
     """Read an eomgen YAML robot file.
 
     Parameters
@@ -62,6 +62,9 @@ def load(path, strict: bool = False) -> RobotModel:
         The ``.yaml`` file.
     strict:
         Refuse (rather than warn about) inertias that break the triangle inequality.
+    defer_notices:
+        Record such findings in ``RobotModel.notices`` without warning or refusing yet
+        (see :func:`eomgen.parsers.load`).
 
     Raises
     ------
@@ -70,10 +73,12 @@ def load(path, strict: bool = False) -> RobotModel:
         subclass tells the kind of problem (see :mod:`eomgen.errors`).
     """
     path = Path(path)
-    return parse(read_document(path), str(path), strict, default_name=path.stem)
+    return parse(read_document(path), str(path), strict, default_name=path.stem,
+                 defer_notices=defer_notices)
 
 
-def parse(data: dict, source: str, strict: bool = False, default_name: str = "robot") -> RobotModel:
+def parse(data: dict, source: str, strict: bool = False, default_name: str = "robot",
+          defer_notices: bool = False) -> RobotModel:
     """Build the model from an already loaded document (see :func:`load`)."""
     r = Reader(source)
     r.mapping(data, "robot", required=("links", "joints"), optional=TOP_KEYS)
@@ -116,7 +121,8 @@ def parse(data: dict, source: str, strict: bool = False, default_name: str = "ro
 
     info = {"description": r.text(data["description"], "description")} \
         if "description" in data else {}
-    return build_model(source, name, links, joints, gravity, r.used_parameters(), strict, info)
+    return build_model(source, name, links, joints, gravity, r.used_parameters(), strict, info,
+                       defer_notices=defer_notices)
 
 
 def _inertial(r: Reader, entry: dict, where: str) -> Inertial | None:
