@@ -27,8 +27,8 @@ from eomgen.errors import (
     UnsupportedError,
     UnsupportedFeatureWarning,
 )
-from eomgen.model import JointType, RobotModel, Transform
-from eomgen.parsers.urdf import load_urdf, parse_urdf_string, rotate_inertia
+from eomgen.model import JointType, Notice, NoticeKind, RobotModel, Transform, emit_notices
+from eomgen.parsers.urdf import LEG_REACH, load_urdf, parse_urdf_string, rotate_inertia
 from eomgen.reduction import load_for_scene
 from eomgen.scene import Scene
 
@@ -628,3 +628,157 @@ def test_triangle_inequality_raises_under_strict(tmp_path):
             eomgen.load(path, strict=True)
     assert str(caught.value).startswith(f"{path}: link 'arm'")
     assert "triangle inequality" in str(caught.value)
+
+
+# ----------------------------------------------------------------------------------------------
+# Floating bases: a root that looks like a legged robot's trunk warns (refused under strict)
+# ----------------------------------------------------------------------------------------------
+
+def legged(direction=(0, 0, -1), legs: int = 4, length: float = 0.3, hip: float = 0.2,
+           world: bool = False, massless_root: bool = False) -> str:
+    """A trunk with ``legs`` two-joint branches, each reaching ``length`` along ``direction``
+    from a hip ``hip`` metres out of the trunk's centre (at q = 0). ``world``: bolted to a
+    ``world`` root link; ``massless_root``: a massless root fixed to the massive trunk, as
+    ANYmal and Go1 are written."""
+    parts = [link("trunk")]
+    if world:
+        parts += [link("world", None), joint("bolt", "world", "trunk", "fixed", "")]
+    if massless_root:
+        parts += [link("base", None), joint("base_to_trunk", "base", "trunk", "fixed", "")]
+    half = " ".join(f"{length / 2 * d:g}" for d in direction)
+    for k in range(legs):
+        angle = 2 * math.pi * k / legs
+        at = f"{hip * math.cos(angle):.6g} {hip * math.sin(angle):.6g} 0"
+        parts += [link(f"thigh{k}"), link(f"shin{k}"), link(f"foot{k}", None),
+                  joint(f"hip{k}", "trunk", f"thigh{k}",
+                        body=f'<origin xyz="{at}"/><axis xyz="0 1 0"/>'),
+                  joint(f"knee{k}", f"thigh{k}", f"shin{k}",
+                        body=f'<origin xyz="{half}"/><axis xyz="0 1 0"/>'),
+                  joint(f"sole{k}", f"shin{k}", f"foot{k}", "fixed", f'<origin xyz="{half}"/>')]
+    return robot(*parts, name="legged")
+
+
+def floating_notices(model: RobotModel) -> list[Notice]:
+    return [n for n in model.notices if n.kind is NoticeKind.FLOATING_BASE]
+
+
+def test_a_quadruped_warns_once_naming_the_file_the_root_and_the_legs():
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        model = parse_urdf_string(legged(), source="quad.urdf")
+    assert [w.category for w in caught] == [UnsupportedFeatureWarning]
+    message = str(caught[0].message)
+    assert message.startswith("quad.urdf: root link 'trunk': looks like a floating base (4 "
+                              "branches reach down from it like legs at q = 0: 'hip0', 'hip1', "
+                              "'hip2', 'hip3'), but eomgen models fixed-base robots only; read "
+                              "as bolted to the world at 'trunk'")
+    assert "fixed_base: true" in message and len(message.splitlines()) == 1
+    assert model.dof == 8  # read all the same, as legs of a trunk held still
+
+
+def test_a_floating_base_is_refused_under_strict():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(UnsupportedError) as caught:
+            parse_urdf_string(legged(), source="quad.urdf", strict=True)
+    assert str(caught.value).startswith("quad.urdf: root link 'trunk': looks like a floating base")
+    assert str(caught.value).endswith("fixed-base robots only (refused under --strict)")
+
+
+@pytest.mark.parametrize("case, document, warns", [
+    ("quadruped", legged(), True),
+    ("biped", legged(legs=2), True),
+    ("massless root fixed to the trunk (ANYmal, Go1)", legged(massless_root=True), True),
+    ("bolted to a 'world' link", legged(world=True), False),
+    ("one chain down (an arm under a ceiling)", legged(legs=1), False),
+    ("four chains up (a hand's fingers)", legged(direction=(0, 0, 1)), False),
+    ("four chains sideways (legs folded, arms of a torso)", legged(direction=(1, 0, 0)), False),
+    ("legs reach down 0.55 of the extent", legged(legs=2, hip=1.0, length=0.6586), True),
+    ("legs reach down 0.45 of the extent", legged(legs=2, hip=1.0, length=0.5039), False),
+])
+def test_which_roots_look_floating(case, document, warns):
+    """The rule (docs/formats.md): not rooted at 'world', and two or more movable branches of
+    the root body reach below the root origin by at least LEG_REACH of the model's extent."""
+    model = parse_urdf_string(document, defer_notices=True)
+    assert bool(floating_notices(model)) == warns, case
+    assert LEG_REACH == 0.5  # the two threshold cases sit at 0.45 and 0.55 of the extent
+
+
+def test_deferred_notices_warn_nothing_and_emit_as_loading_would(tmp_path):
+    path = tmp_path / "quad.urdf"
+    path.write_text(legged(), encoding="utf-8")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        model = eomgen.load(path, defer_notices=True)
+    assert [n.kind for n in model.notices] == [NoticeKind.FLOATING_BASE]
+    with warnings.catch_warnings(record=True) as emitted:
+        warnings.simplefilter("always")
+        emit_notices(model.notices)
+    with warnings.catch_warnings(record=True) as loaded:
+        warnings.simplefilter("always")
+        eomgen.load(path)
+    assert [str(w.message) for w in emitted] == [str(w.message) for w in loaded]
+    assert model == eomgen.load(path, defer_notices=True)  # notices take no part in equality
+
+
+def test_floating_joint_error_says_what_to_do():
+    document = robot(link("world", None), link("trunk"),
+                     joint("root_joint", "world", "trunk", "floating", ""))
+    with pytest.raises(UnsupportedError) as caught:
+        parse_urdf_string(document, source="f.urdf")
+    assert str(caught.value) == (
+        "f.urdf: joint 'root_joint': floating joints are not supported: eomgen models "
+        "fixed-base robots only; make it a fixed joint to model link 'trunk' bolted to the world")
+    fixed = parse_urdf_string(document.replace('type="floating"', 'type="fixed"'),
+                              defer_notices=True)
+    assert fixed.root == "world" and not fixed.notices  # as the message says: no warning left
+
+
+#: example-robot-data's own loader (python/example_robot_data/robots_loader.py, version 4.x)
+#: adds a free-flyer root joint for these files: the independent label of "floating base".
+ERD_FREE_FLYER = {
+    "a1_description/urdf/a1.urdf", "anymal_b_simple_description/robots/anymal.urdf",
+    "anymal_b_simple_description/robots/anymal-kinova.urdf",
+    "anymal_c_simple_description/urdf/anymal.urdf", "b1_description/urdf/b1.urdf",
+    "b1_description/urdf/b1-z1.urdf", "bolt_description/robots/bolt.urdf",
+    "go1_description/urdf/go1.urdf", "hector_description/robots/quadrotor_base.urdf",
+    "hyq_description/robots/hyq_no_sensors.urdf", "icub_description/robots/icub.urdf",
+    "icub_description/robots/icub_reduced.urdf", "iris_description/robots/iris_simple.urdf",
+    "laikago_description/urdf/laikago.urdf", "romeo_description/urdf/romeo.urdf",
+    "simple_humanoid_description/urdf/simple_humanoid.urdf",
+    "simple_humanoid_description/urdf/simple_humanoid_classical.urdf",
+    "solo_description/robots/solo.urdf", "solo_description/robots/solo12.urdf",
+    "talos_data/robots/talos_reduced.urdf", "talos_data/robots/talos_reduced_box.urdf",
+    "talos_data/robots/talos_full_v2.urdf", "talos_data/robots/talos_full_v2_box.urdf",
+}
+#: Free flyers without legs, which the rule misses by design (docs/formats.md).
+ERD_FLYING = {"hector_description/robots/quadrotor_base.urdf",
+              "iris_description/robots/iris_simple.urdf"}
+#: Legged robots the loader does not list (no loader class), which the rule finds too.
+ERD_LEGGED_UNLISTED = {
+    "alexander_description/urdf/alexander_v1.lowerBodyOnly.urdf",
+    "centauro_description/urdf/centauro.urdf", "g1_description/urdf/g1_29dof_rev_1_0.urdf",
+    "g1_description/urdf/g1_29dof_with_hand_rev_1_0.urdf", "go2_description/urdf/go2.urdf",
+    "quadruped_description/urdf/quadruped.urdf", "romeo_description/urdf/romeo_small.urdf",
+    "talos_data/robots/talos_reduced_corrected.urdf",
+}
+
+
+@pytest.mark.slow
+def test_floating_base_rule_over_every_example_robot_data_file(erd_robots_dir):
+    """The survey docs/formats.md reports: warns for every legged free flyer and the unlisted
+    legged robots, for nothing else (arms, hands, Baxter, PR2, Tiago Pro, ...)."""
+    warned, silent = set(), set()
+    for path in sorted(erd_robots_dir.rglob("*.urdf")):
+        relative = path.relative_to(erd_robots_dir).as_posix()
+        try:
+            model = eomgen.load(path, defer_notices=True)
+        except DescriptionError:
+            continue  # refused for other reasons (no robot name, a broken tree)
+        (warned if floating_notices(model) else silent).add(relative)
+    assert warned == (ERD_FREE_FLYER - ERD_FLYING) | ERD_LEGGED_UNLISTED
+    assert (len(warned), len(silent)) == (29, 34)
+    arms = {relative for relative, _ in ARMS} | {"talos_data/robots/talos_left_arm.urdf",
+                                                "allegro_hand_description/urdf/allegro_left_hand.urdf",
+                                                "baxter_description/urdf/baxter.urdf"}
+    assert arms <= silent
