@@ -565,3 +565,186 @@ def test_documented_error_lines_are_what_eomgen_prints():
             apply_scene(model, load_scene("arm_scene.yaml", text="version: 1\n" + scene))
         printed.append(str(caught.value))
     assert printed == documented
+
+
+# ----------------------------------------------------------------------------------------------
+# Warnings after the scene: only about what it keeps (mimic, triangle inequality, floating base)
+# ----------------------------------------------------------------------------------------------
+
+#: A 2-joint arm on a 'world' root with a two-finger gripper (finger2 mimics finger1), a second
+#: arm whose link 'other' breaks the triangle inequality, a plate fixed to the world and a
+#: sensor fixed to link1 that break it too.
+_BAD_INERTIA = '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="3"/>'
+_GOOD_INERTIA = '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/>'
+
+
+def _urdf_link(name, inertia=_GOOD_INERTIA, mass=1.0):
+    if inertia is None:
+        return f'<link name="{name}"/>'
+    return (f'<link name="{name}"><inertial><origin xyz="0.1 0 0"/><mass value="{mass}"/>'
+            f'{inertia}</inertial></link>')
+
+
+def _urdf_joint(name, parent, child, kind="revolute", xyz="0 0 0.1", axis="0 1 0", extra=""):
+    return (f'<joint name="{name}" type="{kind}"><parent link="{parent}"/>'
+            f'<child link="{child}"/><origin xyz="{xyz}"/><axis xyz="{axis}"/>{extra}</joint>')
+
+
+GRIPPER_ARM = "<robot name=\"gripper_arm\">" + "".join([
+    _urdf_link("world", None), _urdf_link("link1"), _urdf_link("link2"),
+    _urdf_link("finger1", mass=0.1), _urdf_link("finger2", mass=0.1),
+    _urdf_link("other", _BAD_INERTIA), _urdf_link("plate", _BAD_INERTIA),
+    _urdf_link("sensor", _BAD_INERTIA, mass=0.01),
+    _urdf_joint("joint1", "world", "link1"), _urdf_joint("joint2", "link1", "link2", xyz="0.4 0 0"),
+    _urdf_joint("finger_joint1", "link2", "finger1", "prismatic", "0.3 0 0"),
+    _urdf_joint("finger_joint2", "link2", "finger2", "prismatic", "0.3 0 0", axis="0 -1 0",
+                extra='<mimic joint="finger_joint1"/>'),
+    _urdf_joint("other_joint", "world", "other", xyz="0 0.5 0.1"),
+    _urdf_joint("plate_joint", "world", "plate", "fixed"),
+    _urdf_joint("sensor_joint", "link1", "sensor", "fixed", "0.2 0 0"),
+]) + "</robot>"
+
+
+def gripper_arm():
+    from eomgen.parsers.urdf import parse_urdf_string
+
+    return parse_urdf_string(GRIPPER_ARM, source="gripper_arm.urdf", defer_notices=True)
+
+
+def kept(reduction: Reduction) -> list[str]:
+    return [n.element for n in reduction.model.notices]
+
+
+def test_the_parser_records_every_finding_in_file_order():
+    model = gripper_arm()
+    assert [(n.kind.name, n.element) for n in model.notices] == [
+        ("TRIANGLE_INEQUALITY", "link 'other' inertial"),
+        ("TRIANGLE_INEQUALITY", "link 'plate' inertial"),
+        ("TRIANGLE_INEQUALITY", "link 'sensor' inertial"),
+        ("MIMIC", "joint 'finger_joint2' <mimic>")]
+
+
+@pytest.mark.parametrize("scene, expected", [
+    # the fingers locked, the other arm outside the moving part (locked at 0, dropped)
+    ("locked: {finger_joint1: 0.01, finger_joint2: 0.01}\ntips: [link2]",
+     ["link 'sensor' inertial"]),  # merged into link1: its data still counts
+    # the mimicked joint moves: reading finger2 as independent still matters
+    ("locked: {finger_joint2: 0.01}\ntips: [finger1, finger2]",
+     ["link 'sensor' inertial", "joint 'finger_joint2' <mimic>"]),
+    # everything moves: all but the plate, which is fixed to the world
+    ("description: every joint", ["link 'other' inertial", "link 'sensor' inertial",
+                                  "joint 'finger_joint2' <mimic>"]),
+])
+def test_a_scene_keeps_the_notices_about_what_it_models(scene, expected):
+    reduction = apply_scene(gripper_arm(), scene_text("version: 1\n" + scene))
+    assert kept(reduction) == expected
+    left_out = len(gripper_arm().notices) - len(expected)
+    notes = [n for n in reduction.report.notes if n.startswith("warnings left out")]
+    assert notes == [f"warnings left out, about what the scene locks or drops ({left_out}): "
+                     + ", ".join(n.element for n in gripper_arm().notices
+                                 if n.element not in expected)]
+
+
+def test_fixed_base_silences_the_floating_base_and_nothing_else():
+    talos = erd_model(EXAMPLES["talos_left_arm"])
+    assert [n.kind.name for n in talos.notices] == ["FLOATING_BASE"]
+    shipped = load_scene(SCENES / "talos_left_arm.yaml")
+    assert shipped.fixed_base
+    reduction = apply_scene(talos, shipped)
+    assert reduction.model.notices == ()
+    assert any(n.startswith("root link 'base_link' taken as bolted to the world")
+               for n in reduction.report.notes)
+    unsaid = dataclasses.replace(shipped, fixed_base=False)  # every leg locked: still floating
+    assert kept(apply_scene(talos, unsaid)) == ["root link 'base_link'"]
+    everything = apply_scene(gripper_arm(), scene_text("version: 1\nfixed_base: true"))
+    assert kept(everything) == ["link 'other' inertial", "link 'sensor' inertial",
+                                "joint 'finger_joint2' <mimic>"]  # as without fixed_base
+
+
+def test_fixed_base_must_be_true_or_false():
+    with pytest.raises(SceneError) as caught:
+        scene_text("version: 1\nfixed_base: yes please\n", "s.yaml")
+    assert str(caught.value) == "s.yaml: fixed_base: expected true or false, got 'yes please'"
+    assert scene_text("version: 1\nfixed_base: false\n").fixed_base is False
+
+
+# Through the command line, in real processes ----------------------------------------------------
+
+def run_process(*args) -> "subprocess.CompletedProcess":
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "eomgen.cli", *map(str, args)],
+                          capture_output=True, text=True, timeout=300)
+
+
+def warning_lines(stderr: str) -> list[str]:
+    return [line for line in stderr.splitlines() if line.startswith("eomgen: warning: ")]
+
+
+def test_cli_warns_and_refuses_only_about_what_the_scene_keeps(tmp_path):
+    description = tmp_path / "gripper_arm.urdf"
+    description.write_text(GRIPPER_ARM, encoding="utf-8")
+    fingers = tmp_path / "fingers.yaml"
+    fingers.write_text("version: 1\nlocked: {finger_joint1: 0.01, finger_joint2: 0.01}\n"
+                       "tips: [link2]\noutputs: [g]\n", encoding="utf-8")
+    one_finger = tmp_path / "one_finger.yaml"
+    one_finger.write_text("version: 1\nlocked: {finger_joint2: 0.01}\ntips: [finger1]\n"
+                          "outputs: [g]\n", encoding="utf-8")
+    common = ("--backend", "numpy", "--quiet")
+    whole = run_process("generate", description, "-o", tmp_path / "a", *common)
+    assert whole.returncode == 0, whole.stderr
+    assert len(warning_lines(whole.stderr)) == 4  # without a scene: everything, as before
+    locked = run_process("generate", description, "--scene", fingers, "-o", tmp_path / "b",
+                         *common)
+    assert locked.returncode == 0, locked.stderr
+    assert warning_lines(locked.stderr) == [
+        f"eomgen: warning: {description}: link 'sensor' inertial: principal moments 1, 1, 3 "
+        "break the triangle inequality (not a physical rigid body)"]
+    refused = run_process("generate", description, "--scene", one_finger, "-o", tmp_path / "c",
+                          "--strict", *common)
+    assert refused.returncode == 2 and not (tmp_path / "c").exists()
+    assert refused.stderr.splitlines() == [
+        f"eomgen: error: {description}: link 'sensor' inertial: principal moments 1, 1, 3 "
+        "break the triangle inequality (not a physical rigid body) (refused under --strict)"]
+
+
+def test_cli_floating_base_warns_is_refused_and_silenced_by_fixed_base(tmp_path):
+    from test_parsers_urdf import legged
+
+    description = tmp_path / "biped.urdf"
+    description.write_text(legged(legs=2), encoding="utf-8")
+    leg = "version: 1\ntips: [shin0]\noutputs: [g]\n"
+    free, fixed = tmp_path / "leg.yaml", tmp_path / "leg_fixed.yaml"
+    free.write_text(leg, encoding="utf-8")
+    fixed.write_text(leg + "fixed_base: true\n", encoding="utf-8")
+    common = ("--backend", "numpy", "--quiet")
+    warned = run_process("generate", description, "--scene", free, "-o", tmp_path / "a", *common)
+    assert warned.returncode == 0, warned.stderr
+    assert [line[:80] for line in warning_lines(warned.stderr)] == [
+        f"eomgen: warning: {description}: root link 'trunk': looks like a floating base"[:80]]
+    refused = run_process("generate", description, "-o", tmp_path / "b", "--strict", *common)
+    assert refused.returncode == 2 and not (tmp_path / "b").exists()
+    assert refused.stderr.splitlines()[0].startswith(
+        f"eomgen: error: {description}: root link 'trunk': looks like a floating base")
+    silenced = run_process("generate", description, "--scene", fixed, "-o", tmp_path / "c",
+                           "--strict", *common)
+    assert silenced.returncode == 0, silenced.stderr
+    assert silenced.stderr == ""
+
+
+@pytest.mark.slow
+def test_cli_panda_with_its_mimic_finger_locked_passes_strict(tmp_path):
+    """The issue's case: panda_fingers_locked.yaml locks the mimic finger, so neither the
+    warning nor --strict's refusal concerns what is generated."""
+    robots = erd_robots_dir()
+    if robots is None:
+        pytest.skip("example-robot-data is not installed")
+    panda = robots / EXAMPLES["panda_fingers_locked"]
+    result = run_process("generate", panda, "--scene", SCENES / "panda_fingers_locked.yaml",
+                         "--backend", "numpy", "-o", tmp_path / "out", "--strict", "--quiet")
+    assert result.returncode == 0, result.stderr
+    assert result.stderr == ""
+    report = (tmp_path / "out" / "panda_scene_report.md").read_text(encoding="utf-8")
+    assert "warnings left out, about what the scene locks or drops (1): joint " \
+           "'panda_finger_joint2' <mimic>" in report
