@@ -26,15 +26,22 @@ Decisions
   (ROS, Pinocchio) requires; a point mass is written with zero moments of inertia. A missing
   ``<inertia>`` is more often an authoring slip than a deliberate point mass.
 * ``floating`` and ``planar`` joints raise :class:`~eomgen.errors.UnsupportedError`.
+* A root link that looks like the floating base of a legged robot (quadrupeds and humanoids
+  are written as trees rooted at the trunk, without a floating joint) is read as bolted to
+  the world, with one :class:`~eomgen.errors.UnsupportedFeatureWarning` naming the file and
+  the root link (:func:`floating_base_notice` states the rule); ``strict=True`` raises
+  :class:`~eomgen.errors.UnsupportedError`. A ``world`` root link (the ROS convention for a
+  model bolted to the world) or a scene with ``fixed_base: true`` says the fixed base is
+  meant.
 * A joint with ``<mimic joint="...">`` is read as an ordinary independent joint with its own
   coordinate, as Pinocchio's ``buildModelFromUrdf`` does by default, so that descriptions such
   as the Franka Panda and Talos (gripper fingers coupled by ``<mimic>``) load unchanged. The
   coupling ``q = multiplier · q_other + offset`` is *not* modelled: each such joint issues one
   :class:`~eomgen.errors.UnsupportedFeatureWarning` naming the file and the joint, and
   ``strict=True`` raises :class:`~eomgen.errors.UnsupportedError` instead. To remove the extra
-  coordinates, lock the joints (:func:`eomgen.model.lock_joints`). The ``joint`` attribute is
-  required (as urdfdom requires it) and must name a joint of the file; ``multiplier`` and
-  ``offset`` are not read. A ``<mimic>`` on a *fixed* joint (Talos' reduced models) couples
+  coordinates, lock the joints (a scene's ``locked``: the warning is then left out). The
+  ``joint`` attribute is required (as urdfdom requires it) and must name a joint of the file;
+  ``multiplier`` and ``offset`` are not read. A ``<mimic>`` on a *fixed* joint (Talos' reduced models) couples
   nothing and is ignored without a warning.
 * Numbers are plain decimal numbers read with :func:`float` (URDF has no expressions); they
   must be finite. Exact integers stay exact (see :func:`eomgen.model.scalar`).
