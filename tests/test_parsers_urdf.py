@@ -782,3 +782,11 @@ def test_floating_base_rule_over_every_example_robot_data_file(erd_robots_dir):
                                                 "allegro_hand_description/urdf/allegro_left_hand.urdf",
                                                 "baxter_description/urdf/baxter.urdf"}
     assert arms <= silent
+
+
+def test_documented_floating_base_warning_is_what_eomgen_prints(erd_robots_dir):
+    text = (Path(__file__).resolve().parents[1] / "docs" / "formats.md").read_text("utf-8")
+    documented = [line for line in text.splitlines() if line.startswith("solo12.urdf: root")]
+    path = erd_robots_dir / "solo_description/robots/solo12.urdf"
+    model = parse_urdf_string(path.read_bytes(), source="solo12.urdf", defer_notices=True)
+    assert documented == [n.message for n in floating_notices(model)]

@@ -41,8 +41,8 @@ Decisions
   ``strict=True`` raises :class:`~eomgen.errors.UnsupportedError` instead. To remove the extra
   coordinates, lock the joints (a scene's ``locked``: the warning is then left out). The
   ``joint`` attribute is required (as urdfdom requires it) and must name a joint of the file;
-  ``multiplier`` and ``offset`` are not read. A ``<mimic>`` on a *fixed* joint (Talos' reduced models) couples
-  nothing and is ignored without a warning.
+  ``multiplier`` and ``offset`` are not read. A ``<mimic>`` on a *fixed* joint (Talos'
+  reduced models) couples nothing and is ignored without a warning.
 * Numbers are plain decimal numbers read with :func:`float` (URDF has no expressions); they
   must be finite. Exact integers stay exact (see :func:`eomgen.model.scalar`).
 * A singleton element (``<inertial>``, ``<origin>``, ``<axis>``, ...) given twice is an error
