@@ -160,6 +160,15 @@ CASADI_SYMBOL_EXPORT casadi_int mass_matrix_n_out(void) { return 1;}
 
 CASADI_SYMBOL_EXPORT casadi_real mass_matrix_default_in(casadi_int i) {
   switch (i) {
+    case 1: return 8.3333333333333329e-02;
+    case 2: return 8.3333333333333329e-02;
+    case 3: return 9.8100000000000005e+00;
+    case 4: return 1.;
+    case 5: return 1.;
+    case 6: return 5.0000000000000000e-01;
+    case 7: return 5.0000000000000000e-01;
+    case 8: return 1.;
+    case 9: return 1.;
     default: return 0;
   }
 }
@@ -305,6 +314,15 @@ CASADI_SYMBOL_EXPORT casadi_int coriolis_matrix_n_out(void) { return 1;}
 
 CASADI_SYMBOL_EXPORT casadi_real coriolis_matrix_default_in(casadi_int i) {
   switch (i) {
+    case 2: return 8.3333333333333329e-02;
+    case 3: return 8.3333333333333329e-02;
+    case 4: return 9.8100000000000005e+00;
+    case 5: return 1.;
+    case 6: return 1.;
+    case 7: return 5.0000000000000000e-01;
+    case 8: return 5.0000000000000000e-01;
+    case 9: return 1.;
+    case 10: return 1.;
     default: return 0;
   }
 }
@@ -429,6 +447,15 @@ CASADI_SYMBOL_EXPORT casadi_int gravity_vector_n_out(void) { return 1;}
 
 CASADI_SYMBOL_EXPORT casadi_real gravity_vector_default_in(casadi_int i) {
   switch (i) {
+    case 1: return 8.3333333333333329e-02;
+    case 2: return 8.3333333333333329e-02;
+    case 3: return 9.8100000000000005e+00;
+    case 4: return 1.;
+    case 5: return 1.;
+    case 6: return 5.0000000000000000e-01;
+    case 7: return 5.0000000000000000e-01;
+    case 8: return 1.;
+    case 9: return 1.;
     default: return 0;
   }
 }
@@ -589,6 +616,15 @@ CASADI_SYMBOL_EXPORT casadi_int inverse_dynamics_n_out(void) { return 1;}
 
 CASADI_SYMBOL_EXPORT casadi_real inverse_dynamics_default_in(casadi_int i) {
   switch (i) {
+    case 3: return 8.3333333333333329e-02;
+    case 4: return 8.3333333333333329e-02;
+    case 5: return 9.8100000000000005e+00;
+    case 6: return 1.;
+    case 7: return 1.;
+    case 8: return 5.0000000000000000e-01;
+    case 9: return 5.0000000000000000e-01;
+    case 10: return 1.;
+    case 11: return 1.;
     default: return 0;
   }
 }
@@ -798,6 +834,15 @@ CASADI_SYMBOL_EXPORT casadi_int forward_dynamics_n_out(void) { return 1;}
 
 CASADI_SYMBOL_EXPORT casadi_real forward_dynamics_default_in(casadi_int i) {
   switch (i) {
+    case 3: return 8.3333333333333329e-02;
+    case 4: return 8.3333333333333329e-02;
+    case 5: return 9.8100000000000005e+00;
+    case 6: return 1.;
+    case 7: return 1.;
+    case 8: return 5.0000000000000000e-01;
+    case 9: return 5.0000000000000000e-01;
+    case 10: return 1.;
+    case 11: return 1.;
     default: return 0;
   }
 }

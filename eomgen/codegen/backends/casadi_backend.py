@@ -62,7 +62,10 @@ class CasADiConfig:
 
 def _render_module(job: Job, config: CasADiConfig) -> str:
     printer = CasADiPrinter({"standard": "python3"})
-    return render(config.template, **python_module_context(job, printer, config.template))
+    # Parameters without a value have no default: the module refuses calls that leave them out.
+    required = [p.identifier for p in job.parameters if p.default is None]
+    return render(config.template, required=required,
+                  **python_module_context(job, printer, config.template))
 
 
 @register("casadi", "CasADi module: casadi.Function objects (SX) with named inputs and outputs")
