@@ -718,6 +718,42 @@ def test_parameters_without_a_value_are_required(tmp_path):
             assert_close(shape(c(**vectors, m2=2.5)[output]), expected, f"C {function}")
 
 
+def test_no_c_compiler_is_one_warning_line(tmp_path):
+    """Without a C compiler the C backend writes the .c and .h and says, in one line on
+    stderr, that the .so is missing: also when the run is answered from the cache."""
+    empty = tmp_path / "bin"
+    empty.mkdir()
+    env = {k: v for k, v in os.environ.items() if k != "CC"}
+    env["PATH"] = str(empty)
+    command = [sys.executable, "-m", "eomgen.cli", "generate", "--backend", "numpy,c",
+               "--cache-dir", str(tmp_path / "cache"), "-o", str(tmp_path / "out")]
+    expected = ("eomgen: warning: no C compiler found ($CC, cc, gcc, clang): wrote "
+                "planar_2link_casadi.c/.h without the .so")
+    for run in ("derived", "cached"):
+        result = subprocess.run(command + ["--quiet"], env=env, capture_output=True, text=True,
+                                timeout=120)
+        assert result.returncode == 0, result.stderr
+        assert result.stderr.splitlines() == [expected], f"{run}: {result.stderr}"
+        assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [
+            "planar_2link_casadi.c", "planar_2link_casadi.h", "planar_2link_numpy.py"]
+
+
+def test_no_c_compiler_warns_library_callers(build, tmp_path, monkeypatch):
+    from eomgen.cache import CachedNotice
+    from eomgen.codegen.backends.casadi_backend import NoCompilerWarning
+
+    monkeypatch.delenv("CC", raising=False)
+    monkeypatch.setenv("PATH", str(tmp_path))
+    assert c_compiler() is None
+    model = build("planar_2link").model
+    match = r"^no C compiler found .*: wrote planar_2link_casadi\.c/\.h without the \.so$"
+    with pytest.warns(NoCompilerWarning, match=match):
+        paths = generate(model, tmp_path / "a", "c", cache_dir=tmp_path / "cache")
+    assert [p.name for p in paths] == ["planar_2link_casadi.c", "planar_2link_casadi.h"]
+    with pytest.warns(CachedNotice, match=match):  # answered from the cache: said again
+        generate(model, tmp_path / "b", "c", cache_dir=tmp_path / "cache")
+
+
 # ----------------------------------------------------------------------------------------------
 # Hostile names
 # ----------------------------------------------------------------------------------------------

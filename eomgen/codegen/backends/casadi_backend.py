@@ -13,6 +13,7 @@ import re
 import shutil
 import subprocess
 import tempfile
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -83,6 +84,10 @@ def load_module_source(source: str, name: str) -> dict:
 FUNCTION_NAMES = ALL_FUNCTIONS  # every function a module can export (a job may ask fewer)
 
 
+class NoCompilerWarning(UserWarning):
+    """The C backend found no C compiler: it wrote the C source and header, not the ``.so``."""
+
+
 def c_compiler() -> str | None:
     """The C compiler to use: $CC, else cc or gcc on PATH, else None."""
     for candidate in (os.environ.get("CC"), "cc", "gcc", "clang"):
@@ -123,4 +128,7 @@ def generate_c(job: Job, config: CasADiConfig = CasADiConfig()) -> list[Generate
             if result.returncode != 0:
                 raise RuntimeError(f"compiling {stem}.c failed: {result.stderr.strip()[:500]}")
             files.append(GeneratedFile(stem + ".so", library.read_bytes(), golden=False))
+        else:
+            warnings.warn(f"no C compiler found ($CC, cc, gcc, clang): wrote {stem}.c/.h "
+                          "without the .so", NoCompilerWarning, stacklevel=2)
     return files
