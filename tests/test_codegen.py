@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import ast
 import builtins
+import ctypes
 import importlib.util
 import io
 import keyword
@@ -565,6 +566,7 @@ class Interfaces:
     compiled: dict | None
     nm: NumericModel
     functions: tuple[str, ...]
+    library: Path | None
 
 
 def load_interfaces(files: list[GeneratedFile], outdir: Path, model: RobotModel,
@@ -578,7 +580,7 @@ def load_interfaces(files: list[GeneratedFile], outdir: Path, model: RobotModel,
         assert c_compiler() is None, "a C compiler exists but no shared library was built"
     compiled = None if library is None else {f: ca.external(f, str(library)) for f in functions}
     return Interfaces(numpy_module, load_module(paths[stem + "_casadi.py"], f"{name}_casadi"),
-                      compiled, numeric_model(model), functions)
+                      compiled, numeric_model(model), functions, library)
 
 
 def as_array(x, function: str) -> np.ndarray:
@@ -600,6 +602,14 @@ def assert_interfaces_use_description_values(ex: Interfaces, rng: np.random.Gene
     subsets = [[], *([n] for n in names), names[::2]]
     n = ex.numpy.NQ
     routes = {"CasADi": ex.casadi.__dict__, "C": ex.compiled or {}}
+    if ex.library is not None:  # the C symbol casadi.external reads the defaults from
+        shared = ctypes.CDLL(str(ex.library))
+        for function in ex.functions:
+            default_in = getattr(shared, function + "_default_in")
+            default_in.restype, default_in.argtypes = ctypes.c_double, [ctypes.c_longlong]
+            first = len(SIGNATURES[function][0])
+            assert [default_in(first + k) for k in range(len(names))] == list(
+                parameters.values()), function
     for q, qd, qdd in random_states(rng, n, count=2):
         tau = ex.numpy.inverse_dynamics(q, qd, qdd)
         values = {"q": q, "qd": qd, "qdd": qdd, "tau": tau}

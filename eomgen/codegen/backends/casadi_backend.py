@@ -96,6 +96,14 @@ def c_compiler() -> str | None:
     return None
 
 
+#: What the C files say, below their header, about the parameter inputs.
+_C_PARAMETER_NOTE = [
+    "Inputs: the vectors (q, qd, qdd or tau), then the parameters kept symbolic, sorted by name.",
+    "casadi.external gives a parameter left out of a call by name <function>_default_in(i), the",
+    "description's value (NaN where it has none); a direct C call reads a NULL input as zeros.",
+]
+
+
 @register("c", "C source through CasADi's code generator, and a shared library when a C compiler is found")
 def generate_c(job: Job, config: CasADiConfig = CasADiConfig()) -> list[GeneratedFile]:
     import casadi as ca
@@ -113,8 +121,10 @@ def generate_c(job: Job, config: CasADiConfig = CasADiConfig()) -> list[Generate
         generator.generate(tmp + os.sep)
         c_source = Path(tmp, prefix + ".c").read_text()
         h_source = Path(tmp, prefix + ".h").read_text()
-        header = "".join(f"/* {line.replace('*/', '* /')} */\n"
-                         for line in job.header_lines("CasADi CodeGenerator via casadi/module.py.jinja"))
+        lines = job.header_lines("CasADi CodeGenerator via casadi/module.py.jinja")
+        if job.parameters:
+            lines += _C_PARAMETER_NOTE
+        header = "".join(f"/* {line.replace('*/', '* /')} */\n" for line in lines)
         files = [GeneratedFile(stem + ".c", header + c_source),
                  GeneratedFile(stem + ".h", header + h_source)]
         compiler = c_compiler()
