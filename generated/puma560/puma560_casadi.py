@@ -11,9 +11,10 @@ Call it with every input in order, or by name:
     mass_matrix(q)
     mass_matrix(q=q)["M"]
 
-A parameter left out takes its value in PARAMETERS, the description's (CasADi's ``default_in``,
-which the C code of eomgen's C backend keeps, also in a shared library loaded with
-``casadi.external``); a vector left out (q, qd, qdd, tau) is zero, CasADi's rule. Units are SI.
+A parameter left out takes its value in PARAMETERS, the description's; a vector left out (q,
+qd, qdd, tau) is zero, CasADi's rule. These are CasADi's ``default_in``: the C code of eomgen's
+C backend keeps them, so a shared library loaded with ``casadi.external`` defaults alike. Units
+are SI.
 """
 
 import casadi as ca
