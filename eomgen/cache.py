@@ -61,6 +61,8 @@ import secrets
 import shutil
 import stat
 import sys
+import warnings
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -551,6 +553,29 @@ def _decode_file(data: dict) -> GeneratedFile:
 # Use from code generation
 # ----------------------------------------------------------------------------------------------
 
+class CachedNotice(UserWarning):
+    """A warning the run that filled a cache entry showed while rendering (e.g. that no C
+    compiler was found), shown again when a library call is answered from that entry."""
+
+
+@contextmanager
+def _shown_warnings():
+    """Within the block, warnings are shown as usual and the lines shown collected in the list
+    yielded."""
+    shown: list[str] = []
+    show = warnings.showwarning
+
+    def record(message, *args, **kwargs):
+        shown.append(" ".join(str(message).split()))
+        show(message, *args, **kwargs)
+
+    warnings.showwarning = record
+    try:
+        yield shown
+    finally:
+        warnings.showwarning = show
+
+
 def render_cached(render: Callable[..., list], model, backends: Sequence[str],
                   progress: Callable[[str], None], *, cache: bool | CacheRequest = True,
                   cache_dir: Path | None = None, **options) -> list[GeneratedFile]:
@@ -558,7 +583,9 @@ def render_cached(render: Callable[..., list], model, backends: Sequence[str],
     identical earlier call.
 
     ``cache`` False calls ``render``; True keys the call with :func:`generation_key`; a
-    :class:`CacheRequest` gives the key (and the notices to store) itself.
+    :class:`CacheRequest` gives the key (and the notices to store) itself. The warnings
+    ``render`` shows are stored with the entry too; a call answered from the cache shows them
+    again (as :class:`CachedNotice`; ``eomgen generate`` prints an entry's notices itself).
     """
     if cache is False:
         return render(model, backends, progress, **options)
@@ -570,7 +597,11 @@ def render_cached(render: Callable[..., list], model, backends: Sequence[str],
     entry = store.get(request.key)
     if entry is not None:
         progress(f"using cached result (key {request.key[:16]}…)")
+        if not isinstance(cache, CacheRequest):  # the caller's own notices are not replayed
+            for notice in entry.notices:
+                warnings.warn(notice, CachedNotice, stacklevel=3)
         return list(entry.files)
-    files = render(model, backends, progress, **options)
-    store.put(request.key, files, tuple(request.notices))
+    with _shown_warnings() as shown:
+        files = render(model, backends, progress, **options)
+    store.put(request.key, files, (*request.notices, *shown))
     return files

@@ -20,10 +20,12 @@ from __future__ import annotations
 
 import ast
 import builtins
+import ctypes
 import importlib.util
 import io
 import keyword
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -41,7 +43,7 @@ import sympy as sp
 import eomgen
 from eomgen.codegen import BACKENDS, Backend, GeneratedFile, available_backends
 from eomgen.codegen.backends.casadi_backend import FUNCTION_NAMES, c_compiler
-from eomgen.codegen.generate import generate, render_files, write_atomically
+from eomgen.codegen.generate import generate, keep_symbolic, render_files, write_atomically
 from eomgen.model import (Inertial, Joint, JointType, Link, Parameter, RobotModel, Transform,
                           build_model, vec3)
 from eomgen.numeric import NumericModel, numeric_model, rnea
@@ -550,6 +552,219 @@ def test_symbolic_subset_fixes_the_other_parameters(build, tmp_path):
 
 
 # ----------------------------------------------------------------------------------------------
+# Parameters left out of a call: the description's values in every interface, never zeros
+# ----------------------------------------------------------------------------------------------
+
+@dataclass
+class Interfaces:
+    """One generation's NumPy module, CasADi module and (with a C compiler) the shared library
+    loaded with ``casadi.external``; ``nm`` is Newton–Euler on the model with the
+    description's values."""
+
+    numpy: ModuleType
+    casadi: ModuleType
+    compiled: dict | None
+    nm: NumericModel
+    functions: tuple[str, ...]
+    library: Path | None
+
+
+def load_interfaces(files: list[GeneratedFile], outdir: Path, model: RobotModel,
+                    name: str) -> Interfaces:
+    paths = {p.name: p for p in write_atomically(files, outdir)}
+    stem = next(n[:-len("_numpy.py")] for n in paths if n.endswith("_numpy.py"))
+    numpy_module = load_module(paths[stem + "_numpy.py"], f"{name}_numpy")
+    functions = tuple(f for f in FUNCTION_NAMES if hasattr(numpy_module, f))
+    library = paths.get(stem + "_casadi.so")
+    if library is None:
+        assert c_compiler() is None, "a C compiler exists but no shared library was built"
+    compiled = None if library is None else {f: ca.external(f, str(library)) for f in functions}
+    return Interfaces(numpy_module, load_module(paths[stem + "_casadi.py"], f"{name}_casadi"),
+                      compiled, numeric_model(model), functions, library)
+
+
+def as_array(x, function: str) -> np.ndarray:
+    """A CasADi result as the NumPy module returns it: (n, n) matrices, (n,) vectors."""
+    out = np.array(x.full())
+    return out if function in MATRIX_OUTPUTS else out[:, 0]
+
+
+def _changed(value: float) -> float:
+    return 1.7 * value + 0.3  # never the value itself, never zero for a positive value
+
+
+def assert_interfaces_use_description_values(ex: Interfaces, rng: np.random.Generator):
+    """Every function of every interface, called in order with all inputs, by name with none,
+    one or half of the parameters, and with a dict (``call``), equals the NumPy module with the
+    same parameters; left out, they are the description's values (Newton–Euler)."""
+    parameters = ex.numpy.PARAMETERS
+    names = list(parameters)
+    subsets = [[], *([n] for n in names), names[::2]]
+    n = ex.numpy.NQ
+    routes = {"CasADi": ex.casadi.__dict__, "C": ex.compiled or {}}
+    if ex.library is not None:  # the C symbol casadi.external reads the defaults from
+        shared = ctypes.CDLL(str(ex.library))
+        for function in ex.functions:
+            default_in = getattr(shared, function + "_default_in")
+            default_in.restype, default_in.argtypes = ctypes.c_double, [ctypes.c_longlong]
+            first = len(SIGNATURES[function][0])
+            assert [default_in(first + k) for k in range(len(names))] == list(
+                parameters.values()), function
+    for q, qd, qdd in random_states(rng, n, count=2):
+        tau = ex.numpy.inverse_dynamics(q, qd, qdd)
+        values = {"q": q, "qd": qd, "qdd": qdd, "tau": tau}
+        # The NumPy module without parameters is Newton–Euler with the description's values.
+        assert_close(ex.numpy.gravity_vector(q),
+                     rnea_reference(ex.nm, "gravity_vector", q, qd, qdd), "NumPy g")
+        assert_close(tau, rnea(ex.nm, q, qd, qdd), "NumPy tau")
+        for function in ex.functions:
+            inputs, output = SIGNATURES[function]
+            vectors = {a: values[a] for a in inputs}
+            for route, functions in routes.items():
+                if function not in functions:
+                    continue
+                f = functions[function]
+                shape = lambda x: as_array(x, function)  # noqa: E731
+                what = f"{route} {function}"
+                expected = numpy_call(ex.numpy, function, *vectors.values())
+                positional = f(*vectors.values(), *parameters.values())
+                assert_close(shape(positional), expected, f"{what} in order")
+                assert_close(shape(f.call(dict(vectors))[output]), expected,
+                             f"{what} call(dict)")
+                for subset in subsets:
+                    given = {p: _changed(parameters[p]) for p in subset}
+                    expected = numpy_call(ex.numpy, function, *vectors.values(), **given)
+                    assert_close(shape(f(**vectors, **given)[output]), expected,
+                                 f"{what} by name with {sorted(given) or 'no parameters'}")
+
+
+SYMBOLIC_SUBSETS = [None, ["m2", "g"], ["m2"], []]
+
+
+@pytest.mark.parametrize("symbolic", SYMBOLIC_SUBSETS, ids=lambda s: "all" if s is None else
+                         ",".join(s) or "none")
+def test_left_out_parameters_take_the_description_values(build, tmp_path, symbolic):
+    """The issue: ``gravity_vector(q=q)["g"]`` of ``--symbolic m2,g`` was [0, 0] (CasADi filled
+    the parameters with zeros)."""
+    model = build("planar_2link").model
+    files = render_files(keep_symbolic(model, symbolic), ["numpy", "casadi", "c"])
+    ex = load_interfaces(files, tmp_path, model, "planar_defaults")
+    if symbolic is not None:
+        assert sorted(ex.casadi.PARAMETERS) == sorted({"g": "g_"}.get(s, s) for s in symbolic)
+    q = np.array([0.3, -0.7])
+    g = rnea_reference(ex.nm, "gravity_vector", q, None, None)
+    assert np.all(np.abs(g) > 1.0)  # so that zeros would show
+    assert_close(as_array(ex.casadi.gravity_vector(q=q)["g"], "gravity_vector"), g, "the issue's call")
+    assert_interfaces_use_description_values(ex, np.random.default_rng(14))
+
+
+def test_scene_payload_is_in_the_defaults(tmp_path):
+    """examples/scenes/ur5_payload.yaml keeps the payload mass m_load symbolic (2 kg): called
+    without it, every interface carries the payload, which moves g(q) from the bare arm's."""
+    robots = erd_robots_dir()
+    if robots is None:
+        pytest.skip("example-robot-data is not installed")
+    from eomgen.codegen.scene_generate import render_scene_files
+    from eomgen.reduction import apply_scene
+    from eomgen.scene import load_scene
+
+    scene = load_scene(TESTS.parent / "examples" / "scenes" / "ur5_payload.yaml")
+    model = load_quietly(robots / "ur_description" / "urdf" / "ur5_robot.urdf")
+    produced = render_scene_files(model, scene, ["numpy", "casadi", "c"])
+    reduced = apply_scene(model, scene).model
+    ex = load_interfaces(produced.files, tmp_path, reduced, "ur5_payload")
+    assert ex.casadi.PARAMETERS == {"m_load": 2.0}
+    q = np.linspace(-1.0, 1.0, ex.numpy.NQ)
+    loaded = rnea_reference(ex.nm, "gravity_vector", q, None, None)
+    bare = rnea_reference(numeric_model(reduced, {"m_load": 0.0}), "gravity_vector", q, None,
+                          None)
+    assert np.max(np.abs(loaded - bare)) > 1.0  # the payload shows in g
+    assert_close(as_array(ex.casadi.gravity_vector(q=q)["g"], "gravity_vector"), loaded, "CasADi g")
+    assert_interfaces_use_description_values(ex, np.random.default_rng(15))
+
+
+def test_parameters_without_a_value_are_required(tmp_path):
+    """m2 declared without a value: NumPy and CasADi calls that leave it out raise TypeError;
+    the C code, which cannot refuse, gives NaN."""
+    text = eomgen.example_path("planar_2link").read_text(encoding="utf-8")
+    declared = re.search(r"\n  m2: .*", text)
+    path = tmp_path / "planar_2link.yaml"
+    path.write_text(text.replace(declared.group(), "\n  m2: null"), encoding="utf-8")
+    model = load_quietly(path)
+    files = render_files(model, ["numpy", "casadi", "c"])
+    source = next(f.content for f in files if f.name.endswith("_casadi.py"))
+    assert_safe_python(source, "ca", CASADI_CALLS | {"_Function", "isinstance", "TypeError"},
+                       CASADI_LOCAL_OBJECTS | {"self"})
+    with_m2 = model.substitute({sp.Symbol("m2", real=True): 2.5})  # for Newton–Euler
+    ex = load_interfaces(files, tmp_path / "out", with_m2, "no_m2")
+    assert ex.casadi.PARAMETERS["m2"] is None and ex.numpy.PARAMETERS["m2"] is None
+    q, qd, qdd = random_states(np.random.default_rng(16), 2, count=1)[0]
+    tau = rnea(ex.nm, q, qd, qdd)  # with m2 = 2.5
+    others = {k: v for k, v in ex.casadi.PARAMETERS.items() if v is not None}
+    with pytest.raises(TypeError, match="m2"):
+        ex.numpy.inverse_dynamics(q, qd, qdd)
+    assert_close(ex.numpy.inverse_dynamics(q, qd, qdd, m2=2.5), tau, "NumPy tau")
+    for function in ex.functions:
+        inputs, output = SIGNATURES[function]
+        vectors = {"q": q, "qd": qd, "qdd": qdd, "tau": tau}
+        vectors = {a: vectors[a] for a in inputs}
+        expected = numpy_call(ex.numpy, function, *vectors.values(), m2=2.5)
+        f = getattr(ex.casadi, function)
+        for call in (lambda: f(**vectors), lambda: f(**vectors, **others),
+                     lambda: f.call(dict(vectors))):
+            with pytest.raises(TypeError, match=f"^{function}: parameter m2 has no value"):
+                call()
+        shape = lambda x: as_array(x, function)  # noqa: E731
+        assert_close(shape(f(**vectors, m2=2.5)[output]), expected, f"CasADi {function}")
+        assert_close(shape(f(*vectors.values(), *{**ex.casadi.PARAMETERS, "m2": 2.5}.values())),
+                     expected, f"CasADi {function} in order")
+        if ex.compiled is not None:  # NaN where the result depends on m2, else the value
+            c = ex.compiled[function]
+            depends = expected != numpy_call(ex.numpy, function, *vectors.values(), m2=3.5)
+            assert depends.any()
+            left_out = shape(c(**vectors)[output])
+            assert np.all(np.isnan(left_out[depends])), f"C {function} without m2: {left_out}"
+            assert_close(left_out[~depends], expected[~depends], f"C {function} without m2")
+            assert_close(shape(c(**vectors, m2=2.5)[output]), expected, f"C {function}")
+
+
+def test_no_c_compiler_is_one_warning_line(tmp_path):
+    """Without a C compiler the C backend writes the .c and .h and says, in one line on
+    stderr, that the .so is missing: also when the run is answered from the cache."""
+    empty = tmp_path / "bin"
+    empty.mkdir()
+    env = {k: v for k, v in os.environ.items() if k != "CC"}
+    env["PATH"] = str(empty)
+    command = [sys.executable, "-m", "eomgen.cli", "generate", "--backend", "numpy,c",
+               "--cache-dir", str(tmp_path / "cache"), "-o", str(tmp_path / "out")]
+    expected = ("eomgen: warning: no C compiler found ($CC, cc, gcc, clang): wrote "
+                "planar_2link_casadi.c/.h without the .so")
+    for run in ("derived", "cached"):
+        result = subprocess.run(command + ["--quiet"], env=env, capture_output=True, text=True,
+                                timeout=120)
+        assert result.returncode == 0, result.stderr
+        assert result.stderr.splitlines() == [expected], f"{run}: {result.stderr}"
+        assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [
+            "planar_2link_casadi.c", "planar_2link_casadi.h", "planar_2link_numpy.py"]
+
+
+def test_no_c_compiler_warns_library_callers(build, tmp_path, monkeypatch):
+    from eomgen.cache import CachedNotice
+    from eomgen.codegen.backends.casadi_backend import NoCompilerWarning
+
+    monkeypatch.delenv("CC", raising=False)
+    monkeypatch.setenv("PATH", str(tmp_path))
+    assert c_compiler() is None
+    model = build("planar_2link").model
+    match = r"^no C compiler found .*: wrote planar_2link_casadi\.c/\.h without the \.so$"
+    with pytest.warns(NoCompilerWarning, match=match):
+        paths = generate(model, tmp_path / "a", "c", cache_dir=tmp_path / "cache")
+    assert [p.name for p in paths] == ["planar_2link_casadi.c", "planar_2link_casadi.h"]
+    with pytest.warns(CachedNotice, match=match):  # answered from the cache: said again
+        generate(model, tmp_path / "b", "c", cache_dir=tmp_path / "cache")
+
+
+# ----------------------------------------------------------------------------------------------
 # Hostile names
 # ----------------------------------------------------------------------------------------------
 
@@ -576,7 +791,9 @@ NUMPY_CALLS = {"_batch", "_states", "mass_matrix", "inverse_dynamics", "ValueErr
                "reversed", "zip", "all", "int", "_at", "_not_positive_definite",
                "FloatingPointError"}
 NUMPY_LOCAL_OBJECTS = {"arrays", "singles", "_warnings"}
-CASADI_CALLS = {"_build", "_cholesky_solve", "sum", "range", "reversed"} | {
+CASADI_LOCAL_OBJECTS = {"PARAMETERS"}  # the module's dict literal: PARAMETERS.values()
+CASADI_CALLS = {"_build", "_function", "_cholesky_solve", "sum", "range", "reversed", "len",
+                "float"} | {
     f"_{f}_expression" for f in FUNCTION_NAMES}
 #: Tokens holding literal text (Python 3.12 splits f-strings into several tokens).
 _LITERAL_TOKENS = {tokenize.STRING, tokenize.COMMENT} | (
@@ -627,7 +844,7 @@ def hostile(tmp_path_factory) -> Example:
 def test_hostile_names_generate_safe_modules(hostile, capfd):
     ex = hostile
     for kind, alias, calls, local in (("numpy", "np", NUMPY_CALLS, NUMPY_LOCAL_OBJECTS),
-                                      ("casadi", "ca", CASADI_CALLS, ())):
+                                      ("casadi", "ca", CASADI_CALLS, CASADI_LOCAL_OBJECTS)):
         path = Path(getattr(ex, kind).__file__)
         tree = assert_safe_python(path.read_text(encoding="utf-8"), alias, calls, local)
         assert repr(DOCSTRING_BREAKER) in ast.get_docstring(tree)
@@ -680,8 +897,8 @@ def test_hostile_robot_names_stay_text(robot_name):
         assert name.isascii() and name.endswith(("_numpy.py", "_casadi.py"))
         alias = "np" if name.endswith("_numpy.py") else "ca"
         calls = NUMPY_CALLS if alias == "np" else CASADI_CALLS
-        tree = assert_safe_python(content, alias, calls,
-                                  NUMPY_LOCAL_OBJECTS if alias == "np" else ())
+        local = NUMPY_LOCAL_OBJECTS if alias == "np" else CASADI_LOCAL_OBJECTS
+        tree = assert_safe_python(content, alias, calls, local)
         assert repr(robot_name) in ast.get_docstring(tree)
         joint_names = next(ast.literal_eval(node.value) for node in tree.body
                            if isinstance(node, ast.Assign)
@@ -700,7 +917,7 @@ def test_hostile_names_through_urdf(tmp_path):
     for f in render_files(model, ["numpy", "casadi"]):
         alias = "np" if f.name.endswith("_numpy.py") else "ca"
         assert_safe_python(f.content, alias, NUMPY_CALLS if alias == "np" else CASADI_CALLS,
-                           NUMPY_LOCAL_OBJECTS if alias == "np" else ())
+                           NUMPY_LOCAL_OBJECTS if alias == "np" else CASADI_LOCAL_OBJECTS)
 
 
 def test_parameters_named_like_private_helpers_do_not_shadow_them(tmp_path):
@@ -782,7 +999,7 @@ def test_colliding_parameter_names_become_sound_keywords(colliding):
         assert sorted(module.PARAMETERS.values()) == sorted(COLLIDING.values())
     assert list(colliding.numpy.PARAMETERS.items()) == list(colliding.casadi.PARAMETERS.items())
     for kind, alias, calls, local in (("numpy", "np", NUMPY_CALLS, NUMPY_LOCAL_OBJECTS),
-                                      ("casadi", "ca", CASADI_CALLS, ())):
+                                      ("casadi", "ca", CASADI_CALLS, CASADI_LOCAL_OBJECTS)):
         assert_safe_python(Path(getattr(colliding, kind).__file__).read_text(encoding="utf-8"),
                            alias, calls, local)
     identifiers = set(colliding.numpy.PARAMETERS)

@@ -4,9 +4,18 @@
 """Equations of motion M(q) qdd + C(q, qd) qd + g(q) = tau of robot 'planar_2link' as CasADi
 functions (SX graphs).
 
-Joint order: JOINT_NAMES. Each function has named inputs (q, qd, qdd, tau and the parameters
-kept symbolic: I1, I2, g_, l1, l2, lc1, lc2, m1, m2) and one named output, e.g.
-``mass_matrix(q=q)["M"]`` or ``mass_matrix(q, I1, I2, g_, l1, l2, lc1, lc2, m1, m2)``. Units are SI.
+Joint order: JOINT_NAMES. Each function has named inputs, vectors among q, qd, qdd and tau, then
+the parameters kept symbolic (PARAMETERS: I1, I2, g_, l1, l2, lc1, lc2, m1, m2), and one named output.
+Call it with every input in order, or by name:
+
+    mass_matrix(q, I1, I2, g_, l1, l2, lc1, lc2, m1, m2)
+    mass_matrix(q=q)["M"]
+    mass_matrix(q=q, I1=...)["M"]
+
+A parameter left out takes its value in PARAMETERS, the description's; a vector left out (q,
+qd, qdd, tau) is zero, CasADi's rule. These are CasADi's ``default_in``: the C code of eomgen's
+C backend keeps them, so a shared library loaded with ``casadi.external`` defaults alike. Units
+are SI.
 """
 
 import casadi as ca
@@ -30,6 +39,8 @@ PARAMETERS = {
     "m1": 1.0,  # 'mass of link 1 [kg]'
     "m2": 1.0,  # 'mass of link 2 [kg]'
 }
+#: default_in of the parameter inputs: their PARAMETERS values, NaN for a parameter without one.
+_PARAMETER_DEFAULTS = [float("nan") if v is None else v for v in PARAMETERS.values()]
 
 
 def _mass_matrix_expression(q, I1, I2, g_, l1, l2, lc1, lc2, m1, m2):
@@ -167,6 +178,14 @@ def _cholesky_solve(M, b):
     return ca.vertcat(*x)
 
 
+def _function(name, inputs, output, input_names, output_name):
+    """casadi.Function ``name`` of ``inputs`` (vectors, then parameters) with one output. By
+    name, a parameter left out takes its PARAMETERS value, a vector left out is zero."""
+    vectors = len(inputs) - len(_PARAMETER_DEFAULTS)
+    options = {"default_in": [0.0] * vectors + _PARAMETER_DEFAULTS}
+    return ca.Function(name, inputs, [output], input_names, [output_name], options)
+
+
 def _build():
     q = ca.SX.sym("q", NQ)
     qd = ca.SX.sym("qd", NQ)
@@ -186,30 +205,26 @@ def _build():
     vectors = {"q": q, "qd": qd, "qdd": qdd}
     functions = {}
     args = [vectors["q"]]
-    functions["mass_matrix"] = ca.Function(
-        "mass_matrix", args + parameters,
-        [_mass_matrix_expression(*args, *parameters)],
-        ["q"] + names, ["M"])
+    functions["mass_matrix"] = _function(
+        "mass_matrix", args + parameters, _mass_matrix_expression(*args, *parameters),
+        ["q"] + names, "M")
     args = [vectors["q"], vectors["qd"]]
-    functions["coriolis_matrix"] = ca.Function(
-        "coriolis_matrix", args + parameters,
-        [_coriolis_matrix_expression(*args, *parameters)],
-        ["q", "qd"] + names, ["C"])
+    functions["coriolis_matrix"] = _function(
+        "coriolis_matrix", args + parameters, _coriolis_matrix_expression(*args, *parameters),
+        ["q", "qd"] + names, "C")
     args = [vectors["q"]]
-    functions["gravity_vector"] = ca.Function(
-        "gravity_vector", args + parameters,
-        [_gravity_vector_expression(*args, *parameters)],
-        ["q"] + names, ["g"])
+    functions["gravity_vector"] = _function(
+        "gravity_vector", args + parameters, _gravity_vector_expression(*args, *parameters),
+        ["q"] + names, "g")
     args = [vectors["q"], vectors["qd"], vectors["qdd"]]
-    functions["inverse_dynamics"] = ca.Function(
-        "inverse_dynamics", args + parameters,
-        [_inverse_dynamics_expression(*args, *parameters)],
-        ["q", "qd", "qdd"] + names, ["tau"])
+    functions["inverse_dynamics"] = _function(
+        "inverse_dynamics", args + parameters, _inverse_dynamics_expression(*args, *parameters),
+        ["q", "qd", "qdd"] + names, "tau")
     M = _mass_matrix_expression(q, *parameters)
     bias = _inverse_dynamics_expression(q, qd, ca.SX.zeros(NQ, 1), *parameters)
-    functions["forward_dynamics"] = ca.Function(
-        "forward_dynamics", [q, qd, tau] + parameters, [_cholesky_solve(M, tau - bias)],
-        ["q", "qd", "tau"] + names, ["qdd"])
+    functions["forward_dynamics"] = _function(
+        "forward_dynamics", [q, qd, tau] + parameters, _cholesky_solve(M, tau - bias),
+        ["q", "qd", "tau"] + names, "qdd")
     return functions
 
 

@@ -4,9 +4,17 @@
 """Equations of motion M(q) qdd + C(q, qd) qd + g(q) = tau of robot 'ur5' as CasADi
 functions (SX graphs).
 
-Joint order: JOINT_NAMES. Each function has named inputs (q, qd, qdd, tau and the parameters
-kept symbolic) and one named output, e.g.
-``mass_matrix(q=q)["M"]`` or ``mass_matrix(q)``. Units are SI.
+Joint order: JOINT_NAMES. Each function has named inputs, vectors among q, qd, qdd and tau, then
+the parameters kept symbolic (PARAMETERS), and one named output.
+Call it with every input in order, or by name:
+
+    mass_matrix(q)
+    mass_matrix(q=q)["M"]
+
+A parameter left out takes its value in PARAMETERS, the description's; a vector left out (q,
+qd, qdd, tau) is zero, CasADi's rule. These are CasADi's ``default_in``: the C code of eomgen's
+C backend keeps them, so a shared library loaded with ``casadi.external`` defaults alike. Units
+are SI.
 """
 
 import casadi as ca
@@ -25,6 +33,8 @@ JOINT_NAMES = (
 NQ = 6
 PARAMETERS = {
 }
+#: default_in of the parameter inputs: their PARAMETERS values, NaN for a parameter without one.
+_PARAMETER_DEFAULTS = [float("nan") if v is None else v for v in PARAMETERS.values()]
 
 
 def _mass_matrix_expression(q):
@@ -958,6 +968,14 @@ def _cholesky_solve(M, b):
     return ca.vertcat(*x)
 
 
+def _function(name, inputs, output, input_names, output_name):
+    """casadi.Function ``name`` of ``inputs`` (vectors, then parameters) with one output. By
+    name, a parameter left out takes its PARAMETERS value, a vector left out is zero."""
+    vectors = len(inputs) - len(_PARAMETER_DEFAULTS)
+    options = {"default_in": [0.0] * vectors + _PARAMETER_DEFAULTS}
+    return ca.Function(name, inputs, [output], input_names, [output_name], options)
+
+
 def _build():
     q = ca.SX.sym("q", NQ)
     qd = ca.SX.sym("qd", NQ)
@@ -968,30 +986,26 @@ def _build():
     vectors = {"q": q, "qd": qd, "qdd": qdd}
     functions = {}
     args = [vectors["q"]]
-    functions["mass_matrix"] = ca.Function(
-        "mass_matrix", args + parameters,
-        [_mass_matrix_expression(*args, *parameters)],
-        ["q"] + names, ["M"])
+    functions["mass_matrix"] = _function(
+        "mass_matrix", args + parameters, _mass_matrix_expression(*args, *parameters),
+        ["q"] + names, "M")
     args = [vectors["q"], vectors["qd"]]
-    functions["coriolis_matrix"] = ca.Function(
-        "coriolis_matrix", args + parameters,
-        [_coriolis_matrix_expression(*args, *parameters)],
-        ["q", "qd"] + names, ["C"])
+    functions["coriolis_matrix"] = _function(
+        "coriolis_matrix", args + parameters, _coriolis_matrix_expression(*args, *parameters),
+        ["q", "qd"] + names, "C")
     args = [vectors["q"]]
-    functions["gravity_vector"] = ca.Function(
-        "gravity_vector", args + parameters,
-        [_gravity_vector_expression(*args, *parameters)],
-        ["q"] + names, ["g"])
+    functions["gravity_vector"] = _function(
+        "gravity_vector", args + parameters, _gravity_vector_expression(*args, *parameters),
+        ["q"] + names, "g")
     args = [vectors["q"], vectors["qd"], vectors["qdd"]]
-    functions["inverse_dynamics"] = ca.Function(
-        "inverse_dynamics", args + parameters,
-        [_inverse_dynamics_expression(*args, *parameters)],
-        ["q", "qd", "qdd"] + names, ["tau"])
+    functions["inverse_dynamics"] = _function(
+        "inverse_dynamics", args + parameters, _inverse_dynamics_expression(*args, *parameters),
+        ["q", "qd", "qdd"] + names, "tau")
     M = _mass_matrix_expression(q, *parameters)
     bias = _inverse_dynamics_expression(q, qd, ca.SX.zeros(NQ, 1), *parameters)
-    functions["forward_dynamics"] = ca.Function(
-        "forward_dynamics", [q, qd, tau] + parameters, [_cholesky_solve(M, tau - bias)],
-        ["q", "qd", "tau"] + names, ["qdd"])
+    functions["forward_dynamics"] = _function(
+        "forward_dynamics", [q, qd, tau] + parameters, _cholesky_solve(M, tau - bias),
+        ["q", "qd", "tau"] + names, "qdd")
     return functions
 
 

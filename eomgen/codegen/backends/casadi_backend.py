@@ -13,6 +13,7 @@ import re
 import shutil
 import subprocess
 import tempfile
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -62,7 +63,10 @@ class CasADiConfig:
 
 def _render_module(job: Job, config: CasADiConfig) -> str:
     printer = CasADiPrinter({"standard": "python3"})
-    return render(config.template, **python_module_context(job, printer, config.template))
+    # Parameters without a value have no default: the module refuses calls that leave them out.
+    required = [p.identifier for p in job.parameters if p.default is None]
+    return render(config.template, required=required,
+                  **python_module_context(job, printer, config.template))
 
 
 @register("casadi", "CasADi module: casadi.Function objects (SX) with named inputs and outputs")
@@ -80,12 +84,24 @@ def load_module_source(source: str, name: str) -> dict:
 FUNCTION_NAMES = ALL_FUNCTIONS  # every function a module can export (a job may ask fewer)
 
 
+class NoCompilerWarning(UserWarning):
+    """The C backend found no C compiler: it wrote the C source and header, not the ``.so``."""
+
+
 def c_compiler() -> str | None:
     """The C compiler to use: $CC, else cc or gcc on PATH, else None."""
     for candidate in (os.environ.get("CC"), "cc", "gcc", "clang"):
         if candidate and shutil.which(candidate):
             return candidate
     return None
+
+
+#: What the C files say, below their header, about the parameter inputs.
+_C_PARAMETER_NOTE = [
+    "Inputs: the vectors (q, qd, qdd or tau), then the parameters kept symbolic, sorted by name.",
+    "casadi.external gives a parameter left out of a call by name <function>_default_in(i), the",
+    "description's value (NaN where it has none); a direct C call reads a NULL input as zeros.",
+]
 
 
 @register("c", "C source through CasADi's code generator, and a shared library when a C compiler is found")
@@ -105,8 +121,10 @@ def generate_c(job: Job, config: CasADiConfig = CasADiConfig()) -> list[Generate
         generator.generate(tmp + os.sep)
         c_source = Path(tmp, prefix + ".c").read_text()
         h_source = Path(tmp, prefix + ".h").read_text()
-        header = "".join(f"/* {line.replace('*/', '* /')} */\n"
-                         for line in job.header_lines("CasADi CodeGenerator via casadi/module.py.jinja"))
+        lines = job.header_lines("CasADi CodeGenerator via casadi/module.py.jinja")
+        if job.parameters:
+            lines += _C_PARAMETER_NOTE
+        header = "".join(f"/* {line.replace('*/', '* /')} */\n" for line in lines)
         files = [GeneratedFile(stem + ".c", header + c_source),
                  GeneratedFile(stem + ".h", header + h_source)]
         compiler = c_compiler()
@@ -120,4 +138,7 @@ def generate_c(job: Job, config: CasADiConfig = CasADiConfig()) -> list[Generate
             if result.returncode != 0:
                 raise RuntimeError(f"compiling {stem}.c failed: {result.stderr.strip()[:500]}")
             files.append(GeneratedFile(stem + ".so", library.read_bytes(), golden=False))
+        else:
+            warnings.warn(f"no C compiler found ($CC, cc, gcc, clang): wrote {stem}.c/.h "
+                          "without the .so", NoCompilerWarning, stacklevel=2)
     return files
