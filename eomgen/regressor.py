@@ -134,28 +134,35 @@ class Regressor:
         """Potential energy row, 1 × p: ``P = Y_P(q) π`` [J], P = −Σ m g_vec · c."""
         return self.program.expand(self.program.output("P"))
 
+    def base_program(self, columns: Sequence[int]) -> Program:
+        """The program computing only ``Y_base = Y[:, columns]`` (n × b), output ``"Y_base"``;
+        unused intermediates pruned (what generated ``base_regressor(q, qd, qdd)`` prints)."""
+        Y = self.program.output("Y")
+        out = Y.extract(list(range(Y.rows)), list(columns))
+        return Program(self.program.assignments, (("Y_base", out),)).pruned(["Y_base"])
+
     def operation_count(self, columns: Sequence[int] | None = None) -> int:
-        """Operations of the program computing Y, or only the given columns of Y."""
+        """Operations (SymPy ``count_ops``) of the program computing Y, or only the given
+        columns of Y (the base regressor)."""
         if columns is None:
             return self.program.operation_count(["Y"])
-        Y = self.program.output("Y")
-        sub = Program(self.program.assignments, (("Y", Y.extract(list(range(Y.rows)),
-                                                                   list(columns))),))
-        return sub.operation_count(["Y"])
+        return self.base_program(columns).operation_count()
 
-    def compiled(self, values: Mapping | None = None):
-        """A numeric function ``f(q, qd, qdd) -> {"Y": (n, p), "K": (1, p), "P": (1, p)}``.
+    def compiled(self, values: Mapping | None = None, program: Program | None = None):
+        """A numeric function ``f(q, qd, qdd) -> {"Y": (n, p), "K": (1, p), "P": (1, p)}``
+        (or the outputs of ``program``, e.g. :meth:`base_program`).
 
         Geometry parameters take their default values (``values`` overriding, symbol or name).
         """
+        program = self.program if program is None else program
         merged = dict(self.model.parameter_values)
         merged.update({(parameter_symbol(k) if isinstance(k, str) else k): v
                        for k, v in (values or {}).items()})
         signs = tuple(sp.Symbol(f"sign_{s.name}", real=True) for s in self.qd)
         swap = {sp.sign(s): t for s, t in zip(self.qd, signs)}
         subs = {k: sp.Float(v) for k, v in merged.items()}
-        assignments = tuple((s, e.xreplace(subs)) for s, e in self.program.assignments)
-        outputs = tuple((name, m.xreplace(swap).xreplace(subs)) for name, m in self.program.outputs)
+        assignments = tuple((s, e.xreplace(subs)) for s, e in program.assignments)
+        outputs = tuple((name, m.xreplace(swap).xreplace(subs)) for name, m in program.outputs)
         raw = compile_program(Program(assignments, outputs), self.q + self.qd + self.qdd + signs)
 
         def evaluate(q, qd, qdd) -> dict:
@@ -206,6 +213,9 @@ def derive_regressor(model: RobotModel, actuators: Iterable[str] = ()) -> Regres
 #: residuals near 1e-14; independent columns of the robots tested stay above 1e-4 (see
 #: :attr:`BaseParameters.gap`).
 RANK_TOLERANCE = 1e-8
+#: Columns whose norm over the samples is below this fraction of the largest are zero (rounding
+#: leaves ~1e-16 where a structural zero was not seen symbolically).
+ZERO_COLUMN = 1e-10
 
 
 @dataclass(frozen=True)
@@ -329,19 +339,34 @@ def base_parameters(reg: Regressor, samples: int | None = None, seed: int = 0,
 
     W = sample_regressor(reg, samples, seed, values)
     norms = np.linalg.norm(W, axis=0)
-    scale = np.where(norms > 0, norms, 1.0)
-    Wn = W / scale
+    nonzero = norms > ZERO_COLUMN * norms.max()
+    Wn = np.where(nonzero, W / np.where(nonzero, norms, 1.0), 0.0)
     R = scipy.linalg.qr(Wn, mode="r", pivoting=True)[0]
     d = np.abs(np.diag(R))
     rank = int(np.sum(d > tolerance * d[0])) if d.size and d[0] > 0 else 0
 
+    kept, gap = _independent_columns(Wn, nonzero, tolerance)
+    if len(kept) != rank:
+        raise RuntimeError(f"rank by pivoted QR is {rank} but {len(kept)} columns were kept: "
+                           f"no clear gap at tolerance {tolerance}")
+    dependent = [k for k in range(W.shape[1]) if k not in kept]
+    K, *_ = np.linalg.lstsq(W[:, kept], W[:, dependent], rcond=None)
+    if K.size:
+        K[np.abs(K) < 1e-10 * max(1.0, np.abs(K).max())] = 0.0
+    return BaseParameters(reg.PARAMETER_NAMES, tuple(kept), tuple(dependent), K, rank, gap)
+
+
+def _independent_columns(Wn: np.ndarray, candidates, tolerance: float):
+    """Greedy selection in column order among ``candidates`` (boolean mask) of the unit-norm
+    columns of ``Wn``: a column is kept when its residual after projection on those kept before
+    it exceeds ``tolerance``. Returns (kept indices, (smallest kept residual, largest dropped))."""
     kept: list[int] = []
-    Q = np.zeros((W.shape[0], 0))
+    Q = np.zeros((Wn.shape[0], 0))
     kept_min, dropped_max = np.inf, 0.0
-    for k in range(W.shape[1]):
-        w = Wn[:, k]
-        if norms[k] == 0:
+    for k in range(Wn.shape[1]):
+        if not candidates[k]:
             continue
+        w = Wn[:, k]
         res = w - Q @ (Q.T @ w)
         res = res - Q @ (Q.T @ res)  # twice is enough (Kahan–Parlett)
         rel = float(np.linalg.norm(res))
@@ -351,12 +376,132 @@ def base_parameters(reg: Regressor, samples: int | None = None, seed: int = 0,
             kept_min = min(kept_min, rel)
         else:
             dropped_max = max(dropped_max, rel)
-    if len(kept) != rank:
-        raise RuntimeError(f"rank by pivoted QR is {rank} but {len(kept)} columns were kept; "
-                           "no clear gap at tolerance {tolerance}")
-    dependent = [k for k in range(W.shape[1]) if k not in kept]
-    K, *_ = np.linalg.lstsq(W[:, kept], W[:, dependent], rcond=None)
-    if K.size:
-        K[np.abs(K) < 1e-10 * max(1.0, np.abs(K).max())] = 0.0
-    return BaseParameters(reg.PARAMETER_NAMES, tuple(kept), tuple(dependent), K, rank,
-                          (kept_min, dropped_max))
+    return kept, (kept_min, dropped_max)
+
+
+# ----------------------------------------------------------------------------------------------
+# Base parameters, symbolically (closed-form grouping), checked numerically
+# ----------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SymbolicBase:
+    """Base parameters from the closed-form grouping rules (:mod:`eomgen.symbolic.grouping`).
+
+    Attributes
+    ----------
+    names:
+        Name of each base parameter: the column's name, with ``R`` appended when other
+        parameters were grouped into it (``XX2R``).
+    base:
+        Their column indices in Y (``Y_base = Y[:, base]``), increasing.
+    expressions:
+        β as SymPy expressions of the standard parameter symbols (:attr:`Regressor.
+        parameter_symbols`) and of the model's geometry symbols (kept symbolic).
+    unidentifiable:
+        Columns the rules kept that are zero at every sampled state (gravity along the first
+        axis, bodies that cannot rotate about some axis, …): their parameters have no effect.
+    residual:
+        Columns the rules kept that were still found dependent numerically (special cases the
+        rules do not cover). Empty when the grouping alone is complete.
+    """
+
+    names: tuple[str, ...]
+    base: tuple[int, ...]
+    expressions: tuple[sp.Expr, ...]
+    unidentifiable: tuple[int, ...]
+    residual: tuple[int, ...]
+    parameter_symbols: tuple[sp.Symbol, ...]
+    geometry: tuple[tuple[sp.Symbol, float], ...] = ()
+
+    @property
+    def count(self) -> int:
+        return len(self.base)
+
+    def beta(self, pi, values: Mapping | None = None) -> np.ndarray:
+        """β(π) as floats; geometry symbols at the model's defaults (``values`` overriding)."""
+        subs = dict(self.geometry)
+        subs.update({(parameter_symbol(k) if isinstance(k, str) else k): v
+                     for k, v in (values or {}).items()})
+        subs.update(zip(self.parameter_symbols, (float(x) for x in pi)))
+        return np.array([float(e.xreplace(subs)) for e in self.expressions], dtype=float)
+
+    def latex(self) -> str:
+        """``\\begin{aligned} name &= expression \\\\ … \\end{aligned}``."""
+        lines = []
+        for name, expr in zip(self.names, self.expressions):
+            tex = sp.latex(expr, symbol_names={s: _latex_name(s.name)
+                                               for s in expr.free_symbols
+                                               if s in self.parameter_symbols})
+            lines.append(f"{_latex_name(name)} &= {tex}")
+        return "\\begin{aligned}\n" + " \\\\\n".join(lines) + "\n\\end{aligned}"
+
+
+def symbolic_base_parameters(reg: Regressor, samples: int | None = None, seed: int = 0,
+                             values: Mapping | None = None, tolerance: float = RANK_TOLERANCE
+                             ) -> SymbolicBase:
+    """Base parameters by the closed-form grouping rules, then checked over random states.
+
+    The grouping (:func:`eomgen.symbolic.grouping.group_parameters`) gives β as expressions of
+    π and of the geometry symbols. Numerically, at the geometry's default values (``values``
+    overriding): the identity ``Y π = Y[:, kept] β(π)`` is checked for a random π (a wrong rule
+    raises), kept columns that are zero are reported as unidentifiable, and kept columns still
+    dependent on earlier ones (special cases the rules do not cover) are reported as
+    ``residual`` and left out of the base. Actuator columns are kept when not zero or dependent.
+
+    Raises
+    ------
+    ValueError
+        For a revolute axis not along ±x, ±y, ±z of its joint frame.
+    RuntimeError
+        When the grouped regressor does not reproduce Y π (a defect).
+    """
+    from .symbolic.grouping import group_parameters
+
+    grouping = group_parameters(reg.tree, reg.parameter_symbols)
+    kept = list(grouping.kept) + list(range(10 * reg.n, reg.p))
+    expressions = list(grouping.expressions) + [reg.parameter_symbols[k]
+                                                for k in range(10 * reg.n, reg.p)]
+    geometry = dict(reg.model.parameter_values)
+    geometry.update({(parameter_symbol(k) if isinstance(k, str) else k): v
+                     for k, v in (values or {}).items()})
+    W = sample_regressor(reg, samples, seed, values)
+    rng = np.random.default_rng(seed + 1)
+    pi = rng.uniform(0.5, 1.5, reg.p)
+    subs = {**{k: sp.Float(v) for k, v in geometry.items()}, **dict(zip(reg.parameter_symbols, pi))}
+    beta = np.array([float(e.xreplace(subs)) for e in expressions])
+    Wk = W[:, kept]
+    error = np.abs(Wk @ beta - W @ pi).max()
+    if error > 1e-9 * max(1.0, np.abs(W @ pi).max()):
+        raise RuntimeError(f"grouped regressor misses Y π by {error:.3g} (a grouping defect)")
+    norms = np.linalg.norm(Wk, axis=0)
+    nonzero = norms > ZERO_COLUMN * np.linalg.norm(W, axis=0).max()
+    Wn = np.where(nonzero, Wk / np.where(nonzero, norms, 1.0), 0.0)
+    independent, _ = _independent_columns(Wn, nonzero, tolerance)
+    unidentifiable = tuple(kept[c] for c in range(len(kept)) if not nonzero[c])
+    residual = tuple(kept[c] for c in range(len(kept)) if nonzero[c] and c not in independent)
+    names, cols, exprs = [], [], []
+    for c in independent:
+        k, expr = kept[c], expressions[c]
+        cols.append(k)
+        exprs.append(_by_coefficient(expr, reg.parameter_symbols))
+        names.append(reg.PARAMETER_NAMES[k] + ("R" if expr != reg.parameter_symbols[k] else ""))
+    return SymbolicBase(tuple(names), tuple(cols), tuple(exprs), unidentifiable, residual,
+                        reg.parameter_symbols, tuple((k, float(v)) for k, v in geometry.items()))
+
+
+def _by_coefficient(expr: sp.Expr, pi: Sequence[sp.Symbol]) -> sp.Expr:
+    """A linear form in ``pi`` written as Σ coefficient · (sum of the parameters sharing it):
+    ``a2**2*(M3 + M4 + M5 + M6) + XX2 - YY2``."""
+    terms: dict = {}
+    order: list = []
+    poly = sp.expand(expr)
+    used = [s for s in pi if s in poly.free_symbols]
+    for s in used:
+        coef = poly.coeff(s)
+        if coef not in terms:
+            terms[coef] = []
+            order.append(coef)
+        terms[coef].append(s)
+    constant = poly.subs({s: 0 for s in used})
+    return sp.Add(*[c * sp.Add(*terms[c]) for c in order]) + constant
