@@ -5,16 +5,19 @@ hand-derived base parameters of the planar two-link arm."""
 from __future__ import annotations
 
 import functools
+import tempfile
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
+import sympy as sp
 
 import eomgen
 from conftest import erd_robots_dir
 from eomgen.errors import UnsupportedFeatureWarning
 from eomgen.numeric import kinetic_energy, numeric_model, potential_energy, rnea
-from eomgen.regressor import base_parameters, derive_regressor
+from eomgen.regressor import base_parameters, derive_regressor, symbolic_base_parameters
 from reference import pin_q_order, random_robot, to_pinocchio
 
 URDF = {
@@ -185,3 +188,78 @@ def test_planar_2link_base_parameters_are_the_closed_form():
     np.testing.assert_allclose(base.K, expected, atol=1e-12)
     assert [name for name, _ in base.expressions()] == ["MX1R", "MY1", "ZZ1R", "MX2", "MY2",
                                                         "ZZ2"]
+
+
+# ----------------------------------------------------------------------------------------------
+# Symbolic base parameters (closed-form grouping) against the numeric route
+# ----------------------------------------------------------------------------------------------
+
+PUMA_SYMBOLIC = {"a: 0.4318": "a: a2", "a: 0.0203": "a: a3", "d: 0.15005": "d: d3",
+                 "d: 0.4318": "d: d4"}
+
+
+@functools.cache
+def puma_symbolic_geometry():
+    """The PUMA 560 with its DH lengths a2, a3, d3, d4 kept as symbols."""
+    text = eomgen.example_path("puma560_dh").read_text()
+    for old, new in PUMA_SYMBOLIC.items():
+        assert text.count(old) == 1
+        text = text.replace(old, new)
+    text = text.replace("\ndh:\n", "\nparameters: {a2: 0.4318, a3: 0.0203, d3: 0.15005, "
+                        "d4: 0.4318}\ndh:\n", 1)
+    path = Path(tempfile.mkdtemp()) / "puma560_symbolic.yaml"
+    path.write_text(text)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return derive_regressor(eomgen.load(path))
+
+
+def test_planar_2link_symbolic_grouping_is_the_closed_form():
+    reg = regressor("planar_2link")
+    base = symbolic_base_parameters(reg)
+    M2, MX1, ZZ1 = (sp.Symbol(n, real=True) for n in ("M2", "MX1", "ZZ1"))
+    l1 = sp.Symbol("l1", real=True)
+    got = dict(zip(base.names, base.expressions))
+    assert list(got) == ["MX1R", "MY1", "ZZ1R", "MX2", "MY2", "ZZ2"]
+    assert sp.expand(got["MX1R"] - (MX1 + l1 * M2)) == 0
+    assert sp.expand(got["ZZ1R"] - (ZZ1 + l1 ** 2 * M2)) == 0
+    assert base.residual == ()
+
+
+@pytest.mark.parametrize("name", ["puma560_dh", "ur5", "panda_arm"])
+def test_symbolic_and_numeric_base_parameters_agree(name):
+    reg = regressor(name)
+    symbolic, numeric = symbolic_base_parameters(reg), base_parameters(reg)
+    assert symbolic.residual == ()  # the rules alone leave no dependency on these arms
+    assert symbolic.base == numeric.base
+    pi = np.random.default_rng(4).uniform(-1, 1, reg.p)
+    np.testing.assert_allclose(symbolic.beta(pi), numeric.beta(pi), rtol=1e-9, atol=1e-12)
+
+
+def test_symbolic_geometry_puma_base_parameters():
+    """DH lengths stay symbols in β; at other lengths β matches the numeric route there."""
+    reg = puma_symbolic_geometry()
+    base = symbolic_base_parameters(reg)
+    assert base.count == 36
+    got = dict(zip(base.names, base.expressions))
+    a2 = sp.Symbol("a2", real=True)
+    M, MX2, XX2, YY2 = ([sp.Symbol(f"M{k}", real=True) for k in (3, 4, 5, 6)],
+                        *(sp.Symbol(n, real=True) for n in ("MX2", "XX2", "YY2")))
+    assert sp.expand(got["MX2R"] - (MX2 + a2 * sum(M))) == 0
+    assert sp.expand(got["XX2R"] - (XX2 - YY2 - a2 ** 2 * sum(M))) == 0
+    other = {"a2": 0.6, "a3": 0.05, "d3": 0.2, "d4": 0.3}
+    numeric = base_parameters(reg, values=other)
+    assert numeric.base == base.base
+    pi = np.random.default_rng(5).uniform(-1, 1, reg.p)
+    np.testing.assert_allclose(base.beta(pi, other), numeric.beta(pi), rtol=1e-9, atol=1e-12)
+    assert base.latex().startswith("\\begin{aligned}\n\\mathrm{ZZ}_{1}^{R} &= ")
+
+
+def test_base_program_computes_the_base_columns():
+    reg = regressor("puma560_dh")
+    base = base_parameters(reg)
+    full, only = reg.compiled(), reg.compiled(program=reg.base_program(base.base))
+    for q, qd, qdd in states(reg.n, 2):
+        np.testing.assert_array_equal(only(q, qd, qdd)["Y_base"],
+                                      full(q, qd, qdd)["Y"][:, list(base.base)])
+    assert reg.operation_count(base.base) < reg.operation_count()
