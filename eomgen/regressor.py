@@ -267,7 +267,8 @@ class BaseParameters:
                     near = round(coef)
                     value = sp.Integer(near) if abs(coef - near) < 1e-9 else sp.Float(coef, digits)
                     expr = expr + value * syms[d]
-            out.append((self.names[k] + "R" if expr != syms[k] else self.names[k], expr))
+            name = self.names[k] + "R" if expr != syms[k] else self.names[k]
+            out.append((name, _by_coefficient(expr, syms)))
         return out
 
     def latex(self, digits: int = 6) -> str:
@@ -426,10 +427,15 @@ class SymbolicBase:
         subs.update(zip(self.parameter_symbols, (float(x) for x in pi)))
         return np.array([float(e.xreplace(subs)) for e in self.expressions], dtype=float)
 
-    def latex(self) -> str:
-        """``\\begin{aligned} name &= expression \\\\ … \\end{aligned}``."""
+    def latex(self, digits: int = 6) -> str:
+        """``\\begin{aligned} name &= expression \\\\ … \\end{aligned}``, numbers rounded to
+        ``digits`` significant digits."""
         lines = []
         for name, expr in zip(self.names, self.expressions):
+            expr = sp.expand(expr)
+            expr = _by_coefficient(expr.xreplace({f: sp.Float(f, digits)
+                                                  for f in expr.atoms(sp.Float)}),
+                                   self.parameter_symbols)
             tex = sp.latex(expr, symbol_names={s: _latex_name(s.name)
                                                for s in expr.free_symbols
                                                if s in self.parameter_symbols})
@@ -504,4 +510,7 @@ def _by_coefficient(expr: sp.Expr, pi: Sequence[sp.Symbol]) -> sp.Expr:
             order.append(coef)
         terms[coef].append(s)
     constant = poly.subs({s: 0 for s in used})
-    return sp.Add(*[c * sp.Add(*terms[c]) for c in order]) + constant
+    # a number times a sum is distributed by SymPy unless told not to
+    return sp.Add(*[sp.Mul(c, sp.Add(*terms[c]), evaluate=False)
+                    if len(terms[c]) > 1 and abs(c) != 1 else c * sp.Add(*terms[c])
+                    for c in order]) + constant
