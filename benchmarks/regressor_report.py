@@ -60,7 +60,7 @@ def models() -> dict:
     return out
 
 
-def timed(f, repeat: int) -> tuple[float, list[float]]:
+def timed(f, repeat: int) -> tuple[float, list[float], object]:
     start = time.perf_counter()
     result = f()
     first = time.perf_counter() - start

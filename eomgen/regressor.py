@@ -22,7 +22,7 @@ then, if asked, one group of n actuator columns per term: ``IA`` (armature, τ_k
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import cached_property
 from typing import Iterable, Mapping, Sequence
 
@@ -338,6 +338,8 @@ def base_parameters(reg: Regressor, samples: int | None = None, seed: int = 0,
     """
     import scipy.linalg
 
+    if reg.p == 0:  # nothing moves
+        return BaseParameters((), (), (), np.zeros((0, 0)), 0, (np.inf, 0.0))
     W = sample_regressor(reg, samples, seed, values)
     norms = np.linalg.norm(W, axis=0)
     nonzero = norms > ZERO_COLUMN * norms.max()
@@ -404,7 +406,9 @@ class SymbolicBase:
         axis, bodies that cannot rotate about some axis, …): their parameters have no effect.
     residual:
         Columns the rules kept that were still found dependent numerically (special cases the
-        rules do not cover). Empty when the grouping alone is complete.
+        rules do not cover); they are regrouped into the base ones with numeric coefficients
+        (least squares at the sampled geometry values). Empty when the grouping alone is
+        complete, and then β is exact in the geometry symbols.
     """
 
     names: tuple[str, ...]
@@ -453,7 +457,7 @@ def symbolic_base_parameters(reg: Regressor, samples: int | None = None, seed: i
     overriding): the identity ``Y π = Y[:, kept] β(π)`` is checked for a random π (a wrong rule
     raises), kept columns that are zero are reported as unidentifiable, and kept columns still
     dependent on earlier ones (special cases the rules do not cover) are reported as
-    ``residual`` and left out of the base. Actuator columns are kept when not zero or dependent.
+    ``residual`` and regrouped into the others with numeric coefficients. Actuator columns are kept when not zero or dependent.
 
     Raises
     ------
@@ -464,6 +468,8 @@ def symbolic_base_parameters(reg: Regressor, samples: int | None = None, seed: i
     """
     from .symbolic.grouping import group_parameters
 
+    if reg.p == 0:  # nothing moves
+        return SymbolicBase((), (), (), (), (), ())
     grouping = group_parameters(reg.tree, reg.parameter_symbols)
     kept = list(grouping.kept) + list(range(10 * reg.n, reg.p))
     expressions = list(grouping.expressions) + [reg.parameter_symbols[k]
@@ -486,9 +492,17 @@ def symbolic_base_parameters(reg: Regressor, samples: int | None = None, seed: i
     independent, _ = _independent_columns(Wn, nonzero, tolerance)
     unidentifiable = tuple(kept[c] for c in range(len(kept)) if not nonzero[c])
     residual = tuple(kept[c] for c in range(len(kept)) if nonzero[c] and c not in independent)
+    # residual dependencies: regrouped with numeric coefficients (at the sampled geometry)
+    dependent = [c for c in range(len(kept)) if nonzero[c] and c not in independent]
+    regroup = np.zeros((len(independent), 0))
+    if dependent:
+        regroup, *_ = np.linalg.lstsq(Wk[:, independent], Wk[:, dependent], rcond=None)
+        regroup[np.abs(regroup) < 1e-10 * max(1.0, np.abs(regroup).max())] = 0.0
     names, cols, exprs = [], [], []
-    for c in independent:
+    for r, c in enumerate(independent):
         k, expr = kept[c], expressions[c]
+        expr = expr + sp.Add(*[sp.Float(regroup[r, e]) * expressions[d]
+                               for e, d in enumerate(dependent) if regroup[r, e] != 0])
         cols.append(k)
         exprs.append(_by_coefficient(expr, reg.parameter_symbols))
         names.append(reg.PARAMETER_NAMES[k] + ("R" if expr != reg.parameter_symbols[k] else ""))
