@@ -31,6 +31,7 @@ import sympy as sp
 
 from .bodies import BodyTree, body_tree
 from .dynamics import joint_symbols
+from .errors import UnsupportedError
 from .model import RobotModel, parameter_symbol
 from .symbolic.evaluate import compile_program
 from .symbolic.program import Program, ProgramBuilder
@@ -461,8 +462,9 @@ def symbolic_base_parameters(reg: Regressor, samples: int | None = None, seed: i
 
     Raises
     ------
-    ValueError
-        For a revolute axis not along ±x, ±y, ±z of its joint frame.
+    UnsupportedError
+        For a revolute axis not along ±x, ±y, ±z of its joint frame (use
+        :func:`base_parameters`).
     RuntimeError
         When the grouped regressor does not reproduce Y π (a defect).
     """
@@ -470,7 +472,10 @@ def symbolic_base_parameters(reg: Regressor, samples: int | None = None, seed: i
 
     if reg.p == 0:  # nothing moves
         return SymbolicBase((), (), (), (), (), ())
-    grouping = group_parameters(reg.tree, reg.parameter_symbols)
+    try:
+        grouping = group_parameters(reg.tree, reg.parameter_symbols)
+    except ValueError as exc:
+        raise UnsupportedError(reg.model.source, "symbolic base parameters", str(exc)) from None
     kept = list(grouping.kept) + list(range(10 * reg.n, reg.p))
     expressions = list(grouping.expressions) + [reg.parameter_symbols[k]
                                                 for k in range(10 * reg.n, reg.p)]
@@ -528,3 +533,73 @@ def _by_coefficient(expr: sp.Expr, pi: Sequence[sp.Symbol]) -> sp.Expr:
     return sp.Add(*[sp.Mul(c, sp.Add(*terms[c]), evaluate=False)
                     if len(terms[c]) > 1 and abs(c) != 1 else c * sp.Add(*terms[c])
                     for c in order]) + constant
+
+
+# ----------------------------------------------------------------------------------------------
+# Identification: least squares of β from measured joint efforts
+# ----------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Identification:
+    """Least-squares estimate of the base parameters from measurements.
+
+    Attributes
+    ----------
+    beta:
+        Estimated β, (b,), in the order of the base used.
+    std:
+        Standard deviations of β from the residual (σ² (WᵀW)⁻¹, σ² = |τ − W β|² / (rows − b)).
+    rms:
+        Root mean square of the residual τ − W β [N m or N].
+    condition:
+        Condition number of the column-normalised observation matrix W (a measure of how well
+        the trajectory excites the base parameters).
+    """
+
+    beta: np.ndarray
+    std: np.ndarray
+    rms: float
+    condition: float
+
+
+def identify(reg: Regressor, base, q, qd, qdd, tau, values: Mapping | None = None
+             ) -> Identification:
+    """Estimate β by ordinary least squares, ``min |W β − τ|`` with W the base regressor
+    stacked over the samples.
+
+    Parameters
+    ----------
+    reg:
+        The regressor.
+    base:
+        A :class:`BaseParameters` or :class:`SymbolicBase` (its ``base`` columns are used).
+    q, qd, qdd, tau:
+        (N, n) arrays of joint positions, velocities, accelerations and measured efforts, in
+        JOINT_NAMES order (SI units).
+    values:
+        Geometry parameter values overriding the model's defaults.
+
+    Raises
+    ------
+    ValueError
+        When the arrays are not (N, n) or there are fewer rows N n than base parameters.
+    """
+    arrays = [np.atleast_2d(np.asarray(x, dtype=float)) for x in (q, qd, qdd, tau)]
+    if any(a.shape != arrays[0].shape or a.shape[1] != reg.n for a in arrays):
+        raise ValueError(f"q, qd, qdd and tau must all have shape (N, {reg.n})")
+    columns = list(base.base)
+    if arrays[0].size < len(columns):
+        raise ValueError(f"{arrays[0].size} equations for {len(columns)} base parameters")
+    f = reg.compiled(values, program=reg.base_program(columns))
+    W = np.vstack([f(*row)["Y_base"] for row in zip(*arrays[:3])])
+    y = arrays[3].reshape(-1)
+    beta, *_ = np.linalg.lstsq(W, y, rcond=None)
+    residual = y - W @ beta
+    dof = max(W.shape[0] - W.shape[1], 1)
+    sigma2 = float(residual @ residual) / dof
+    cov = sigma2 * np.linalg.pinv(W.T @ W)
+    norms = np.linalg.norm(W, axis=0)
+    condition = float(np.linalg.cond(W / np.where(norms > 0, norms, 1.0)))
+    return Identification(beta, np.sqrt(np.clip(np.diag(cov), 0, None)),
+                          float(np.sqrt(np.mean(residual ** 2))), condition)

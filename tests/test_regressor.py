@@ -15,9 +15,10 @@ import sympy as sp
 
 import eomgen
 from conftest import erd_robots_dir
-from eomgen.errors import UnsupportedFeatureWarning
+from eomgen.errors import UnsupportedError, UnsupportedFeatureWarning
 from eomgen.numeric import kinetic_energy, numeric_model, potential_energy, rnea
-from eomgen.regressor import base_parameters, derive_regressor, symbolic_base_parameters
+from eomgen.regressor import (base_parameters, derive_regressor, identify,
+                              symbolic_base_parameters)
 from reference import pin_q_order, random_robot, to_pinocchio
 
 URDF = {
@@ -278,7 +279,8 @@ def test_symbolic_route_reports_what_its_rules_leave_on_prismatic_chains():
 
 
 def test_symbolic_route_refuses_a_tilted_revolute_axis():
-    with pytest.raises(ValueError, match="needs a revolute axis along"):
+    with pytest.raises(UnsupportedError, match=r"^<random>: symbolic base parameters: joint "
+                       r"'joint\d+': the closed-form grouping needs a revolute axis along"):
         symbolic_base_parameters(regressor("random_tree"))
 
 
@@ -296,3 +298,21 @@ def test_planar_2link_Y_pi_is_the_lagrangian_tau_exactly():
     dyn = eomgen.derive(reg.model)
     difference = reg.Y * reg.inertial_parameters() - dyn.tau
     assert all(sp.simplify(sp.expand(e)) == 0 for e in difference)
+
+
+def test_identification_recovers_beta_from_newton_euler_torques():
+    """τ simulated by eomgen.numeric's RNEA (plus friction) for a π unlike the description's;
+    least squares on the base regressor returns β(π) of that π."""
+    reg = regressor("puma560_dh", ("viscous", "coulomb"))
+    base = base_parameters(reg)
+    rng = np.random.default_rng(11)
+    n = reg.n
+    fv, fc = rng.uniform(0.5, 2, n), rng.uniform(0.1, 1, n)
+    nm = numeric_model(reg.model)
+    samples = list(states(n, 30, seed=12))
+    tau = [rnea(nm, *s) + fv * s[1] + fc * np.sign(s[1]) for s in samples]
+    q, qd, qdd = (np.array([s[k] for s in samples]) for k in range(3))
+    result = identify(reg, base, q, qd, qdd, np.array(tau))
+    pi = np.concatenate([reg.numeric_parameters()[:10 * n], fv, fc])
+    np.testing.assert_allclose(result.beta, base.beta(pi), rtol=1e-7, atol=1e-9)
+    assert result.rms < 1e-9 and np.isfinite(result.condition)
