@@ -161,6 +161,7 @@ def regressor_program(tree: BodyTree, q, qd, qdd, gravity, b: ProgramBuilder,
     Y = sp.zeros(n, p)
     YK = sp.zeros(1, p)
     YP = sp.zeros(1, p)
+    axes_at: list[dict] = []  # per body j: {ancestor-or-self i: s_i^j}
     for j, body in enumerate(tree.bodies):
         tag = body.q_index + 1
         col = 10 * body.q_index
@@ -175,30 +176,18 @@ def regressor_program(tree: BodyTree, q, qd, qdd, gravity, b: ProgramBuilder,
         YP[0, col] = b.define(-height[j], f"P{tag}_0")
         for e in range(3):
             YP[0, col + 1 + e] = -grav[j][e]
-        # torque columns: joint i's motion axis carried down to body j
-        z = body.joint.axis
-        s = (tuple(z), zero3) if body.joint.type.is_revolute else (zero3, tuple(z))
-        i, chain = j, []
-        axes = {j: s}
-        while True:
-            chain.append(i)
-            parent = tree.bodies[i].parent
-            if parent < 0:
-                break
-            i = parent
-        # axes of the ancestors, transported from each ancestor down to j
-        path = list(reversed(chain))  # root-side first, ending at j
-        for anc in path[:-1]:
-            ax = tree.bodies[anc].joint.axis
-            s_a = (tuple(ax), zero3) if tree.bodies[anc].joint.type.is_revolute else (zero3, tuple(ax))
-            for step in path[path.index(anc) + 1:]:
-                w_s, v_s = s_a
-                r = offset(step)
+        # torque columns: the motion axis s_i^j of every joint i on the path, in body j's
+        # frame at its origin, carried from the parent's (X_{j←p}: rotate, shift by r × ω)
+        z = tuple(body.joint.axis)
+        axes = {j: (z, zero3) if body.joint.type.is_revolute else (zero3, z)}
+        if body.parent >= 0:
+            r = offset(j)
+            for anc, (w_s, v_s) in axes_at[body.parent].items():
                 v_moved = tuple(v_s[e] + x for e, x in enumerate(_cross(w_s, r)))
-                t = f"{tree.bodies[anc].q_index + 1}_{tree.bodies[step].q_index + 1}"
-                s_a = (b.define_all(to_body(step, w_s), f"sw{t}_"),
-                       b.define_all(to_body(step, v_moved), f"sv{t}_"))
-            axes[anc] = s_a
+                t = f"{tree.bodies[anc].q_index + 1}_{tag}"
+                axes[anc] = (b.define_all(to_body(j, w_s), f"sw{t}_"),
+                             b.define_all(to_body(j, v_moved), f"sv{t}_"))
+        axes_at.append(axes)
         for anc, (w_s, v_s) in axes.items():
             row = tree.bodies[anc].q_index
             t = f"{row + 1}_{tag}"
