@@ -2,7 +2,10 @@
 
 :func:`derive_regressor` builds Y as a straight-line program (see
 :mod:`eomgen.symbolic.regressor` for the derivation, frames and parameter order);
-:func:`base_parameters` finds the identifiable combinations numerically.
+:func:`base_parameters` finds the identifiable combinations numerically (QR over random
+states), :func:`symbolic_base_parameters` by the closed-form grouping rules
+(:mod:`eomgen.symbolic.grouping`), checked numerically; :func:`identify` estimates them from
+measured efforts by least squares. See docs/regressor.md.
 
 Parameters π, per moving body in JOINT_NAMES order (body k is the child of joint k, fixed links
 merged, frame = joint k's frame after it has moved), Pinocchio's order::
