@@ -34,7 +34,7 @@ import sympy as sp
 
 from .bodies import BodyTree, body_tree
 from .dynamics import joint_symbols
-from .errors import UnsupportedError
+from .errors import ParameterError, UnsupportedError
 from .model import RobotModel, parameter_symbol
 from .symbolic.evaluate import compile_program
 from .symbolic.program import Program, ProgramBuilder
@@ -165,6 +165,12 @@ class Regressor:
         signs = tuple(sp.Symbol(f"sign_{s.name}", real=True) for s in self.qd)
         swap = {sp.sign(s): t for s, t in zip(self.qd, signs)}
         subs = {k: sp.Float(v) for k, v in merged.items()}
+        free = {s for s in self.model.free_symbols if s not in subs}
+        used = set().union(*(e.free_symbols for _, e in program.assignments),
+                           *(m.free_symbols for _, m in program.outputs))
+        if free & used:
+            raise ParameterError(self.model.source, "parameters", "no numeric value for "
+                                 + ", ".join(sorted(s.name for s in free & used)))
         assignments = tuple((s, e.xreplace(subs)) for s, e in program.assignments)
         outputs = tuple((name, m.xreplace(swap).xreplace(subs)) for name, m in program.outputs)
         raw = compile_program(Program(assignments, outputs), self.q + self.qd + self.qdd + signs)

@@ -316,3 +316,15 @@ def test_identification_recovers_beta_from_newton_euler_torques():
     pi = np.concatenate([reg.numeric_parameters()[:10 * n], fv, fc])
     np.testing.assert_allclose(result.beta, base.beta(pi), rtol=1e-7, atol=1e-9)
     assert result.rms < 1e-9 and np.isfinite(result.condition)
+
+
+def test_evaluating_without_a_parameter_value_names_it():
+    from eomgen.errors import ParameterError
+    from eomgen.model import Parameter
+    from dataclasses import replace
+
+    reg = regressor("planar_2link")
+    model = replace(reg.model, parameters=tuple(
+        Parameter(p.symbol) if p.name == "l1" else p for p in reg.model.parameters))
+    with pytest.raises(ParameterError, match="no numeric value for l1$"):
+        derive_regressor(model).compiled()
