@@ -1,0 +1,614 @@
+"""Linear parameterization τ = Y(q, q̇, q̈) π: the regressor, its parameters and base parameters.
+
+:func:`derive_regressor` builds Y as a straight-line program (see
+:mod:`eomgen.symbolic.regressor` for the derivation, frames and parameter order);
+:func:`base_parameters` finds the identifiable combinations numerically (QR over random
+states), :func:`symbolic_base_parameters` by the closed-form grouping rules
+(:mod:`eomgen.symbolic.grouping`), checked numerically; :func:`identify` estimates them from
+measured efforts by least squares. See docs/regressor.md.
+
+Parameters π, per moving body in JOINT_NAMES order (body k is the child of joint k, fixed links
+merged, frame = joint k's frame after it has moved), Pinocchio's order::
+
+    M, MX, MY, MZ, XX, XY, YY, XZ, YZ, ZZ       (m, m c, inertia about the body origin)
+
+then, if asked, one group of n actuator columns per term: ``IA`` (armature, τ_k += I_a q̈_k),
+``FV`` (viscous, f_v q̇_k), ``FC`` (Coulomb, f_c sign q̇_k), ``FO`` (offset, f_o).
+
+>>> import eomgen
+>>> from eomgen.regressor import derive_regressor
+>>> reg = derive_regressor(eomgen.load(eomgen.example_path("planar_2link")))
+>>> reg.PARAMETER_NAMES[:4]
+('M1', 'MX1', 'MY1', 'MZ1')
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Iterable, Mapping, Sequence
+
+import numpy as np
+import sympy as sp
+
+from .bodies import BodyTree, body_tree
+from .dynamics import joint_symbols
+from .errors import ParameterError, UnsupportedError
+from .model import RobotModel, parameter_symbol
+from .symbolic.evaluate import compile_program
+from .symbolic.program import Program, ProgramBuilder
+from .symbolic.regressor import (ACTUATOR_NAMES, ACTUATOR_TERMS, INERTIAL_NAMES,
+                                 regressor_program)
+
+
+@dataclass(frozen=True)
+class Regressor:
+    """The regressor of one model. Immutable.
+
+    Attributes
+    ----------
+    model:
+        The model it was derived from.
+    tree:
+        Its moving bodies (one 10-column block per body, in JOINT_NAMES order).
+    q, qd, qdd:
+        Joint symbols in JOINT_NAMES order.
+    program:
+        Straight-line program with outputs ``"Y"`` (n × p), ``"K"`` and ``"P"`` (1 × p):
+        ``τ = Y π``, kinetic energy ``K = Y_K π``, potential energy ``P = Y_P π``.
+    actuators:
+        The actuator terms with columns (subset of ``ACTUATOR_TERMS``, in column order).
+    seconds:
+        Time spent building the program.
+    """
+
+    model: RobotModel
+    tree: BodyTree
+    q: tuple
+    qd: tuple
+    qdd: tuple
+    program: Program
+    actuators: tuple[str, ...] = ()
+    seconds: float = 0.0
+
+    @property
+    def n(self) -> int:
+        return len(self.q)
+
+    @cached_property
+    def PARAMETER_NAMES(self) -> tuple[str, ...]:
+        """Name of each column of Y: ``M1, MX1, …, ZZ1, M2, …`` then ``IA1…``, ``FV1…`` etc."""
+        names = [f"{name}{k + 1}" for k in range(self.n) for name in INERTIAL_NAMES]
+        for term in self.actuators:
+            names += [f"{ACTUATOR_NAMES[term]}{k + 1}" for k in range(self.n)]
+        return tuple(names)
+
+    @property
+    def p(self) -> int:
+        """Number of standard parameters (columns of Y)."""
+        return len(self.PARAMETER_NAMES)
+
+    @cached_property
+    def parameter_symbols(self) -> tuple[sp.Symbol, ...]:
+        """π as symbols named after :attr:`PARAMETER_NAMES` (for β(π) expressions)."""
+        return tuple(parameter_symbol(name) for name in self.PARAMETER_NAMES)
+
+    def inertial_parameters(self, values: Mapping | None = None, actuator: Mapping | None = None
+                            ) -> sp.Matrix:
+        """π of the description, p × 1: each body's (m, h, I about its origin), symbolic in the
+        model's parameters unless ``values`` (symbol or name → number) are given.
+
+        Actuator entries are not in descriptions: 0 unless ``actuator`` maps their names
+        (``"FV2"``) to values.
+        """
+        pi = []
+        bodies = sorted(self.tree.bodies, key=lambda body: body.q_index)
+        for body in bodies:
+            par = body.inertial
+            I = par.inertia
+            pi += [par.mass, *par.first_moment, I[0][0], I[0][1], I[1][1], I[0][2], I[1][2],
+                   I[2][2]]
+        pi += [sp.sympify((actuator or {}).get(name, 0)) for name in self.PARAMETER_NAMES[10 * self.n:]]
+        out = sp.Matrix(pi)
+        if values is not None:
+            subs = {(parameter_symbol(k) if isinstance(k, str) else k): v for k, v in values.items()}
+            out = out.xreplace({k: sp.sympify(v) for k, v in subs.items()})
+        return out
+
+    def numeric_parameters(self, values: Mapping | None = None) -> np.ndarray:
+        """π as floats at the model's default parameter values (``values`` overriding)."""
+        merged = dict(self.model.parameter_values)
+        merged.update({(parameter_symbol(k) if isinstance(k, str) else k): v
+                       for k, v in (values or {}).items()})
+        return np.array([float(x) for x in self.inertial_parameters(merged)], dtype=float)
+
+    @cached_property
+    def Y(self) -> sp.Matrix:
+        """Y(q, q̇, q̈), n × p, expanded to full expressions (small models only)."""
+        return self.program.expand(self.program.output("Y"))
+
+    @cached_property
+    def Y_K(self) -> sp.Matrix:
+        """Kinetic energy row, 1 × p: ``K = Y_K(q, q̇) π`` [J]."""
+        return self.program.expand(self.program.output("K"))
+
+    @cached_property
+    def Y_P(self) -> sp.Matrix:
+        """Potential energy row, 1 × p: ``P = Y_P(q) π`` [J], P = −Σ m g_vec · c."""
+        return self.program.expand(self.program.output("P"))
+
+    def base_program(self, columns: Sequence[int]) -> Program:
+        """The program computing only ``Y_base = Y[:, columns]`` (n × b), output ``"Y_base"``;
+        unused intermediates pruned (what generated ``base_regressor(q, qd, qdd)`` prints)."""
+        Y = self.program.output("Y")
+        out = Y.extract(list(range(Y.rows)), list(columns))
+        return Program(self.program.assignments, (("Y_base", out),)).pruned(["Y_base"])
+
+    def operation_count(self, columns: Sequence[int] | None = None) -> int:
+        """Operations (SymPy ``count_ops``) of the program computing Y, or only the given
+        columns of Y (the base regressor)."""
+        if columns is None:
+            return self.program.operation_count(["Y"])
+        return self.base_program(columns).operation_count()
+
+    def compiled(self, values: Mapping | None = None, program: Program | None = None):
+        """A numeric function ``f(q, qd, qdd) -> {"Y": (n, p), "K": (1, p), "P": (1, p)}``
+        (or the outputs of ``program``, e.g. :meth:`base_program`).
+
+        Geometry parameters take their default values (``values`` overriding, symbol or name).
+        """
+        program = self.program if program is None else program
+        merged = dict(self.model.parameter_values)
+        merged.update({(parameter_symbol(k) if isinstance(k, str) else k): v
+                       for k, v in (values or {}).items()})
+        signs = tuple(sp.Symbol(f"sign_{s.name}", real=True) for s in self.qd)
+        swap = {sp.sign(s): t for s, t in zip(self.qd, signs)}
+        subs = {k: sp.Float(v) for k, v in merged.items()}
+        free = {s for s in self.model.free_symbols if s not in subs}
+        used = set().union(*(e.free_symbols for _, e in program.assignments),
+                           *(m.free_symbols for _, m in program.outputs))
+        if free & used:
+            raise ParameterError(self.model.source, "parameters", "no numeric value for "
+                                 + ", ".join(sorted(s.name for s in free & used)))
+        assignments = tuple((s, e.xreplace(subs)) for s, e in program.assignments)
+        outputs = tuple((name, m.xreplace(swap).xreplace(subs)) for name, m in program.outputs)
+        raw = compile_program(Program(assignments, outputs), self.q + self.qd + self.qdd + signs)
+
+        def evaluate(q, qd, qdd) -> dict:
+            q, qd, qdd = (np.asarray(x, dtype=float) for x in (q, qd, qdd))
+            return raw(*q, *qd, *qdd, *np.sign(qd))
+
+        return evaluate
+
+
+def derive_regressor(model: RobotModel, actuators: Iterable[str] = ()) -> Regressor:
+    """Derive the joint torque regressor of ``model`` (see the module docstring).
+
+    Parameters
+    ----------
+    model:
+        A robot model; geometry may stay symbolic (DH lengths as parameters).
+    actuators:
+        Actuator terms to add columns for, from ``("armature", "viscous", "coulomb",
+        "offset")``; their groups follow the inertial columns in the order given.
+
+    Raises
+    ------
+    ValueError
+        For an unknown or repeated actuator term.
+    """
+    actuators = tuple(actuators)
+    bad = [t for t in actuators if t not in ACTUATOR_TERMS]
+    if bad or len(set(actuators)) != len(actuators):
+        raise ValueError(f"actuator terms must be distinct ones of {ACTUATOR_TERMS}, got {actuators}")
+    start = time.perf_counter()
+    tree = body_tree(model)
+    q, qd, qdd = joint_symbols(model.dof)
+    reserved = {s.name for s in q + qd + qdd} | {p.name for p in model.parameters}
+    b = ProgramBuilder(reserved)
+    out = regressor_program(tree, q, qd, qdd, model.gravity, b, actuators)
+    names = ("Y", "K", "P")
+    program = Program(tuple(b.assignments), tuple((k, out[k]) for k in names)).pruned(names)
+    return Regressor(model, tree, q, qd, qdd, program, actuators, time.perf_counter() - start)
+
+
+# ----------------------------------------------------------------------------------------------
+# Base parameters, numerically
+# ----------------------------------------------------------------------------------------------
+
+#: A column whose component orthogonal to the columns kept before it is below this fraction of
+#: its own norm is dependent (and is regrouped); the same relative tolerance on |R_kk| / |R_00|
+#: of the pivoted QR of the column-normalised stack gives the rank. Exact dependencies leave
+#: residuals near 1e-14; independent columns of the robots tested stay above 1e-4 (see
+#: :attr:`BaseParameters.gap`).
+RANK_TOLERANCE = 1e-8
+#: Columns whose norm over the samples is below this fraction of the largest are zero (rounding
+#: leaves ~1e-16 where a structural zero was not seen symbolically).
+ZERO_COLUMN = 1e-10
+
+
+@dataclass(frozen=True)
+class BaseParameters:
+    """Identifiable combinations β = π_base + K π_dependent of the standard parameters.
+
+    Attributes
+    ----------
+    names:
+        Names of all standard parameters (columns of Y).
+    base:
+        Indices of the base columns, increasing (``Y_base = Y[:, base]``).
+    dependent:
+        Indices of the other columns; ``Y[:, dependent] = Y[:, base] @ K``.
+    K:
+        Regrouping matrix, (b, p − b); entries below 1e-10 of the largest set to 0.
+    rank:
+        Rank of the sample stack by pivoted QR (equals ``len(base)``).
+    gap:
+        (smallest relative residual kept, largest dropped): how clear the decision was.
+    """
+
+    names: tuple[str, ...]
+    base: tuple[int, ...]
+    dependent: tuple[int, ...]
+    K: np.ndarray
+    rank: int
+    gap: tuple[float, float]
+
+    @property
+    def count(self) -> int:
+        return len(self.base)
+
+    def beta(self, pi) -> np.ndarray:
+        """β(π): the base parameters of a standard parameter vector ``pi`` (p,)."""
+        pi = np.asarray(pi, dtype=float)
+        return pi[list(self.base)] + self.K @ pi[list(self.dependent)]
+
+    def expressions(self, digits: int = 6) -> list[tuple[str, sp.Expr]]:
+        """β as SymPy expressions in the standard parameter symbols (coefficients rounded to
+        ``digits`` significant digits; integers exact)."""
+        syms = [parameter_symbol(n) for n in self.names]
+        out = []
+        for r, k in enumerate(self.base):
+            expr = syms[k]
+            for c, d in enumerate(self.dependent):
+                coef = self.K[r, c]
+                if coef != 0:
+                    near = round(coef)
+                    value = sp.Integer(near) if abs(coef - near) < 1e-9 else sp.Float(coef, digits)
+                    expr = expr + value * syms[d]
+            name = self.names[k] + "R" if expr != syms[k] else self.names[k]
+            out.append((name, _by_coefficient(expr, syms)))
+        return out
+
+    def latex(self, digits: int = 6) -> str:
+        """The base parameters as a LaTeX ``aligned`` block, one ``name = expression`` a line."""
+        lines = []
+        for name, expr in self.expressions(digits):
+            lines.append(f"{_latex_name(name)} &= {sp.latex(expr, symbol_names=_tex_symbols(expr))}")
+        return "\\begin{aligned}\n" + " \\\\\n".join(lines) + "\n\\end{aligned}"
+
+
+def _latex_name(name: str) -> str:
+    head = name.rstrip("0123456789R")
+    rest = name[len(head):]
+    index = rest.rstrip("R")
+    return f"\\mathrm{{{head}}}_{{{index}}}" + ("^{R}" if rest.endswith("R") else "")
+
+
+def _tex_symbols(expr: sp.Expr) -> dict:
+    return {s: _latex_name(s.name) for s in expr.free_symbols}
+
+
+def sample_regressor(reg: Regressor, samples: int | None = None, seed: int = 0,
+                     values: Mapping | None = None) -> np.ndarray:
+    """Y stacked over random states, (samples · n, p): q uniform in [−π, π], q̇ and q̈
+    standard normal (prismatic joints too)."""
+    f = reg.compiled(values)
+    n, p = reg.n, reg.p
+    samples = samples or max(20, 3 * p // max(n, 1) + 10)
+    rng = np.random.default_rng(seed)
+    rows = []
+    for _ in range(samples):
+        q = rng.uniform(-np.pi, np.pi, n)
+        rows.append(f(q, rng.standard_normal(n), rng.standard_normal(n))["Y"])
+    return np.vstack(rows)
+
+
+def base_parameters(reg: Regressor, samples: int | None = None, seed: int = 0,
+                    values: Mapping | None = None, tolerance: float = RANK_TOLERANCE
+                    ) -> BaseParameters:
+    """Base parameters by QR of Y over random states (Gautier's numerical method).
+
+    The rank comes from ``scipy.linalg.qr(W, pivoting=True)`` of the column-normalised sample
+    stack W: the number of ``|R_kk| > tolerance · |R_00|``. The base columns are then chosen in
+    column order (proximal bodies first, within a body Pinocchio's order): a column is kept when
+    its residual after projection on the columns kept before it exceeds ``tolerance`` times its
+    norm. This keeps what the classical grouping rules keep (XX_j absorbing YY_j as XXR_j, a
+    body's mass and first moments pushed into its parent's parameters), and the regrouping
+    matrix comes from least squares, ``W_dependent = W_base K``.
+
+    Parameters
+    ----------
+    reg:
+        The regressor.
+    samples:
+        Number of random states (default: enough for 3 p rows).
+    seed:
+        Random seed (the result is deterministic for a given seed).
+    values:
+        Geometry parameter values overriding the model's defaults.
+    tolerance:
+        Relative rank tolerance, see :data:`RANK_TOLERANCE`.
+
+    Raises
+    ------
+    RuntimeError
+        When the greedy selection and the pivoted QR disagree on the rank (no clear gap).
+    """
+    import scipy.linalg
+
+    if reg.p == 0:  # nothing moves
+        return BaseParameters((), (), (), np.zeros((0, 0)), 0, (np.inf, 0.0))
+    W = sample_regressor(reg, samples, seed, values)
+    norms = np.linalg.norm(W, axis=0)
+    nonzero = norms > ZERO_COLUMN * norms.max()
+    Wn = np.where(nonzero, W / np.where(nonzero, norms, 1.0), 0.0)
+    R = scipy.linalg.qr(Wn, mode="r", pivoting=True)[0]
+    d = np.abs(np.diag(R))
+    rank = int(np.sum(d > tolerance * d[0])) if d.size and d[0] > 0 else 0
+
+    kept, gap = _independent_columns(Wn, nonzero, tolerance)
+    if len(kept) != rank:
+        raise RuntimeError(f"rank by pivoted QR is {rank} but {len(kept)} columns were kept: "
+                           f"no clear gap at tolerance {tolerance}")
+    dependent = [k for k in range(W.shape[1]) if k not in kept]
+    K, *_ = np.linalg.lstsq(W[:, kept], W[:, dependent], rcond=None)
+    if K.size:
+        K[np.abs(K) < 1e-10 * max(1.0, np.abs(K).max())] = 0.0
+    return BaseParameters(reg.PARAMETER_NAMES, tuple(kept), tuple(dependent), K, rank, gap)
+
+
+def _independent_columns(Wn: np.ndarray, candidates, tolerance: float):
+    """Greedy selection in column order among ``candidates`` (boolean mask) of the unit-norm
+    columns of ``Wn``: a column is kept when its residual after projection on those kept before
+    it exceeds ``tolerance``. Returns (kept indices, (smallest kept residual, largest dropped))."""
+    kept: list[int] = []
+    Q = np.zeros((Wn.shape[0], 0))
+    kept_min, dropped_max = np.inf, 0.0
+    for k in range(Wn.shape[1]):
+        if not candidates[k]:
+            continue
+        w = Wn[:, k]
+        res = w - Q @ (Q.T @ w)
+        res = res - Q @ (Q.T @ res)  # twice is enough (Kahan–Parlett)
+        rel = float(np.linalg.norm(res))
+        if rel > tolerance:
+            kept.append(k)
+            Q = np.column_stack([Q, res / rel])
+            kept_min = min(kept_min, rel)
+        else:
+            dropped_max = max(dropped_max, rel)
+    return kept, (kept_min, dropped_max)
+
+
+# ----------------------------------------------------------------------------------------------
+# Base parameters, symbolically (closed-form grouping), checked numerically
+# ----------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SymbolicBase:
+    """Base parameters from the closed-form grouping rules (:mod:`eomgen.symbolic.grouping`).
+
+    Attributes
+    ----------
+    names:
+        Name of each base parameter: the column's name, with ``R`` appended when other
+        parameters were grouped into it (``XX2R``).
+    base:
+        Their column indices in Y (``Y_base = Y[:, base]``), increasing.
+    expressions:
+        β as SymPy expressions of the standard parameter symbols (:attr:`Regressor.
+        parameter_symbols`) and of the model's geometry symbols (kept symbolic).
+    unidentifiable:
+        Columns the rules kept that are zero at every sampled state (gravity along the first
+        axis, bodies that cannot rotate about some axis, …): their parameters have no effect.
+    residual:
+        Columns the rules kept that were still found dependent numerically (special cases the
+        rules do not cover); they are regrouped into the base ones with numeric coefficients
+        (least squares at the sampled geometry values). Empty when the grouping alone is
+        complete, and then β is exact in the geometry symbols.
+    """
+
+    names: tuple[str, ...]
+    base: tuple[int, ...]
+    expressions: tuple[sp.Expr, ...]
+    unidentifiable: tuple[int, ...]
+    residual: tuple[int, ...]
+    parameter_symbols: tuple[sp.Symbol, ...]
+    geometry: tuple[tuple[sp.Symbol, float], ...] = ()
+
+    @property
+    def count(self) -> int:
+        return len(self.base)
+
+    def beta(self, pi, values: Mapping | None = None) -> np.ndarray:
+        """β(π) as floats; geometry symbols at the model's defaults (``values`` overriding)."""
+        subs = dict(self.geometry)
+        subs.update({(parameter_symbol(k) if isinstance(k, str) else k): v
+                     for k, v in (values or {}).items()})
+        subs.update(zip(self.parameter_symbols, (float(x) for x in pi)))
+        return np.array([float(e.xreplace(subs)) for e in self.expressions], dtype=float)
+
+    def latex(self, digits: int = 6) -> str:
+        """``\\begin{aligned} name &= expression \\\\ … \\end{aligned}``, numbers rounded to
+        ``digits`` significant digits."""
+        lines = []
+        for name, expr in zip(self.names, self.expressions):
+            expr = sp.expand(expr)
+            expr = _by_coefficient(expr.xreplace({f: sp.Float(f, digits)
+                                                  for f in expr.atoms(sp.Float)}),
+                                   self.parameter_symbols)
+            tex = sp.latex(expr, symbol_names={s: _latex_name(s.name)
+                                               for s in expr.free_symbols
+                                               if s in self.parameter_symbols})
+            lines.append(f"{_latex_name(name)} &= {tex}")
+        return "\\begin{aligned}\n" + " \\\\\n".join(lines) + "\n\\end{aligned}"
+
+
+def symbolic_base_parameters(reg: Regressor, samples: int | None = None, seed: int = 0,
+                             values: Mapping | None = None, tolerance: float = RANK_TOLERANCE
+                             ) -> SymbolicBase:
+    """Base parameters by the closed-form grouping rules, then checked over random states.
+
+    The grouping (:func:`eomgen.symbolic.grouping.group_parameters`) gives β as expressions of
+    π and of the geometry symbols. Numerically, at the geometry's default values (``values``
+    overriding): the identity ``Y π = Y[:, kept] β(π)`` is checked for a random π (a wrong rule
+    raises), kept columns that are zero are reported as unidentifiable, and kept columns still
+    dependent on earlier ones (special cases the rules do not cover) are reported as
+    ``residual`` and regrouped into the others with numeric coefficients. Actuator columns are kept when not zero or dependent.
+
+    Raises
+    ------
+    UnsupportedError
+        For a revolute axis not along ±x, ±y, ±z of its joint frame (use
+        :func:`base_parameters`).
+    RuntimeError
+        When the grouped regressor does not reproduce Y π (a defect).
+    """
+    from .symbolic.grouping import group_parameters
+
+    if reg.p == 0:  # nothing moves
+        return SymbolicBase((), (), (), (), (), ())
+    try:
+        grouping = group_parameters(reg.tree, reg.parameter_symbols)
+    except ValueError as exc:
+        raise UnsupportedError(reg.model.source, "symbolic base parameters", str(exc)) from None
+    kept = list(grouping.kept) + list(range(10 * reg.n, reg.p))
+    expressions = list(grouping.expressions) + [reg.parameter_symbols[k]
+                                                for k in range(10 * reg.n, reg.p)]
+    geometry = dict(reg.model.parameter_values)
+    geometry.update({(parameter_symbol(k) if isinstance(k, str) else k): v
+                     for k, v in (values or {}).items()})
+    W = sample_regressor(reg, samples, seed, values)
+    rng = np.random.default_rng(seed + 1)
+    pi = rng.uniform(0.5, 1.5, reg.p)
+    subs = {**{k: sp.Float(v) for k, v in geometry.items()}, **dict(zip(reg.parameter_symbols, pi))}
+    beta = np.array([float(e.xreplace(subs)) for e in expressions])
+    Wk = W[:, kept]
+    error = np.abs(Wk @ beta - W @ pi).max()
+    if error > 1e-9 * max(1.0, np.abs(W @ pi).max()):
+        raise RuntimeError(f"grouped regressor misses Y π by {error:.3g} (a grouping defect)")
+    norms = np.linalg.norm(Wk, axis=0)
+    nonzero = norms > ZERO_COLUMN * np.linalg.norm(W, axis=0).max()
+    Wn = np.where(nonzero, Wk / np.where(nonzero, norms, 1.0), 0.0)
+    independent, _ = _independent_columns(Wn, nonzero, tolerance)
+    unidentifiable = tuple(kept[c] for c in range(len(kept)) if not nonzero[c])
+    residual = tuple(kept[c] for c in range(len(kept)) if nonzero[c] and c not in independent)
+    # residual dependencies: regrouped with numeric coefficients (at the sampled geometry)
+    dependent = [c for c in range(len(kept)) if nonzero[c] and c not in independent]
+    regroup = np.zeros((len(independent), 0))
+    if dependent:
+        regroup, *_ = np.linalg.lstsq(Wk[:, independent], Wk[:, dependent], rcond=None)
+        regroup[np.abs(regroup) < 1e-10 * max(1.0, np.abs(regroup).max())] = 0.0
+    names, cols, exprs = [], [], []
+    for r, c in enumerate(independent):
+        k, expr = kept[c], expressions[c]
+        expr = expr + sp.Add(*[sp.Float(regroup[r, e]) * expressions[d]
+                               for e, d in enumerate(dependent) if regroup[r, e] != 0])
+        cols.append(k)
+        exprs.append(_by_coefficient(expr, reg.parameter_symbols))
+        names.append(reg.PARAMETER_NAMES[k] + ("R" if expr != reg.parameter_symbols[k] else ""))
+    return SymbolicBase(tuple(names), tuple(cols), tuple(exprs), unidentifiable, residual,
+                        reg.parameter_symbols, tuple((k, float(v)) for k, v in geometry.items()))
+
+
+def _by_coefficient(expr: sp.Expr, pi: Sequence[sp.Symbol]) -> sp.Expr:
+    """A linear form in ``pi`` written as Σ coefficient · (sum of the parameters sharing it):
+    ``a2**2*(M3 + M4 + M5 + M6) + XX2 - YY2``."""
+    terms: dict = {}
+    order: list = []
+    poly = sp.expand(expr)
+    used = [s for s in pi if s in poly.free_symbols]
+    for s in used:
+        coef = poly.coeff(s)
+        if coef not in terms:
+            terms[coef] = []
+            order.append(coef)
+        terms[coef].append(s)
+    constant = poly.subs({s: 0 for s in used})
+    # a number times a sum is distributed by SymPy unless told not to
+    return sp.Add(*[sp.Mul(c, sp.Add(*terms[c]), evaluate=False)
+                    if len(terms[c]) > 1 and abs(c) != 1 else c * sp.Add(*terms[c])
+                    for c in order]) + constant
+
+
+# ----------------------------------------------------------------------------------------------
+# Identification: least squares of β from measured joint efforts
+# ----------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Identification:
+    """Least-squares estimate of the base parameters from measurements.
+
+    Attributes
+    ----------
+    beta:
+        Estimated β, (b,), in the order of the base used.
+    std:
+        Standard deviations of β from the residual (σ² (WᵀW)⁻¹, σ² = |τ − W β|² / (rows − b)).
+    rms:
+        Root mean square of the residual τ − W β [N m or N].
+    condition:
+        Condition number of the column-normalised observation matrix W (a measure of how well
+        the trajectory excites the base parameters).
+    """
+
+    beta: np.ndarray
+    std: np.ndarray
+    rms: float
+    condition: float
+
+
+def identify(reg: Regressor, base, q, qd, qdd, tau, values: Mapping | None = None
+             ) -> Identification:
+    """Estimate β by ordinary least squares, ``min |W β − τ|`` with W the base regressor
+    stacked over the samples.
+
+    Parameters
+    ----------
+    reg:
+        The regressor.
+    base:
+        A :class:`BaseParameters` or :class:`SymbolicBase` (its ``base`` columns are used).
+    q, qd, qdd, tau:
+        (N, n) arrays of joint positions, velocities, accelerations and measured efforts, in
+        JOINT_NAMES order (SI units).
+    values:
+        Geometry parameter values overriding the model's defaults.
+
+    Raises
+    ------
+    ValueError
+        When the arrays are not (N, n) or there are fewer rows N n than base parameters.
+    """
+    arrays = [np.atleast_2d(np.asarray(x, dtype=float)) for x in (q, qd, qdd, tau)]
+    if any(a.shape != arrays[0].shape or a.shape[1] != reg.n for a in arrays):
+        raise ValueError(f"q, qd, qdd and tau must all have shape (N, {reg.n})")
+    columns = list(base.base)
+    if arrays[0].size < len(columns):
+        raise ValueError(f"{arrays[0].size} equations for {len(columns)} base parameters")
+    f = reg.compiled(values, program=reg.base_program(columns))
+    W = np.vstack([f(*row)["Y_base"] for row in zip(*arrays[:3])])
+    y = arrays[3].reshape(-1)
+    beta, *_ = np.linalg.lstsq(W, y, rcond=None)
+    residual = y - W @ beta
+    dof = max(W.shape[0] - W.shape[1], 1)
+    sigma2 = float(residual @ residual) / dof
+    cov = sigma2 * np.linalg.pinv(W.T @ W)
+    norms = np.linalg.norm(W, axis=0)
+    condition = float(np.linalg.cond(W / np.where(norms > 0, norms, 1.0)))
+    return Identification(beta, np.sqrt(np.clip(np.diag(cov), 0, None)),
+                          float(np.sqrt(np.mean(residual ** 2))), condition)
