@@ -445,3 +445,20 @@ def test_teach_pdf_without_pdflatex_is_refused_before_the_work(tmp_path):
         f"{ERROR}--format pdf needs pdflatex, which is not installed (TeX Live: apt install "
         "texlive-latex-base); choose html, md or tex"]
     assert snapshot(tmp_path) == before
+
+
+def test_the_readme_finds_the_example_robots():
+    """The README's one-liner for example-robot-data's ``robots/`` folder finds it, and the
+    robots it names are there."""
+    if erd_robots_dir() is None:
+        pytest.skip("example-robot-data is not installed")
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    line = next(line.strip() for line in readme.splitlines() if "ROBOTS=$(python3 -c" in line)
+    code = line.split('python3 -c "', 1)[1].rsplit('")', 1)[0]
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=60)
+    assert done.returncode == 0, done.stderr
+    robots = Path(done.stdout.strip())
+    assert robots.resolve() == erd_robots_dir().resolve()
+    named = re.findall(r"`\$ROBOTS/([^`]+\.urdf)`", readme)
+    assert len(named) >= 3 and all((robots / path).is_file() for path in named), named
