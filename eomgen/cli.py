@@ -26,6 +26,7 @@ import click
 
 from . import __version__
 from .errors import EomgenError, GenerationError, one_line
+from .progress import end_line
 
 
 def _default_description() -> Path:
@@ -63,6 +64,7 @@ def _handle_errors(command):
     @functools.wraps(command)
     def wrapper(*args, debug: bool = False, **kwargs):
         def show_warning(message, category, filename, lineno, file=None, line=None):
+            end_line()
             click.echo(f"eomgen: warning: {message}", err=True)
 
         warnings.showwarning = show_warning
@@ -70,11 +72,13 @@ def _handle_errors(command):
             with _sigterm_raises():
                 return command(*args, **kwargs)
         except EomgenError as exc:
+            end_line()
             if debug:
                 raise
             click.echo(f"eomgen: error: {exc}", err=True)
             sys.exit(2)
         except KeyboardInterrupt as exc:
+            end_line()
             if debug:
                 raise
             click.echo("eomgen: interrupted", err=True)
@@ -272,6 +276,7 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
     from .output import check_output_folder
 
     check_output_folder(outdir)
+    progress = _progress(quiet)
     request = None
     if not no_cache:
         from .cache import command_request
@@ -289,7 +294,6 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
     if symbolic is not None:
         names = [] if symbolic.strip().lower() == "none" else [
             n.strip() for n in symbolic.split(",") if n.strip()]
-    progress = _progress(quiet)
     if scene_path is not None or explain:
         from .codegen.scene_generate import generate_scene
         from .scene import load_scene

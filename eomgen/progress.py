@@ -23,6 +23,21 @@ import time
 from typing import Callable, Iterator, TextIO
 
 
+#: The Progress whose terminal line is open (not ended by a newline), if any.
+_open: "Progress | None" = None
+
+
+def end_line() -> None:
+    """End an open terminal progress line with a newline, keeping the stage on screen, so that
+    a warning or an error printed next starts on a line of its own."""
+    global _open
+    if _open is not None and _open._pending:
+        _open.stream.write("\n")
+        _open.stream.flush()
+        _open._pending = False
+    _open = None
+
+
 def plural(count: int, noun: str) -> str:
     """``"1 joint"``, ``"2 joints"``, ``"0 joints"``."""
     return f"{count} {noun}" + ("" if count == 1 else "s")
@@ -74,8 +89,10 @@ class Progress:
         if self.quiet:
             return
         if self.tty:
+            global _open
             self.stream.write(f"\r\x1b[Keomgen: {line}")
             self._pending = True
+            _open = self
         else:
             self.stream.write(f"eomgen: {line} [+{self.elapsed():.1f} s]\n")
         self.stream.flush()

@@ -286,6 +286,20 @@ def test_steps_in_a_log_print_each_tenth_and_each_named_step():
     assert quiet.getvalue() == ""
 
 
+def test_a_warning_or_error_after_a_terminal_line_starts_a_new_line():
+    from eomgen.progress import end_line
+
+    stream = io.StringIO()
+    progress = Progress(stream=stream, tty=True)
+    progress("deriving")
+    progress("compiling")
+    end_line()  # what the CLI calls before a warning or an error
+    end_line()  # once only
+    assert stream.getvalue() == "\r\x1b[Keomgen: deriving\r\x1b[Keomgen: compiling\n"
+    progress.clear()
+    assert stream.getvalue().endswith("compiling\n")  # nothing left to clear
+
+
 def test_plural():
     assert [plural(n, "joint") for n in (0, 1, 2)] == ["0 joints", "1 joint", "2 joints"]
 
