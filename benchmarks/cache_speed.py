@@ -2,7 +2,9 @@
 
 Usage::
 
-    python benchmarks/cache_speed.py [--repeat 5] [--backend all] [--csv]
+    python benchmarks/cache_speed.py [--repeat 5] [--backend all] [--csv] [--quick]
+
+``--quick``: the NumPy backend only and 2 cached runs (seconds instead of a minute).
 
 For the PUMA 560 (``eomgen/robots/puma560_dh.yaml``) and the UR5 (example-robot-data's
 ``ur5_robot.urdf``), with a fresh cache folder each:
@@ -93,11 +95,20 @@ def measure(label: str, description: Path, repeat: int, backend: str) -> dict:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--repeat", type=int, default=5, help="cached runs (best kept)")
-    parser.add_argument("--backend", default="all", help="backends, as eomgen generate takes")
+    parser.add_argument("--repeat", type=int, default=None,
+                        help="cached runs (best kept; default 5, 2 with --quick)")
+    parser.add_argument("--backend", default=None,
+                        help="backends, as eomgen generate takes (default all; numpy with "
+                             "--quick)")
+    parser.add_argument("--quick", action="store_true",
+                        help="the NumPy backend only, 2 cached runs")
     parser.add_argument("--csv", action="store_true",
                         help="also write benchmarks/results/cache_speed.csv")
     args = parser.parse_args()
+    if args.repeat is None:
+        args.repeat = 2 if args.quick else 5
+    if args.backend is None:
+        args.backend = "numpy" if args.quick else "all"
     robots = [("PUMA 560", ROOT / "eomgen" / "robots" / "puma560_dh.yaml")]
     ur5 = ur5_path()
     if ur5 is None:

@@ -3,6 +3,10 @@
     python benchmarks/numerics_report.py                 # everything (about 10 minutes)
     python benchmarks/numerics_report.py --only bench    # speed against error only
     python benchmarks/numerics_report.py --only simulate --duration 5 --panda-duration 1
+    python benchmarks/numerics_report.py --quick         # 10 samples, 2 s and 0.5 s simulated
+
+``--quick`` checks that the report runs; it overwrites the recorded tables and plots with
+numbers from fewer samples and shorter runs, so do not commit what it writes.
 
 Writes ``docs/img/bench_<robot>.png``, ``docs/img/simulate.png`` and
 ``benchmarks/results/{bench_<robot>,simulate,hard_cases,forms}.{md,csv}``. Robots: the bundled planar
@@ -201,11 +205,20 @@ def forms() -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", choices=("bench", "simulate", "hard", "forms"), default=None)
-    parser.add_argument("--samples", type=int, default=50)
-    parser.add_argument("--duration", type=float, default=10.0,
-                        help="simulated seconds of the double pendulum")
-    parser.add_argument("--panda-duration", type=float, default=2.0)
+    parser.add_argument("--samples", type=int, default=None, help="default 50; 10 with --quick")
+    parser.add_argument("--duration", type=float, default=None,
+                        help="simulated seconds of the double pendulum (default 10; 2 with "
+                             "--quick)")
+    parser.add_argument("--panda-duration", type=float, default=None,
+                        help="default 2; 0.5 with --quick")
+    parser.add_argument("--quick", action="store_true",
+                        help="10 samples, 2 s and 0.5 s simulated")
     args = parser.parse_args()
+    quick = {"samples": 10, "duration": 2.0, "panda_duration": 0.5}
+    full = {"samples": 50, "duration": 10.0, "panda_duration": 2.0}
+    for name in full:
+        if getattr(args, name) is None:
+            setattr(args, name, (quick if args.quick else full)[name])
     IMAGES.mkdir(parents=True, exist_ok=True)
     RESULTS.mkdir(parents=True, exist_ok=True)
     if args.only in (None, "hard"):

@@ -76,7 +76,11 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--csv", action="store_true", help="write benchmarks/results/regressor.csv")
+    parser.add_argument("--quick", action="store_true",
+                        help="one repeat: checks that the script runs, not a measurement")
     args = parser.parse_args()
+    if args.quick:
+        args.repeat = 1
     rows = []
     ok = True
     for name, model in models().items():

@@ -3,7 +3,10 @@
 Usage::
 
     python benchmarks/scene_speed.py [--timeout 600] [--repeat 3] [--cases talos,simple_humanoid]
-                                     [--csv]
+                                     [--csv] [--quick]
+
+``--quick`` (a check that the script runs, not a measurement to quote): the simple humanoid
+only, one process per number, timeout 60 s (the whole humanoid may then show as "> 60 s").
 
 Cases (example-robot-data robots, outputs M, C and g):
 
@@ -150,14 +153,24 @@ def ratio(a: float | None, b: float | None, bound: bool = False) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--timeout", type=float, default=600.0,
-                        help="seconds each derivation may take (default 600)")
-    parser.add_argument("--repeat", type=int, default=3, help="processes per number (best)")
-    parser.add_argument("--cases", default=",".join(CASES), help="comma-separated cases")
+    parser.add_argument("--timeout", type=float, default=None,
+                        help="seconds each derivation may take (default 600; 60 with --quick)")
+    parser.add_argument("--repeat", type=int, default=None,
+                        help="processes per number (best; default 3, 1 with --quick)")
+    parser.add_argument("--cases", default=None,
+                        help="comma-separated cases (default: all; simple_humanoid with --quick)")
+    parser.add_argument("--quick", action="store_true",
+                        help="the simple humanoid, one process per number, timeout 60 s")
     parser.add_argument("--csv", action="store_true",
                         help="also write benchmarks/results/scene_speed.csv")
     parser.add_argument("--worker", nargs=3, help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.timeout is None:
+        args.timeout = 60.0 if args.quick else 600.0
+    if args.repeat is None:
+        args.repeat = 1 if args.quick else 3
+    if args.cases is None:
+        args.cases = "simple_humanoid" if args.quick else ",".join(CASES)
     if args.worker:
         case, kind, warm = args.worker
         worker(case, kind, warm == "warm")

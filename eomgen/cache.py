@@ -83,9 +83,10 @@ _KEY = re.compile(r"^[0-9a-f]{64}$")
 _FILE_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.\-]*$")
 #: ``eomgen generate`` parameters that do not change what is written.
 COMMAND_IGNORED = frozenset({"description", "outdir", "quiet", "debug", "no_cache", "cache_dir"})
-#: ``eomgen generate`` parameters that enter the key. A parameter in neither set, given with a
-#: value other than None or False (``--scene``, ``--explain``), turns the command-level cache
-#: off for that run: it may print more than the files, which a cached run would not repeat.
+#: ``eomgen generate`` parameters that enter the key (and ``scene_path``, keyed by the scene
+#: file's bytes and name). A parameter in none of these, given with a value other than None or
+#: False (``--explain``), turns the command-level cache off for that run: it may print more
+#: than the files, which a cached run would not repeat.
 COMMAND_KEYED = frozenset({"backends", "symbolic", "strict"})
 
 Notify = Callable[[str], None]
@@ -230,7 +231,8 @@ def command_request(description: Path, params: Mapping[str, object]) -> CacheReq
     """The cache request of an ``eomgen generate`` run, made before the description is read.
 
     ``params`` are the command's parameters (click's ``ctx.params``). The key covers the
-    description file's bytes and name, every parameter of :data:`COMMAND_KEYED`,
+    description file's bytes and name, the scene file's bytes and name (``--scene``; its
+    report and the files' headers name it), every parameter of :data:`COMMAND_KEYED`,
     :func:`toolchain` and :func:`code_version`. Returns None (answer without the
     command-level cache) when the description cannot be read or a parameter the cache does not
     know is given.
@@ -241,15 +243,22 @@ def command_request(description: Path, params: Mapping[str, object]) -> CacheReq
         return None
     options: dict[str, object] = {"request": "eomgen generate", "file": description.name,
                                   "toolchain": toolchain()}
+    scene = None
+    if params.get("scene_path") is not None:
+        scene_path = Path(params["scene_path"])
+        scene = _read_limited(scene_path)
+        if scene is None:
+            return None
+        options["scene_file"] = scene_path.name
     for name, value in sorted(params.items()):
-        if name in COMMAND_IGNORED:
+        if name in COMMAND_IGNORED or name == "scene_path":
             continue
         if name not in COMMAND_KEYED:
             if value is None or value is False:
                 continue
             return None
         options[name] = value
-    return CacheRequest(cache_key(data, options))
+    return CacheRequest(cache_key(data, options, scene=scene))
 
 
 def generation_key(model, backends: Sequence[str], options: Mapping[str, object]) -> str:

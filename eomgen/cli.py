@@ -1,8 +1,13 @@
-"""Command line interface: ``eomgen verify``, ``eomgen generate``.
+"""Command line interface: ``eomgen verify``, ``generate``, ``notebook``, ``teach`` (and
+``bench``, ``simulate`` from :mod:`eomgen.analysis.commands`).
 
 Exit codes: 0 success, 1 a verification check failed, 2 bad input (one line on stderr naming the
 file, the element and the problem; a traceback only with ``--debug``), 130 interrupted (SIGINT,
 Ctrl-C) and 143 terminated (SIGTERM), each with the one line ``eomgen: interrupted``.
+
+Every command that writes checks first that its output can be written (:mod:`eomgen.output`),
+so that a bad ``-o`` is one error line before minutes of work. Progress goes to stderr through
+one :class:`eomgen.progress.Progress` (``--quiet`` on every command silences it).
 """
 
 from __future__ import annotations
@@ -20,7 +25,8 @@ from pathlib import Path
 import click
 
 from . import __version__
-from .errors import EomgenError, one_line
+from .errors import EomgenError, GenerationError, one_line
+from .progress import end_line
 
 
 def _default_description() -> Path:
@@ -58,6 +64,7 @@ def _handle_errors(command):
     @functools.wraps(command)
     def wrapper(*args, debug: bool = False, **kwargs):
         def show_warning(message, category, filename, lineno, file=None, line=None):
+            end_line()
             click.echo(f"eomgen: warning: {message}", err=True)
 
         warnings.showwarning = show_warning
@@ -65,11 +72,13 @@ def _handle_errors(command):
             with _sigterm_raises():
                 return command(*args, **kwargs)
         except EomgenError as exc:
+            end_line()
             if debug:
                 raise
             click.echo(f"eomgen: error: {exc}", err=True)
             sys.exit(2)
         except KeyboardInterrupt as exc:
+            end_line()
             if debug:
                 raise
             click.echo("eomgen: interrupted", err=True)
@@ -131,9 +140,49 @@ def _load(description: Path | None, strict: bool, scene=None):
     return load_for_scene(description or _default_description(), scene, strict)
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+# Options and helpers shared by the commands (``bench`` and ``simulate`` take them too).
+
+quiet_option = click.option("--quiet", is_flag=True,
+                            help="No progress on stderr (stage lines in a log, an updating "
+                                 "line or bar on a terminal).")
+
+
+def scene_option(help: str = "Scene file (YAML, docs/scenes.md): reduce the robot to what the "
+                             "scene moves first (e.g. examples/scenes/panda_two_joints.yaml)."):
+    return click.option("--scene", "scene_path", default=None,
+                        type=click.Path(dir_okay=False, path_type=Path), help=help)
+
+
+def output_folder_option(default: str):
+    """``-o/--output`` for a folder; whether it can be written is checked by the command
+    (:func:`eomgen.output.check_output_folder`: one error line, not click's usage text)."""
+    return click.option("-o", "--output", "outdir", default=default, show_default=True,
+                        type=click.Path(path_type=Path), help="Output folder.")
+
+
+def _load_reduced(description: Path | None, scene_path: Path | None, strict: bool):
+    """``(model, report)``: the description reduced by the scene file (report None without
+    one). The scene is read first, so that warnings concern only what it keeps."""
+    if scene_path is None:
+        return _load(description, strict), None
+    from .reduction import apply_scene
+    from .scene import load_scene
+
+    scene = load_scene(scene_path, strict=strict)
+    return apply_scene(_load(description, strict, scene), scene)
+
+
+def _progress(quiet: bool):
+    from .progress import Progress
+
+    return Progress(quiet)
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]},
+             invoke_without_command=True)
 @click.version_option(__version__, prog_name="eomgen")
-def main():
+@click.pass_context
+def main(ctx):
     """eomgen: symbolic equations of motion M(q) q̈ + C(q, q̇) q̇ + g(q) = τ for robots.
 
     \b
@@ -143,6 +192,9 @@ def main():
       eomgen verify                          # check the bundled arm against Newton-Euler
       eomgen verify robot.urdf --samples 50
     """
+    if ctx.invoked_subcommand is None:  # plain ``eomgen``: the help, and success
+        click.echo(ctx.get_help())
+        ctx.exit(0)
 
 
 @main.command()
@@ -150,9 +202,11 @@ def main():
 @click.option("--samples", default=20, show_default=True, help="Random states for numeric checks.")
 @click.option("--seed", default=0, show_default=True, help="Seed of the random states.")
 @click.option("--tolerance", default=1e-9, show_default=True, help="Relative tolerance.")
+@scene_option()
+@quiet_option
 @strict_option
 @_handle_errors
-def verify(description, samples, seed, tolerance, strict):
+def verify(description, samples, seed, tolerance, scene_path, quiet, strict):
     """Derive DESCRIPTION's dynamics and check them against Newton–Euler.
 
     DESCRIPTION is a URDF, DH-table YAML or eomgen YAML file (default: the bundled planar
@@ -163,16 +217,26 @@ def verify(description, samples, seed, tolerance, strict):
     Examples:
       eomgen verify
       eomgen verify ur5.urdf --samples 100 --seed 3
+      eomgen verify panda.urdf --scene examples/scenes/panda_two_joints.yaml
     """
     from .dynamics import ALL_OUTPUTS, derive
+    from .errors import VerificationError
+    from .progress import plural
     from .verify import verify as run_verify
 
-    model = _load(description, strict)
+    if samples < 1:
+        raise VerificationError(f"--samples must be at least 1, got {samples}")
+    progress = _progress(quiet)
+    model, _ = _load_reduced(description, scene_path, strict)
     start = time.perf_counter()
+    progress(f"deriving M, C, g and tau of {model.name} ({plural(model.dof, 'joint')})")
     dynamics = derive(model, outputs=ALL_OUTPUTS)
-    click.echo(f"derived {model.name} ({model.dof} joints: {', '.join(model.joint_names)}) "
-               f"in {time.perf_counter() - start:.2f} s")
+    seconds = time.perf_counter() - start
+    progress(f"checking at {plural(samples, 'random state')}")
     report = run_verify(dynamics, samples=samples, seed=seed, tolerance=tolerance)
+    progress.clear()
+    click.echo(f"derived {model.name} ({plural(model.dof, 'joint')}: "
+               f"{', '.join(model.joint_names)}) in {seconds:.2f} s")
     click.echo(report.format())
     sys.exit(0 if report.passed else 1)
 
@@ -181,16 +245,13 @@ def verify(description, samples, seed, tolerance, strict):
 @description_argument
 @click.option("--backend", "backends", default="all", show_default=True,
               help="Comma-separated backends among numpy, casadi, c, latex; or all.")
-@click.option("-o", "--output", "outdir", default="eomgen_output", show_default=True,
-              type=click.Path(file_okay=False, path_type=Path), help="Output folder.")
+@output_folder_option("eomgen_output")
 @click.option("--symbolic", default=None,
               help="Comma-separated parameters to keep symbolic (default: all the description "
                    "declares; 'none' for none). The others take their values.")
-@click.option("--quiet", is_flag=True, help="No progress lines.")
-@click.option("--scene", "scene_path", default=None,
-              type=click.Path(dir_okay=False, path_type=Path),
-              help="Scene file (YAML, docs/scenes.md): the part that moves, locked joints, "
-                   "payloads, gravity, outputs. Writes <robot>_scene_report.md too.")
+@quiet_option
+@scene_option("Scene file (YAML, docs/scenes.md): the part that moves, locked joints, "
+              "payloads, gravity, outputs. Writes <robot>_scene_report.md too.")
 @click.option("--explain", is_flag=True,
               help="Print what was merged, locked and dropped, and derive the whole "
                    "description too to compare operation counts and times.")
@@ -217,6 +278,10 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
       eomgen generate eomgen/robots/planar_2link.yaml --symbolic m2,g
       eomgen generate talos_reduced.urdf --scene examples/scenes/talos_left_arm.yaml --explain
     """
+    from .output import check_output_folder
+
+    check_output_folder(outdir)
+    progress = _progress(quiet)
     request = None
     if not no_cache:
         from .cache import command_request
@@ -227,44 +292,43 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
             return
     from .codegen.generate import generate as run_generate
 
-    scene = None
-    if scene_path is not None:
-        from .scene import load_scene
-
-        scene = load_scene(scene_path, strict=strict)
     with _recorded_warnings() as notices:
+        scene = None
+        if scene_path is not None:
+            from .scene import load_scene
+
+            scene = load_scene(scene_path, strict=strict)
         model = _load(description, strict, scene)
     cache = dataclasses.replace(request, notices=notices) if request else not no_cache
     names = None
     if symbolic is not None:
         names = [] if symbolic.strip().lower() == "none" else [
             n.strip() for n in symbolic.split(",") if n.strip()]
-
-    def progress(line: str) -> None:
-        if not quiet:
-            click.echo(f"eomgen: {line}", err=True)
-
     if scene_path is not None or explain:
         from .codegen.scene_generate import generate_scene
 
         paths, produced = generate_scene(model, scene, outdir, backends, names, progress,
-                                         explain)
+                                         explain, cache=cache, cache_dir=cache_dir)
+        progress.clear()
         if explain:
             click.echo(produced.markdown)
     else:
         paths = run_generate(model, outdir, backends, names, progress, cache=cache,
                              cache_dir=cache_dir)
+        progress.clear()
     for path in paths:
         click.echo(str(path))
 
 
 @main.command()
 @description_argument
-@click.option("-o", "--output", "output", default=None, type=click.Path(dir_okay=False, path_type=Path),
+@click.option("-o", "--output", "output", default=None, type=click.Path(path_type=Path),
               help="Notebook file to write (default: <robot>_derivation.ipynb).")
+@scene_option()
+@quiet_option
 @strict_option
 @_handle_errors
-def notebook(description, output, strict):
+def notebook(description, output, scene_path, quiet, strict):
     """Write a Jupyter notebook deriving DESCRIPTION's equations of motion step by step.
 
     The notebook (saved without outputs) loads the robot, derives positions, Jacobians,
@@ -275,27 +339,35 @@ def notebook(description, output, strict):
     Examples:
       eomgen notebook                        # the bundled planar 2-link arm
       eomgen notebook ur5.urdf -o ur5.ipynb
+      eomgen notebook panda.urdf --scene examples/scenes/panda_two_joints.yaml
     """
     from .notebook import build_notebook, write_notebook
+    from .output import check_output_file
 
-    model = _load(description, strict)
+    if output is not None:
+        check_output_file(output)
+    progress = _progress(quiet)
+    model, _ = _load_reduced(description, scene_path, strict)
     path = output or Path(f"{model.name}_derivation.ipynb")
-    click.echo(str(write_notebook(build_notebook(model, description), path)))
+    if output is None:
+        check_output_file(path)
+    progress(f"building the notebook of {model.name}")
+    nb = build_notebook(model, description, scene=scene_path)
+    progress.clear()
+    click.echo(str(write_notebook(nb, path)))
 
 
 @main.command()
 @description_argument
-@click.option("--format", "formats", default="pdf", show_default=True,
-              help="Comma-separated handout formats among pdf, html, md, tex; or all.")
-@click.option("-o", "--output", "outdir", default="eomgen_handout", show_default=True,
-              type=click.Path(file_okay=False, path_type=Path), help="Output folder.")
-@click.option("--scene", "scene_path", default=None,
-              type=click.Path(dir_okay=False, path_type=Path),
-              help="Scene file (YAML, docs/scenes.md): derive only what it moves, e.g. two "
-                   "joints of a real arm (examples/scenes/panda_two_joints.yaml).")
+@click.option("--format", "formats", default=None,
+              help="Comma-separated handout formats among pdf, html, md, tex; or all. "
+                   "[default: pdf; html, with a note, when pdflatex is not installed]")
+@output_folder_option("eomgen_handout")
+@scene_option("Scene file (YAML, docs/scenes.md): derive only what it moves, e.g. two "
+              "joints of a real arm (examples/scenes/panda_two_joints.yaml).")
 @click.option("--no-check", is_flag=True,
               help="Leave out the numeric verification (the handout says so).")
-@click.option("--quiet", is_flag=True, help="No progress lines.")
+@quiet_option
 @strict_option
 @_handle_errors
 def teach(description, formats, outdir, scene_path, no_check, quiet, strict):
@@ -306,7 +378,8 @@ def teach(description, formats, outdir, scene_path, no_check, quiet, strict):
     the equations of motion; named subexpressions for models too large to print expanded) and
     the verified properties with their numbers. Formats: pdf (through pdflatex), html (one
     self-contained file, math as MathML), md (Markdown with $...$ math, plus the sketch as SVG),
-    tex (LaTeX source, plus the sketch as PDF). All files or none are written.
+    tex (LaTeX source, plus the sketch as PDF). All files or none are written. The pdf format
+    needs pdflatex (TeX Live); without it the default is html, and asking for pdf is an error.
 
     \b
     Examples:
@@ -314,26 +387,28 @@ def teach(description, formats, outdir, scene_path, no_check, quiet, strict):
       eomgen teach robot.urdf --format html,md -o handouts/
       eomgen teach panda.urdf --scene examples/scenes/panda_two_joints.yaml
     """
+    import shutil
+
+    from .output import check_output_folder
     from .teach import parse_formats, write_handout
 
-    chosen = parse_formats(formats)
-    scene = report = None
-    if scene_path is not None:
-        from .scene import load_scene
-
-        scene = load_scene(scene_path, strict=strict)
-    model = _load(description, strict, scene)
-    if scene is not None:
-        from .reduction import apply_scene
-
-        model, report = apply_scene(model, scene)
-
-    def progress(line: str) -> None:
-        if not quiet:
-            click.echo(f"eomgen: {line}", err=True)
-
-    for path in write_handout(model, outdir, chosen, progress, check=not no_check,
-                              scene=report):
+    progress = _progress(quiet)
+    have_pdflatex = shutil.which("pdflatex") is not None
+    if formats is None:
+        chosen = ["pdf"] if have_pdflatex else ["html"]
+        if not have_pdflatex:
+            progress.note("pdflatex not found: writing the html handout instead of the pdf "
+                          "(install TeX Live for pdf, or choose with --format)")
+    else:
+        chosen = parse_formats(formats)
+        if "pdf" in chosen and not have_pdflatex:
+            raise GenerationError("--format pdf needs pdflatex, which is not installed (TeX "
+                                  "Live: apt install texlive-latex-base); choose html, md or tex")
+    check_output_folder(outdir)
+    model, report = _load_reduced(description, scene_path, strict)
+    paths = write_handout(model, outdir, chosen, progress, check=not no_check, scene=report)
+    progress.clear()
+    for path in paths:
         click.echo(str(path))
 
 
@@ -341,7 +416,8 @@ def teach(description, formats, outdir, scene_path, no_check, quiet, strict):
 # error handling, DESCRIPTION argument, --strict and loading.
 from .analysis.commands import add_commands as _add_analysis_commands  # noqa: E402
 
-_add_analysis_commands(main, _handle_errors, description_argument, strict_option, _load)
+_add_analysis_commands(main, _handle_errors, description_argument, strict_option,
+                       _load_reduced)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -27,15 +27,22 @@ from .model import RobotModel
 from .symbolic.textbook import TEXTBOOK_MAX_DOF
 
 
-def _load_code(description: Path | None) -> str:
+def _load_code(description: Path | None, scene: Path | None = None) -> str:
     if description is None:
-        return 'model = eomgen.load(eomgen.example_path("planar_2link"))'
-    return f"model = eomgen.load({str(Path(description).resolve())!r})"
+        code = 'model = eomgen.load(eomgen.example_path("planar_2link"))'
+    else:
+        code = f"model = eomgen.load({str(Path(description).resolve())!r})"
+    if scene is not None:
+        code += ("\nfrom eomgen.reduction import apply_scene\nfrom eomgen.scene import load_scene"
+                 f"\nmodel = apply_scene(model, load_scene({str(Path(scene).resolve())!r})).model")
+    return code
 
 
-def build_notebook(model: RobotModel, description: Path | None = None) -> nbformat.NotebookNode:
+def build_notebook(model: RobotModel, description: Path | None = None,
+                   scene: Path | None = None) -> nbformat.NotebookNode:
     """The derivation notebook of ``model``, loaded from ``description`` (None: the bundled
-    planar 2-link arm).
+    planar 2-link arm) and reduced by the scene file ``scene`` when given (``model`` is then the
+    reduced model, see :func:`eomgen.reduction.apply_scene`).
 
     Raises
     ------
@@ -78,7 +85,7 @@ from IPython.display import Math, display
 import eomgen
 from eomgen.display import expression_latex
 
-{_load_code(description)}
+{_load_code(description, scene)}
 dyn = eomgen.derive(model)
 
 

@@ -1,11 +1,20 @@
-"""Generated files and how they are written: all of them or none.
+"""Generated files and how they are written: all of them or none, checked before the work.
 
 Plain data and the standard library only (no SymPy): ``eomgen generate`` answers a request
-from the derivation cache (:mod:`eomgen.cache`) with these two names alone.
+from the derivation cache (:mod:`eomgen.cache`) with these names alone.
+
+* :func:`check_output_folder` and :func:`check_output_file` tell, before any work, whether an
+  output can be written where it is asked for (an existing file given as a folder, a parent
+  that is a file, a read-only or virtual file system such as ``/proc``), as one-line
+  :class:`OutputError` naming the path and the problem. They try for real (a probe folder made
+  and removed at once), since permission bits do not stop root.
+* :func:`write_atomically` writes a set of files: all of them or none, the previous output left
+  as it was on failure or interrupt, whether or not the output folder is a mount point.
 """
 
 from __future__ import annotations
 
+import errno
 import os
 import shutil
 import signal
@@ -13,6 +22,13 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
+
+from .errors import GenerationError, one_line
+
+
+class OutputError(GenerationError):
+    """An output path that cannot be written (a file where a folder is needed, a parent that is
+    not a folder, a read-only or virtual file system). The message names the path."""
 
 
 @dataclass(frozen=True)
@@ -25,15 +41,108 @@ class GeneratedFile:
     golden: bool = True
 
 
+def _existing_ancestor(path: Path) -> Path:
+    """The nearest of ``path``'s ancestors that exists (``path``'s parent at the closest)."""
+    parent = path.parent
+    while not os.path.lexists(parent) and parent != parent.parent:
+        parent = parent.parent
+    return parent
+
+
+def _problem(exc: OSError, folder: Path) -> str:
+    """What refusing to make an entry in ``folder`` with ``exc`` means, in words."""
+    if exc.errno == errno.EROFS:
+        return f"{folder} is on a read-only file system"
+    if exc.errno in (errno.EACCES, errno.EPERM):
+        return f"no permission to write in {folder}"
+    if exc.errno in (errno.ENOSPC, errno.EDQUOT):
+        return f"no space left in {folder}"
+    return f"{folder} does not accept new files ({(exc.strerror or str(exc)).lower()})"
+
+
+def _refuse(path: Path, problem: str) -> OutputError:
+    return OutputError(one_line(f"{path}: cannot write the output: {problem}"))
+
+
+def _probe(folder: Path, path: Path) -> None:
+    """Make and remove a folder in ``folder``; raise :class:`OutputError` about ``path`` when
+    that fails (the file system refuses new entries there)."""
+    try:
+        os.rmdir(tempfile.mkdtemp(prefix=".eomgen-probe-", dir=folder))
+    except OSError as exc:
+        raise _refuse(path, _problem(exc, folder)) from None
+
+
+def _check_parent(path: Path) -> None:
+    """``path``'s missing folders can be made: the nearest existing ancestor is a writable
+    folder."""
+    ancestor = _existing_ancestor(path)
+    if not ancestor.is_dir():
+        raise _refuse(path, f"{ancestor} is a file, not a folder")
+    _probe(ancestor, path)
+
+
+def check_output_folder(outdir: Path) -> None:
+    """Raise :class:`OutputError` unless files can be written into the folder ``outdir``
+    (made when missing, with its parents). Nothing is left behind."""
+    outdir = Path(outdir)
+    if os.path.lexists(outdir):
+        if not outdir.is_dir():
+            raise _refuse(outdir, "it is a file, not a folder")
+        _probe(outdir, outdir)
+    else:
+        _check_parent(outdir)
+
+
+def check_output_file(path: Path) -> None:
+    """Raise :class:`OutputError` unless the file ``path`` can be written (made or replaced;
+    its folder made when missing). Nothing is left behind."""
+    path = Path(path)
+    if path.is_dir():
+        raise _refuse(path, "it is a folder, not a file")
+    if path.parent.is_dir():
+        _probe(path.parent, path)
+    else:
+        _check_parent(path)
+
+
+def _make_folders(folder: Path) -> list[Path]:
+    """Make ``folder`` and its missing parents; returns those made, deepest last."""
+    made = []
+    for candidate in [folder, *folder.parents][::-1]:
+        if not os.path.lexists(candidate):
+            candidate.mkdir()
+            made.append(candidate)
+    return made
+
+
 def write_atomically(files: Sequence[GeneratedFile], outdir: Path) -> list[Path]:
     """Write ``files`` into ``outdir``: all of them or, on any failure, none.
 
-    Files are first written into a staging folder beside ``outdir``; then they are moved in with
-    ``os.replace`` while SIGINT and SIGTERM are held back, and the staging folder is removed.
+    Files are first written into a staging folder on the same file system as their
+    destination, so that moving them in is a rename (never a copy, which fails across file
+    systems with ``EXDEV``):
+
+    * ``outdir`` missing: the staging folder is made beside it and renamed to ``outdir`` as a
+      whole; the parents made for it are removed again on failure.
+    * ``outdir`` existing (a mount point such as a container volume included): the staging
+      folder is made inside it, a hidden ``.eomgen-staging-*``, and each file is moved in with
+      ``os.replace``; files of other names are left alone.
+
+    The moves happen while SIGINT and SIGTERM are held back; the staging folder is always
+    removed.
     """
     outdir = Path(outdir)
-    outdir.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=f".{outdir.name}.staging-", dir=outdir.parent))
+    made = _make_folders(outdir.parent)
+    fresh = not os.path.lexists(outdir)
+    try:
+        if fresh:
+            staging = Path(tempfile.mkdtemp(prefix=f".{outdir.name}.staging-", dir=outdir.parent))
+        else:
+            staging = Path(tempfile.mkdtemp(prefix=".eomgen-staging-", dir=outdir))
+    except BaseException:
+        _remove_folders(made)
+        raise
     try:
         for f in files:
             target = staging / f.name
@@ -41,14 +150,50 @@ def write_atomically(files: Sequence[GeneratedFile], outdir: Path) -> list[Path]
                 target.write_bytes(f.content)
             else:
                 target.write_text(f.content, encoding="utf-8", newline="\n")
+        if fresh:
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(staging, 0o777 & ~umask)  # mkdtemp made it 0700: as mkdir would
         blocked = {signal.SIGINT, signal.SIGTERM}
         previous = signal.pthread_sigmask(signal.SIG_BLOCK, blocked)
         try:
-            outdir.mkdir(exist_ok=True)
-            for f in files:
-                os.replace(staging / f.name, outdir / f.name)
+            if fresh and _rename_folder(staging, outdir):
+                staging = None
+            else:
+                outdir.mkdir(exist_ok=True)
+                for f in files:
+                    os.replace(staging / f.name, outdir / f.name)
         finally:
             signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+    except BaseException:
+        if staging is not None:
+            shutil.rmtree(staging, ignore_errors=True)
+            staging = None
+        if fresh:
+            _remove_folders(made)
+        raise
     finally:
-        shutil.rmtree(staging, ignore_errors=True)
+        if staging is not None:
+            shutil.rmtree(staging, ignore_errors=True)
     return [outdir / f.name for f in files]
+
+
+def _rename_folder(staging: Path, outdir: Path) -> bool:
+    """Rename ``staging`` to ``outdir``; False when ``outdir`` appeared meanwhile (then the
+    files are moved in one by one)."""
+    try:
+        os.rename(staging, outdir)
+    except OSError as exc:
+        if exc.errno in (errno.EEXIST, errno.ENOTEMPTY, errno.EISDIR) or os.path.isdir(outdir):
+            return False
+        raise
+    return True
+
+
+def _remove_folders(made: list[Path]) -> None:
+    """Remove the (empty) folders ``made``, deepest first; ignore those no longer empty."""
+    for folder in reversed(made):
+        try:
+            folder.rmdir()
+        except OSError:
+            return

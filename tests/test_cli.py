@@ -51,14 +51,19 @@ def test_verify_without_arguments_checks_the_bundled_arm():
     assert lines[-1] == "all checks passed"
     assert "(exact)" in result.stdout
     assert "FAIL" not in result.stdout
-    assert result.stderr == ""
+    assert [line.split(" [+")[0] for line in result.stderr.splitlines()] == [
+        "eomgen: deriving M, C, g and tau of planar_2link (2 joints)",
+        "eomgen: checking at 20 random states"]  # progress on stderr; results on stdout
+    quiet = run("verify", "--quiet")
+    assert quiet.stdout.splitlines()[1:] == lines[1:] and quiet.stderr == ""
 
 
 def test_verify_a_urdf_from_example_robot_data():
     robots = erd_robots_dir()
     if robots is None:
         pytest.skip("example-robot-data is not installed")
-    result = run("verify", robots / "ur_description/urdf/ur5_robot.urdf", "--samples", "5")
+    result = run("verify", robots / "ur_description/urdf/ur5_robot.urdf", "--samples", "5",
+                 "--quiet")
     assert result.exit_code == 0, result.output
     assert result.stdout.startswith("derived ur5 (6 joints: shoulder_pan_joint, ")
     assert result.stdout.splitlines()[-1] == "all checks passed"
@@ -165,7 +170,7 @@ def test_debug_shows_a_traceback(tmp_path):
 
 def test_puma560_warns_about_link1_and_passes():
     path = example_path("puma560_dh")
-    result = run("verify", path, "--samples", "3")
+    result = run("verify", path, "--samples", "3", "--quiet")  # warnings even when quiet
     assert result.exit_code == 0, result.output
     warnings = result.stderr.splitlines()
     assert warnings and all(line.startswith(f"{WARNING}{path}: link '") for line in warnings)

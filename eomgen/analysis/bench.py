@@ -36,6 +36,7 @@ from typing import Callable, Protocol
 import numpy as np
 
 from ..model import RobotModel
+from ..progress import plural
 from .precision import Reference, relative_error
 from .report import csv_text, fmt, markdown_table, pareto_front, pyplot
 from .routes import Route, build_routes, numeric_only
@@ -105,7 +106,7 @@ class BenchResult:
         return csv_text(self.CSV_HEADERS, rows)
 
     def markdown(self, image: str | None = None) -> str:
-        lines = [f"# Speed against error: {self.robot} ({self.dof} joints)", "",
+        lines = [f"# Speed against error: {self.robot} ({plural(self.dof, 'joint')})", "",
                  f"{self.samples} sampled states; batch routes on {self.batch_size} states per "
                  f"call; {self.repeats} repeats. Error: largest normwise relative error against "
                  f"the 40-digit reference (program and mpmath Newton–Euler agree to "

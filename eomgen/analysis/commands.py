@@ -4,19 +4,22 @@
 own helpers (error handling, the DESCRIPTION argument, ``--strict``, loading), so this module
 imports nothing from the CLI and nothing heavy until a command runs.
 
-``--scene`` is offered when eomgen's scenes (``eomgen.scene`` and ``eomgen.reduction``) are
-installed: the model is reduced by the scene before anything is measured.
+``--scene`` reduces the model by a scene file (``eomgen.scene``, ``eomgen.reduction``) before
+anything is measured. Whether OUTPUT can be written is checked before the work
+(:func:`eomgen.output.check_output_folder`); progress goes through :class:`eomgen.progress.Progress`
+(stage lines with elapsed times in a log, a bar on a terminal, nothing with ``--quiet``).
 """
 
 from __future__ import annotations
 
 import importlib.util
-import sys
 from pathlib import Path
 
 import click
 
 from ..errors import EomgenError
+from ..output import check_output_folder
+from ..progress import Progress, plural
 
 
 class AnalysisError(EomgenError):
@@ -24,14 +27,7 @@ class AnalysisError(EomgenError):
     dependency, a malformed list of numbers)."""
 
 
-def _scenes_available() -> bool:
-    return all(importlib.util.find_spec(name) is not None
-               for name in ("eomgen.scene", "eomgen.reduction"))
-
-
 def _scene_option(command):
-    if not _scenes_available():
-        return command
     return click.option(
         "--scene", "scene_path", default=None, type=click.Path(dir_okay=False, path_type=Path),
         help="Scene file (YAML): reduce the robot to what the scene moves first "
@@ -57,16 +53,6 @@ def _floats(text: str | None, option: str) -> list[float] | None:
     return values
 
 
-def _model(load, description, strict, scene_path):
-    if scene_path is None:
-        return load(description, strict)
-    from ..reduction import apply_scene
-    from ..scene import load_scene
-
-    scene = load_scene(scene_path, strict=strict)
-    return apply_scene(load(description, strict, scene), scene).model
-
-
 def _stem(model) -> str:
     from ..codegen.functions import module_name
 
@@ -74,20 +60,21 @@ def _stem(model) -> str:
 
 
 def add_commands(main: click.Group, handle_errors, description_argument, strict_option,
-                 load) -> None:
+                 load_reduced) -> None:
     """Register ``bench`` and ``simulate`` on ``main`` with the CLI's helpers."""
 
     @main.command()
     @description_argument
     @click.option("-o", "--output", "outdir", default="eomgen_bench", show_default=True,
-                  type=click.Path(file_okay=False, path_type=Path), help="Output folder.")
+                  type=click.Path(path_type=Path), help="Output folder.")
     @click.option("--samples", default=50, show_default=True,
                   help="Sampled states (errors are the largest over them).")
     @click.option("--seed", default=0, show_default=True, help="Seed of the sampled states.")
     @click.option("--repeats", default=7, show_default=True, help="Timing repeats per route.")
     @click.option("--batch-size", default=1000, show_default=True,
                   help="States per call of the batch routes.")
-    @click.option("--quiet", is_flag=True, help="No progress bar.")
+    @click.option("--quiet", is_flag=True, help="No progress on stderr (stage lines in a log, "
+                                                "a bar on a terminal).")
     @_scene_option
     @strict_option
     @handle_errors
@@ -108,25 +95,20 @@ def add_commands(main: click.Group, handle_errors, description_argument, strict_
           eomgen bench ur5_robot.urdf --samples 100 -o build/bench
         """
         _require("matplotlib", "mpmath")
-        from .bench import prepare_bench, write_outputs
-
-        model = _model(load, description, strict, scene_path)
         if samples < 1 or repeats < 1 or batch_size < 1:
             raise AnalysisError("--samples, --repeats and --batch-size must be positive")
+        check_output_folder(outdir)
+        from .bench import prepare_bench, write_outputs
 
-        def log(line: str) -> None:
-            if not quiet:
-                click.echo(f"eomgen: {line}", err=True)
-
+        progress = Progress(quiet)
+        model = load_reduced(description, scene_path, strict)[0]
         plan = prepare_bench(model, samples=samples, seed=seed, batch_size=batch_size,
-                             repeats=repeats, log=log)
-        if quiet:
-            result = plan.run()
-        else:
-            with click.progressbar(length=plan.steps, label="eomgen: measuring",
-                                   file=sys.stderr) as bar:
-                result = plan.run(bar)
+                             repeats=repeats, log=progress)
+        with progress.steps(plan.steps, "measuring") as steps:
+            result = plan.run(steps)
+        progress("writing the report and plot")
         paths = write_outputs(result, outdir, _stem(model))
+        progress.clear()
         click.echo(result.markdown())
         for path in paths:
             click.echo(str(path))
@@ -134,7 +116,7 @@ def add_commands(main: click.Group, handle_errors, description_argument, strict_
     @main.command()
     @description_argument
     @click.option("-o", "--output", "outdir", default="eomgen_simulate", show_default=True,
-                  type=click.Path(file_okay=False, path_type=Path), help="Output folder.")
+                  type=click.Path(path_type=Path), help="Output folder.")
     @click.option("--duration", default=5.0, show_default=True, help="Simulated time [s].")
     @click.option("--dt", "dts", default="1e-2,3e-3,1e-3", show_default=True,
                   help="Steps of the fixed-step integrators [s], comma-separated.")
@@ -146,7 +128,8 @@ def add_commands(main: click.Group, handle_errors, description_argument, strict_
     @click.option("--q0", default=None, help="Initial joint positions, comma-separated "
                                              "(default: 1 rad or m per joint).")
     @click.option("--qd0", default=None, help="Initial joint velocities (default: zero).")
-    @click.option("--quiet", is_flag=True, help="No progress bar.")
+    @click.option("--quiet", is_flag=True, help="No progress on stderr (stage lines in a log, "
+                                                "a bar on a terminal).")
     @_scene_option
     @strict_option
     @handle_errors
@@ -178,27 +161,25 @@ def add_commands(main: click.Group, handle_errors, description_argument, strict_
                                             step_list, rtol_list)
         except ValueError as exc:
             raise AnalysisError(f"--integrators: {exc}") from None
-        model = _model(load, description, strict, scene_path)
+        check_output_folder(outdir)
+        progress = Progress(quiet)
+        model = load_reduced(description, scene_path, strict)[0]
         start = _floats(q0, "--q0")
         velocity = _floats(qd0, "--qd0")
         for values, option in ((start, "--q0"), (velocity, "--qd0")):
             if values is not None and len(values) != model.dof:
-                raise AnalysisError(f"{option}: {model.name} has {model.dof} joints "
+                raise AnalysisError(f"{option}: {model.name} has {plural(model.dof, 'joint')} "
                                     f"({', '.join(model.joint_names)}), got {len(values)} values")
-        if not quiet:
-            click.echo(f"eomgen: deriving M, C, g and tau of {model.name} ({model.dof} joints)",
-                       err=True)
+        progress(f"deriving M, C, g and tau of {model.name} ({plural(model.dof, 'joint')})")
         from .simulate import System
 
         system = System(model)
-        if quiet:
-            study = run_study(model, integrators, duration, start, velocity, system=system)
-        else:
-            with click.progressbar(length=len(integrators) + 1, label="eomgen: integrating",
-                                   file=sys.stderr) as bar:
-                study = run_study(model, integrators, duration, start, velocity,
-                                  progress=lambda _: bar.update(1), system=system)
+        with progress.steps(len(integrators) + 1, "integrating") as steps:
+            study = run_study(model, integrators, duration, start, velocity,
+                              progress=lambda name: steps.update(1, name), system=system)
+        progress("writing the report and plot")
         paths = write_outputs([study], outdir, f"simulate_{_stem(model)}")
+        progress.clear()
         click.echo(study.describe())
         click.echo(study.markdown_table())
         for path in paths:

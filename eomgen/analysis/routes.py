@@ -49,6 +49,7 @@ from ..codegen import available_backends, make_job
 from ..codegen.backends.casadi_backend import c_compiler
 from ..dynamics import Dynamics, derive
 from ..model import RobotModel
+from ..progress import plural
 from ..numeric import mass_matrix_rnea, numeric_model, rnea
 from ..symbolic.program import Program
 
@@ -219,7 +220,7 @@ def build_routes(model: RobotModel, workdir: Path, dynamics: Dynamics | None = N
     """
     model = numeric_only(model)
     if dynamics is None:
-        progress(f"deriving M and tau of {model.name} ({model.dof} joints)")
+        progress(f"deriving M and tau of {model.name} ({plural(model.dof, 'joint')})")
         dynamics = derive(model, outputs=("M", "tau"), simplify=False)
     n = model.dof
     skip = set(skip)

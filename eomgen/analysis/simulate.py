@@ -54,6 +54,7 @@ import numpy as np
 
 from ..dynamics import derive
 from ..model import RobotModel
+from ..progress import plural
 from ..numeric import kinetic_energy, numeric_model, potential_energy
 from .conditioning import (CONDITION_LIMIT, EXACT_FROM, IllConditionedWarning,
                            ill_conditioned_message)
@@ -430,7 +431,7 @@ class Study:
                                "status"], rows, "llrrrrrrl")
 
     def describe(self) -> str:
-        return (f"{self.robot} ({self.dof} joints), {self.duration:g} s from q0 = "
+        return (f"{self.robot} ({plural(self.dof, 'joint')}), {self.duration:g} s from q0 = "
                 f"({', '.join(f'{x:g}' for x in self.q0)}), q̇0 = "
                 f"({', '.join(f'{x:g}' for x in self.qd0)}), zero torque, no damping; "
                 f"energy scale {self.energy_scale:.3g} J; reference DOP853 rtol = atol = "

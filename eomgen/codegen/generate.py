@@ -16,6 +16,7 @@ from ..cache import CacheRequest, render_cached
 from ..errors import GenerationError
 from ..model import RobotModel
 from ..output import write_atomically  # noqa: F401  (re-exported)
+from ..progress import plural
 from . import GeneratedFile, available_backends, make_job
 from .functions import derived_outputs, select_functions
 
@@ -70,7 +71,7 @@ def render_files(model: RobotModel, backends: Sequence[str], progress: Progress 
     """
     start = time.perf_counter()
     outputs = derived_outputs(functions)
-    progress(f"deriving {', '.join(outputs)} of {model.name} ({model.dof} joints)")
+    progress(f"deriving {', '.join(outputs)} of {model.name} ({plural(model.dof, 'joint')})")
     dynamics = derive(model, outputs=outputs, simplify=False)
     job = make_job(dynamics, functions, notes)
     progress(f"derived in {time.perf_counter() - start:.2f} s; "
@@ -109,6 +110,7 @@ def render_job(job, backends: Sequence[str], progress: Progress = lambda _: None
                 f"{', '.join(missing)}; ask for more outputs or choose other backends")
     for name in backends:
         start = time.perf_counter()
+        progress(f"{name}: generating")  # the C backend compiles: a stage of its own in a log
         produced = registry[name].generate(job)
         progress(f"{name}: {', '.join(f.name for f in produced)} "
                  f"({time.perf_counter() - start:.2f} s)")

@@ -14,8 +14,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterable, Sequence
 
+from ..cache import Cache, CacheRequest
 from ..dynamics import derive
 from ..model import RobotModel
+from ..progress import plural
 from ..reduction import (
     MEASURE_TIMEOUT,
     DerivationCost,
@@ -65,13 +67,14 @@ def render_scene_files(model: RobotModel, scene: Scene | None, backends: Sequenc
     """
     start = time.perf_counter()
     reduced, report = apply_scene(model, scene)
-    progress(f"scene {Path(report.scene).name}: {report.after.dof} of {report.before.dof} joints "
-             f"move, {report.after.links} of {report.before.links} links kept "
+    progress(f"scene {Path(report.scene).name}: {report.after.dof} of "
+             f"{plural(report.before.dof, 'joint')} move, {report.after.links} of {report.before.links} links kept "
              f"({time.perf_counter() - start:.2f} s)")
     reduced = keep_symbolic(reduced, symbolic)
     functions = report.outputs
     outputs = derived_outputs(functions)
-    progress(f"deriving {', '.join(outputs)} of {reduced.name} ({reduced.dof} joints)")
+    progress(f"deriving {', '.join(outputs)} of {reduced.name} "
+             f"({plural(reduced.dof, 'joint')})")
     dynamics = derive(reduced, outputs=outputs, simplify=False)
     after = derivation_cost(dynamics)
     notes = _header_notes(report, scene)
@@ -82,7 +85,8 @@ def render_scene_files(model: RobotModel, scene: Scene | None, backends: Sequenc
     before = None
     if explain:
         whole = _with_scene_parameters(model, reduced)
-        progress(f"measuring the whole description ({whole.dof} joints) for comparison, at most "
+        progress(f"measuring the whole description ({plural(whole.dof, 'joint')}) for comparison, "
+                 "at most "
                  f"{timeout:g} s")
         before = measure_derivation(whole, outputs, timeout)
         progress("measuring the reduced model the same way")
@@ -113,13 +117,17 @@ def _header_notes(report: ReductionReport, scene: Scene | None) -> tuple[str, ..
 def generate_scene(model: RobotModel, scene: Scene | None, outdir: Path,
                    backends: str | Sequence[str] = "all", symbolic: Iterable[str] | None = None,
                    progress: Progress = lambda _: None, explain: bool = False,
-                   timeout: float = MEASURE_TIMEOUT) -> tuple[list[Path], SceneGeneration]:
+                   timeout: float = MEASURE_TIMEOUT, cache: bool | CacheRequest = False,
+                   cache_dir: Path | None = None) -> tuple[list[Path], SceneGeneration]:
     """Generate the chosen backends' files for ``model`` reduced by ``scene``, and the scene
     report, into ``outdir`` (all files or none); returns their paths and what was produced.
 
     Backends as for :func:`~.generate.generate`: with ``"all"``, a backend that cannot serve the
     scene's outputs (the LaTeX derivation needs M, C and g) is left out with a progress line.
-    ``symbolic`` narrows further the parameters the scene keeps symbolic.
+    ``symbolic`` narrows further the parameters the scene keeps symbolic. ``cache``: a
+    :class:`~eomgen.cache.CacheRequest` (``eomgen generate --scene`` keys the description and
+    scene files before reading them, :func:`eomgen.cache.command_request`) stores the files
+    under its key in the derivation cache (folder ``cache_dir``); anything else stores nothing.
     """
     chosen = select_backends(backends)
     outputs = scene.outputs if scene is not None else None
@@ -130,4 +138,6 @@ def generate_scene(model: RobotModel, scene: Scene | None, outdir: Path,
         for name in skipped:
             progress(f"{name}: skipped (needs {', '.join(available_backends()[name].needs)})")
     produced = render_scene_files(model, scene, chosen, symbolic, progress, explain, timeout)
+    if isinstance(cache, CacheRequest):
+        Cache(cache_dir).put(cache.key, produced.files, tuple(cache.notices))
     return write_atomically(produced.files, Path(outdir)), produced

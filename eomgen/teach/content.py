@@ -33,6 +33,7 @@ from ..codegen.functions import module_name
 from ..dynamics import Dynamics, derive
 from ..errors import ParameterError
 from ..model import IDENTITY3, RobotModel
+from ..progress import plural
 from ..symbolic.textbook import TextbookDerivation
 from ..verify import VerificationReport, verify
 from . import readability as rd
@@ -516,7 +517,7 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
     """
     from .sketch import render_sketch, sketch_geometry
 
-    progress(f"deriving the equations of motion of {model.name} ({model.dof} joints)")
+    progress(f"deriving the equations of motion of {model.name} ({plural(model.dof, 'joint')})")
     dyn = derive(model, outputs=("M", "C", "g"), simplify=False)
     book = lb.textbook_for(dyn, HANDOUT_CONFIG)
     w = _Writer(lb.printing(dyn, HANDOUT_CONFIG, compact_trig=book is not None,

@@ -1,0 +1,159 @@
+"""Progress of long commands on stderr: stage lines in a log, one updating line on a terminal.
+
+Every command that works for a while (``generate``, ``teach``, ``bench``, ``simulate``, ...)
+reports through one :class:`Progress`, which the CLI makes from ``--quiet`` and hands down as a
+plain callable ``progress(line)`` (library code never needs more, and defaults to a no-op):
+
+* stderr is not a terminal (a log file, CI): each stage is one line
+  ``eomgen: <stage> [+12.3 s]``, the time since the command started, so that a long run is
+  never silent and its log says where the time went;
+* stderr is a terminal: the stage replaces the previous one on a single line, cleared when the
+  command ends;
+* ``quiet``: nothing.
+
+:meth:`Progress.steps` counts the steps of a loop (integrators, measurements): a click progress
+bar on a terminal, and in a log a line at each tenth of the way and for each named step.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import sys
+import time
+from typing import Callable, Iterator, TextIO
+
+
+#: The Progress whose terminal line is open (not ended by a newline), if any.
+_open: "Progress | None" = None
+
+
+def end_line() -> None:
+    """End an open terminal progress line with a newline, keeping the stage on screen, so that
+    a warning or an error printed next starts on a line of its own."""
+    global _open
+    if _open is not None and _open._pending:
+        _open.stream.write("\n")
+        _open.stream.flush()
+        _open._pending = False
+    _open = None
+
+
+def plural(count: int, noun: str) -> str:
+    """``"1 joint"``, ``"2 joints"``, ``"0 joints"``."""
+    return f"{count} {noun}" + ("" if count == 1 else "s")
+
+
+class Progress:
+    """Stage lines on ``stream`` (default stderr); see the module docstring.
+
+    Parameters
+    ----------
+    quiet:
+        Print nothing.
+    stream:
+        Where to print (default: ``sys.stderr`` at the time of each call).
+    tty:
+        Whether ``stream`` is a terminal (default: ``stream.isatty()``).
+    clock:
+        Seconds, for the elapsed times (default: :func:`time.monotonic`).
+    """
+
+    def __init__(self, quiet: bool = False, stream: TextIO | None = None,
+                 tty: bool | None = None, clock: Callable[[], float] = time.monotonic):
+        self.quiet = quiet
+        self._stream = stream
+        self._tty = tty
+        self._clock = clock
+        self._start = clock()
+        self._pending = False  # a terminal line not yet cleared
+
+    @property
+    def stream(self) -> TextIO:
+        return self._stream if self._stream is not None else sys.stderr
+
+    @property
+    def tty(self) -> bool:
+        if self._tty is not None:
+            return self._tty
+        try:
+            return self.stream.isatty()
+        except (AttributeError, ValueError):
+            return False
+
+    def elapsed(self) -> float:
+        """Seconds since the command started."""
+        return self._clock() - self._start
+
+    def __call__(self, line: str) -> None:
+        """Report a stage (``line`` without the ``eomgen:`` prefix)."""
+        if self.quiet:
+            return
+        if self.tty:
+            global _open
+            self.stream.write(f"\r\x1b[Keomgen: {line}")
+            self._pending = True
+            _open = self
+        else:
+            self.stream.write(f"eomgen: {line} [+{self.elapsed():.1f} s]\n")
+        self.stream.flush()
+
+    def note(self, line: str) -> None:
+        """A line that stays on a terminal too (e.g. a fallback taken), unless ``quiet``."""
+        if self.quiet:
+            return
+        self.clear()
+        self.stream.write(f"eomgen: {line}\n")
+        self.stream.flush()
+
+    def clear(self) -> None:
+        """End the updating terminal line (before printing results)."""
+        if self._pending:
+            self.stream.write("\r\x1b[K")
+            self.stream.flush()
+            self._pending = False
+
+    def __enter__(self) -> "Progress":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.clear()
+
+    @contextlib.contextmanager
+    def steps(self, total: int, label: str) -> Iterator["Steps"]:
+        """Count ``total`` steps of ``label`` (see the module docstring); yields an object
+        with ``update(n=1, name=None)``."""
+        if self.quiet:
+            yield Steps(self, total, label, None)
+            return
+        if self.tty:
+            import click
+
+            self.clear()
+            with click.progressbar(length=total, label=f"eomgen: {label}",
+                                   file=self.stream) as bar:
+                yield Steps(self, total, label, bar)
+            return
+        self(f"{label}: 0/{total}")
+        yield Steps(self, total, label, None)
+
+
+class Steps:
+    """The counter :meth:`Progress.steps` yields."""
+
+    def __init__(self, progress: Progress, total: int, label: str, bar):
+        self._progress, self._total, self._label, self._bar = progress, max(total, 1), label, bar
+        self._done = 0
+
+    def update(self, n: int = 1, name: str | None = None) -> None:
+        """``n`` more steps done; ``name`` (the step begun next, e.g. an integrator) is
+        printed in a log."""
+        before, self._done = self._done, self._done + n
+        if self._progress.quiet:
+            return
+        if self._bar is not None:
+            self._bar.update(n)
+            return
+        tenth = self._done * 10 // self._total > before * 10 // self._total
+        if name is not None or tenth:
+            self._progress(f"{self._label}: {self._done}/{self._total}"
+                           + (f", {name}" if name else ""))
