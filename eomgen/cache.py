@@ -84,7 +84,7 @@ COMMAND_IGNORED = frozenset({"description", "outdir", "quiet", "debug", "no_cach
 #: ``eomgen generate`` parameters that enter the key. A parameter in neither set, given with a
 #: value other than None or False (``--scene``, ``--explain``), turns the command-level cache
 #: off for that run: it may print more than the files, which a cached run would not repeat.
-COMMAND_KEYED = frozenset({"backends", "symbolic", "strict"})
+COMMAND_KEYED = frozenset({"backends", "symbolic", "strict", "no_snap"})
 
 Notify = Callable[[str], None]
 

@@ -122,10 +122,10 @@ strict_option = click.option(
          "instead of warning.")
 
 
-def _load(description: Path | None, strict: bool):
+def _load(description: Path | None, strict: bool, snap: bool = True):
     from .parsers import load
 
-    return load(description or _default_description(), strict=strict)
+    return load(description or _default_description(), strict=strict, snap=snap)
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -196,10 +196,13 @@ def verify(description, samples, seed, tolerance, strict):
 @click.option("--cache-dir", default=None, type=click.Path(file_okay=False, path_type=Path),
               help="Derivation cache folder (default: $EOMGEN_CACHE_DIR, else "
                    "$XDG_CACHE_HOME/eomgen, else ~/.cache/eomgen).")
+@click.option("--no-snap", is_flag=True,
+              help="Keep rotation and axis entries exactly as the description's floats give "
+                   "them (default: entries within 1e-11 of 0 or ±1 are made exact).")
 @strict_option
 @_handle_errors
 def generate(description, backends, outdir, symbolic, quiet, scene_path, explain, no_cache,
-             cache_dir, strict):
+             cache_dir, no_snap, strict):
     """Generate code and a derivation for DESCRIPTION (default: the bundled planar 2-link arm).
 
     Writes <robot>_numpy.py (NumPy, single states and batches), <robot>_casadi.py (CasADi
@@ -225,7 +228,7 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
     from .codegen.generate import generate as run_generate
 
     with _recorded_warnings() as notices:
-        model = _load(description, strict)
+        model = _load(description, strict, snap=not no_snap)
     cache = dataclasses.replace(request, notices=notices) if request else not no_cache
     names = None
     if symbolic is not None:

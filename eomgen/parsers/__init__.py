@@ -7,12 +7,12 @@ format touches no other module.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable
 
 from ..errors import TooLargeError, UnknownFormatError, UnreadableFileError
-from ..model import RobotModel
+from ..model import RobotModel, snapping
 
 Loader = Callable[[Path, bool], RobotModel]
 
@@ -41,7 +41,7 @@ def register(name: str, suffixes: tuple[str, ...], sniff: Callable[[str], bool] 
 MAX_FILE_BYTES = 50 * 1024 * 1024
 
 
-def load(path, strict: bool = False) -> RobotModel:
+def load(path, strict: bool = False, snap: bool = True) -> RobotModel:
     """Read a robot description: URDF (``.urdf``), DH table (``.yaml`` with ``dh:``) or eomgen
     YAML (``.yaml`` with ``links:``/``joints:``).
 
@@ -52,6 +52,12 @@ def load(path, strict: bool = False) -> RobotModel:
     strict:
         Refuse (rather than warn about) inertias that break the triangle inequality and
         features read in a simpler way than described (URDF ``<mimic>`` joints).
+    snap:
+        Make rotation and axis entries within :data:`~eomgen.model.SNAP_TOLERANCE` of 0 or ±1
+        exact (structural zeros, shorter code); ``False`` keeps the description's floats
+        exactly. The entries snapped are listed in ``model.info`` under ``"snapped"``
+        (:class:`~eomgen.model.Snap`: what, value, target; see
+        :func:`~eomgen.model.snap_summary`).
 
     Raises
     ------
@@ -88,4 +94,8 @@ def load(path, strict: bool = False) -> RobotModel:
                 "cannot tell which format this is (" + " or ".join(f.name for f in candidates)
                 + "): a DH table needs a top-level 'dh' list, an eomgen robot 'links' and 'joints'")
         candidates = sniffed
-    return candidates[0].load(path, strict)
+    with snapping(snap) as snaps:
+        model = candidates[0].load(path, strict)
+    if snaps:
+        model = replace(model, info=model.info + (("snapped", tuple(snaps)),))
+    return model
