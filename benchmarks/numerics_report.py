@@ -49,10 +49,12 @@ def robots() -> dict[str, Path]:
     return found
 
 
-def bench(samples: int) -> None:
+def bench(samples: int, names: list[str] | None = None) -> None:
     from eomgen.analysis.bench import prepare_bench
 
     for name, path in robots().items():
+        if names and name not in names:
+            continue
         start = time.perf_counter()
         plan = prepare_bench(load(path), samples=samples)
         result = plan.run()
@@ -205,6 +207,8 @@ def main() -> None:
     parser.add_argument("--duration", type=float, default=10.0,
                         help="simulated seconds of the double pendulum")
     parser.add_argument("--panda-duration", type=float, default=2.0)
+    parser.add_argument("--robots", default=None,
+                        help="comma-separated robots for --only bench (default: all found)")
     args = parser.parse_args()
     IMAGES.mkdir(parents=True, exist_ok=True)
     RESULTS.mkdir(parents=True, exist_ok=True)
@@ -213,7 +217,7 @@ def main() -> None:
     if args.only in (None, "forms"):
         forms()
     if args.only in (None, "bench"):
-        bench(args.samples)
+        bench(args.samples, args.robots.split(",") if args.robots else None)
     if args.only in (None, "simulate"):
         simulate(args.duration, args.panda_duration)
 
