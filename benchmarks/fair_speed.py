@@ -98,10 +98,14 @@ def pinocchio_panda(path: Path, joint_names):
 CLOCK = {"cpu": time.process_time, "wall": time.perf_counter}
 
 
+Samples = dict[str, list[float]]
+
+
 def timed(statements: dict[str, str], namespace: dict, number: int, repeats: int,
-          units: int = 1, clock=time.process_time) -> tuple[dict[str, list[float]], dict[str, list[float]]]:
+          units: int = 1, clock=time.process_time) -> tuple[Samples, Samples]:
     """µs per unit of each statement per repeat, in turns; and ratios to the last statement."""
-    timers = {k: timeit.Timer(s, globals=namespace, timer=clock) for k, s in statements.items()}
+    timers = {k: timeit.Timer(s, globals=namespace, timer=clock)
+              for k, s in statements.items()}
     for t in timers.values():
         t.timeit(max(1, number // 10))
     samples: dict[str, list[float]] = {k: [] for k in statements}

@@ -111,12 +111,15 @@ def _render_source(job: Job, config: FastConfig) -> str:
             rows=rows, cols=0 if spec.is_vector else cols, size=rows * cols,
             assignments=[(local[s].name, doprint(e)) for s, e in spec.program.assignments],
             entries=entries, operation_count=spec.operation_count, units=spec.units))
-    signature = "".join(", " + p.identifier + ("" if p.default is None else f"={float(p.default)!r}")
+    # the docstrings open with a text signature (inspect.signature reads it)
+    signature = "".join(", " + p.identifier
+                        + ("" if p.default is None else f"={float(p.default)!r}")
                         for p in job.parameters)
     for f in functions:
         shape = f"({f['rows']}, {f['cols']})" if f["cols"] else f"({f['rows']},)"
+        keywords = ", *" + signature if signature else ""
         f["doc"] = c_string_literal(
-            f"{f['name']}({', '.join(f['inputs'])}{', *' + signature if signature else ''})\n--\n\n"
+            f"{f['name']}({', '.join(f['inputs'])}{keywords})\n--\n\n"
             f"{f['summary']}\n\nInputs of shape (NQ,) or (N, NQ) in JOINT_NAMES order; returns "
             f"shape {shape} or (N,) + that, in {f['units']}. {f['operation_count']} arithmetic "
             "operations per state.")
@@ -128,7 +131,8 @@ def _render_source(job: Job, config: FastConfig) -> str:
         "numpy.linalg.LinAlgError when M is not positive definite and FloatingPointError when "
         "M, C qd + g or tau is not finite.")
     parameters = [dict(name=c_string_literal(p.identifier),
-                       default="NAN" if p.default is None else printer.doprint(sp.Float(p.default)),
+                       default=("NAN" if p.default is None
+                                else printer.doprint(sp.Float(p.default))),
                        has_default=int(p.default is not None),
                        doc=c_comment(p.doc))
                   for p in job.parameters]
