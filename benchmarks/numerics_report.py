@@ -53,10 +53,12 @@ def robots() -> dict[str, Path]:
     return found
 
 
-def bench(samples: int) -> None:
+def bench(samples: int, names: list[str] | None = None) -> None:
     from eomgen.analysis.bench import prepare_bench
 
     for name, path in robots().items():
+        if names and name not in names:
+            continue
         start = time.perf_counter()
         plan = prepare_bench(load(path), samples=samples)
         result = plan.run()
@@ -213,6 +215,8 @@ def main() -> None:
                         help="default 2; 0.5 with --quick")
     parser.add_argument("--quick", action="store_true",
                         help="10 samples, 2 s and 0.5 s simulated")
+    parser.add_argument("--robots", default=None,
+                        help="comma-separated robots for --only bench (default: all found)")
     args = parser.parse_args()
     quick = {"samples": 10, "duration": 2.0, "panda_duration": 0.5}
     full = {"samples": 50, "duration": 10.0, "panda_duration": 2.0}
@@ -226,7 +230,7 @@ def main() -> None:
     if args.only in (None, "forms"):
         forms()
     if args.only in (None, "bench"):
-        bench(args.samples)
+        bench(args.samples, args.robots.split(",") if args.robots else None)
     if args.only in (None, "simulate"):
         simulate(args.duration, args.panda_duration)
 

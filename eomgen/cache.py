@@ -63,6 +63,7 @@ import stat
 import sys
 import warnings
 from contextlib import contextmanager
+import sysconfig
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -87,7 +88,7 @@ COMMAND_IGNORED = frozenset({"description", "outdir", "quiet", "debug", "no_cach
 #: file's bytes and name). A parameter in none of these, given with a value other than None or
 #: False (``--explain``), turns the command-level cache off for that run: it may print more
 #: than the files, which a cached run would not repeat.
-COMMAND_KEYED = frozenset({"backends", "symbolic", "strict"})
+COMMAND_KEYED = frozenset({"backends", "symbolic", "strict", "no_snap"})
 
 Notify = Callable[[str], None]
 
@@ -137,13 +138,20 @@ def code_version() -> str:
     return f"{__version__}+{_code_fingerprint()[:16]}"
 
 
-def toolchain() -> dict[str, str | None]:
-    """What outside the inputs changes the files: the C compiler the C backend would use
-    (looked up as :func:`eomgen.codegen.backends.casadi_backend.c_compiler` does)."""
+def toolchain() -> dict[str, str | bool | None]:
+    """What outside the inputs changes the files: the C compiler the C backends would use
+    (looked up as :func:`eomgen.codegen.backends.casadi_backend.c_compiler` does), and for the
+    fast backend's compiled extension the Python it is built for (its ``EXT_SUFFIX`` names the
+    ABI) and whether Python's headers are there. (NumPy's C API is backward compatible: an
+    extension built against NumPy 2 headers targets the oldest supported NumPy by default.)"""
+    compiler = None
     for candidate in (os.environ.get("CC"), "cc", "gcc", "clang"):
         if candidate and shutil.which(candidate):
-            return {"cc": shutil.which(candidate)}
-    return {"cc": None}
+            compiler = shutil.which(candidate)
+            break
+    include = sysconfig.get_paths().get("include")
+    return {"cc": compiler, "ext_suffix": sysconfig.get_config_var("EXT_SUFFIX"),
+            "python_headers": bool(include) and Path(include, "Python.h").is_file()}
 
 
 def canonical(value) -> object:

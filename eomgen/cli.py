@@ -132,12 +132,13 @@ strict_option = click.option(
          "--scene keeps).")
 
 
-def _load(description: Path | None, strict: bool, scene=None):
+def _load(description: Path | None, strict: bool, scene=None, snap: bool = True):
     """The whole model; warns (refuses under ``strict``) only about what ``scene`` (a loaded
-    :class:`eomgen.scene.Scene`, applied by the caller) keeps."""
+    :class:`eomgen.scene.Scene`, applied by the caller) keeps. ``snap=False`` keeps the
+    description's floats exactly (``--no-snap``)."""
     from .reduction import load_for_scene
 
-    return load_for_scene(description or _default_description(), scene, strict)
+    return load_for_scene(description or _default_description(), scene, strict, snap=snap)
 
 
 # Options and helpers shared by the commands (``bench`` and ``simulate`` take them too).
@@ -244,7 +245,7 @@ def verify(description, samples, seed, tolerance, scene_path, quiet, strict):
 @main.command()
 @description_argument
 @click.option("--backend", "backends", default="all", show_default=True,
-              help="Comma-separated backends among numpy, casadi, c, latex; or all.")
+              help="Comma-separated backends among numpy, casadi, c, fast, latex; or all.")
 @output_folder_option("eomgen_output")
 @click.option("--symbolic", default=None,
               help="Comma-separated parameters to keep symbolic (default: all the description "
@@ -260,10 +261,13 @@ def verify(description, samples, seed, tolerance, scene_path, quiet, strict):
 @click.option("--cache-dir", default=None, type=click.Path(file_okay=False, path_type=Path),
               help="Derivation cache folder (default: $EOMGEN_CACHE_DIR, else "
                    "$XDG_CACHE_HOME/eomgen, else ~/.cache/eomgen).")
+@click.option("--no-snap", is_flag=True,
+              help="Keep rotation and axis entries exactly as the description's floats give "
+                   "them (default: entries within 1e-11 of 0 or ±1 are made exact).")
 @strict_option
 @_handle_errors
 def generate(description, backends, outdir, symbolic, quiet, scene_path, explain, no_cache,
-             cache_dir, strict):
+             cache_dir, no_snap, strict):
     """Generate code and a derivation for DESCRIPTION (default: the bundled planar 2-link arm).
 
     Writes <robot>_numpy.py (NumPy, single states and batches), <robot>_casadi.py (CasADi
@@ -298,7 +302,7 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
             from .scene import load_scene
 
             scene = load_scene(scene_path, strict=strict)
-        model = _load(description, strict, scene)
+        model = _load(description, strict, scene, snap=not no_snap)
     cache = dataclasses.replace(request, notices=notices) if request else not no_cache
     names = None
     if symbolic is not None:

@@ -221,7 +221,8 @@ def _steps(program: Program, result: dict) -> tuple[Step, ...]:
              "World rotation R_i, origin p_i and motion axis S_i of every body.",
              named("R") + named("o") + named("p") + named("z") + named("v")),
         Step("inertia", "Composite inertias",
-             "Mass m, first moment h and rotational inertia about the world origin of each subtree.",
+             "Mass m, first moment h and rotational inertia of each subtree about the first moving "
+             "joint's origin.",
              named("mc") + named("hc") + named("Ic")),
     ]
     if "M" in result:

@@ -21,6 +21,8 @@ exact so that structural zeros stay zeros) or an expression in the model's param
 from __future__ import annotations
 
 import enum
+from contextlib import contextmanager
+from contextvars import ContextVar
 import math
 import warnings
 from dataclasses import dataclass, field, replace
@@ -49,8 +51,58 @@ Mat3 = tuple[Vec3, Vec3, Vec3]
 
 #: Rotation entries read from floats that lie within this distance of 0 or ±1 are made exact,
 #: so that ``rpy="1.57079632679 0 0"`` keeps its structural zeros. The change to the model is
-#: below the precision such descriptions are written with.
+#: below the precision such descriptions are written with, but not below float64's: a model
+#: snapped this way differs from tools that keep the floats by up to this much (relative 1e-10
+#: in τ of the UR5). ``eomgen.load(path, snap=False)`` (``--no-snap``) keeps the floats; the
+#: entries that were snapped are listed in ``model.info`` under ``"snapped"`` (:class:`Snap`).
 SNAP_TOLERANCE = 1e-11
+
+
+@dataclass(frozen=True)
+class Snap:
+    """One entry made exact by snapping: ``what`` it is (``cos(1.5707963268)``, a joint's axis
+    component), the float ``value`` computed from the description and the ``target`` 0 or ±1
+    used instead."""
+
+    what: str
+    value: float
+    target: int
+
+    @property
+    def change(self) -> float:
+        return abs(self.value - self.target)
+
+
+_SNAP_ENABLED: ContextVar[bool] = ContextVar("eomgen_snap_enabled", default=True)
+_SNAP_RECORDS: ContextVar[list | None] = ContextVar("eomgen_snap_records", default=None)
+
+
+@contextmanager
+def snapping(enabled: bool = True):
+    """Within this block, rotation and axis entries are snapped (``enabled``) or kept exactly
+    as computed from the description's floats; yields the list of :class:`Snap` records made
+    inside the block."""
+    records: list[Snap] = []
+    enabled_token = _SNAP_ENABLED.set(enabled)
+    records_token = _SNAP_RECORDS.set(records)
+    try:
+        yield records
+    finally:
+        _SNAP_RECORDS.reset(records_token)
+        _SNAP_ENABLED.reset(enabled_token)
+
+
+def snap_summary(snaps) -> str:
+    """One line: how many entries were snapped, the largest change and where."""
+    if not snaps:
+        return "no rotation or axis entry snapped"
+    worst = max(snaps, key=lambda s: s.change)
+    kinds = sorted({s.what for s in snaps})
+    listed = ", ".join(kinds[:4]) + (f" and {len(kinds) - 4} more" if len(kinds) > 4 else "")
+    noun = "entry" if len(snaps) == 1 else "entries"
+    return (f"snapped {len(snaps)} rotation/axis {noun} within {SNAP_TOLERANCE:g} of 0 or ±1 "
+            f"to exact values (largest change {worst.change:.1e}, {worst.what}; from {listed}); "
+            "--no-snap keeps the description's floats")
 
 #: At most this many joints (and one more link) in a model: beyond, a symbolic derivation is
 #: out of reach anyway, and the checks stay linear in practice.
@@ -83,10 +135,14 @@ def scalar(value) -> sp.Expr:
     return sp.Float(value, 17)
 
 
-def _snap(value: float) -> sp.Expr:
-    for target in (0.0, 1.0, -1.0):
-        if abs(value - target) <= SNAP_TOLERANCE:
-            return sp.Integer(int(target))
+def _snap(value: float, what: str = "") -> sp.Expr:
+    if _SNAP_ENABLED.get():
+        for target in (0.0, 1.0, -1.0):
+            if abs(value - target) <= SNAP_TOLERANCE:
+                records = _SNAP_RECORDS.get()
+                if records is not None and value != target:
+                    records.append(Snap(what, value, int(target)))
+                return sp.Integer(int(target))
     return scalar(value)
 
 
@@ -123,7 +179,8 @@ def rotation_about_axis(axis: Vec3, angle) -> Mat3:
     if isinstance(angle, sp.Basic) and not angle.is_number:
         c, s = sp.cos(angle), sp.sin(angle)
     else:
-        c, s = _snap(math.cos(float(angle))), _snap(math.sin(float(angle)))
+        c = _snap(math.cos(float(angle)), f"cos({float(angle)!r})")
+        s = _snap(math.sin(float(angle)), f"sin({float(angle)!r})")
     x, y, z = axis
     t = 1 - c
     return mat3(
@@ -575,7 +632,7 @@ def check_axis(source: str, joint: str, axis: Vec3) -> Vec3:
         raise InvalidAxisError(source, f"joint '{joint}' axis", "axis is zero")
     if abs(norm - 1.0) < 1e-12:
         return axis
-    return vec3([_snap(v / norm) for v in values])
+    return vec3([_snap(v / norm, f"joint '{joint}' axis") for v in values])
 
 
 def _is_symbolic(inertial: Inertial) -> bool:

@@ -395,7 +395,8 @@ def _moot_notes(moot: Sequence[Notice]) -> list[str]:
     return notes
 
 
-def load_for_scene(path, scene: Scene | None = None, strict: bool = False) -> RobotModel:
+def load_for_scene(path, scene: Scene | None = None, strict: bool = False,
+                   snap: bool = True) -> RobotModel:
     """Read a description and warn (or, under ``strict``, refuse) only about what ``scene``
     keeps; without a scene, about everything, as :func:`eomgen.load` does.
 
@@ -412,6 +413,8 @@ def load_for_scene(path, scene: Scene | None = None, strict: bool = False) -> Ro
         The scene the caller will apply (:func:`eomgen.scene.load_scene`), or None.
     strict:
         Raise the first remaining finding's error (``--strict``) instead of warning.
+    snap:
+        As :func:`eomgen.load` (``False``: keep the description's floats exactly).
 
     Returns
     -------
@@ -427,8 +430,8 @@ def load_for_scene(path, scene: Scene | None = None, strict: bool = False) -> Ro
     from .parsers import load
 
     if scene is None:
-        return load(path, strict=strict)
-    model = load(path, strict=strict, defer_notices=True)
+        return load(path, strict=strict, snap=snap)
+    model = load(path, strict=strict, snap=snap, defer_notices=True)
     emit_notices(apply_scene(model, scene).model.notices, strict)
     return model
 

@@ -99,6 +99,11 @@ def test_every_route_agrees_with_the_reference(planar, tmp_path):
     assert {"NumPy, one state", "NumPy, batch", "NumPy float32, batch",
             "Python floats, one state", "CasADi SX, one state", "CasADi SX, map",
             "RNEA (eomgen.numeric)"} <= names
+    from eomgen.codegen.backends.casadi_backend import c_compiler
+    from eomgen.codegen.backends.fast_backend import python_headers
+
+    if c_compiler() and python_headers():
+        assert {"C extension (fast), one state", "C extension (fast), batch"} <= names
     reference = Reference(planar)
     rng = np.random.default_rng(0)
     q, qd, qdd = (rng.normal(size=(3, 2)) for _ in range(3))

@@ -17,6 +17,7 @@ import shutil
 import stat
 import subprocess
 import sys
+import sysconfig
 import warnings
 from pathlib import Path
 
@@ -29,6 +30,7 @@ from eomgen.cache import Cache, CacheRequest, cache_key, command_request, genera
 from eomgen.cli import main
 from eomgen.codegen import BACKENDS, Backend, GeneratedFile, available_backends
 from eomgen.codegen.backends.casadi_backend import c_compiler
+from eomgen.codegen.backends.fast_backend import python_headers
 from eomgen.codegen.generate import generate
 from eomgen.model import lock_joints
 
@@ -211,7 +213,10 @@ def test_library_key_covers_the_model_and_the_backends(arm, monkeypatch):
 
 def test_toolchain_is_the_c_backends_compiler():
     found = c_compiler()
-    assert cache.toolchain() == {"cc": shutil.which(found) if found else None}
+    assert cache.toolchain()["cc"] == (shutil.which(found) if found else None)
+    # the fast backend's extension is built for this Python's ABI, with its headers
+    assert cache.toolchain()["ext_suffix"] == sysconfig.get_config_var("EXT_SUFFIX")
+    assert cache.toolchain()["python_headers"] == (python_headers() is not None)
 
 
 def test_code_version_changes_with_the_code(monkeypatch):

@@ -31,6 +31,9 @@ import eomgen
 from eomgen import errors
 from eomgen.cli import main
 from eomgen.codegen.backends.casadi_backend import c_compiler
+from eomgen.codegen.backends.fast_backend import python_headers
+from eomgen.codegen.functions import parameter_arguments
+from eomgen.dynamics import derive
 
 CORPUS = Path(__file__).resolve().parent / "corpus"
 EXPECTED = yaml.safe_load((CORPUS / "expected.yaml").read_text(encoding="utf-8"))
@@ -165,11 +168,24 @@ def test_hostile_but_valid_files_generate_with_every_backend(name, tmp_path, cap
     written = {p.name: p for p in outdir.iterdir()}
     assert sorted(Path(line).name for line in result.stdout.splitlines()) == sorted(written)
     suffixes = sorted(p.name.removeprefix(p.name.split("_")[0]) for p in written.values())
-    assert len(written) == 5 + (c_compiler() is not None), suffixes
+    compiled = c_compiler() is not None and python_headers() is not None
+    # numpy, casadi, casadi .c/.h, fast .c, tex; the casadi .so and the fast module when compiled
+    assert len(written) == 6 + (c_compiler() is not None) + compiled, suffixes
     assert any(n.endswith(".tex") for n in written) and any(n.endswith(".c") for n in written)
     n = model.dof
     for file_name, file in written.items():
         assert file_name.isascii() and "/" not in file_name
+        if "_fast." in file_name and not file_name.endswith(".c"):  # the compiled fast module
+            stem = file_name.split(".")[0]
+            spec = importlib.util.spec_from_file_location(stem, file)
+            fast = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(fast)
+            assert fast.JOINT_NAMES == model.joint_names and fast.NQ == n
+            assert set(fast.PARAMETERS) == {p.identifier for p in parameter_arguments(
+                derive(model, outputs=("g",), simplify=False))}
+            M = fast.mass_matrix(np.linspace(-1, 1, n))
+            assert M.shape == (n, n) and np.all(np.isfinite(M)) and np.allclose(M, M.T)
+            continue
         if not file_name.endswith(".py"):
             continue
         source = file.read_text(encoding="utf-8")

@@ -84,7 +84,8 @@ def add_commands(main: click.Group, handle_errors, description_argument, strict_
 
         Routes: the generated NumPy module (one state, batch), the same program in float32 and
         over Python floats, the CasADi functions (SX, and the compiled C when a compiler is
-        found), eomgen's numeric Newton-Euler and Pinocchio when installed. Each evaluates
+        found), the fast C extension (one state, batch) when it compiles, eomgen's numeric
+        Newton-Euler and Pinocchio (plain pin.rnea and pin.crba calls) when installed. Each evaluates
         inverse dynamics and the mass matrix on sampled states; errors are against a 40-digit
         mpmath reference. Writes bench_<robot>.md, .csv and .png (speed against error, Pareto
         front marked) into OUTPUT.

@@ -21,9 +21,13 @@ C (CasADi), map            float64  the same, mapped over the batch
 C (ctypes), one state      float64  the same library's C functions called through ctypes
                                     (no CasADi call layer: the speed of the C code itself
                                     plus about a microsecond of ctypes overhead)
+C extension, one state     float64  the compiled ``<robot>_fast`` module (``--backend fast``)
+C extension, batch         float64  the same on the whole batch (the loop runs in C)
 RNEA (eomgen.numeric)      float64  :func:`eomgen.numeric.rnea` and ``mass_matrix_rnea``
-Pinocchio                  float64  ``pinocchio.rnea`` and ``pinocchio.crba`` on the model
-                                    built by :mod:`~eomgen.analysis.pinocchio_bridge`
+Pinocchio                  float64  plain ``pin.rnea(model, data, q, qd, qdd)`` and
+                                    ``pin.crba(model, data, q)`` on the model built by
+                                    :mod:`~eomgen.analysis.pinocchio_bridge` (the joint
+                                    reordering only where its order differs from eomgen's)
 =========================  =======  ====================================================
 
 The C routes exist when a C compiler is found, Pinocchio when it is installed. Only the
@@ -226,7 +230,7 @@ def build_routes(model: RobotModel, workdir: Path, dynamics: Dynamics | None = N
     skip = set(skip)
     job = make_job(dynamics, ("mass_matrix", "inverse_dynamics"))
     registry = available_backends()
-    chosen = ["numpy", "casadi"] + (["c"] if c_compiler() else [])
+    chosen = ["numpy", "casadi"] + (["c", "fast"] if c_compiler() else [])
     files = []
     for backend in chosen:
         progress(f"generating the {backend} code")
@@ -289,6 +293,18 @@ def build_routes(model: RobotModel, workdir: Path, dynamics: Dynamics | None = N
                             _per_state(lambda q: M_c(q).reshape(n, n), (n, n)),
                             "compiled <robot>_casadi.so called through ctypes"))
 
+    fast = [p for name, p in paths.items() if name.startswith(job.stem + "_fast.")
+            and not name.endswith(".c")]
+    if fast:
+        fast_module = _import(fast[0], job.stem + "_fast")
+        routes.append(Route("C extension (fast), one state", "float64", False,
+                            _per_state(fast_module.inverse_dynamics, (n,)),
+                            _per_state(fast_module.mass_matrix, (n, n)),
+                            "generated <robot>_fast module (--backend fast), called per state"))
+        routes.append(Route("C extension (fast), batch", "float64", True,
+                            fast_module.inverse_dynamics, fast_module.mass_matrix,
+                            "generated <robot>_fast module on the (N, n) batch (loop in C)"))
+
     nm = numeric_model(model)
     routes.append(Route("RNEA (eomgen.numeric)", "float64", False,
                         _per_state(lambda q, qd, qdd: rnea(nm, q, qd, qdd), (n,)),
@@ -301,9 +317,28 @@ def build_routes(model: RobotModel, workdir: Path, dynamics: Dynamics | None = N
     except ImportError:
         progress("Pinocchio is not installed: no Pinocchio route")
     else:
-        routes.append(Route("Pinocchio", "float64", False,
-                            _per_state(pm.rnea, (n,)), _per_state(pm.crba, (n, n)),
-                            "pinocchio.rnea and pinocchio.crba"))
+        routes.append(pinocchio_route(pm, n))
+    return [r for r in routes if r.name not in skip]
+
+
+def pinocchio_route(pm, n: int) -> Route:
+    """Pinocchio through its plain public calls, ``pin.rnea(model, data, q, qd, qdd)`` and
+    ``pin.crba(model, data, q)`` (which from Python returns the whole symmetric M), on arrays
+    already in Pinocchio's joint order. When that order is not eomgen's (a tree whose
+    description lists joints out of depth-first order), the reordering a user would need is
+    part of the route and its note says so."""
+    import pinocchio as pin
+
+    model, data = pm.model, pm.data
+    if np.array_equal(pm.perm, np.arange(n)):
+        return Route("Pinocchio", "float64", False,
+                     _per_state(lambda q, qd, qdd: pin.rnea(model, data, q, qd, qdd), (n,)),
+                     _per_state(lambda q: pin.crba(model, data, q), (n, n)),
+                     f"pinocchio {pin.__version__}: plain pin.rnea and pin.crba calls")
+    return Route("Pinocchio", "float64", False, _per_state(pm.rnea, (n,)),
+                 _per_state(pm.crba, (n, n)),
+                 f"pinocchio {pin.__version__}: pin.rnea and pin.crba with the joints "
+                 "reordered to eomgen's order (a conversion a user of this model needs)")
     return [r for r in routes if r.name not in skip]
 
 

@@ -14,7 +14,7 @@ from typing import Callable, Iterable, Sequence
 from ..dynamics import derive
 from ..cache import CacheRequest, render_cached
 from ..errors import GenerationError
-from ..model import RobotModel
+from ..model import RobotModel, snap_summary
 from ..output import write_atomically  # noqa: F401  (re-exported)
 from ..progress import plural
 from . import GeneratedFile, available_backends, make_job
@@ -71,6 +71,9 @@ def render_files(model: RobotModel, backends: Sequence[str], progress: Progress 
     """
     start = time.perf_counter()
     outputs = derived_outputs(functions)
+    snapped = dict(model.info).get("snapped")
+    if snapped:
+        progress(snap_summary(snapped))
     progress(f"deriving {', '.join(outputs)} of {model.name} ({plural(model.dof, 'joint')})")
     dynamics = derive(model, outputs=outputs, simplify=False)
     job = make_job(dynamics, functions, notes)

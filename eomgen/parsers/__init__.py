@@ -8,12 +8,12 @@ format touches no other module.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable
 
 from ..errors import TooLargeError, UnknownFormatError, UnreadableFileError
-from ..model import RobotModel
+from ..model import RobotModel, snapping
 
 #: ``load(path, strict, defer_notices=False)``.
 Loader = Callable[..., RobotModel]
@@ -44,7 +44,8 @@ def register(name: str, suffixes: tuple[str, ...], sniff: Callable[[str], bool] 
 MAX_FILE_BYTES = 50 * 1024 * 1024
 
 
-def load(path, strict: bool = False, defer_notices: bool = False) -> RobotModel:
+def load(path, strict: bool = False, defer_notices: bool = False,
+         snap: bool = True) -> RobotModel:
     """Read a robot description: URDF (``.urdf``), DH table (``.yaml`` with ``dh:``) or eomgen
     YAML (``.yaml`` with ``links:``/``joints:``).
 
@@ -60,6 +61,12 @@ def load(path, strict: bool = False, defer_notices: bool = False) -> RobotModel:
         Neither warn nor refuse yet: record these findings in the model's ``notices``
         (:class:`~eomgen.model.Notice`) for the caller to emit once it knows which still
         matter, e.g. after a scene (:func:`eomgen.reduction.load_for_scene`).
+    snap:
+        Make rotation and axis entries within :data:`~eomgen.model.SNAP_TOLERANCE` of 0 or ±1
+        exact (structural zeros, shorter code); ``False`` keeps the description's floats
+        exactly. The entries snapped are listed in ``model.info`` under ``"snapped"``
+        (:class:`~eomgen.model.Snap`: what, value, target; see
+        :func:`~eomgen.model.snap_summary`).
 
     Raises
     ------
@@ -96,4 +103,8 @@ def load(path, strict: bool = False, defer_notices: bool = False) -> RobotModel:
                 "cannot tell which format this is (" + " or ".join(f.name for f in candidates)
                 + "): a DH table needs a top-level 'dh' list, an eomgen robot 'links' and 'joints'")
         candidates = sniffed
-    return candidates[0].load(path, strict, defer_notices=defer_notices)
+    with snapping(snap) as snaps:
+        model = candidates[0].load(path, strict, defer_notices=defer_notices)
+    if snaps:
+        model = replace(model, info=model.info + (("snapped", tuple(snaps)),))
+    return model

@@ -4,12 +4,17 @@ This is the Lagrangian method, M = Σ_l J_lᵀ I_l J_l and c_ijk = ½(∂M_ij/�
 ∂M_jk/∂q_i), with the sums over links regrouped by subtree so that no expression grows with the
 number of links:
 
-* Every quantity is expressed in the **world (root link) frame**; spatial vectors are 6-vectors
-  ``[angular; linear]`` referred to the world origin. ``S_i`` is the motion axis of joint i
+* Every quantity is expressed in the **world (root link) frame**'s orientation; spatial vectors
+  are 6-vectors ``[angular; linear]`` referred to one fixed point on the robot, ``o``: the origin
+  of the first moving joint (a constant, since nothing before that joint moves). Positions
+  ``p_i`` are measured from ``o``. Referring to ``o`` rather than to the root origin keeps the
+  digits of a robot far from its root origin (a mobile base in a map frame): about the root
+  origin, a robot at distance d with links of size ℓ has inertias with terms m d² that cancel in
+  M and lose (d/ℓ)² relative; about ``o`` only link-sized offsets appear. ``S_i`` is the motion axis of joint i
   (``[z_i; p_i × z_i]`` for a revolute joint through ``p_i``, ``[0; z_i]`` for a prismatic one),
   so that the column i of the spatial Jacobian of any body after joint i is ``S_i``.
-* ``I^c_j`` is the spatial inertia of the subtree rooted at body j about the world origin, a
-  sum of the bodies' inertial parameters (m, h, Ī) moved to the world frame.
+* ``I^c_j`` is the spatial inertia of the subtree rooted at body j about ``o``, a sum of the
+  bodies' inertial parameters (m, h, Ī) moved to the world orientation and to ``o``.
 * ``F_j = I^c_j S_j`` (the momentum of the subtree for a unit rate of joint j), and
   ``M_ij = S_iᵀ F_j`` for i an ancestor of (or equal to) j; 0 when i and j lie on different
   branches.
@@ -20,7 +25,8 @@ number of links:
   - ``∂M_ij/∂q_k = −(S_k × S_i)ᵀ I^c_k S_j − (I^c_k S_i)ᵀ (S_k × S_j)``  for j ≺ k,
   - 0 otherwise (in particular for k ⪯ i: moving everything rigidly leaves M_ij unchanged).
 * ``g_i = ∂P/∂q_i = −g_vecᵀ f_i`` where ``f_i`` is the linear part of ``F_i`` and
-  ``P = −Σ m_l g_vecᵀ c_l`` (``g_vec`` the gravitational acceleration, e.g. (0, 0, −9.81)).
+  ``P = −Σ m_l g_vecᵀ c_l`` (``g_vec`` the gravitational acceleration, e.g. (0, 0, −9.81);
+  ``c_l`` from the root origin: P is the potential energy in the root frame).
 
 Units: SI (rad, m, kg, s). Sign convention: M q̈ + C q̇ + g = τ.
 """
@@ -66,7 +72,8 @@ def _rotation(axis: Vec3, c, s) -> tuple:
 
 @dataclass
 class SpatialInertia:
-    """Inertial parameters about the world origin: mass, first moment h, inertia Ī (3×3)."""
+    """Inertial parameters about the reference point o (world orientation): mass, first moment h,
+    inertia Ī (3×3)."""
 
     mass: sp.Expr
     h: tuple
@@ -110,20 +117,25 @@ class Kinematics:
     """World-frame kinematics of every body, as intermediates of a program."""
 
     R: list = field(default_factory=list)   # body rotation (3×3) in world
-    p: list = field(default_factory=list)   # body frame origin in world [m]
-    S: list = field(default_factory=list)   # joint motion axis, spatial, world origin
+    p: list = field(default_factory=list)   # body frame origin, from the point o [m]
+    S: list = field(default_factory=list)   # joint motion axis, spatial, about o
+    origin: tuple = (0, 0, 0)               # o: the reference point, from the root origin [m]
     sin_cos: list = field(default_factory=list)
 
 
 def forward_kinematics(tree: BodyTree, q, b: ProgramBuilder) -> Kinematics:
-    """World rotations ``R_i``, origins ``p_i`` and motion axes ``S_i`` of all bodies."""
-    kin = Kinematics()
+    """World rotations ``R_i``, origins ``p_i`` (from the reference point ``o``, the first moving
+    joint's origin) and motion axes ``S_i`` (about ``o``) of all bodies."""
+    roots = [body for body in tree.bodies if body.parent < 0]
+    origin = tuple(sp.sympify(x) for x in roots[0].placement.translation) if roots else (
+        sp.Integer(0),) * 3
+    kin = Kinematics(origin=origin)
     for i, body in enumerate(tree.bodies):
         n = body.q_index + 1
         joint = body.joint
         if body.parent < 0:
             R0 = body.placement.rotation
-            p0 = body.placement.translation
+            p0 = tuple(sp.sympify(x) - o for x, o in zip(body.placement.translation, origin))
         else:
             Rp, pp = kin.R[body.parent], kin.p[body.parent]
             R0 = tuple(b.define_all(row, f"A{n}_{r}") for r, row in
@@ -152,7 +164,7 @@ def forward_kinematics(tree: BodyTree, q, b: ProgramBuilder) -> Kinematics:
 
 
 def body_inertia_in_world(tree: BodyTree, kin: Kinematics, b: ProgramBuilder) -> list[SpatialInertia]:
-    """Each body's inertial parameters about the world origin, in world coordinates."""
+    """Each body's inertial parameters about the reference point ``o``, in world orientation."""
     out = []
     for i, body in enumerate(tree.bodies):
         n = body.q_index + 1
@@ -227,7 +239,9 @@ def derive_program(tree: BodyTree, q, qd, gravity: Vec3, outputs: set[str], b: P
         result["g"] = sp.Matrix([[0]] * n)
         for i in range(n):
             result["g"][idx[i], 0] = b.define(-_dot(gvec, F[i][3:]), f"g{idx[i] + 1}")
-        P_total = -_dot(gvec, comp_total_first_moment(tree, comp))
+        h_total = comp_total_first_moment(tree, comp)  # about o
+        mass = sp.Add(*[comp[i].mass for i, body in enumerate(tree.bodies) if body.parent < 0])
+        P_total = -_dot(gvec, tuple(h + mass * o for h, o in zip(h_total, kin.origin)))
         result["P"] = sp.Matrix([[b.define(P_total, "P")]])
     if "C" in outputs:
         result["C"] = _coriolis(tree, S, F, comp, qd, idx, b)

@@ -45,23 +45,23 @@ _NOTATION_NAMES = re.compile(
 #: The families of named subexpressions of eomgen's straight-line program (the name prefixes of
 #: :mod:`eomgen.symbolic.composite`) and what they are, in LaTeX, for the legend of large
 #: documents. Vectors and matrices are in world coordinates; spatial 6-vectors are
-#: [angular; linear] about the world origin.
+#: [angular; linear] about the reference point o, the first moving joint's origin.
 PROGRAM_NAMES = {
     "s": r"$\sin q_{i}$",
     "c": r"$\cos q_{i}$",
     "A": r"rotation of joint frame $i$ before the joint moves, entry $(r, c)$",
     "R": r"rotation of body $i$, entry $(r, c)$",
-    "o": r"origin of joint frame $i$",
+    "o": r"origin of joint frame $i$, from the first joint's origin $o$",
     "p": r"origin of body $i$ (moved by its prismatic joint)",
     "z": r"axis of joint $i$",
     "v": r"linear part $o_{i} \times z_{i}$ of the motion axis $S_{i}$ of joint $i$",
     "Rh": r"first moment of body $i$ in world axes",
-    "Iw": r"rotational inertia of body $i$ about the world origin, entry $(r, c)$",
-    "hw": r"first moment of body $i$ about the world origin",
+    "Iw": r"rotational inertia of body $i$ about the first joint's origin $o$, entry $(r, c)$",
+    "hw": r"first moment of body $i$ about the first joint's origin $o$",
     "mc": r"mass of the subtree of body $i$ (composite body)",
     "hc": r"first moment of composite body $i$",
-    "Ic": r"rotational inertia $I^{c}_{i}$ of composite body $i$ about the world origin, "
-          r"entry $(r, c)$",
+    "Ic": r"rotational inertia $I^{c}_{i}$ of composite body $i$ about the first joint's "
+          r"origin $o$, entry $(r, c)$",
     "F": r"momentum $F_{i} = I^{c}_{i} S_{i}$ of composite body $i$ for a unit rate of joint $i$",
     "M": r"entry $(i, j)$ of the mass matrix, $S_{i}^{T} F_{j}$",
     "g": r"entry $i$ of the gravity vector",

@@ -1,0 +1,208 @@
+"""Fast backend: ``<robot>_fast.c``, a CPython extension module in C, and where a C compiler and
+Python's headers are found, the compiled module ``<robot>_fast<EXT_SUFFIX>`` (e.g.
+``ur5_fast.cpython-311-x86_64-linux-gnu.so``) that ``import ur5_fast`` loads.
+
+The module exports the same names as the NumPy module (``JOINT_NAMES``, ``NQ``, ``PARAMETERS``,
+``mass_matrix``, ``coriolis_matrix``, ``gravity_vector``, ``inverse_dynamics``,
+``forward_dynamics``, ``IllConditionedWarning``), each function taking one state ``(NQ,)`` or a
+batch ``(N, NQ)`` and looping over the batch in C. It is the route for one state at a time
+from Python: a call costs the C arithmetic plus a few hundred nanoseconds of argument parsing
+and one NumPy array allocation (no CasADi call layer, no ctypes).
+
+Printer: SymPy's :class:`~sympy.printing.c.C99CodePrinter` with exact float literals and
+small integer powers written as products. Template: ``templates/fast/module.c.jinja``.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sysconfig
+import tempfile
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import sympy as sp
+from sympy.printing.c import C99CodePrinter
+from sympy.printing.precedence import PRECEDENCE
+
+from .. import GeneratedFile, Job, register
+from ..render import render
+from .casadi_backend import c_compiler
+
+
+#: parenthesize(x, _BARE) leaves only atoms (symbols, numbers) without parentheses
+_BARE = PRECEDENCE["Atom"] - 1
+
+
+class FastCPrinter(C99CodePrinter):
+    """C99 over doubles: floats with all 17 significant digits, ``x*x`` for small powers."""
+
+    def _print_Float(self, expr):
+        text = repr(float(expr))
+        return text if any(c in text for c in ".en") else text + ".0"
+
+    def _print_Rational(self, expr):
+        return f"({int(expr.p)}.0/{int(expr.q)}.0)"
+
+    def _print_Integer(self, expr):
+        return f"{int(expr)}.0"
+
+    def _print_Pow(self, expr):
+        base, exponent = expr.args
+        if exponent.is_Integer and 2 <= abs(int(exponent)) <= 4:
+            factor = self.parenthesize(base, _BARE)
+            product = "*".join([factor] * abs(int(exponent)))
+            return product if exponent > 0 else f"1.0/({product})"
+        if exponent == -1:
+            return f"1.0/{self.parenthesize(base, _BARE)}"
+        return super()._print_Pow(expr)
+
+
+def c_string_literal(text: str) -> str:
+    """A C string literal holding ``text`` in UTF-8; every byte outside printable ASCII, and
+    ``"``, ``\\`` and ``?`` (trigraphs), as a three-digit octal escape."""
+    out = []
+    for byte in str(text).encode("utf-8"):
+        char = chr(byte)
+        out.append(char if 32 <= byte < 127 and char not in '"\\?' else f"\\{byte:03o}")
+    return '"' + "".join(out) + '"'
+
+
+def c_comment(text: str) -> str:
+    """``text`` safe inside a C block comment (no ``*/``, ASCII only)."""
+    return str(text).replace("*/", "* /").encode("ascii", "backslashreplace").decode("ascii")
+
+
+@dataclass(frozen=True)
+class FastConfig:
+    """Options of the fast backend."""
+
+    template: str = "fast/module.c.jinja"
+    suffix: str = "_fast"
+    flags: tuple[str, ...] = ("-O2", "-fPIC", "-shared", "-fno-math-errno")
+
+
+def _render_source(job: Job, config: FastConfig) -> str:
+    n = job.model.dof
+    names: dict[sp.Symbol, sp.Symbol] = {}
+    for vector, symbols in (("q", job.dynamics.q), ("qd", job.dynamics.qd),
+                            ("qdd", job.dynamics.qdd)):
+        for k, symbol in enumerate(symbols):
+            names[symbol] = sp.Symbol(f"{vector}[{k}]", real=True)
+    for k, parameter in enumerate(job.parameters):
+        names[parameter.symbol] = sp.Symbol(f"p[{k}]", real=True)
+    printer = FastCPrinter()
+    functions = []
+    for spec in job.specs:
+        # intermediates become C locals named t_<name> (never a C keyword nor q, p, out)
+        local = {symbol: sp.Symbol("t_" + symbol.name, real=True)
+                 for symbol, _ in spec.program.assignments}
+        rename = {**names, **local}
+
+        def doprint(expr: sp.Expr) -> str:
+            return printer.doprint(expr.xreplace(rename))
+
+        rows, cols = spec.output.shape
+        entries = [(r * cols + c, doprint(spec.output[r, c]))
+                   for r in range(rows) for c in range(cols) if spec.output[r, c] != 0]
+        functions.append(dict(
+            name=spec.name, summary=spec.summary, inputs=[a.name for a in spec.arguments],
+            rows=rows, cols=0 if spec.is_vector else cols, size=rows * cols,
+            assignments=[(local[s].name, doprint(e)) for s, e in spec.program.assignments],
+            entries=entries, operation_count=spec.operation_count, units=spec.units))
+    # the docstrings open with a text signature (inspect.signature reads it)
+    signature = "".join(", " + p.identifier
+                        + ("" if p.default is None else f"={float(p.default)!r}")
+                        for p in job.parameters)
+    for f in functions:
+        shape = f"({f['rows']}, {f['cols']})" if f["cols"] else f"({f['rows']},)"
+        keywords = ", *" + signature if signature else ""
+        f["doc"] = c_string_literal(
+            f"{f['name']}({', '.join(f['inputs'])}{keywords})\n--\n\n"
+            f"{f['summary']}\n\nInputs of shape (NQ,) or (N, NQ) in JOINT_NAMES order; returns "
+            f"shape {shape} or (N,) + that, in {f['units']}. {f['operation_count']} arithmetic "
+            "operations per state.")
+    forward_doc = c_string_literal(
+        f"forward_dynamics(q, qd, tau, *{signature}, return_condition=False)\n--\n\n"
+        "Joint accelerations qdd solving M(q) qdd = tau - (C(q, qd) qd + g(q)) by Cholesky.\n\n"
+        "Warns IllConditionedWarning when (max L_ii / min L_ii)^2, a lower bound of cond(M), "
+        "exceeds 1e-6 / eps; return_condition=True also returns that estimate. Raises "
+        "numpy.linalg.LinAlgError when M is not positive definite and FloatingPointError when "
+        "M, C qd + g or tau is not finite.")
+    parameters = [dict(name=c_string_literal(p.identifier),
+                       default=("NAN" if p.default is None
+                                else printer.doprint(sp.Float(p.default))),
+                       has_default=int(p.default is not None),
+                       doc=c_comment(p.doc))
+                  for p in job.parameters]
+    module = job.stem + config.suffix
+    return render(
+        config.template,
+        header=[c_comment(line) for line in job.header_lines(config.template)],
+        robot=c_comment(job.model.name),
+        module=module,
+        module_literal=c_string_literal(module),
+        nq=n,
+        joint_names=[c_string_literal(name) for name in job.dynamics.joint_names],
+        parameters=parameters,
+        functions=functions,
+        exports=list(job.functions) + (["IllConditionedWarning"]
+                                       if "forward_dynamics" in job.functions else []),
+        forward_doc=forward_doc,
+        forward_dynamics="forward_dynamics" in job.functions,
+    )
+
+
+def python_headers() -> tuple[str, ...] | None:
+    """Include folders for Python's and NumPy's C headers, or None when ``Python.h`` is
+    missing (a Python built without its development files)."""
+    import numpy
+
+    include = sysconfig.get_paths().get("include")
+    if not include or not Path(include, "Python.h").is_file():
+        return None
+    return include, numpy.get_include()
+
+
+def compile_module(source: str, module: str, config: FastConfig = FastConfig()
+                   ) -> bytes | str:
+    """Compile the extension ``module`` from ``source``: the shared library's bytes, or a
+    one-line reason why it was not built (no C compiler, no Python headers)."""
+    compiler = c_compiler()
+    if compiler is None:
+        return "no C compiler found (set CC)"
+    headers = python_headers()
+    if headers is None:
+        return "Python's C headers (Python.h) are not installed"
+    suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
+    with tempfile.TemporaryDirectory() as tmp:
+        c_path = Path(tmp, module + ".c")
+        c_path.write_text(source, encoding="utf-8")
+        library = Path(tmp, module + suffix)
+        command = [compiler, *config.flags, *(f"-I{h}" for h in headers), "-o", str(library),
+                   str(c_path), "-lm"]
+        result = subprocess.run(command, capture_output=True, text=True)
+        if result.returncode != 0:
+            raise RuntimeError(f"compiling {module}.c failed: {result.stderr.strip()[:800]}")
+        return library.read_bytes()
+
+
+@register("fast", "C extension module for Python (one state or a batch looped in C), "
+          "compiled when a C compiler is found")
+def generate_fast(job: Job, config: FastConfig = FastConfig()) -> list[GeneratedFile]:
+    module = job.stem + config.suffix
+    source = _render_source(job, config)
+    files = [GeneratedFile(module + ".c", source)]
+    built = compile_module(source, module, config)
+    if isinstance(built, bytes):
+        suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
+        files.append(GeneratedFile(module + suffix, built, golden=False))
+    else:
+        warnings.warn(f"fast backend: {built}; wrote {module}.c only, not the compiled module",
+                      RuntimeWarning, stacklevel=2)
+    return files
+
+
+__all__ = ["FastCPrinter", "FastConfig", "generate_fast", "compile_module", "c_string_literal",
+           "python_headers"]
