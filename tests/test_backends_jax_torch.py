@@ -281,3 +281,36 @@ def test_forward_dynamics_singular_and_ill_conditioned(robot):
     bad[1, 0] = np.inf
     with pytest.raises(FloatingPointError, match="not finite at state 1"):
         modules.torch.forward_dynamics(*(torch.from_numpy(a) for a in (q, qd, bad)))
+
+
+def test_hostile_names_stay_text_and_the_modules_run():
+    """Robot and joint names that try to break out of strings stay text; the modules import
+    and agree with the NumPy module (imports only of the module's own framework)."""
+    import ast
+
+    from eomgen.codegen.generate import render_files
+    from test_codegen import DOCSTRING_BREAKER, HOSTILE, hostile_star
+
+    files = {f.name: f.content for f in render_files(hostile_star(DOCSTRING_BREAKER),
+                                                     ["numpy", "jax", "torch"])}
+    assert len(files) == 3
+    modules = {}
+    for name, content in files.items():
+        tree = ast.parse(content)
+        assert repr(DOCSTRING_BREAKER) in ast.get_docstring(tree)
+        imports = sorted(alias.name for node in ast.walk(tree)
+                         if isinstance(node, (ast.Import, ast.ImportFrom))
+                         for alias in node.names)
+        kind = name.rsplit("_", 1)[1][:-3]
+        assert set(imports) <= {"numpy", "warnings", "jax.numpy", "cho_solve", "torch"}
+        assert ("jax.numpy" in imports) == (kind == "jax")
+        assert ("torch" in imports) == (kind == "torch")
+        namespace: dict = {}
+        exec(compile(content, name, "exec"), namespace)  # noqa: S102 - our generated code
+        assert namespace["JOINT_NAMES"] == HOSTILE
+        modules[kind] = namespace
+    q, qd, qdd = states(len(HOSTILE), seed=8)
+    expected = modules["numpy"]["inverse_dynamics"](q, qd, qdd)
+    assert_relative(modules["jax"]["inverse_dynamics"](q, qd, qdd), expected)
+    assert_relative(modules["torch"]["inverse_dynamics"](
+        *(torch.from_numpy(a) for a in (q, qd, qdd))), expected)
