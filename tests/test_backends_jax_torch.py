@@ -314,3 +314,32 @@ def test_hostile_names_stay_text_and_the_modules_run():
     assert_relative(modules["jax"]["inverse_dynamics"](q, qd, qdd), expected)
     assert_relative(modules["torch"]["inverse_dynamics"](
         *(torch.from_numpy(a) for a in (q, qd, qdd))), expected)
+
+
+def test_parameters_named_like_the_frameworks_do_not_shadow_them(tmp_path):
+    """Parameters named ``torch``, ``jnp`` and ``jax`` become ``torch_``, ... keywords; the
+    modules still reach their framework and the keywords' defaults are the description's."""
+    import sympy as sp
+
+    from eomgen.model import (Inertial, Joint, JointType, Link, Parameter, Transform,
+                              build_model, vec3)
+
+    mass, length, gravity = (sp.Symbol(name, real=True) for name in ("torch", "jnp", "jax"))
+    body = Inertial(mass, [length, 0, 0], [[0.01, 0, 0], [0, 0.01, 0], [0, 0, 0.01]])
+    model = build_model("<test>", "shadowing", [Link("base"), Link("l1", body)],
+                        [Joint("j1", JointType.REVOLUTE, "base", "l1", Transform(),
+                               vec3([0, 0, 1]))],
+                        parameters=[Parameter(mass, 1.5), Parameter(length, 0.3),
+                                    Parameter(gravity, 2.0)], gravity=(0.0, -gravity, 0.0))
+    paths = generate(model, tmp_path, "numpy,jax,torch", cache=False)
+    numpy_module, jax_module, torch_module = (
+        load_module(p, f"shadowing_{p.stem}") for p in sorted(paths, key=lambda p: (
+            not p.name.endswith("_numpy.py"), not p.name.endswith("_jax.py"))))
+    assert list(torch_module.PARAMETERS) == ["jax_", "jnp_", "torch_"]
+    q = np.array([[0.4], [1.1]])
+    expected = numpy_module.gravity_vector(q)
+    assert np.all(np.abs(expected) > 0)
+    assert_relative(jax_module.gravity_vector(q), expected)
+    assert_relative(torch_module.gravity_vector(torch.from_numpy(q)), expected)
+    assert_relative(torch_module.gravity_vector(torch.from_numpy(q), torch_=3.0),
+                    numpy_module.gravity_vector(q, torch_=3.0))
