@@ -245,7 +245,7 @@ def verify(description, samples, seed, tolerance, scene_path, quiet, strict):
 @main.command()
 @description_argument
 @click.option("--backend", "backends", default="all", show_default=True,
-              help="Comma-separated backends among numpy, casadi, c, fast, latex; or all.")
+              help="Comma-separated backends among numpy, casadi, c, fast, latex, jax, torch; or all.")
 @output_folder_option("eomgen_output")
 @click.option("--symbolic", default=None,
               help="Comma-separated parameters to keep symbolic (default: all the description "

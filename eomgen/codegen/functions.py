@@ -68,7 +68,8 @@ class FunctionSpec:
 
 #: Identifiers every generated module uses itself; parameters and intermediates avoid them.
 RESERVED_IDENTIFIERS = frozenset(
-    {"np", "ca", "casadi", "math", "q", "qd", "qdd", "tau", "out", "single", "batch", "n",
+    {"np", "ca", "casadi", "math", "jnp", "jax", "torch", "q", "qd", "qdd", "tau", "out",
+     "single", "batch", "n",
      "JOINT_NAMES", "NQ", "PARAMETERS", "mass_matrix", "coriolis_matrix", "gravity_vector",
      "inverse_dynamics", "forward_dynamics", "self", "cls", "M", "C", "g", "L", "x", "y", "d",
      "rhs", "bias", "args", "names", "vectors", "functions", "parameters", "q_columns",

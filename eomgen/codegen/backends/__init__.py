@@ -3,7 +3,8 @@
 from importlib import import_module
 
 #: Modules that register a backend when imported.
-BACKEND_MODULES = ("numpy_backend", "casadi_backend", "fast_backend", "latex_backend")
+BACKEND_MODULES = ("numpy_backend", "casadi_backend", "fast_backend", "latex_backend",
+                   "jax_backend", "torch_backend")
 
 for _name in BACKEND_MODULES:
     try:

@@ -1,0 +1,92 @@
+"""Batches larger than one machine's memory: any generated function over a ``dask.array``.
+
+:func:`dask_map` turns a generated function (``inverse_dynamics`` of a NumPy module, or a JAX
+function, jitted or not) and state arrays of shape ``(N, NQ)`` into a lazy ``dask.array`` of
+its results, evaluated chunk by chunk of states by whatever dask scheduler is active: threads,
+processes, or a ``distributed`` cluster. Needs the ``dask`` extra (``pip install
+eomgen[dask]``); nothing here imports dask until it is called.
+
+Workers of a ``distributed`` cluster in other processes import the generated module by name:
+upload it first with ``client.upload_file("ur5_numpy.py")`` (or install it where they run).
+See ``docs/backends.md``.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+__all__ = ["dask_map"]
+
+_AXES = "abcdefgh"  # names of the output's per-state axes in dask's blockwise notation
+
+
+def dask_map(function: Callable, *states, chunks: int = 100_000, **parameters):
+    """``function(*states, **parameters)`` over a batch of states, chunk by chunk, lazily.
+
+    Parameters
+    ----------
+    function : callable
+        A generated function taking state arrays of shape ``(N, NQ)`` and returning an array of
+        shape ``(N,) + S`` (``S = (NQ,)`` for vectors, ``(NQ, NQ)`` for matrices), e.g.
+        ``ur5_numpy.inverse_dynamics``, or a JAX one (its results are copied back to NumPy).
+    *states : array or dask.array, shape (N, NQ)
+        The function's state arguments (q, qd, ...), in JOINT_NAMES order. NumPy arrays are
+        split into chunks of ``chunks`` states; dask arrays are rechunked to the first one's
+        chunks of states, with all joints of a state in one chunk.
+    chunks : int
+        States per chunk when the first state argument is not a dask array already.
+    **parameters : float or array of shape (N,)
+        The module's parameter keywords; arrays of shape (N,) go chunk by chunk with their
+        states. Parameters left out take the module's defaults (the description's values).
+
+    Returns
+    -------
+    dask.array.Array, shape (N,) + S, float64
+        Lazy: call ``.compute()``, or store it chunk by chunk (``dask.array.to_zarr``, ...).
+
+    Raises
+    ------
+    ValueError
+        When no state is given, or the states are not 2-D arrays of the same number of states.
+    ImportError
+        When dask is not installed.
+    """
+    try:
+        import dask.array as da
+    except ImportError as exc:  # pragma: no cover - depends on the environment
+        raise ImportError("eomgen.batch.dask_map needs dask: pip install 'eomgen[dask]'") from exc
+    if not states:
+        raise ValueError("dask_map: give at least one state array (q, ...)")
+    arrays = [x if isinstance(x, da.Array) else da.from_array(np.asarray(x, dtype=float),
+                                                             chunks=(chunks, -1))
+              for x in states]
+    if any(x.ndim != 2 for x in arrays) or len({x.shape for x in arrays}) != 1:
+        raise ValueError("dask_map: the states must be arrays of one shape (N, NQ), got "
+                         + ", ".join(str(x.shape) for x in arrays))
+    rows = arrays[0].chunks[0]
+    arrays = [x.rechunk((rows, -1)) for x in arrays]
+    per_state = {name: value for name, value in parameters.items() if np.ndim(value) == 1}
+    fixed = {name: value for name, value in parameters.items() if name not in per_state}
+    for name, value in per_state.items():
+        if len(value) != arrays[0].shape[0]:
+            raise ValueError(f"dask_map: parameter {name} has {len(value)} values for "
+                             f"{arrays[0].shape[0]} states")
+    columns = [da.asarray(value).rechunk((rows,)) for value in per_state.values()]
+    # The shape of one state's result, from the first state (a tiny computation).
+    first = function(*(np.asarray(x[:1]) for x in arrays), **fixed,
+                     **{name: np.asarray(c[:1]) for name, c in zip(per_state, columns)})
+    shape = np.shape(first)[1:]
+    axes = _AXES[:len(shape)]
+    names = list(per_state)
+
+    def evaluate(*blocks):
+        block_states, block_parameters = blocks[:len(arrays)], blocks[len(arrays):]
+        return np.asarray(function(*block_states, **fixed,
+                                   **dict(zip(names, block_parameters))), dtype=float)
+
+    pairs = [item for x in arrays for item in (x, "iz")]
+    pairs += [item for c in columns for item in (c, "i")]
+    return da.blockwise(evaluate, "i" + axes, *pairs, dtype=float, concatenate=True,
+                        new_axes=dict(zip(axes, shape)), meta=np.empty((0,) * (1 + len(shape))))

@@ -1,0 +1,86 @@
+"""eomgen.batch.dask_map: generated functions over dask arrays, on a distributed.LocalCluster of
+worker processes, equal to the NumPy module on the whole batch (the ``dask`` extra)."""
+
+from __future__ import annotations
+
+import importlib
+import sys
+
+import numpy as np
+import pytest
+
+import eomgen
+from eomgen.batch import dask_map
+from eomgen.codegen.generate import generate
+
+da = pytest.importorskip("dask.array", reason="dask_map needs dask: pip install 'eomgen[dask]'")
+
+
+@pytest.fixture(scope="module")
+def planar(tmp_path_factory):
+    """The planar arm's NumPy module, importable by name (workers import it by name too)."""
+    outdir = tmp_path_factory.mktemp("planar")
+    generate(eomgen.load(eomgen.example_path("planar_2link")), outdir, "numpy,jax", cache=False)
+    sys.path.insert(0, str(outdir))
+    try:
+        yield outdir, importlib.import_module("planar_2link_numpy")
+    finally:
+        sys.path.remove(str(outdir))
+        sys.modules.pop("planar_2link_numpy", None)
+
+
+def batch(count: int, seed: int = 0):
+    rng = np.random.default_rng(seed)
+    return [rng.uniform(-np.pi, np.pi, (count, 2)) for _ in range(3)]
+
+
+def test_dask_map_on_a_local_cluster_equals_the_numpy_batch(planar):
+    distributed = pytest.importorskip("distributed", reason="needs eomgen[dask] (distributed)")
+    outdir, module = planar
+    q, qd, qdd = batch(1001)
+    masses = np.linspace(0.5, 1.5, len(q))
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        client.upload_file(str(outdir / "planar_2link_numpy.py"))
+        for function, args in ((module.mass_matrix, (q,)), (module.coriolis_matrix, (q, qd)),
+                               (module.gravity_vector, (q,)),
+                               (module.inverse_dynamics, (q, qd, qdd)),
+                               (module.forward_dynamics, (q, qd, qdd))):
+            lazy = dask_map(function, *args, chunks=300, m2=masses, g_=3.7)
+            assert lazy.chunks[0] == (300, 300, 300, 101)
+            expected = function(*args, m2=masses, g_=3.7)
+            assert lazy.shape == expected.shape
+            with distributed.get_task_stream(client) as stream:
+                np.testing.assert_array_equal(lazy.compute(), expected)
+            # the chunks ran on the cluster's worker processes
+            workers = {task["worker"] for task in stream.data if task["key"][0] == lazy.name}
+            assert len([t for t in stream.data if t["key"][0] == lazy.name]) == 4
+            assert workers <= set(cluster.workers[k].worker_address for k in cluster.workers)
+
+
+def test_dask_map_takes_dask_inputs_and_jax_functions(planar):
+    jax = pytest.importorskip("jax", reason="needs eomgen[jax]")
+    jax.config.update("jax_enable_x64", True)
+    outdir, module = planar
+    spec = importlib.util.spec_from_file_location("planar_2link_jax_batch",
+                                                  outdir / "planar_2link_jax.py")
+    jax_module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(jax_module)
+    q, qd, qdd = batch(500, seed=1)
+    lazy_q = da.from_array(q, chunks=(128, 1))  # joints split too: dask_map joins them
+    lazy = dask_map(jax.jit(jax_module.inverse_dynamics), lazy_q, qd, qdd)
+    assert lazy.chunks[0] == (128, 128, 128, 116)
+    np.testing.assert_allclose(lazy.compute(scheduler="threads"),
+                               module.inverse_dynamics(q, qd, qdd), rtol=1e-12, atol=1e-12)
+
+
+def test_dask_map_rejects_mismatched_inputs(planar):
+    _, module = planar
+    q, qd, _ = batch(10)
+    with pytest.raises(ValueError, match=r"one shape \(N, NQ\), got \(10, 2\), \(9, 2\)"):
+        dask_map(module.coriolis_matrix, q, qd[:9])
+    with pytest.raises(ValueError, match="parameter m2 has 3 values for 10 states"):
+        dask_map(module.gravity_vector, q, m2=np.ones(3))
+    with pytest.raises(ValueError, match="at least one state"):
+        dask_map(module.gravity_vector)
