@@ -34,13 +34,35 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Mapping
+from typing import Callable, Mapping
 
 import numpy as np
 
 from .model import RobotModel
 
 POINT, SURFACE = "point", "surface"
+
+#: ``constrained_forward_dynamics`` without damping refuses a contact Jacobian whose smallest
+#: singular value is below this fraction of its largest.
+RANK_TOLERANCE = 1e-10
+
+
+def derived_mass_and_bias(model: RobotModel) -> Callable:
+    """``(q, qd) -> (M, h = C q̇ + g)`` from :func:`eomgen.derive`'s program, evaluated in
+    Python floats (parameters at their default values); for :class:`ContactDynamics`."""
+    from .dynamics import derive
+    from .symbolic.evaluate import compile_program
+
+    dyn = derive(model, outputs=("M", "C", "g"))
+    params = tuple(p.symbol for p in model.parameters)
+    values = tuple(float(model.parameter_values[s]) for s in params)
+    f = compile_program(dyn.program, dyn.q + dyn.qd + params)
+
+    def mass_and_bias(q, qd):
+        out = f(*map(float, q), *map(float, qd), *values)
+        return out["M"], out["C"] @ np.asarray(qd, dtype=float) + out["g"].reshape(-1)
+
+    return mass_and_bias
 
 
 @dataclass(frozen=True)
@@ -65,11 +87,26 @@ class Contact:
 
 @dataclass(frozen=True)
 class ContactDynamics:
-    """Contact dynamics of ``model`` with ``contacts`` (see the module docstring)."""
+    """Contact dynamics of ``model`` with ``contacts`` (see the module docstring).
+
+    Attributes
+    ----------
+    model:
+        The robot (a floating one from :func:`eomgen.floating.add_floating_base`, or not).
+    contacts:
+        The contacts, in the order of the rows of ``J_c`` and of ``F_c``.
+    anchors:
+        ``{frame: world position}`` for the ``kp`` term of point contacts.
+    mass_and_bias:
+        A function ``(q, qd) -> (M, h)`` with ``h = C q̇ + g``; None for eomgen's numeric
+        Newton–Euler (:mod:`eomgen.numeric`, n + 2 passes). :func:`derived_mass_and_bias`
+        gives the derived program's, faster for repeated calls.
+    """
 
     model: RobotModel
     contacts: tuple[Contact, ...]
     anchors: Mapping[str, np.ndarray] = field(default_factory=dict)
+    mass_and_bias: Callable | None = None
 
     @cached_property
     def _numeric(self):
@@ -123,6 +160,8 @@ class ContactDynamics:
         return self._rows(q, np.asarray(qd, dtype=float))[1]
 
     def _mh(self, q, qd):
+        if self.mass_and_bias is not None:
+            return self.mass_and_bias(q, qd)
         from .numeric import coriolis_times_qd, gravity_torques, mass_matrix_rnea
 
         nm = self._numeric
@@ -133,13 +172,25 @@ class ContactDynamics:
                                      ) -> tuple[np.ndarray, np.ndarray]:
         """``(q̈, F_c)`` [(n,), (m,)] holding every contact (module docstring).
 
-        ``damping = 0`` solves the KKT system exactly (``LinAlgError`` for redundant
-        contacts, whose forces are not unique); ``damping > 0`` the damped system.
+        ``damping = 0`` solves the KKT system exactly; ``damping > 0`` the damped system.
+
+        Raises
+        ------
+        numpy.linalg.LinAlgError
+            With ``damping = 0``, when ``J_c`` has dependent rows (redundant contacts, or a
+            direction no joint can move the frame in, as out of a planar arm's plane): the
+            forces are then not unique; use ``damping > 0``.
         """
         q, qd, tau = (np.asarray(x, dtype=float) for x in (q, qd, tau))
         M, h = self._mh(q, qd)
         J, bias, gamma = self._rows(q, qd)
         n, m = len(q), len(bias)
+        if damping <= 0 and m:
+            sv = np.linalg.svd(J, compute_uv=False)
+            if len(sv) < m or sv.min() <= RANK_TOLERANCE * sv.max():
+                raise np.linalg.LinAlgError(
+                    f"the contact Jacobian ({m}×{n}) has dependent rows (smallest singular "
+                    f"value {sv.min():.3g}): the contact forces are not unique; use damping > 0")
         if damping > 0:
             Minv_J = np.linalg.solve(M, J.T)
             free = np.linalg.solve(M, tau - h)
@@ -179,4 +230,5 @@ class ContactDynamics:
         return out
 
 
-__all__ = ["POINT", "SURFACE", "Contact", "ContactDynamics"]
+__all__ = ["POINT", "SURFACE", "RANK_TOLERANCE", "Contact", "ContactDynamics",
+           "derived_mass_and_bias"]
