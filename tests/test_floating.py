@@ -15,6 +15,7 @@ import pytest
 import eomgen
 from conftest import erd_robots_dir
 from eomgen import floating, numeric
+from eomgen.floating import PinocchioFreeFlyer as FreeFlyerReference
 from eomgen.errors import InvalidInertiaError, KinematicTreeError, SceneError
 from eomgen.model import Inertial, Joint, JointType, Link, build_model, vec3
 from eomgen.reduction import apply_scene
@@ -29,45 +30,6 @@ def _quiet_load(path):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return eomgen.load(path)
-
-
-class FreeFlyerReference:
-    """Pinocchio's free-flyer model of a URDF, evaluated in eomgen's Euler coordinates and
-    joint order (``joint_names``: the floating model's, virtual joints first)."""
-
-    def __init__(self, urdf, joint_names, locked=()):
-        import pinocchio as pin
-
-        self.pin = pin
-        model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
-        if locked:
-            ids = [model.getJointId(name) for name in locked]
-            model = pin.buildReducedModel(model, ids, pin.neutral(model))
-        self.model, self.data = model, model.createData()
-        names = list(model.names)[2:]  # after 'universe' and the free flyer
-        assert sorted(names) == sorted(joint_names[6:])
-        # Pinocchio coordinate k (after the base) is eomgen's joint index perm[k]
-        self.idx = np.array(list(range(6)) + [joint_names.index(n) for n in names])
-
-    def state(self, q, qd):
-        q_ff, v = floating.to_free_flyer(q, qd)
-        q_pin = np.concatenate([q_ff[:7], q[self.idx[6:]]])
-        return q_pin, v[self.idx]
-
-    def dynamics(self, q, qd):
-        """M, C q̇, g in Euler coordinates, eomgen's order."""
-        pin = self.pin
-        q_pin, v = self.state(q, qd)
-        n = len(q)
-        M = pin.crba(self.model, self.data, q_pin)
-        M = np.triu(M) + np.triu(M, 1).T
-        g = pin.computeGeneralizedGravity(self.model, self.data, q_pin)
-        h = pin.rnea(self.model, self.data, q_pin, v, np.zeros(n)) - g
-        M_o = np.empty((n, n))
-        M_o[np.ix_(self.idx, self.idx)] = M
-        h_o, g_o = np.empty(n), np.empty(n)
-        h_o[self.idx], g_o[self.idx] = h, g
-        return floating.dynamics_from_free_flyer(q, qd, M_o, h_o, g_o)
 
 
 def relative(a, b) -> float:
