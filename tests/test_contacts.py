@@ -267,3 +267,19 @@ def test_documented_contact_errors_are_what_eomgen_prints(solo):
     assert printed == documented
     for line in printed:
         assert "\n" not in line
+
+
+def test_cli_refuses_a_bad_contact_with_one_line_and_exit_code_2(solo, tmp_path):
+    import subprocess
+    import sys
+
+    path, _ = solo
+    scene = tmp_path / "solo_scene.yaml"
+    scene.write_text("version: 1\nfloating_base: true\ncontacts: [{frame: FL_FOOT, mu: -0.5}]\n")
+    result = subprocess.run([sys.executable, "-m", "eomgen.cli", "generate", str(path),
+                             "--scene", str(scene), "-o", str(tmp_path / "out")],
+                            capture_output=True, text=True, timeout=300)
+    assert result.returncode == 2
+    assert result.stderr.strip() == (f"eomgen: error: {scene}: contacts[0] 'FL_FOOT' mu: "
+                                     "friction coefficient -0.5 is negative (μ ≥ 0)")
+    assert not (tmp_path / "out").exists()
