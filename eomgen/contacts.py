@@ -79,6 +79,17 @@ class Contact:
     normal: tuple[float, float, float] = (0.0, 0.0, 1.0)
     name: str = ""
 
+    def __post_init__(self):
+        if self.kind not in (POINT, SURFACE):
+            raise ValueError(f"contact '{self.name or self.frame}': kind must be 'point' or "
+                             f"'surface', got {self.kind!r}")
+        if self.mu is not None and not self.mu >= 0:
+            raise ValueError(f"contact '{self.name or self.frame}': friction coefficient "
+                             f"{self.mu} is negative (μ ≥ 0)")
+        if not (self.kp >= 0 and self.kd >= 0):
+            raise ValueError(f"contact '{self.name or self.frame}': Baumgarte gains must be "
+                             "non-negative")
+
     @property
     def size(self) -> int:
         """Rows of the contact in ``J_c``: 3 (point) or 6 (surface)."""

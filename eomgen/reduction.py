@@ -359,6 +359,11 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
                                                  "along the normal" else ""))
     reduced, world = _reroot(reduced)
     reduced = _keep_contact_frames(locked_model, reduced, scene, set(dropped))
+    if scene.contacts:
+        notes.append("contacts (eomgen.contacts.ContactDynamics; not generated as code yet): "
+                     + ", ".join(f"{c.name} on '{c.frame}' ({c.kind}"
+                                 + (f", μ = {c.mu:g}" if c.mu is not None else "") + ")"
+                                 for c in scene.contacts))
     used = reduced.free_symbols
     unused = [p.name for p in reduced.parameters if p.symbol not in used]
     if unused:

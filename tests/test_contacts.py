@@ -228,6 +228,26 @@ def test_baumgarte_velocity_gain_damps_a_drifting_contact(solo):
     assert np.allclose(J @ qdd + cd.contact_bias(q, qd), -10.0 * J @ qd, atol=1e-8)
 
 
+def test_baumgarte_position_gain_pulls_a_point_contact_to_its_anchor(solo):
+    _, model = solo
+    q, qd = next(random_states(18, 1, seed=26))
+    anchor = np.array([0.1, -0.2, 0.0])
+    cd = ContactDynamics(model, (Contact("FL_FOOT", kp=25.0, kd=10.0),),
+                         anchors={"FL_FOOT": anchor})
+    qdd, _ = cd.constrained_forward_dynamics(q, qd, np.zeros(18))
+    J = cd.contact_jacobian(q)
+    error = cd._kinematics(q, qd)["FL_FOOT"]["p"] - anchor
+    assert np.allclose(J @ qdd + cd.contact_bias(q, qd), -10.0 * J @ qd - 25.0 * error,
+                       atol=1e-8)
+
+
+def test_contacts_made_in_python_are_checked():
+    for kwargs, match in (({"kind": "line"}, "kind"), ({"mu": -0.1}, "negative"),
+                          ({"kd": -1.0}, "non-negative")):
+        with pytest.raises(ValueError, match=match):
+            Contact("FL_FOOT", **kwargs)
+
+
 def test_scene_contacts_through_apply_scene(solo):
     path, model = solo
     robot = _quiet_load(path)
@@ -236,6 +256,7 @@ def test_scene_contacts_through_apply_scene(solo):
     reduced, report = apply_scene(robot, scene)
     assert reduced.joint_names == model.joint_names
     assert [c.frame for c in report.contacts] == list(FEET)
+    assert any(note.startswith("contacts") and "μ = 0.7" in note for note in report.notes)
     assert all(f in reduced.link_by_name for f in FEET)  # kept though merged into the shanks
     q, qd = next(random_states(18, 1, seed=25))
     tau = np.ones(18)
