@@ -78,6 +78,8 @@ def test_solo12_symbolic_derivation_matches_pinocchio(solo):
 
     model, ref = solo
     dyn = eomgen.derive(model, outputs=("M", "C", "g"))
+    report = eomgen.verify(dyn, samples=3)  # SPD, Ṁ − 2C skew, against Newton–Euler
+    assert all(check.passed for check in report.checks), report
     f = compile_program(dyn.program, dyn.q + dyn.qd)
     for q, qd in random_states(18, 3, seed=1):
         out = f(*q, *qd)
