@@ -12,7 +12,8 @@ Version 1 of the format (every key but ``version`` is optional)::
     robot: talos                  # the robot's name; another robot is an error
     description: Left arm, the rest of the robot held still.
     fixed_base: true              # the root link is bolted to the world, on purpose
-    floating_base: false          # or: the root link flies free (six virtual joints)
+    floating_base: false          # or: the root link flies free (six virtual joints);
+                                  #   'base: floating' says the same
     base: torso_2_link            # the link the moving part hangs from (default: the root)
     tips: [arm_left_7_link]       # its ends (default: everything below base)
     locked:                       # joint: position [rad or m]; other joints outside the
@@ -70,6 +71,10 @@ SCENE_KEYS = ("version", "robot", "description", "fixed_base", "floating_base", 
 PLANNED_KEYS = ("friction", "armature", "flexible_joints", "joint_limits")
 
 PAYLOAD_KEYS = ("link", "name", "mass", "com", "inertia")
+
+#: ``base: floating`` is short for ``floating_base: true`` (a link of this name cannot be a
+#: scene's base).
+FLOATING = "floating"
 
 CONTACT_KEYS = ("frame", "type", "mu", "baumgarte", "normal", "name")
 
@@ -229,6 +234,11 @@ def _read(data: dict, source: str, strict: bool) -> Scene:
     floating_base = data.get("floating_base", False)
     if not isinstance(floating_base, bool):
         raise r.error("floating_base", f"expected true or false, got {floating_base!r}")
+    if data.get("base") == FLOATING:  # the spelling: base: floating
+        if "floating_base" in data and not floating_base:
+            raise r.error("base", "'base: floating' contradicts 'floating_base: false'")
+        floating_base = True
+        data = {k: v for k, v in data.items() if k != "base"}
     if floating_base and fixed_base:
         raise r.error("floating_base", "the base cannot be both fixed (fixed_base: true) and "
                       "floating")

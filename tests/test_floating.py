@@ -203,6 +203,15 @@ def test_scene_floating_errors_name_the_scene():
             load_scene("s.yaml", text="version: 1\n" + text)
 
 
+def test_base_floating_is_short_for_floating_base():
+    scene = load_scene("s.yaml", text="version: 1\nbase: floating")
+    assert scene.floating_base and scene.base is None
+    reduced, _ = apply_scene(_point_mass_robot(2.0), scene)
+    assert reduced.joint_names[:6] == floating.EULER_JOINTS
+    with pytest.raises(SceneError, match="^s.yaml: base: 'base: floating' contradicts"):
+        load_scene("s.yaml", text="version: 1\nbase: floating\nfloating_base: false")
+
+
 def test_small_floating_robot_symbolic_matches_numeric():
     """derive() on a floating model, against eomgen's Newton–Euler (exact structure check of
     the virtual joints with a symbolic-sized model)."""
