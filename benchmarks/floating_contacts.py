@@ -12,7 +12,7 @@ largest relative difference over random states between eomgen and Pinocchio's fr
   CONTACT_3D (LOCAL_WORLD_ALIGNED) and 1 CONTACT_6D (LOCAL) on solo12;
 
 and the derivation time of the floating solo12 (M, C, g; the frame kinematics of its feet),
-and the wall-clock time of ``eomgen generate`` with examples/scenes/solo12_standing.yaml
+and the wall-clock time of ``eomgen generate`` with examples/contacts/solo12_standing.yaml
 (all backends, no cache; contacts are not generated as code yet). Targets: ≤ 1e-10 (M, C q̇,
 g), ≤ 1e-8 (q̈, F_c), generation ≤ 60 s. Exit status 2 when one is missed.
 """
@@ -158,7 +158,7 @@ def main() -> int:
         with tempfile.TemporaryDirectory() as out:
             start = time.perf_counter()
             subprocess.run([sys.executable, "-m", "eomgen.cli", "generate", str(solo_path),
-                            "--scene", str(ROOT / "examples/scenes/solo12_standing.yaml"),
+                            "--scene", str(ROOT / "examples/contacts/solo12_standing.yaml"),
                             "-o", out, "--no-cache", "--quiet"], check=True,
                            env={**__import__("os").environ, "PYTHONPATH": str(ROOT)})
             seconds = time.perf_counter() - start

@@ -304,3 +304,13 @@ def test_cli_refuses_a_bad_contact_with_one_line_and_exit_code_2(solo, tmp_path)
     assert result.stderr.strip() == (f"eomgen: error: {scene}: contacts[0] 'FL_FOOT' mu: "
                                      "friction coefficient -0.5 is negative (μ ≥ 0)")
     assert not (tmp_path / "out").exists()
+
+
+def test_example_contact_scene(solo):
+    path, model = solo
+    scene = load_scene(Path(__file__).resolve().parents[1] / "examples" / "contacts"
+                       / "solo12_standing.yaml")
+    reduced, report = apply_scene(_quiet_load(path), scene)
+    assert scene.robot == "solo" and reduced.joint_names == model.joint_names
+    assert [(c.frame, c.kind, c.mu) for c in report.contacts] == [(f, "point", 0.7)
+                                                                 for f in FEET]

@@ -51,7 +51,8 @@ def test_jacobians_are_finite_differences_of_the_poses(solo):
             assert np.allclose(f["J"] @ qd, np.r_[p_dot, w], atol=1e-8)
             assert np.allclose(f["Jb"] @ qd, np.r_[R.T @ p_dot, R.T @ w], atol=1e-8)
             # J̇ q̇ = d/dt (J q̇) along q(t) = q + t q̇ (q̈ = 0)
-            Jdot = (fk.evaluate(q + h * qd)[name]["J"] - fk.evaluate(q - h * qd)[name]["J"]) / (2 * h)
+            Jdot = (fk.evaluate(q + h * qd)[name]["J"]
+                    - fk.evaluate(q - h * qd)[name]["J"]) / (2 * h)
             assert np.allclose(f["dJqd"], Jdot @ qd, atol=1e-7)
             Jbdot = (fk.evaluate(q + h * qd)[name]["Jb"]
                      - fk.evaluate(q - h * qd)[name]["Jb"]) / (2 * h)

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Iterable, Sequence
+from typing import Iterable
 
 import numpy as np
 import sympy as sp
@@ -35,8 +35,21 @@ import sympy as sp
 from ..bodies import body_tree
 from ..errors import KinematicTreeError
 from ..model import IDENTITY3, RobotModel, Transform, ZERO3
-from .composite import _cross, _matmul, _matvec, forward_kinematics, motion_cross
+from .composite import forward_kinematics, motion_cross
 from .program import Program, ProgramBuilder
+
+def _cross(a, b) -> tuple:
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _matvec(A, v) -> tuple:
+    return tuple(sp.Add(*[A[r][k] * v[k] for k in range(3)]) for r in range(3))
+
+
+def _matmul(A, B) -> tuple:
+    return tuple(tuple(sp.Add(*[A[r][k] * B[k][c] for k in range(3)]) for c in range(3))
+                 for r in range(3))
+
 
 #: The outputs of each frame, ``<kind>_<k>`` with k the frame's index in ``frames``.
 FRAME_OUTPUTS = ("p", "R", "J", "Jb", "dJqd", "dJbqd")
