@@ -314,3 +314,11 @@ def test_example_contact_scene(solo):
     assert scene.robot == "solo" and reduced.joint_names == model.joint_names
     assert [(c.frame, c.kind, c.mu) for c in report.contacts] == [(f, "point", 0.7)
                                                                  for f in FEET]
+
+
+def test_documented_contact_scene_loads(solo):
+    path, model = solo
+    text = (DOCS / "scenes.md").read_text(encoding="utf-8")
+    block = [b for b in text.split("```yaml\n")[1:] if "floating_base" in b][0].split("```")[0]
+    reduced, report = apply_scene(_quiet_load(path), load_scene("doc.yaml", text=block))
+    assert reduced.joint_names == model.joint_names and len(report.contacts) == 4
