@@ -319,6 +319,6 @@ def test_example_contact_scene(solo):
 def test_documented_contact_scene_loads(solo):
     path, model = solo
     text = (DOCS / "scenes.md").read_text(encoding="utf-8")
-    block = [b for b in text.split("```yaml\n")[1:] if "floating_base" in b][0].split("```")[0]
+    block = [b for b in text.split("```yaml\n")[1:] if "robot: solo" in b][0].split("```")[0]
     reduced, report = apply_scene(_quiet_load(path), load_scene("doc.yaml", text=block))
     assert reduced.joint_names == model.joint_names and len(report.contacts) == 4
