@@ -65,10 +65,12 @@ from typing import Iterable, NamedTuple, Sequence
 import sympy as sp
 
 from .bodies import InertialParameters
+from .floating import EULER_JOINTS, add_floating_base
 from .model import (
     ZERO3,
     Inertial,
     Joint,
+    JointType,
     Link,
     Notice,
     NoticeKind,
@@ -184,6 +186,9 @@ class ReductionReport:
     planar: PlanarMotion | None
     notes: tuple[str, ...]
     outputs: tuple[str, ...]
+    #: The scene's contacts (:class:`eomgen.contacts.Contact`); each frame is a link of the
+    #: reduced model (a massless frame fixed to its body when the merge absorbed it).
+    contacts: tuple = ()
 
     @property
     def locked_by_default(self) -> tuple[str, ...]:
@@ -328,6 +333,11 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
                           f"'{model.name}' ({model.source})")
     before = ModelSize.of(model)
     model, payloads, scene_gravity, notes = _parameters(model, scene)
+    if scene.floating_base:
+        model = _float(model, scene)
+        notes.append(f"the root link '{model.joints[5].child}' floats: six virtual joints "
+                     f"{', '.join(EULER_JOINTS)} (position, ZYX Euler angles) from the fixed "
+                     f"link '{model.root}' (see eomgen.floating)")
     _check_names(model, scene, payloads)
     base = scene.base or model.root
     moving = _moving_joints(model, scene, base)
@@ -348,6 +358,12 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
                      "motion and was dropped" + (": g(q) ≡ 0" if planar.gravity ==
                                                  "along the normal" else ""))
     reduced, world = _reroot(reduced)
+    reduced = _keep_contact_frames(locked_model, reduced, scene, set(dropped))
+    if scene.contacts:
+        notes.append("contacts (eomgen.contacts.ContactDynamics; not generated as code yet): "
+                     + ", ".join(f"{c.name} on '{c.frame}' ({c.kind}"
+                                 + (f", μ = {c.mu:g}" if c.mu is not None else "") + ")"
+                                 for c in scene.contacts))
     used = reduced.free_symbols
     unused = [p.name for p in reduced.parameters if p.symbol not in used]
     if unused:
@@ -365,8 +381,52 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
         moving=reduced.joint_names, world=world, locked=tuple(locks), merged=merged,
         dropped=dropped,
         dropped_payloads=dropped_payloads, planar=planar, notes=tuple(notes),
-        outputs=select_functions(scene.outputs))
+        outputs=select_functions(scene.outputs), contacts=scene.contacts)
     return Reduction(reduced, report)
+
+
+def _float(model: RobotModel, scene: Scene) -> RobotModel:
+    """``model`` with a floating base (:func:`eomgen.floating.add_floating_base`); its
+    errors name the scene's ``floating_base`` entry."""
+    from .errors import DescriptionError
+    from .scene import scene_error
+
+    try:
+        return add_floating_base(model)
+    except DescriptionError as exc:
+        raise scene_error(type(exc))(scene.source, "floating_base",
+                                     f"{exc.element}: {exc.problem}") from None
+
+
+def _keep_contact_frames(locked: RobotModel, reduced: RobotModel, scene: Scene,
+                         dropped: set[str]) -> RobotModel:
+    """Check the scene's contact frames and keep each one in the reduced model: a frame the
+    merge absorbed into its body comes back as a massless link fixed to that body."""
+    from .symbolic.frames import frame_site
+
+    present = reduced.link_by_name
+    links, joints = list(reduced.links), list(reduced.joints)
+    names = {l.name for l in links} | {j.name for j in joints}
+    for k, contact in enumerate(scene.contacts):
+        where = f"contacts[{k}] '{contact.name}' frame"
+        if contact.frame not in locked.link_by_name:
+            raise scene.error(where, f"no link '{contact.frame}' in robot '{locked.name}'"
+                              + did_you_mean(contact.frame, locked.link_by_name))
+        if contact.frame in dropped:
+            raise scene.error(where, f"link '{contact.frame}' is fixed to the world once the "
+                              "scene locks its joints (dropped): a contact there holds nothing")
+        if contact.frame in present or contact.frame in names:
+            continue
+        body, pose = frame_site(locked, contact.frame)
+        joint = f"{contact.frame}_contact_frame"
+        while joint in names:
+            joint += "_"
+        links.append(Link(contact.frame, None))
+        joints.append(Joint(joint, JointType.FIXED, body, contact.frame, _clean(pose)))
+        names |= {contact.frame, joint}
+    if len(links) == len(reduced.links):
+        return reduced
+    return replace(reduced, links=tuple(links), joints=tuple(joints))
 
 
 def _split_notices(notices: Sequence[Notice], scene: Scene, moving: set[str],

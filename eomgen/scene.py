@@ -12,6 +12,8 @@ Version 1 of the format (every key but ``version`` is optional)::
     robot: talos                  # the robot's name; another robot is an error
     description: Left arm, the rest of the robot held still.
     fixed_base: true              # the root link is bolted to the world, on purpose
+    floating_base: false          # or: the root link flies free (six virtual joints);
+                                  #   'base: floating' says the same
     base: torso_2_link            # the link the moving part hangs from (default: the root)
     tips: [arm_left_7_link]       # its ends (default: everything below base)
     locked:                       # joint: position [rad or m]; other joints outside the
@@ -26,6 +28,11 @@ Version 1 of the format (every key but ``version`` is optional)::
     parameters: {m_load: 1.5}     # new symbols for payload values (name: default value)
     symbolic: [m_load]            # parameters kept symbolic (default: all; none for none)
     outputs: [M, C, g]            # M, C, g, tau / inverse_dynamics, forward_dynamics
+    contacts:                     # frames held still (see eomgen.contacts, docs/contact.md)
+      - frame: FL_FOOT            # a link of the robot
+        type: point               # point (3D, default) or surface (6D)
+        mu: 0.7                   # friction coefficient, >= 0 (optional)
+        baumgarte: {kp: 0, kd: 0} # optional stabilisation gains [1/s², 1/s]
 
 The file is read like eomgen's robot YAML (:mod:`eomgen.parsers._yaml`): safe loading, no
 aliases, size and depth limits, and an unknown key is an error that lists the known ones. Keys
@@ -48,6 +55,7 @@ from pathlib import Path
 from typing import Iterable
 
 from .codegen.functions import select_functions
+from .contacts import POINT, SURFACE, Contact
 from .errors import DescriptionError, SceneError
 from .model import Inertial, Parameter, Vec3, check_inertial, mat3, vec3
 from .parsers._yaml import Reader, read_document
@@ -56,13 +64,19 @@ from .parsers._yaml import Reader, read_document
 SCENE_VERSION = 1
 
 #: Top-level keys of a version-1 scene, in documentation order.
-SCENE_KEYS = ("version", "robot", "description", "fixed_base", "base", "tips", "locked",
-              "payloads", "gravity", "parameters", "symbolic", "outputs")
+SCENE_KEYS = ("version", "robot", "description", "fixed_base", "floating_base", "base", "tips",
+              "locked", "payloads", "gravity", "parameters", "symbolic", "outputs", "contacts")
 
 #: Keys reserved for later versions of the format; refused with a message saying so.
-PLANNED_KEYS = ("friction", "armature", "contacts", "flexible_joints", "joint_limits")
+PLANNED_KEYS = ("friction", "armature", "flexible_joints", "joint_limits")
 
 PAYLOAD_KEYS = ("link", "name", "mass", "com", "inertia")
+
+#: ``base: floating`` is short for ``floating_base: true`` (a link of this name cannot be a
+#: scene's base).
+FLOATING = "floating"
+
+CONTACT_KEYS = ("frame", "type", "mu", "baumgarte", "normal", "name")
 
 
 @dataclass(frozen=True)
@@ -87,6 +101,9 @@ class Scene:
         The robot's root link is meant to be bolted to the world: silences the warning about a
         root that looks like a floating base (:mod:`eomgen.parsers.urdf`), as the task holds
         the robot still (an arm of a humanoid on a fixed torso, a legged robot on a stand).
+    floating_base:
+        The root link flies free: :func:`eomgen.floating.add_floating_base` puts six virtual
+        joints (x, y, z, yaw, pitch, roll) between a fixed ``world`` link and it.
     base, tips:
         The moving part is every movable joint on a path from ``base`` (default: the root) to
         one of ``tips`` (default: every joint below ``base``).
@@ -103,6 +120,8 @@ class Scene:
     outputs:
         The functions wanted (:func:`eomgen.codegen.functions.select_functions` names); None
         for all.
+    contacts:
+        Frames held still (:class:`eomgen.contacts.Contact`), in file order.
     """
 
     source: str = "<scene>"
@@ -118,6 +137,8 @@ class Scene:
     parameters: tuple[Parameter, ...] = ()
     symbolic: tuple[str, ...] | None = None
     outputs: tuple[str, ...] | None = None
+    floating_base: bool = False
+    contacts: tuple[Contact, ...] = ()
 
     @property
     def locked_positions(self) -> dict[str, float]:
@@ -210,6 +231,20 @@ def _read(data: dict, source: str, strict: bool) -> Scene:
     fixed_base = data.get("fixed_base", False)
     if not isinstance(fixed_base, bool):
         raise r.error("fixed_base", f"expected true or false, got {fixed_base!r}")
+    floating_base = data.get("floating_base", False)
+    if not isinstance(floating_base, bool):
+        raise r.error("floating_base", f"expected true or false, got {floating_base!r}")
+    if data.get("base") == FLOATING:  # the issue's spelling: base: floating
+        if "floating_base" in data and not floating_base:
+            raise r.error("base", "'base: floating' contradicts 'floating_base: false'")
+        floating_base = True
+        data = {k: v for k, v in data.items() if k != "base"}
+    if floating_base and fixed_base:
+        raise r.error("floating_base", "the base cannot be both fixed (fixed_base: true) and "
+                      "floating")
+    if floating_base and data.get("base") is not None:
+        raise r.error("base", "a floating robot moves as a whole from its root; 'base' "
+                      "(the link a moving part hangs from) cannot be used with floating_base")
     base = r.name(data["base"], "base") if data.get("base") is not None else None
     tips: list[str] = []
     if data.get("tips") is not None:
@@ -236,8 +271,16 @@ def _read(data: dict, source: str, strict: bool) -> Scene:
     gravity = _gravity(r, data["gravity"]) if "gravity" in data else None
     symbolic = _symbolic(r, data["symbolic"]) if "symbolic" in data else None
     outputs = _outputs(r, data["outputs"]) if data.get("outputs") is not None else None
+    contacts: list[Contact] = []
+    if data.get("contacts") is not None:
+        for k, entry in enumerate(r.sequence(data["contacts"], "contacts")):
+            contacts.append(_contact(r, entry, k))
+        names = [c.name for c in contacts]
+        for c in contacts:
+            if names.count(c.name) > 1:
+                raise r.error(f"contacts '{c.name}'", "two contacts have this name")
     declared = tuple(r.declared.values())
-    return Scene(source=source, version=version, robot=robot, description=description,
+    return Scene(floating_base=floating_base, contacts=tuple(contacts), source=source, version=version, robot=robot, description=description,
                  fixed_base=fixed_base, base=base, tips=tuple(tips), locked=tuple(locked),
                  payloads=tuple(payloads),
                  gravity=gravity, parameters=declared, symbolic=symbolic, outputs=outputs)
@@ -266,6 +309,41 @@ def _payload(r: _SceneReader, entry, k: int, source: str, strict: bool) -> Paylo
                                             notice.problem + " (refused under --strict)")
         warnings.warn(replace(notice, element=where).message, notice.category, stacklevel=4)
     return Payload(link, inertial, name)
+
+
+def _contact(r: _SceneReader, entry, k: int) -> Contact:
+    where = f"contacts[{k}]"
+    r.mapping(entry, where, required=("frame",), optional=CONTACT_KEYS)
+    frame = r.name(entry["frame"], f"{where} frame")
+    name = r.name(entry["name"], f"{where} name") if "name" in entry else frame
+    where = f"{where} '{name}'"
+    kind = r.choice(entry.get("type", POINT), f"{where} type", (POINT, SURFACE))
+    mu = None
+    if entry.get("mu") is not None:
+        mu = r.number(entry["mu"], f"{where} mu")
+        if mu < 0:
+            raise r.error(f"{where} mu", f"friction coefficient {mu:g} is negative (μ ≥ 0)")
+    gains = {"kp": 0.0, "kd": 0.0}
+    if entry.get("baumgarte") is not None:
+        value = entry["baumgarte"]
+        r.mapping(value, f"{where} baumgarte", optional=("kp", "kd"))
+        for key in value:
+            gains[key] = r.number(value[key], f"{where} baumgarte {key}")
+            if gains[key] < 0:
+                raise r.error(f"{where} baumgarte {key}", f"gain {gains[key]:g} is negative")
+    normal = (0.0, 0.0, 1.0)
+    if entry.get("normal") is not None:
+        if kind != POINT:
+            raise r.error(f"{where} normal", "a surface contact's normal is its frame's z axis")
+        value = entry["normal"]
+        if not isinstance(value, list) or len(value) != 3:
+            raise r.error(f"{where} normal", "expected a list of 3 numbers [x, y, z]")
+        vector = [r.number(x, f"{where} normal[{i}]") for i, x in enumerate(value)]
+        norm = sum(x * x for x in vector) ** 0.5
+        if not norm > 0:
+            raise r.error(f"{where} normal", "the normal is zero")
+        normal = tuple(x / norm for x in vector)
+    return Contact(frame, kind, mu, gains["kp"], gains["kd"], normal, name)
 
 
 def _at(value, values: dict):

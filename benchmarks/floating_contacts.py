@@ -1,0 +1,172 @@
+"""Floating bases and contacts: agreement with Pinocchio and generation time (issue 16 targets).
+
+    python benchmarks/floating_contacts.py            # 10 random states, generation timed
+    python benchmarks/floating_contacts.py --quick    # 3 states, no generation
+
+Prints, for the floating-base solo12 and Talos (legs only, everything else locked at 0), the
+largest relative difference over random states between eomgen and Pinocchio's free flyer
+(its own URDF reader; M, C q̇, g mapped to Euler coordinates, eomgen.floating) of:
+
+* M, C q̇, g from eomgen's numeric Newton–Euler and from the derived (symbolic) program;
+* constrained q̈ and F_c (eomgen.contacts) against ``pinocchio.constraintDynamics`` with 4
+  CONTACT_3D (LOCAL_WORLD_ALIGNED) and 1 CONTACT_6D (LOCAL) on solo12;
+
+and the derivation time of the floating solo12 (M, C, g; the frame kinematics of its feet),
+and the wall-clock time of ``eomgen generate`` with examples/contacts/solo12_standing.yaml
+(all backends, no cache; contacts are not generated as code yet). Targets: ≤ 1e-10 (M, C q̇,
+g), ≤ 1e-8 (q̈, F_c), generation ≤ 60 s. Exit status 2 when one is missed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tests"))
+
+import eomgen  # noqa: E402
+from conftest import erd_robots_dir  # noqa: E402
+from eomgen import floating, numeric  # noqa: E402
+from eomgen.contacts import Contact, ContactDynamics  # noqa: E402
+from eomgen.reduction import apply_scene  # noqa: E402
+from eomgen.scene import load_scene  # noqa: E402
+from eomgen.symbolic.evaluate import compile_program  # noqa: E402
+from eomgen.symbolic.frames import derive_frames  # noqa: E402
+
+FEET = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
+
+
+def rel(a, b):
+    return float(np.abs(np.asarray(a) - b).max() / np.abs(b).max())
+
+
+def states(n, count, seed):
+    rng = np.random.default_rng(seed)
+    for _ in range(count):
+        q = rng.uniform(-1, 1, n)
+        q[4] = rng.uniform(-1.2, 1.2)
+        yield q, rng.uniform(-1, 1, n)
+
+
+def load(path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return eomgen.load(path)
+
+
+def dynamics_agreement(name, model, ref, count, derived=True):
+    nm = numeric.numeric_model(model)
+    worst = {"numeric": [0, 0, 0], "derived": [0, 0, 0]}
+    f = None
+    if derived:
+        start = time.perf_counter()
+        dyn = eomgen.derive(model, outputs=("M", "C", "g"))
+        print(f"{name}: derive M, C, g ({model.dof} DOF) {time.perf_counter() - start:.2f} s")
+        f = compile_program(dyn.program, dyn.q + dyn.qd)
+    for q, qd in states(model.dof, count, 1):
+        M, Cqd, g = ref.dynamics(q, qd)
+        ours = {"numeric": (numeric.mass_matrix_rnea(nm, q), numeric.coriolis_times_qd(nm, q, qd),
+                            numeric.gravity_torques(nm, q))}
+        if f is not None:
+            out = f(*q, *qd)
+            ours["derived"] = (out["M"], out["C"] @ qd, out["g"].ravel())
+        for key, (M2, C2, g2) in ours.items():
+            worst[key] = [max(w, rel(x, y)) for w, x, y in zip(worst[key], (M2, C2, g2),
+                                                                  (M, Cqd, g))]
+    ok = True
+    for key, values in worst.items():
+        if key == "derived" and f is None:
+            continue
+        print(f"{name} {key:8s} vs Pinocchio: M {values[0]:.1e}, C q̇ {values[1]:.1e}, "
+              f"g {values[2]:.1e}")
+        ok &= max(values) <= 1e-10
+    return ok
+
+
+def contact_agreement(path, model, count):
+    import pinocchio as pin
+
+    ref = floating.PinocchioFreeFlyer(path, model.joint_names)
+    pm, pd, idx = ref.model, ref.data, ref.idx
+    ok = True
+    for kind, feet, ctype, frame in (("point", FEET, pin.ContactType.CONTACT_3D,
+                                      pin.LOCAL_WORLD_ALIGNED),
+                                     ("surface", FEET[:1], pin.ContactType.CONTACT_6D, pin.LOCAL)):
+        cd = ContactDynamics(model, tuple(Contact(f, kind) for f in feet))
+        models = pin.StdVec_RigidConstraintModel()
+        for f in feet:
+            fr = pm.frames[pm.getFrameId(f)]
+            models.append(pin.RigidConstraintModel(ctype, pm, fr.parentJoint, fr.placement,
+                                                   frame))
+        datas = pin.StdVec_RigidConstraintData([c.createData() for c in models])
+        pin.initConstraintDynamics(pm, pd, models, datas)
+        worst = [0.0, 0.0]
+        rng = np.random.default_rng(2)
+        for q, qd in states(18, count, 3):
+            tau = rng.uniform(-2, 2, 18)
+            qdd, F = cd.constrained_forward_dynamics(q, qd, tau)
+            q_pin, v = ref.state(q, qd)
+            T = floating.velocity_map(q)
+            a = pin.constraintDynamics(pm, pd, q_pin, v, np.linalg.solve(T.T, tau)[idx],
+                                       models, datas, pin.ProximalSettings(1e-14, 1e-12, 1))
+            a_ours = np.empty(18)
+            a_ours[idx] = a
+            qdd_pin = np.linalg.solve(T, a_ours - floating.velocity_map_dot_qd(q, qd))
+            worst = [max(worst[0], rel(qdd, qdd_pin)), max(worst[1], rel(F, pd.lambda_c))]
+        print(f"solo12 {len(feet)} {kind} contact(s) vs constraintDynamics: q̈ {worst[0]:.1e}, "
+              f"F_c {worst[1]:.1e}")
+        ok &= max(worst) <= 1e-8
+    return ok
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true")
+    args = parser.parse_args()
+    count = 3 if args.quick else 10
+    robots = erd_robots_dir()
+    if robots is None:
+        print("example-robot-data is not installed")
+        return 1
+    solo_path = robots / "solo_description/robots/solo12.urdf"
+    solo = floating.add_floating_base(load(solo_path))
+    ok = dynamics_agreement("solo12", solo,
+                            floating.PinocchioFreeFlyer(solo_path, solo.joint_names), count)
+    talos_path = robots / "talos_data/robots/talos_reduced.urdf"
+    talos = load(talos_path)
+    scene = load_scene("legs.yaml", text="version: 1\nfloating_base: true\n"
+                       "tips: [leg_left_6_link, leg_right_6_link]\n")
+    legs = apply_scene(talos, scene).model
+    locked = [j.name for j in talos.movable_joints if j.name not in legs.joint_names]
+    ok &= dynamics_agreement("talos legs", legs,
+                             floating.PinocchioFreeFlyer(talos_path, legs.joint_names, locked),
+                             count)
+    start = time.perf_counter()
+    derive_frames(solo, FEET)
+    print(f"solo12: frame kinematics of the 4 feet {time.perf_counter() - start:.2f} s")
+    ok &= contact_agreement(solo_path, solo, count)
+    if not args.quick:
+        with tempfile.TemporaryDirectory() as out:
+            start = time.perf_counter()
+            subprocess.run([sys.executable, "-m", "eomgen.cli", "generate", str(solo_path),
+                            "--scene", str(ROOT / "examples/contacts/solo12_standing.yaml"),
+                            "-o", out, "--no-cache", "--quiet"], check=True,
+                           env={**__import__("os").environ, "PYTHONPATH": str(ROOT)})
+            seconds = time.perf_counter() - start
+        print(f"eomgen generate solo12 floating, 4 contacts (all backends): {seconds:.1f} s "
+              "(target ≤ 60 s)")
+        ok &= seconds <= 60
+    return 0 if ok else 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

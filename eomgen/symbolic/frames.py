@@ -1,0 +1,226 @@
+"""Frame kinematics of named links: pose, Jacobians and J̇ q̇, as a straight-line program.
+
+For every frame ``f`` asked for (any link of the model: a body, or a frame fixed to one such as
+a foot or a tool), :func:`derive_frames` builds, in the model's root (world) frame:
+
+* ``p_f`` (3×1): the frame origin [m] in world coordinates;
+* ``R_f`` (3×3): the frame axes in world coordinates (``x_world = R_f x_f + p_f``);
+* ``J_f`` (6×n), **world-aligned at the frame origin** (Pinocchio's ``LOCAL_WORLD_ALIGNED``):
+  ``[ṗ_f; ω] = J_f q̇``, linear rows first, ω the angular velocity in world axes;
+* ``Jb_f`` (6×n), **body** (Pinocchio's ``LOCAL``): ``[R_fᵀ ṗ_f; R_fᵀ ω] = Jb_f q̇``;
+* ``dJqd_f`` (6×1), the world-aligned ``J̇ q̇``: the classical acceleration ``[p̈_f; ω̇]`` at
+  ``q̈ = 0``, so that ``[p̈_f; ω̇] = J_f q̈ + dJqd_f``;
+* ``dJbqd_f`` (6×1), the body ``J̇ q̇``: the time derivative of ``[v_b; ω_b] = Jb_f q̇`` at
+  ``q̈ = 0``, i.e. ``[R_fᵀ p̈_f − ω_b × v_b; R_fᵀ ω̇]`` (the spatial body acceleration, which is
+  what Pinocchio's ``CONTACT_6D`` constraint in ``LOCAL`` holds at zero).
+
+Columns follow ``JOINT_NAMES`` order. The construction reuses the world-frame forward
+kinematics of :mod:`eomgen.symbolic.composite`: joint i's motion axis ``S_i = [z_i; p_i × z_i]``
+(angular first, referred to the world origin). A frame on body k moves with the joints on the
+path from the root to k; its Jacobian column for such a joint is ``[S_lin + S_ang × p_f;
+S_ang]``. With ``V_i = Σ_{j ⪯ i} S_j q̇_j`` the spatial velocity of body i, ``Ṡ_i = V_i × S_i``,
+so the spatial acceleration bias is ``A = Σ_i (V_i × S_i) q̇_i`` and
+``p̈_f = A_lin + A_ang × p_f + ω × ṗ_f`` at ``q̈ = 0``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Iterable
+
+import numpy as np
+import sympy as sp
+
+from ..bodies import body_tree
+from ..errors import KinematicTreeError
+from ..model import IDENTITY3, RobotModel, Transform, ZERO3
+from .composite import forward_kinematics, motion_cross
+from .program import Program, ProgramBuilder
+
+def _cross(a, b) -> tuple:
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _matvec(A, v) -> tuple:
+    return tuple(sp.Add(*[A[r][k] * v[k] for k in range(3)]) for r in range(3))
+
+
+def _matmul(A, B) -> tuple:
+    return tuple(tuple(sp.Add(*[A[r][k] * B[k][c] for k in range(3)]) for c in range(3))
+                 for r in range(3))
+
+
+#: The outputs of each frame, ``<kind>_<k>`` with k the frame's index in ``frames``.
+FRAME_OUTPUTS = ("p", "R", "J", "Jb", "dJqd", "dJbqd")
+
+
+def frame_site(model: RobotModel, name: str) -> tuple[str | None, Transform]:
+    """Where link ``name`` sits: ``(body link, pose in that link's frame)``.
+
+    The body link is the child link of the nearest movable joint above ``name`` (``name``
+    itself when its own joint moves); None when ``name`` is rigidly attached to the root
+    (the pose is then in the root frame).
+
+    Raises
+    ------
+    KinematicTreeError
+        When the model has no link ``name``.
+    """
+    if name not in model.link_by_name:
+        raise KinematicTreeError(model.source, f"frame '{name}'",
+                                 f"no link '{name}' in robot '{model.name}'")
+    pose = Transform(IDENTITY3, ZERO3)
+    link = name
+    parent = model.parent_joint
+    while link in parent and not parent[link].type.is_movable:
+        joint = parent[link]
+        pose = joint.origin @ pose
+        link = joint.parent
+    return (link if link in parent else None), pose
+
+
+@dataclass(frozen=True)
+class FrameKinematics:
+    """The frame kinematics of one model (see the module docstring). Immutable.
+
+    Attributes
+    ----------
+    model:
+        The model.
+    frames:
+        The frame (link) names, in the order of the outputs' index ``k``.
+    q, qd:
+        Joint position and velocity symbols, ``JOINT_NAMES`` order.
+    program:
+        Outputs ``p_k``, ``R_k``, ``J_k``, ``Jb_k``, ``dJqd_k``, ``dJbqd_k`` per frame k.
+    """
+
+    model: RobotModel
+    frames: tuple[str, ...]
+    q: tuple[sp.Symbol, ...]
+    qd: tuple[sp.Symbol, ...]
+    program: Program
+
+    def output(self, kind: str, frame: str) -> sp.Matrix:
+        """The output ``kind`` (one of :data:`FRAME_OUTPUTS`) of ``frame``, in intermediates."""
+        return self.program.output(f"{kind}_{self.frames.index(frame)}")
+
+    @cached_property
+    def _compiled(self):
+        from .evaluate import compile_program
+
+        params = tuple(p.symbol for p in self.model.parameters)
+        values = self.model.parameter_values
+        missing = [p.name for p in self.model.parameters if p.symbol not in values]
+        if missing:
+            raise ValueError("no numeric value for parameters " + ", ".join(missing))
+        f = compile_program(self.program, self.q + self.qd + params)
+        tail = tuple(float(values[s]) for s in params)
+        return lambda q, qd: f(*(float(x) for x in q), *(float(x) for x in qd), *tail)
+
+    def evaluate(self, q, qd=None) -> dict[str, dict[str, np.ndarray]]:
+        """Numbers at one state: ``{frame: {"p": (3,), "R": (3, 3), "J": (6, n), "Jb": (6, n),
+        "dJqd": (6,), "dJbqd": (6,)}}``; parameters take their default values; ``qd``
+        defaults to zero."""
+        n = len(self.q)
+        q = np.asarray(q, dtype=float).reshape(n)
+        qd = np.zeros(n) if qd is None else np.asarray(qd, dtype=float).reshape(n)
+        raw = self._compiled(q, qd)
+        out = {}
+        for k, name in enumerate(self.frames):
+            out[name] = {kind: raw[f"{kind}_{k}"] for kind in FRAME_OUTPUTS}
+            for kind in ("p", "dJqd", "dJbqd"):
+                out[name][kind] = out[name][kind].reshape(-1)
+        return out
+
+
+def derive_frames(model: RobotModel, frames: Iterable[str] | None = None) -> FrameKinematics:
+    """Derive pose, Jacobians and J̇ q̇ of the named links (all links by default).
+
+    Raises
+    ------
+    KinematicTreeError
+        For a name that is not a link of the model.
+    """
+    from ..dynamics import joint_symbols
+
+    frames = tuple(frames) if frames is not None else tuple(l.name for l in model.links)
+    sites = [frame_site(model, name) for name in frames]
+    tree = body_tree(model)
+    body_of = {body.joint.child: i for i, body in enumerate(tree.bodies)}
+    n = model.dof
+    q, qd, _ = joint_symbols(n)
+    reserved = {s.name for s in q + qd} | {p.name for p in model.parameters}
+    b = ProgramBuilder(reserved)
+    kin = forward_kinematics(tree, q, b)
+    outputs: list[tuple[str, sp.Matrix]] = []
+    velocity: dict[int, tuple] = {}  # body -> spatial velocity V_i (world origin)
+    bias: dict[int, tuple] = {}      # body -> spatial acceleration at q̈ = 0
+
+    def motion(i: int) -> tuple[tuple, tuple]:
+        if i not in velocity:
+            parent = tree.bodies[i].parent
+            V0, A0 = motion(parent) if parent >= 0 else ((0,) * 6, (0,) * 6)
+            rate = qd[tree.bodies[i].q_index]
+            V = b.define_all(tuple(V0[r] + kin.S[i][r] * rate for r in range(6)), f"V{i + 1}_")
+            VxS = motion_cross(V, kin.S[i])
+            A = b.define_all(tuple(A0[r] + VxS[r] * rate for r in range(6)), f"Ab{i + 1}_")
+            velocity[i], bias[i] = V, A
+        return velocity[i], bias[i]
+
+    for k, (name, (link, pose)) in enumerate(zip(frames, sites)):
+        J = sp.zeros(6, n)
+        if link is None:
+            R = pose.rotation
+            p = pose.translation
+            dJqd = (0,) * 6
+            w = v_lin = (0, 0, 0)
+        else:
+            i = body_of[link]
+            R = tuple(b.define_all(row, f"Rf{k}_{r}") for r, row in
+                      enumerate(_matmul(kin.R[i], pose.rotation)))
+            p = b.define_all(tuple(kin.p[i][r] + e for r, e in
+                                   enumerate(_matvec(kin.R[i], pose.translation))), f"pf{k}_")
+            for j in [i] + tree.ancestors(i):
+                S = kin.S[j]
+                lin = b.define_all(tuple(S[3 + r] + e for r, e in
+                                         enumerate(_cross(S[:3], p))), f"Jf{k}_{j + 1}_")
+                col = tree.bodies[j].q_index
+                for r in range(3):
+                    J[r, col] = lin[r]
+                    J[3 + r, col] = S[r]
+            V, A = motion(i)
+            w = V[:3]
+            v_lin = b.define_all(tuple(V[3 + r] + e for r, e in enumerate(_cross(w, p))),
+                                 f"vf{k}_")
+            Axp = _cross(A[:3], p)
+            wxv = _cross(w, v_lin)
+            acc = b.define_all(tuple(A[3 + r] + Axp[r] + wxv[r] for r in range(3)), f"af{k}_")
+            dJqd = tuple(acc) + tuple(A[:3])
+        Rt = tuple(tuple(R[c][r] for c in range(3)) for r in range(3))
+        Jb = sp.zeros(6, n)
+        for col in range(n):
+            for half in (0, 3):
+                rotated = _matvec(Rt, tuple(J[half + r, col] for r in range(3)))
+                for r in range(3):
+                    Jb[half + r, col] = b.define(rotated[r], f"Jb{k}_{half + r}_{col + 1}")
+        w_b = b.define_all(_matvec(Rt, w), f"wb{k}_")
+        v_b = b.define_all(_matvec(Rt, v_lin), f"vb{k}_")
+        a_b = _matvec(Rt, dJqd[:3])
+        wxv_b = _cross(w_b, v_b)
+        dJbqd = (tuple(b.define(a_b[r] - wxv_b[r], f"ab{k}_{r}") for r in range(3))
+                 + b.define_all(_matvec(Rt, dJqd[3:]), f"wdb{k}_"))
+        outputs += [
+            (f"p_{k}", sp.Matrix(3, 1, list(p))),
+            (f"R_{k}", sp.Matrix(3, 3, [x for row in R for x in row])),
+            (f"J_{k}", J),
+            (f"Jb_{k}", Jb),
+            (f"dJqd_{k}", sp.Matrix(6, 1, list(dJqd))),
+            (f"dJbqd_{k}", sp.Matrix(6, 1, list(dJbqd))),
+        ]
+    program = Program(tuple(b.assignments), tuple(outputs)).pruned([n_ for n_, _ in outputs])
+    return FrameKinematics(model, frames, q, qd, program)
+
+
+__all__ = ["FRAME_OUTPUTS", "FrameKinematics", "derive_frames", "frame_site"]
