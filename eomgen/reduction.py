@@ -374,7 +374,7 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
     notes += _massless_notes(reduced)
     kept, moot = _split_notices(model.notices, scene, set(reduced.joint_names), set(dropped))
     reduced = replace(reduced, notices=kept)
-    notes += _moot_notes(moot)
+    notes += _moot_notes(moot, scene.floating_base)
     report = ReductionReport(
         robot=model.name, scene=scene.source, description=scene.description, before=before,
         after=ModelSize.of(reduced), base=base, tips=scene.tips,
@@ -435,7 +435,7 @@ def _split_notices(notices: Sequence[Notice], scene: Scene, moving: set[str],
     kept, moot = [], []
     for notice in notices:
         if notice.kind is NoticeKind.FLOATING_BASE:
-            matters = not scene.fixed_base
+            matters = not (scene.fixed_base or scene.floating_base)
         else:
             matters = ((not notice.joints or any(j in moving for j in notice.joints))
                        and (not notice.links or any(l not in dropped for l in notice.links)))
@@ -443,10 +443,10 @@ def _split_notices(notices: Sequence[Notice], scene: Scene, moving: set[str],
     return tuple(kept), tuple(moot)
 
 
-def _moot_notes(moot: Sequence[Notice]) -> list[str]:
+def _moot_notes(moot: Sequence[Notice], scene_floating: bool = False) -> list[str]:
     """Report notes naming the notices the scene made moot."""
-    notes = [f"{n.element} taken as bolted to the world (the scene says fixed_base: true): "
-             "the floating-base warning is left out"
+    said = "floating_base: true" if scene_floating else "fixed_base: true"
+    notes = [f"{n.element}: the scene says {said}, so the floating-base warning is left out"
              for n in moot if n.kind is NoticeKind.FLOATING_BASE]
     others = [n.element for n in moot if n.kind is not NoticeKind.FLOATING_BASE]
     if others:

@@ -670,9 +670,10 @@ def test_a_quadruped_warns_once_naming_the_file_the_root_and_the_legs():
     message = str(caught[0].message)
     assert message.startswith("quad.urdf: root link 'trunk': looks like a floating base (4 "
                               "branches reach down from it like legs at q = 0: 'hip0', 'hip1', "
-                              "'hip2', 'hip3'), but eomgen models fixed-base robots only; read "
-                              "as bolted to the world at 'trunk'")
-    assert "fixed_base: true" in message and len(message.splitlines()) == 1
+                              "'hip2', 'hip3'), but is read as bolted to the world; M, C and g "
+                              "are those of a robot held at 'trunk'")
+    assert "floating_base: true" in message and "fixed_base: true" in message
+    assert len(message.splitlines()) == 1
     assert model.dof == 8  # read all the same, as legs of a trunk held still
 
 
@@ -682,7 +683,7 @@ def test_a_floating_base_is_refused_under_strict():
         with pytest.raises(UnsupportedError) as caught:
             parse_urdf_string(legged(), source="quad.urdf", strict=True)
     assert str(caught.value).startswith("quad.urdf: root link 'trunk': looks like a floating base")
-    assert str(caught.value).endswith("fixed-base robots only (refused under --strict)")
+    assert str(caught.value).endswith("read as bolted to the world (refused under --strict)")
 
 
 @pytest.mark.parametrize("case, document, warns", [

@@ -652,8 +652,11 @@ def test_fixed_base_silences_the_floating_base_and_nothing_else():
     assert shipped.fixed_base
     reduction = apply_scene(talos, shipped)
     assert reduction.model.notices == ()
-    assert any(n.startswith("root link 'base_link' taken as bolted to the world")
+    assert any(n.startswith("root link 'base_link': the scene says fixed_base: true")
                for n in reduction.report.notes)
+    free = apply_scene(talos, dataclasses.replace(shipped, fixed_base=False, floating_base=True))
+    assert free.model.notices == ()  # a free base is what the warning asked for
+    assert any(n.startswith("the root link 'base_link' floats") for n in free.report.notes)
     unsaid = dataclasses.replace(shipped, fixed_base=False)  # every leg locked: still floating
     assert kept(apply_scene(talos, unsaid)) == ["root link 'base_link'"]
     everything = apply_scene(gripper_arm(), scene_text("version: 1\nfixed_base: true"))

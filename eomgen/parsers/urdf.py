@@ -307,9 +307,10 @@ def floating_base_notice(model: RobotModel) -> Notice | None:
     return Notice(
         NoticeKind.FLOATING_BASE, model.source, f"root link '{model.root}'",
         f"looks like a floating base ({len(legs)} branches reach down from it like legs at "
-        f"q = 0: {shown}), but eomgen models fixed-base robots only",
-        f"read as bolted to the world at '{model.root}' (a scene with 'fixed_base: true' says "
-        "this is meant and silences this warning)")
+        f"q = 0: {shown}), but is read as bolted to the world",
+        f"M, C and g are those of a robot held at '{model.root}' (a scene with "
+        "'floating_base: true' gives it a free base, one with 'fixed_base: true' says bolted is "
+        "meant; either silences this warning)")
 
 
 def _parse_xml(data: str | bytes, source: str) -> ET.Element:
