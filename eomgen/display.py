@@ -13,6 +13,8 @@ from __future__ import annotations
 import html
 from typing import TYPE_CHECKING
 
+import sympy as sp
+
 if TYPE_CHECKING:
     from .dynamics import Dynamics
     from .model import RobotModel
@@ -52,12 +54,9 @@ def model_html(model: RobotModel) -> str:
 
 
 def _printer(dynamics: Dynamics):
-    from .codegen.backends.latex_backend import symbol_names
-    from .codegen.backends.latex_printer import DerivationLatexPrinter
+    from .codegen.backends.latex_backend import LatexConfig, printing
 
-    return DerivationLatexPrinter({"joint_positions": dynamics.q,
-                                   "symbol_names": symbol_names(dynamics),
-                                   "mat_str": "pmatrix", "mat_delim": ""})
+    return printing(dynamics, LatexConfig(), compact_trig=True).printer
 
 
 def _text(value: str) -> str:
@@ -66,8 +65,32 @@ def _text(value: str) -> str:
     return r"\text{" + latex_escape(value) + "}"
 
 
+def readable_matrices(dynamics: Dynamics) -> dict | None:
+    """M, C and g of ``dynamics`` as the LaTeX document and the handout print them (the
+    textbook derivation, entries of M grouped by body mass, those of g by trigonometric
+    factor), or None when the model is not teaching-sized (the bounds of
+    :func:`eomgen.codegen.backends.latex_backend.textbook_for`, checked on the program's size
+    before anything is expanded)."""
+    from .codegen.backends.latex_backend import textbook_for
+    from .teach import readability as rd
+
+    book = textbook_for(dynamics)
+    if book is None:
+        return None
+    masses = [b.mass for b in book.bodies if isinstance(b.mass, sp.Symbol)]
+    angles = list(dynamics.q)
+    return {"M": book.M.applyfunc(lambda e: rd.mass_grouped(e, masses)),
+            "C": book.C,
+            "g": book.g.applyfunc(lambda e: rd.trig_grouped(e, angles))}
+
+
 def dynamics_latex(dynamics: Dynamics, max_dof: int = DISPLAY_MAX_DOF) -> str:
     """LaTeX (one ``$$…$$`` display) of ``dynamics``: M, C, g for small models, else a summary.
+
+    Small models (at most ``max_dof`` joints and within the size bounds of
+    :func:`readable_matrices`) show M, C and g in the reduced forms of the LaTeX document and
+    the handout; others show the operation counts of the straight-line program, which cost
+    nothing to compute.
 
     >>> import eomgen
     >>> tex = dynamics_latex(eomgen.derive(eomgen.load(eomgen.example_path("planar_2link"))))
@@ -76,18 +99,21 @@ def dynamics_latex(dynamics: Dynamics, max_dof: int = DISPLAY_MAX_DOF) -> str:
     """
     model = dynamics.model
     title = _text(f"{model.name}: {model.dof} joints ({', '.join(model.joint_names)})")
-    if model.dof > max_dof:
+    matrices = readable_matrices(dynamics) if model.dof <= max_dof else None
+    if matrices is None:
         counts = ",\\ ".join(
             _text(f"{name}: {dynamics.operation_count([name])} operations")
             for name in dynamics.outputs)
+        why = (f"models of at most {max_dof} joints" if model.dof > max_dof
+               else "teaching-sized models (this one's expanded M, C, g are too large)")
         return ("$$\\begin{array}{l}" + title + r"\\ " + counts + r"\\ "
-                + _text("(M, C, g are shown for models of at most "
-                        f"{max_dof} joints; see dynamics.M, .C, .g)") + r"\end{array}$$")
+                + _text(f"(M, C, g are shown for {why}; see dynamics.M, .C, .g, "
+                        "dynamics.lambdify())") + r"\end{array}$$")
     printer = _printer(dynamics)
     lines = [title]
     for name in ("M", "C", "g"):
         if name in dynamics.outputs:
-            lines.append(f"{name} = {printer.doprint(getattr(dynamics, name))}")
+            lines.append(f"{name} = {printer.doprint(matrices[name])}")
     return "$$\\begin{array}{l}" + r"\\[1ex] ".join(lines) + r"\end{array}$$"
 
 
