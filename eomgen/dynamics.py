@@ -23,6 +23,7 @@ from .model import Parameter, RobotModel
 from .symbolic.composite import derive_program
 from .symbolic.newton_euler import inverse_dynamics_program
 from .symbolic.program import Program, ProgramBuilder
+from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS
 
 #: What :func:`derive` can build: the mass matrix, Coriolis matrix, gravity vector and the
 #: inverse dynamics τ(q, q̇, q̈) (by a symbolic Newton–Euler pass; cheaper to evaluate).
@@ -187,8 +188,12 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
         Give ``dynamics.M``, ``.C``, ``.g``, ``.P``, ``.tau`` in reduced textbook form (those of
         :attr:`Dynamics.textbook`: ``sin² + cos² = 1`` applied, angle sums along parallel
         axes, exact numbers) instead of the program's expressions substituted into each other.
-        ``None`` (default) does it for teaching-sized models (at most 3 joints) only: the
-        expanded form grows exponentially with the model size. ``True`` is refused above
+        ``None`` (default) does it for teaching-sized models only (at most
+        :data:`~eomgen.symbolic.textbook.TEXTBOOK_MAX_DOF` joints and a program of at most
+        :data:`~eomgen.symbolic.textbook.TEXTBOOK_MAX_OPERATIONS` operations, an estimate of
+        the cost known before anything is expanded): the expanded form grows exponentially
+        with the model size. ``True`` forces it (a 3-joint arm with general axes: tens of
+        seconds). ``True`` is refused above
         :data:`MAX_SIMPLIFY_JOINTS` joints.
 
     Returns
@@ -233,8 +238,10 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     names = [name for name in ("M", "C", "g", "P", "tau") if name in result]
     program = Program(tuple(builder.assignments), tuple((n, result[n]) for n in names)).pruned(names)
     steps = _steps(program, result)
-    if simplify is None:
-        simplify = model.dof <= 3
+    if simplify is None:  # teaching-sized: few joints and a small program (a cheap estimate)
+        counted = [o for o in ("M", "C", "g") if o in outputs]
+        simplify = model.dof <= TEXTBOOK_MAX_DOF and (
+            not counted or program.operation_count(counted) <= TEXTBOOK_MAX_OPERATIONS)
     return Dynamics(model, q, qd, qdd, program, steps, tuple(timings), bool(simplify))
 
 

@@ -2,7 +2,8 @@
 (``eomgen notebook``).
 
 Sections, each a short explanation followed by a code cell using eomgen's API: loading the
-robot; for models of at most :data:`~eomgen.symbolic.textbook.TEXTBOOK_MAX_DOF` joints the
+robot; for teaching-sized models (at most :data:`~eomgen.symbolic.textbook.TEXTBOOK_MAX_DOF`
+joints and :data:`~eomgen.symbolic.textbook.TEXTBOOK_MAX_OPERATIONS` program operations) the
 textbook derivation (centre-of-mass positions, Jacobians, kinetic and potential energy per link,
 M, Christoffel symbols, C, g); the equations of motion; the property checks of
 :func:`eomgen.verify`; a comparison with the numeric Newton–Euler algorithm at a sample state;
@@ -24,13 +25,22 @@ from nbformat import v4
 
 from .errors import ParameterError
 from .model import RobotModel
-from .symbolic.textbook import TEXTBOOK_MAX_DOF
+from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS
 
 
 def _load_code(description: Path | None) -> str:
     if description is None:
         return 'model = eomgen.load(eomgen.example_path("planar_2link"))'
     return f"model = eomgen.load({str(Path(description).resolve())!r})"
+
+
+def _teaching_sized(model: RobotModel) -> bool:
+    """Whether the notebook shows the textbook derivation: the bound of the LaTeX document and
+    the display, checked on the straight-line program before anything is expanded."""
+    from .codegen.backends.latex_backend import teaching_sized
+    from .dynamics import derive
+
+    return teaching_sized(derive(model, simplify=False))
 
 
 def build_notebook(model: RobotModel, description: Path | None = None) -> nbformat.NotebookNode:
@@ -48,7 +58,7 @@ def build_notebook(model: RobotModel, description: Path | None = None) -> nbform
         raise ParameterError(model.source, "parameters",
                              "the notebook's numeric cells need a value for "
                              + ", ".join(missing))
-    small = model.dof <= TEXTBOOK_MAX_DOF
+    small = model.dof <= TEXTBOOK_MAX_DOF and _teaching_sized(model)
     cells = []
 
     def md(text: str) -> None:
@@ -153,8 +163,9 @@ for (i, j, k), value in book.christoffel:
 
 `{model.name}` has {model.dof} joints: the body-by-body textbook derivation (expanded
 expressions, exponential in the number of joints) is shown for models of at most
-{TEXTBOOK_MAX_DOF} joints. `eomgen.derive` computes M, C and g as a straight-line program
-without expression swell; its size:
+{TEXTBOOK_MAX_DOF} joints whose program has at most {TEXTBOOK_MAX_OPERATIONS} operations.
+`eomgen.derive` computes M, C and g as a straight-line program without expression swell; its
+size (`dyn.lambdify()` turns it into NumPy functions):
 """)
         code('{name: dyn.operation_count([name]) for name in dyn.outputs}')
     md("## The equations of motion\n\n$M(q)\\,\\ddot q + C(q, \\dot q)\\,\\dot q + g(q) = "
