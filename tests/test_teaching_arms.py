@@ -300,3 +300,28 @@ def test_lambdify_equals_the_generated_numpy_module(tmp_path):
                          (f.g(q, **params), module.gravity_vector(q, **params)),
                          (f.tau(q, qd, qdd, **params), module.inverse_dynamics(q, qd, qdd, **params))):
         np.testing.assert_allclose(ours, theirs, rtol=1e-13, atol=1e-13)
+
+
+def test_large_models_are_bounded_before_anything_is_expanded():
+    """A 3-joint arm with general axes and offsets (the issue's robot whose display ran for
+    20 minutes): its program is above the shared bound, so derive does not simplify, the
+    display shows the summary and the notebook leaves out the textbook cells, all decided on
+    the straight-line program alone."""
+    from dataclasses import replace
+
+    from reference import random_robot
+
+    from eomgen.notebook import build_notebook
+    from eomgen.symbolic.textbook import TEXTBOOK_MAX_OPERATIONS
+
+    model = replace(random_robot(np.random.default_rng(0), 3), name="general_arm")
+    dyn = eomgen.derive(model)
+    assert dyn.operation_count(["M", "C", "g"]) > TEXTBOOK_MAX_OPERATIONS
+    assert not dyn.simplified
+    assert "teaching-sized models" in dyn._repr_latex_()
+    assert not any("textbook_derivation" in cell.source for cell in build_notebook(model).cells)
+    # the teaching arms are well inside the bound, and keep the textbook form
+    for name in ARMS:
+        small = dynamics(name)
+        assert small.simplified
+        assert small.operation_count(["M", "C", "g"]) <= TEXTBOOK_MAX_OPERATIONS

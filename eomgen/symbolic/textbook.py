@@ -14,11 +14,15 @@ For each moving body i (a movable joint's child link with its fixed descendants 
   ``c_ijk = ½ (∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i)``, with ``C_ij = Σ_k c_ijk q̇_k``;
 * ``g_i = ∂P/∂q_i`` with ``P = Σ_i P_i``.
 
-Everything is expanded and written as sums of harmonics of the joint angles
-(:func:`simplify_trig`): the derivation as printed in textbooks. Expanded expressions grow
-exponentially with the number of joints, so this is for models of at most
-:data:`TEXTBOOK_MAX_DOF` joints. :func:`eomgen.derive` computes the same M, C, g without
-expression swell; the tests check that the two agree.
+Everything is computed in one sparse polynomial ring over ``sin q_i``, ``cos q_i``, the
+parameters and the velocities, reduced with ``sin² + cos² = 1``, and written as a textbook
+does: products of sines and cosines of the joint angles, or of the absolute angles
+``q_2 + q_3`` along chains of parallel revolute axes (whichever has fewer terms), with
+``cos²`` or ``sin²`` chosen per parameter group (``I_x2 sin² q_2 + I_y2 cos² q_2``).
+Expanded expressions grow exponentially with the number of joints, so this is for models of at
+most :data:`TEXTBOOK_MAX_DOF` joints (and, by default, :data:`TEXTBOOK_MAX_OPERATIONS`).
+:func:`eomgen.derive` computes the same M, C, g without expression swell; the tests check that
+the two agree. (:func:`fourier_form` gives the alternative canonical form, sums of harmonics.)
 """
 
 from __future__ import annotations

@@ -30,8 +30,7 @@ import sympy as sp
 from ... import __version__
 from ...dynamics import Dynamics
 from ...model import IDENTITY3, RobotModel
-from ...symbolic.textbook import (TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS, TextbookDerivation,
-                                  textbook_derivation)
+from ...symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS, TextbookDerivation
 from .. import GeneratedFile, Job, register
 from ..render import render
 from .latex_printer import DerivationLatexPrinter, display_width, latex_comment, latex_escape
@@ -173,7 +172,8 @@ def textbook_for(dynamics: Dynamics,
     :class:`LatexConfig`), else None: documents then print the straight-line program."""
     if not teaching_sized(dynamics, config):
         return None
-    book = textbook_derivation(dynamics.model, max_dof=config.textbook_max_dof)
+    # computed once per Dynamics, shared with dyn.M and the display
+    book = dynamics.textbook
     return book if expanded_size(book) <= config.textbook_max_size else None
 
 
