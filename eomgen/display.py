@@ -70,13 +70,16 @@ def readable_matrices(dynamics: Dynamics) -> dict | None:
     textbook derivation, entries of M grouped by body mass, those of g by trigonometric
     factor), or None when the model is not teaching-sized (the bounds of
     :func:`eomgen.codegen.backends.latex_backend.textbook_for`, checked on the program's size
-    before anything is expanded)."""
+    before anything is expanded) and ``derive(..., simplify=True)`` did not force it."""
     from .codegen.backends.latex_backend import textbook_for
     from .teach import readability as rd
 
-    book = textbook_for(dynamics)
-    if book is None:
-        return None
+    if dynamics.simplified:  # derive(..., simplify=True) asked for it whatever the size
+        book = dynamics.textbook
+    else:
+        book = textbook_for(dynamics)
+        if book is None:
+            return None
     masses = [b.mass for b in book.bodies if isinstance(b.mass, sp.Symbol)]
     angles = list(dynamics.q)
     return {"M": book.M.applyfunc(lambda e: rd.mass_grouped(e, masses)),
@@ -104,11 +107,14 @@ def dynamics_latex(dynamics: Dynamics, max_dof: int = DISPLAY_MAX_DOF) -> str:
         counts = ",\\ ".join(
             _text(f"{name}: {dynamics.operation_count([name])} operations")
             for name in dynamics.outputs)
-        why = (f"models of at most {max_dof} joints" if model.dof > max_dof
-               else "teaching-sized models (this one's expanded M, C, g are too large)")
+        if model.dof > max_dof:
+            why = f"models of at most {max_dof} joints"
+        else:
+            why = ("teaching-sized models; derive(model, simplify=True) forces the expanded "
+                   "textbook form, which takes long for this one")
         return ("$$\\begin{array}{l}" + title + r"\\ " + counts + r"\\ "
-                + _text(f"(M, C, g are shown for {why}; see dynamics.M, .C, .g, "
-                        "dynamics.lambdify())") + r"\end{array}$$")
+                + _text(f"(M, C, g are shown for {why}; numbers: dynamics.lambdify())")
+                + r"\end{array}$$")
     printer = _printer(dynamics)
     lines = [title]
     for name in ("M", "C", "g"):
