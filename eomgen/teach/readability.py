@@ -82,8 +82,9 @@ def group_by_factor(expr: sp.Expr, key: Callable[[sp.Expr], sp.Expr | None],
 
 def perfect_power(expr: sp.Expr) -> sp.Expr:
     """``expr`` written as a power (``a_2^2 c_2^2 + 2 a_2 l_{c3} c_2 c_{23} + l_{c3}^2 c_{23}^2``
-    → ``(a_2 c_2 + l_{c3} c_{23})^2``, the textbook's form of a point's squared distance) when it
-    is a number times a power of a sum, else ``expr`` unchanged.
+    → ``(a_2 c_2 + l_{c3} c_{23})^2``, the textbook's form of a point's squared distance) or a
+    product of sums (``(a_2 c_2 + l_{c3} c_{23}) (a_2 s_2 + l_{c3} s_{23})``) when it is a
+    number times one, else ``expr`` unchanged.
 
     >>> a, b, x = sp.symbols("a b x")
     >>> perfect_power(a**2*sp.cos(x)**2 + 2*a*b*sp.cos(x) + b**2)
@@ -96,6 +97,9 @@ def perfect_power(expr: sp.Expr) -> sp.Expr:
     factored = sp.factor(expr)
     coefficient, rest = factored.as_coeff_Mul()
     if rest.is_Pow and rest.exp.is_Integer and rest.exp >= 2 and rest.base.is_Add:
+        return factored
+    factors = sp.Mul.make_args(rest)  # a product of sums only: (a c_2 + b c_23)(a s_2 + b s_23)
+    if len(factors) >= 2 and all(f.is_Add or (f.is_Pow and f.base.is_Add) for f in factors):
         return factored
     return expr
 
