@@ -150,7 +150,8 @@ class Dynamics:
     @cached_property
     def tau(self) -> sp.Matrix:
         """Inverse dynamics τ = M q̈ + C q̇ + g, n×1: from the Newton–Euler program when it was
-        derived (``outputs`` with ``"tau"``), else formed from M, C and g."""
+        derived (``outputs`` with ``"tau"``), else formed from M, C and g; in reduced textbook
+        form (from :attr:`textbook`'s M, C, g) when ``simplified``."""
         if "tau" in self.outputs:
             return self._expanded("tau")
         return self.M * sp.Matrix(self.qdd) + self.C * sp.Matrix(self.qd) + self.g
