@@ -119,8 +119,26 @@ def dynamics_latex(dynamics: Dynamics, max_dof: int = DISPLAY_MAX_DOF) -> str:
     lines = [title]
     for name in ("M", "C", "g"):
         if name in dynamics.outputs:
-            lines.append(f"{name} = {printer.doprint(matrices[name])}")
+            lines.append(f"{name} = {_matrix_latex(printer, matrices[name])}")
     return "$$\\begin{array}{l}" + r"\\[1ex] ".join(lines) + r"\end{array}$$"
+
+
+def _matrix_latex(printer, matrix) -> str:
+    """A ``pmatrix``; the grouped sums of :func:`readable_matrices` keep their order (masses
+    first, as the LaTeX document and the handout print them)."""
+    def entry(e):
+        if e.is_Add and _unevaluated(e):
+            return printer.print_sum_lines(list(e.args), 10 ** 9)[0]
+        return printer.doprint(e)
+
+    rows = [" & ".join(entry(matrix[r, c]) for c in range(matrix.cols))
+            for r in range(matrix.rows)]
+    return r"\begin{pmatrix}" + r"\\".join(rows) + r"\end{pmatrix}"
+
+
+def _unevaluated(e) -> bool:
+    """Whether the sum ``e`` was built with ``evaluate=False`` (a grouped sum)."""
+    return e.args != sp.Add(*e.args).args
 
 
 def expression_latex(dynamics: Dynamics, expr) -> str:

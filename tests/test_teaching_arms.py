@@ -251,16 +251,22 @@ def test_elbow_prints_in_textbook_form():
 
 
 def test_display_and_documents_share_the_reduced_form():
-    """The Jupyter display, the handout and the LaTeX document print M from the same
-    derivation: the textbook derivation's entries."""
+    """The Jupyter display and the LaTeX document print M and g from the same derivation
+    (``dyn.textbook``), grouped the same way, with the same printer."""
+    from eomgen.codegen import make_job
+    from eomgen.codegen.backends.latex_backend import render_document
     from eomgen.display import readable_matrices
 
-    dyn = dynamics("elbow_rrr")
+    dyn = eomgen.derive(eomgen.load(example_path("elbow_rrr")), outputs=("M", "C", "g", "tau"))
     shown = readable_matrices(dyn)
-    assert shown is not None
+    assert shown is not None and dyn.M is dyn.textbook.M
     assert (shown["M"].applyfunc(lambda e: e.doit()) - dyn.textbook.M).applyfunc(sp.expand) \
         == sp.zeros(3, 3)
-    assert dyn.M is dyn.textbook.M
+    document = render_document(make_job(dyn))
+    tex = dyn._repr_latex_()
+    for lhs in ("M_{1,1}", "M_{2,2}", "g_{2}"):
+        line = next(line for line in document.splitlines() if line.startswith(lhs + " &= "))
+        assert line[len(lhs + " &= "):] in tex
 
 
 def test_numbers_print_as_short_decimals():

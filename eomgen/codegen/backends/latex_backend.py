@@ -343,7 +343,14 @@ def _textbook_sections(job: Job, book: TextbookDerivation, p: Printing) -> dict:
             "kinematics": p.chunks(kinematics),
             "energies": p.chunks(energies),
         })
-    M = [p.equation(f"M_{{{i + 1},{j + 1}}}", book.M[i, j]) for i in range(n) for j in range(i, n)]
+    from ...teach import readability as rd  # the handout's and the display's grouping
+
+    def grouped(lhs, terms):
+        return Equation(lhs, p.printer.print_sum_lines(terms or [sp.Integer(0)], p.width))
+
+    masses = [b.mass for b in book.bodies if isinstance(b.mass, sp.Symbol)]
+    M = [grouped(f"M_{{{i + 1},{j + 1}}}", rd.by_mass(book.M[i, j], masses))
+         for i in range(n) for j in range(i, n)]
     christoffel = []
     for (i, j, k), value in book.christoffel:
         lhs = rf"\Gamma_{{{i + 1},{j + 1},{k + 1}}}"
@@ -351,8 +358,8 @@ def _textbook_sections(job: Job, book: TextbookDerivation, p: Printing) -> dict:
             lhs += rf" = \Gamma_{{{i + 1},{k + 1},{j + 1}}}"
         christoffel.append(p.equation(lhs, value))
     C = [p.equation(f"C_{{{i + 1},{j + 1}}}", book.C[i, j]) for i in range(n) for j in range(n)]
-    g = [p.equation(f"g_{{{i + 1}}}", book.g[i]) for i in range(n)]
     dyn = job.dynamics
+    g = [grouped(f"g_{{{i + 1}}}", rd.by_trig(book.g[i], list(dyn.q))) for i in range(n)]
     equations = []
     for i in range(n):
         terms = [book.M[i, j] * dyn.qdd[j] for j in range(n) if book.M[i, j] != 0]
