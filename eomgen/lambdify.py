@@ -67,10 +67,10 @@ def lambdify(dynamics: Dynamics) -> NumericDynamics:
     >>> import numpy as np, eomgen
     >>> dyn = eomgen.derive(eomgen.load(eomgen.example_path("planar_2link")))
     >>> f = dyn.lambdify()
-    >>> f.parameters[:3]
-    ('m1', 'm2', 'l1')
+    >>> f.parameters[:3]  # sorted by name; g_ because g is the gravity vector's name
+    ('I1', 'I2', 'g_')
     >>> np.round(f.g(np.zeros(2), m2=2.0), 4)
-    array([19.62 ,  9.81])
+    array([34.335,  9.81 ])
     """
     from .codegen import make_job
     from .codegen.backends.common import python_module_context
