@@ -13,6 +13,8 @@ from __future__ import annotations
 import html
 from typing import TYPE_CHECKING
 
+import sympy as sp
+
 if TYPE_CHECKING:
     from .dynamics import Dynamics
     from .model import RobotModel
@@ -52,12 +54,9 @@ def model_html(model: RobotModel) -> str:
 
 
 def _printer(dynamics: Dynamics):
-    from .codegen.backends.latex_backend import symbol_names
-    from .codegen.backends.latex_printer import DerivationLatexPrinter
+    from .codegen.backends.latex_backend import LatexConfig, printing
 
-    return DerivationLatexPrinter({"joint_positions": dynamics.q,
-                                   "symbol_names": symbol_names(dynamics),
-                                   "mat_str": "pmatrix", "mat_delim": ""})
+    return printing(dynamics, LatexConfig(), compact_trig=True).printer
 
 
 def _text(value: str) -> str:
@@ -66,8 +65,35 @@ def _text(value: str) -> str:
     return r"\text{" + latex_escape(value) + "}"
 
 
+def readable_matrices(dynamics: Dynamics) -> dict | None:
+    """M, C and g of ``dynamics`` as the LaTeX document and the handout print them (the
+    textbook derivation, entries of M grouped by body mass, those of g by trigonometric
+    factor), or None when the model is not teaching-sized (the bounds of
+    :func:`eomgen.codegen.backends.latex_backend.textbook_for`, checked on the program's size
+    before anything is expanded) and ``derive(..., simplify=True)`` did not force it."""
+    from .codegen.backends.latex_backend import textbook_for
+    from .teach import readability as rd
+
+    if dynamics.simplified:  # derive(..., simplify=True) asked for it whatever the size
+        book = dynamics.textbook
+    else:
+        book = textbook_for(dynamics)
+        if book is None:
+            return None
+    masses = [b.mass for b in book.bodies if isinstance(b.mass, sp.Symbol)]
+    angles = list(dynamics.q)
+    return {"M": book.M.applyfunc(lambda e: rd.mass_grouped(e, masses)),
+            "C": book.C,
+            "g": book.g.applyfunc(lambda e: rd.trig_grouped(e, angles))}
+
+
 def dynamics_latex(dynamics: Dynamics, max_dof: int = DISPLAY_MAX_DOF) -> str:
     """LaTeX (one ``$$…$$`` display) of ``dynamics``: M, C, g for small models, else a summary.
+
+    Small models (at most ``max_dof`` joints and within the size bounds of
+    :func:`readable_matrices`) show M, C and g in the reduced forms of the LaTeX document and
+    the handout; others show the operation counts of the straight-line program, which cost
+    nothing to compute.
 
     >>> import eomgen
     >>> tex = dynamics_latex(eomgen.derive(eomgen.load(eomgen.example_path("planar_2link"))))
@@ -76,19 +102,43 @@ def dynamics_latex(dynamics: Dynamics, max_dof: int = DISPLAY_MAX_DOF) -> str:
     """
     model = dynamics.model
     title = _text(f"{model.name}: {model.dof} joints ({', '.join(model.joint_names)})")
-    if model.dof > max_dof:
+    matrices = readable_matrices(dynamics) if model.dof <= max_dof else None
+    if matrices is None:
         counts = ",\\ ".join(
             _text(f"{name}: {dynamics.operation_count([name])} operations")
             for name in dynamics.outputs)
+        if model.dof > max_dof:
+            why = f"models of at most {max_dof} joints"
+        else:
+            why = ("teaching-sized models; derive(model, simplify=True) forces the expanded "
+                   "textbook form, which takes long for this one")
         return ("$$\\begin{array}{l}" + title + r"\\ " + counts + r"\\ "
-                + _text("(M, C, g are shown for models of at most "
-                        f"{max_dof} joints; see dynamics.M, .C, .g)") + r"\end{array}$$")
+                + _text(f"(M, C, g are shown for {why}; numbers: dynamics.lambdify())")
+                + r"\end{array}$$")
     printer = _printer(dynamics)
     lines = [title]
     for name in ("M", "C", "g"):
         if name in dynamics.outputs:
-            lines.append(f"{name} = {printer.doprint(getattr(dynamics, name))}")
+            lines.append(f"{name} = {_matrix_latex(printer, matrices[name])}")
     return "$$\\begin{array}{l}" + r"\\[1ex] ".join(lines) + r"\end{array}$$"
+
+
+def _matrix_latex(printer, matrix) -> str:
+    """A ``pmatrix``; the grouped sums of :func:`readable_matrices` keep their order (masses
+    first, as the LaTeX document and the handout print them)."""
+    def entry(e):
+        if e.is_Add and _unevaluated(e):
+            return printer.print_sum_lines(list(e.args), 10 ** 9)[0]
+        return printer.doprint(e)
+
+    rows = [" & ".join(entry(matrix[r, c]) for c in range(matrix.cols))
+            for r in range(matrix.rows)]
+    return r"\begin{pmatrix}" + r"\\".join(rows) + r"\end{pmatrix}"
+
+
+def _unevaluated(e) -> bool:
+    """Whether the sum ``e`` was built with ``evaluate=False`` (a grouped sum)."""
+    return e.args != sp.Add(*e.args).args
 
 
 def expression_latex(dynamics: Dynamics, expr) -> str:

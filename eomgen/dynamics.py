@@ -23,6 +23,7 @@ from .model import Parameter, RobotModel
 from .symbolic.composite import derive_program
 from .symbolic.newton_euler import inverse_dynamics_program
 from .symbolic.program import Program, ProgramBuilder
+from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS
 
 #: What :func:`derive` can build: the mass matrix, Coriolis matrix, gravity vector and the
 #: inverse dynamics τ(q, q̇, q̈) (by a symbolic Newton–Euler pass; cheaper to evaluate).
@@ -96,13 +97,28 @@ class Dynamics:
     def _full(self) -> dict:
         return self.program.expanded()
 
+    @cached_property
+    def textbook(self):
+        """The body-by-body textbook derivation of the model
+        (:class:`eomgen.symbolic.textbook.TextbookDerivation`): M, C, g reduced with
+        ``sin² + cos² = 1``, in angle sums ``cos(q2 + q3)`` along parallel joint axes, exact
+        numbers. Computed in a polynomial ring (seconds for 3 joints), on first use."""
+        from .symbolic.textbook import textbook_derivation
+
+        return textbook_derivation(self.model, max_dof=MAX_SIMPLIFY_JOINTS)
+
     def _expanded(self, name: str) -> sp.Matrix:
         if name not in self.outputs:
             raise KeyError(f"{name} was not derived (outputs: {', '.join(self.outputs)})")
-        matrix = self.program.expand(self.program.output(name), self._full)
         if self.simplified:
-            matrix = matrix.applyfunc(lambda e: sp.factor_terms(sp.trigsimp(sp.expand(e))))
-        return matrix
+            book = self.textbook
+            if name == "P":
+                return sp.Matrix([[book.P]])
+            if name == "tau":
+                tau = book.M * sp.Matrix(self.qdd) + book.C * sp.Matrix(self.qd) + book.g
+                return tau.applyfunc(lambda e: sp.factor_terms(sp.expand(e)))
+            return getattr(book, name)
+        return self.program.expand(self.program.output(name), self._full)
 
     @cached_property
     def M(self) -> sp.Matrix:
@@ -134,7 +150,8 @@ class Dynamics:
     @cached_property
     def tau(self) -> sp.Matrix:
         """Inverse dynamics τ = M q̈ + C q̇ + g, n×1: from the Newton–Euler program when it was
-        derived (``outputs`` with ``"tau"``), else formed from M, C and g."""
+        derived (``outputs`` with ``"tau"``), else formed from M, C and g; in reduced textbook
+        form (from :attr:`textbook`'s M, C, g) when ``simplified``."""
         if "tau" in self.outputs:
             return self._expanded("tau")
         return self.M * sp.Matrix(self.qdd) + self.C * sp.Matrix(self.qd) + self.g
@@ -142,6 +159,15 @@ class Dynamics:
     def operation_count(self, names: Iterable[str] | None = None) -> int:
         """Arithmetic operations of the straight-line program for the given outputs."""
         return self.program.operation_count(names)
+
+    def lambdify(self):
+        """NumPy functions ``M(q, **p)``, ``C(q, qd, **p)``, ``g(q, **p)``,
+        ``tau(q, qd, qdd, **p)`` compiled from the program (not from expanded matrices): the
+        generated NumPy module's functions, with the parameters kept symbolic as keyword
+        arguments. See :class:`eomgen.lambdify.NumericDynamics`."""
+        from .lambdify import lambdify
+
+        return lambdify(self)
 
     def _repr_latex_(self) -> str:  # rich display in notebooks: see eomgen.display
         from .display import dynamics_latex
@@ -160,9 +186,16 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
         Which of ``"M"``, ``"C"``, ``"g"``, ``"tau"`` to derive; what is not asked is not
         computed.
     simplify:
-        Trig-simplify the expanded expressions (``dynamics.M`` etc.). ``None`` (default) does it
-        for teaching-sized models (at most 3 joints) only: it is exponential in the model size.
-        ``True`` is refused above :data:`MAX_SIMPLIFY_JOINTS` joints.
+        Give ``dynamics.M``, ``.C``, ``.g``, ``.P``, ``.tau`` in reduced textbook form (those of
+        :attr:`Dynamics.textbook`: ``sin² + cos² = 1`` applied, angle sums along parallel
+        axes, exact numbers) instead of the program's expressions substituted into each other.
+        ``None`` (default) does it for teaching-sized models only (at most
+        :data:`~eomgen.symbolic.textbook.TEXTBOOK_MAX_DOF` joints and a program of at most
+        :data:`~eomgen.symbolic.textbook.TEXTBOOK_MAX_OPERATIONS` operations, an estimate of
+        the cost known before anything is expanded): the expanded form grows exponentially
+        with the model size. ``True`` forces it (a 3-joint arm with general axes: tens of
+        seconds). ``True`` is refused above
+        :data:`MAX_SIMPLIFY_JOINTS` joints.
 
     Returns
     -------
@@ -206,8 +239,10 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     names = [name for name in ("M", "C", "g", "P", "tau") if name in result]
     program = Program(tuple(builder.assignments), tuple((n, result[n]) for n in names)).pruned(names)
     steps = _steps(program, result)
-    if simplify is None:
-        simplify = model.dof <= 3
+    if simplify is None:  # teaching-sized: few joints and a small program (a cheap estimate)
+        counted = [o for o in ("M", "C", "g") if o in outputs]
+        simplify = model.dof <= TEXTBOOK_MAX_DOF and (
+            not counted or program.operation_count(counted) <= TEXTBOOK_MAX_OPERATIONS)
     return Dynamics(model, q, qd, qdd, program, steps, tuple(timings), bool(simplify))
 
 

@@ -2,7 +2,8 @@
 (``eomgen notebook``).
 
 Sections, each a short explanation followed by a code cell using eomgen's API: loading the
-robot; for models of at most :data:`~eomgen.symbolic.textbook.TEXTBOOK_MAX_DOF` joints the
+robot; for teaching-sized models (at most :data:`~eomgen.symbolic.textbook.TEXTBOOK_MAX_DOF`
+joints and :data:`~eomgen.symbolic.textbook.TEXTBOOK_MAX_OPERATIONS` program operations) the
 textbook derivation (centre-of-mass positions, Jacobians, kinetic and potential energy per link,
 M, Christoffel symbols, C, g); the equations of motion; the property checks of
 :func:`eomgen.verify`; a comparison with the numeric Newton–Euler algorithm at a sample state;
@@ -24,7 +25,7 @@ from nbformat import v4
 
 from .errors import ParameterError
 from .model import RobotModel
-from .symbolic.textbook import TEXTBOOK_MAX_DOF
+from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS
 
 
 def _load_code(description: Path | None, scene: Path | None = None) -> str:
@@ -36,6 +37,15 @@ def _load_code(description: Path | None, scene: Path | None = None) -> str:
         code += ("\nfrom eomgen.reduction import apply_scene\nfrom eomgen.scene import load_scene"
                  f"\nmodel = apply_scene(model, load_scene({str(Path(scene).resolve())!r})).model")
     return code
+
+
+def _teaching_sized(model: RobotModel) -> bool:
+    """Whether the notebook shows the textbook derivation: the bound of the LaTeX document and
+    the display, checked on the straight-line program before anything is expanded."""
+    from .codegen.backends.latex_backend import teaching_sized
+    from .dynamics import derive
+
+    return teaching_sized(derive(model, simplify=False))
 
 
 def build_notebook(model: RobotModel, description: Path | None = None,
@@ -55,7 +65,7 @@ def build_notebook(model: RobotModel, description: Path | None = None,
         raise ParameterError(model.source, "parameters",
                              "the notebook's numeric cells need a value for "
                              + ", ".join(missing))
-    small = model.dof <= TEXTBOOK_MAX_DOF
+    small = model.dof <= TEXTBOOK_MAX_DOF and _teaching_sized(model)
     cells = []
 
     def md(text: str) -> None:
@@ -160,8 +170,9 @@ for (i, j, k), value in book.christoffel:
 
 `{model.name}` has {model.dof} joints: the body-by-body textbook derivation (expanded
 expressions, exponential in the number of joints) is shown for models of at most
-{TEXTBOOK_MAX_DOF} joints. `eomgen.derive` computes M, C and g as a straight-line program
-without expression swell; its size:
+{TEXTBOOK_MAX_DOF} joints whose program has at most {TEXTBOOK_MAX_OPERATIONS} operations.
+`eomgen.derive` computes M, C and g as a straight-line program without expression swell; its
+size (`dyn.lambdify()` turns it into NumPy functions):
 """)
         code('{name: dyn.operation_count([name]) for name in dyn.outputs}')
     md("## The equations of motion\n\n$M(q)\\,\\ddot q + C(q, \\dot q)\\,\\dot q + g(q) = "
@@ -210,7 +221,9 @@ assert np.allclose(tau, tau_rnea, rtol=1e-9, atol=1e-9)
 ## A short simulation
 
 Forward dynamics $\\ddot q = M^{-1}(\\tau - C \\dot q - g)$ with $\\tau = 0$ (the robot falls
-under gravity), integrated with SciPy's `solve_ivp`.
+under gravity), integrated with SciPy's `solve_ivp` in steps of 0.1 s. A very stiff robot (a
+tiny inertia next to a large one) would need millions of steps: the simulation stops after
+`budget` evaluations of the dynamics and says so, so that the notebook always finishes.
 """)
     code("""
 import io
@@ -223,20 +236,40 @@ import matplotlib.pyplot as plt
 from scipy.integrate import solve_ivp
 
 
+budget = 50_000
+calls = 0
+
+
+class OverBudget(Exception):
+    pass
+
+
 def rhs(t, state):
+    global calls
+    calls += 1
+    if calls > budget:
+        raise OverBudget
     q, qd = state[:n], state[n:]
     out = evaluate(*q, *qd, *values)
     qdd = np.linalg.solve(out["M"], -out["C"] @ qd - out["g"][:, 0])
     return np.concatenate([qd, qdd])
 
 
-times = np.linspace(0.0, 2.0, 201)
-solution = solve_ivp(rhs, (times[0], times[-1]), np.concatenate([q0, np.zeros(n)]),
-                     t_eval=times, rtol=1e-8, atol=1e-10)
-assert solution.success, solution.message
+t_all, y_all = [0.0], [np.concatenate([q0, np.zeros(n)])]
+for start in np.arange(0.0, 2.0, 0.1):
+    try:
+        chunk = solve_ivp(rhs, (start, start + 0.1), y_all[-1], rtol=1e-8, atol=1e-10,
+                          t_eval=np.linspace(start, start + 0.1, 11)[1:])
+    except OverBudget:
+        print(f"stopped at t = {start:.1f} s after {budget} evaluations: the robot is stiff")
+        break
+    assert chunk.success, chunk.message
+    t_all += list(chunk.t)
+    y_all += list(chunk.y.T)
+t_all, y_all = np.array(t_all), np.array(y_all).T
 fig, ax = plt.subplots(figsize=(7, 3.5))
 for k, name in enumerate(dyn.joint_names):
-    ax.plot(solution.t, solution.y[k], label=name)
+    ax.plot(t_all, y_all[k], label=name)
 ax.set_xlabel("time [s]")
 ax.set_ylabel("joint position")
 ax.legend()

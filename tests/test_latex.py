@@ -333,7 +333,7 @@ def test_planar_document_has_the_textbook_entries_in_compact_form():
     assert all(line.startswith("% ") for line in tex.splitlines()[:3])
     assert "do not edit by hand" in tex and r"\texttt{planar\_2link}" in tex
     M11 = equation(tex, "M_{1,1}")
-    assert "c_{2}" in M11 and "l_{c1}^{2} m_{1}" in M11 and r"\cos" not in M11
+    assert "c_{2}" in M11 and "m_{1} l_{c1}^{2}" in M11 and r"\cos" not in M11  # grouped by mass
     assert "s_{2}" in equation(tex, "C_{1,1}") and "s_{2}" in equation(tex, "C_{1,2}")
     assert equation(tex, "C_{2,2}") == "0"
     assert "c_{12}" in equation(tex, "g_{1}") and "c_{12}" in equation(tex, "g_{2}")

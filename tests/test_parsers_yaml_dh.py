@@ -175,7 +175,9 @@ def pin_M_g(model: RobotModel, q):
 
 
 def test_examples_are_package_data():
-    assert DEFAULT == "planar_2link" and set(EXAMPLES) == {"planar_2link", "puma560_dh"}
+    assert DEFAULT == "planar_2link" and set(EXAMPLES) == {
+        "planar_2link", "puma560_dh", "elbow_rrr", "scara_rrp", "stanford_rrp",
+        "cylindrical_rpp", "puma560_arm3"}
     package_dir = Path(eomgen.__file__).resolve().parent
     for name, path in EXAMPLES.items():
         assert example_path(name) == path and path.is_file()

@@ -56,14 +56,16 @@ class Job:
         ]
 
 
-def make_job(dynamics: Dynamics, functions=None, notes=()) -> Job:
+def make_job(dynamics: Dynamics, functions=None, notes=(), count_operations: bool = True) -> Job:
     """Build the specs shared by every backend from dynamics derived with the outputs that
     ``functions`` need (default: all functions, hence M, C, g and tau; see
-    :func:`~eomgen.codegen.functions.select_functions`). ``notes`` are extra header lines."""
+    :func:`~eomgen.codegen.functions.select_functions`). ``notes`` are extra header lines;
+    ``count_operations=False`` leaves the operation counts of the header at 0 (faster)."""
     source = Path(dynamics.model.source)
     digest = hashlib.sha256(source.read_bytes()).hexdigest() if source.is_file() else "0" * 64
     chosen = select_functions(functions)
-    return Job(dynamics, function_specs(dynamics, chosen), parameter_arguments(dynamics),
+    return Job(dynamics, function_specs(dynamics, chosen, count_operations),
+               parameter_arguments(dynamics),
                module_name(dynamics.model.name), source.name, digest, chosen, tuple(notes))
 
 

@@ -199,10 +199,13 @@ def derived_outputs(functions=None) -> tuple[str, ...]:
     return tuple(o for o in ALL_OUTPUTS if o in needed)
 
 
-def function_specs(dynamics: Dynamics, functions=None) -> tuple[FunctionSpec, ...]:
+def function_specs(dynamics: Dynamics, functions=None,
+                   count_operations: bool = True) -> tuple[FunctionSpec, ...]:
     """The specs of the printed functions among ``functions`` (default: all; see
     :func:`select_functions`), from dynamics derived with the outputs they need.
-    ``forward_dynamics`` has no spec: backends compose it."""
+    ``forward_dynamics`` has no spec: backends compose it. Without ``count_operations`` the
+    specs' ``operation_count`` is 0 (counting costs as much as printing; files need it for their
+    header, in-memory modules do not)."""
     vectors = {"q": dynamics.q, "qd": dynamics.qd, "qdd": dynamics.qdd}
     chosen = select_functions(functions)
     specs = []
@@ -220,7 +223,7 @@ def function_specs(dynamics: Dynamics, functions=None) -> tuple[FunctionSpec, ..
             output=program.output(output),
             is_vector=is_vector,
             program=program,
-            operation_count=program.operation_count(),
+            operation_count=program.operation_count() if count_operations else 0,
             units=units,
         ))
     return tuple(specs)

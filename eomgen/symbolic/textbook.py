@@ -14,11 +14,15 @@ For each moving body i (a movable joint's child link with its fixed descendants 
   ``c_ijk = ½ (∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i)``, with ``C_ij = Σ_k c_ijk q̇_k``;
 * ``g_i = ∂P/∂q_i`` with ``P = Σ_i P_i``.
 
-Everything is expanded and written as sums of harmonics of the joint angles
-(:func:`simplify_trig`): the derivation as printed in textbooks. Expanded expressions grow
-exponentially with the number of joints, so this is for models of at most
-:data:`TEXTBOOK_MAX_DOF` joints. :func:`eomgen.derive` computes the same M, C, g without
-expression swell; the tests check that the two agree.
+Everything is computed in one sparse polynomial ring over ``sin q_i``, ``cos q_i``, the
+parameters and the velocities, reduced with ``sin² + cos² = 1``, and written as a textbook
+does: products of sines and cosines of the joint angles, or of the absolute angles
+``q_2 + q_3`` along chains of parallel revolute axes (whichever has fewer terms), with
+``cos²`` or ``sin²`` chosen per parameter group (``I_x2 sin² q_2 + I_y2 cos² q_2``).
+Expanded expressions grow exponentially with the number of joints, so this is for models of at
+most :data:`TEXTBOOK_MAX_DOF` joints (and, by default, :data:`TEXTBOOK_MAX_OPERATIONS`).
+:func:`eomgen.derive` computes the same M, C, g without expression swell; the tests check that
+the two agree. (:func:`fourier_form` gives the alternative canonical form, sums of harmonics.)
 """
 
 from __future__ import annotations
@@ -34,6 +38,13 @@ from ..model import IDENTITY3, RobotModel, Transform, ZERO3, joint_motion
 
 #: Largest number of joints for which the textbook derivation is computed by default.
 TEXTBOOK_MAX_DOF = 3
+
+#: Largest straight-line program (operations of M, C and g, see
+#: :meth:`eomgen.Dynamics.operation_count`) for which the textbook derivation is computed by
+#: default: a cheap estimate of its cost, known before anything is expanded. The bundled
+#: teaching arms have 400-550 operations and take about a second; a 3-joint arm with general
+#: axes and offsets of 1500 operations takes 20 s.
+TEXTBOOK_MAX_OPERATIONS = 1200
 
 #: In a sum with floating-point coefficients, terms whose coefficient is smaller than this
 #: fraction of the largest coefficient are rounding noise of the description's numbers (e.g.
@@ -323,16 +334,25 @@ def textbook_derivation(model: RobotModel, max_dof: int = TEXTBOOK_MAX_DOF) -> T
 
     # The textbook quantities, computed in the polynomial ring.
     gravity = [A(x) for x in model.gravity]
+    zero = A.ring.zero
     axes = []   # world axis of each body's joint (zero for prismatic)
+    for body, pose in zip(tree.bodies, poses):
+        R = [[A(x) for x in row] for row in pose.rotation]
+        axis = [A(x) for x in body.joint.axis]
+        axes.append([A.reduce(sum((R[r][k] * axis[k] for k in range(3)), zero))
+                     for r in range(3)] if body.joint.type.is_revolute else [zero] * 3)
+    # Chains of parallel revolute joints (the elbow arm's shoulder and elbow): write results in
+    # the absolute angles q2 + q3 where that is shorter.
+    A.absolute_angles({body.q_index: tree.bodies[body.parent].q_index
+                       for i, body in enumerate(tree.bodies)
+                       if body.parent >= 0 and body.joint.type.is_revolute
+                       and tree.bodies[body.parent].joint.type.is_revolute
+                       and any(axes[i]) and axes[i] == axes[body.parent]})
     bodies = []
     shares = []
     potentials = []
     for i, (body, pose, (m, c, I_c)) in enumerate(zip(tree.bodies, poses, inputs)):
         R = [[A(x) for x in row] for row in pose.rotation]
-        axis = [A(x) for x in body.joint.axis]
-        zero = A.ring.zero
-        axes.append([sum((R[r][k] * axis[k] for k in range(3)), zero) for r in range(3)]
-                    if body.joint.type.is_revolute else [zero] * 3)
         mass = A(m)
         com = [A(c[r]) for r in range(3)]
         p_c = [A(pose.translation[r]) + sum((R[r][k] * com[k] for k in range(3)), zero)
@@ -385,7 +405,9 @@ class _TrigAlgebra:
     polynomial ring over a field: products and derivatives without SymPy's ``expand``.
 
     ``scalars`` are all the model's expressions the derivation starts from; :meth:`__call__`
-    returns the ring element of one of them.
+    returns the ring element of one of them. A model with floating-point numbers is computed in
+    floating point (its rotations are orthonormal only to rounding, so exact arithmetic would
+    keep the rounding as terms that never cancel); :meth:`expr` drops the rounding noise.
     """
 
     def __init__(self, scalars, q, qd):
@@ -406,6 +428,9 @@ class _TrigAlgebra:
         self.q_gen = elements[at + 2 * n:at + 3 * n]
         self.qd = elements[at + 3 * n:]
         self._pythagoras = [s * s + c * c - 1 for s, c in zip(self.s, self.c)]
+        position = {symbol: k for k, symbol in enumerate(ring.symbols)}
+        self._pair_index = [(position[sp.sin(x)], position[sp.cos(x)]) for x in q]
+        self._angles = None  # see absolute_angles
 
     def reduce(self, f):
         """``f`` modulo ``sin² q_k + cos² q_k = 1``: a canonical form of degree at most one in
@@ -420,6 +445,90 @@ class _TrigAlgebra:
         s, c, x = self.s[k], self.c[k], self.q_gen[k]
         return f.diff(x) + c * f.diff(s) - s * f.diff(c)
 
+    def absolute_angles(self, parent: dict[int, int]) -> None:
+        """Declare chains of parallel revolute joints: ``parent[k] = p`` when joint ``k``'s axis
+        is parallel to that of joint ``p`` just before it, so that body k turns by the absolute
+        angle ``θ_k = θ_p + q_k`` (``θ_p = q_p`` at the start of a chain). :meth:`expr` then
+        writes each result in whichever of the relative angles ``q_k`` or the absolute angles
+        ``θ_k`` (``c_{23} = cos(q_2 + q_3)``) gives it fewer terms."""
+        if not parent:
+            return
+        theta: dict[int, sp.Expr] = {}
+
+        def angle(k):
+            if k not in theta:
+                theta[k] = self.q[k] + angle(parent[k]) if k in parent else self.q[k]
+            return theta[k]
+
+        extra = [f(angle(k)) for k in sorted(parent) for f in (sp.sin, sp.cos)]
+        ring = self.ring.clone(symbols=self.ring.symbols + tuple(extra))
+        width = len(self.ring.symbols)
+        gens = ring.gens[width:]
+        S = {k: g for k, g in zip(sorted(parent), gens[0::2])}
+        C = {k: g for k, g in zip(sorted(parent), gens[1::2])}
+        s = [self._lift(x, ring) for x in self.s]
+        c = [self._lift(x, ring) for x in self.c]
+
+        def absolute(k):  # sin and cos of θ_k in the new ring
+            return (S[k], C[k]) if k in parent else (s[k], c[k])
+
+        rewrite = []
+        for k, p in parent.items():  # q_k = θ_k − θ_p
+            Sk, Ck = absolute(k)
+            Sp, Cp = absolute(p)
+            rewrite += [(s[k], Sk * Cp - Ck * Sp), (c[k], Ck * Cp + Sk * Sp)]
+        pairs = [(S[k], C[k]) for k in sorted(parent)]
+        pairs += [(s[k], c[k]) for k in range(len(self.q)) if k not in parent]
+        self._angles = (ring, rewrite, [a * a + b * b - 1 for a, b in pairs],
+                        [(width + 2 * j, width + 2 * j + 1) for j in range(len(parent))]
+                        + [self._pair_index[k] for k in range(len(self.q)) if k not in parent])
+
+    @staticmethod
+    def _lift(f, ring):
+        """``f`` in ``ring``, which has the generators of ``f.ring`` first and more after."""
+        extra = (0,) * (ring.ngens - f.ring.ngens)
+        return ring({monomial + extra: coefficient for monomial, coefficient in f.terms()})
+
+    def readable(self, f):
+        """``f`` (reduced) as the ring element to print: relative or absolute angles (see
+        :meth:`absolute_angles`), and per product of other factors (parameters, velocities)
+        ``c²`` or ``1 − s²``, whichever is shorter (``I_x s_2² + I_y c_2²``)."""
+        best = self._shortest_squares(f, [self._pair_index[k] for k in range(len(self.q))])
+        if self._angles is not None:
+            ring, rewrite, pythagoras, pairs = self._angles
+            g = self._lift(f, ring).compose(rewrite).rem(pythagoras)
+            if len(g) < len(best):
+                g = self._shortest_squares(g, pairs)
+                if len(g) < len(best):
+                    best = g
+        return best
+
+    @staticmethod
+    def _shortest_squares(f, pairs):
+        """``f`` with, per product of the non-trigonometric generators, ``c²`` written as
+        ``1 − s²`` or ``s²`` as ``1 − c²`` (``pairs``: generator indices of ``(s, c)``) where
+        that has fewer terms."""
+        ring = f.ring
+        trig_index = {k for pair in pairs for k in pair}
+        if not any(monomial[k] >= 2 for monomial in f.itermonoms() for k in trig_index):
+            return f
+        groups: dict[tuple, dict] = {}
+        for monomial, coefficient in f.terms():
+            rest = tuple(0 if k in trig_index else e for k, e in enumerate(monomial))
+            trig = tuple(e if k in trig_index else 0 for k, e in enumerate(monomial))
+            groups.setdefault(rest, {})[trig] = coefficient
+        out = ring.zero
+        for rest, terms in groups.items():
+            part = ring(terms)
+            for s, c in pairs:  # c² → 1 − s² or s² → 1 − c², when that is shorter
+                for a, b in ((c, s), (s, c)):
+                    if any(monomial[a] >= 2 for monomial in part.itermonoms()):
+                        other = _swap_squares(part, a, b)
+                        if len(other) < len(part):
+                            part = other
+            out += part * ring({rest: ring.domain.one})
+        return out
+
     def largest(self, matrix) -> float:
         """The largest magnitude of a numeric coefficient among the entries of ``matrix``
         (0 over exact domains, where there is no rounding noise)."""
@@ -429,15 +538,65 @@ class _TrigAlgebra:
                    default=0.0)
 
     def expr(self, f, reference: float = 0.0) -> sp.Expr:
-        """``f`` as a SymPy expression in the form of :func:`simplify_trig`."""
-        return sp.factor_terms(drop_float_noise(harmonics(self.reduce(f), self.q),
-                                                reference=reference))
+        """``f`` as a SymPy expression in the form of :meth:`readable`: float rounding noise
+        dropped (:func:`drop_float_noise`), floats written with 15 significant digits
+        (:func:`round_floats`: ``0.009``, not ``0.0090000000000000018``), common factors pulled
+        out."""
+        value = self.readable(self._denoise(self.reduce(f), reference)).as_expr()
+        return sp.factor_terms(round_floats(value))
+
+    def _denoise(self, f, reference: float = 0.0, rtol: float = FLOAT_NOISE_RTOL):
+        """``f`` without the terms whose (float) coefficient is below ``rtol`` times the largest
+        of ``f`` or ``reference`` (see :func:`drop_float_noise`); exact domains have none."""
+        if not self.ring.domain.is_RR or not f:
+            return f
+        largest = max([reference] + [abs(float(c)) for c in f.itercoeffs()])
+        kept = {m: c for m, c in f.iterterms() if abs(float(c)) >= rtol * largest}
+        return f if len(kept) == len(f) else self.ring(kept)
 
     def matrix(self, rows, reference: float | None = None) -> sp.Matrix:
         """A SymPy matrix of ring elements; float noise is judged against the largest
         coefficient of the whole matrix unless ``reference`` is given."""
         reference = self.largest(rows) if reference is None else reference
         return sp.Matrix([[self.expr(f, reference) for f in row] for row in rows])
+
+
+def round_floats(expr: sp.Expr, digits: int = 15) -> sp.Expr:
+    """``expr`` with every Float rounded to ``digits`` significant digits (the last bits of a
+    float sum are rounding noise: ``0.0090000000000000018`` is ``0.009``), and a Float that is
+    then a whole number replaced by that Integer (``1.0*x`` is ``x``).
+
+    >>> x = sp.Symbol("x")
+    >>> round_floats(sp.Float("0.0090000000000000018", 20) * x + sp.Float(1.0) * x**2)
+    x**2 + 0.009*x
+    """
+    floats = expr.atoms(sp.Float)
+    if not floats:
+        return expr
+    rounded = {}
+    for x in floats:
+        value = float(f"{float(x):.{digits}g}")
+        rounded[x] = (sp.Integer(int(value)) if value.is_integer() and abs(value) < 2 ** 53
+                      else sp.Float(value))
+    return expr.xreplace(rounded)
+
+
+def _swap_squares(f, k: int, j: int):
+    """``f`` with every ``x_k²`` replaced by ``1 − x_j²`` (for a pair ``x_k² + x_j² = 1`` of
+    generators)."""
+    ring = f.ring
+    b = ring.gens[j]
+    one_minus = ring.one - b * b
+    out = ring.zero
+    for monomial, coefficient in f.terms():
+        e = monomial[k]
+        if e < 2:
+            out += ring({monomial: coefficient})
+            continue
+        base = list(monomial)
+        base[k] = e % 2
+        out += ring({tuple(base): coefficient}) * one_minus ** (e // 2)
+    return out
 
 
 def _transpose(A):

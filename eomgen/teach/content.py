@@ -297,10 +297,7 @@ def _names(names) -> list:
 HALF = sp.Symbol("eomgen_one_half", positive=True)
 
 
-def _mass_grouped(expr: sp.Expr, masses) -> sp.Expr:
-    """``expr`` as one (unevaluated) sum of its terms grouped by mass, to print in a product."""
-    grouped = rd.by_mass(expr, masses)
-    return grouped[0] if len(grouped) == 1 else sp.Add(*grouped, evaluate=False)
+_mass_grouped = rd.mass_grouped
 
 
 def _quadratic_terms(M: sp.Matrix, qd, masses) -> list[sp.Expr]:

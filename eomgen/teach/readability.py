@@ -64,7 +64,7 @@ def group_by_factor(expr: sp.Expr, key: Callable[[sp.Expr], sp.Expr | None],
     out = []
     for k, parts in groups.items():
         inner = sp.Add(*parts)
-        inner = sp.factor_terms(inner) if factor else inner
+        inner = sp.factor_terms(inner) if factor else perfect_power(inner)
         if inner.is_Number:  # a number goes first, as usual: 8.08 c_1, -2 m_2
             out.append(inner * k)
             continue
@@ -78,6 +78,44 @@ def group_by_factor(expr: sp.Expr, key: Callable[[sp.Expr], sp.Expr | None],
             term = sp.Mul(k, sp.UnevaluatedExpr(inner), evaluate=False)
         out.append(sp.Mul(-1, term, evaluate=False) if negative else term)
     return out + rest
+
+
+def perfect_power(expr: sp.Expr) -> sp.Expr:
+    """``expr`` written as a power (``a_2^2 c_2^2 + 2 a_2 l_{c3} c_2 c_{23} + l_{c3}^2 c_{23}^2``
+    → ``(a_2 c_2 + l_{c3} c_{23})^2``, the textbook's form of a point's squared distance) or a
+    product of sums (``(a_2 c_2 + l_{c3} c_{23}) (a_2 s_2 + l_{c3} s_{23})``) when it is a
+    number times one, else ``expr`` unchanged.
+
+    >>> a, b, x = sp.symbols("a b x")
+    >>> perfect_power(a**2*sp.cos(x)**2 + 2*a*b*sp.cos(x) + b**2)
+    (a*cos(x) + b)**2
+    >>> perfect_power(a**2 + b**2)
+    a**2 + b**2
+    """
+    if not expr.is_Add or len(expr.args) < 3:
+        return expr
+    factored = sp.factor(expr)
+    coefficient, rest = factored.as_coeff_Mul()
+    if rest.is_Pow and rest.exp.is_Integer and rest.exp >= 2 and rest.base.is_Add:
+        return factored
+    factors = sp.Mul.make_args(rest)  # a product of sums only: (a c_2 + b c_23)(a s_2 + b s_23)
+    if len(factors) >= 2 and all(f.is_Add or (f.is_Pow and f.base.is_Add) for f in factors):
+        return factored
+    return expr
+
+
+def mass_grouped(expr: sp.Expr, masses: Sequence[sp.Symbol]) -> sp.Expr:
+    """``expr`` as one (unevaluated) sum of its terms grouped by mass (:func:`by_mass`), to print
+    as one expression (in a product, a matrix entry). ``.doit()`` gives back an ordinary sum."""
+    grouped = by_mass(expr, masses)
+    return grouped[0] if len(grouped) == 1 else sp.Add(*grouped, evaluate=False)
+
+
+def trig_grouped(expr: sp.Expr, angles: Sequence[sp.Symbol]) -> sp.Expr:
+    """``expr`` as one (unevaluated) sum of its terms grouped by trigonometric factor
+    (:func:`by_trig`)."""
+    grouped = by_trig(expr, angles)
+    return grouped[0] if len(grouped) == 1 else sp.Add(*grouped, evaluate=False)
 
 
 def by_mass(expr: sp.Expr, masses: Sequence[sp.Symbol]) -> list[sp.Expr]:

@@ -30,7 +30,7 @@ import sympy as sp
 from ... import __version__
 from ...dynamics import Dynamics
 from ...model import IDENTITY3, RobotModel
-from ...symbolic.textbook import TEXTBOOK_MAX_DOF, TextbookDerivation, textbook_derivation
+from ...symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS, TextbookDerivation
 from .. import GeneratedFile, Job, register
 from ..render import render
 from .latex_printer import DerivationLatexPrinter, display_width, latex_comment, latex_escape
@@ -100,6 +100,9 @@ class LatexConfig:
         The largest model given the textbook derivation: number of joints, operations of the
         straight-line program of M, C and g (checked first, it costs nothing), and operations
         of the expanded M, C and g of the textbook derivation (checked after computing it).
+        The default operation bound is :data:`~eomgen.symbolic.textbook.TEXTBOOK_MAX_OPERATIONS`,
+        shared by ``derive``'s default ``simplify``, the display, the notebook, the handout and
+        this document.
     max_program_lines:
         At most this many named subexpressions are printed for large models.
     """
@@ -110,7 +113,7 @@ class LatexConfig:
     line_width: int = 80
     block_size: int = 24
     textbook_max_dof: int = TEXTBOOK_MAX_DOF
-    textbook_max_operations: int = 2000
+    textbook_max_operations: int = TEXTBOOK_MAX_OPERATIONS
     textbook_max_size: int = 4000
     max_program_lines: int = 2500
 
@@ -155,14 +158,22 @@ def expanded_size(book: TextbookDerivation) -> int:
     return int(sum(sp.count_ops(e) for matrix in (book.M, book.C, book.g) for e in matrix))
 
 
+def teaching_sized(dynamics: Dynamics, config: LatexConfig = LatexConfig()) -> bool:
+    """Whether the textbook derivation of ``dynamics``' model is worth computing: few joints
+    and a small program (:class:`LatexConfig`). Costs nothing next to the derivation: it
+    looks at the straight-line program only."""
+    return (dynamics.model.dof <= config.textbook_max_dof
+            and dynamics.operation_count(["M", "C", "g"]) <= config.textbook_max_operations)
+
+
 def textbook_for(dynamics: Dynamics,
                  config: LatexConfig = LatexConfig()) -> TextbookDerivation | None:
     """The textbook derivation of ``dynamics``' model when it is teaching-sized (see
     :class:`LatexConfig`), else None: documents then print the straight-line program."""
-    if (dynamics.model.dof > config.textbook_max_dof
-            or dynamics.operation_count(["M", "C", "g"]) > config.textbook_max_operations):
+    if not teaching_sized(dynamics, config):
         return None
-    book = textbook_derivation(dynamics.model, max_dof=config.textbook_max_dof)
+    # computed once per Dynamics, shared with dyn.M and the display
+    book = dynamics.textbook
     return book if expanded_size(book) <= config.textbook_max_size else None
 
 
@@ -332,7 +343,14 @@ def _textbook_sections(job: Job, book: TextbookDerivation, p: Printing) -> dict:
             "kinematics": p.chunks(kinematics),
             "energies": p.chunks(energies),
         })
-    M = [p.equation(f"M_{{{i + 1},{j + 1}}}", book.M[i, j]) for i in range(n) for j in range(i, n)]
+    from ...teach import readability as rd  # the handout's and the display's grouping
+
+    def grouped(lhs, terms):
+        return Equation(lhs, p.printer.print_sum_lines(terms or [sp.Integer(0)], p.width))
+
+    masses = [b.mass for b in book.bodies if isinstance(b.mass, sp.Symbol)]
+    M = [grouped(f"M_{{{i + 1},{j + 1}}}", rd.by_mass(book.M[i, j], masses))
+         for i in range(n) for j in range(i, n)]
     christoffel = []
     for (i, j, k), value in book.christoffel:
         lhs = rf"\Gamma_{{{i + 1},{j + 1},{k + 1}}}"
@@ -340,8 +358,8 @@ def _textbook_sections(job: Job, book: TextbookDerivation, p: Printing) -> dict:
             lhs += rf" = \Gamma_{{{i + 1},{k + 1},{j + 1}}}"
         christoffel.append(p.equation(lhs, value))
     C = [p.equation(f"C_{{{i + 1},{j + 1}}}", book.C[i, j]) for i in range(n) for j in range(n)]
-    g = [p.equation(f"g_{{{i + 1}}}", book.g[i]) for i in range(n)]
     dyn = job.dynamics
+    g = [grouped(f"g_{{{i + 1}}}", rd.by_trig(book.g[i], list(dyn.q))) for i in range(n)]
     equations = []
     for i in range(n):
         terms = [book.M[i, j] * dyn.qdd[j] for j in range(n) if book.M[i, j] != 0]
