@@ -65,8 +65,10 @@ from typing import Iterable, NamedTuple, Sequence
 import sympy as sp
 
 from .bodies import InertialParameters
+from .errors import DescriptionError
 from .model import (
     ZERO3,
+    Actuator,
     Inertial,
     Joint,
     Link,
@@ -74,13 +76,14 @@ from .model import (
     NoticeKind,
     RobotModel,
     Transform,
+    check_actuator,
     emit_notices,
     lock_joints,
     scalar,
     vec3,
 )
 from .codegen.functions import select_functions
-from .scene import Payload, Scene, did_you_mean
+from .scene import Payload, Scene, did_you_mean, scene_error
 
 #: Relative size below which a number computed while merging is roundoff of an exact zero.
 ROUNDOFF = 1e-13
@@ -327,6 +330,7 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
         raise scene.error("robot", f"the scene is for robot '{scene.robot}', not "
                           f"'{model.name}' ({model.source})")
     before = ModelSize.of(model)
+    model = _with_actuators(model, scene)
     model, payloads, scene_gravity, notes = _parameters(model, scene)
     _check_names(model, scene, payloads)
     base = scene.base or model.root
@@ -475,6 +479,9 @@ def _parameters(model: RobotModel, scene: Scene):
         for value in _inertial_scalars(inertial):
             used |= {s.name for s in value.free_symbols}
         payloads.append(replace(payload, inertial=inertial))
+    for joint in reduced.joints:  # scene parameters set in the scene's actuators
+        if joint.actuator is not None:
+            used |= {s.name for v in joint.actuator.scalars() for s in v.free_symbols}
     gravity = None
     if scene.gravity is not None:
         gravity = vec3([g.xreplace({k: scalar(v) for k, v in fixed.items()})
@@ -482,6 +489,33 @@ def _parameters(model: RobotModel, scene: Scene):
         used |= {s.name for g in gravity for s in g.free_symbols}
     extra = tuple(p for p in scene.parameters if p.name in kept and p.name in used)
     return replace(reduced, parameters=reduced.parameters + extra), payloads, gravity, notes
+
+
+def _with_actuators(model: RobotModel, scene: Scene) -> RobotModel:
+    """``model`` with the scene's actuator values set over the description's (see
+    :class:`eomgen.model.Actuator`), checked at the parameters' values."""
+    if not scene.actuators:
+        return model
+    joints = {j.name: j for j in model.joints}
+    changed = {}
+    for name, values in scene.actuators:
+        where = f"actuators '{name}'"
+        if name not in joints:
+            raise scene.error(where, f"no joint '{name}' in robot '{model.name}'"
+                              + did_you_mean(name, joints))
+        joint = joints[name]
+        if not joint.type.is_movable:
+            raise scene.error(where, "a fixed joint cannot have an actuator")
+        base = joint.actuator or Actuator()
+        joint = replace(joint, actuator=base.updated(dict(values)))
+        defaults = {p.symbol: p.value for p in (*model.parameters, *scene.parameters)
+                    if p.value is not None}
+        try:
+            check_actuator(scene.source, joint, defaults, where=where)
+        except DescriptionError as exc:
+            raise scene_error(type(exc))(scene.source, where, exc.problem) from None
+        changed[name] = joint
+    return replace(model, joints=tuple(changed.get(j.name, j) for j in model.joints))
 
 
 def _substituted(inertial: Inertial, values: dict) -> Inertial:
