@@ -1,0 +1,316 @@
+"""Actuators and flexible joints (eomgen.actuators, docs/actuators.md).
+
+References: MuJoCo (``qM``, ``qfrc_bias``, ``qfrc_passive`` with ``armature`` and ``damping``
+set on the same URDF) for the rigid model with actuators; eomgen's numeric Newton–Euler for
+the link torques and their time derivatives (finite differences in time); energy conservation
+and the limit K → ∞ for Spong's model; flatness fed back to forward dynamics.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import eomgen
+from eomgen import actuators as A
+from eomgen.errors import InvalidNumberError, SceneError, SchemaError
+from eomgen.model import Actuator
+from eomgen.numeric import numeric_model, rnea
+from eomgen.parsers.urdf import parse_urdf_string
+from eomgen.reduction import apply_scene
+from eomgen.scene import load_scene
+
+from conftest import erd_robots_dir
+
+ROOT = Path(__file__).resolve().parents[1]
+FLEXIBLE_2LINK = ROOT / "examples" / "robots" / "flexible_2link.yaml"
+
+ARM = """<robot name="r"><link name="base"/>
+<link name="arm"><inertial><mass value="2"/><origin xyz="0.3 0 0"/>
+<inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+<link name="tool"/>
+<joint name="j1" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
+{dynamics}</joint>
+<joint name="j2" type="fixed"><parent link="arm"/><child link="tool"/>
+<dynamics damping="9"/></joint></robot>"""
+
+
+# ----------------------------------------------------------------------------------------------
+# Reading actuator data
+# ----------------------------------------------------------------------------------------------
+
+def test_urdf_dynamics_is_read_as_damping_and_coulomb_friction():
+    model = parse_urdf_string(ARM.format(dynamics='<dynamics damping="0.5" friction="0.25"/>'))
+    a = model.joints[0].actuator
+    assert (float(a.damping), float(a.friction), a.armature, a.flexible) == (0.5, 0.25, 0, False)
+    assert model.joints[1].actuator is None  # a fixed joint's <dynamics> couples nothing
+    zero = parse_urdf_string(ARM.format(dynamics='<dynamics damping="0" friction="0.0"/>'))
+    assert zero.joints[0].actuator is None
+
+
+def test_yaml_rotor_and_gear_give_the_reflected_inertia_and_stay_symbolic():
+    arm = eomgen.load(FLEXIBLE_2LINK)
+    B1, K1 = sp.Symbol("B1", real=True), sp.Symbol("K1", real=True)
+    assert arm.movable_joints[0].actuator == Actuator(armature=B1, stiffness=K1)
+    assert {"B1", "K1"} <= {p.name for p in arm.parameters}
+    scene = load_scene("s.yaml", text="version: 1\nactuators:\n  joint2: {rotor_inertia: 2.0e-4, "
+                       "gear_ratio: 50, damping: 0.1}\n")
+    a = apply_scene(arm, scene).model.movable_joints[1].actuator
+    assert float(a.armature) == pytest.approx(50 ** 2 * 2.0e-4, rel=1e-15)
+    assert (float(a.gear_ratio), float(a.damping), a.stiffness.name) == (50, 0.1, "K2")
+
+
+@pytest.mark.parametrize("text, element, problem", [
+    ("actuators: {joint2: {stiffness: -3}}", "actuators 'joint2'", "stiffness -3 is negative"),
+    ("actuators: {joint2: {armature: 0}}", "actuators 'joint2'",
+     "zero motor inertia on a flexible joint"),
+    ("actuators: {joint2: {rotor_inertia: 1.0e-4, gear_ratio: 0}}", "actuators 'joint2'",
+     "gear_ratio is 0"),
+    ("actuators: {joint9: {damping: 1}}", "actuators 'joint9'", "no joint 'joint9'"),
+    ("actuators: {tip_fixed: {damping: 1}}", "actuators 'tip_fixed'", "fixed joint"),
+    ("actuators: {joint2: {armature: 1, gear_ratio: 3}}", "actuators 'joint2'", "not both"),
+    ("friction: {joint2: 0.1}", "friction", "under 'actuators'"),
+])
+def test_bad_scene_actuators_are_one_line_naming_the_scene_and_the_joint(text, element, problem):
+    arm = eomgen.load(FLEXIBLE_2LINK)
+    with pytest.raises(SceneError) as caught:
+        apply_scene(arm, load_scene("bad.yaml", text="version: 1\n" + text + "\n"))
+    message = str(caught.value)
+    assert "\n" not in message and message.startswith(f"bad.yaml: {element}: "), message
+    assert problem in message
+
+
+# ----------------------------------------------------------------------------------------------
+# Rigid model with actuators: against MuJoCo
+# ----------------------------------------------------------------------------------------------
+
+def _mujoco_model(urdf: Path, armature: dict, damping: dict):
+    """MuJoCo's model of the URDF (visual and collision geometry removed: MuJoCo would load
+    the meshes) with the given armature and damping per joint."""
+    mujoco = pytest.importorskip("mujoco", reason="MuJoCo is the reference (test extra)")
+    text = re.sub(r"<(visual|collision)\b.*?</\1>", "", urdf.read_text(), flags=re.S)
+    m = mujoco.MjSpec.from_string(text).compile()
+    for name in armature:  # runtime model fields, read by mj_crb (qM) and mj_passive
+        m.dof_armature[m.joint(name).dofadr[0]] = armature[name]
+        m.dof_damping[m.joint(name).dofadr[0]] = damping[name]
+    return mujoco, m
+
+
+@pytest.mark.parametrize("robot, scene_head", [
+    ("ur_description/urdf/ur5_robot.urdf", "version: 1\n"),
+    ("panda_description/urdf/panda.urdf", "version: 1\n"),
+])
+def test_mass_matrix_bias_and_damping_match_mujoco(robot, scene_head):
+    robots = erd_robots_dir()
+    if robots is None:
+        pytest.skip("example-robot-data is not installed")
+    urdf = robots / robot
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the Panda's mimic fingers: independent in both
+        model = eomgen.load(urdf)
+    names = model.joint_names
+    rng = np.random.default_rng(7)
+    armature = {n: float(v) for n, v in zip(names, rng.uniform(0.05, 0.5, len(names)))}
+    damping = {n: float(v) for n, v in zip(names, rng.uniform(0.1, 2.0, len(names)))}
+    scene = load_scene("s.yaml", text=scene_head + "actuators:\n" + "".join(
+        f"  {n}: {{armature: {armature[n]!r}, damping: {damping[n]!r}}}\n" for n in names))
+    model = apply_scene(model, scene).model  # fixed joints merged, as MuJoCo's fusestatic
+    assert model.joint_names == names
+    am = A.actuated_model(eomgen.derive(model))
+    mujoco, m = _mujoco_model(urdf, armature, damping)
+    data = mujoco.MjData(m)
+    qadr = [m.joint(n).qposadr[0] for n in names]
+    vadr = [m.joint(n).dofadr[0] for n in names]
+    for _ in range(3):
+        q, qd = rng.uniform(-2, 2, len(names)), rng.uniform(-2, 2, len(names))
+        data.qpos[qadr], data.qvel[vadr] = q, qd
+        mujoco.mj_forward(m, data)
+        full = np.zeros((m.nv, m.nv))
+        try:
+            mujoco.mj_fullM(m, data, full)  # MuJoCo ≥ 3.3 (sparse data.M)
+        except TypeError:
+            mujoco.mj_fullM(m, full, data.qM)
+        M_ref = full[np.ix_(vadr, vadr)]
+        M, h, _ = am.rigid_terms(q, qd)
+        M_a = A.rigid_mass_matrix(am, q)
+        assert np.abs(M_a - M_ref).max() <= 1e-10 * np.abs(M_ref).max()
+        assert np.allclose(M_a - M, np.diag([armature[n] for n in names]), rtol=0, atol=1e-14)
+        bias = data.qfrc_bias[vadr]
+        assert np.abs(h - bias).max() <= 1e-10 * np.abs(bias).max()
+        passive = data.qfrc_passive[vadr]  # −d q̇: the torque friction applies to the joint
+        tau_f = A.friction_torque(am, qd)
+        assert np.abs(tau_f + passive).max() <= 1e-12 * np.abs(passive).max()
+
+
+def test_mujoco_reads_the_same_urdf_damping_as_eomgen():
+    robots = erd_robots_dir()
+    if robots is None:
+        pytest.skip("example-robot-data is not installed")
+    urdf = robots / "panda_description/urdf/panda.urdf"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = eomgen.load(urdf)
+    mujoco, m = _mujoco_model(urdf, {}, {})
+    ours = [float(j.actuator.damping) if j.actuator else 0.0 for j in model.movable_joints]
+    theirs = [float(m.dof_damping[m.joint(n).dofadr[0]]) for n in model.joint_names]
+    assert ours == theirs and 0.003 in ours and 0.3 in ours
+
+
+def test_symbolic_rigid_model_adds_the_armature_and_friction():
+    arm = eomgen.load(eomgen.example_path("planar_2link"))
+    acts = (Actuator(armature=0.2, damping=0.3, friction=0.5, friction_width=0.05),
+            Actuator.from_rotor(1e-4, 60, damping=0.1))
+    it = iter(acts)
+    arm = replace(arm, joints=tuple(replace(j, actuator=next(it)) if j.type.is_movable else j
+                                    for j in arm.joints))
+    rigid = A.rigid_with_actuators(eomgen.derive(arm))
+    nm = numeric_model(arm)
+    q, qd, qdd = np.array([0.3, -0.7]), np.array([0.4, -1.1]), np.array([1.5, 0.2])
+    values = dict(zip(rigid.dynamics.q, q)) | dict(zip(rigid.dynamics.qd, qd)) \
+        | dict(zip(rigid.dynamics.qdd, qdd)) | arm.parameter_values
+    armature = np.array([0.2, 60 ** 2 * 1e-4])
+    friction = np.array([0.3 * 0.4 + 0.5, 0.1 * -1.1])
+    expected = rnea(nm, q, qd, qdd) + armature * qdd + friction
+    exact = np.array(rigid.tau().xreplace(values).evalf(), float).ravel()
+    assert np.allclose(exact, expected, rtol=1e-12, atol=0)
+    smooth = np.array(rigid.tau(smooth=True).xreplace(values).evalf(), float).ravel()
+    assert smooth[0] - exact[0] == pytest.approx(0.5 * (np.tanh(0.4 / 0.05) - 1), rel=1e-12)
+    am = A.actuated_model(rigid.dynamics)
+    assert np.allclose(A.rigid_inverse_dynamics(am, q, qd, qdd), expected, rtol=1e-12)
+    qdd_back = A.rigid_forward_dynamics(am, q, qd, expected, smooth=False)
+    assert np.allclose(qdd_back, qdd, rtol=1e-10)
+
+
+# ----------------------------------------------------------------------------------------------
+# Spong's model
+# ----------------------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def flexible_arm():
+    dyn = eomgen.derive(eomgen.load(FLEXIBLE_2LINK))
+    return dyn, A.actuated_model(dyn)
+
+
+def _integrate(am, x0, tau, duration, rtol=1e-11, atol=1e-11, method="DOP853"):
+    from scipy.integrate import solve_ivp
+
+    return solve_ivp(lambda t, x: A.flexible_forward_dynamics(am, x, tau(t)), (0, duration),
+                     x0, method=method, rtol=rtol, atol=atol, dense_output=True)
+
+
+def test_energy_is_conserved_without_friction_and_input(flexible_arm):
+    _, am = flexible_arm
+    x0 = np.array([0.4, -0.6, 0.0, 0.0, 0.45, -0.5, 1.0, -2.0])  # springs wound, motors moving
+    result = _integrate(am, x0, lambda t: np.zeros(2), 2.0)
+    assert result.success
+    energy = [A.flexible_energy(am, x) for x in result.y.T]
+    scale = max(abs(e) for e in energy)
+    assert np.ptp(energy) <= 1e-8 * scale
+    # the spring exchanges energy: the motor angles do move away from their start
+    assert np.ptp(result.y[4]) > 0.05
+
+
+def test_symbolic_equations_vanish_along_numeric_forward_dynamics(flexible_arm):
+    dyn, am = flexible_arm
+    sd = A.spong_dynamics(dyn)
+    rng = np.random.default_rng(3)
+    x, tau = rng.normal(size=8), rng.normal(size=2)
+    xd = A.flexible_forward_dynamics(am, x, tau)
+    values = dict(zip(dyn.q, x[:2])) | dict(zip(dyn.qd, x[2:4])) | dict(zip(sd.theta, x[4:6])) \
+        | dict(zip(sd.thetad, x[6:])) | dict(zip(dyn.qdd, xd[2:4])) \
+        | dict(zip(sd.thetadd, xd[6:])) | dict(zip(sd.tau, tau)) | dyn.model.parameter_values
+    link = np.array(sd.link_equations().xreplace(values).evalf(), float)
+    motor = np.array(sd.motor_equations().xreplace(values).evalf(), float)
+    assert np.abs(link).max() < 1e-10 and np.abs(motor).max() < 1e-10
+    energy = float(sd.energy().xreplace(values))
+    assert energy == pytest.approx(A.flexible_energy(am, x), rel=1e-12)
+
+
+def test_stiff_limit_is_the_rigid_model_with_reflected_inertia():
+    arm = eomgen.load(FLEXIBLE_2LINK)
+    rigid = A.actuated_model(eomgen.derive(arm))
+    q0, tau = np.array([0.3, 0.5]), lambda t: np.array([2.0, -1.0])
+    from scipy.integrate import solve_ivp
+
+    ref = solve_ivp(lambda t, x: np.concatenate(
+        [x[2:], A.rigid_forward_dynamics(rigid, x[:2], x[2:], tau(t))]), (0, 0.5),
+        np.concatenate([q0, [0, 0]]), method="DOP853", rtol=1e-11, atol=1e-11)
+    errors = []
+    for K in (1e3, 1e4, 1e5):
+        am = A.actuated_model(eomgen.derive(arm), {"K1": K, "K2": K})
+        x0 = A.flexible_rest_state(am, q0)  # the springs start wound for gravity
+        result = _integrate(am, x0, tau, 0.5, rtol=1e-10, atol=1e-10)
+        errors.append(np.abs(result.y[:2, -1] - ref.y[:2, -1]).max())
+    # the link angles approach the rigid model's as 1/K (one decade per decade)
+    assert errors[2] < errors[1] < errors[0]
+    assert errors[0] / errors[2] > 30 and errors[2] < 1e-3
+
+
+def _trajectory(t):
+    """q(t) = a sin(ω t + φ) and its derivatives up to order 4."""
+    a, w, phi = np.array([0.5, -0.8]), np.array([2.0, 3.0]), np.array([0.2, 1.0])
+    s, c = np.sin(w * t + phi), np.cos(w * t + phi)
+    return a * s, a * w * c, -a * w ** 2 * s, -a * w ** 3 * c, a * w ** 4 * s
+
+
+def test_link_torque_derivatives_match_finite_differences_of_newton_euler(flexible_arm):
+    dyn, am = flexible_arm
+    nm = numeric_model(dyn.model)
+    t, h = 0.37, 1e-3
+    tau, taud, taudd = am.link_torque_derivatives(*_trajectory(t))
+    L = [rnea(nm, *_trajectory(t + k * h)[:3]) for k in (-2, -1, 0, 1, 2)]
+    assert np.allclose(tau, L[2], rtol=1e-13, atol=1e-12)
+    fd1 = (L[0] - 8 * L[1] + 8 * L[3] - L[4]) / (12 * h)       # O(h⁴)
+    fd2 = (-L[0] + 16 * L[1] - 30 * L[2] + 16 * L[3] - L[4]) / (12 * h * h)
+    assert np.allclose(taud, fd1, rtol=1e-8, atol=1e-8)
+    assert np.allclose(taudd, fd2, rtol=1e-5, atol=1e-5)
+
+
+def test_flat_inverse_dynamics_fed_to_forward_dynamics_reproduces_the_trajectory(flexible_arm):
+    _, am = flexible_arm
+    flat = [A.flexible_inverse_dynamics(am, *_trajectory(t)) for t in (0.0,)]
+    q0, qd0, *_ = _trajectory(0.0)
+    x0 = np.concatenate([q0, qd0, flat[0]["theta"], flat[0]["thetad"]])
+    result = _integrate(am, x0, lambda t: A.flexible_inverse_dynamics(
+        am, *_trajectory(t))["tau"], 1.5)
+    worst = max(np.abs(result.sol(t)[:2] - _trajectory(t)[0]).max()
+                for t in np.linspace(0, 1.5, 16))
+    assert worst < 1e-7
+
+
+def test_symbolic_flat_inverse_dynamics_keeps_k_and_b_and_matches_numeric(flexible_arm):
+    dyn, am = flexible_arm
+    sd = A.spong_dynamics(dyn)
+    flat = sd.flat_inverse_dynamics()
+    assert {"K1", "K2", "B1", "B2"} <= {s.name for s in flat["tau"].free_symbols}
+    q, qd, qdd, q3, q4 = _trajectory(0.8)
+    values = dict(zip(dyn.q, q)) | dict(zip(dyn.qd, qd)) | dict(zip(dyn.qdd, qdd)) \
+        | dict(zip(sd.qddd, q3)) | dict(zip(sd.qdddd, q4)) | dyn.model.parameter_values
+    numeric = A.flexible_inverse_dynamics(am, q, qd, qdd, q3, q4)
+    for name in ("theta", "thetadd", "tau"):
+        exact = np.array(flat[name].xreplace(values).evalf(), float).ravel()
+        assert np.allclose(exact, numeric[name], rtol=1e-11), name
+
+
+def test_full_model_coupling_of_the_planar_arm_is_the_textbook_constant():
+    # Planar 2R: rotor 2 rides on link 1 and spins about the same z axis, so the full model's
+    # coupling is S = [[0, I_m2 r2], [0, 0]] (De Luca & Book, Springer Handbook, ch. 11).
+    arm = eomgen.load(FLEXIBLE_2LINK)
+    scene = load_scene("s.yaml", text="version: 1\nactuators:\n"
+                       "  joint1: {rotor_inertia: 1.0e-4, gear_ratio: 70}\n"
+                       "  joint2: {rotor_inertia: 2.0e-4, gear_ratio: 50}\n")
+    sd = A.spong_dynamics(eomgen.derive(apply_scene(arm, scene).model), coupling=True)
+    assert (sd.S[0, 0], sd.S[1, 0], sd.S[1, 1]) == (0, 0, 0)
+    assert float(sd.S[0, 1]) == pytest.approx(2.0e-4 * 50, rel=1e-15)
+    link, motor = sd.link_equations(), sd.motor_equations()
+    assert sp.expand(motor[1]).coeff(sd.dynamics.qdd[0]) == sd.S[0, 1]   # S^T q̈
+    assert sp.expand(link[0]).coeff(sd.thetadd[1]) == sd.S[0, 1]         # S θ̈
+    assert sp.expand(motor[0]).coeff(sd.dynamics.qdd[1]) == 0
+    with pytest.raises(eomgen.errors.ParameterError, match="rotor_inertia and gear_ratio"):
+        A.spong_dynamics(eomgen.derive(arm), coupling=True)
