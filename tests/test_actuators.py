@@ -314,3 +314,48 @@ def test_full_model_coupling_of_the_planar_arm_is_the_textbook_constant():
     assert sp.expand(motor[0]).coeff(sd.dynamics.qdd[1]) == 0
     with pytest.raises(eomgen.errors.ParameterError, match="rotor_inertia and gear_ratio"):
         A.spong_dynamics(eomgen.derive(arm), coupling=True)
+
+
+def test_mixed_rigid_and_flexible_joints_with_friction_round_trip():
+    # joint 1 rigid (armature, viscous and Coulomb friction), joint 2 flexible with motor
+    # friction: the flat inputs (smoothed friction) drive forward dynamics along q(t)
+    arm = eomgen.load(FLEXIBLE_2LINK)
+    scene = load_scene("s.yaml", text="version: 1\nactuators:\n"
+                       "  joint1: {armature: 0.3, damping: 0.4, friction: 0.2, "
+                       "friction_width: 0.5}\n"
+                       "  joint2: {damping: 0.05, friction: 0.1, friction_width: 0.5}\n")
+    model = apply_scene(arm, scene).model
+    a1 = model.movable_joints[0].actuator
+    assert a1.flexible and float(a1.armature) == 0.3  # the description's K1 is kept
+    joints = tuple(replace(j, actuator=replace(j.actuator, stiffness=None))
+                   if j.name == "joint1" else j for j in model.joints)
+    model = replace(model, joints=joints)
+    am = A.actuated_model(eomgen.derive(model))
+    assert am.flexible.tolist() == [1] and am.rigid.tolist() == [0]
+    flat0 = A.flexible_inverse_dynamics(am, *_trajectory(0.0), smooth=True)
+    q0, qd0, *_ = _trajectory(0.0)
+    x0 = np.concatenate([q0, qd0, flat0["theta"], flat0["thetad"]])
+    result = _integrate(am, x0, lambda t: A.flexible_inverse_dynamics(
+        am, *_trajectory(t), smooth=True)["tau"], 1.0)
+    worst = max(np.abs(result.sol(t)[:2] - _trajectory(t)[0]).max()
+                for t in np.linspace(0, 1.0, 11))
+    assert worst < 1e-7
+    # the rigid joint's torque is the rigid model's: link torque + armature + friction
+    q, qd, qdd, *_ = _trajectory(0.3)
+    tau = A.flexible_inverse_dynamics(am, *_trajectory(0.3))["tau"]
+    nm = numeric_model(model)
+    expected = rnea(nm, q, qd, qdd)[0] + 0.3 * qdd[0] + 0.4 * qd[0] + 0.2 * np.sign(qd[0])
+    assert tau[0] == pytest.approx(expected, rel=1e-12)
+
+
+def test_rigid_actuator_program_prints_m_plus_armature(flexible_arm):
+    from eomgen.symbolic.evaluate import compile_program
+
+    dyn, am = flexible_arm
+    rigid = A.rigid_with_actuators(dyn)
+    params = [p.symbol for p in dyn.model.parameters]
+    run = compile_program(rigid.program(), tuple(dyn.q) + tuple(dyn.qd) + tuple(params))
+    q, qd = np.array([0.2, 1.1]), np.array([0.0, 0.0])
+    out = run(*q, *qd, *[p.value for p in dyn.model.parameters])
+    assert np.allclose(out["M"], A.rigid_mass_matrix(am, q), rtol=1e-14)
+    assert np.allclose(out["tau_f"], 0)
