@@ -360,6 +360,7 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
         notes.append("parameters that no longer appear in the reduced model (dropped): "
                      + ", ".join(unused))
     notes += _massless_notes(reduced)
+    notes += _actuator_notes(reduced, scene)
     kept, moot = _split_notices(model.notices, scene, set(reduced.joint_names), set(dropped))
     reduced = replace(reduced, notices=kept)
     notes += _moot_notes(moot)
@@ -516,6 +517,24 @@ def _with_actuators(model: RobotModel, scene: Scene) -> RobotModel:
             raise scene_error(type(exc))(scene.source, where, exc.problem) from None
         changed[name] = joint
     return replace(model, joints=tuple(changed.get(j.name, j) for j in model.joints))
+
+
+def _actuator_notes(model: RobotModel, scene: Scene) -> list[str]:
+    """What the scene set of the moving joints' actuators, and which joints are flexible."""
+    moving = set(model.joint_names)
+    notes = []
+    set_here = [f"{name} ({', '.join(key for key, _ in values)})"
+                for name, values in scene.actuators if name in moving]
+    if set_here:
+        notes.append("actuators set by the scene: " + ", ".join(set_here))
+    ignored = [name for name, _ in scene.actuators if name not in moving]
+    if ignored:
+        notes.append("actuators of joints that do not move (no effect): " + ", ".join(ignored))
+    flexible = [j.name for j in model.movable_joints if j.actuator and j.actuator.flexible]
+    if flexible:
+        notes.append("flexible joints (Spong's model, eomgen.actuators; the generated M, C, g "
+                     "are the rigid links'): " + ", ".join(flexible))
+    return notes
 
 
 def _substituted(inertial: Inertial, values: dict) -> Inertial:

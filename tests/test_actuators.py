@@ -359,3 +359,13 @@ def test_rigid_actuator_program_prints_m_plus_armature(flexible_arm):
     out = run(*q, *qd, *[p.value for p in dyn.model.parameters])
     assert np.allclose(out["M"], A.rigid_mass_matrix(am, q), rtol=1e-14)
     assert np.allclose(out["tau_f"], 0)
+
+
+def test_scene_report_says_what_the_scene_set_and_which_joints_are_flexible():
+    arm = eomgen.load(FLEXIBLE_2LINK)
+    scene = load_scene("s.yaml", text="version: 1\nlocked: {joint2: 0.1}\nactuators:\n"
+                       "  joint1: {damping: 0.2}\n  joint2: {damping: 0.3}\n")
+    notes = apply_scene(arm, scene).report.notes
+    assert "actuators set by the scene: joint1 (damping)" in notes
+    assert "actuators of joints that do not move (no effect): joint2" in notes
+    assert any(n.startswith("flexible joints") and n.endswith(": joint1") for n in notes)
