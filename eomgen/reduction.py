@@ -508,7 +508,12 @@ def _with_actuators(model: RobotModel, scene: Scene) -> RobotModel:
         if not joint.type.is_movable:
             raise scene.error(where, "a fixed joint cannot have an actuator")
         base = joint.actuator or Actuator()
-        joint = replace(joint, actuator=base.updated(dict(values)))
+        values = dict(values)
+        if "gear_ratio" in values and "rotor_inertia" not in values \
+                and base.rotor_inertia is None:
+            raise scene.error(where, "'gear_ratio' given without 'rotor_inertia' (the "
+                              "description gives none)")
+        joint = replace(joint, actuator=base.updated(values))
         defaults = {p.symbol: p.value for p in (*model.parameters, *scene.parameters)
                     if p.value is not None}
         try:

@@ -76,6 +76,8 @@ def test_yaml_rotor_and_gear_give_the_reflected_inertia_and_stay_symbolic():
     ("actuators: {tip_fixed: {damping: 1}}", "actuators 'tip_fixed'", "fixed joint"),
     ("actuators: {joint2: {armature: 1, gear_ratio: 3}}", "actuators 'joint2'", "not both"),
     ("friction: {joint2: 0.1}", "friction", "under 'actuators'"),
+    ("actuators: {joint2: {gear_ratio: 100}}", "actuators 'joint2'",
+     "'gear_ratio' given without 'rotor_inertia'"),
 ])
 def test_bad_scene_actuators_are_one_line_naming_the_scene_and_the_joint(text, element, problem):
     arm = eomgen.load(FLEXIBLE_2LINK)
@@ -420,3 +422,22 @@ def test_full_model_with_configuration_dependent_coupling_conserves_energy(tmp_p
     result = solve_ivp(rhs, (0, 1.0), x0, method="DOP853", rtol=1e-11, atol=1e-11)
     energy = np.array([f_E(*x) for x in result.y.T])
     assert np.ptp(energy) <= 1e-8 * np.abs(energy).max()
+
+
+@pytest.mark.parametrize("actuator, error, problem", [
+    ({"gear_ratio": 100}, SchemaError, "'gear_ratio' given without 'rotor_inertia'"),
+    ({"damping": -1}, InvalidNumberError, "damping -1 is negative"),
+    ({"friction": 1, "friction_width": 0}, InvalidNumberError, "friction_width 0 is not"),
+    ({"stiffnes": 1}, SchemaError, "did you mean 'stiffness'?"),
+])
+def test_bad_yaml_actuators_name_the_file_and_the_joint(actuator, error, problem):
+    from eomgen.parsers.yaml_format import parse
+
+    document = {"links": [{"name": "base"}, {"name": "arm", "mass": 1}],
+                "joints": [{"name": "j1", "type": "revolute", "parent": "base", "child": "arm",
+                            "actuator": actuator}]}
+    with pytest.raises(error) as caught:
+        parse(document, "robot.yaml")
+    message = str(caught.value)
+    assert message.startswith("robot.yaml: ") and "'j1' actuator" in message, message
+    assert problem in message
