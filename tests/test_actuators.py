@@ -441,3 +441,42 @@ def test_bad_yaml_actuators_name_the_file_and_the_joint(actuator, error, problem
     message = str(caught.value)
     assert message.startswith("robot.yaml: ") and "'j1' actuator" in message, message
     assert problem in message
+
+
+@pytest.mark.slow
+def test_panda_flexible_model_derivatives_and_energy():
+    robots = erd_robots_dir()
+    if robots is None:
+        pytest.skip("example-robot-data is not installed")
+    from eomgen.reduction import load_for_scene
+
+    scene = load_scene(ROOT / "examples/scenes/panda_flexible.yaml")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = apply_scene(load_for_scene(robots / "panda_description/urdf/panda.urdf", scene),
+                            scene).model
+    am = A.actuated_model(eomgen.derive(model))
+    assert am.m == 7 and float(am.stiffness[0]) == 1e4 and float(am.damping[0]) == 0.003
+    nm = numeric_model(model)
+    a, w, phi = np.linspace(0.3, 0.9, 7), np.linspace(1.0, 2.5, 7), np.linspace(0, 1, 7)
+
+    def trajectory(t):
+        s, c = np.sin(w * t + phi), np.cos(w * t + phi)
+        return a * s, a * w * c, -a * w ** 2 * s, -a * w ** 3 * c, a * w ** 4 * s
+
+    t, h = 0.4, 1e-3
+    tau, taud, taudd = am.link_torque_derivatives(*trajectory(t))
+    L = [rnea(nm, *trajectory(t + k * h)[:3]) for k in (-2, -1, 0, 1, 2)]
+    scale = np.abs(L[2]).max()
+    assert np.abs(tau - L[2]).max() < 1e-12 * scale
+    fd1 = (L[0] - 8 * L[1] + 8 * L[3] - L[4]) / (12 * h)
+    fd2 = (-L[0] + 16 * L[1] - 30 * L[2] + 16 * L[3] - L[4]) / (12 * h * h)
+    assert np.abs(taud - fd1).max() < 1e-7 * np.abs(fd1).max()
+    assert np.abs(taudd - fd2).max() < 1e-5 * np.abs(fd2).max()
+    # released from rest with the springs wound for gravity, no friction, no input
+    free = replace(am, damping=np.zeros(7))
+    x0 = A.flexible_rest_state(free, [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785])
+    x0[14:21] += 0.01  # motors off their equilibrium: the springs oscillate
+    result = _integrate(free, x0, lambda t: np.zeros(7), 0.05, rtol=1e-10, atol=1e-10)
+    energy = [A.flexible_energy(free, x) for x in result.y.T]
+    assert np.ptp(energy) < 1e-8 * np.abs(energy).max()
