@@ -347,7 +347,6 @@ def _coupling_matrix(model: RobotModel, q: Sequence[sp.Symbol], actuators: Seque
         moved = (joint.name,) if joint.type.is_revolute else ()
         ancestors[joint.child] = ancestors[joint.parent] + moved
     S = sp.zeros(len(q), len(flexible))
-    joints = {j.name: j for j in model.joints}
     for col, k in enumerate(flexible):
         joint = model.movable_joints[k]
         a = actuators[k]
@@ -357,7 +356,6 @@ def _coupling_matrix(model: RobotModel, q: Sequence[sp.Symbol], actuators: Seque
                                  "armature alone does not give the rotor's own inertia)")
         for name in ancestors[joint.parent]:
             i = index[name]
-            _ = joints[name]
             S[i, col] = a.rotor_inertia * a.gear_ratio * (axis[joint.name].T * axis[name])[0, 0]
     return S.applyfunc(sp.simplify) if len(q) <= 3 else S
 
@@ -400,8 +398,9 @@ def time_derivative_program(program: Program, rates: Mapping[sp.Symbol, sp.Expr]
 
     Each intermediate ``x = f(s₁, …)`` gets ``d_x = Σ ∂f/∂s_k · ṡ_k`` (forward mode along
     time), ``rates`` giving the derivative of each input (``q → qd``, ``qd → qdd``, …; inputs
-    not listed, such as parameters, are constant). The new outputs are named ``prefix + name``.
-    Applying it twice gives second derivatives; the program stays linear in size.
+    not listed, such as parameters, are constant) and of intermediates whose derivative an
+    earlier pass defined. The new outputs are named ``prefix + name``. Applying it twice gives
+    second derivatives; the program stays linear in size.
     """
     d: dict[sp.Symbol, sp.Expr] = dict(rates)
 
@@ -411,6 +410,8 @@ def time_derivative_program(program: Program, rates: Mapping[sp.Symbol, sp.Expr]
     taken = {s.name for s, _ in program.assignments}
     assignments = list(program.assignments)
     for symbol, expr in program.assignments:
+        if symbol in d:  # its derivative is known (from an earlier pass)
+            continue
         if prefix + symbol.name in taken:
             raise ValueError(f"prefix {prefix!r} clashes with intermediate {symbol.name}")
         rate = derivative(expr)
@@ -559,7 +560,9 @@ def actuated_model(dynamics: Dynamics, values: Mapping[str | sp.Symbol, float] |
     rates = dict(zip(q, qd)) | dict(zip(qd, qdd)) | dict(zip(qdd, qddd)) \
         | dict(zip(qddd, qdddd))
     once = time_derivative_program(base, rates, ["tauL"], "d_")
-    twice = time_derivative_program(once, rates, ["d_tauL"], "dd_")
+    defined = {s.name: s for s, _ in once.assignments}
+    known = {s: defined["d_" + s.name] for s, _ in base.assignments if "d_" + s.name in defined}
+    twice = time_derivative_program(once, rates | known, ["d_tauL"], "dd_")
     flexible = np.array(flexible_indices(model), dtype=int)
     return ActuatedModel(
         model.joint_names, flexible,
