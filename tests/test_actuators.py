@@ -480,3 +480,21 @@ def test_panda_flexible_model_derivatives_and_energy():
     result = _integrate(free, x0, lambda t: np.zeros(7), 0.05, rtol=1e-10, atol=1e-10)
     energy = [A.flexible_energy(free, x) for x in result.y.T]
     assert np.ptp(energy) < 1e-8 * np.abs(energy).max()
+
+
+def test_scene_parameters_in_actuators_stay_symbolic_or_take_their_values():
+    arm = eomgen.load(eomgen.example_path("planar_2link"))
+    text = ("version: 1\nparameters: {K: 5.0e3, Bm: 0.2}\nactuators:\n"
+            "  joint2: {armature: Bm, stiffness: K}\n")
+    kept = apply_scene(arm, load_scene("s.yaml", text=text + "symbolic: [K]\n")).model
+    stiffness = kept.movable_joints[1].actuator.stiffness
+    assert stiffness == sp.Symbol("K", real=True)
+    assert [p.value for p in kept.parameters if p.name == "K"] == [5.0e3]
+    assert float(kept.movable_joints[1].actuator.armature) == 0.2  # Bm fixed at its value
+    fixed = apply_scene(arm, load_scene("s.yaml", text=text + "symbolic: none\n")).model
+    assert float(fixed.movable_joints[1].actuator.stiffness) == 5.0e3
+    assert not {"K", "Bm"} & {p.name for p in fixed.parameters}
+    am = A.actuated_model(eomgen.derive(kept), {"K": 123.0})
+    assert am.stiffness[1] == 123.0 and np.isnan(am.stiffness[0])
+    with pytest.raises(SceneError, match="stiffness -1 is negative"):
+        apply_scene(arm, load_scene("s.yaml", text=text.replace("5.0e3", "-1")))
