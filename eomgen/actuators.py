@@ -313,6 +313,38 @@ class SpongDynamics:
         tau = rigid.tau(smooth) + self.E * (tau_m - t0)  # flexible rows: τ_L,F → τ_m
         return {"theta": theta, "thetad": thetad, "thetadd": thetadd, "tau": tau}
 
+    def forward_dynamics_function(self, values: Mapping[str, float] | None = None,
+                                  smooth: bool = True) -> Callable[..., np.ndarray]:
+        """``f(x, tau) -> ẋ`` of this model (with the coupling when ``coupling``), lambdified
+        from the symbolic equations: for small models (the numeric
+        :func:`flexible_forward_dynamics` is the reduced model's for any size). Derive with
+        ``simplify=False`` unless the model is tiny: the equations use the expanded ``M``.
+
+        ``x = (q, q̇, θ, θ̇)`` (2n + 2m,); the equations are linear in the accelerations,
+        ``A(x) [q̈; θ̈] + b(x, τ) = 0``, solved with NumPy. Parameters take ``values`` (by
+        name) over their defaults.
+        """
+        d = self.dynamics
+        numbers = {p.symbol: float(p.value) for p in d.model.parameters if p.value is not None}
+        numbers.update({sp.Symbol(k, real=True): float(v) for k, v in (values or {}).items()})
+        residual = self.link_equations(smooth).col_join(self.motor_equations(smooth))
+        residual = residual.xreplace(numbers)
+        accelerations = list(d.qdd) + list(self.thetadd)
+        states = list(d.q) + list(d.qd) + list(self.theta) + list(self.thetad)
+        matrix = residual.jacobian(accelerations)
+        rest = residual.xreplace({a: 0 for a in accelerations})
+        f_matrix = sp.lambdify(states, matrix, "numpy")
+        f_rest = sp.lambdify(states + list(self.tau), rest, "numpy")
+        n, m = len(d.q), len(self.flexible)
+
+        def forward(x, tau) -> np.ndarray:
+            x = np.asarray(x, float)
+            acc = np.linalg.solve(np.array(f_matrix(*x), float),
+                                  -np.array(f_rest(*x, *tau), float).ravel())
+            return np.concatenate([x[n:2 * n], acc[:n], x[2 * n + m:], acc[n:]])
+
+        return forward
+
     # -- the full model's coupling ----------------------------------------------------------
 
     def _coupling_link_terms(self) -> sp.Matrix:
