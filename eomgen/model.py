@@ -12,6 +12,8 @@ Conventions (URDF's, whatever the input format):
   URDF ``<inertial><origin rpy>`` is already applied by the parser).
 * ``gravity`` is the gravitational acceleration [m/s²] in the root link frame, e.g.
   ``(0, 0, -9.81)`` for URDF input.
+* A movable joint may carry an :class:`Actuator` (armature, friction, stiffness): the rigid
+  bodies' ``M``, ``C``, ``g`` do not use it; :mod:`eomgen.actuators` does (docs/actuators.md).
 
 Every geometric and inertial quantity is a SymPy expression: a number (exact integers are kept
 exact so that structural zeros stay zeros) or an expression in the model's parameter symbols.
