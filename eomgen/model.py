@@ -12,6 +12,8 @@ Conventions (URDF's, whatever the input format):
   URDF ``<inertial><origin rpy>`` is already applied by the parser).
 * ``gravity`` is the gravitational acceleration [m/s²] in the root link frame, e.g.
   ``(0, 0, -9.81)`` for URDF input.
+* A movable joint may carry an :class:`Actuator` (armature, friction, stiffness): the rigid
+  bodies' ``M``, ``C``, ``g`` do not use it; :mod:`eomgen.actuators` does (docs/actuators.md).
 
 Every geometric and inertial quantity is a SymPy expression: a number (exact integers are kept
 exact so that structural zeros stay zeros) or an expression in the model's parameter symbols.
@@ -264,6 +266,102 @@ class Link:
     inertial: Inertial | None = None
 
 
+#: Coulomb friction is smoothed as ``friction · tanh(q̇ / friction_width)`` for simulation; this
+#: width [rad/s or m/s] is used when a description gives Coulomb friction without a width.
+DEFAULT_FRICTION_WIDTH = 0.01
+
+
+@dataclass(frozen=True)
+class Actuator:
+    """The drive of one movable joint: a motor behind a gear, with friction, and optionally
+    an elastic transmission (a flexible joint, Spong's model). See docs/actuators.md.
+
+    Conventions: the gear ratio ``r`` is motor turns per joint turn (``θ_rotor = r θ``), so a
+    rotor of inertia ``I_rotor`` [kg m²] about its spin axis adds the *reflected inertia*
+    (armature) ``r² I_rotor`` to the joint's diagonal entry of ``M`` (MuJoCo's ``armature``,
+    Drake's rotor inertia and gear ratio). Motor angles of flexible joints are on the link side
+    of the gear (``θ_m = θ_rotor / r`` [rad]), so the motor inertia of Spong's model is
+    ``B = armature``. Torques are joint-side (N m; N for prismatic joints), positive along the
+    joint axis; friction opposes the motion (``τ_friction = -damping q̇ - friction sign(q̇)``
+    acts on the joint).
+
+    Attributes
+    ----------
+    armature:
+        Reflected rotor inertia [kg m²; kg for a prismatic joint], ``≥ 0``: given directly or
+        computed as ``gear_ratio² · rotor_inertia``.
+    damping:
+        Viscous friction coefficient [N m s/rad], ``≥ 0``.
+    friction:
+        Coulomb friction torque [N m], ``≥ 0``.
+    friction_width:
+        Velocity [rad/s] of the ``tanh`` smoothing of Coulomb friction used for simulation
+        (inverse dynamics uses the exact sign), ``> 0``.
+    stiffness:
+        Joint stiffness ``K`` [N m/rad] of a flexible joint, ``> 0``; None for a rigid joint.
+    rotor_inertia, gear_ratio:
+        The rotor inertia [kg m²] and gear ratio when the description gives them (None
+        otherwise); ``armature`` holds their product ``r² I_rotor``.
+    """
+
+    armature: Scalar = sp.Integer(0)
+    damping: Scalar = sp.Integer(0)
+    friction: Scalar = sp.Integer(0)
+    friction_width: Scalar = scalar(DEFAULT_FRICTION_WIDTH)
+    stiffness: Scalar | None = None
+    rotor_inertia: Scalar | None = None
+    gear_ratio: Scalar | None = None
+
+    def __post_init__(self):  # accept plain numbers from Python callers
+        for name in ("armature", "damping", "friction", "friction_width", "stiffness",
+                     "rotor_inertia", "gear_ratio"):
+            value = getattr(self, name)
+            if value is not None:
+                object.__setattr__(self, name, scalar(value))
+
+    @staticmethod
+    def from_rotor(rotor_inertia, gear_ratio, **others) -> "Actuator":
+        """An actuator whose armature is ``gear_ratio² · rotor_inertia``."""
+        I, r = scalar(rotor_inertia), scalar(gear_ratio)
+        return Actuator(armature=r ** 2 * I, rotor_inertia=I, gear_ratio=r, **others)
+
+    def updated(self, values: Mapping[str, object]) -> "Actuator":
+        """A copy with the given fields replaced (a scene over a description). Giving
+        ``rotor_inertia`` or ``gear_ratio`` recomputes ``armature`` from both (a missing gear
+        ratio is 1); giving ``armature`` forgets them."""
+        fields = {name: getattr(self, name) for name in self.__dataclass_fields__}
+        values = {k: scalar(v) for k, v in values.items()}
+        if "rotor_inertia" in values or "gear_ratio" in values:
+            I = values.pop("rotor_inertia", self.rotor_inertia)
+            r = values.pop("gear_ratio", self.gear_ratio)
+            r = sp.Integer(1) if r is None else r
+            I = sp.Integer(0) if I is None else I
+            values.update(armature=r ** 2 * I, rotor_inertia=I, gear_ratio=r)
+        elif "armature" in values:
+            values.update(rotor_inertia=None, gear_ratio=None)
+        fields.update(values)
+        return Actuator(**fields)
+
+    @property
+    def flexible(self) -> bool:
+        """Whether the joint is elastic (has a stiffness): Spong's model gives it a motor."""
+        return self.stiffness is not None
+
+    def scalars(self) -> tuple[sp.Expr, ...]:
+        """Every value it holds (for symbol bookkeeping)."""
+        return tuple(v for v in (self.armature, self.damping, self.friction,
+                                 self.friction_width, self.stiffness, self.rotor_inertia,
+                                 self.gear_ratio) if v is not None)
+
+    def substitute(self, subs: Mapping[sp.Symbol, sp.Expr]) -> "Actuator":
+        """A copy with ``subs`` applied to every value."""
+        def s(x):
+            return None if x is None else scalar(x.xreplace(subs))
+        return Actuator(s(self.armature), s(self.damping), s(self.friction),
+                        s(self.friction_width), s(self.stiffness), s(self.rotor_inertia),
+                        s(self.gear_ratio))
+
+
 @dataclass(frozen=True)
 class Joint:
     """A joint from ``parent`` link to ``child`` link; see the module docstring for frames."""
@@ -274,6 +372,8 @@ class Joint:
     child: str
     origin: Transform = Transform()
     axis: Vec3 = vec3([0, 0, 1])
+    #: The drive of a movable joint (armature, friction, elasticity); None for none.
+    actuator: "Actuator | None" = None
 
     def __post_init__(self):  # accept plain numbers from Python callers
         object.__setattr__(self, "axis", vec3(self.axis))
@@ -473,6 +573,7 @@ class RobotModel:
                     tuple(sv(r) for r in j.origin.rotation), sv(j.origin.translation)
                 ),
                 axis=sv(j.axis),
+                actuator=None if j.actuator is None else j.actuator.substitute(subs),
             )
             for j in self.joints
         )
@@ -510,6 +611,8 @@ def _all_scalars(model: RobotModel) -> Iterable[sp.Expr]:
         yield from joint.origin.translation
         for row in joint.origin.rotation:
             yield from row
+        if joint.actuator is not None:
+            yield from joint.actuator.scalars()
 
 
 # ----------------------------------------------------------------------------------------------
@@ -646,6 +749,61 @@ def _substituted(inertial: Inertial, values: Mapping[sp.Symbol, sp.Expr]) -> Ine
                     tuple(tuple(v.xreplace(values) for v in row) for row in inertial.inertia))
 
 
+def check_actuator(source: str, joint: Joint, values: Mapping[sp.Symbol, sp.Expr] | None = None,
+                   where: str | None = None) -> None:
+    """Refuse an actuator that is not physical; values still symbolic after ``values`` (the
+    parameters' defaults) are not checked.
+
+    Raises
+    ------
+    KinematicTreeError
+        An actuator on a fixed joint.
+    InvalidNumberError
+        Negative damping or Coulomb friction, a friction width or stiffness that is not
+        positive (negative stiffness), a gear ratio of 0.
+    InvalidInertiaError
+        Negative armature or rotor inertia, or zero motor inertia (armature) on a flexible
+        joint: Spong's motor equation ``B θ̈_m + K (θ_m − q) = τ_m`` needs ``B > 0``.
+    """
+    a = joint.actuator
+    if a is None:
+        return
+    where = where or f"joint '{joint.name}' actuator"
+    if not joint.type.is_movable:
+        raise KinematicTreeError(source, where, "a fixed joint cannot have an actuator")
+    if values:
+        a = a.substitute(values)
+
+    def number(name):
+        value = getattr(a, name)
+        return None if value is None else _number(value)
+
+    for name in ("armature", "rotor_inertia"):
+        v = number(name)
+        if v is not None and v < 0:
+            raise InvalidInertiaError(source, where, f"{name} {v:g} is negative")
+    for name in ("damping", "friction"):
+        v = number(name)
+        if v is not None and v < 0:
+            raise InvalidNumberError(source, where, f"{name} {v:g} is negative")
+    v = number("friction_width")
+    if v is not None and v <= 0:
+        raise InvalidNumberError(source, where, f"friction_width {v:g} is not positive")
+    v = number("gear_ratio")
+    if v is not None and v == 0:
+        raise InvalidNumberError(source, where, "gear_ratio is 0 (the motor would not move "
+                                 "the joint)")
+    v = number("stiffness")
+    if v is not None and v <= 0:
+        raise InvalidNumberError(source, where, f"stiffness {v:g} is "
+                                 + ("negative" if v < 0 else "zero")
+                                 + " (a flexible joint needs K > 0)")
+    B = number("armature")
+    if a.flexible and B is not None and B == 0:
+        raise InvalidInertiaError(source, where, "zero motor inertia on a flexible joint (give "
+                                  "armature or rotor_inertia and gear_ratio > 0)")
+
+
 def check_size(source: str, links: int, joints: int) -> None:
     """Refuse models with more than :data:`MAX_JOINTS` joints (or ``MAX_JOINTS + 1`` links);
     parsers call it as soon as they have counted, before reading the elements."""
@@ -695,6 +853,11 @@ def build_model(
             if defaults and _is_symbolic(link.inertial):
                 notices += check_inertial(source, link.name,
                                           _substituted(link.inertial, defaults), at_defaults=True)
+    for joint in joints:
+        check_actuator(source, joint)
+        if defaults and joint.actuator is not None:
+            check_actuator(source, joint, defaults, where=f"joint '{joint.name}' actuator at "
+                           "the parameters' default values")
     gravity = vec3(gravity)
     for v in gravity:
         g = _number(v)

@@ -66,8 +66,10 @@ import sympy as sp
 
 from .bodies import InertialParameters
 from .floating import EULER_JOINTS, add_floating_base
+from .errors import DescriptionError
 from .model import (
     ZERO3,
+    Actuator,
     Inertial,
     Joint,
     JointType,
@@ -76,13 +78,14 @@ from .model import (
     NoticeKind,
     RobotModel,
     Transform,
+    check_actuator,
     emit_notices,
     lock_joints,
     scalar,
     vec3,
 )
 from .codegen.functions import select_functions
-from .scene import Payload, Scene, did_you_mean
+from .scene import Payload, Scene, did_you_mean, scene_error
 
 #: Relative size below which a number computed while merging is roundoff of an exact zero.
 ROUNDOFF = 1e-13
@@ -332,6 +335,7 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
         raise scene.error("robot", f"the scene is for robot '{scene.robot}', not "
                           f"'{model.name}' ({model.source})")
     before = ModelSize.of(model)
+    model = _with_actuators(model, scene)
     model, payloads, scene_gravity, notes = _parameters(model, scene)
     if scene.floating_base:
         model = _float(model, scene)
@@ -372,6 +376,7 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
         notes.append("parameters that no longer appear in the reduced model (dropped): "
                      + ", ".join(unused))
     notes += _massless_notes(reduced)
+    notes += _actuator_notes(reduced, scene)
     kept, moot = _split_notices(model.notices, scene, set(reduced.joint_names), set(dropped))
     reduced = replace(reduced, notices=kept)
     notes += _moot_notes(moot, scene.floating_base)
@@ -538,6 +543,9 @@ def _parameters(model: RobotModel, scene: Scene):
         for value in _inertial_scalars(inertial):
             used |= {s.name for s in value.free_symbols}
         payloads.append(replace(payload, inertial=inertial))
+    for joint in reduced.joints:  # scene parameters set in the scene's actuators
+        if joint.actuator is not None:
+            used |= {s.name for v in joint.actuator.scalars() for s in v.free_symbols}
     gravity = None
     if scene.gravity is not None:
         gravity = vec3([g.xreplace({k: scalar(v) for k, v in fixed.items()})
@@ -545,6 +553,56 @@ def _parameters(model: RobotModel, scene: Scene):
         used |= {s.name for g in gravity for s in g.free_symbols}
     extra = tuple(p for p in scene.parameters if p.name in kept and p.name in used)
     return replace(reduced, parameters=reduced.parameters + extra), payloads, gravity, notes
+
+
+def _with_actuators(model: RobotModel, scene: Scene) -> RobotModel:
+    """``model`` with the scene's actuator values set over the description's (see
+    :class:`eomgen.model.Actuator`), checked at the parameters' values."""
+    if not scene.actuators:
+        return model
+    joints = {j.name: j for j in model.joints}
+    changed = {}
+    for name, values in scene.actuators:
+        where = f"actuators '{name}'"
+        if name not in joints:
+            raise scene.error(where, f"no joint '{name}' in robot '{model.name}'"
+                              + did_you_mean(name, joints))
+        joint = joints[name]
+        if not joint.type.is_movable:
+            raise scene.error(where, "a fixed joint cannot have an actuator")
+        base = joint.actuator or Actuator()
+        values = dict(values)
+        if "gear_ratio" in values and "rotor_inertia" not in values \
+                and base.rotor_inertia is None:
+            raise scene.error(where, "'gear_ratio' given without 'rotor_inertia' (the "
+                              "description gives none)")
+        joint = replace(joint, actuator=base.updated(values))
+        defaults = {p.symbol: p.value for p in (*model.parameters, *scene.parameters)
+                    if p.value is not None}
+        try:
+            check_actuator(scene.source, joint, defaults, where=where)
+        except DescriptionError as exc:
+            raise scene_error(type(exc))(scene.source, where, exc.problem) from None
+        changed[name] = joint
+    return replace(model, joints=tuple(changed.get(j.name, j) for j in model.joints))
+
+
+def _actuator_notes(model: RobotModel, scene: Scene) -> list[str]:
+    """What the scene set of the moving joints' actuators, and which joints are flexible."""
+    moving = set(model.joint_names)
+    notes = []
+    set_here = [f"{name} ({', '.join(key for key, _ in values)})"
+                for name, values in scene.actuators if name in moving]
+    if set_here:
+        notes.append("actuators set by the scene: " + ", ".join(set_here))
+    ignored = [name for name, _ in scene.actuators if name not in moving]
+    if ignored:
+        notes.append("actuators of joints that do not move (no effect): " + ", ".join(ignored))
+    flexible = [j.name for j in model.movable_joints if j.actuator and j.actuator.flexible]
+    if flexible:
+        notes.append("flexible joints (Spong's model, eomgen.actuators; the generated M, C, g "
+                     "are the rigid links'): " + ", ".join(flexible))
+    return notes
 
 
 def _substituted(inertial: Inertial, values: dict) -> Inertial:

@@ -24,6 +24,9 @@ Version 1 of the format (every key but ``version`` is optional)::
         mass: 1.5                 # kg
         com: [0, 0, -0.1]         # m, in the link frame
         inertia: {ixx: 0.01, iyy: 0.01, izz: 0.002}   # kg m², about com, link axes
+    actuators:                    # joint: drive values over the description's
+      arm_left_4_joint: {rotor_inertia: 1.0e-4, gear_ratio: 100, damping: 0.5,
+                         friction: 0.2, stiffness: 1.0e4}   # see docs/actuators.md
     gravity: [0, 0, -9.81]        # m/s² in the root link frame; none for no gravity
     parameters: {m_load: 1.5}     # new symbols for payload values (name: default value)
     symbolic: [m_load]            # parameters kept symbolic (default: all; none for none)
@@ -65,10 +68,15 @@ SCENE_VERSION = 1
 
 #: Top-level keys of a version-1 scene, in documentation order.
 SCENE_KEYS = ("version", "robot", "description", "fixed_base", "floating_base", "base", "tips",
-              "locked", "payloads", "gravity", "parameters", "symbolic", "outputs", "contacts")
+              "locked", "payloads", "actuators", "gravity", "parameters", "symbolic", "outputs",
+              "contacts")
 
-#: Keys reserved for later versions of the format; refused with a message saying so.
+#: Keys reserved for later versions of the format; refused with a message saying so (those of
+#: :data:`ACTUATOR_ALIASES` with a pointer to ``actuators``, which holds them per joint now).
 PLANNED_KEYS = ("friction", "armature", "flexible_joints", "joint_limits")
+
+#: Planned whole-scene keys that ``actuators`` now covers per joint.
+ACTUATOR_ALIASES = ("friction", "armature", "flexible_joints")
 
 PAYLOAD_KEYS = ("link", "name", "mass", "com", "inertia")
 
@@ -111,6 +119,9 @@ class Scene:
         ``(joint, position)`` pairs [rad or m], in file order.
     payloads:
         Loads fixed to links.
+    actuators:
+        ``(joint, ((key, value), ...))`` pairs, in file order: actuator values (see
+        :class:`~eomgen.model.Actuator`) set over the description's, key by key.
     gravity:
         Gravitational acceleration [m/s²] in the root link frame; None keeps the description's.
     parameters:
@@ -133,6 +144,7 @@ class Scene:
     tips: tuple[str, ...] = ()
     locked: tuple[tuple[str, float], ...] = ()
     payloads: tuple[Payload, ...] = ()
+    actuators: tuple[tuple[str, tuple[tuple[str, object], ...]], ...] = ()
     gravity: Vec3 | None = None
     parameters: tuple[Parameter, ...] = ()
     symbolic: tuple[str, ...] | None = None
@@ -216,8 +228,11 @@ def _read(data: dict, source: str, strict: bool) -> Scene:
     r = _SceneReader(source)
     for key in data:
         if key in PLANNED_KEYS:
+            hint = (" (write it per joint under 'actuators', e.g. actuators: {joint1: "
+                    "{armature: 0.1, damping: 0.5, stiffness: 1e4}})"
+                    if key in ACTUATOR_ALIASES else "")
             raise r.error(str(key), f"'{key}' is planned for a later scene version; version "
-                          f"{SCENE_VERSION} knows: {', '.join(SCENE_KEYS)}")
+                          f"{SCENE_VERSION} knows: {', '.join(SCENE_KEYS)}{hint}")
     r.mapping(data, "scene", required=("version",), optional=SCENE_KEYS)
     version = data["version"]
     if isinstance(version, bool) or not isinstance(version, int):
@@ -268,6 +283,15 @@ def _read(data: dict, source: str, strict: bool) -> Scene:
         for p in payloads:
             if names.count(p.name) > 1:
                 raise r.error(f"payloads '{p.name}'", "two payloads have this name")
+    actuators: list[tuple[str, tuple[tuple[str, object], ...]]] = []
+    if data.get("actuators") is not None:
+        if not isinstance(data["actuators"], dict):
+            raise r.error("actuators", "expected a mapping of joint: {armature, rotor_inertia, "
+                          "gear_ratio, damping, friction, friction_width, stiffness}")
+        for joint, entry in data["actuators"].items():
+            name = r.name(joint, "actuators")
+            values = r.actuator_values(entry, f"actuators '{name}'")
+            actuators.append((name, tuple(values.items())))
     gravity = _gravity(r, data["gravity"]) if "gravity" in data else None
     symbolic = _symbolic(r, data["symbolic"]) if "symbolic" in data else None
     outputs = _outputs(r, data["outputs"]) if data.get("outputs") is not None else None
@@ -280,9 +304,10 @@ def _read(data: dict, source: str, strict: bool) -> Scene:
             if names.count(c.name) > 1:
                 raise r.error(f"contacts '{c.name}'", "two contacts have this name")
     declared = tuple(r.declared.values())
-    return Scene(floating_base=floating_base, contacts=tuple(contacts), source=source, version=version, robot=robot, description=description,
+    return Scene(source=source, version=version, robot=robot, description=description,
+                 floating_base=floating_base, contacts=tuple(contacts),
                  fixed_base=fixed_base, base=base, tips=tuple(tips), locked=tuple(locked),
-                 payloads=tuple(payloads),
+                 payloads=tuple(payloads), actuators=tuple(actuators),
                  gravity=gravity, parameters=declared, symbolic=symbolic, outputs=outputs)
 
 

@@ -419,7 +419,7 @@ def test_ignored_elements_do_not_matter():
         f'<inertial><mass value="1"/>{INERTIA}</inertial></link>',
         link("b"),
         joint("j", "a", "b", body='<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" '
-                                  'velocity="1"/><dynamics damping="0.5"/>'),
+                                  'velocity="1"/>'),  # <dynamics> is read: test_actuators
         '<transmission name="t"><joint name="j"/></transmission>',
         '<gazebo reference="a"><joint name="ghost" type="floating"/></gazebo>',
     )

@@ -46,6 +46,7 @@ EXAMPLES = {
     "ur5_payload": "ur_description/urdf/ur5_robot.urdf",
     "talos_left_arm": "talos_data/robots/talos_reduced.urdf",
     "panda_two_joints": "panda_description/urdf/panda.urdf",
+    "panda_flexible": "panda_description/urdf/panda.urdf",  # docs/actuators.md
 }
 
 

@@ -39,7 +39,7 @@ from ..errors import (
     one_line,
 )
 from ..expressions import check_parameter_name, parse_scalar
-from ..model import Mat3, Parameter, Vec3, parameter_symbol, scalar
+from ..model import Actuator, Mat3, Parameter, Vec3, parameter_symbol, scalar
 
 MAX_BYTES = 1024 * 1024
 MAX_NODES = 100_000
@@ -47,6 +47,10 @@ MAX_DEPTH = 32
 
 #: Link and joint names: used in generated code and LaTeX, so kept to a safe alphabet.
 NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_.\-]{0,63}$")
+
+#: Keys of an actuator mapping (robot YAML ``joints[i] actuator``, scene ``actuators``).
+ACTUATOR_KEYS = ("armature", "rotor_inertia", "gear_ratio", "damping", "friction",
+                 "friction_width", "stiffness")
 
 INERTIA_KEYS = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
 _INERTIA_INDEX = {
@@ -338,6 +342,27 @@ class Reader:
             i, j = _INERTIA_INDEX[key]
             m[i][j] = m[j][i] = self.scalar(entry, f"{where} {key}")
         return tuple(tuple(row) for row in m)  # type: ignore[return-value]
+
+    def actuator_values(self, value, where: str) -> dict[str, sp.Expr]:
+        """The values of an actuator mapping (:data:`ACTUATOR_KEYS`; see
+        :class:`~eomgen.model.Actuator`): ``armature`` or ``rotor_inertia`` with
+        ``gear_ratio`` (not both), ``damping``, ``friction``, ``friction_width``,
+        ``stiffness``; numbers or expressions in declared parameters. Physical checks are
+        :func:`eomgen.model.check_actuator`'s; :meth:`Actuator.updated
+        <eomgen.model.Actuator.updated>` makes the actuator."""
+        self.mapping(value, where, optional=ACTUATOR_KEYS)
+        values = {key: self.scalar(entry, f"{where} {key}") for key, entry in value.items()}
+        if "armature" in values and ("rotor_inertia" in values or "gear_ratio" in values):
+            raise self.error(where, "give either 'armature' or 'rotor_inertia' with "
+                             "'gear_ratio' (armature = gear_ratio² · rotor_inertia), not both")
+        return values
+
+    def actuator(self, value, where: str) -> Actuator:
+        """The :class:`~eomgen.model.Actuator` of a mapping (see :meth:`actuator_values`)."""
+        values = self.actuator_values(value, where)
+        if "gear_ratio" in values and "rotor_inertia" not in values:
+            raise self.error(where, "'gear_ratio' given without 'rotor_inertia'")
+        return Actuator().updated(values)
 
     def used_parameters(self) -> tuple[Parameter, ...]:
         """Declared parameters the document uses, in declaration order."""

@@ -17,8 +17,17 @@ What is read
   ``1 0 0`` as the URDF specification says; not read for fixed joints). Joints keep document
   order, so the joint vector ``q`` lists the movable joints in the order the file does.
 
-Everything else (visual, collision, limit, dynamics, transmission, gazebo, material, sensors)
-is ignored: it does not enter the rigid-body equations of motion.
+* ``<dynamics damping friction>`` of a movable joint (both default 0): viscous friction
+  [N m s/rad] and Coulomb friction [N m] of the joint's :class:`~eomgen.model.Actuator` (see
+  docs/actuators.md; MuJoCo reads the same attributes as ``damping`` and ``frictionloss``).
+  They enter the equations of motion only through :mod:`eomgen.actuators` (the generated
+  ``M``, ``C``, ``g`` stay those of the rigid bodies). A ``<dynamics>`` on a fixed joint is
+  ignored.
+
+Everything else (visual, collision, limit, transmission, gazebo, material, sensors) is ignored:
+it does not enter the equations of motion. URDF has no rotor inertia, gear ratio or joint
+stiffness (``<transmission>`` ``mechanicalReduction`` is not read); give them in a scene's
+``actuators``.
 
 Decisions
 ---------
@@ -86,6 +95,7 @@ from ..errors import (
 )
 from ..expressions import MAX_MAGNITUDE
 from ..model import (
+    Actuator,
     Inertial,
     Joint,
     JointType,
@@ -413,8 +423,27 @@ def _read_joint(element: ET.Element, index: int, source: str) -> tuple[Joint, st
     axis_element = _single_child(element, "axis", source, where)
     if joint_type.is_movable and axis_element is not None:
         axis = _vector_attribute(axis_element, "xyz", 3, source, f"{where} <axis>")
-    return (Joint(name, joint_type, parent, child, Transform.from_xyz_rpy(xyz, rpy), vec3(axis)),
-            mimicked)
+    actuator = None
+    dynamics = _single_child(element, "dynamics", source, where)
+    if joint_type.is_movable and dynamics is not None:
+        actuator = _read_dynamics(dynamics, source, f"{where} <dynamics>")
+    return (Joint(name, joint_type, parent, child, Transform.from_xyz_rpy(xyz, rpy), vec3(axis),
+                  actuator), mimicked)
+
+
+def _read_dynamics(element: ET.Element, source: str, where: str) -> Actuator | None:
+    """``<dynamics damping friction>``: viscous [N m s/rad] and Coulomb [N m] friction (both
+    default 0, as urdfdom); None when both are zero."""
+    values = {}
+    for attribute in ("damping", "friction"):
+        if element.get(attribute) is not None:
+            value = _number_attribute(element, attribute, source, where)
+            if value < 0:
+                raise InvalidNumberError(source, where, f"{attribute} {value:g} is negative")
+            values[attribute] = scalar(value)
+    if not any(values.values()):
+        return None
+    return Actuator(**values)
 
 
 def _read_joint_type(element: ET.Element, source: str, where: str) -> JointType:

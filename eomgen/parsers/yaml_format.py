@@ -22,6 +22,12 @@
         child: link1
         origin: {xyz: [0, 0, 0], rpy: [0, 0, 0]}   # optional, default identity
         axis: [0, 0, 1]                            # optional, default [0, 0, 1]
+        actuator:                                  # optional: the drive (docs/actuators.md)
+          rotor_inertia: 1.0e-4    # [kg m²], with gear_ratio (or armature: r² I directly)
+          gear_ratio: 100          # motor turns per joint turn
+          damping: 0.1             # viscous [N m s/rad]
+          friction: 0.5            # Coulomb [N m], smoothed over friction_width [rad/s]
+          stiffness: K1            # [N m/rad]: a flexible joint (Spong's model)
 
 Frames and units follow :mod:`eomgen.model` (URDF's conventions). Values are numbers or
 expressions read by :func:`eomgen.expressions.parse_scalar`; every symbol must be declared under
@@ -41,7 +47,7 @@ from ._yaml import Reader, read_document, top_level_key
 
 TOP_KEYS = ("name", "description", "gravity", "parameters", "links", "joints")
 LINK_KEYS = ("name", "mass", "com", "inertia")
-JOINT_KEYS = ("name", "type", "parent", "child", "origin", "axis")
+JOINT_KEYS = ("name", "type", "parent", "child", "origin", "axis", "actuator")
 ORIGIN_KEYS = ("xyz", "rpy")
 JOINT_TYPES = {t.value: t for t in JointType}
 UNSUPPORTED_TYPES = ("floating", "planar", "spherical", "mimic")
@@ -113,11 +119,13 @@ def parse(data: dict, source: str, strict: bool = False, default_name: str = "ro
             rpy = r.vector(o["rpy"], f"{where} origin rpy") if "rpy" in o else (0, 0, 0)
             origin = Transform.from_xyz_rpy(xyz, rpy)
         axis = r.vector(entry["axis"], f"{where} axis") if "axis" in entry else vec3([0, 0, 1])
+        actuator = r.actuator(entry["actuator"], f"{where} actuator") \
+            if "actuator" in entry else None
         joints.append(Joint(
             joint_name, kind,
             r.name(entry["parent"], f"{where} parent"),
             r.name(entry["child"], f"{where} child"),
-            origin, axis))
+            origin, axis, actuator))
 
     info = {"description": r.text(data["description"], "description")} \
         if "description" in data else {}

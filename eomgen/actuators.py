@@ -1,0 +1,711 @@
+"""Actuators: armature, friction and flexible joints (Spong's model).
+
+A robot joint is driven by a motor through a gear. With the drive data of each joint
+(:class:`eomgen.model.Actuator`, read from eomgen YAML, scenes and URDF ``<dynamics>``) this
+module forms, from the rigid-body equations of a :class:`~eomgen.dynamics.Dynamics`:
+
+**Rigid joints with actuators** (every joint stiff)::
+
+    (M(q) + diag(a)) q̈ + C(q, q̇) q̇ + g(q) + τ_f(q̇) = τ
+    τ_f,i(q̇) = d_i q̇_i + f_i sign(q̇_i)            exact (inverse dynamics)
+    τ_f,i(q̇) = d_i q̇_i + f_i tanh(q̇_i / w_i)      smoothed (simulation)
+
+with ``a = r² I_rotor`` the armature (reflected rotor inertia), ``d`` the viscous and ``f`` the
+Coulomb friction, ``w`` the smoothing width (:attr:`~eomgen.model.Actuator.friction_width`).
+``τ`` is the joint torque the drives apply; ``τ_f`` is the torque friction takes from them.
+
+**Flexible joints** (Spong 1987, the *reduced model*): every joint with a stiffness ``K_j``
+gets a motor angle ``θ_j`` (link side of the gear, ``θ_j = θ_rotor,j / r_j``)::
+
+    M_a(q) q̈ + C(q, q̇) q̇ + g(q) + τ_f,R(q̇) = S_R τ_R + E K (θ − Eᵀ q)      (link equations)
+    B θ̈ + K (θ − Eᵀ q) + τ_f,F(θ̇) = τ_m                                 (motor equations)
+
+``E`` (n×m) selects the m flexible joints, ``S_R`` the rigid ones, ``M_a = M + diag(a)`` with
+the armature of *rigid* joints only, ``B = diag(a_F)`` the motor inertias (armature of the
+flexible joints) and the friction of a flexible joint acts on its motor. The reduced model
+assumes each rotor's kinetic energy comes only from its own spin (Spong's assumption): the
+rotor's angular velocity due to the links that carry it is neglected (rotor mass and
+transverse inertia belong in the carrying link). The full model adds the coupling
+``q̇ᵀ S(q) θ̇`` to the kinetic energy (:func:`spong_dynamics` with ``coupling=True``, symbolic
+only, small models).
+
+The inputs are one vector ``tau`` (n,) in joint order: the joint torque for a rigid joint,
+the motor torque ``τ_m`` for a flexible one.
+
+**Flatness.** The link angles ``q`` are a flat output of the reduced model: from ``q`` and its
+time derivatives up to order 4 (``q⁽³⁾ = qddd``, ``q⁽⁴⁾ = qdddd``)::
+
+    τ_L = M q̈ + C q̇ + g                           (rigid-body inverse dynamics)
+    θ   = q_F + K⁻¹ τ_L,F,   θ̇ = q̇_F + K⁻¹ τ̇_L,F,   θ̈ = q̈_F + K⁻¹ τ̈_L,F
+    τ_m = B θ̈ + K (θ − q_F) + τ_f,F(θ̇),    τ_R = τ_L,R + a_R q̈_R + τ_f,R(q̇)
+
+The time derivatives ``τ̇_L`` and ``τ̈_L`` are computed without numeric differentiation: the
+straight-line program of ``τ_L`` is differentiated in forward mode along the trajectory
+(:func:`time_derivative_program`: each intermediate ``x = f(…)`` gets ``ẋ = Σ ∂f/∂s ṡ``), which
+keeps the program's size linear in the model (the 7-DOF Panda included).
+
+Nothing here is generated as code yet (the backends' ``M``, ``C``, ``g`` are the rigid
+bodies'); see docs/actuators.md.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Callable, Mapping, Sequence
+
+import numpy as np
+import sympy as sp
+
+from .dynamics import Dynamics
+from .errors import ParameterError
+from .model import Actuator, RobotModel, joint_motion, scalar
+from .symbolic.evaluate import compile_program
+from .symbolic.program import Program
+
+__all__ = [
+    "joint_actuators", "flexible_indices", "friction_torque_expr", "RigidActuatorDynamics",
+    "rigid_with_actuators", "SpongDynamics", "spong_dynamics", "time_derivative_program",
+    "ActuatedModel", "actuated_model", "rigid_mass_matrix", "friction_torque",
+    "rigid_inverse_dynamics", "rigid_forward_dynamics", "flexible_forward_dynamics",
+    "flexible_energy", "flexible_inverse_dynamics", "flexible_rest_state",
+]
+
+
+# ----------------------------------------------------------------------------------------------
+# Actuator data of a model
+# ----------------------------------------------------------------------------------------------
+
+def joint_actuators(model: RobotModel) -> tuple[Actuator, ...]:
+    """The actuator of every movable joint, in ``model.joint_names`` order (a joint without
+    one gets ``Actuator()``: no armature, no friction, rigid)."""
+    return tuple(j.actuator or Actuator() for j in model.movable_joints)
+
+
+def flexible_indices(model: RobotModel) -> tuple[int, ...]:
+    """Indices (into ``q``) of the flexible joints (those with a stiffness), in joint order."""
+    return tuple(k for k, a in enumerate(joint_actuators(model)) if a.flexible)
+
+
+def friction_torque_expr(actuators: Sequence[Actuator], qd: Sequence[sp.Expr],
+                         smooth: bool = False) -> sp.Matrix:
+    """Symbolic friction torques ``τ_f,i = d_i q̇_i + f_i sign(q̇_i)`` (``smooth``: ``tanh(q̇_i /
+    w_i)`` in place of the sign), (len(qd), 1); positive along the joint axis when the joint
+    turns positively, i.e. the torque the drive spends on friction."""
+    out = []
+    for a, v in zip(actuators, qd):
+        coulomb = sp.tanh(v / a.friction_width) if smooth else sp.sign(v)
+        out.append(a.damping * v + (a.friction * coulomb if a.friction != 0 else 0))
+    return sp.Matrix(out)
+
+
+# ----------------------------------------------------------------------------------------------
+# Symbolic: rigid joints with actuators
+# ----------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class RigidActuatorDynamics:
+    """Rigid equations of motion with actuators: ``(M + diag(a)) q̈ + C q̇ + g + τ_f(q̇) = τ``.
+
+    Attributes
+    ----------
+    dynamics:
+        The rigid-body equations (``M``, ``C``, ``g`` of the links only).
+    actuators:
+        One per joint, in ``dynamics.joint_names`` order.
+    """
+
+    dynamics: Dynamics
+    actuators: tuple[Actuator, ...]
+
+    @property
+    def armature(self) -> sp.Matrix:
+        """Armature ``a`` (n×1) [kg m² or kg]: ``r² I_rotor`` per joint."""
+        return sp.Matrix([a.armature for a in self.actuators])
+
+    @cached_property
+    def M(self) -> sp.Matrix:
+        """``M(q) + diag(a)`` (n×n)."""
+        return self.dynamics.M + sp.diag(*self.armature)
+
+    def tau_friction(self, smooth: bool = False) -> sp.Matrix:
+        """Friction torques ``τ_f(q̇)`` (n×1): exact sign, or ``tanh`` when ``smooth``."""
+        return friction_torque_expr(self.actuators, self.dynamics.qd, smooth)
+
+    def tau(self, smooth: bool = False) -> sp.Matrix:
+        """Inverse dynamics ``(M + diag(a)) q̈ + C q̇ + g + τ_f(q̇)`` (n×1)."""
+        d = self.dynamics
+        return self.M * sp.Matrix(d.qdd) + d.C * sp.Matrix(d.qd) + d.g + self.tau_friction(smooth)
+
+    def program(self) -> Program:
+        """The rigid-body program with ``M`` replaced by ``M + diag(a)`` and an output
+        ``tau_f`` (smoothed friction): what a code generator would print."""
+        p = self.dynamics.program
+        outputs = []
+        for name, matrix in p.outputs:
+            if name == "M":
+                matrix = matrix + sp.diag(*self.armature)
+            outputs.append((name, matrix))
+        outputs.append(("tau_f", self.tau_friction(smooth=True)))
+        return Program(p.assignments, tuple(outputs))
+
+
+def rigid_with_actuators(dynamics: Dynamics) -> RigidActuatorDynamics:
+    """The rigid equations of ``dynamics`` with its model's actuators (every joint stiff; a
+    flexible joint's motor inertia is its armature: the limit ``K → ∞``).
+
+    >>> import eomgen
+    >>> from eomgen.model import Actuator
+    >>> from dataclasses import replace
+    >>> arm = eomgen.load(eomgen.example_path("planar_2link"))
+    >>> joints = tuple(replace(j, actuator=Actuator(armature=0.5)) for j in arm.joints)
+    >>> rigid = rigid_with_actuators(eomgen.derive(replace(arm, joints=joints)))
+    >>> sp.simplify(rigid.M - rigid.dynamics.M)
+    Matrix([
+    [0.5,   0],
+    [  0, 0.5]])
+    """
+    return RigidActuatorDynamics(dynamics, joint_actuators(dynamics.model))
+
+
+# ----------------------------------------------------------------------------------------------
+# Symbolic: Spong's flexible-joint model
+# ----------------------------------------------------------------------------------------------
+
+def _symbols(prefix: str, indices: Sequence[int]) -> tuple[sp.Symbol, ...]:
+    return tuple(sp.Symbol(f"{prefix}{k + 1}", real=True) for k in indices)
+
+
+@dataclass(frozen=True)
+class SpongDynamics:
+    """Spong's flexible-joint model of a :class:`~eomgen.dynamics.Dynamics` (see the module
+    docstring for the equations and conventions).
+
+    Attributes
+    ----------
+    dynamics:
+        The rigid-body equations of the links.
+    actuators:
+        One per joint, in joint order.
+    flexible:
+        Indices of the flexible joints (m of them).
+    theta, thetad, thetadd:
+        Motor angle [rad], rate and acceleration symbols ``thm<k>``, ``thmd<k>``, ``thmdd<k>``
+        (k the joint's 1-based index), one per flexible joint.
+    tau:
+        Input symbols ``tau1…taun``: joint torque (rigid joint) or motor torque (flexible).
+    qddd, qdddd:
+        Symbols of the third and fourth derivatives of ``q`` (for the flat inverse dynamics).
+    coupling:
+        Whether the full model's rotor–link coupling ``q̇ᵀ S(q) θ̇`` is included.
+    S:
+        The coupling matrix ``S(q)`` (n×m), zero without ``coupling``.
+    """
+
+    dynamics: Dynamics
+    actuators: tuple[Actuator, ...]
+    flexible: tuple[int, ...]
+    theta: tuple[sp.Symbol, ...]
+    thetad: tuple[sp.Symbol, ...]
+    thetadd: tuple[sp.Symbol, ...]
+    tau: tuple[sp.Symbol, ...]
+    qddd: tuple[sp.Symbol, ...]
+    qdddd: tuple[sp.Symbol, ...]
+    coupling: bool = False
+    S: sp.Matrix | None = None
+
+    @property
+    def rigid(self) -> tuple[int, ...]:
+        return tuple(k for k in range(len(self.actuators)) if k not in self.flexible)
+
+    @property
+    def K(self) -> sp.Matrix:
+        """Joint stiffnesses, diag (m×m) [N m/rad]."""
+        return sp.diag(*[self.actuators[k].stiffness for k in self.flexible])
+
+    @property
+    def B(self) -> sp.Matrix:
+        """Motor inertias (link side of the gear), diag (m×m) [kg m²]: the armature."""
+        return sp.diag(*[self.actuators[k].armature for k in self.flexible])
+
+    @property
+    def E(self) -> sp.Matrix:
+        """Selection of the flexible joints (n×m): ``Eᵀ q`` are their angles."""
+        n = len(self.actuators)
+        return sp.Matrix(n, len(self.flexible),
+                         lambda i, j: 1 if self.flexible[j] == i else 0)
+
+    @cached_property
+    def M_links(self) -> sp.Matrix:
+        """``M(q)`` plus the armature of the rigid joints (n×n)."""
+        a = [0 if k in self.flexible else self.actuators[k].armature
+             for k in range(len(self.actuators))]
+        return self.dynamics.M + sp.diag(*a)
+
+    def spring(self) -> sp.Matrix:
+        """``K (θ − Eᵀ q)`` (m×1): the torque the springs pass from the motors to the links."""
+        return self.K * (sp.Matrix(self.theta) - self.E.T * sp.Matrix(self.dynamics.q))
+
+    def link_equations(self, smooth: bool = False) -> sp.Matrix:
+        """Residuals (n×1) of the link equations; zero along a solution."""
+        d = self.dynamics
+        rigid_friction = friction_torque_expr(
+            [self.actuators[k] if k in self.rigid else Actuator() for k in range(len(d.q))],
+            d.qd, smooth)
+        S_R = sp.diag(*[1 if k in self.rigid else 0 for k in range(len(d.q))])
+        out = (self.M_links * sp.Matrix(d.qdd) + d.C * sp.Matrix(d.qd) + d.g + rigid_friction
+               - S_R * sp.Matrix(self.tau) - self.E * self.spring())
+        if self.coupling:
+            out += self._coupling_link_terms()
+        return out
+
+    def motor_equations(self, smooth: bool = False) -> sp.Matrix:
+        """Residuals (m×1) of the motor equations; zero along a solution."""
+        motor_friction = friction_torque_expr([self.actuators[k] for k in self.flexible],
+                                              self.thetad, smooth)
+        out = (self.B * sp.Matrix(self.thetadd) + self.spring() + motor_friction
+               - self.E.T * sp.Matrix(self.tau))
+        if self.coupling:
+            out += self._coupling_motor_terms()
+        return out
+
+    def energy(self) -> sp.Expr:
+        """Total energy [J] without friction and input: link and motor kinetic energy (and
+        the coupling's), gravity potential, spring potential."""
+        d = self.dynamics
+        qd, thd = sp.Matrix(d.qd), sp.Matrix(self.thetad)
+        T = (qd.T * self.M_links * qd)[0, 0] / 2 + (thd.T * self.B * thd)[0, 0] / 2
+        if self.coupling:
+            T += (qd.T * self.S * thd)[0, 0]
+        e = sp.Matrix(self.theta) - self.E.T * sp.Matrix(d.q)
+        return T + d.P + (e.T * self.K * e)[0, 0] / 2
+
+    def _total_derivative(self, expr: sp.Expr) -> sp.Expr:
+        d = self.dynamics
+        chain = list(zip(d.q, d.qd)) + list(zip(d.qd, d.qdd)) + list(zip(d.qdd, self.qddd)) \
+            + list(zip(self.qddd, self.qdddd)) + list(zip(self.theta, self.thetad)) \
+            + list(zip(self.thetad, self.thetadd))
+        symbols = expr.free_symbols
+        return sp.Add(*[sp.diff(expr, s) * ds for s, ds in chain if s in symbols])
+
+    def flat_inverse_dynamics(self, smooth: bool = False) -> dict[str, sp.Matrix]:
+        """``θ``, ``θ̇``, ``θ̈`` (m×1) and the inputs ``tau`` (n×1) that make the links follow
+        ``q(t)``, as expressions in ``q, q̇, q̈, q⁽³⁾, q⁽⁴⁾`` (reduced model only; expanded
+        expressions: small models). Symbolic ``K`` and ``B`` are kept."""
+        if self.coupling:
+            raise NotImplementedError("the flat inverse dynamics is formed for the reduced "
+                                      "model (coupling=False) only")
+        d = self.dynamics
+        tau_L = d.M * sp.Matrix(d.qdd) + d.C * sp.Matrix(d.qd) + d.g
+        Kinv = sp.diag(*[1 / self.actuators[k].stiffness for k in self.flexible])
+        t0 = self.E.T * tau_L
+        t1 = t0.applyfunc(self._total_derivative)
+        t2 = t1.applyfunc(self._total_derivative)
+        E = self.E.T
+        theta = E * sp.Matrix(d.q) + Kinv * t0
+        thetad = E * sp.Matrix(d.qd) + Kinv * t1
+        thetadd = E * sp.Matrix(d.qdd) + Kinv * t2
+        motor_friction = friction_torque_expr([self.actuators[k] for k in self.flexible],
+                                              list(thetad), smooth)
+        tau_m = self.B * thetadd + t0 + motor_friction
+        rigid = RigidActuatorDynamics(d, tuple(
+            a if k in self.rigid else Actuator() for k, a in enumerate(self.actuators)))
+        tau = rigid.tau(smooth) + self.E * (tau_m - t0)  # flexible rows: τ_L,F → τ_m
+        return {"theta": theta, "thetad": thetad, "thetadd": thetadd, "tau": tau}
+
+    def forward_dynamics_function(self, values: Mapping[str, float] | None = None,
+                                  smooth: bool = True) -> Callable[..., np.ndarray]:
+        """``f(x, tau) -> ẋ`` of this model (with the coupling when ``coupling``), lambdified
+        from the symbolic equations: for small models (the numeric
+        :func:`flexible_forward_dynamics` is the reduced model's for any size). Derive with
+        ``simplify=False`` unless the model is tiny: the equations use the expanded ``M``.
+
+        ``x = (q, q̇, θ, θ̇)`` (2n + 2m,); the equations are linear in the accelerations,
+        ``A(x) [q̈; θ̈] + b(x, τ) = 0``, solved with NumPy. Parameters take ``values`` (by
+        name) over their defaults.
+        """
+        d = self.dynamics
+        numbers = {p.symbol: float(p.value) for p in d.model.parameters if p.value is not None}
+        numbers.update({sp.Symbol(k, real=True): float(v) for k, v in (values or {}).items()})
+        residual = self.link_equations(smooth).col_join(self.motor_equations(smooth))
+        residual = residual.xreplace(numbers)
+        accelerations = list(d.qdd) + list(self.thetadd)
+        states = list(d.q) + list(d.qd) + list(self.theta) + list(self.thetad)
+        matrix = residual.jacobian(accelerations)
+        rest = residual.xreplace({a: 0 for a in accelerations})
+        f_matrix = sp.lambdify(states, matrix, "numpy")
+        f_rest = sp.lambdify(states + list(self.tau), rest, "numpy")
+        n, m = len(d.q), len(self.flexible)
+
+        def forward(x, tau) -> np.ndarray:
+            x = np.asarray(x, float)
+            acc = np.linalg.solve(np.array(f_matrix(*x), float),
+                                  -np.array(f_rest(*x, *tau), float).ravel())
+            return np.concatenate([x[n:2 * n], acc[:n], x[2 * n + m:], acc[n:]])
+
+        return forward
+
+    # -- the full model's coupling ----------------------------------------------------------
+
+    def _coupling_link_terms(self) -> sp.Matrix:
+        """``d/dt(∂L_c/∂q̇) − ∂L_c/∂q`` of ``L_c = q̇ᵀ S(q) θ̇``."""
+        d = self.dynamics
+        p = self.S * sp.Matrix(self.thetad)
+        L = (sp.Matrix(d.qd).T * p)[0, 0]
+        return sp.Matrix([self._total_derivative(p[i]) - sp.diff(L, d.q[i])
+                          for i in range(len(d.q))])
+
+    def _coupling_motor_terms(self) -> sp.Matrix:
+        """``d/dt(∂L_c/∂θ̇)`` (``L_c`` does not depend on ``θ``)."""
+        p = self.S.T * sp.Matrix(self.dynamics.qd)
+        return p.applyfunc(self._total_derivative)
+
+
+def _coupling_matrix(model: RobotModel, q: Sequence[sp.Symbol], actuators: Sequence[Actuator],
+                     flexible: Sequence[int]) -> sp.Matrix:
+    """``S(q)`` (n×m) of the full model: ``S[i, j] = I_rotor,j r_j (z_j · z_i)`` for every
+    revolute joint ``i`` that moves the link carrying rotor ``j`` (the parent link of joint
+    ``j``), ``z`` the joint axes in the root frame. The rotor spins about its joint's axis."""
+    index = {j.name: k for k, j in enumerate(model.movable_joints)}
+    R = {model.root: sp.eye(3)}
+    axis: dict[str, sp.Matrix] = {}
+    ancestors: dict[str, tuple[str, ...]] = {model.root: ()}
+    for joint in model.topological_joints:
+        R_origin = sp.Matrix(joint.origin.rotation)
+        R_joint = R[joint.parent] * R_origin
+        axis[joint.name] = R_joint * sp.Matrix(joint.axis)
+        value = q[index[joint.name]] if joint.name in index else 0
+        R[joint.child] = R_joint * sp.Matrix(joint_motion(joint, value).rotation)
+        moved = (joint.name,) if joint.type.is_revolute else ()
+        ancestors[joint.child] = ancestors[joint.parent] + moved
+    S = sp.zeros(len(q), len(flexible))
+    for col, k in enumerate(flexible):
+        joint = model.movable_joints[k]
+        a = actuators[k]
+        if a.rotor_inertia is None or a.gear_ratio is None:
+            raise ParameterError(model.source, f"joint '{joint.name}' actuator",
+                                 "coupling=True needs rotor_inertia and gear_ratio (the "
+                                 "armature alone does not give the rotor's own inertia)")
+        for name in ancestors[joint.parent]:
+            i = index[name]
+            S[i, col] = a.rotor_inertia * a.gear_ratio * (axis[joint.name].T * axis[name])[0, 0]
+    return S.applyfunc(sp.simplify) if len(q) <= 3 else S
+
+
+def spong_dynamics(dynamics: Dynamics, coupling: bool = False) -> SpongDynamics:
+    """Spong's flexible-joint model of ``dynamics``'s model (its joints with a ``stiffness``).
+
+    Parameters
+    ----------
+    dynamics:
+        From :func:`eomgen.derive` (``M``, ``C``, ``g``; ``P`` for :meth:`~SpongDynamics.energy`).
+    coupling:
+        Include the full model's rotor–link coupling ``q̇ᵀ S(q) θ̇`` (needs ``rotor_inertia``
+        and ``gear_ratio`` on each flexible joint); the default is the reduced model.
+
+    Raises
+    ------
+    ParameterError
+        ``coupling=True`` on a flexible joint given by its armature only.
+    """
+    model = dynamics.model
+    actuators = joint_actuators(model)
+    flexible = flexible_indices(model)
+    S = _coupling_matrix(model, dynamics.q, actuators, flexible) if coupling else \
+        sp.zeros(len(actuators), len(flexible))
+    n = range(len(actuators))
+    return SpongDynamics(
+        dynamics, actuators, flexible, _symbols("thm", flexible), _symbols("thmd", flexible),
+        _symbols("thmdd", flexible), _symbols("tau", n), _symbols("qddd", n),
+        _symbols("qdddd", n), coupling, S)
+
+
+# ----------------------------------------------------------------------------------------------
+# Forward-mode time derivatives of a straight-line program
+# ----------------------------------------------------------------------------------------------
+
+def time_derivative_program(program: Program, rates: Mapping[sp.Symbol, sp.Expr],
+                            names: Sequence[str], prefix: str = "d_") -> Program:
+    """The program extended with the time derivatives of the outputs ``names``.
+
+    Each intermediate ``x = f(s₁, …)`` gets ``d_x = Σ ∂f/∂s_k · ṡ_k`` (forward mode along
+    time), ``rates`` giving the derivative of each input (``q → qd``, ``qd → qdd``, …; inputs
+    not listed, such as parameters, are constant) and of intermediates whose derivative an
+    earlier pass defined. The new outputs are named ``prefix + name``. Applying it twice gives
+    second derivatives; the program stays linear in size.
+    """
+    d: dict[sp.Symbol, sp.Expr] = dict(rates)
+
+    def derivative(expr: sp.Expr) -> sp.Expr:
+        return _time_derivative(expr, d, {})
+
+    taken = {s.name for s, _ in program.assignments}
+    assignments = list(program.assignments)
+    for symbol, expr in program.assignments:
+        if symbol in d:  # its derivative is known (from an earlier pass)
+            continue
+        if prefix + symbol.name in taken:
+            raise ValueError(f"prefix {prefix!r} clashes with intermediate {symbol.name}")
+        rate = derivative(expr)
+        if rate == 0:
+            continue
+        if rate.is_Atom:
+            d[symbol] = rate
+            continue
+        new = sp.Symbol(prefix + symbol.name, real=True)
+        assignments.append((new, rate))
+        d[symbol] = new
+    outputs = list(program.outputs)
+    for name in names:
+        outputs.append((prefix + name, program.output(name).applyfunc(derivative)))
+    return Program(tuple(assignments), tuple(outputs))
+
+
+def _time_derivative(expr: sp.Expr, d: Mapping[sp.Symbol, sp.Expr], memo: dict) -> sp.Expr:
+    """``d/dt expr`` by one pass over the expression tree (product and chain rules), symbols
+    changing at the rates ``d``: linear in the size of ``expr``, where ``sp.diff`` by each
+    symbol in turn would be quadratic."""
+    if expr in memo:
+        return memo[expr]
+    if expr.is_Symbol:
+        out = d.get(expr, sp.Integer(0))
+    elif expr.is_Number or not (expr.free_symbols & d.keys()):
+        out = sp.Integer(0)
+    elif expr.is_Add:
+        out = sp.Add(*[_time_derivative(a, d, memo) for a in expr.args])
+    elif expr.is_Mul:
+        args = expr.args
+        terms = []
+        for k, a in enumerate(args):
+            da = _time_derivative(a, d, memo)
+            if da != 0:
+                terms.append(sp.Mul(*args[:k], da, *args[k + 1:]))
+        out = sp.Add(*terms)
+    elif expr.is_Pow and expr.exp.is_Number:
+        base, e = expr.args
+        out = e * base ** (e - 1) * _time_derivative(base, d, memo)
+    elif isinstance(expr, sp.sin):
+        out = sp.cos(expr.args[0]) * _time_derivative(expr.args[0], d, memo)
+    elif isinstance(expr, sp.cos):
+        out = -sp.sin(expr.args[0]) * _time_derivative(expr.args[0], d, memo)
+    else:  # anything else: by the symbols it depends on
+        out = sp.Add(*[sp.diff(expr, s) * d[s] for s in expr.free_symbols if s in d])
+    memo[expr] = out
+    return out
+
+
+# ----------------------------------------------------------------------------------------------
+# Numeric
+# ----------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True, eq=False)
+class ActuatedModel:
+    """A model with actuators, every parameter a number: what the numeric functions read.
+
+    Arrays are (n,) float64 in ``joint_names`` order; ``flexible`` and ``rigid`` are index
+    arrays. ``stiffness`` is NaN for rigid joints.
+    """
+
+    joint_names: tuple[str, ...]
+    flexible: np.ndarray
+    rigid: np.ndarray
+    armature: np.ndarray
+    damping: np.ndarray
+    friction: np.ndarray
+    friction_width: np.ndarray
+    stiffness: np.ndarray
+    _program: Callable[..., dict]
+    _taylor_source: Program
+    _inputs: tuple[sp.Symbol, ...]
+    _parameter_values: tuple[float, ...]
+
+    @property
+    def n(self) -> int:
+        return len(self.joint_names)
+
+    @property
+    def m(self) -> int:
+        return len(self.flexible)
+
+    def rigid_terms(self, q, qd) -> tuple[np.ndarray, np.ndarray, float]:
+        """``M(q)`` (n×n), ``C(q, q̇) q̇ + g(q)`` (n,) and ``P(q)`` [J] of the links alone."""
+        out = self._program(*np.concatenate([q, qd]), *self._parameter_values)
+        return out["M"], (out["C"] @ np.asarray(qd) + out["g"][:, 0]), float(out["P"][0, 0])
+
+    @cached_property
+    def _taylor(self) -> Callable[..., dict]:
+        return compile_program(self._taylor_source, self._inputs)
+
+    def link_torque_derivatives(self, q, qd, qdd, qddd, qdddd):
+        """``τ_L = M q̈ + C q̇ + g`` and its first and second time derivatives along the
+        trajectory (n,) each, from the forward-mode differentiated program."""
+        out = self._taylor(*np.concatenate([q, qd, qdd, qddd, qdddd]), *self._parameter_values)
+        return out["tauL"][:, 0], out["d_tauL"][:, 0], out["dd_d_tauL"][:, 0]
+
+
+def _number(x, values: Mapping[sp.Symbol, float], what: str, source: str) -> float:
+    x = scalar(x).xreplace(values) if isinstance(x, sp.Basic) else x
+    try:
+        return float(x)
+    except TypeError:
+        raise ParameterError(source, what, f"no numeric value for {x}") from None
+
+
+def actuated_model(dynamics: Dynamics, values: Mapping[str | sp.Symbol, float] | None = None
+                   ) -> ActuatedModel:
+    """Compile ``dynamics`` (``M``, ``C``, ``g``, ``P``) with its model's actuators for
+    numeric use; parameters take ``values`` (by name or symbol) over their defaults.
+
+    Raises
+    ------
+    ParameterError
+        A parameter without a value.
+    """
+    model = dynamics.model
+    given = {(parameter_key.name if isinstance(parameter_key, sp.Symbol) else parameter_key): v
+             for parameter_key, v in (values or {}).items()}
+    params = [p.symbol for p in model.parameters]
+    numbers = {}
+    for p in model.parameters:
+        value = given.get(p.name, p.value)
+        if value is None:
+            raise ParameterError(model.source, f"parameter '{p.name}'", "no numeric value")
+        numbers[p.symbol] = float(value)
+    actuators = joint_actuators(model)
+
+    def column(name):
+        return np.array([np.nan if getattr(a, name) is None else
+                         _number(getattr(a, name), numbers, f"joint '{j}' actuator {name}",
+                                 model.source)
+                         for a, j in zip(actuators, model.joint_names)], dtype=float)
+
+    program = dynamics.program
+    missing = {"M", "C", "g", "P"} - set(dynamics.outputs)
+    if missing:
+        raise ValueError(f"dynamics lacks {sorted(missing)}: derive with outputs M, C, g")
+    q, qd, qdd = dynamics.q, dynamics.qd, dynamics.qdd
+    n = len(q)
+    qddd, qdddd = _symbols("qddd", range(n)), _symbols("qdddd", range(n))
+    tau_L = (program.output("M") * sp.Matrix(qdd) + program.output("C") * sp.Matrix(qd)
+             + program.output("g"))
+    base = Program(program.assignments, (("tauL", tau_L),)).pruned(["tauL"])
+    rates = dict(zip(q, qd)) | dict(zip(qd, qdd)) | dict(zip(qdd, qddd)) \
+        | dict(zip(qddd, qdddd))
+    once = time_derivative_program(base, rates, ["tauL"], "d_")
+    defined = {s.name: s for s, _ in once.assignments}
+    known = {s: defined["d_" + s.name] for s, _ in base.assignments if "d_" + s.name in defined}
+    twice = time_derivative_program(once, rates | known, ["d_tauL"], "dd_")
+    flexible = np.array(flexible_indices(model), dtype=int)
+    return ActuatedModel(
+        model.joint_names, flexible,
+        np.array([k for k in range(n) if k not in set(flexible.tolist())], dtype=int),
+        column("armature"), column("damping"), column("friction"), column("friction_width"),
+        column("stiffness"),
+        compile_program(program.pruned(["M", "C", "g", "P"]), tuple(q) + tuple(qd)
+                        + tuple(params)),
+        twice.pruned(["tauL", "d_tauL", "dd_d_tauL"]),
+        tuple(q) + tuple(qd) + tuple(qdd) + qddd + qdddd + tuple(params),
+        tuple(numbers[s] for s in params))
+
+
+def rigid_mass_matrix(am: ActuatedModel, q) -> np.ndarray:
+    """``M(q) + diag(a)`` (n×n), every joint's armature added (the rigid model)."""
+    M, _, _ = am.rigid_terms(np.asarray(q, float), np.zeros(am.n))
+    return M + np.diag(am.armature)
+
+
+def friction_torque(am: ActuatedModel, qd, smooth: bool = False, joints=None) -> np.ndarray:
+    """``d q̇ + f sign(q̇)`` (``smooth``: ``f tanh(q̇/w)``) for the joints ``joints`` (indices,
+    default all; ``qd`` of matching length)."""
+    k = np.arange(am.n) if joints is None else np.asarray(joints, int)
+    qd = np.asarray(qd, float)
+    coulomb = np.tanh(qd / am.friction_width[k]) if smooth else np.sign(qd)
+    return am.damping[k] * qd + am.friction[k] * coulomb
+
+
+def rigid_inverse_dynamics(am: ActuatedModel, q, qd, qdd, smooth: bool = False) -> np.ndarray:
+    """``(M + diag(a)) q̈ + C q̇ + g + τ_f(q̇)`` (n,), every joint rigid."""
+    M, h, _ = am.rigid_terms(np.asarray(q, float), np.asarray(qd, float))
+    return (M + np.diag(am.armature)) @ qdd + h + friction_torque(am, qd, smooth)
+
+
+def rigid_forward_dynamics(am: ActuatedModel, q, qd, tau, smooth: bool = True) -> np.ndarray:
+    """``q̈`` (n,) of the rigid model with actuators under joint torques ``tau``."""
+    M, h, _ = am.rigid_terms(np.asarray(q, float), np.asarray(qd, float))
+    rhs = np.asarray(tau, float) - h - friction_torque(am, qd, smooth)
+    return np.linalg.solve(M + np.diag(am.armature), rhs)
+
+
+def _split(am: ActuatedModel, x):
+    x = np.asarray(x, float)
+    n, m = am.n, am.m
+    if x.shape != (2 * n + 2 * m,):
+        raise ValueError(f"the state must have shape ({2 * n + 2 * m},): q, qd ({n} each), "
+                         f"theta, thetad ({m} each); got {x.shape}")
+    return x[:n], x[n:2 * n], x[2 * n:2 * n + m], x[2 * n + m:]
+
+
+def flexible_forward_dynamics(am: ActuatedModel, x, tau, smooth: bool = True) -> np.ndarray:
+    """``ẋ`` of the reduced Spong model, ``x = (q, q̇, θ, θ̇)`` (2n + 2m,), inputs ``tau`` (n,):
+    joint torques of rigid joints, motor torques of flexible ones."""
+    q, qd, th, thd = _split(am, x)
+    tau = np.asarray(tau, float)
+    F, R = am.flexible, am.rigid
+    M, h, _ = am.rigid_terms(q, qd)
+    a_rigid = np.zeros(am.n)
+    a_rigid[R] = am.armature[R]
+    spring = am.stiffness[F] * (th - q[F])
+    u = np.zeros(am.n)
+    u[R] = tau[R] - friction_torque(am, qd[R], smooth, R)
+    u[F] = spring
+    qdd = np.linalg.solve(M + np.diag(a_rigid), u - h)
+    thdd = (tau[F] - spring - friction_torque(am, thd, smooth, F)) / am.armature[F]
+    return np.concatenate([qd, qdd, thd, thdd])
+
+
+def flexible_energy(am: ActuatedModel, x) -> float:
+    """Total energy [J] of the reduced Spong model: link and motor kinetic energy, gravity
+    and spring potential. Conserved without friction and input."""
+    q, qd, th, thd = _split(am, x)
+    F, R = am.flexible, am.rigid
+    M, _, P = am.rigid_terms(q, qd)
+    a_rigid = np.zeros(am.n)
+    a_rigid[R] = am.armature[R]
+    e = th - q[F]
+    return float(0.5 * qd @ (M + np.diag(a_rigid)) @ qd + 0.5 * am.armature[F] @ thd ** 2
+                 + P + 0.5 * am.stiffness[F] @ e ** 2)
+
+
+def flexible_inverse_dynamics(am: ActuatedModel, q, qd, qdd, qddd, qdddd,
+                              smooth: bool = False) -> dict[str, np.ndarray]:
+    """The motor states and inputs that make the links of the reduced Spong model follow a
+    trajectory, from ``q`` and its derivatives up to order 4 (flatness; no numeric
+    differentiation: see the module docstring).
+
+    Returns
+    -------
+    dict
+        ``theta``, ``thetad``, ``thetadd`` (m,) and ``tau`` (n,): motor torques for flexible
+        joints, joint torques for rigid ones.
+    """
+    q, qd, qdd = (np.asarray(v, float) for v in (q, qd, qdd))
+    F, R = am.flexible, am.rigid
+    t0, t1, t2 = am.link_torque_derivatives(q, qd, qdd, np.asarray(qddd, float),
+                                            np.asarray(qdddd, float))
+    K = am.stiffness[F]
+    theta = q[F] + t0[F] / K
+    thetad = qd[F] + t1[F] / K
+    thetadd = qdd[F] + t2[F] / K
+    tau = np.empty(am.n)
+    tau[F] = am.armature[F] * thetadd + t0[F] + friction_torque(am, thetad, smooth, F)
+    tau[R] = t0[R] + am.armature[R] * qdd[R] + friction_torque(am, qd[R], smooth, R)
+    return {"theta": theta, "thetad": thetad, "thetadd": thetadd, "tau": tau}
+
+
+def flexible_rest_state(am: ActuatedModel, q) -> np.ndarray:
+    """The state ``x`` at rest at link angles ``q``: springs wound up to hold gravity,
+    ``θ = q_F + K⁻¹ g_F(q)`` (the inputs that hold it: ``tau = g(q)``)."""
+    q = np.asarray(q, float)
+    F = am.flexible
+    _, g, _ = am.rigid_terms(q, np.zeros(am.n))
+    return np.concatenate([q, np.zeros(am.n), q[F] + g[F] / am.stiffness[F], np.zeros(am.m)])
