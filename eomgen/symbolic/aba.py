@@ -38,7 +38,8 @@ import sympy as sp
 from ..bodies import BodyTree, body_tree
 from ..model import RobotModel, Vec3
 from .composite import _cross, _dot, _matvec
-from .newton_euler import _aligned, _name, _name_all, _rotate_aligned, _rotate_back, _transpose_apply
+from .newton_euler import (_aligned, _name, _name_all, _rotate_aligned, _rotate_back,
+                           _transpose_apply, grouped_inertials)
 from .program import Program, ProgramBuilder
 
 _ZERO = sp.Integer(0)
@@ -156,7 +157,8 @@ def _full(b: ProgramBuilder, A, hint: str) -> tuple:
     return tuple(tuple(_name(b, A[r][c], f"{hint}{r}{c}") for c in range(3)) for r in range(3))
 
 
-def forward_dynamics_program(tree: BodyTree, q, qd, tau, gravity: Vec3, b: ProgramBuilder) -> sp.Matrix:
+def forward_dynamics_program(tree: BodyTree, q, qd, tau, gravity: Vec3, b: ProgramBuilder,
+                             grouped: bool = True) -> sp.Matrix:
     """Build q̈(q, q̇, τ) into ``b`` by the Articulated-Body Algorithm.
 
     Parameters
@@ -170,6 +172,10 @@ def forward_dynamics_program(tree: BodyTree, q, qd, tau, gravity: Vec3, b: Progr
         Gravitational acceleration in the root frame [m/s²], e.g. (0, 0, −9.81).
     b:
         The program builder the intermediates are defined into.
+    grouped:
+        Run on the grouped inertial parameters of :func:`~eomgen.symbolic.newton_euler.
+        grouped_inertials` (the default): they give the same M(q) and C q̇ + g, hence the same
+        q̈, with fewer non-zero parameters and so fewer operations.
 
     Returns
     -------
@@ -186,6 +192,7 @@ def forward_dynamics_program(tree: BodyTree, q, qd, tau, gravity: Vec3, b: Progr
         else:
             sincos.append(None)
     frames = _Frames(tree, q, sincos)
+    inertials = grouped_inertials(tree) if grouped else [body.inertial for body in tree.bodies]
 
     def subspace(i):
         body = tree.bodies[i]
@@ -209,7 +216,7 @@ def forward_dynamics_program(tree: BodyTree, q, qd, tau, gravity: Vec3, b: Progr
         c_ang = _cross(ang, vJ_ang)
         c_lin = _add(_cross(ang, vJ_lin), _cross(lin, vJ_ang))
         cvec.append((_name_all(b, c_ang, f"c{tag}w"), _name_all(b, c_lin, f"c{tag}v")))
-        par = body.inertial
+        par = inertials[i]
         m, h, I_O = par.mass, par.first_moment, par.inertia
         Bh = ((0, -h[2], h[1]), (h[2], 0, -h[0]), (-h[1], h[0], 0))
         IA.append([I_O, Bh, tuple(tuple(m if r == c else _ZERO for c in range(3)) for r in range(3))])
@@ -336,4 +343,48 @@ def aba_program(model: RobotModel) -> ForwardDynamics:
     builder = ProgramBuilder(reserved)
     qdd = forward_dynamics_program(tree, q, qd, tau, model.gravity, builder)
     program = Program(tuple(builder.assignments), (("qdd", qdd),)).pruned(["qdd"])
+    return ForwardDynamics(q, qd, tau, program)
+
+
+def cholesky_program(model: RobotModel) -> ForwardDynamics:
+    """The Cholesky route to q̈ as one straight-line program, for comparison with the ABA.
+
+    M(q) from the composite-body program (:func:`eomgen.symbolic.composite.derive_program`),
+    the bias ``C q̇ + g = τ(q, q̇, 0)`` from the Newton–Euler program, then ``M = L Lᵀ``
+    (``L_jj = √(M_jj − Σ_k L_jk²)``, ``L_ij = (M_ij − Σ_k L_ik L_jk) / L_jj``) and two triangular
+    solves, unrolled. This is the arithmetic of a generated module's ``forward_dynamics``
+    (``mass_matrix``, ``inverse_dynamics`` at q̈ = 0, Cholesky factor and solves), written out:
+    its operation count is that route's cost, O(n³) for the factorisation.
+    """
+    from ..dynamics import joint_symbols
+    from .composite import derive_program
+    from .newton_euler import inverse_dynamics_program
+
+    tree = body_tree(model)
+    n = model.dof
+    q, qd, _ = joint_symbols(n)
+    tau = tuple(sp.Symbol(f"tau{k + 1}", real=True) for k in range(n))
+    reserved = {s.name for s in q + qd + tau} | {p.name for p in model.parameters}
+    b = ProgramBuilder(reserved)
+    M = derive_program(tree, q, qd, model.gravity, {"M"}, b)["M"]
+    bias = inverse_dynamics_program(tree, q, qd, (_ZERO,) * n, model.gravity, b)
+    L = [[_ZERO] * n for _ in range(n)]
+    inv_diag = [_ZERO] * n
+    for j in range(n):
+        for i in range(j, n):
+            value = M[i, j] - sp.Add(*[L[i][k] * L[j][k] for k in range(j)])
+            if i == j:
+                L[j][j] = _name(b, sp.sqrt(value), f"L{j + 1}_{j + 1}")
+                inv_diag[j] = _name(b, 1 / L[j][j], f"Linv{j + 1}")
+            else:
+                L[i][j] = _name(b, value * inv_diag[j], f"L{i + 1}_{j + 1}")
+    y = [_ZERO] * n
+    for i in range(n):
+        rhs = tau[i] - bias[i, 0] - sp.Add(*[L[i][k] * y[k] for k in range(i)])
+        y[i] = _name(b, rhs * inv_diag[i], f"y{i + 1}")
+    x = [_ZERO] * n
+    for i in reversed(range(n)):
+        rhs = y[i] - sp.Add(*[L[k][i] * x[k] for k in range(i + 1, n)])
+        x[i] = _name(b, rhs * inv_diag[i], f"qdd{i + 1}")
+    program = Program(tuple(b.assignments), (("qdd", sp.Matrix(x)),)).pruned(["qdd"])
     return ForwardDynamics(q, qd, tau, program)
