@@ -4,7 +4,8 @@ programs for spatial chains of n = 2…30 links, with fitted log-log slopes.
 Usage::
 
     python benchmarks/complexity.py                 # n = 2…30 (several minutes)
-    python benchmarks/complexity.py --quick         # n = 2…12, no C beyond n = 8 (< 1 min)
+    python benchmarks/complexity.py --quick         # n = 2, 4, 8, 12; C up to n = 8 (< 1 min)
+    python benchmarks/complexity.py --replot        # table and plot again from the CSV
     python benchmarks/complexity.py --csv --plot    # also write benchmarks/results/complexity.csv
                                                     # and docs/img/complexity.png
     python benchmarks/complexity.py --robots        # operation counts of the Panda and PUMA 560
@@ -18,8 +19,8 @@ What is measured, for each n (a chain of n revolute joints, see :func:`spatial_c
   (:mod:`eomgen.symbolic.composite`: M_ij = S_iᵀ I^c_j S_j with everything referred to the root
   origin);
 * ``aba``  — the Articulated-Body Algorithm program q̈(q, q̇, τ) (:mod:`eomgen.symbolic.aba`);
-* ``chol`` — the Cholesky route to q̈ as one program (the composite M, bias τ(q, q̇, 0),
-  M = L Lᵀ, two triangular solves), what a generated ``forward_dynamics`` computes;
+* ``chol`` — the Cholesky route to q̈ as one program (the CRBA's M, bias τ(q, q̇, 0),
+  M = L Lᵀ, two triangular solves);
 * ``C``    — the Coriolis matrix from the Christoffel symbols (the Lagrangian derivation's C);
 * ``derive`` — ``eomgen.derive(model)`` (M, C, g): seconds and assignments of its program (the
   Lagrangian derivation's own cost).
@@ -66,7 +67,7 @@ from eomgen.symbolic.opcount import program_operation_count  # noqa: E402
 from eomgen.symbolic.program import Program, ProgramBuilder  # noqa: E402
 
 FULL_NS = (2, 3, 4, 6, 8, 10, 12, 15, 20, 25, 30)
-QUICK_NS = (2, 4, 6, 8, 10, 12)
+QUICK_NS = (2, 4, 8, 12)
 FIT_FROM = 8
 QUANTITIES = ("tau", "crba", "M", "aba", "chol", "C")
 
@@ -236,7 +237,7 @@ def plot(rows, path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    labels = {"tau": "τ (RNEA)", "crba": "M (CRBA, body frames)", "M": "M (composite, root frame)", "aba": "q̈ (ABA)", "chol": "q̈ (Cholesky of M)",
+    labels = {"tau": "τ (RNEA)", "crba": "M (CRBA, body frames)", "M": "M (composite, root frame)", "aba": "q̈ (ABA)", "chol": "q̈ (CRBA + Cholesky)",
               "C": "C (Christoffel)"}
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     for q in QUANTITIES:
@@ -245,9 +246,9 @@ def plot(rows, path: Path) -> None:
         axes[0].loglog(ns, [r[f"{q}_ops"] for r in have], "o-", label=labels[q])
         axes[1].loglog(ns, [r[f"{q}_us"] for r in have], "o-", label=labels[q])
     ns = [r["n"] for r in rows]
-    for q, style in (("tau", ":"), ("crba", "-."), ("aba", "--")):
+    for q, style, name in (("tau", ":", "RNEA"), ("crba", "-.", "CRBA"), ("aba", "--", "ABA")):
         axes[0].loglog(ns, [featherstone(q, n) for n in ns], "k" + style, lw=0.8,
-                       label=f"Featherstone {labels[q]}")
+                       label=f"Featherstone's {name} (m + a)")
     axes[0].set(xlabel="links n", ylabel="operations (printed NumPy code)",
                 title="Operation count")
     axes[1].set(xlabel="links n", ylabel="µs per evaluation (Python floats)",
@@ -258,6 +259,13 @@ def plot(rows, path: Path) -> None:
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
+
+
+def read_csv(path: Path) -> list[dict]:
+    """Rows written by :func:`write_csv`, numbers parsed."""
+    with path.open() as handle:
+        return [{k: (int(v) if k == "n" or k.endswith(("_ops", "_assignments")) else float(v))
+                 for k, v in row.items() if v != ""} for row in csv.DictReader(handle)]
 
 
 def robots() -> None:
@@ -282,14 +290,21 @@ def robots() -> None:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--quick", action="store_true", help="n = 2…12, C up to n = 8 (< 1 min)")
+    parser.add_argument("--quick", action="store_true", help="n = 2, 4, 8, 12; C up to n = 8 (< 1 min)")
     parser.add_argument("--csv", action="store_true", help="write benchmarks/results/complexity.csv")
     parser.add_argument("--plot", action="store_true", help="write docs/img/complexity.png")
     parser.add_argument("--robots", action="store_true", help="Panda and PUMA 560 counts only")
+    parser.add_argument("--replot", action="store_true",
+                        help="table and plot from benchmarks/results/complexity.csv, no measuring")
     parser.add_argument("--c-max-n", type=int, default=None, help="largest n for C (default 30; 8 with --quick)")
     args = parser.parse_args(argv)
     if args.robots:
         robots()
+        return 0
+    if args.replot:
+        rows = read_csv(ROOT / "benchmarks" / "results" / "complexity.csv")
+        print_table(rows)
+        plot(rows, ROOT / "docs" / "img" / "complexity.png")
         return 0
     ns = QUICK_NS if args.quick else FULL_NS
     c_max = args.c_max_n if args.c_max_n is not None else (8 if args.quick else max(ns))
