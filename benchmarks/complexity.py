@@ -29,7 +29,9 @@ What is measured, for each n (a chain of n revolute joints, see :func:`spatial_c
 generated function executes: ``+ − * / **``, unary minus, ``np.sin``…). ``µs`` is the time of
 one evaluation of the program printed as plain Python over floats
 (:func:`eomgen.symbolic.evaluate.compile_program`), best of 7 timed loops of 0.03 s: Python's
-cost per operation is nearly constant, so it follows the operation count. ``build s`` is the time
+cost per operation is nearly constant, so it follows the operation count; ``batch µs`` is the
+time per state of the same program over NumPy arrays of 1000 states (as the generated NumPy
+modules run), best of 7 timed loops. ``build s`` is the time
 to build the program symbolically. Slopes are least-squares fits of log(value) against log(n)
 over n ≥ 8.
 
@@ -114,7 +116,6 @@ def programs(model, with_C: bool) -> dict:
     n = model.dof
     tree = body_tree(model)
     q, qd, qdd = joint_symbols(n)
-    tau_sym = tuple(sp.Symbol(f"tau{k + 1}", real=True) for k in range(n))
 
     def tau():
         b = ProgramBuilder({s.name for s in q + qd + qdd})
@@ -142,7 +143,6 @@ def programs(model, with_C: bool) -> dict:
                 "chol": forward(cholesky_program)}
     if with_C:
         builders["C"] = lagrangian("C")
-    del tau_sym
     return {name: _program(build) for name, build in builders.items()}
 
 
@@ -155,6 +155,22 @@ def time_evaluation(program: Program, inputs, repeat: int = 7) -> float:
     number = max(1, int(0.03 / max(1e-7, min(timeit.repeat(lambda: f(*values), number=1, repeat=3)))))
     runs = timeit.repeat(lambda: f(*values), number=number, repeat=repeat)
     return float(min(runs)) / number
+
+
+BATCH = 1000
+
+
+def time_batch(program: Program, inputs, repeat: int = 7) -> float:
+    """Seconds per state of the program over NumPy arrays of :data:`BATCH` states (as the
+    generated NumPy modules run it), best of ``repeat``."""
+    from eomgen.analysis.routes import compile_batch
+
+    names = [name for name, _ in program.outputs]
+    f = compile_batch(program, inputs, names)
+    columns = list(np.random.default_rng(0).uniform(-1, 1, (len(inputs), BATCH)))
+    f(*columns)
+    number = max(1, int(0.03 / max(1e-6, min(timeit.repeat(lambda: f(*columns), number=1, repeat=3)))))
+    return min(timeit.repeat(lambda: f(*columns), number=number, repeat=repeat)) / number / BATCH
 
 
 def slope(ns, values) -> float:
@@ -174,6 +190,7 @@ def measure(ns, c_max_n: int, derive_max_n: int, progress=print) -> list[dict]:
             row[f"{name}_ops"] = program_operation_count(program)
             row[f"{name}_build_s"] = build_s
             row[f"{name}_us"] = time_evaluation(program, inputs) * 1e6
+            row[f"{name}_batch_us"] = time_batch(program, inputs) * 1e6
         if n <= derive_max_n:
             start = time.perf_counter()
             dyn = derive(model, simplify=False)
@@ -187,21 +204,23 @@ def measure(ns, c_max_n: int, derive_max_n: int, progress=print) -> list[dict]:
 
 
 def print_table(rows) -> None:
-    head = ("| n | τ RNEA ops (µs) | M CRBA ops (µs) | M composite ops (µs) | q̈ ABA ops (µs) "
-            "| q̈ Cholesky ops (µs) | C Christoffel ops (µs) | derive M,C,g s (assignments) "
+    print("cells: operations (µs per evaluation over Python floats; µs per state in a NumPy "
+          f"batch of {BATCH})")
+    head = ("| n | τ RNEA | M CRBA | M composite | q̈ ABA "
+            "| q̈ CRBA + Cholesky | C Christoffel | derive M,C,g s (assignments) "
             "| Featherstone RNEA / CRBA / ABA |")
     print(head)
     print("|" + "---|" * 9)
     for r in rows:
         cells = [str(r["n"])]
         for q in QUANTITIES:
-            cells.append(f"{r[f'{q}_ops']} ({r[f'{q}_us']:.0f})" if f"{q}_ops" in r else "–")
+            batch = f"; {r[f'{q}_batch_us']:.2f}" if f"{q}_batch_us" in r else ""
+            cells.append(f"{r[f'{q}_ops']} ({r[f'{q}_us']:.0f}{batch})" if f"{q}_ops" in r else "–")
         cells.append(f"{r['derive_s']:.2f} ({r['derive_assignments']})" if "derive_s" in r else "–")
         cells.append(" / ".join(str(featherstone(q, r["n"])) for q in ("tau", "M", "aba")))
         print("| " + " | ".join(cells) + " |")
-    ns = [r["n"] for r in rows]
     print()
-    print(f"log-log slopes over n ≥ {FIT_FROM} (ops; time per evaluation; build time):")
+    print(f"log-log slopes over n ≥ {FIT_FROM} (ops; scalar time; batch time per state; build time):")
     for q in QUANTITIES:
         have = [r for r in rows if f"{q}_ops" in r]
         if len([r for r in have if r["n"] >= FIT_FROM]) < 2:
@@ -209,6 +228,7 @@ def print_table(rows) -> None:
         hn = [r["n"] for r in have]
         print(f"  {q:5s} {slope(hn, [r[f'{q}_ops'] for r in have]):5.2f}; "
               f"{slope(hn, [r[f'{q}_us'] for r in have]):5.2f}; "
+              f"{slope(hn, [r.get(f'{q}_batch_us', 0) for r in have]):5.2f}; "
               f"{slope(hn, [r[f'{q}_build_s'] for r in have]):5.2f}")
     dn = [r for r in rows if "derive_s" in r]
     if len([r for r in dn if r["n"] >= FIT_FROM]) >= 2:
@@ -216,9 +236,10 @@ def print_table(rows) -> None:
               f"size {slope([r['n'] for r in dn], [r['derive_assignments'] for r in dn]):.2f}")
     crossing = [r["n"] for r in rows if r["aba_ops"] < r["chol_ops"]]
     faster = [r["n"] for r in rows if r["aba_us"] < r["chol_us"]]
+    faster_batch = [r["n"] for r in rows if r.get("aba_batch_us", 1) < r.get("chol_batch_us", 0)]
     print(f"ABA fewer operations than the Cholesky route from n = {min(crossing) if crossing else '–'}"
-          f" (n = {crossing}); faster per evaluation for n = {faster}")
-    del ns
+          f" (n = {crossing}); faster per evaluation for n = {faster} (scalar), "
+          f"{faster_batch} (batch)")
 
 
 def write_csv(rows, path: Path) -> None:
@@ -244,14 +265,15 @@ def plot(rows, path: Path) -> None:
         have = [r for r in rows if f"{q}_ops" in r]
         ns = [r["n"] for r in have]
         axes[0].loglog(ns, [r[f"{q}_ops"] for r in have], "o-", label=labels[q])
-        axes[1].loglog(ns, [r[f"{q}_us"] for r in have], "o-", label=labels[q])
+        axes[1].loglog(ns, [r.get(f"{q}_batch_us", r[f"{q}_us"]) for r in have], "o-",
+                       label=labels[q])
     ns = [r["n"] for r in rows]
     for q, style, name in (("tau", ":", "RNEA"), ("crba", "-.", "CRBA"), ("aba", "--", "ABA")):
         axes[0].loglog(ns, [featherstone(q, n) for n in ns], "k" + style, lw=0.8,
                        label=f"Featherstone's {name} (m + a)")
     axes[0].set(xlabel="links n", ylabel="operations (printed NumPy code)",
                 title="Operation count")
-    axes[1].set(xlabel="links n", ylabel="µs per evaluation (Python floats)",
+    axes[1].set(xlabel="links n", ylabel=f"µs per state (NumPy batch of {BATCH})",
                 title="Time per evaluation")
     for ax in axes:
         ax.grid(True, which="both", lw=0.3)

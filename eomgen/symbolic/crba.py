@@ -19,7 +19,7 @@ import sympy as sp
 
 from ..bodies import BodyTree, body_tree
 from ..model import RobotModel
-from .aba import _force_to_parent, _Frames, _full, _inertia_to_parent, _symmetric, ForwardDynamics
+from .aba import _force_to_parent, _Frames, _full, _inertia_to_parent, _symmetric
 from .composite import _dot, _matvec
 from .newton_euler import _name, _name_all, grouped_inertials
 from .program import Program, ProgramBuilder
@@ -106,5 +106,3 @@ def crba_program(model: RobotModel) -> tuple[tuple[sp.Symbol, ...], Program]:
     M = mass_matrix_program(body_tree(model), q, b)
     return q, Program(tuple(b.assignments), (("M", M),)).pruned(["M"])
 
-
-__all__ = ["ForwardDynamics", "crba_program", "mass_matrix_program"]
