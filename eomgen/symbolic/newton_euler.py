@@ -8,21 +8,34 @@ Frames and conventions: every body quantity is in its own body frame (the joint 
 joint has moved, see :mod:`eomgen.model`). ``ω``, ``ω̇`` are the body's angular velocity and
 acceleration, ``a`` the linear acceleration of the body-frame origin, with gravity entering as a
 base acceleration ``a_0 = −g_vec``. Body inertial parameters are about the body origin (m, h, I_O,
-see :mod:`eomgen.bodies`), so the net force and moment about the origin are
+see :mod:`eomgen.bodies`). With Khalil's matrix ``U = [ω̇]× + [ω]×[ω]×`` (so that the
+acceleration of a point at ``r`` on the body is ``a + U r``), the net force and moment about the
+origin are
 
-    f = m a + ω̇ × h + ω × (ω × h),
+    f = m a + U h,
     n = I_O ω̇ + ω × (I_O ω) + h × a,
 
-and the joint torque is ``τ_i = ẑ_i · n_i`` (revolute) or ``ẑ_i · f_i`` (prismatic), ``ẑ_i`` the
-unit joint axis in body coordinates.
+and the joint torque is ``τ_i = k_i · n_i`` (revolute) or ``k_i · f_i`` (prismatic), ``k_i`` the
+unit joint axis in body coordinates. ``U`` costs 6 products of ω's components once per body and
+is shared by ``U h`` and by the children's origin accelerations ``a + U r``.
+
+Leaner programs (Khalil and Kleinfinger's customised Newton–Euler): besides the structural zeros
+of rotations, offsets and inertias, which SymPy folds, the inertial parameters are **regrouped**
+before the recursion (:func:`grouped_inertials`): the part of a body's parameters that looks the
+same at every angle of its joint (for a revolute joint about ``k``: the mass, the first moment
+along ``k`` and an inertia ``β (1 − k kᵀ)``; for a prismatic joint: the rotational inertia) moves
+to the parent body, and off a root body into the fixed base, where it does nothing. The joint
+efforts are exactly those of the original parameters (the moved part's kinetic and potential
+energy do not depend on that joint's position or rate), while most bodies lose their mass and
+three of their ten parameters become zero.
 """
 
 from __future__ import annotations
 
 import sympy as sp
 
-from ..bodies import BodyTree
-from ..model import Vec3
+from ..bodies import BodyTree, InertialParameters
+from ..model import Transform, Vec3
 from .composite import _cross, _dot, _matvec
 from .program import ProgramBuilder
 
@@ -61,11 +74,113 @@ def _rotate_aligned(k: int, c, s, v, transpose: bool) -> tuple:
     return tuple(w)
 
 
+def _leads_negative(expr: sp.Expr) -> bool:
+    """Whether ``expr`` prints with a leading minus sign (one more operation than its negation
+    when that negation can be absorbed where it is used: a constant factor, a subtraction)."""
+    if expr.is_Add:
+        return expr.as_ordered_terms()[0].could_extract_minus_sign()
+    return expr.is_Mul and expr.could_extract_minus_sign()
+
+
+def _name(b: ProgramBuilder, expr, hint: str) -> sp.Expr:
+    """``b.define(expr)``, but an expression that leads with a minus sign is named negated and
+    used as ``−name``: the sign then folds into the products and sums that use it."""
+    expr = sp.sympify(expr)
+    if _leads_negative(expr):
+        negated = sp.Add(*[-t for t in expr.args]) if expr.is_Add else -expr
+        return -b.define(negated, hint)
+    return b.define(expr, hint)
+
+
+def _name_all(b: ProgramBuilder, exprs, hint: str) -> tuple:
+    return tuple(_name(b, e, f"{hint}{k}") for k, e in enumerate(exprs))
+
+
+def _invariant_part(axis: Vec3, revolute: bool, par: InertialParameters) -> InertialParameters:
+    """The part of ``par`` that is the same at every position of the joint (see module doc).
+
+    Revolute about the unit axis ``k``: mass m, first moment (h·k) k and inertia β (1 − k kᵀ),
+    with β the inertia about the first body axis after ``k`` when ``k`` is a coordinate axis
+    (making that entry zero on the body) and 0 otherwise. Prismatic: the inertia I_O alone.
+    """
+    zero = sp.Integer(0)
+    if not revolute:
+        return InertialParameters(zero, (zero,) * 3, par.inertia)
+    k = tuple(axis)
+    along = _dot(k, par.first_moment)
+    aligned = _aligned(k)
+    beta = par.inertia[(aligned[0] + 2) % 3][(aligned[0] + 2) % 3] if aligned else zero
+    inertia = tuple(tuple(beta * ((1 if r == c else 0) - k[r] * k[c]) for c in range(3))
+                    for r in range(3))
+    return InertialParameters(par.mass, tuple(along * x for x in k), inertia)  # type: ignore
+
+
+def grouped_inertials(tree: BodyTree) -> list[InertialParameters]:
+    """Body inertial parameters regrouped so that the joint efforts stay exactly the same.
+
+    Walking from the leaves to the root, each body hands the part of its parameters that its own
+    joint cannot move (:func:`_invariant_part`) to its parent, expressed in the parent frame
+    through the joint placement; a root body hands it to the fixed base, which drops it. The
+    result gives the same τ(q, q̇, q̈) as ``tree``'s own parameters for every state, with fewer
+    non-zero parameters (Khalil and Kleinfinger's grouping of inertial parameters).
+
+    Returns
+    -------
+    list of InertialParameters
+        One per body of ``tree``, in its order, about the body origin in body coordinates.
+    """
+    params = [body.inertial for body in tree.bodies]
+    for i in reversed(range(len(tree.bodies))):
+        body = tree.bodies[i]
+        moved = _invariant_part(body.joint.axis, body.joint.type.is_revolute, params[i])
+        if moved.is_zero:
+            continue
+        params[i] = params[i] + _negated(moved)
+        if body.parent >= 0:
+            placement = Transform(body.placement.rotation, body.placement.translation)
+            params[body.parent] = params[body.parent] + moved.transformed(placement)
+    return [_folded(p) for p in params]
+
+
+def _negated(par: InertialParameters) -> InertialParameters:
+    return InertialParameters(-par.mass, tuple(-x for x in par.first_moment),  # type: ignore
+                              tuple(tuple(-x for x in row) for row in par.inertia))  # type: ignore
+
+
+def _folded(par: InertialParameters) -> InertialParameters:
+    """Entries expanded, so that a parameter minus itself is an exact zero."""
+    return InertialParameters(sp.expand(par.mass), tuple(sp.expand(x) for x in par.first_moment),  # type: ignore
+                              tuple(tuple(sp.expand(x) for x in row) for row in par.inertia))  # type: ignore
+
+
+def _khalil_U(w, dw, b: ProgramBuilder, tag) -> tuple:
+    """U = [ω̇]× + [ω]×[ω]× = [ω̇]× + ω ωᵀ − |ω|² 1, entries named (only those used survive)."""
+    ww = [[_name(b, w[r] * w[c], f"ww{tag}_{r}{c}") for c in range(3)] for r in range(3)]
+    for r in range(3):
+        for c in range(r):
+            ww[r][c] = ww[c][r]
+    skew = ((0, -dw[2], dw[1]), (dw[2], 0, -dw[0]), (-dw[1], dw[0], 0))
+    U = []
+    for r in range(3):
+        row = []
+        for c in range(3):
+            if r == c:  # −(ω_j² + ω_k²), named without its sign
+                e = -b.define(sum((ww[x][x] for x in range(3) if x != r), sp.Integer(0)),
+                              f"U{tag}_{r}{c}")
+            else:
+                e = _name(b, ww[r][c] + skew[r][c], f"U{tag}_{r}{c}")
+            row.append(e)
+        U.append(tuple(row))
+    return tuple(U)
+
+
 def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: ProgramBuilder) -> sp.Matrix:
     """Build τ(q, q̇, q̈) into ``b``; returns the n×1 matrix of joint efforts [N m or N]."""
     n = len(tree.bodies)
-    omega, domega, acc, sincos = [], [], [], []
+    omega, domega, acc, sincos, khalil = [], [], [], [], []
     zero = (sp.Integer(0),) * 3
+    zero33 = (zero, zero, zero)
+    inertials = grouped_inertials(tree)
 
     def to_body(i, v):
         """Parent-frame vector → body i frame: Rot(axis, q)ᵀ R_placeᵀ v (revolute)."""
@@ -93,53 +208,60 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
                 w = _rotate_back(body.joint.axis, c, -s, v)
         return _matvec(body.placement.rotation, w)
 
+    def offset(i):
+        """Joint i's frame origin in the parent frame [m] (prismatic: moved by q)."""
+        body = tree.bodies[i]
+        r = body.placement.translation
+        if body.joint.type.is_revolute:
+            return r
+        k = _matvec(body.placement.rotation, body.joint.axis)
+        return tuple(r[j] + k[j] * q[body.q_index] for j in range(3))
+
     base_acc = tuple(-x for x in gravity)
     for i, body in enumerate(tree.bodies):
         k = body.q_index
         tag = k + 1
         z = body.joint.axis
         if body.joint.type.is_revolute:
-            sincos.append((b.define(sp.sin(q[k]), f"s{tag}"), b.define(sp.cos(q[k]), f"c{tag}")))
+            sincos.append((_name(b, sp.sin(q[k]), f"s{tag}"), _name(b, sp.cos(q[k]), f"c{tag}")))
         else:
             sincos.append(None)
         if body.parent < 0:
-            w_p, dw_p, a_p = zero, zero, base_acc
-            r = body.placement.translation
+            w_p, dw_p, a_p, U_p = zero, zero, base_acc, zero33
         else:
-            w_p, dw_p, a_p = omega[body.parent], domega[body.parent], acc[body.parent]
-            r = body.placement.translation
+            p = body.parent
+            w_p, dw_p, a_p, U_p = omega[p], domega[p], acc[p], khalil[p]
+        # origin acceleration of this body in the parent frame: a_p + U_p r
+        Ur = _matvec(U_p, offset(i))
+        a_o = _name_all(b, tuple(a_p[j] + Ur[j] for j in range(3)), f"ap{tag}_")
         if body.joint.type.is_revolute:
-            # origin acceleration of this body, in the parent frame, then rotated in
-            a_o = tuple(a_p[j] + e for j, e in enumerate(
-                tuple(x + y for x, y in zip(_cross(dw_p, r), _cross(w_p, _cross(w_p, r))))))
-            a = b.define_all(to_body(i, b.define_all(a_o, f"ap{tag}_")), f"a{tag}_")
-            w_in = b.define_all(to_body(i, w_p), f"wp{tag}_")
-            w = b.define_all(tuple(w_in[j] + z[j] * qd[k] for j in range(3)), f"w{tag}_")
+            a = _name_all(b, to_body(i, a_o), f"a{tag}_")
+            w_in = _name_all(b, to_body(i, w_p), f"wp{tag}_")
+            w = _name_all(b, tuple(w_in[j] + z[j] * qd[k] for j in range(3)), f"w{tag}_")
             dw_rel = _cross(w_in, tuple(z[j] * qd[k] for j in range(3)))
-            dw = b.define_all(tuple(e + dw_rel[j] + z[j] * qdd[k] for j, e in
+            dw = _name_all(b, tuple(e + dw_rel[j] + z[j] * qdd[k] for j, e in
                                     enumerate(to_body(i, dw_p))), f"dw{tag}_")
         else:
-            r_q = tuple(r[j] + e * q[k] for j, e in enumerate(_matvec(body.placement.rotation, z)))
-            a_o = tuple(a_p[j] + e for j, e in enumerate(
-                tuple(x + y for x, y in zip(_cross(dw_p, r_q), _cross(w_p, _cross(w_p, r_q))))))
-            w = b.define_all(to_body(i, w_p), f"w{tag}_")
-            dw = b.define_all(to_body(i, dw_p), f"dw{tag}_")
+            w = _name_all(b, to_body(i, w_p), f"w{tag}_")
+            dw = _name_all(b, to_body(i, dw_p), f"dw{tag}_")
             cor = _cross(w, tuple(2 * z[j] * qd[k] for j in range(3)))
-            a = b.define_all(tuple(e + cor[j] + z[j] * qdd[k] for j, e in
-                                   enumerate(to_body(i, b.define_all(a_o, f"ap{tag}_")))), f"a{tag}_")
+            a = _name_all(b, tuple(e + cor[j] + z[j] * qdd[k] for j, e in
+                                   enumerate(to_body(i, a_o))), f"a{tag}_")
         omega.append(w)
         domega.append(dw)
         acc.append(a)
+        khalil.append(_khalil_U(w, dw, b, tag))
 
     force: list = [None] * n
     moment: list = [None] * n
     for i, body in enumerate(tree.bodies):
         tag = body.q_index + 1
-        par = body.inertial
+        par = inertials[i]
         m, h, I = par.mass, par.first_moment, par.inertia
         w, dw, a = omega[i], domega[i], acc[i]
-        f = tuple(m * a[j] + x + y for j, (x, y) in enumerate(zip(_cross(dw, h), _cross(w, _cross(w, h)))))
-        Iw = b.define_all(_matvec(I, w), f"Iw{tag}_")
+        Uh = _matvec(khalil[i], h)
+        f = tuple(m * a[j] + Uh[j] for j in range(3))
+        Iw = _name_all(b, _matvec(I, w), f"Iw{tag}_")
         nn = tuple(x + y + z_ for x, y, z_ in zip(_matvec(I, dw), _cross(w, Iw), _cross(h, a)))
         force[i] = list(f)
         moment[i] = list(nn)
@@ -148,22 +270,16 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
     for i in reversed(range(n)):
         body = tree.bodies[i]
         tag = body.q_index + 1
-        f = b.define_all(force[i], f"f{tag}_")
-        nn = b.define_all(moment[i], f"n{tag}_")
+        f = _name_all(b, force[i], f"f{tag}_")
+        nn = _name_all(b, moment[i], f"n{tag}_")
         axis = body.joint.axis
-        tau[body.q_index, 0] = b.define(_dot(axis, nn if body.joint.type.is_revolute else f),
+        tau[body.q_index, 0] = _name(b, _dot(axis, nn if body.joint.type.is_revolute else f),
                                         f"tau{tag}")
         p = body.parent
         if p >= 0:
-            f_p = to_parent(i, f)
+            f_p = _name_all(b, to_parent(i, f), f"fp{tag}_")
             n_p = to_parent(i, nn)
-            if body.joint.type.is_revolute:
-                r = body.placement.translation
-            else:
-                r = tuple(body.placement.translation[j] + e * q[body.q_index]
-                          for j, e in enumerate(_matvec(body.placement.rotation, axis)))
-            f_p = b.define_all(f_p, f"fp{tag}_")
-            rf = _cross(r, f_p)
+            rf = _cross(offset(i), f_p)
             for j in range(3):
                 force[p][j] = force[p][j] + f_p[j]
                 moment[p][j] = moment[p][j] + n_p[j] + rf[j]

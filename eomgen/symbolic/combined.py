@@ -1,0 +1,50 @@
+"""M(q), C(q, q̇) q̇ and g(q) in one straight-line program, from the O(n) and O(n²) recursions.
+
+One call that wants several quantities shares their common work (sines and cosines, rotations,
+the gravity part of the accelerations): M by the body-frame CRBA
+(:mod:`eomgen.symbolic.crba`), ``g = τ(q, 0, 0)`` and ``C q̇ + g = τ(q, q̇, 0)`` by the
+Newton–Euler program (:mod:`eomgen.symbolic.newton_euler`), so ``C q̇ = τ(q, q̇, 0) − g``.
+The Coriolis *matrix* C (Christoffel symbols, Ṁ − 2C skew-symmetric) is not produced here: its
+product with q̇ is what forward dynamics and computed-torque control need, and it costs O(n)
+instead of O(n³).
+
+Outputs: ``"M"`` (n×n), ``"Cqd"`` (n×1, C(q, q̇) q̇), ``"g"`` (n×1), in ``JOINT_NAMES`` order,
+SI units (N m or N for the vectors).
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from ..bodies import body_tree
+from ..model import RobotModel
+from .crba import mass_matrix_program
+from .newton_euler import _name, inverse_dynamics_program
+from .program import Program, ProgramBuilder
+
+
+def dynamics_program(model: RobotModel) -> tuple[tuple, tuple, Program]:
+    """``(q symbols, q̇ symbols, program)`` with outputs ``M``, ``Cqd`` and ``g`` of ``model``.
+
+    Examples
+    --------
+    >>> import eomgen
+    >>> from eomgen.symbolic.combined import dynamics_program
+    >>> q, qd, program = dynamics_program(eomgen.load(eomgen.example_path("planar_2link")))
+    >>> [name for name, _ in program.outputs]
+    ['M', 'Cqd', 'g']
+    """
+    from ..dynamics import joint_symbols
+
+    n = model.dof
+    q, qd, _ = joint_symbols(n)
+    reserved = {s.name for s in q + qd} | {p.name for p in model.parameters}
+    b = ProgramBuilder(reserved)
+    tree = body_tree(model)
+    zero = (sp.Integer(0),) * n
+    M = mass_matrix_program(tree, q, b)
+    g = inverse_dynamics_program(tree, q, zero, zero, model.gravity, b)
+    bias = inverse_dynamics_program(tree, q, qd, zero, model.gravity, b)
+    Cqd = sp.Matrix([[_name(b, bias[k, 0] - g[k, 0], f"Cqd{k + 1}")] for k in range(n)])
+    outputs = (("M", M), ("Cqd", Cqd), ("g", g))
+    return q, qd, Program(tuple(b.assignments), outputs).pruned([o for o, _ in outputs])

@@ -1,0 +1,108 @@
+"""The mass matrix M(q) by the Composite-Rigid-Body Algorithm in body frames, as a straight-line
+program.
+
+Featherstone's CRBA (*Rigid Body Dynamics Algorithms*, 2008, Table 6.2): composite inertias
+``I^c_i = I_i + Σ_children X_cᵀ I^c_c X_c`` from the leaves to the root, then for each body
+``F = I^c_i S_i``, ``M_ii = S_iᵀ F`` and, walking up the ancestors j of i, ``F ← X_jᵀ F``
+(force to the parent), ``M_ji = M_ij = S_jᵀ F``. O(n) composite inertias and O(n·depth) force
+transforms: O(n²) operations for a chain.
+
+Everything is in body coordinates about the body origin (see :mod:`eomgen.symbolic.aba` for
+the spatial conventions), so every vector is link-sized: no quantity is referred to a far-away
+root origin. The inertial parameters are the grouped ones of
+:func:`~eomgen.symbolic.newton_euler.grouped_inertials`, which give exactly the same M(q).
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from ..bodies import BodyTree, body_tree
+from ..model import RobotModel
+from .aba import _force_to_parent, _Frames, _full, _inertia_to_parent, _symmetric
+from .composite import _dot, _matvec
+from .newton_euler import _name, _name_all, grouped_inertials
+from .program import Program, ProgramBuilder
+
+_ZERO = sp.Integer(0)
+
+
+def mass_matrix_program(tree: BodyTree, q, b: ProgramBuilder, grouped: bool = True) -> sp.Matrix:
+    """Build M(q) into ``b`` by the body-frame CRBA; returns the symmetric n×n matrix
+    [kg m², kg m, kg] in ``JOINT_NAMES`` order."""
+    n = len(tree.bodies)
+    zero = (_ZERO,) * 3
+    sincos = []
+    for body in tree.bodies:
+        k = body.q_index
+        if body.joint.type.is_revolute:
+            sincos.append((_name(b, sp.sin(q[k]), f"s{k + 1}"), _name(b, sp.cos(q[k]), f"c{k + 1}")))
+        else:
+            sincos.append(None)
+    frames = _Frames(tree, q, sincos)
+    inertials = grouped_inertials(tree) if grouped else [body.inertial for body in tree.bodies]
+    IC = []
+    for par in inertials:
+        h, m = par.first_moment, par.mass
+        Bh = ((_ZERO, -h[2], h[1]), (h[2], _ZERO, -h[0]), (-h[1], h[0], _ZERO))
+        IC.append([par.inertia, Bh, tuple(tuple(m if r == c else _ZERO for c in range(3))
+                                          for r in range(3))])
+
+    def subspace(i):
+        body = tree.bodies[i]
+        k = tuple(body.joint.axis)
+        return (k, zero) if body.joint.type.is_revolute else (zero, k)
+
+    M = sp.zeros(n, n)
+    for i in reversed(range(n)):
+        body = tree.bodies[i]
+        tag = body.q_index + 1
+        A = _symmetric(b, IC[i][0], f"Ic{tag}_A")
+        B = _full(b, IC[i][1], f"Ic{tag}_B")
+        C = _symmetric(b, IC[i][2], f"Ic{tag}_C")
+        S_ang, S_lin = subspace(i)
+        Bt = tuple(tuple(B[c][r] for c in range(3)) for r in range(3))
+        F_n = _name_all(b, tuple(x + y for x, y in zip(_matvec(A, S_ang), _matvec(B, S_lin))),
+                        f"F{tag}_{tag}n")
+        F_f = _name_all(b, tuple(x + y for x, y in zip(_matvec(Bt, S_ang), _matvec(C, S_lin))),
+                        f"F{tag}_{tag}f")
+        M[body.q_index, body.q_index] = _name(b, _dot(S_ang, F_n) + _dot(S_lin, F_f),
+                                              f"M{tag}_{tag}")
+        j = i
+        while tree.bodies[j].parent >= 0:
+            F_n, F_f = _force_to_parent(frames, j, F_n, F_f)
+            j = tree.bodies[j].parent
+            other = tree.bodies[j].q_index
+            F_n = _name_all(b, F_n, f"F{other + 1}_{tag}n")
+            F_f = _name_all(b, F_f, f"F{other + 1}_{tag}f")
+            S_ang, S_lin = subspace(j)
+            value = _name(b, _dot(S_ang, F_n) + _dot(S_lin, F_f), f"M{other + 1}_{tag}")
+            M[other, body.q_index] = M[body.q_index, other] = value
+        if body.parent >= 0:
+            A_p, B_p, C_p = _inertia_to_parent(frames, i, A, B, C, b, tag)
+            p = body.parent
+            IC[p] = [tuple(tuple(x + y for x, y in zip(r1, r2)) for r1, r2 in zip(IC[p][0], A_p)),
+                     tuple(tuple(x + y for x, y in zip(r1, r2)) for r1, r2 in zip(IC[p][1], B_p)),
+                     tuple(tuple(x + y for x, y in zip(r1, r2)) for r1, r2 in zip(IC[p][2], C_p))]
+    return M
+
+
+def crba_program(model: RobotModel) -> tuple[tuple[sp.Symbol, ...], Program]:
+    """M(q) of ``model`` by the body-frame CRBA: ``(q symbols, program with output "M")``.
+
+    Examples
+    --------
+    >>> import eomgen
+    >>> from eomgen.symbolic.crba import crba_program
+    >>> q, program = crba_program(eomgen.load(eomgen.example_path("planar_2link")))
+    >>> program.output("M").shape
+    (2, 2)
+    """
+    from ..dynamics import joint_symbols
+
+    q, _, _ = joint_symbols(model.dof)
+    reserved = {s.name for s in q} | {p.name for p in model.parameters}
+    b = ProgramBuilder(reserved)
+    M = mass_matrix_program(body_tree(model), q, b)
+    return q, Program(tuple(b.assignments), (("M", M),)).pruned(["M"])
+
