@@ -11,7 +11,7 @@ The pieces, each a plain function over plain data:
   SI units (s, rad or m, rad/s or m/s, rad/s² or m/s², N m or N). In the second form q̇ and q̈
   come from :func:`filtered_derivatives`: q and τ through the same zero-phase Butterworth
   low-pass filter (order 4, run forward and backward by ``scipy.signal.sosfiltfilt``), then
-  second-order central differences (``numpy.gradient``).
+  second-order central differences (``numpy.gradient``), then decimation.
 * **Estimation** (:func:`weighted_least_squares`): Gautier's weighted least squares, standard
   deviations, condition number; :func:`physical_fit` adds the constraint that every body's
   pseudo-inertia be positive semi-definite (an SDP, needs cvxpy).
@@ -211,7 +211,10 @@ def filtered_derivatives(t, q, tau, cutoff: float | None = None, source: str = "
     differences (``numpy.gradient``). The signals are extended at both ends by odd reflection
     over three periods of the cut-off frequency (``padlen``), and the samples within those
     three periods of either end, where the filter has not settled, are dropped (interior error
-    of q̇ ~1e-4, of q̈ ~1e-3 of their peaks on the excitation trajectories tested).
+    of q̇ ~1e-4, of q̈ ~1e-3 of their peaks on the excitation trajectories tested). The rest is
+    decimated to every ⌊fs / (2 cutoff)⌋-th sample (Gautier's parallel decimation): the
+    filtered noise has no content above the cut-off, so samples closer than that are
+    correlated and would make the least-squares standard deviations too small.
 
     Parameters
     ----------
@@ -258,7 +261,7 @@ def filtered_derivatives(t, q, tau, cutoff: float | None = None, source: str = "
     tauf = signal.sosfiltfilt(sos, tau, axis=0, padlen=padlen)
     qd = np.gradient(qf, dt, axis=0, edge_order=2)
     qdd = np.gradient(qd, dt, axis=0, edge_order=2)
-    keep = slice(trim, t.size - trim)
+    keep = slice(trim, t.size - trim, max(1, int(fs / (2 * cutoff))))
     return t[keep], qf[keep], qd[keep], qdd[keep], tauf[keep]
 
 
