@@ -79,6 +79,8 @@ def add_commands(main: click.Group, handle_errors, strict_option, quiet_option, 
           eomgen excite eomgen/robots/puma560_dh.yaml -o puma.csv --noise 0.01
           eomgen identify eomgen/robots/puma560_dh.yaml puma.csv -o puma_id
         """
+        if importlib.util.find_spec("scipy") is None:
+            raise IdentificationError("eomgen excite needs scipy: pip install 'eomgen[identify]'")
         from . import excitation_trajectory, measurements_csv, simulate_measurements
 
         if not duration > 0 or duration == float("inf"):
