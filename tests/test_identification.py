@@ -254,11 +254,12 @@ def test_unexciting_data_name_the_rank(tmp_path):
                         np.zeros((10, 2)), np.zeros((10, 2)), np.ones((10, 2)))
     path = tmp_path / "still.csv"
     path.write_text(measurements_csv(data))
-    with pytest.raises(IdentificationError, match=r"excite only \d of the 6 base parameters"):
-        model, reg, base, _ = setup("planar_2link")
-        read = read_measurements(path, model.joint_names)
-        weighted_least_squares(observation_matrix(reg, base.base, read.q, read.qd, read.qdd),
-                               read.tau, str(path))
+    model, reg, base, _ = setup("planar_2link")
+    read = read_measurements(path, model.joint_names)
+    W = observation_matrix(reg, base.base, read.q, read.qd, read.qdd)
+    with pytest.raises(IdentificationError, match=r"still.csv: the 10 samples excite only \d "
+                                                  r"of the 6 base parameters"):
+        weighted_least_squares(W, read.tau, str(path))
 
 
 def test_excite_refuses_a_folder_as_output_before_any_work(tmp_path):
