@@ -178,6 +178,13 @@ def test_physical_fit_returns_psd_pseudo_inertias():
     # for a consistent π fitting as well as the unconstrained estimate
     assert np.all(fit.rms < 1.05 * est.rms + 1e-12)
     np.testing.assert_allclose(fit.beta, base.beta(fit.pi))
+    # noise-free (weights from rounding errors, up to ~1e15): still a fit to 3e-5 of each
+    # joint's RMS effort
+    clean, W, _ = simulated("puma560_dh", 200)
+    exact = physical_fit(reg, base, W, clean.tau,
+                         weighted_least_squares(W, clean.tau).sigma)
+    assert np.all(exact.rms < 1e-4 * np.sqrt(np.mean(clean.tau ** 2, axis=0)))
+    assert np.all(exact.min_eigenvalues > -1e-7)
 
 
 def test_physical_fit_of_a_physical_robot_keeps_the_estimate():
@@ -211,21 +218,24 @@ def test_physical_fit_of_a_physical_robot_keeps_the_estimate():
 
 @pytest.mark.slow
 def test_excite_then_identify_puma(tmp_path):
+    pytest.importorskip("cvxpy", reason="--physical needs cvxpy (pip install 'eomgen[identify]')")
     data = tmp_path / "puma.csv"
     result = run_process("excite", PUMA, "-o", data, "--samples", 150, "--noise", 0.01,
                          "--quiet")
     assert result.returncode == 0, result.stderr
     assert result.stdout.splitlines()[-1] == str(data)
     out = tmp_path / "id"
-    result = run_process("identify", PUMA, data, "-o", out, "--quiet")
+    result = run_process("identify", PUMA, data, "-o", out, "--quiet", "--physical")
     assert result.returncode == 0, result.stderr
+    assert "min eig of its body's pseudo-inertia J" in result.stdout
     names = sorted(p.name for p in out.iterdir())
     assert names == ["identify_puma560.csv", "identify_puma560.md", "identify_puma560.png"]
     rows = (out / "identify_puma560.csv").read_text().splitlines()
     assert len(rows) == 1 + 36 and rows[0].startswith("name,expression,estimate,std")
     png = (out / "identify_puma560.png").read_bytes()
     again = tmp_path / "id2"
-    assert run_process("identify", PUMA, data, "-o", again, "--quiet").returncode == 0
+    assert run_process("identify", PUMA, data, "-o", again, "--quiet",
+                       "--physical").returncode == 0
     assert (again / "identify_puma560.png").read_bytes() == png  # deterministic
     assert "| 36 | ZZ6 | `ZZ6` |" in result.stdout
 

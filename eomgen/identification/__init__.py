@@ -439,11 +439,12 @@ def physical_fit(reg, base, W: np.ndarray, tau: np.ndarray, sigma: np.ndarray,
     """Weighted least squares over π subject to every body's pseudo-inertia J_k(π) ⪰ 0 (and
     viscous and Coulomb friction coefficients ≥ 0), as a semi-definite program in cvxpy.
 
-    Minimises |R E π − Qᵀ τ̃|² where W̃ = Q R is the weighted observation matrix (rows of
+    Minimises |R E π − Qᵀ τ̃|² (written as one Euclidean norm, scaled so that the largest
+    singular value of R E is 1) where W̃ = Q R is the weighted observation matrix (rows of
     joint j divided by ``sigma[j]``), E the map β = E π (:func:`base_map`); a ridge
     1e-8 s_min² |π|² (s_min the smallest singular value of R E) keeps the parts of π that β
     does not fix bounded while moving the fit by no more than 1e-8 of its weakest direction.
-    Clarabel solves it when installed, else SCS.
+    Clarabel solves it when installed (gap and feasibility tolerances 1e-10), else SCS.
 
     Raises
     ------
@@ -463,6 +464,8 @@ def physical_fit(reg, base, W: np.ndarray, tau: np.ndarray, sigma: np.ndarray,
     E = base_map(base, reg.p)
     A = R @ E
     singular = np.linalg.svd(A, compute_uv=False)
+    if singular[0] > 0:  # the same minimiser, numbers near 1 for the solver
+        A, z, singular = A / singular[0], z / singular[0], singular / singular[0]
     ridge = 1e-8 * float(singular[singular > 0].min() if np.any(singular > 0) else 1.0) ** 2
     pi = cp.Variable(reg.p)
     constraints = []
@@ -477,11 +480,16 @@ def physical_fit(reg, base, W: np.ndarray, tau: np.ndarray, sigma: np.ndarray,
     for term, offset in zip(reg.actuators, range(10 * reg.n, reg.p, reg.n)):
         if term in ("viscous", "coulomb", "armature"):
             constraints.append(pi[offset:offset + reg.n] >= 0)
-    problem = cp.Problem(cp.Minimize(cp.sum_squares(A @ pi - z)
-                                     + ridge * cp.sum_squares(pi)), constraints)
+    # |A π − z|² + ridge |π|² as one Euclidean norm (a second-order cone): the same
+    # minimiser, and the solver's tolerance then bounds the residual, not its square
+    stacked = np.vstack([A, math.sqrt(ridge) * np.eye(reg.p)])
+    target = np.concatenate([z, np.zeros(reg.p)])
+    problem = cp.Problem(cp.Minimize(cp.norm(stacked @ pi - target, 2)), constraints)
     solver = cp.CLARABEL if "CLARABEL" in cp.installed_solvers() else cp.SCS
     try:
-        problem.solve(solver=solver)
+        tight = ({"tol_gap_abs": 1e-10, "tol_gap_rel": 1e-10, "tol_feas": 1e-10}
+                 if solver == cp.CLARABEL else {"eps": 1e-9})
+        problem.solve(solver=solver, **tight)
     except cp.error.SolverError as exc:
         raise IdentificationError(one_line(f"{source}: physically consistent fit: {exc}")) from None
     if problem.status not in ("optimal", "optimal_inaccurate") or pi.value is None:

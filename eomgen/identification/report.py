@@ -72,7 +72,7 @@ class IdentificationReport:
                 row += [f"{self.physical.beta[k]:.6g}"]
             lines.append("| " + " | ".join(row) + " |")
         lines += ["", "| joint | σ_j | residual RMS"
-                  + (" | residual RMS, physical fit | min eig J (pseudo-inertia) |"
+                  + (" | residual RMS, physical fit | min eig of its body's pseudo-inertia J |"
                      if self.physical is not None else " |"),
                   "|---|---|---|" + ("---|---|" if self.physical is not None else "")]
         for j, joint in enumerate(m.joint_names):
