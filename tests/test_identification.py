@@ -22,6 +22,8 @@ from eomgen.identification import (IdentificationError, Measurements, excitation
                                    weighted_least_squares)
 from eomgen.regressor import base_parameters, derive_regressor
 
+from conftest import erd_robots_dir
+
 pytest.importorskip("scipy", reason="identification needs scipy (pip install 'eomgen[identify]')")
 
 PUMA = eomgen.example_path("puma560_dh")
@@ -309,8 +311,6 @@ def test_excite_refuses_a_folder_as_output_before_any_work(tmp_path):
 def test_excite_and_identify_a_scene_of_the_panda(tmp_path):
     """--scene: the Panda reduced to its shoulder and elbow; columns named after the joints
     the scene keeps, the description's β recovered within 3 std from 1 % noise."""
-    from conftest import erd_robots_dir
-
     robots = erd_robots_dir()
     if robots is None:
         pytest.skip("example-robot-data is not installed")
