@@ -393,7 +393,7 @@ def pseudo_inertia(pi10) -> np.ndarray:
     J ⪰ 0 exactly when some non-negative mass distribution has these parameters.
 
     >>> J = pseudo_inertia([2.0, 0.2, 0, 0, 0, 0, 0.02, 0, 0, 0.02])  # 2 kg at x = 0.1 m
-    >>> J.diagonal().round(12).tolist(), abs(np.linalg.eigvalsh(J)[0]) < 1e-15  # PSD, singular
+    >>> J.diagonal().round(12).tolist(), bool(abs(np.linalg.eigvalsh(J)[0]) < 1e-15)  # singular
     ([0.02, 0.0, 0.0, 2.0], True)
     """
     m, hx, hy, hz, xx, xy, yy, xz, yz, zz = pi10
