@@ -1,5 +1,6 @@
 """Command line interface: ``eomgen verify``, ``generate``, ``notebook``, ``teach`` (and
-``bench``, ``simulate`` from :mod:`eomgen.analysis.commands`).
+``bench``, ``simulate`` from :mod:`eomgen.analysis.commands`; ``excite``, ``identify`` from
+:mod:`eomgen.identification.commands`).
 
 Exit codes: 0 success, 1 a verification check failed, 2 bad input (one line on stderr naming the
 file, the element and the problem; a traceback only with ``--debug``), 130 interrupted (SIGINT,
@@ -422,6 +423,12 @@ from .analysis.commands import add_commands as _add_analysis_commands  # noqa: E
 
 _add_analysis_commands(main, _handle_errors, description_argument, strict_option,
                        _load_reduced)
+
+# ``eomgen excite`` and ``eomgen identify`` (eomgen/identification/commands.py).
+from .identification.commands import add_commands as _add_identification_commands  # noqa: E402
+
+_add_identification_commands(main, _handle_errors, strict_option, quiet_option, scene_option,
+                             _load_reduced)
 
 
 if __name__ == "__main__":  # pragma: no cover

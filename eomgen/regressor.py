@@ -575,7 +575,9 @@ class Identification:
 def identify(reg: Regressor, base, q, qd, qdd, tau, values: Mapping | None = None
              ) -> Identification:
     """Estimate β by ordinary least squares, ``min |W β − τ|`` with W the base regressor
-    stacked over the samples.
+    stacked over the samples (:func:`eomgen.identification.observation_matrix`). Gautier's
+    weighted least squares, CSV data and the physically consistent fit are in
+    :mod:`eomgen.identification`.
 
     Parameters
     ----------
@@ -600,15 +602,14 @@ def identify(reg: Regressor, base, q, qd, qdd, tau, values: Mapping | None = Non
     columns = list(base.base)
     if arrays[0].size < len(columns):
         raise ValueError(f"{arrays[0].size} equations for {len(columns)} base parameters")
-    f = reg.compiled(values, program=reg.base_program(columns))
-    W = np.vstack([f(*row)["Y_base"] for row in zip(*arrays[:3])])
+    from .identification import normalised_condition, observation_matrix
+
+    W = observation_matrix(reg, columns, *arrays[:3], values=values)
     y = arrays[3].reshape(-1)
     beta, *_ = np.linalg.lstsq(W, y, rcond=None)
     residual = y - W @ beta
     dof = max(W.shape[0] - W.shape[1], 1)
     sigma2 = float(residual @ residual) / dof
     cov = sigma2 * np.linalg.pinv(W.T @ W)
-    norms = np.linalg.norm(W, axis=0)
-    condition = float(np.linalg.cond(W / np.where(norms > 0, norms, 1.0)))
     return Identification(beta, np.sqrt(np.clip(np.diag(cov), 0, None)),
-                          float(np.sqrt(np.mean(residual ** 2))), condition)
+                          float(np.sqrt(np.mean(residual ** 2))), normalised_condition(W))
