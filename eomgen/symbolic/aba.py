@@ -69,6 +69,19 @@ class _Frames:
     def __init__(self, tree: BodyTree, q, sincos):
         self.tree, self.q, self.sincos = tree, q, sincos
 
+    @classmethod
+    def named(cls, tree: BodyTree, q, b: ProgramBuilder) -> "_Frames":
+        """The frames of ``tree`` with each revolute joint's ``s_k``, ``c_k`` named in ``b``."""
+        sincos = []
+        for body in tree.bodies:
+            k = body.q_index
+            if body.joint.type.is_revolute:
+                sincos.append((_name(b, sp.sin(q[k]), f"s{k + 1}"),
+                               _name(b, sp.cos(q[k]), f"c{k + 1}")))
+            else:
+                sincos.append(None)
+        return cls(tree, q, sincos)
+
     def to_body(self, i, v) -> tuple:
         """Parent-frame 3-vector → body i frame: Rot(k, q)ᵀ R_placeᵀ v."""
         body = self.tree.bodies[i]
@@ -184,14 +197,7 @@ def forward_dynamics_program(tree: BodyTree, q, qd, tau, gravity: Vec3, b: Progr
     """
     n = len(tree.bodies)
     zero = (_ZERO,) * 3
-    sincos = []
-    for body in tree.bodies:
-        k = body.q_index
-        if body.joint.type.is_revolute:
-            sincos.append((_name(b, sp.sin(q[k]), f"s{k + 1}"), _name(b, sp.cos(q[k]), f"c{k + 1}")))
-        else:
-            sincos.append(None)
-    frames = _Frames(tree, q, sincos)
+    frames = _Frames.named(tree, q, b)
     inertials = grouped_inertials(tree) if grouped else [body.inertial for body in tree.bodies]
 
     def subspace(i):

@@ -32,14 +32,7 @@ def mass_matrix_program(tree: BodyTree, q, b: ProgramBuilder, grouped: bool = Tr
     [kg m², kg m, kg] in ``JOINT_NAMES`` order."""
     n = len(tree.bodies)
     zero = (_ZERO,) * 3
-    sincos = []
-    for body in tree.bodies:
-        k = body.q_index
-        if body.joint.type.is_revolute:
-            sincos.append((_name(b, sp.sin(q[k]), f"s{k + 1}"), _name(b, sp.cos(q[k]), f"c{k + 1}")))
-        else:
-            sincos.append(None)
-    frames = _Frames(tree, q, sincos)
+    frames = _Frames.named(tree, q, b)
     inertials = grouped_inertials(tree) if grouped else [body.inertial for body in tree.bodies]
     IC = []
     for par in inertials:
