@@ -27,6 +27,7 @@ from sympy.printing.c import C99CodePrinter
 from sympy.printing.precedence import PRECEDENCE
 
 from .. import GeneratedFile, Job, register
+from ...outputs import FORWARD, composition_names
 from ..render import render
 from .casadi_backend import c_compiler
 
@@ -150,7 +151,8 @@ def _render_source(job: Job, config: FastConfig) -> str:
         exports=list(job.functions) + (["IllConditionedWarning"]
                                        if "forward_dynamics" in job.functions else []),
         forward_doc=forward_doc,
-        forward_dynamics="forward_dynamics" in job.functions,
+        forward_dynamics=FORWARD.function in job.functions,
+        fd=composition_names(FORWARD),
     )
 
 

@@ -370,10 +370,10 @@ def _textbook_sections(job: Job, book: TextbookDerivation, p: Printing) -> dict:
     return {
         "bodies": bodies,
         "energies": p.chunks([p.equation("K", book.K), p.equation("P", book.P)]),
-        "mass_matrix": p.chunks(M),
+        "M_blocks": p.chunks(M),
         "christoffel": p.chunks(christoffel),
         "coriolis": p.chunks(C),
-        "gravity_vector": p.chunks(g),
+        "g_blocks": p.chunks(g),
         "equations": p.chunks(equations),
     }
 
