@@ -481,6 +481,6 @@ def render_document(job: Job, config: LatexConfig = LatexConfig()) -> str:
 
 @register("latex", "LaTeX document of the derivation: textbook steps for small models, the "
                    "program of named subexpressions for large ones (pdflatex)",
-          needs=("M", "C", "g"))
+          needs=("M", "C", "g"), config=LatexConfig, order=50)
 def generate_latex(job: Job, config: LatexConfig = LatexConfig()) -> list[GeneratedFile]:
     return [GeneratedFile(job.stem + config.suffix, render_document(job, config))]
