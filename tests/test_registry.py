@@ -22,7 +22,7 @@ from eomgen import cache, compiler, outputs
 from eomgen.codegen import BACKENDS, available_backends, make_job
 from eomgen.codegen.backends import BACKEND_MODULES, casadi_backend, fast_backend
 from eomgen.codegen.functions import (FUNCTION_ALIASES, RESERVED_IDENTIFIERS, derived_outputs,
-                                      select_functions)
+                                      reserved_identifiers, safe_identifier, select_functions)
 from eomgen.codegen.render import TEMPLATES_DIR
 from eomgen.dynamics import ALL_OUTPUTS, derive
 from eomgen.outputs import BY_SYMBOL, FORWARD, OUTPUTS, Output, register_output
@@ -121,6 +121,16 @@ def test_a_caller_passes_a_config(planar):
     (renamed,) = backend.generate(job, backend.config(suffix="_np.py"))
     assert default.name == "planar_2link_numpy.py" and renamed.name == "planar_2link_np.py"
     assert renamed.content == default.content
+
+
+def test_backends_reserve_the_names_their_modules_import(monkeypatch):
+    assert {"np", "ca", "casadi", "jnp", "torch"} <= reserved_identifiers()
+    assert not {"np", "ca", "jnp", "torch"} & RESERVED_IDENTIFIERS  # each says it itself
+    assert safe_identifier("np", set()) == "np_"
+    available_backends()
+    monkeypatch.setitem(BACKENDS, "other", dataclasses.replace(
+        BACKENDS["numpy"], name="other", reserved=("stiffness",)))
+    assert safe_identifier("stiffness", set()) == "stiffness_"
 
 
 def test_replacing_a_backend_keeps_its_place(monkeypatch):

@@ -77,7 +77,8 @@ class Backend:
     whatever functions are asked (a derivation document needs M, C and g); empty when it prints
     just the asked functions. ``config`` is the backend's config dataclass (its defaults are used
     when a caller passes none; ``config().suffix`` names its main file); ``order`` places it in
-    :func:`available_backends` (and so in ``--backend all``).
+    :func:`available_backends` (and so in ``--backend all``). ``reserved`` are names its modules
+    bind themselves (``np``); no parameter of any backend's module takes them.
     """
 
     name: str
@@ -86,19 +87,21 @@ class Backend:
     needs: tuple[str, ...] = ()
     config: type | None = None
     order: int = 1000
+    reserved: tuple[str, ...] = ()
 
 
 BACKENDS: dict[str, Backend] = {}
 
 
 def register(name: str, description: str, needs: tuple[str, ...] = (), config: type | None = None,
-             order: int = 1000):
+             order: int = 1000, reserved: tuple[str, ...] = ()):
     """Decorator registering ``generate(job, config=...) -> list[GeneratedFile]`` as backend
-    ``name``, with its config dataclass ``config``. Backends are listed by ``order``, then
-    name."""
+    ``name``, with its config dataclass ``config`` and the identifiers its modules bind
+    (``reserved``). Backends are listed by ``order``, then name."""
 
     def decorate(function: Callable[..., list[GeneratedFile]]):
-        BACKENDS[name] = Backend(name, description, function, tuple(needs), config, order)
+        BACKENDS[name] = Backend(name, description, function, tuple(needs), config, order,
+                                 tuple(reserved))
         ordered = sorted(BACKENDS.items(), key=lambda item: (item[1].order, item[0]))
         BACKENDS.clear()
         BACKENDS.update(ordered)

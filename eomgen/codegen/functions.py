@@ -58,10 +58,11 @@ class FunctionSpec:
     units: str
 
 
-#: Identifiers every generated module uses itself; parameters and intermediates avoid them.
+#: Identifiers every generated module uses itself, whatever its backend; parameters avoid them,
+#: and the names each backend's modules import (``register(..., reserved=("np",))``), see
+#: :func:`reserved_identifiers`.
 RESERVED_IDENTIFIERS = frozenset(
-    {"np", "ca", "casadi", "math", "jnp", "jax", "torch", "q", "qd", "qdd", "tau", "out",
-     "single", "batch", "n",
+    {"math", "q", "qd", "qdd", "tau", "out", "single", "batch", "n",
      "JOINT_NAMES", "NQ", "PARAMETERS", *OUTPUTS, *BY_SYMBOL,
      "self", "cls", "L", "x", "y", "d",
      "rhs", "bias", "args", "names", "vectors", "functions", "parameters", "q_columns",
@@ -69,15 +70,27 @@ RESERVED_IDENTIFIERS = frozenset(
      "close", "eigenvalues", "IllConditionedWarning"}
 ) | frozenset(keyword.kwlist) | frozenset(keyword.softkwlist) | frozenset(dir(builtins))
 
+
+def reserved_identifiers() -> frozenset[str]:
+    """:data:`RESERVED_IDENTIFIERS` and the names every registered backend reserves: the same
+    parameter names in every backend's module."""
+    from . import available_backends
+
+    return RESERVED_IDENTIFIERS.union(*(b.reserved for b in available_backends().values()))
+
+
 _IDENTIFIER = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 
 
-def safe_identifier(name: str, taken: set[str]) -> str:
-    """A valid, unused Python/C identifier derived from ``name`` (ASCII letters, digits, _)."""
+def safe_identifier(name: str, taken: set[str], reserved: frozenset[str] | None = None) -> str:
+    """A valid, unused Python/C identifier derived from ``name`` (ASCII letters, digits, _),
+    none of ``reserved`` (default: :func:`reserved_identifiers`)."""
+    if reserved is None:
+        reserved = reserved_identifiers()
     candidate = re.sub(r"[^A-Za-z0-9_]", "_", name.encode("ascii", "replace").decode("ascii"))
     if not candidate or not _IDENTIFIER.match(candidate) or candidate.startswith("_"):
         candidate = "p" + candidate if candidate.startswith("_") else "p_" + candidate
-    while candidate in taken or candidate in RESERVED_IDENTIFIERS:
+    while candidate in taken or candidate in reserved:
         candidate += "_"
     taken.add(candidate)
     return candidate
@@ -93,10 +106,12 @@ def module_name(robot_name: str) -> str:
 def parameter_arguments(dynamics: Dynamics) -> tuple[ParameterArgument, ...]:
     """Keyword arguments for the parameters the model keeps symbolic, sorted by name."""
     taken: set[str] = set()
+    reserved = reserved_identifiers()
     out = []
     for p in sorted(dynamics.parameters, key=lambda p: p.name):
         doc = p.description or "model parameter"
-        out.append(ParameterArgument(safe_identifier(p.name, taken), p.symbol, p.value, doc))
+        out.append(ParameterArgument(safe_identifier(p.name, taken, reserved), p.symbol, p.value,
+                                     doc))
     return tuple(out)
 
 

@@ -70,7 +70,7 @@ def _render_module(job: Job, config: CasADiConfig) -> str:
 
 
 @register("casadi", "CasADi module: casadi.Function objects (SX) with named inputs and outputs",
-          config=CasADiConfig, order=20)
+          config=CasADiConfig, order=20, reserved=("ca", "casadi"))
 def generate_casadi(job: Job, config: CasADiConfig = CasADiConfig()) -> list[GeneratedFile]:
     return [GeneratedFile(job.stem + config.suffix, _render_module(job, config))]
 

@@ -39,7 +39,7 @@ class NumPyConfig:
 
 
 @register("numpy", "NumPy module: single states (n,) and batches (N, n), NumPy only",
-          config=NumPyConfig, order=10)
+          config=NumPyConfig, order=10, reserved=("np",))
 def generate_numpy(job: Job, config: NumPyConfig = NumPyConfig()) -> list[GeneratedFile]:
     printer = NumPyModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
     extra = ["IllConditionedWarning"] if FORWARD.function in job.functions else []

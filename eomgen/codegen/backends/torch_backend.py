@@ -34,7 +34,8 @@ class TorchConfig:
 
 
 @register("torch", "PyTorch module: tensors (n,) or (N, n), any device and dtype, autograd "
-                   "(needs torch)", config=TorchConfig, order=70)
+                   "(needs torch)", config=TorchConfig, order=70,
+          reserved=("torch",))
 def generate_torch(job: Job, config: TorchConfig = TorchConfig()) -> list[GeneratedFile]:
     printer = TorchModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
     extra = ["IllConditionedWarning"] if FORWARD.function in job.functions else []
