@@ -154,3 +154,16 @@ def test_one_compiler_lookup(monkeypatch):
     monkeypatch.setenv("PATH", "")
     assert compiler.c_compiler() is None and cache.toolchain()["cc"] is None
     assert outputs.OUTPUTS  # the registry needs no compiler
+
+
+def test_cli_help_lists_the_registered_backends(monkeypatch):
+    from click.testing import CliRunner
+
+    from eomgen.cli import main
+
+    available_backends()
+    monkeypatch.setitem(BACKENDS, "zig", dataclasses.replace(BACKENDS["numpy"], name="zig"))
+    result = CliRunner().invoke(main, ["generate", "--help"], terminal_width=200)
+    assert result.exit_code == 0, result.output
+    assert ("among " + ", ".join(available_backends()) + "; or all") in result.output
+    assert "torch, zig" in result.output
