@@ -1,6 +1,6 @@
 """Batches larger than one machine's memory: any generated function over a ``dask.array``.
 
-:func:`dask_map` turns a generated function (``inverse_dynamics`` of a NumPy module, or a JAX
+:func:`dask_map` turns a generated function (the inverse dynamics of a NumPy module, or a JAX
 function, jitted or not) and state arrays of shape ``(N, NQ)`` into a lazy ``dask.array`` of
 its results, evaluated chunk by chunk of states by whatever dask scheduler is active: threads,
 processes, or a ``distributed`` cluster. Needs the ``dask`` extra (``pip install
@@ -29,8 +29,9 @@ def dask_map(function: Callable, *states, chunks: int = 100_000, **parameters):
     ----------
     function : callable
         A generated function taking state arrays of shape ``(N, NQ)`` and returning an array of
-        shape ``(N,) + S`` (``S = (NQ,)`` for vectors, ``(NQ, NQ)`` for matrices), e.g.
-        ``ur5_numpy.inverse_dynamics``, or a JAX one (its results are copied back to NumPy).
+        shape ``(N,) + S`` (``S = (NQ,)`` for vectors, ``(NQ, NQ)`` for matrices), e.g. the
+        NumPy module's inverse dynamics (see :data:`eomgen.outputs.OUTPUTS`), or a JAX one (its
+        results are copied back to NumPy).
     *states : array or dask.array, shape (N, NQ)
         The function's state arguments (q, qd, ...), in JOINT_NAMES order. NumPy arrays are
         split into chunks of ``chunks`` states; dask arrays are rechunked to the first one's

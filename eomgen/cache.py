@@ -58,7 +58,6 @@ import json
 import os
 import re
 import secrets
-import shutil
 import stat
 import sys
 import warnings
@@ -140,15 +139,12 @@ def code_version() -> str:
 
 def toolchain() -> dict[str, str | bool | None]:
     """What outside the inputs changes the files: the C compiler the C backends would use
-    (looked up as :func:`eomgen.codegen.backends.casadi_backend.c_compiler` does), and for the
-    fast backend's compiled extension the Python it is built for (its ``EXT_SUFFIX`` names the
-    ABI) and whether Python's headers are there. (NumPy's C API is backward compatible: an
+    (:func:`eomgen.compiler.c_compiler_path`), and for the fast backend's compiled extension
+    the Python it is built for (its ``EXT_SUFFIX`` names the ABI) and whether Python's headers are there. (NumPy's C API is backward compatible: an
     extension built against NumPy 2 headers targets the oldest supported NumPy by default.)"""
-    compiler = None
-    for candidate in (os.environ.get("CC"), "cc", "gcc", "clang"):
-        if candidate and shutil.which(candidate):
-            compiler = shutil.which(candidate)
-            break
+    from .compiler import c_compiler_path
+
+    compiler = c_compiler_path()
     include = sysconfig.get_paths().get("include")
     return {"cc": compiler, "ext_suffix": sysconfig.get_config_var("EXT_SUFFIX"),
             "python_headers": bool(include) and Path(include, "Python.h").is_file()}

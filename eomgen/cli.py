@@ -243,10 +243,25 @@ def verify(description, samples, seed, tolerance, scene_path, quiet, strict):
     sys.exit(0 if report.passed else 1)
 
 
+class _BackendOption(click.Option):
+    """``--backend``, whose help lists the registered backends (looked up when help is shown,
+    so that ``eomgen`` starts without importing the code generators)."""
+
+    def get_help_record(self, ctx):
+        from .codegen import available_backends
+
+        template = self.help
+        self.help = template.format(backends=", ".join(available_backends()))
+        try:
+            return super().get_help_record(ctx)
+        finally:
+            self.help = template
+
+
 @main.command()
 @description_argument
-@click.option("--backend", "backends", default="all", show_default=True,
-              help="Comma-separated backends among numpy, casadi, c, fast, latex, jax, torch; or all.")
+@click.option("--backend", "backends", default="all", show_default=True, cls=_BackendOption,
+              help="Comma-separated backends among {backends}; or all.")
 @output_folder_option("eomgen_output")
 @click.option("--symbolic", default=None,
               help="Comma-separated parameters to keep symbolic (default: all the description "

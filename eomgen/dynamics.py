@@ -20,6 +20,7 @@ import sympy as sp
 from .bodies import body_tree
 from .errors import TooLargeError
 from .model import Parameter, RobotModel
+from .outputs import derived_symbols
 from .symbolic.composite import derive_program
 from .symbolic.newton_euler import inverse_dynamics_program
 from .symbolic.program import Program, ProgramBuilder
@@ -27,7 +28,7 @@ from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS
 
 #: What :func:`derive` can build: the mass matrix, Coriolis matrix, gravity vector and the
 #: inverse dynamics τ(q, q̇, q̈) (by a symbolic Newton–Euler pass; cheaper to evaluate).
-ALL_OUTPUTS = ("M", "C", "g", "tau")
+ALL_OUTPUTS = derived_symbols()  # ("M", "C", "g", "tau"), from eomgen.outputs
 DEFAULT_OUTPUTS = ("M", "C", "g")
 #: ``derive(model, simplify=True)`` refuses models with more movable joints: trigonometric
 #: simplification of the expanded expressions grows exponentially with the number of joints

@@ -76,6 +76,7 @@ def lambdify(dynamics: Dynamics) -> NumericDynamics:
     from .codegen.backends.common import python_module_context
     from .codegen.backends.numpy_backend import NumPyConfig, NumPyModulePrinter
     from .codegen.functions import FUNCTION_OUTPUTS
+    from .outputs import BY_SYMBOL, FORWARD
     from .codegen.render import render
 
     derived = set(dynamics.outputs)
@@ -86,7 +87,7 @@ def lambdify(dynamics: Dynamics) -> NumericDynamics:
     printer = NumPyModulePrinter({"fully_qualified_modules": True, "standard": "python3",
                                   "order": "none"})
     config = NumPyConfig()
-    extra = ["IllConditionedWarning"] if "forward_dynamics" in functions else []
+    extra = ["IllConditionedWarning"] if FORWARD.function in functions else []
     content = render(config.template, **python_module_context(job, printer, config.template, extra))
     module = types.ModuleType(f"eomgen_lambdified_{job.stem}")
     module.__file__ = f"<eomgen lambdify {job.stem}>"
@@ -99,5 +100,6 @@ def lambdify(dynamics: Dynamics) -> NumericDynamics:
     return NumericDynamics(
         dynamics.joint_names, tuple(p.identifier for p in job.parameters),
         tuple(p.symbol for p in job.parameters),
-        get("mass_matrix"), get("coriolis_matrix"), get("gravity_vector"),
-        get("inverse_dynamics"), get("forward_dynamics"), module, content)
+        get(BY_SYMBOL["M"].function), get(BY_SYMBOL["C"].function),
+        get(BY_SYMBOL["g"].function), get(BY_SYMBOL["tau"].function), get(FORWARD.function),
+        module, content)

@@ -941,7 +941,9 @@ def _massless_notes(model: RobotModel) -> list[str]:
 def derivation_cost(dynamics) -> DerivationCost:
     """The cost of a finished derivation (:class:`eomgen.Dynamics`): seconds and operations per
     output (M, C, g, tau as derived)."""
-    names = [n for n in ("M", "C", "g", "tau") if n in dynamics.outputs]
+    from .outputs import derived_symbols
+
+    names = [n for n in derived_symbols() if n in dynamics.outputs]
     return DerivationCost(sum(t for _, t in dynamics.timings),
                           tuple((n, dynamics.operation_count([n])) for n in names))
 

@@ -30,7 +30,7 @@ Version 1 of the format (every key but ``version`` is optional)::
     gravity: [0, 0, -9.81]        # m/s² in the root link frame; none for no gravity
     parameters: {m_load: 1.5}     # new symbols for payload values (name: default value)
     symbolic: [m_load]            # parameters kept symbolic (default: all; none for none)
-    outputs: [M, C, g]            # M, C, g, tau / inverse_dynamics, forward_dynamics
+    outputs: [M, C, g]            # symbols or function names of eomgen.outputs.OUTPUTS
     contacts:                     # frames held still (see eomgen.contacts, docs/contact.md)
       - frame: FL_FOOT            # a link of the robot
         type: point               # point (3D, default) or surface (6D)
@@ -44,8 +44,9 @@ planned for later versions (:data:`PLANNED_KEYS`) are refused by name until they
 Examples
 --------
 >>> scene = load_scene("s.yaml", text="version: 1\\nlocked: {joint2: 0.5}\\noutputs: [g]")
->>> scene.locked_positions, scene.outputs
-({'joint2': 0.5}, ('gravity_vector',))
+>>> from eomgen.outputs import OUTPUTS
+>>> scene.locked_positions, [OUTPUTS[f].symbol for f in scene.outputs]
+({'joint2': 0.5}, ['g'])
 """
 
 from __future__ import annotations

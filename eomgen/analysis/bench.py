@@ -283,7 +283,7 @@ def prepare_bench(model: RobotModel, samples: int = 50, seed: int = 0, batch_siz
         workdir.cleanup()
         raise
     skipped = []
-    from ..codegen.backends.casadi_backend import c_compiler
+    from ..compiler import c_compiler
 
     if c_compiler() is None:
         skipped.append("C (CasADi): no C compiler found")

@@ -50,11 +50,12 @@ from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.pycode import PythonCodePrinter
 
 from ..codegen import available_backends, make_job
-from ..codegen.backends.casadi_backend import c_compiler
+from ..compiler import c_compiler
 from ..dynamics import Dynamics, derive
 from ..model import RobotModel
 from ..progress import plural
 from ..numeric import mass_matrix_rnea, numeric_model, rnea
+from ..outputs import INVERSE, MASS
 from ..symbolic.program import Program
 
 # ----------------------------------------------------------------------------------------------
@@ -228,7 +229,8 @@ def build_routes(model: RobotModel, workdir: Path, dynamics: Dynamics | None = N
         dynamics = derive(model, outputs=("M", "tau"), simplify=False)
     n = model.dof
     skip = set(skip)
-    job = make_job(dynamics, ("mass_matrix", "inverse_dynamics"))
+    tau_name, M_name = INVERSE.function, MASS.function
+    job = make_job(dynamics, (INVERSE.symbol, MASS.symbol))
     registry = available_backends()
     chosen = ["numpy", "casadi"] + (["c", "fast"] if c_compiler() else [])
     files = []
@@ -247,13 +249,16 @@ def build_routes(model: RobotModel, workdir: Path, dynamics: Dynamics | None = N
         paths[f.name] = path
     routes: list[Route] = []
 
-    numpy_module = _import(paths[job.stem + "_numpy.py"], f"_eomgen_bench_{job.stem}_numpy")
+    def suffix(backend: str) -> str:
+        return registry[backend].config().suffix
+
+    numpy_module = _import(paths[job.stem + suffix("numpy")], f"_eomgen_bench_{job.stem}_numpy")
     routes.append(Route("NumPy, one state", "float64", False,
-                        _per_state(numpy_module.inverse_dynamics, (n,)),
-                        _per_state(numpy_module.mass_matrix, (n, n)),
+                        _per_state(getattr(numpy_module, tau_name), (n,)),
+                        _per_state(getattr(numpy_module, M_name), (n, n)),
                         "generated <robot>_numpy.py, called per state"))
     routes.append(Route("NumPy, batch", "float64", True,
-                        numpy_module.inverse_dynamics, numpy_module.mass_matrix,
+                        getattr(numpy_module, tau_name), getattr(numpy_module, M_name),
                         "generated <robot>_numpy.py on the (N, n) batch"))
 
     d = dynamics
@@ -275,34 +280,37 @@ def build_routes(model: RobotModel, workdir: Path, dynamics: Dynamics | None = N
         _per_state(lambda q: np.reshape(M_scalar(*q.tolist())[0], (n, n)), (n, n)),
         "the program printed over Python floats (math)"))
 
-    casadi_module = _import(paths[job.stem + "_casadi.py"], f"_eomgen_bench_{job.stem}_casadi")
-    routes += _casadi_routes("CasADi SX", casadi_module.inverse_dynamics,
-                             casadi_module.mass_matrix, n, "casadi.Function (SX virtual machine)")
-    library = paths.get(job.stem + "_casadi.so")
+    casadi_stem = job.stem + suffix("casadi").removesuffix(".py")
+    casadi_module = _import(paths[casadi_stem + ".py"], f"_eomgen_bench_{job.stem}_casadi")
+    routes += _casadi_routes("CasADi SX", getattr(casadi_module, tau_name),
+                             getattr(casadi_module, M_name), n,
+                             "casadi.Function (SX virtual machine)")
+    library = paths.get(casadi_stem + ".so")
     if library is not None:
         import casadi as ca
 
-        routes += _casadi_routes("C (CasADi)", ca.external("inverse_dynamics", str(library)),
-                                 ca.external("mass_matrix", str(library)), n,
+        routes += _casadi_routes("C (CasADi)", ca.external(tau_name, str(library)),
+                                 ca.external(M_name, str(library)), n,
                                  "compiled <robot>_casadi.so via casadi.external")
         shared = ctypes.CDLL(str(library))
-        tau_c = CFunction(shared, "inverse_dynamics")
-        M_c = CFunction(shared, "mass_matrix")
+        tau_c = CFunction(shared, tau_name)
+        M_c = CFunction(shared, M_name)
         routes.append(Route("C (ctypes), one state", "float64", False,
                             _per_state(tau_c, (n,)),
                             _per_state(lambda q: M_c(q).reshape(n, n), (n, n)),
                             "compiled <robot>_casadi.so called through ctypes"))
 
-    fast = [p for name, p in paths.items() if name.startswith(job.stem + "_fast.")
+    fast_stem = job.stem + suffix("fast")
+    fast = [p for name, p in paths.items() if name.startswith(fast_stem + ".")
             and not name.endswith(".c")]
     if fast:
-        fast_module = _import(fast[0], job.stem + "_fast")
+        fast_module = _import(fast[0], fast_stem)
         routes.append(Route("C extension (fast), one state", "float64", False,
-                            _per_state(fast_module.inverse_dynamics, (n,)),
-                            _per_state(fast_module.mass_matrix, (n, n)),
+                            _per_state(getattr(fast_module, tau_name), (n,)),
+                            _per_state(getattr(fast_module, M_name), (n, n)),
                             "generated <robot>_fast module (--backend fast), called per state"))
         routes.append(Route("C extension (fast), batch", "float64", True,
-                            fast_module.inverse_dynamics, fast_module.mass_matrix,
+                            getattr(fast_module, tau_name), getattr(fast_module, M_name),
                             "generated <robot>_fast module on the (N, n) batch (loop in C)"))
 
     nm = numeric_model(model)

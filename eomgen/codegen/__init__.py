@@ -1,9 +1,9 @@
 """Code generation: derived dynamics → printed functions → files, one backend per target.
 
 A backend is three small things (a printer, a config, a template folder under ``templates/``)
-registered with :func:`register`; :func:`eomgen.codegen.generate.generate` runs the chosen
-backends on one :class:`Job` and writes their files atomically. Adding a backend touches no
-other module but ``backends/__init__.py``'s import list.
+registered with :func:`register` in its own module under ``backends/`` (found by name, see
+:mod:`.backends`); :func:`eomgen.codegen.generate.generate` runs the chosen backends on one
+:class:`Job` and writes their files atomically. Adding a backend touches no other module.
 """
 
 from __future__ import annotations
@@ -71,33 +71,48 @@ def make_job(dynamics: Dynamics, functions=None, notes=(), count_operations: boo
 
 @dataclass(frozen=True)
 class Backend:
-    """A code generation target: ``generate(job) -> files``.
+    """A code generation target: ``generate(job, config) -> files``.
 
     ``needs`` lists derived outputs (``"M"``, ``"C"``, ``"g"``, ``"tau"``) the backend needs
     whatever functions are asked (a derivation document needs M, C and g); empty when it prints
-    just the asked functions.
+    just the asked functions. ``config`` is the backend's config dataclass (its defaults are used
+    when a caller passes none; ``config().suffix`` names its main file); ``order`` places it in
+    :func:`available_backends` (and so in ``--backend all``). ``reserved`` are names its modules
+    bind themselves (``np``); no parameter of any backend's module takes them.
     """
 
     name: str
     description: str
-    generate: Callable[[Job], list[GeneratedFile]]
+    generate: Callable[..., list[GeneratedFile]]
     needs: tuple[str, ...] = ()
+    config: type | None = None
+    order: int = 1000
+    reserved: tuple[str, ...] = ()
 
 
 BACKENDS: dict[str, Backend] = {}
 
 
-def register(name: str, description: str, needs: tuple[str, ...] = ()):
-    """Decorator registering ``generate(job) -> list[GeneratedFile]`` as backend ``name``."""
+def register(name: str, description: str, needs: tuple[str, ...] = (), config: type | None = None,
+             order: int = 1000, reserved: tuple[str, ...] = ()):
+    """Decorator registering ``generate(job, config=...) -> list[GeneratedFile]`` as backend
+    ``name``, with its config dataclass ``config`` and the identifiers its modules bind
+    (``reserved``). Backends are listed by ``order``, then name."""
 
-    def decorate(function: Callable[[Job], list[GeneratedFile]]):
-        BACKENDS[name] = Backend(name, description, function, tuple(needs))
+    def decorate(function: Callable[..., list[GeneratedFile]]):
+        BACKENDS[name] = Backend(name, description, function, tuple(needs), config, order,
+                                 tuple(reserved))
+        ordered = sorted(BACKENDS.items(), key=lambda item: (item[1].order, item[0]))
+        BACKENDS.clear()
+        BACKENDS.update(ordered)
         return function
 
     return decorate
 
 
 def available_backends() -> dict[str, Backend]:
+    """Every registered backend, by ``order`` then name (importing :mod:`.backends` finds and
+    registers the built-in ones)."""
     from . import backends  # noqa: F401  (registration)
 
     return dict(BACKENDS)

@@ -2,19 +2,10 @@
 
 A :class:`FunctionSpec` names a function, its inputs (joint vectors and the parameters kept
 symbolic) and its single output, with the straight-line program that computes it. Every
-backend prints the same specs, so every backend exports the same functions:
-
-==================  ===================  ============================================
-function            output               inputs
-==================  ===================  ============================================
-mass_matrix         M (n×n)              q
-coriolis_matrix     C (n×n)              q, qd
-gravity_vector      g (n,)               q
-inverse_dynamics    tau (n,)             q, qd, qdd
-==================  ===================  ============================================
-
-``forward_dynamics(q, qd, tau)`` is composed by each backend from ``mass_matrix`` and
-``inverse_dynamics`` (a Cholesky solve of M q̈ = τ − (C q̇ + g)).
+backend prints the same specs, so every backend exports the same functions: those declared in
+:data:`eomgen.outputs.OUTPUTS` (names, inputs, shapes, units, docstring lines). The composed
+forward-dynamics function has no spec: each backend builds it from the mass-matrix and
+inverse-dynamics functions.
 
 A module may export a subset of these functions (:func:`select_functions`, e.g. from a scene's
 ``outputs``); only the outputs they need are derived (:func:`derived_outputs`).
@@ -31,6 +22,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..dynamics import Dynamics
+from ..outputs import BY_SYMBOL, OUTPUTS
 from ..symbolic.program import Program
 
 
@@ -66,26 +58,39 @@ class FunctionSpec:
     units: str
 
 
-#: Identifiers every generated module uses itself; parameters and intermediates avoid them.
+#: Identifiers every generated module uses itself, whatever its backend; parameters avoid them,
+#: and the names each backend's modules import (``register(..., reserved=("np",))``), see
+#: :func:`reserved_identifiers`.
 RESERVED_IDENTIFIERS = frozenset(
-    {"np", "ca", "casadi", "math", "jnp", "jax", "torch", "q", "qd", "qdd", "tau", "out",
-     "single", "batch", "n",
-     "JOINT_NAMES", "NQ", "PARAMETERS", "mass_matrix", "coriolis_matrix", "gravity_vector",
-     "inverse_dynamics", "forward_dynamics", "self", "cls", "M", "C", "g", "L", "x", "y", "d",
+    {"math", "q", "qd", "qdd", "tau", "out", "single", "batch", "n",
+     "JOINT_NAMES", "NQ", "PARAMETERS", *OUTPUTS, *BY_SYMBOL,
+     "self", "cls", "L", "x", "y", "d",
      "rhs", "bias", "args", "names", "vectors", "functions", "parameters", "q_columns",
      "qd_columns", "qdd_columns", "k", "finite", "condition", "return_condition",
      "close", "eigenvalues", "IllConditionedWarning"}
 ) | frozenset(keyword.kwlist) | frozenset(keyword.softkwlist) | frozenset(dir(builtins))
 
+
+def reserved_identifiers() -> frozenset[str]:
+    """:data:`RESERVED_IDENTIFIERS` and the names every registered backend reserves: the same
+    parameter names in every backend's module."""
+    from . import available_backends
+
+    return RESERVED_IDENTIFIERS.union(*(b.reserved for b in available_backends().values()))
+
+
 _IDENTIFIER = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 
 
-def safe_identifier(name: str, taken: set[str]) -> str:
-    """A valid, unused Python/C identifier derived from ``name`` (ASCII letters, digits, _)."""
+def safe_identifier(name: str, taken: set[str], reserved: frozenset[str] | None = None) -> str:
+    """A valid, unused Python/C identifier derived from ``name`` (ASCII letters, digits, _),
+    none of ``reserved`` (default: :func:`reserved_identifiers`)."""
+    if reserved is None:
+        reserved = reserved_identifiers()
     candidate = re.sub(r"[^A-Za-z0-9_]", "_", name.encode("ascii", "replace").decode("ascii"))
     if not candidate or not _IDENTIFIER.match(candidate) or candidate.startswith("_"):
         candidate = "p" + candidate if candidate.startswith("_") else "p_" + candidate
-    while candidate in taken or candidate in RESERVED_IDENTIFIERS:
+    while candidate in taken or candidate in reserved:
         candidate += "_"
     taken.add(candidate)
     return candidate
@@ -101,24 +106,14 @@ def module_name(robot_name: str) -> str:
 def parameter_arguments(dynamics: Dynamics) -> tuple[ParameterArgument, ...]:
     """Keyword arguments for the parameters the model keeps symbolic, sorted by name."""
     taken: set[str] = set()
+    reserved = reserved_identifiers()
     out = []
     for p in sorted(dynamics.parameters, key=lambda p: p.name):
         doc = p.description or "model parameter"
-        out.append(ParameterArgument(safe_identifier(p.name, taken), p.symbol, p.value, doc))
+        out.append(ParameterArgument(safe_identifier(p.name, taken, reserved), p.symbol, p.value,
+                                     doc))
     return tuple(out)
 
-
-_SPECS = (
-    ("mass_matrix", "M", "Mass matrix M(q), symmetric positive definite.", ("q",), False,
-     "kg m^2 (revolute rows/columns), kg (prismatic)"),
-    ("coriolis_matrix", "C", "Coriolis matrix C(q, qd) from the Christoffel symbols of the first "
-     "kind, so that Mdot - 2 C is skew-symmetric.", ("q", "qd"), False, "kg m^2/s (revolute)"),
-    ("gravity_vector", "g", "Gravity vector g(q) = dP/dq.", ("q",), True,
-     "N m (revolute), N (prismatic)"),
-    ("inverse_dynamics", "tau", "Joint efforts tau = M(q) qdd + C(q, qd) qd + g(q) "
-     "(recursive Newton-Euler, straight-line).", ("q", "qd", "qdd"), True,
-     "N m (revolute), N (prismatic)"),
-)
 
 _ARG_DOCS = {
     "q": "joint positions [rad or m]",
@@ -128,25 +123,16 @@ _ARG_DOCS = {
 
 
 #: Every function a generated module can export, in module order, with the derived outputs
-#: (see :data:`eomgen.dynamics.ALL_OUTPUTS`) it needs.
-FUNCTION_OUTPUTS: dict[str, tuple[str, ...]] = {
-    "mass_matrix": ("M",),
-    "coriolis_matrix": ("C",),
-    "gravity_vector": ("g",),
-    "inverse_dynamics": ("tau",),
-    "forward_dynamics": ("M", "tau"),
-}
+#: (see :data:`eomgen.dynamics.ALL_OUTPUTS`) it needs. Read from :data:`eomgen.outputs.OUTPUTS`.
+FUNCTION_OUTPUTS: dict[str, tuple[str, ...]] = {f: o.needs for f, o in OUTPUTS.items()}
 FUNCTION_NAMES: tuple[str, ...] = tuple(FUNCTION_OUTPUTS)
 
 #: Functions a function is composed from, and so generated with it.
 FUNCTION_REQUIRES: dict[str, tuple[str, ...]] = {
-    "forward_dynamics": ("mass_matrix", "inverse_dynamics"),
-}
+    f: o.composed_from for f, o in OUTPUTS.items() if o.composed}
 
 #: Short names accepted for functions: the symbol of what they return.
-FUNCTION_ALIASES: dict[str, str] = {
-    "M": "mass_matrix", "C": "coriolis_matrix", "g": "gravity_vector", "tau": "inverse_dynamics",
-}
+FUNCTION_ALIASES: dict[str, str] = {s: o.function for s, o in BY_SYMBOL.items()}
 
 
 def select_functions(names=None) -> tuple[str, ...]:
@@ -155,9 +141,10 @@ def select_functions(names=None) -> tuple[str, ...]:
     Parameters
     ----------
     names:
-        Function names (``mass_matrix`` …) or their short names (``M``, ``C``, ``g``, ``tau``);
-        ``None`` for all of :data:`FUNCTION_NAMES`. A function composed from others brings them
-        along (``forward_dynamics`` needs ``mass_matrix`` and ``inverse_dynamics``).
+        Function names (:data:`eomgen.outputs.OUTPUTS`) or their short names, the symbols of
+        what they return (``M``, ``C``, ``g``, ``tau``); ``None`` for all of
+        :data:`FUNCTION_NAMES`. A function composed from others brings them along (forward
+        dynamics needs the mass-matrix and inverse-dynamics functions).
 
     Raises
     ------
@@ -166,8 +153,9 @@ def select_functions(names=None) -> tuple[str, ...]:
 
     Examples
     --------
-    >>> select_functions(["g", "forward_dynamics"])
-    ('mass_matrix', 'gravity_vector', 'inverse_dynamics', 'forward_dynamics')
+    >>> from eomgen.outputs import FORWARD
+    >>> [OUTPUTS[f].symbol for f in select_functions(["g", FORWARD.function])]
+    ['M', 'g', 'tau', None]
     """
     if names is None:
         return FUNCTION_NAMES
@@ -190,7 +178,7 @@ def derived_outputs(functions=None) -> tuple[str, ...]:
     """The outputs :func:`eomgen.derive` must build for ``functions`` (default: all), in
     ``ALL_OUTPUTS`` order.
 
-    >>> derived_outputs(["gravity_vector"])
+    >>> derived_outputs(["g"])
     ('g',)
     """
     from ..dynamics import ALL_OUTPUTS
@@ -203,15 +191,18 @@ def function_specs(dynamics: Dynamics, functions=None,
                    count_operations: bool = True) -> tuple[FunctionSpec, ...]:
     """The specs of the printed functions among ``functions`` (default: all; see
     :func:`select_functions`), from dynamics derived with the outputs they need.
-    ``forward_dynamics`` has no spec: backends compose it. Without ``count_operations`` the
+    A composed function (forward dynamics) has no spec: backends compose it. Without ``count_operations`` the
     specs' ``operation_count`` is 0 (counting costs as much as printing; files need it for their
     header, in-memory modules do not)."""
     vectors = {"q": dynamics.q, "qd": dynamics.qd, "qdd": dynamics.qdd}
     chosen = select_functions(functions)
     specs = []
-    for name, output, summary, args, is_vector, units in _SPECS:
-        if name not in chosen:
+    for name in chosen:
+        declared = OUTPUTS[name]
+        if declared.composed:
             continue
+        output, summary, args = declared.symbol, declared.summary, declared.inputs
+        is_vector, units = declared.is_vector, declared.units
         if output not in dynamics.outputs:
             raise ValueError(f"code generation needs '{output}' among the derived outputs")
         program = dynamics.program.pruned([output])

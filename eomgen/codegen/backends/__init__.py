@@ -1,14 +1,15 @@
-"""The code generation backends; importing this package registers them all."""
+"""The code generation backends, found rather than listed: importing this package imports every
+module of it whose name ends in ``_backend``, and each registers itself with
+:func:`eomgen.codegen.register` where it is defined (printer, config dataclass, template folder
+under ``templates/``). Adding a backend is adding such a module; nothing here changes.
+"""
 
+import pkgutil
 from importlib import import_module
 
-#: Modules that register a backend when imported.
-BACKEND_MODULES = ("numpy_backend", "casadi_backend", "fast_backend", "latex_backend",
-                   "jax_backend", "torch_backend")
+#: Modules that registered a backend when this package was imported, sorted by name.
+BACKEND_MODULES = tuple(sorted(info.name for info in pkgutil.iter_modules(__path__)
+                               if info.name.endswith("_backend")))
 
 for _name in BACKEND_MODULES:
-    try:
-        import_module(f"{__name__}.{_name}")
-    except ModuleNotFoundError as exc:  # a backend still being written
-        if exc.name != f"{__name__}.{_name}":
-            raise
+    import_module(f"{__name__}.{_name}")

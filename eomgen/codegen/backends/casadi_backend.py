@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import os
 import re
-import shutil
 import subprocess
 import tempfile
 import warnings
@@ -20,6 +19,7 @@ from pathlib import Path
 import sympy as sp
 from sympy.printing.pycode import PythonCodePrinter
 
+from ...compiler import c_compiler
 from .. import GeneratedFile, Job, register
 from ..functions import FUNCTION_NAMES as ALL_FUNCTIONS
 from ..render import render
@@ -69,7 +69,8 @@ def _render_module(job: Job, config: CasADiConfig) -> str:
                   **python_module_context(job, printer, config.template))
 
 
-@register("casadi", "CasADi module: casadi.Function objects (SX) with named inputs and outputs")
+@register("casadi", "CasADi module: casadi.Function objects (SX) with named inputs and outputs",
+          config=CasADiConfig, order=20, reserved=("ca", "casadi"))
 def generate_casadi(job: Job, config: CasADiConfig = CasADiConfig()) -> list[GeneratedFile]:
     return [GeneratedFile(job.stem + config.suffix, _render_module(job, config))]
 
@@ -88,14 +89,6 @@ class NoCompilerWarning(UserWarning):
     """The C backend found no C compiler: it wrote the C source and header, not the ``.so``."""
 
 
-def c_compiler() -> str | None:
-    """The C compiler to use: $CC, else cc or gcc on PATH, else None."""
-    for candidate in (os.environ.get("CC"), "cc", "gcc", "clang"):
-        if candidate and shutil.which(candidate):
-            return candidate
-    return None
-
-
 #: What the C files say, below their header, about the parameter inputs.
 _C_PARAMETER_NOTE = [
     "Inputs: the vectors (q, qd, qdd or tau), then the parameters kept symbolic, sorted by name.",
@@ -104,7 +97,8 @@ _C_PARAMETER_NOTE = [
 ]
 
 
-@register("c", "C source through CasADi's code generator, and a shared library when a C compiler is found")
+@register("c", "C source through CasADi's code generator, and a shared library when a C compiler is found",
+          config=CasADiConfig, order=30)
 def generate_c(job: Job, config: CasADiConfig = CasADiConfig()) -> list[GeneratedFile]:
     import casadi as ca
 

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from .. import Job
+from ...outputs import FORWARD, composition_names
 from ..functions import FunctionSpec
 
 
@@ -112,8 +113,8 @@ def docstring_literal(text: str) -> str:
 def dunder_all_lines(names, width: int = 79) -> list[str]:
     """The lines of ``__all__ = [...]`` listing ``names``, filled up to ``width`` characters.
 
-    >>> dunder_all_lines(["NQ", "mass_matrix"])
-    ['__all__ = ["NQ", "mass_matrix"]']
+    >>> dunder_all_lines(["NQ", "M"])
+    ['__all__ = ["NQ", "M"]']
     """
     prefix = "__all__ = ["
     items = [f'"{name}"' for name in names]
@@ -147,5 +148,6 @@ def python_module_context(job: Job, printer, template: str, extra_exports=()) ->
         dunder_all=dunder_all_lines(["JOINT_NAMES", "NQ", "PARAMETERS", *job.functions,
                                      *extra_exports]),
         exports=list(job.functions),
-        forward_dynamics="forward_dynamics" in job.functions,
+        forward_dynamics=FORWARD.function in job.functions,
+        fd=composition_names(FORWARD),
     )

@@ -3,9 +3,8 @@ Python's headers are found, the compiled module ``<robot>_fast<EXT_SUFFIX>`` (e.
 ``ur5_fast.cpython-311-x86_64-linux-gnu.so``) that ``import ur5_fast`` loads.
 
 The module exports the same names as the NumPy module (``JOINT_NAMES``, ``NQ``, ``PARAMETERS``,
-``mass_matrix``, ``coriolis_matrix``, ``gravity_vector``, ``inverse_dynamics``,
-``forward_dynamics``, ``IllConditionedWarning``), each function taking one state ``(NQ,)`` or a
-batch ``(N, NQ)`` and looping over the batch in C. It is the route for one state at a time
+the functions of :data:`eomgen.outputs.OUTPUTS`, ``IllConditionedWarning``), each function
+taking one state ``(NQ,)`` or a batch ``(N, NQ)`` and looping over the batch in C. It is the route for one state at a time
 from Python: a call costs the C arithmetic plus a few hundred nanoseconds of argument parsing
 and one NumPy array allocation (no CasADi call layer, no ctypes).
 
@@ -26,9 +25,10 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.precedence import PRECEDENCE
 
+from ...compiler import c_compiler
 from .. import GeneratedFile, Job, register
+from ...outputs import FORWARD, composition_names
 from ..render import render
-from .casadi_backend import c_compiler
 
 
 #: parenthesize(x, _BARE) leaves only atoms (symbols, numbers) without parentheses
@@ -124,8 +124,8 @@ def _render_source(job: Job, config: FastConfig) -> str:
             f"shape {shape} or (N,) + that, in {f['units']}. {f['operation_count']} arithmetic "
             "operations per state.")
     forward_doc = c_string_literal(
-        f"forward_dynamics(q, qd, tau, *{signature}, return_condition=False)\n--\n\n"
-        "Joint accelerations qdd solving M(q) qdd = tau - (C(q, qd) qd + g(q)) by Cholesky.\n\n"
+        f"{FORWARD.function}({', '.join(FORWARD.inputs)}, *{signature}, "
+        f"return_condition=False)\n--\n\n{FORWARD.summary}\n\n"
         "Warns IllConditionedWarning when (max L_ii / min L_ii)^2, a lower bound of cond(M), "
         "exceeds 1e-6 / eps; return_condition=True also returns that estimate. Raises "
         "numpy.linalg.LinAlgError when M is not positive definite and FloatingPointError when "
@@ -148,9 +148,10 @@ def _render_source(job: Job, config: FastConfig) -> str:
         parameters=parameters,
         functions=functions,
         exports=list(job.functions) + (["IllConditionedWarning"]
-                                       if "forward_dynamics" in job.functions else []),
+                                       if FORWARD.function in job.functions else []),
         forward_doc=forward_doc,
-        forward_dynamics="forward_dynamics" in job.functions,
+        forward_dynamics=FORWARD.function in job.functions,
+        fd=composition_names(FORWARD),
     )
 
 
@@ -189,7 +190,7 @@ def compile_module(source: str, module: str, config: FastConfig = FastConfig()
 
 
 @register("fast", "C extension module for Python (one state or a batch looped in C), "
-          "compiled when a C compiler is found")
+          "compiled when a C compiler is found", config=FastConfig, order=40)
 def generate_fast(job: Job, config: FastConfig = FastConfig()) -> list[GeneratedFile]:
     module = job.stem + config.suffix
     source = _render_source(job, config)

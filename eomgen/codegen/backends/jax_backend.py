@@ -42,7 +42,8 @@ class JaxConfig:
     suffix: str = "_jax.py"
 
 
-@register("jax", "JAX module: pure functions for jax.jit, jax.vmap and jax.grad (needs jax)")
+@register("jax", "JAX module: pure functions for jax.jit, jax.vmap and jax.grad (needs jax)",
+          config=JaxConfig, order=60, reserved=("jnp", "jax"))
 def generate_jax(job: Job, config: JaxConfig = JaxConfig()) -> list[GeneratedFile]:
     printer = JaxModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
     text = render(config.template, **python_module_context(job, printer, config.template))

@@ -370,10 +370,10 @@ def _textbook_sections(job: Job, book: TextbookDerivation, p: Printing) -> dict:
     return {
         "bodies": bodies,
         "energies": p.chunks([p.equation("K", book.K), p.equation("P", book.P)]),
-        "mass_matrix": p.chunks(M),
+        "M_blocks": p.chunks(M),
         "christoffel": p.chunks(christoffel),
         "coriolis": p.chunks(C),
-        "gravity_vector": p.chunks(g),
+        "g_blocks": p.chunks(g),
         "equations": p.chunks(equations),
     }
 
@@ -481,6 +481,6 @@ def render_document(job: Job, config: LatexConfig = LatexConfig()) -> str:
 
 @register("latex", "LaTeX document of the derivation: textbook steps for small models, the "
                    "program of named subexpressions for large ones (pdflatex)",
-          needs=("M", "C", "g"))
+          needs=("M", "C", "g"), config=LatexConfig, order=50)
 def generate_latex(job: Job, config: LatexConfig = LatexConfig()) -> list[GeneratedFile]:
     return [GeneratedFile(job.stem + config.suffix, render_document(job, config))]

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from sympy.printing.numpy import NumPyPrinter
 
 from .. import GeneratedFile, Job, register
+from ...outputs import FORWARD
 from ..render import render
 from .common import python_module_context
 
@@ -37,9 +38,10 @@ class NumPyConfig:
     suffix: str = "_numpy.py"
 
 
-@register("numpy", "NumPy module: single states (n,) and batches (N, n), NumPy only")
+@register("numpy", "NumPy module: single states (n,) and batches (N, n), NumPy only",
+          config=NumPyConfig, order=10, reserved=("np",))
 def generate_numpy(job: Job, config: NumPyConfig = NumPyConfig()) -> list[GeneratedFile]:
     printer = NumPyModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
-    extra = ["IllConditionedWarning"] if "forward_dynamics" in job.functions else []
+    extra = ["IllConditionedWarning"] if FORWARD.function in job.functions else []
     text = render(config.template, **python_module_context(job, printer, config.template, extra))
     return [GeneratedFile(job.stem + config.suffix, text)]

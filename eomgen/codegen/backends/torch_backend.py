@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .. import GeneratedFile, Job, register
+from ...outputs import FORWARD
 from ..render import render
 from .common import python_module_context
 from .jax_backend import ArrayModulePrinter
@@ -33,9 +34,10 @@ class TorchConfig:
 
 
 @register("torch", "PyTorch module: tensors (n,) or (N, n), any device and dtype, autograd "
-                   "(needs torch)")
+                   "(needs torch)", config=TorchConfig, order=70,
+          reserved=("torch",))
 def generate_torch(job: Job, config: TorchConfig = TorchConfig()) -> list[GeneratedFile]:
     printer = TorchModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
-    extra = ["IllConditionedWarning"] if "forward_dynamics" in job.functions else []
+    extra = ["IllConditionedWarning"] if FORWARD.function in job.functions else []
     text = render(config.template, **python_module_context(job, printer, config.template, extra))
     return [GeneratedFile(job.stem + config.suffix, text)]
