@@ -161,6 +161,13 @@ class GenerationError(EomgenError):
     for ``--symbolic``, a parameter fixed without a value)."""
 
 
+class IdentificationError(EomgenError):
+    """Measurements that cannot be used (``eomgen identify``): a CSV file with a missing,
+    unknown or repeated column, a field that is not a finite number, too few samples for the
+    base parameters, or a trajectory that does not excite them. The message names the file,
+    line and column."""
+
+
 class VerificationError(EomgenError):
     """Raised by :func:`eomgen.verify.verify` callers that ask for failures to raise."""
 

@@ -602,7 +602,7 @@ def identify(reg: Regressor, base, q, qd, qdd, tau, values: Mapping | None = Non
     columns = list(base.base)
     if arrays[0].size < len(columns):
         raise ValueError(f"{arrays[0].size} equations for {len(columns)} base parameters")
-    from .identification import normalised_condition, observation_matrix
+    from .identification.estimation import normalised_condition, observation_matrix
 
     W = observation_matrix(reg, columns, *arrays[:3], values=values)
     y = arrays[3].reshape(-1)

@@ -16,7 +16,7 @@ import click
 
 from ..output import GeneratedFile, check_output_file, check_output_folder, write_atomically
 from ..progress import Progress, plural
-from . import IdentificationError
+from ..errors import IdentificationError
 
 
 def _stem(model) -> str:
@@ -81,7 +81,7 @@ def add_commands(main: click.Group, handle_errors, strict_option, quiet_option, 
         """
         if importlib.util.find_spec("scipy") is None:
             raise IdentificationError("eomgen excite needs scipy: pip install 'eomgen[identify]'")
-        from . import excitation_trajectory, measurements_csv, simulate_measurements
+        from .estimation import excitation_trajectory, measurements_csv, simulate_measurements
 
         if not duration > 0 or duration == float("inf"):
             raise IdentificationError(f"--duration must be a positive number of seconds, got "
@@ -144,7 +144,7 @@ def add_commands(main: click.Group, handle_errors, strict_option, quiet_option, 
           eomgen identify eomgen/robots/puma560_dh.yaml puma.csv -o puma_id --physical
         """
         from ..errors import ParameterError
-        from . import (observation_matrix, physical_fit, read_measurements,
+        from .estimation import (observation_matrix, physical_fit, read_measurements,
                        weighted_least_squares)
         from .report import IdentificationReport
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..output import GeneratedFile
-from . import Estimate, Measurements, PhysicalFit
+from .estimation import Estimate, Measurements, PhysicalFit
 
 #: rcParams applied on top of matplotlib's defaults while drawing and saving (as
 #: eomgen.teach.sketch does), so the PNG does not depend on the user's configuration.

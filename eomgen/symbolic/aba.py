@@ -360,7 +360,7 @@ def cholesky_program(model: RobotModel) -> ForwardDynamics:
     (``L_jj = √(M_jj − Σ_k L_jk²)``, ``L_ij = (M_ij − Σ_k L_ik L_jk) / L_jj``) and two triangular
     solves, unrolled: Featherstone's CRBA-plus-Cholesky route, whose factorisation is O(n³).
     A generated module's ``forward_dynamics`` does the same arithmetic with its own
-    ``mass_matrix`` (the root-frame composite program) and a numeric Cholesky factorisation.
+    M (the root-frame composite program) and a numeric Cholesky factorisation.
     """
     from ..dynamics import joint_symbols
     from .crba import mass_matrix_program
