@@ -458,3 +458,100 @@ def test_numbers_lead_their_groups():
     assert rd.by_trig(8.08 * sp.cos(q1) - 0.85 * sp.sin(q1), [q1]) == [
         8.08 * sp.cos(q1), -0.85 * sp.sin(q1)]
     assert _quadratic_terms(sp.Matrix([[0.5]]), [qd1], []) == [0.25 * qd1 ** 2]
+
+
+# -- drives: flexible joints (Spong), armature and friction ---------------------------------
+
+def _drive_residuals(model, textbook: bool = True):
+    """The handout's drive equations as residuals (``terms − lhs``, every name replaced by its
+    value), beside eomgen.actuators' own, for the same derivation; ``textbook=False``: as
+    written for large models (``C_{i,j}`` in place of the Christoffel factors)."""
+    from eomgen.actuators import spong_dynamics
+    from eomgen.teach.content import (abbreviation_values, drive_equations, has_drives,
+                                      spring_values)
+    assert has_drives(model)
+    dyn = eomgen.derive(model, outputs=("M", "C", "g"), simplify=False)
+    book = textbook_derivation(model) if textbook else None
+    coriolis = named_coriolis(dyn, book) if textbook else None
+    spong = spong_dynamics(dyn)
+    links, motors = drive_equations(spong, book, coriolis)
+    values = abbreviation_values(dyn, coriolis) | spring_values(spong)
+
+    def residuals(equations):
+        return sp.Matrix([sp.Add(*terms).subs(values) - lhs.subs(values)
+                          for lhs, terms in equations])
+    return spong, residuals(links), residuals(motors)
+
+
+def _exactly_equal(a: sp.Matrix, b: sp.Matrix) -> bool:
+    return a.shape == b.shape and (a - b).applyfunc(sp.simplify) == sp.zeros(*a.shape)
+
+
+def test_flexible_arm_handout_prints_spongs_two_equations(tmp_path):
+    model = eomgen.load(Path("examples/robots/flexible_2link.yaml"))
+    spong, links, motors = _drive_residuals(model)
+    assert _exactly_equal(links, spong.link_equations())
+    assert _exactly_equal(motors, spong.motor_equations())
+    out = tmp_path / "out"
+    result = CliRunner().invoke(main, ["teach", "examples/robots/flexible_2link.yaml",
+                                       "--format", "md", "--no-check", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    md = (out / "flexible_2link_handout.md").read_text()
+    section = md[md.index("## Flexible joints"):]
+    assert "its own spin" in section  # the reduced model's assumption is stated
+    assert r"M(q)\, \ddot{q} + C(q, \dot{q})\, \dot{q} + g(q) &= K (\theta - q)," in section
+    assert r"B\, \ddot{\theta} + K (\theta - q) &= \tau_{m}," in section
+    # the printed rows of what was checked above, in the description's own symbols
+    assert (r"\textrm{K1} \left(\theta_{1} - q_{1}\right) &= M_{1,1} \ddot{q}_{1} + M_{1,2} "
+            r"\ddot{q}_{2} - h \dot{q}_{2} \left(2 \dot{q}_{1} + \dot{q}_{2}\right) + g_{1}"
+            in section)
+    assert (r"\textrm{K2} \left(\theta_{2} - q_{2}\right) &= M_{1,2} \ddot{q}_{1} + M_{2,2} "
+            r"\ddot{q}_{2} + h \dot{q}_{1}^{2} + g_{2}" in section)
+    assert r"\tau_{m,1} &= B_{1} \ddot{\theta}_{1} + \textrm{K1} \left(\theta_{1} - q_{1}\right)" \
+        in section
+    assert r"\tau_{m,2} &= B_{2} \ddot{\theta}_{2} + \textrm{K2} \left(\theta_{2} - q_{2}\right)" \
+        in section
+
+
+def _with_actuators(model, *actuators):
+    from dataclasses import replace
+    movable = iter(actuators)
+    joints = tuple(replace(j, actuator=next(movable)) if j.type.is_movable else j
+                   for j in model.joints)
+    return replace(model, joints=joints)
+
+
+@pytest.mark.parametrize("textbook", [True, False], ids=["textbook", "large-model form"])
+def test_mixed_rigid_and_flexible_joints_with_friction(arm, textbook):
+    from eomgen.model import Actuator
+    model = _with_actuators(arm, Actuator(armature=0.5, damping=0.1, friction=0.2),
+                            Actuator(armature=0.3, stiffness=100, damping=0.05, friction=0.1))
+    spong, links, motors = _drive_residuals(model, textbook)
+    assert spong.flexible == (1,)
+    assert _exactly_equal(links, spong.link_equations())
+    assert _exactly_equal(motors, spong.motor_equations())
+    if not textbook:
+        return
+    md = {f.name: f.content for f in FORMATS["md"](build_handout(model, check=False))}
+    section = md["planar_2link_handout.md"].split("## Flexible joints")[1]
+    assert r"\tau_{1} &= " in section and r"\tau_{m,2} &= " in section
+    assert r"\operatorname{sign}" in section
+
+
+def test_rigid_joints_with_armature_and_friction(arm):
+    from eomgen.actuators import rigid_with_actuators
+    from eomgen.model import Actuator
+    model = _with_actuators(arm, Actuator(armature=0.5, damping=0.1),
+                            Actuator(armature=0.25, friction=0.2))
+    spong, links, motors = _drive_residuals(model)
+    assert motors.rows == 0
+    rigid = rigid_with_actuators(spong.dynamics)
+    assert _exactly_equal(links, rigid.tau() - sp.Matrix(spong.tau))
+    handout = build_handout(model, check=False)
+    assert [s.title for s in handout.sections][-2] == "Drives: armature and friction"
+    md = {f.name: f.content for f in FORMATS["md"](handout)}["planar_2link_handout.md"]
+    assert r"\bigl(M(q) + \operatorname{diag}(a)\bigr)" in md
+
+
+def test_no_drive_section_without_actuators(arm_handout):
+    assert not any("Drives" in s.title or "Flexible" in s.title for s in arm_handout.sections)
