@@ -555,3 +555,60 @@ def test_rigid_joints_with_armature_and_friction(arm):
 
 def test_no_drive_section_without_actuators(arm_handout):
     assert not any("Drives" in s.title or "Flexible" in s.title for s in arm_handout.sections)
+
+
+# -- contacts: the 2-link arm on a wall -----------------------------------------------------
+
+WALL_SCENE = (Path(__file__).resolve().parents[1] / "examples" / "contacts"
+              / "planar_2link_wall.yaml")
+
+
+def test_wall_contact_equations_are_the_closed_form_and_newton_euler(arm):
+    """J_c of the tip equals ∂p/∂q of the tip position written by hand, J̇_c q̇ its time
+    derivative, and the printed torque rows (names replaced by values) equal eomgen.contacts'
+    numeric inverse dynamics (Newton–Euler) at a moving state."""
+    import numpy as np
+    from eomgen.contacts import ContactDynamics
+    from eomgen.reduction import apply_scene
+    from eomgen.scene import load_scene
+    from eomgen.teach.content import abbreviation_values, contact_equations
+
+    reduction = apply_scene(arm, load_scene(WALL_SCENE))
+    model, contacts = reduction.model, reduction.report.contacts
+    dyn = eomgen.derive(model, outputs=("M", "C", "g"), simplify=False)
+    book = textbook_derivation(model)
+    coriolis = named_coriolis(dyn, book)
+    Jc, dJqd, F, rows = contact_equations(dyn, contacts, book, coriolis)
+    s = {p.name: p.symbol for p in model.parameters}
+    q, qd = sp.Matrix(dyn.q), sp.Matrix(dyn.qd)
+    tip = sp.Matrix([s["l1"] * sp.cos(q[0]) + s["l2"] * sp.cos(q[0] + q[1]),
+                     s["l1"] * sp.sin(q[0]) + s["l2"] * sp.sin(q[0] + q[1]), 0])
+    J = tip.jacobian(q)
+    assert _exactly_equal(Jc, J)
+    assert _exactly_equal(dJqd, (J * qd).jacobian(q) * qd)
+    state = {**dict(zip(dyn.q, (0.4, 0.9))), **dict(zip(dyn.qd, (0.3, -0.7))),
+             **dict(zip(dyn.qdd, (1.1, 0.5)))}
+    force = (-3.0, 1.5, 0.0)
+    values = abbreviation_values(dyn, coriolis)
+    numbers = {**model.parameter_values, **state, **dict(zip(F, force))}
+    printed = [float(sp.Add(*terms).subs(values).subs(numbers)) for _, terms in rows]
+    cd = ContactDynamics(model, contacts)
+    expected = cd.inverse_dynamics([state[v] for v in dyn.q], [state[v] for v in dyn.qd],
+                                   [state[v] for v in dyn.qdd], np.array(force))
+    assert np.allclose(printed, expected, rtol=1e-12, atol=1e-12)
+
+
+def test_wall_scene_handout_has_a_contact_section(tmp_path):
+    out = tmp_path / "out"
+    result = CliRunner().invoke(main, ["teach", "--scene", str(WALL_SCENE), "--format", "md",
+                                       "--no-check", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    md = (out / "planar_2link_handout.md").read_text()
+    section = md[md.index("## Contact"):md.index("## Verified properties")]
+    assert r"&= \tau + J_{c}^{T} F_{c}," in section
+    assert r"J_{c}(q)\, \ddot{q} + \dot{J}_{c}\, \dot{q} &= 0." in section
+    assert (r"J_{c} &= \begin{pmatrix} - (l_{1} s_{1} + l_{2} s_{12}) & - l_{2} s_{12} \\ "
+            r"l_{1} c_{1} + l_{2} c_{12} & l_{2} c_{12} \\ 0 & 0 \end{pmatrix}" in section)
+    assert (r"\tau_{2} &= M_{1,2} \ddot{q}_{1} + M_{2,2} \ddot{q}_{2} + h \dot{q}_{1}^{2} + g_{2} "
+            r"+ f_{x} l_{2} s_{12} - f_{y} l_{2} c_{12}" in section)
+    assert "Row 3 of $J_{c}$ is zero" in section
