@@ -11,7 +11,11 @@ Control*, the planar two-link arm):
    symbols and C (common factors named, e.g. ``h = m_2 l_1 l_{c2} s_2``), the gravity vector
    (grouped by the trigonometric functions), the complete equations of motion;
    for larger models, the straight-line program of named subexpressions instead, saying so;
-4. the verified properties, with the numbers of :func:`eomgen.verify`.
+4. when the joints have drives (:mod:`eomgen.actuators`): Spong's link and motor equations
+   for flexible joints, or ``M + diag(a)`` and the friction torque for rigid ones, joint by
+   joint (:func:`drive_equations`); when the scene has contacts: ``M q̈ + C q̇ + g = τ +
+   J_cᵀ F_c``, ``J_c q̈ + J̇_c q̇ = 0`` and ``J_c`` written out (:func:`contact_equations`);
+5. the verified properties, with the numbers of :func:`eomgen.verify`.
 
 Every expression is printed by eomgen's LaTeX printer
 (:class:`~eomgen.codegen.backends.latex_printer.DerivationLatexPrinter`); user text (names,
@@ -818,7 +822,7 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
     ``progress`` receives one line per stage (deriving, checking…); ``check=False`` leaves out
     the numeric verification (the section then says so); ``scene`` is the
     :class:`~eomgen.reduction.ReductionReport` when ``model`` comes from a scene (a paragraph
-    says what was locked).
+    says what was locked, and its contacts get a section).
 
     >>> import eomgen
     >>> handout = build_handout(eomgen.load(eomgen.example_path("planar_2link")), check=False)
