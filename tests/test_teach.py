@@ -458,3 +458,157 @@ def test_numbers_lead_their_groups():
     assert rd.by_trig(8.08 * sp.cos(q1) - 0.85 * sp.sin(q1), [q1]) == [
         8.08 * sp.cos(q1), -0.85 * sp.sin(q1)]
     assert _quadratic_terms(sp.Matrix([[0.5]]), [qd1], []) == [0.25 * qd1 ** 2]
+
+
+# -- drives: flexible joints (Spong), armature and friction ---------------------------------
+
+def _drive_residuals(model, textbook: bool = True):
+    """The handout's drive equations as residuals (``terms − lhs``, every name replaced by its
+    value), beside eomgen.actuators' own, for the same derivation; ``textbook=False``: as
+    written for large models (``C_{i,j}`` in place of the Christoffel factors)."""
+    from eomgen.actuators import spong_dynamics
+    from eomgen.teach.content import (abbreviation_values, drive_equations, has_drives,
+                                      spring_values)
+    assert has_drives(model)
+    dyn = eomgen.derive(model, outputs=("M", "C", "g"), simplify=False)
+    book = textbook_derivation(model) if textbook else None
+    coriolis = named_coriolis(dyn, book) if textbook else None
+    spong = spong_dynamics(dyn)
+    links, motors = drive_equations(spong, book, coriolis)
+    values = abbreviation_values(dyn, coriolis) | spring_values(spong)
+
+    def residuals(equations):
+        return sp.Matrix([sp.Add(*terms).subs(values) - lhs.subs(values)
+                          for lhs, terms in equations])
+    return spong, residuals(links), residuals(motors)
+
+
+def _exactly_equal(a: sp.Matrix, b: sp.Matrix) -> bool:
+    return a.shape == b.shape and (a - b).applyfunc(sp.simplify) == sp.zeros(*a.shape)
+
+
+def test_flexible_arm_handout_prints_spongs_two_equations(tmp_path):
+    model = eomgen.load(Path("examples/robots/flexible_2link.yaml"))
+    spong, links, motors = _drive_residuals(model)
+    assert _exactly_equal(links, spong.link_equations())
+    assert _exactly_equal(motors, spong.motor_equations())
+    out = tmp_path / "out"
+    result = CliRunner().invoke(main, ["teach", "examples/robots/flexible_2link.yaml",
+                                       "--format", "md", "--no-check", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    md = (out / "flexible_2link_handout.md").read_text()
+    section = md[md.index("## Flexible joints"):]
+    assert "its own spin" in section  # the reduced model's assumption is stated
+    assert r"M(q)\, \ddot{q} + C(q, \dot{q})\, \dot{q} + g(q) &= K (\theta - q)," in section
+    assert r"B\, \ddot{\theta} + K (\theta - q) &= \tau_{m}," in section
+    # the printed rows of what was checked above, in the description's own symbols
+    assert (r"\textrm{K1} \left(\theta_{1} - q_{1}\right) &= M_{1,1} \ddot{q}_{1} + M_{1,2} "
+            r"\ddot{q}_{2} - h \dot{q}_{2} \left(2 \dot{q}_{1} + \dot{q}_{2}\right) + g_{1}"
+            in section)
+    assert (r"\textrm{K2} \left(\theta_{2} - q_{2}\right) &= M_{1,2} \ddot{q}_{1} + M_{2,2} "
+            r"\ddot{q}_{2} + h \dot{q}_{1}^{2} + g_{2}" in section)
+    assert r"\tau_{m,1} &= B_{1} \ddot{\theta}_{1} + \textrm{K1} \left(\theta_{1} - q_{1}\right)" \
+        in section
+    assert r"\tau_{m,2} &= B_{2} \ddot{\theta}_{2} + \textrm{K2} \left(\theta_{2} - q_{2}\right)" \
+        in section
+
+
+def _with_actuators(model, *actuators):
+    from dataclasses import replace
+    movable = iter(actuators)
+    joints = tuple(replace(j, actuator=next(movable)) if j.type.is_movable else j
+                   for j in model.joints)
+    return replace(model, joints=joints)
+
+
+@pytest.mark.parametrize("textbook", [True, False], ids=["textbook", "large-model form"])
+def test_mixed_rigid_and_flexible_joints_with_friction(arm, textbook):
+    from eomgen.model import Actuator
+    model = _with_actuators(arm, Actuator(armature=0.5, damping=0.1, friction=0.2),
+                            Actuator(armature=0.3, stiffness=100, damping=0.05, friction=0.1))
+    spong, links, motors = _drive_residuals(model, textbook)
+    assert spong.flexible == (1,)
+    assert _exactly_equal(links, spong.link_equations())
+    assert _exactly_equal(motors, spong.motor_equations())
+    if not textbook:
+        return
+    md = {f.name: f.content for f in FORMATS["md"](build_handout(model, check=False))}
+    section = md["planar_2link_handout.md"].split("## Flexible joints")[1]
+    assert r"\tau_{1} &= " in section and r"\tau_{m,2} &= " in section
+    assert r"\operatorname{sign}" in section
+
+
+def test_rigid_joints_with_armature_and_friction(arm):
+    from eomgen.actuators import rigid_with_actuators
+    from eomgen.model import Actuator
+    model = _with_actuators(arm, Actuator(armature=0.5, damping=0.1),
+                            Actuator(armature=0.25, friction=0.2))
+    spong, links, motors = _drive_residuals(model)
+    assert motors.rows == 0
+    rigid = rigid_with_actuators(spong.dynamics)
+    assert _exactly_equal(links, rigid.tau() - sp.Matrix(spong.tau))
+    handout = build_handout(model, check=False)
+    assert [s.title for s in handout.sections][-2] == "Drives: armature and friction"
+    md = {f.name: f.content for f in FORMATS["md"](handout)}["planar_2link_handout.md"]
+    assert r"\bigl(M(q) + \operatorname{diag}(a)\bigr)" in md
+
+
+def test_no_drive_section_without_actuators(arm_handout):
+    assert not any("Drives" in s.title or "Flexible" in s.title for s in arm_handout.sections)
+
+
+# -- contacts: the 2-link arm on a wall -----------------------------------------------------
+
+WALL_SCENE = (Path(__file__).resolve().parents[1] / "examples" / "contacts"
+              / "planar_2link_wall.yaml")
+
+
+def test_wall_contact_equations_are_the_closed_form_and_newton_euler(arm):
+    """J_c of the tip equals ∂p/∂q of the tip position written by hand, J̇_c q̇ its time
+    derivative, and the printed torque rows (names replaced by values) equal eomgen.contacts'
+    numeric inverse dynamics (Newton–Euler) at a moving state."""
+    import numpy as np
+    from eomgen.contacts import ContactDynamics
+    from eomgen.reduction import apply_scene
+    from eomgen.scene import load_scene
+    from eomgen.teach.content import abbreviation_values, contact_equations
+
+    reduction = apply_scene(arm, load_scene(WALL_SCENE))
+    model, contacts = reduction.model, reduction.report.contacts
+    dyn = eomgen.derive(model, outputs=("M", "C", "g"), simplify=False)
+    book = textbook_derivation(model)
+    coriolis = named_coriolis(dyn, book)
+    Jc, dJqd, F, rows = contact_equations(dyn, contacts, book, coriolis)
+    s = {p.name: p.symbol for p in model.parameters}
+    q, qd = sp.Matrix(dyn.q), sp.Matrix(dyn.qd)
+    tip = sp.Matrix([s["l1"] * sp.cos(q[0]) + s["l2"] * sp.cos(q[0] + q[1]),
+                     s["l1"] * sp.sin(q[0]) + s["l2"] * sp.sin(q[0] + q[1]), 0])
+    J = tip.jacobian(q)
+    assert _exactly_equal(Jc, J)
+    assert _exactly_equal(dJqd, (J * qd).jacobian(q) * qd)
+    state = {**dict(zip(dyn.q, (0.4, 0.9))), **dict(zip(dyn.qd, (0.3, -0.7))),
+             **dict(zip(dyn.qdd, (1.1, 0.5)))}
+    force = (-3.0, 1.5, 0.0)
+    values = abbreviation_values(dyn, coriolis)
+    numbers = {**model.parameter_values, **state, **dict(zip(F, force))}
+    printed = [float(sp.Add(*terms).subs(values).subs(numbers)) for _, terms in rows]
+    cd = ContactDynamics(model, contacts)
+    expected = cd.inverse_dynamics([state[v] for v in dyn.q], [state[v] for v in dyn.qd],
+                                   [state[v] for v in dyn.qdd], np.array(force))
+    assert np.allclose(printed, expected, rtol=1e-12, atol=1e-12)
+
+
+def test_wall_scene_handout_has_a_contact_section(tmp_path):
+    out = tmp_path / "out"
+    result = CliRunner().invoke(main, ["teach", "--scene", str(WALL_SCENE), "--format", "md",
+                                       "--no-check", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    md = (out / "planar_2link_handout.md").read_text()
+    section = md[md.index("## Contact"):md.index("## Verified properties")]
+    assert r"&= \tau + J_{c}^{T} F_{c}," in section
+    assert r"J_{c}(q)\, \ddot{q} + \dot{J}_{c}\, \dot{q} &= 0." in section
+    assert (r"J_{c} &= \begin{pmatrix} - (l_{1} s_{1} + l_{2} s_{12}) & - l_{2} s_{12} \\ "
+            r"l_{1} c_{1} + l_{2} c_{12} & l_{2} c_{12} \\ 0 & 0 \end{pmatrix}" in section)
+    assert (r"\tau_{2} &= M_{1,2} \ddot{q}_{1} + M_{2,2} \ddot{q}_{2} + h \dot{q}_{1}^{2} + g_{2} "
+            r"+ f_{x} l_{2} s_{12} - f_{y} l_{2} c_{12}" in section)
+    assert "Row 3 of $J_{c}$ is zero" in section
