@@ -24,10 +24,13 @@ DISPLAY_MAX_DOF = 3
 
 
 def _number(value) -> str:
+    """A number as the shortest decimal that reads back as the same double (``0.3``, ``1``),
+    scientific as ``1.5e-05``; a symbolic parameter by its name."""
     try:
-        return f"{float(value):.6g}"
+        value = float(value)
     except TypeError:  # a symbolic parameter
         return str(value)
+    return str(int(value)) if value.is_integer() and abs(value) < 2 ** 53 else repr(value)
 
 
 def model_html(model: RobotModel) -> str:
