@@ -581,3 +581,14 @@ def test_float_one_coefficients_are_not_printed():
     assert p.doprint(1.0 * sp.cos(q1 - q2)) == r"\cos{\left(q_{1} - q_{2} \right)}"
     assert p.doprint(-1.0 * sp.sin(q1) * a) == r"- a s_{1}"
     assert p.doprint(2.5 * a) == "2.5 a"
+
+
+def test_rounded_digits_remain_an_option():
+    """``LatexConfig(float_digits=6)``: the shorter, lossy page of earlier versions, and the
+    document says which rule it used."""
+    job = make_job(dynamics("puma560_dh"))
+    rounded = render_document(job, LatexConfig(float_digits=6))
+    full = render_document(job)
+    assert "numbers are shown with 6 significant digits" in rounded
+    assert "shortest decimals that read back as the same doubles" in full
+    assert "1.03119 R_{2,00}" in rounded and "1.03118515 R_{2,00}" in full
