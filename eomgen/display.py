@@ -24,10 +24,13 @@ DISPLAY_MAX_DOF = 3
 
 
 def _number(value) -> str:
+    """A number as the shortest decimal that reads back as the same double (``0.3``, ``1``),
+    scientific as ``1.5e-05``; a symbolic parameter by its name."""
     try:
-        return f"{float(value):.6g}"
+        value = float(value)
     except TypeError:  # a symbolic parameter
         return str(value)
+    return str(int(value)) if value.is_integer() and abs(value) < 2 ** 53 else repr(value)
 
 
 def model_html(model: RobotModel) -> str:
@@ -72,7 +75,6 @@ def readable_matrices(dynamics: Dynamics) -> dict | None:
     :func:`eomgen.codegen.backends.latex_backend.textbook_for`, checked on the program's size
     before anything is expanded) and ``derive(..., simplify=True)`` did not force it."""
     from .codegen.backends.latex_backend import textbook_for
-    from .teach import readability as rd
 
     if dynamics.simplified:  # derive(..., simplify=True) asked for it whatever the size
         book = dynamics.textbook
@@ -80,8 +82,17 @@ def readable_matrices(dynamics: Dynamics) -> dict | None:
         book = textbook_for(dynamics)
         if book is None:
             return None
+    return grouped_matrices(book)
+
+
+def grouped_matrices(book) -> dict:
+    """M, C and g of a :class:`~eomgen.symbolic.textbook.TextbookDerivation` as every document
+    prints them: entries of M grouped by body mass, those of g by trigonometric factor (sums
+    built unevaluated, so their order is kept; print them with :func:`expression_latex`)."""
+    from .teach import readability as rd
+
     masses = [b.mass for b in book.bodies if isinstance(b.mass, sp.Symbol)]
-    angles = list(dynamics.q)
+    angles = list(book.q)
     return {"M": book.M.applyfunc(lambda e: rd.mass_grouped(e, masses)),
             "C": book.C,
             "g": book.g.applyfunc(lambda e: rd.trig_grouped(e, angles))}
@@ -142,11 +153,17 @@ def _unevaluated(e) -> bool:
 
 
 def expression_latex(dynamics: Dynamics, expr) -> str:
-    """LaTeX of one expression or matrix in the notation of :func:`dynamics_latex`.
+    """LaTeX of one expression or matrix in the notation of :func:`dynamics_latex`; grouped
+    sums (:func:`grouped_matrices`) keep their order, as in :func:`dynamics_latex`.
 
     >>> import eomgen
     >>> dyn = eomgen.derive(eomgen.load(eomgen.example_path("planar_2link")))
     >>> expression_latex(dyn, dyn.g[1])
     'g l_{c2} m_{2} c_{12}'
     """
-    return _printer(dynamics).doprint(expr)
+    printer = _printer(dynamics)
+    if isinstance(expr, sp.MatrixBase):
+        return _matrix_latex(printer, expr)
+    if isinstance(expr, sp.Add) and _unevaluated(expr):
+        return printer.print_sum_lines(list(expr.args), 10 ** 9)[0]
+    return printer.doprint(expr)

@@ -142,10 +142,14 @@ show("P", book.P)
 
 $M = \\sum_i m_i J_{v_i}^T J_{v_i} + J_{\\omega_i}^T R_i I_{c_i} R_i^T J_{\\omega_i}$, so that
 $K = \\tfrac12 \\dot q^T M \\dot q$: the same matrix as `dyn.M`, which `eomgen.derive`
-computes without expanding the intermediate expressions.
+computes without expanding the intermediate expressions. Each entry is grouped by body mass,
+as the LaTeX document and the handout print it.
 """)
         code("""
-show("M", book.M)
+from eomgen.display import grouped_matrices
+
+grouped = grouped_matrices(book)
+show("M", grouped["M"])
 """)
         md("""
 ## Christoffel symbols
@@ -162,8 +166,9 @@ for (i, j, k), value in book.christoffel:
         md("## Coriolis matrix\n\n$C_{ij} = \\sum_k \\Gamma_{ijk} \\dot q_k$: with this choice "
            "$\\dot M - 2C$ is skew-symmetric.")
         code('show("C", book.C)')
-        md("## Gravity vector\n\n$g_i = \\partial P / \\partial q_i$.")
-        code('show("g", book.g)')
+        md("## Gravity vector\n\n$g_i = \\partial P / \\partial q_i$, grouped by trigonometric "
+           "factor.")
+        code('show("g", grouped["g"])')
     else:
         md(f"""
 ## Derivation

@@ -35,7 +35,7 @@ from eomgen.codegen.backends.latex_backend import (
 )
 from eomgen.codegen.backends.latex_printer import (
     TEXT_ESCAPES, DerivationLatexPrinter, display_width, latex_comment, latex_escape,
-    symbol_latex,
+    symbol_latex, written_number,
 )
 from eomgen.dynamics import Dynamics, joint_symbols
 from eomgen.model import (
@@ -45,7 +45,7 @@ from eomgen.model import (
 from eomgen.robots import example_path
 from eomgen.symbolic.evaluate import compile_program
 from eomgen.symbolic.textbook import (
-    TEXTBOOK_MAX_DOF, christoffel_symbols, fourier_form, textbook_derivation,
+    TEXTBOOK_MAX_DOF, christoffel_symbols, description_floats, fourier_form, textbook_derivation,
 )
 from conftest import erd_robots_dir
 from reference import random_robot
@@ -225,9 +225,73 @@ def test_joint_symbols_parameters_and_numbers():
     p = printer(2)
     assert p.doprint(qd[0] * qdd[1]) == r"\dot{q}_{1} \ddot{q}_{2}"
     assert p.doprint(parameter_symbol("lc1") * parameter_symbol("m1")) == "l_{c1} m_{1}"
-    assert p.doprint(sp.Float(2.517506271375) * q[0]) == "2.51751 q_{1}"
+    assert p.doprint(sp.Float(2.517506271375) * q[0]) == "2.517506271375 q_{1}"
+    assert printer(2, float_digits=6).doprint(sp.Float(2.517506271375)) == "2.51751"
     assert p.doprint(sp.Float(3.2e-5)) == r"3.2 \cdot 10^{-5}"
     assert p.doprint(sp.pi / 2) == r"\frac{\pi}{2}"
+
+
+def read_latex_number(tex: str) -> float:
+    """The float a printed number denotes (``-1.5 \\cdot 10^{-5}``, ``10^{6}``, ``0.3``), parsed
+    independently of the printer."""
+    match = re.fullmatch(r"(-?)(?:([0-9.]+)(?: \\cdot )?)?(?:10\^\{(-?[0-9]+)\})?", tex)
+    assert match and (match[2] or match[3]), tex
+    return float(f"{match[1]}{match[2] or '1'}e{match[3] or 0}")
+
+
+@pytest.mark.parametrize("value", [
+    1 / 3, 0.1 + 0.2, 2 / 3 * 1e-9, -7 / 3 * 1e22, 0.3, 123456.78901234567, 1e-4, 5e-324,
+    1.7976931348623157e308, -0.0078125, 6.02214076e23, 100.0, 0.0,
+])
+def test_floats_print_the_shortest_decimal_that_reads_back(value):
+    """Every float prints as the shortest decimal that reads back as the same double: the
+    digits of repr (Python's shortest round-trip algorithm), no rounding noise, no 17th digit
+    that repr would not need."""
+    tex = printer(1).doprint(sp.Float(value))
+    assert read_latex_number(tex) == value
+    digits = re.sub(r"\\cdot 10\^\{-?[0-9]+\}|10\^\{-?[0-9]+\}|[^0-9]", "", tex).strip("0")
+    assert len(digits) == len(repr(abs(value)).split("e")[0].replace(".", "").strip("0"))
+
+
+def test_numbers_as_a_description_wrote_them():
+    q = joint_symbols(1)[0][0]
+    p = printer(1)
+    assert p.doprint(sp.Float(0.3)) == "0.3"
+    assert p.doprint(sp.Float(1 / 3)) == "0.3333333333333333"
+    assert p.doprint(sp.Float(0.1) + sp.Float(0.2)) == "0.30000000000000004"  # another double
+    assert p.doprint(sp.Float(1.0) * q) == "q_{1}" and p.doprint(sp.Float(-1.0) * q) == "- q_{1}"
+    assert p.doprint(sp.Rational(1, 3) * q) == r"\frac{q_{1}}{3}"
+    assert p.doprint(sp.Rational(1, 3)) == r"\frac{1}{3}"
+    assert p.doprint(sp.Float(2.0) * q) == "2 q_{1}"
+    # with the description's floats known, computed ones lose their rounding noise only
+    written = printer(1, written_floats=frozenset({0.1, 0.2, 1 / 3}))
+    assert written.doprint(sp.Float(0.1 + 0.2)) == "0.3"
+    assert written.doprint(sp.Float(1 / 3)) == "0.3333333333333333"
+    assert written.doprint(sp.Float(0.1 * 0.2)) == "0.02"
+    assert written_number(1 / 12) == sp.Rational(1, 12)
+    assert written_number(0.4318) == sp.Float(0.4318) and written_number(3.0) == 3
+
+
+def _long_numbers(tex: str) -> set[float]:
+    """The numbers of ``tex`` printed with 16 or 17 significant digits."""
+    found = set()
+    for match in re.finditer(r"(?<![0-9_{])([0-9]+\.[0-9]+)(?: \\cdot 10\^\{(-?[0-9]+)\})?", tex):
+        if len(match[1].replace(".", "").strip("0")) >= 16:
+            found.add(float(f"{match[1]}e{match[2] or 0}"))
+    return found
+
+
+@pytest.mark.parametrize("name", ["elbow_rrr", "puma560_dh", "puma_arm"])
+def test_documents_show_no_rounding_noise(name):
+    """The elbow arm (textbook), the PUMA 560 (program) and its arm with the wrist locked
+    (textbook over floats): no number with 16-17 digits except the description's own, and
+    the elbow arm's lengths print as written."""
+    dyn = _puma_arm() if name == "puma_arm" else dynamics(name)
+    text = render_document(make_job(dyn))
+    assert "0000000" not in text and "9999999" not in text
+    assert _long_numbers(text) <= description_floats(dyn.model)
+    if name == "elbow_rrr":
+        assert "$a_{3}$ & $0.3$" in text and "$I_{1}$ & $0.01$" in text
 
 
 @pytest.mark.parametrize("name, tex", [
@@ -517,3 +581,14 @@ def test_float_one_coefficients_are_not_printed():
     assert p.doprint(1.0 * sp.cos(q1 - q2)) == r"\cos{\left(q_{1} - q_{2} \right)}"
     assert p.doprint(-1.0 * sp.sin(q1) * a) == r"- a s_{1}"
     assert p.doprint(2.5 * a) == "2.5 a"
+
+
+def test_rounded_digits_remain_an_option():
+    """``LatexConfig(float_digits=6)``: the shorter, lossy page of earlier versions, and the
+    document says which rule it used."""
+    job = make_job(dynamics("puma560_dh"))
+    rounded = render_document(job, LatexConfig(float_digits=6))
+    full = render_document(job)
+    assert "numbers are shown with 6 significant digits" in rounded
+    assert "shortest decimals that read back as the same doubles" in full
+    assert "1.03119 R_{2,00}" in rounded and "1.03118515 R_{2,00}" in full

@@ -7,11 +7,13 @@ import dataclasses
 
 import nbformat
 import pytest
+import sympy as sp
 from click.testing import CliRunner
 
 import eomgen
 from eomgen.cli import main
-from eomgen.display import dynamics_latex
+from eomgen.display import dynamics_latex, expression_latex, grouped_matrices
+from eomgen.symbolic.textbook import textbook_derivation
 from eomgen.notebook import build_notebook
 
 
@@ -71,6 +73,16 @@ def test_cli_notebook_runs_without_errors(tmp_path, example):
     outputs = [o for cell in nb.cells if cell.cell_type == "code" for o in cell.outputs]
     assert not [o for o in outputs if o.output_type == "error"]
     assert any("image/png" in o.get("data", {}) for o in outputs)  # the simulation plot
+    if example != "puma560_dh":  # the textbook cells print M grouped by body mass, as the
+        # document and the handout do: the same M, the same LaTeX as the rich display's
+        dyn = eomgen.derive(eomgen.load(eomgen.example_path(example)))
+        book = textbook_derivation(dyn.model)
+        M = grouped_matrices(book)["M"]
+        assert sp.expand(M.doit() - book.M) == sp.zeros(*M.shape)
+        tex = "M = " + expression_latex(dyn, M)
+        assert tex[4:] in dynamics_latex(dyn)
+        latex = [o.data["text/latex"] for o in outputs if "text/latex" in o.get("data", {})]
+        assert any(tex in text for text in latex)
 
 
 def test_cli_notebook_bad_description(tmp_path):

@@ -331,6 +331,7 @@ def textbook_derivation(model: RobotModel, max_dof: int = TEXTBOOK_MAX_DOF) -> T
     scalars += [x for m, c, I_c in inputs for x in [m, *c, *I_c]]
     scalars += [x for body in tree.bodies for x in body.joint.axis] + list(model.gravity)
     A = _TrigAlgebra(scalars, q, qd)
+    A.written = description_floats(model)  # printed with all their digits, never rounded
 
     # The textbook quantities, computed in the polynomial ring.
     gravity = [A(x) for x in model.gravity]
@@ -431,6 +432,7 @@ class _TrigAlgebra:
         position = {symbol: k for k, symbol in enumerate(ring.symbols)}
         self._pair_index = [(position[sp.sin(x)], position[sp.cos(x)]) for x in q]
         self._angles = None  # see absolute_angles
+        self.written: frozenset[float] = frozenset()  # see textbook_derivation
 
     def reduce(self, f):
         """``f`` modulo ``sin² q_k + cos² q_k = 1``: a canonical form of degree at most one in
@@ -539,11 +541,11 @@ class _TrigAlgebra:
 
     def expr(self, f, reference: float = 0.0) -> sp.Expr:
         """``f`` as a SymPy expression in the form of :meth:`readable`: float rounding noise
-        dropped (:func:`drop_float_noise`), floats written with 15 significant digits
-        (:func:`round_floats`: ``0.009``, not ``0.0090000000000000018``), common factors pulled
-        out."""
+        dropped (:func:`drop_float_noise`), computed floats written with 15 significant digits
+        (:func:`round_floats`: ``0.009``, not ``0.0090000000000000018``) while the description's
+        own floats keep all theirs, common factors pulled out."""
         value = self.readable(self._denoise(self.reduce(f), reference)).as_expr()
-        return sp.factor_terms(round_floats(value))
+        return sp.factor_terms(round_floats(value, keep=self.written))
 
     def _denoise(self, f, reference: float = 0.0, rtol: float = FLOAT_NOISE_RTOL):
         """``f`` without the terms whose (float) coefficient is below ``rtol`` times the largest
@@ -561,21 +563,39 @@ class _TrigAlgebra:
         return sp.Matrix([[self.expr(f, reference) for f in row] for row in rows])
 
 
-def round_floats(expr: sp.Expr, digits: int = 15) -> sp.Expr:
+def description_floats(model: RobotModel) -> frozenset[float]:
+    """The floats of ``model``'s description (gravity, inertials, joint axes and origins,
+    actuators, parameter values): documents print these with all their digits, and round only
+    floats computed from them (:func:`round_floats`)."""
+    from ..model import _all_scalars
+
+    found = {float(p.value) for p in model.parameters if p.value is not None}
+    for value in _all_scalars(model):
+        if isinstance(value, sp.Basic):
+            found.update(float(f) for f in value.atoms(sp.Float))
+        elif isinstance(value, float):
+            found.add(value)
+    return frozenset(found)
+
+
+def round_floats(expr: sp.Expr, digits: int = 15, keep=frozenset()) -> sp.Expr:
     """``expr`` with every Float rounded to ``digits`` significant digits (the last bits of a
-    float sum are rounding noise: ``0.0090000000000000018`` is ``0.009``), and a Float that is
-    then a whole number replaced by that Integer (``1.0*x`` is ``x``).
+    float sum are rounding noise: ``0.0090000000000000018`` is ``0.009``) except those whose
+    value is in ``keep`` (the numbers a description wrote, ``1/3`` with all 16 digits), and a
+    Float that is then a whole number replaced by that Integer (``1.0*x`` is ``x``).
 
     >>> x = sp.Symbol("x")
     >>> round_floats(sp.Float("0.0090000000000000018", 20) * x + sp.Float(1.0) * x**2)
     x**2 + 0.009*x
+    >>> round_floats(sp.Float(1 / 3) * x, keep={1 / 3}) == sp.Float(1 / 3) * x
+    True
     """
     floats = expr.atoms(sp.Float)
     if not floats:
         return expr
     rounded = {}
     for x in floats:
-        value = float(f"{float(x):.{digits}g}")
+        value = float(x) if float(x) in keep else float(f"{float(x):.{digits}g}")
         rounded[x] = (sp.Integer(int(value)) if value.is_integer() and abs(value) < 2 ** 53
                       else sp.Float(value))
     return expr.xreplace(rounded)

@@ -30,10 +30,12 @@ import sympy as sp
 from ... import __version__
 from ...dynamics import Dynamics
 from ...model import IDENTITY3, RobotModel
-from ...symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS, TextbookDerivation
+from ...symbolic.textbook import (TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS, TextbookDerivation,
+                                   description_floats)
 from .. import GeneratedFile, Job, register
 from ..render import render
-from .latex_printer import DerivationLatexPrinter, display_width, latex_comment, latex_escape
+from .latex_printer import (DerivationLatexPrinter, display_width, latex_comment, latex_escape,
+                            written_number)
 
 #: Parameter names that would print like the document's own quantities (K_{1}, M_{1,2},
 #: \Gamma_{1,1,2}, s_{12}, …); such parameters print as upright text instead.
@@ -91,7 +93,9 @@ class LatexConfig:
     suffix:
         Appended to the job's stem to name the file.
     float_digits:
-        Significant digits of printed numbers (the generated code keeps all of them).
+        None (default): numbers print as the shortest decimal that reads back as the same
+        double (``0.3``, ``0.3333333333333333``); an integer rounds them to that many
+        significant digits for a shorter, lossy page (the generated code keeps all digits).
     line_width:
         About how many glyphs a display line holds before a sum is broken.
     block_size:
@@ -109,7 +113,7 @@ class LatexConfig:
 
     template: str = "latex/document.tex.jinja"
     suffix: str = ".tex"
-    float_digits: int = 6
+    float_digits: int | None = None
     line_width: int = 80
     block_size: int = 24
     textbook_max_dof: int = TEXTBOOK_MAX_DOF
@@ -200,6 +204,7 @@ def printing(dynamics: Dynamics, config: LatexConfig, compact_trig: bool,
         "symbol_names": {**symbol_names(dynamics), **(extra_names or {})},
         "compact_trig": compact_trig,
         "float_digits": config.float_digits,
+        "written_floats": description_floats(dynamics.model),
         "mat_str": "pmatrix",
         "mat_delim": "",
     })
@@ -300,7 +305,7 @@ def _link_rows(model: RobotModel, p: Printing) -> list[list[str]]:
 
 def _parameter_rows(model: RobotModel, p: Printing) -> list[list[str]]:
     return [["$" + p.tex(par.symbol) + "$",
-             "$" + p.tex(sp.Float(par.value, 15)) + "$" if par.value is not None else "--",
+             "$" + p.tex(written_number(par.value)) + "$" if par.value is not None else "--",
              latex_escape(par.description)]
             for par in sorted(model.parameters, key=lambda par: par.name)]
 

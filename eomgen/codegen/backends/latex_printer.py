@@ -11,12 +11,18 @@ never patched afterwards):
 * other names (parameters, named subexpressions) by :func:`symbol_latex`: letters then digits as
   subscript (``m1`` → ``m_{1}``, ``lc1`` → ``l_{c1}``, ``Gamma1_2_3`` → ``\\Gamma_{1,2,3}``);
   anything else as escaped upright text, so every name prints to a distinct LaTeX string;
-* floats with a fixed number of significant digits (``2.51751``, ``3.2 \\cdot 10^{-5}``).
+* floats as the shortest decimal that reads back as the same double (:func:`float_parts`:
+  ``0.3``, ``0.3333333333333333``, ``3.2 \\cdot 10^{-5}``; Python's ``repr``), or rounded to a
+  number of significant digits when asked (``float_digits``); a factor ±1.0 prints as nothing
+  and a minus sign; SymPy Rationals stay fractions (``\\frac{1}{3}``).
 """
 
 from __future__ import annotations
 
+import math
 import re
+from decimal import Decimal
+from fractions import Fraction
 from typing import Iterable, Sequence
 
 import sympy as sp
@@ -119,6 +125,70 @@ def symbol_latex(name: str) -> str:
     return tex + "'" * len(primes)
 
 
+#: Significant digits of floats computed from the description's (see ``written_floats`` of
+#: :class:`DerivationLatexPrinter`): the last one or two of 17 are rounding noise.
+COMPUTED_DIGITS = 15
+
+#: Floats print positionally when their decimal exponent k (``d.ddd × 10^k``) is in this range,
+#: else in scientific notation: ``0.0001``, ``123456``, ``1.5 \\cdot 10^{-5}``, ``10^{6}``.
+POSITIONAL_EXPONENTS = range(-4, 6)
+
+
+def float_parts(value: float, digits: int | None = None) -> tuple[str, str, int]:
+    """The sign (``""`` or ``"-"``), significant digits (no trailing zeros) and decimal
+    exponent ``k`` of ``value = ±d.ddd × 10^k``: the shortest decimal that reads back as the
+    same double (as :func:`repr`), or ``value`` rounded to ``digits`` significant digits.
+
+    >>> float_parts(0.1 + 0.2), float_parts(0.3), float_parts(-2.5e-7), float_parts(1/3, 6)
+    (('', '30000000000000004', -1), ('', '3', -1), ('-', '25', -7), ('', '333333', -1))
+    """
+    text = repr(float(value)) if digits is None else f"{float(value):.{digits}g}"
+    number = Decimal(text)
+    if number == 0:
+        return "", "0", 0
+    sign, digit_tuple, exponent = number.normalize().as_tuple()
+    significant = "".join(map(str, digit_tuple))
+    return ("-" if sign else ""), significant, exponent + len(significant) - 1
+
+
+def float_text(value: float, digits: int | None = None, times: str = r" \cdot ") -> str:
+    """``value`` as LaTeX: the digits of :func:`float_parts`, positional for decimal exponents
+    in :data:`POSITIONAL_EXPONENTS`, else ``mantissa \\cdot 10^{k}`` (``times`` joins them).
+    Whole numbers print without a decimal point (``2``, not ``2.0``).
+
+    >>> [float_text(x) for x in (0.3, 2.0, 1 / 3, -1.5e-5, 1e6, 6.02214076e23)]
+    ['0.3', '2', '0.3333333333333333', '-1.5 \\\\cdot 10^{-5}', '10^{6}', '6.02214076 \\\\cdot 10^{23}']
+    """
+    sign, significant, k = float_parts(value, digits)
+    if k in POSITIONAL_EXPONENTS:
+        if k < 0:
+            return sign + "0." + "0" * (-k - 1) + significant
+        whole, fraction = significant[:k + 1].ljust(k + 1, "0"), significant[k + 1:]
+        return sign + whole + ("." + fraction if fraction else "")
+    mantissa = significant[0] + ("." + significant[1:] if len(significant) > 1 else "")
+    power = f"10^{{{k}}}"
+    return sign + (power if mantissa == "1" else mantissa + times + power)
+
+
+def written_number(value: float, max_denominator: int = 1000) -> sp.Expr:
+    """A description's number for display: the fraction ``n/d`` (``d`` at most
+    ``max_denominator``) that reads back as the same double when the shortest decimal is long
+    (``1/12`` written in a description is the double 0.08333333333333333: ``\\frac{1}{12}``),
+    else the Float (``0.3``, ``0.4318``).
+
+    >>> written_number(1 / 12), written_number(2.0), written_number(0.3).is_Float
+    (1/12, 2, True)
+    """
+    value = float(value)
+    if value.is_integer() and abs(value) < 2 ** 53:
+        return sp.Integer(int(value))
+    if math.isfinite(value) and len(float_parts(value)[1]) > 6:
+        fraction = Fraction(value).limit_denominator(max_denominator)
+        if fraction.numerator / fraction.denominator == value:
+            return sp.Rational(fraction.numerator, fraction.denominator)
+    return sp.Float(value)
+
+
 def display_width(tex: str) -> int:
     """A rough count of the glyphs ``tex`` prints (commands count one, braces and sub/superscript
     markers none): what line breaking compares with the line width."""
@@ -149,7 +219,12 @@ class DerivationLatexPrinter(LatexPrinter):
     compact_trig:
         ``s_{1}``, ``c_{12}`` for the sines and cosines of joint positions (default True).
     float_digits:
-        Significant digits of printed floats (default 6).
+        None (default): floats print as the shortest decimal that reads back as the same double
+        (:func:`float_text`); an integer rounds them to that many significant digits.
+    written_floats:
+        None (default), or the floats the description wrote: these print in full, and every
+        other float (computed from them, its last bits rounding noise: ``0.26917800000000003``)
+        is rounded to :data:`COMPUTED_DIGITS` significant digits (``0.269178``).
     symbol_names:
         LatexPrinter's own setting: explicit LaTeX for some symbols (joint symbols, names that
         would collide with the document's notation); all others go through :func:`symbol_latex`.
@@ -159,7 +234,8 @@ class DerivationLatexPrinter(LatexPrinter):
         **LatexPrinter._default_settings,
         "joint_positions": (),
         "compact_trig": True,
-        "float_digits": 6,
+        "float_digits": None,
+        "written_floats": None,
     }
 
     def __init__(self, settings=None):
@@ -205,12 +281,14 @@ class DerivationLatexPrinter(LatexPrinter):
         return super()._print_Mul(expr)
 
     def _print_Float(self, expr):
-        text = f"{float(expr):.{self._settings['float_digits']}g}"
-        if "e" not in text:
-            return text
-        mantissa, exponent = text.split("e")
-        power = f"10^{{{int(exponent)}}}"
-        return power if mantissa == "1" else rf"{mantissa} \cdot {power}"
+        if not math.isfinite(float(expr)):
+            return super()._print_Float(expr)
+        value = float(expr)
+        digits = self._settings["float_digits"]
+        written = self._settings["written_floats"]
+        if digits is None and written is not None and value not in written:
+            digits = COMPUTED_DIGITS
+        return float_text(value, digits)
 
     # -- line breaking -------------------------------------------------------------------------
     def print_lines(self, expr, width: int) -> list[str]:
