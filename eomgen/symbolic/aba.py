@@ -38,8 +38,7 @@ import sympy as sp
 from ..bodies import BodyTree, body_tree
 from ..model import RobotModel, Vec3
 from .composite import _cross, _dot, _matvec
-from .newton_euler import (_aligned, _name, _name_all, _rotate_aligned, _rotate_back,
-                           _transpose_apply, grouped_inertials)
+from .newton_euler import _Frames, _name, _name_all, grouped_inertials
 from .program import Program, ProgramBuilder
 
 _ZERO = sp.Integer(0)
@@ -61,60 +60,6 @@ def _skew_times(p, A) -> tuple:
     """[p]× A, column by column."""
     cols = [_cross(p, tuple(A[r][c] for r in range(3))) for c in range(3)]
     return tuple(tuple(cols[c][r] for c in range(3)) for r in range(3))
-
-
-class _Frames:
-    """Rotations between a body frame and its parent's, by the joint's sine and cosine."""
-
-    def __init__(self, tree: BodyTree, q, sincos):
-        self.tree, self.q, self.sincos = tree, q, sincos
-
-    @classmethod
-    def named(cls, tree: BodyTree, q, b: ProgramBuilder) -> "_Frames":
-        """The frames of ``tree`` with each revolute joint's ``s_k``, ``c_k`` named in ``b``."""
-        sincos = []
-        for body in tree.bodies:
-            k = body.q_index
-            if body.joint.type.is_revolute:
-                sincos.append((_name(b, sp.sin(q[k]), f"s{k + 1}"),
-                               _name(b, sp.cos(q[k]), f"c{k + 1}")))
-            else:
-                sincos.append(None)
-        return cls(tree, q, sincos)
-
-    def to_body(self, i, v) -> tuple:
-        """Parent-frame 3-vector → body i frame: Rot(k, q)ᵀ R_placeᵀ v."""
-        body = self.tree.bodies[i]
-        w = _transpose_apply(body.placement.rotation, v)
-        if body.joint.type.is_revolute:
-            s, c = self.sincos[i]
-            aligned = _aligned(body.joint.axis)
-            if aligned is not None:
-                return _rotate_aligned(aligned[0], c, aligned[1] * s, w, transpose=True)
-            return _rotate_back(body.joint.axis, c, s, w)
-        return w
-
-    def to_parent(self, i, v) -> tuple:
-        """Body i frame 3-vector → parent frame: R_place Rot(k, q) v."""
-        body = self.tree.bodies[i]
-        w = v
-        if body.joint.type.is_revolute:
-            s, c = self.sincos[i]
-            aligned = _aligned(body.joint.axis)
-            if aligned is not None:
-                w = _rotate_aligned(aligned[0], c, aligned[1] * s, v, transpose=False)
-            else:
-                w = _rotate_back(body.joint.axis, c, -s, v)
-        return _matvec(body.placement.rotation, w)
-
-    def offset(self, i) -> tuple:
-        """Body i's origin in the parent frame [m] (moved by q for a prismatic joint)."""
-        body = self.tree.bodies[i]
-        r = body.placement.translation
-        if body.joint.type.is_revolute:
-            return r
-        k = _matvec(body.placement.rotation, body.joint.axis)
-        return tuple(r[j] + k[j] * self.q[body.q_index] for j in range(3))
 
 
 def _motion_to_body(frames: _Frames, i, ang, lin) -> tuple:

@@ -174,6 +174,60 @@ def _khalil_U(w, dw, b: ProgramBuilder, tag) -> tuple:
     return tuple(U)
 
 
+class _Frames:
+    """Rotations between a body frame and its parent's, by the joint's sine and cosine."""
+
+    def __init__(self, tree: BodyTree, q, sincos):
+        self.tree, self.q, self.sincos = tree, q, sincos
+
+    @classmethod
+    def named(cls, tree: BodyTree, q, b: ProgramBuilder) -> "_Frames":
+        """The frames of ``tree`` with each revolute joint's ``s_k``, ``c_k`` named in ``b``."""
+        sincos = []
+        for body in tree.bodies:
+            k = body.q_index
+            if body.joint.type.is_revolute:
+                sincos.append((_name(b, sp.sin(q[k]), f"s{k + 1}"),
+                               _name(b, sp.cos(q[k]), f"c{k + 1}")))
+            else:
+                sincos.append(None)
+        return cls(tree, q, sincos)
+
+    def to_body(self, i, v) -> tuple:
+        """Parent-frame 3-vector → body i frame: Rot(k, q)ᵀ R_placeᵀ v."""
+        body = self.tree.bodies[i]
+        w = _transpose_apply(body.placement.rotation, v)
+        if body.joint.type.is_revolute:
+            s, c = self.sincos[i]
+            aligned = _aligned(body.joint.axis)
+            if aligned is not None:
+                return _rotate_aligned(aligned[0], c, aligned[1] * s, w, transpose=True)
+            return _rotate_back(body.joint.axis, c, s, w)
+        return w
+
+    def to_parent(self, i, v) -> tuple:
+        """Body i frame 3-vector → parent frame: R_place Rot(k, q) v."""
+        body = self.tree.bodies[i]
+        w = v
+        if body.joint.type.is_revolute:
+            s, c = self.sincos[i]
+            aligned = _aligned(body.joint.axis)
+            if aligned is not None:
+                w = _rotate_aligned(aligned[0], c, aligned[1] * s, v, transpose=False)
+            else:
+                w = _rotate_back(body.joint.axis, c, -s, v)
+        return _matvec(body.placement.rotation, w)
+
+    def offset(self, i) -> tuple:
+        """Body i's origin in the parent frame [m] (moved by q for a prismatic joint)."""
+        body = self.tree.bodies[i]
+        r = body.placement.translation
+        if body.joint.type.is_revolute:
+            return r
+        k = _matvec(body.placement.rotation, body.joint.axis)
+        return tuple(r[j] + k[j] * self.q[body.q_index] for j in range(3))
+
+
 def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: ProgramBuilder) -> sp.Matrix:
     """Build τ(q, q̇, q̈) into ``b``; returns the n×1 matrix of joint efforts [N m or N]."""
     n = len(tree.bodies)
@@ -182,40 +236,8 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
     zero33 = (zero, zero, zero)
     inertials = grouped_inertials(tree)
 
-    def to_body(i, v):
-        """Parent-frame vector → body i frame: Rot(axis, q)ᵀ R_placeᵀ v (revolute)."""
-        body = tree.bodies[i]
-        w = _transpose_apply(body.placement.rotation, v)
-        if body.joint.type.is_revolute:
-            s, c = sincos[i]
-            aligned = _aligned(body.joint.axis)
-            if aligned is not None:
-                w = _rotate_aligned(aligned[0], c, aligned[1] * s, w, transpose=True)
-            else:
-                w = _rotate_back(body.joint.axis, c, s, w)
-        return w
-
-    def to_parent(i, v):
-        """Body i frame vector → parent frame: R_place Rot(axis, q) v."""
-        body = tree.bodies[i]
-        w = v
-        if body.joint.type.is_revolute:
-            s, c = sincos[i]
-            aligned = _aligned(body.joint.axis)
-            if aligned is not None:
-                w = _rotate_aligned(aligned[0], c, aligned[1] * s, v, transpose=False)
-            else:
-                w = _rotate_back(body.joint.axis, c, -s, v)
-        return _matvec(body.placement.rotation, w)
-
-    def offset(i):
-        """Joint i's frame origin in the parent frame [m] (prismatic: moved by q)."""
-        body = tree.bodies[i]
-        r = body.placement.translation
-        if body.joint.type.is_revolute:
-            return r
-        k = _matvec(body.placement.rotation, body.joint.axis)
-        return tuple(r[j] + k[j] * q[body.q_index] for j in range(3))
+    frames = _Frames(tree, q, sincos)  # sincos is filled body by body below
+    to_body, to_parent, offset = frames.to_body, frames.to_parent, frames.offset
 
     base_acc = tuple(-x for x in gravity)
     for i, body in enumerate(tree.bodies):

@@ -40,7 +40,7 @@ import sympy as sp
 
 from ..bodies import BodyTree
 from .composite import _cross, _dot
-from .newton_euler import _aligned, _rotate_aligned, _rotate_back, _transpose_apply
+from .newton_euler import _Frames
 from .program import ProgramBuilder
 
 #: Column names of one body's block, Pinocchio's order; the joint number (1-based, JOINT_NAMES
@@ -89,17 +89,7 @@ def regressor_program(tree: BodyTree, q, qd, qdd, gravity, b: ProgramBuilder,
     zero3 = (sp.Integer(0),) * 3
     sincos: list = []
 
-    def to_body(i, v):
-        """Parent-frame vector → body i frame."""
-        body = tree.bodies[i]
-        w = _transpose_apply(body.placement.rotation, v)
-        if body.joint.type.is_revolute:
-            s, c = sincos[i]
-            aligned = _aligned(body.joint.axis)
-            if aligned is not None:
-                return _rotate_aligned(aligned[0], c, aligned[1] * s, w, transpose=True)
-            return _rotate_back(body.joint.axis, c, s, w)
-        return w
+    to_body = _Frames(tree, q, sincos).to_body  # sincos is filled body by body below
 
     def offset(i):
         """Body i's origin in its parent's frame (moves with a prismatic joint)."""
