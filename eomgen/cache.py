@@ -87,7 +87,7 @@ COMMAND_IGNORED = frozenset({"description", "outdir", "quiet", "debug", "no_cach
 #: file's bytes and name). A parameter in none of these, given with a value other than None or
 #: False (``--explain``), turns the command-level cache off for that run: it may print more
 #: than the files, which a cached run would not repeat.
-COMMAND_KEYED = frozenset({"backends", "symbolic", "strict", "no_snap"})
+COMMAND_KEYED = frozenset({"backends", "symbolic", "strict", "no_snap", "outputs"})
 
 Notify = Callable[[str], None]
 

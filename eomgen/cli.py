@@ -162,6 +162,18 @@ def output_folder_option(default: str):
                         type=click.Path(path_type=Path), help="Output folder.")
 
 
+def _functions_option(text: str | None) -> tuple[str, ...] | None:
+    """The functions ``--outputs`` names (None when not given), or a one-line error."""
+    if text is None:
+        return None
+    from .outputs import select
+
+    try:
+        return select([n.strip() for n in text.split(",") if n.strip()])
+    except ValueError as exc:
+        raise GenerationError(f"--outputs: {exc}") from None
+
+
 def _load_reduced(description: Path | None, scene_path: Path | None, strict: bool):
     """``(model, report)``: the description reduced by the scene file (report None without
     one). The scene is read first, so that warnings concern only what it keeps."""
@@ -280,10 +292,14 @@ class _BackendOption(click.Option):
 @click.option("--no-snap", is_flag=True,
               help="Keep rotation and axis entries exactly as the description's floats give "
                    "them (default: entries within 1e-11 of 0 or ±1 are made exact).")
+@click.option("--outputs", default=None,
+              help="Comma-separated functions to export, by name or symbol (default: M, C, g, "
+                   "tau and forward dynamics; docs/outputs.md lists the others, e.g. Y). "
+                   "Replaces a scene's outputs.")
 @strict_option
 @_handle_errors
 def generate(description, backends, outdir, symbolic, quiet, scene_path, explain, no_cache,
-             cache_dir, no_snap, strict):
+             cache_dir, no_snap, outputs, strict):
     """Generate code and a derivation for DESCRIPTION (default: the bundled planar 2-link arm).
 
     Writes <robot>_numpy.py (NumPy, single states and batches), <robot>_casadi.py (CasADi
@@ -301,6 +317,7 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
     from .output import check_output_folder
 
     check_output_folder(outdir)
+    functions = _functions_option(outputs)
     progress = _progress(quiet)
     request = None
     if not no_cache:
@@ -318,6 +335,8 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
             from .scene import load_scene
 
             scene = load_scene(scene_path, strict=strict)
+            if functions is not None:
+                scene = dataclasses.replace(scene, outputs=functions)
         model = _load(description, strict, scene, snap=not no_snap)
     cache = dataclasses.replace(request, notices=notices) if request else not no_cache
     names = None
@@ -333,7 +352,7 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
         if explain:
             click.echo(produced.markdown)
     else:
-        paths = run_generate(model, outdir, backends, names, progress, cache=cache,
+        paths = run_generate(model, outdir, backends, names, progress, functions, cache=cache,
                              cache_dir=cache_dir)
         progress.clear()
     for path in paths:

@@ -17,18 +17,17 @@ from typing import Iterable
 
 import sympy as sp
 
-from .bodies import body_tree
+from .bodies import BodyTree, body_tree
 from .errors import TooLargeError
 from .model import Parameter, RobotModel
-from .outputs import derived_symbols
-from .symbolic.composite import derive_program
-from .symbolic.newton_euler import inverse_dynamics_program
+from .outputs import BY_SYMBOL, INPUTS, derived_symbols
 from .symbolic.program import Program, ProgramBuilder
 from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS
 
-#: What :func:`derive` can build: the mass matrix, Coriolis matrix, gravity vector and the
-#: inverse dynamics τ(q, q̇, q̈) (by a symbolic Newton–Euler pass; cheaper to evaluate).
-ALL_OUTPUTS = derived_symbols()  # ("M", "C", "g", "tau"), from eomgen.outputs
+#: What generated modules export by default: the mass matrix, Coriolis matrix, gravity vector
+#: and the inverse dynamics τ(q, q̇, q̈) (by a symbolic Newton–Euler pass; cheaper to evaluate).
+#: :func:`derive` builds these and every further output of :mod:`eomgen.outputs`.
+ALL_OUTPUTS = derived_symbols(default_only=True)  # ("M", "C", "g", "tau")
 DEFAULT_OUTPUTS = ("M", "C", "g")
 #: ``derive(model, simplify=True)`` refuses models with more movable joints: trigonometric
 #: simplification of the expanded expressions grows exponentially with the number of joints
@@ -38,10 +37,44 @@ MAX_SIMPLIFY_JOINTS = 6
 
 def joint_symbols(n: int) -> tuple[tuple[sp.Symbol, ...], tuple[sp.Symbol, ...], tuple[sp.Symbol, ...]]:
     """Symbols ``q1…qn``, ``qd1…qdn``, ``qdd1…qddn`` (real)."""
-    def make(prefix):
-        return tuple(sp.Symbol(f"{prefix}{k + 1}", real=True) for k in range(n))
+    return vector_symbols("q", n), vector_symbols("qd", n), vector_symbols("qdd", n)
 
-    return make("q"), make("qd"), make("qdd")
+
+def vector_symbols(prefix: str, n: int) -> tuple[sp.Symbol, ...]:
+    """Symbols ``<prefix>1 … <prefix>n`` (real): the entries of an input vector."""
+    return tuple(sp.Symbol(f"{prefix}{k + 1}", real=True) for k in range(n))
+
+
+@dataclass(frozen=True)
+class Derivation:
+    """What an output's builder (:attr:`eomgen.outputs.Output.build`) works with: the model,
+    its body tree (fixed links merged), the symbols of every input vector of
+    :data:`eomgen.outputs.INPUTS` in ``JOINT_NAMES`` order (``inputs["q"]`` is ``q1 … qn``; also
+    as the attributes ``q``, ``qd``, ``qdd``, ``tau``) and the program builder to define
+    intermediates in. ``shared`` lets builders keep what another builder may reuse (keyed by
+    the builder's own module name)."""
+
+    model: RobotModel
+    tree: BodyTree
+    inputs: dict[str, tuple[sp.Symbol, ...]]
+    builder: ProgramBuilder
+    shared: dict = field(default_factory=dict)
+
+    @property
+    def q(self) -> tuple[sp.Symbol, ...]:
+        return self.inputs["q"]
+
+    @property
+    def qd(self) -> tuple[sp.Symbol, ...]:
+        return self.inputs["qd"]
+
+    @property
+    def qdd(self) -> tuple[sp.Symbol, ...]:
+        return self.inputs["qdd"]
+
+    @property
+    def tau(self) -> tuple[sp.Symbol, ...]:
+        return self.inputs["tau"]
 
 
 @dataclass(frozen=True)
@@ -71,6 +104,8 @@ class Dynamics:
         The ordered derivation steps (for LaTeX and notebook export).
     timings:
         Seconds spent in each stage.
+    vectors:
+        ``(name, symbols)`` of every input vector of :data:`eomgen.outputs.INPUTS`.
     """
 
     model: RobotModel
@@ -81,6 +116,18 @@ class Dynamics:
     steps: tuple[Step, ...]
     timings: tuple[tuple[str, float], ...] = ()
     simplified: bool = False
+    vectors: tuple[tuple[str, tuple[sp.Symbol, ...]], ...] = ()
+
+    @property
+    def input_symbols(self) -> dict[str, tuple[sp.Symbol, ...]]:
+        """The symbols of each input vector of :data:`eomgen.outputs.INPUTS` (``q``: ``q1 …
+        qn``; ``tau``: ``tau1 … taun``, the joint efforts, for outputs taking them; ...)."""
+        return {"q": self.q, "qd": self.qd, "qdd": self.qdd, **dict(self.vectors)}
+
+    @property
+    def efforts(self) -> tuple[sp.Symbol, ...]:
+        """The symbols ``tau1 … taun`` of the joint efforts (an input of some outputs)."""
+        return self.input_symbols["tau"]
 
     @property
     def joint_names(self) -> tuple[str, ...]:
@@ -217,9 +264,10 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     ('joint1', 'joint2')
     """
     outputs = set(outputs)
-    unknown = outputs - set(ALL_OUTPUTS)
+    known = derived_symbols()
+    unknown = outputs - set(known)
     if unknown:
-        raise ValueError(f"unknown outputs {sorted(unknown)}; choose from {ALL_OUTPUTS}")
+        raise ValueError(f"unknown outputs {sorted(unknown)}; choose from {known}")
     if simplify and model.dof > MAX_SIMPLIFY_JOINTS:
         raise TooLargeError(
             model.source, "derive(simplify=True)",
@@ -228,23 +276,31 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     timings = []
     start = time.perf_counter()
     tree = body_tree(model)
-    q, qd, qdd = joint_symbols(model.dof)
-    reserved = {s.name for s in q + qd + qdd} | {p.name for p in model.parameters}
+    inputs = {name: vector_symbols(name, model.dof) for name in INPUTS}
+    q, qd, qdd = inputs["q"], inputs["qd"], inputs["qdd"]
+    reserved = {s.name for v in inputs.values() for s in v} | {p.name for p in model.parameters}
     builder = ProgramBuilder(reserved)
     timings.append(("bodies", time.perf_counter() - start))
     start = time.perf_counter()
-    result = derive_program(tree, q, qd, model.gravity, outputs, builder)
-    if "tau" in outputs:
-        result["tau"] = inverse_dynamics_program(tree, q, qd, qdd, model.gravity, builder)
+    derivation = Derivation(model, tree, inputs, builder)
+    result: dict[str, sp.Matrix] = {}
+    for symbol in known:  # registry order; outputs sharing a builder are built in one call
+        declared = BY_SYMBOL[symbol]
+        if symbol not in outputs or symbol in result:
+            continue
+        wanted = {s for s in outputs if BY_SYMBOL[s].build == declared.build}
+        built = declared.builder()(derivation, wanted)
+        result.update({name: value for name, value in built.items() if name not in result})
     timings.append(("program", time.perf_counter() - start))
-    names = [name for name in ("M", "C", "g", "P", "tau") if name in result]
+    names = list(result)
     program = Program(tuple(builder.assignments), tuple((n, result[n]) for n in names)).pruned(names)
     steps = _steps(program, result)
     if simplify is None:  # teaching-sized: few joints and a small program (a cheap estimate)
         counted = [o for o in ("M", "C", "g") if o in outputs]
         simplify = model.dof <= TEXTBOOK_MAX_DOF and (
             not counted or program.operation_count(counted) <= TEXTBOOK_MAX_OPERATIONS)
-    return Dynamics(model, q, qd, qdd, program, steps, tuple(timings), bool(simplify))
+    vectors = tuple((k, v) for k, v in inputs.items() if k not in ("q", "qd", "qdd"))
+    return Dynamics(model, q, qd, qdd, program, steps, tuple(timings), bool(simplify), vectors)
 
 
 def _steps(program: Program, result: dict) -> tuple[Step, ...]:

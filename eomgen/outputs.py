@@ -20,13 +20,31 @@ inverse_dynamics    tau     q, qd, qdd           (n,)
 body; each backend's template builds it from the mass-matrix and inverse-dynamics functions (a
 Cholesky solve of ``M q̈ = τ − (C q̇ + g)``), whose names it receives from :data:`FORWARD`.
 
-Adding an output is one :func:`register_output` call here (plus the program that builds its
-symbol in :func:`eomgen.derive`).
+Further outputs are derived and exported only when asked for (``default=False``: ``eomgen
+generate --outputs Y`` or a scene's ``outputs``), so that existing modules stay as they were.
+
+Adding an output is one module with the function that builds its symbol (``build``, see
+:class:`Output`) and one :func:`register_output` call here. :func:`eomgen.derive` calls the
+builders; the backends print what they return.
 """
 
 from __future__ import annotations
 
+import difflib
+import importlib
 from dataclasses import dataclass
+from typing import Callable
+
+#: The vector inputs a generated function may take, each of length n (the joints, in
+#: ``JOINT_NAMES`` order), with their docstring line. Their symbols are ``<name>1 … <name>n``
+#: (:attr:`eomgen.dynamics.Derivation.inputs`); adding an input is one line here (the fast
+#: backend's kernels take at most three vectors).
+INPUTS: dict[str, str] = {
+    "q": "joint positions [rad or m]",
+    "qd": "joint velocities [rad/s or m/s]",
+    "qdd": "joint accelerations [rad/s^2 or m/s^2]",
+    "tau": "joint efforts [N m or N]",
+}
 
 
 @dataclass(frozen=True)
@@ -53,6 +71,20 @@ class Output:
         Symbols of the derived outputs it needs (its own symbol for a printed output).
     composed_from:
         Functions a composed output is built from (generated along with it); empty otherwise.
+    build:
+        ``"module:function"``, the builder of ``symbol``, imported when first needed:
+        ``function(derivation, wanted) -> dict`` takes a
+        :class:`~eomgen.dynamics.Derivation` (the model, its body tree, the joint symbols and
+        the program builder) and the set of symbols wanted of those it builds, and returns
+        ``{symbol: sympy.Matrix}`` in terms of the builder's intermediates. Outputs sharing a
+        builder are built in one call. A returned symbol no output declares (the potential
+        energy ``P`` of the Lagrangian builder) is kept in the program as well.
+    default:
+        Whether a generated module exports it when the caller names no outputs.
+    constants:
+        ``"module:function"`` or ``None``: ``function(dynamics) -> {NAME: (str, ...)}``, tuples
+        of names a module exporting this output also exports (e.g. ``PARAMETER_NAMES``, the
+        columns of the regressor).
     """
 
     function: str
@@ -63,6 +95,9 @@ class Output:
     units: str
     needs: tuple[str, ...]
     composed_from: tuple[str, ...] = ()
+    build: str | None = None
+    default: bool = True
+    constants: str | None = None
 
     @property
     def composed(self) -> bool:
@@ -70,8 +105,20 @@ class Output:
         return bool(self.composed_from)
 
     def shape(self, n: int) -> tuple[int, ...]:
-        """Its result's shape for ``n`` joints."""
+        """Its result's shape for ``n`` joints, for the outputs whose rows and columns are the
+        joints (the printed shape of any output is that of the matrix its builder returns)."""
         return (n,) if self.is_vector else (n, n)
+
+    def builder(self) -> Callable:
+        """The function :attr:`build` names, imported."""
+        return resolve(self.build)
+
+
+def resolve(reference: str) -> Callable:
+    """The object ``"package.module:name"`` refers to (imported on demand, so that the registry
+    stays light to import)."""
+    module, _, name = reference.partition(":")
+    return getattr(importlib.import_module(module), name)
 
 
 #: Every output, by function name, in module order.
@@ -92,6 +139,12 @@ def register_output(output: Output) -> Output:
     if output.symbol is not None and output.symbol in BY_SYMBOL:
         raise ValueError(f"output symbol {output.symbol!r} is already registered")
     missing = [f for f in output.composed_from if f not in OUTPUTS]
+    if output.symbol is not None and output.build is None:
+        raise ValueError(f"printed output {output.function!r} has no builder")
+    unknown = [name for name in output.inputs if name not in INPUTS]
+    if unknown:
+        raise ValueError(f"{output.function!r} takes unknown inputs {unknown}; known: "
+                         f"{', '.join(INPUTS)}")
     if missing:
         raise ValueError(f"{output.function!r} is composed from unregistered {missing}")
     OUTPUTS[output.function] = output
@@ -104,36 +157,78 @@ def register_output(output: Output) -> Output:
 BY_SYMBOL: dict[str, Output] = {}
 
 _REVOLUTE_EFFORT = "N m (revolute), N (prismatic)"
+#: M, C and g (and the potential energy P) come from one Lagrangian program.
+_LAGRANGIAN = "eomgen.symbolic.composite:build_lagrangian"
 
 MASS = register_output(Output(
     "mass_matrix", "M", "Mass matrix M(q), symmetric positive definite.", ("q",), False,
-    "kg m^2 (revolute rows/columns), kg (prismatic)", ("M",)))
+    "kg m^2 (revolute rows/columns), kg (prismatic)", ("M",), build=_LAGRANGIAN))
 CORIOLIS = register_output(Output(
     "coriolis_matrix", "C", "Coriolis matrix C(q, qd) from the Christoffel symbols of the first "
     "kind, so that Mdot - 2 C is skew-symmetric.", ("q", "qd"), False, "kg m^2/s (revolute)",
-    ("C",)))
+    ("C",), build=_LAGRANGIAN))
 GRAVITY = register_output(Output(
     "gravity_vector", "g", "Gravity vector g(q) = dP/dq.", ("q",), True, _REVOLUTE_EFFORT,
-    ("g",)))
+    ("g",), build=_LAGRANGIAN))
 INVERSE = register_output(Output(
     "inverse_dynamics", "tau", "Joint efforts tau = M(q) qdd + C(q, qd) qd + g(q) "
     "(recursive Newton-Euler, straight-line).", ("q", "qd", "qdd"), True, _REVOLUTE_EFFORT,
-    ("tau",)))
+    ("tau",), build="eomgen.symbolic.newton_euler:build_inverse_dynamics"))
 FORWARD = register_output(Output(
     "forward_dynamics", None, "Joint accelerations qdd solving M(q) qdd = tau - (C(q, qd) qd "
     "+ g(q)) by Cholesky.", ("q", "qd", "tau"), True, "rad/s^2 (revolute), m/s^2 (prismatic)",
     ("M", "tau"), composed_from=(MASS.function, INVERSE.function)))
 
 
-def derived_symbols() -> tuple[str, ...]:
-    """The symbols :func:`eomgen.derive` can build, in registry order: ``("M", "C", "g",
-    "tau")``."""
-    return tuple(BY_SYMBOL)
+def derived_symbols(default_only: bool = False) -> tuple[str, ...]:
+    """The symbols :func:`eomgen.derive` can build, in registry order (with ``default_only``,
+    those of the outputs exported by default: ``("M", "C", "g", "tau")``)."""
+    return tuple(s for s, o in BY_SYMBOL.items() if o.default or not default_only)
 
 
-def function_names() -> tuple[str, ...]:
-    """Every function a generated module can export, in module order."""
-    return tuple(OUTPUTS)
+def function_names(default_only: bool = False) -> tuple[str, ...]:
+    """Every function a generated module can export, in module order (with ``default_only``,
+    those it exports when the caller names none)."""
+    return tuple(f for f, o in OUTPUTS.items() if o.default or not default_only)
+
+
+def select(names=None) -> tuple[str, ...]:
+    """The functions to generate for the requested ``names``, in module order.
+
+    Parameters
+    ----------
+    names:
+        Function names (:data:`eomgen.outputs.OUTPUTS`) or their short names, the symbols of
+        what they return (``M``, ``C``, ``g``, ``tau``, ...); ``None`` for
+        those exported by default (:attr:`Output.default`). A function composed from others brings them along (forward
+        dynamics needs the mass-matrix and inverse-dynamics functions).
+
+    Raises
+    ------
+    ValueError
+        For an unknown name, or no name at all.
+
+    Examples
+    --------
+    >>> [OUTPUTS[f].symbol for f in select(["g", FORWARD.function])]
+    ['M', 'g', 'tau', None]
+    """
+    if names is None:
+        return function_names(default_only=True)
+    aliases = {s: o.function for s, o in BY_SYMBOL.items()}
+    wanted: set[str] = set()
+    for name in names:
+        function = aliases.get(name, name)
+        if function not in OUTPUTS:
+            known = list(aliases) + list(OUTPUTS)
+            hint = difflib.get_close_matches(str(name), known, n=1)
+            raise ValueError(f"unknown output {name!r} (known: {', '.join(known)})"
+                             + (f"; did you mean '{hint[0]}'?" if hint else ""))
+        wanted.add(function)
+        wanted.update(OUTPUTS[function].composed_from)
+    if not wanted:
+        raise ValueError("no output asked for")
+    return tuple(f for f in OUTPUTS if f in wanted)
 
 
 def composition_names(output: Output = FORWARD) -> dict[str, str]:
@@ -143,6 +238,6 @@ def composition_names(output: Output = FORWARD) -> dict[str, str]:
     return {"name": output.function, "mass": mass, "bias": bias}
 
 
-__all__ = ["Output", "OUTPUTS", "BY_SYMBOL", "register_output", "derived_symbols",
-           "function_names", "composition_names", "MASS", "CORIOLIS", "GRAVITY", "INVERSE",
+__all__ = ["INPUTS", "Output", "OUTPUTS", "resolve", "BY_SYMBOL", "register_output", "derived_symbols",
+           "function_names", "select", "composition_names", "MASS", "CORIOLIS", "GRAVITY", "INVERSE",
            "FORWARD"]

@@ -15,6 +15,7 @@ import shutil
 from pathlib import Path
 
 import numpy as np
+import sympy as sp
 import pytest
 
 import eomgen
@@ -40,11 +41,13 @@ def planar():
 
 
 def test_registry_holds_the_documented_functions_in_module_order():
-    assert {f: (o.symbol, o.inputs) for f, o in OUTPUTS.items()} == DOCUMENTED
-    assert list(OUTPUTS) == list(DOCUMENTED)
+    default = {f: o for f, o in OUTPUTS.items() if o.default}
+    assert {f: (o.symbol, o.inputs) for f, o in default.items()} == DOCUMENTED
+    assert list(default) == list(DOCUMENTED) == list(select_functions())
     assert ALL_OUTPUTS == ("M", "C", "g", "tau")
-    assert FUNCTION_ALIASES == {"M": "mass_matrix", "C": "coriolis_matrix",
-                                "g": "gravity_vector", "tau": "inverse_dynamics"}
+    assert {s: f for s, f in FUNCTION_ALIASES.items() if OUTPUTS[f].default} == {
+        "M": "mass_matrix", "C": "coriolis_matrix", "g": "gravity_vector",
+        "tau": "inverse_dynamics"}
     assert FORWARD.composed and FORWARD.composed_from == ("mass_matrix", "inverse_dynamics")
     assert set(OUTPUTS) | set(BY_SYMBOL) <= RESERVED_IDENTIFIERS
 
@@ -83,6 +86,9 @@ def test_generated_module_exports_the_registry_with_its_shapes(planar, tmp_path)
               "tau": rng.normal(size=n)}
     results = {}
     for name, output in OUTPUTS.items():
+        if not output.default:
+            assert not hasattr(module, name), name
+            continue
         function = getattr(module, name)
         params = [p.name for p in inspect.signature(function).parameters.values()
                   if p.kind is p.POSITIONAL_OR_KEYWORD]
@@ -167,3 +173,132 @@ def test_cli_help_lists_the_registered_backends(monkeypatch):
     assert result.exit_code == 0, result.output
     assert ("among " + ", ".join(available_backends()) + "; or all") in result.output
     assert "torch, zig" in result.output
+
+
+# ----------------------------------------------------------------------------------------------
+# An output is one builder plus one registration: three made-up outputs (a 2×3 matrix of q, a
+# vector of q, qd and tau, a vector without inputs with module constants) go through every
+# backend and are compared with SymPy evaluating what the builders returned.
+# ----------------------------------------------------------------------------------------------
+
+def _toy_builder(derivation, wanted):
+    q, qd, tau = derivation.q, derivation.qd, derivation.tau
+    p = {s.name: s for s in derivation.model.parameter_symbols} if hasattr(
+        derivation.model, "parameter_symbols") else {
+        par.name: par.symbol for par in derivation.model.parameters}
+    shared = derivation.builder.define(sp.cos(q[0]) * p["l1"], "toy_c")
+    built = {
+        "TOY_A": sp.Matrix([[shared, sp.sin(q[1]), 1], [q[0] * q[1], 0, p["m2"] * shared]]),
+        "TOY_B": sp.Matrix([tau[k] - qd[k] * q[k] + shared for k in range(len(q))]),
+        "TOY_C": sp.Matrix([p["m1"], 2 * p["m2"] + sp.Rational(1, 3)]),
+    }
+    return {name: built[name] for name in wanted}
+
+
+def _toy_constants(dynamics):
+    return {"TOY_NAMES": ("first", "second 'quoted'")}
+
+
+_TOYS = (
+    Output("toy_a", "TOY_A", "A 2x3 matrix of q.", ("q",), False, "1", ("TOY_A",),
+           build=f"{__name__}:_toy_builder", default=False),
+    Output("toy_b", "TOY_B", "A vector of q, qd and tau.", ("q", "qd", "tau"), True, "1",
+           ("TOY_B",), build=f"{__name__}:_toy_builder", default=False),
+    Output("toy_c", "TOY_C", "A vector of the parameters only.", (), True, "kg", ("TOY_C",),
+           build=f"{__name__}:_toy_builder", default=False, constants=f"{__name__}:_toy_constants"),
+)
+
+
+@pytest.fixture
+def toys():
+    for toy in _TOYS:
+        register_output(toy)
+    try:
+        yield _TOYS
+    finally:
+        for toy in _TOYS:
+            OUTPUTS.pop(toy.function, None)
+            BY_SYMBOL.pop(toy.symbol, None)
+
+
+def test_a_registered_output_reaches_every_backend(toys, tmp_path):
+    import sympy as sp  # noqa: F811  (the builder's module-level name, for clarity here)
+    from eomgen.codegen.backends.casadi_backend import load_module_source
+    from eomgen.codegen.generate import render_files
+
+    model = eomgen.load(eomgen.example_path("planar_2link"))
+    assert "toy_a" not in select_functions() and "TOY_A" not in ALL_OUTPUTS
+    functions = select_functions(["TOY_A", "toy_b", "TOY_C", "g"])
+    assert functions == ("gravity_vector", "toy_a", "toy_b", "toy_c")
+    dyn = derive(model, outputs=derived_outputs(functions), simplify=False)
+    job = make_job(dyn, functions, count_operations=False)
+    assert job.constants == (("TOY_NAMES", ("first", "second 'quoted'")),)
+
+    rng = np.random.default_rng(7)
+    q, qd, tau = rng.normal(size=(3, 2))
+    values = {p.symbol: p.value for p in model.parameters}
+    subs = {**values, **dict(zip(dyn.q, q)), **dict(zip(dyn.qd, qd)), **dict(zip(dyn.efforts, tau))}
+    full = dyn.program.expanded()
+    expected = {o.function: np.array(dyn.program.expand(dyn.program.output(o.symbol), full)
+                                     .subs(subs).evalf(), dtype=float) for o in toys}
+    expected = {f: (e.ravel() if OUTPUTS[f].is_vector else e) for f, e in expected.items()}
+    args = {"toy_a": (q,), "toy_b": (q, qd, tau), "toy_c": ()}
+
+    backends = ["numpy", "casadi", "fast", "jax", "torch"]
+    have = [b for b in backends if b not in ("jax", "torch") or importlib.util.find_spec(b)]
+    if "jax" in have:
+        import jax
+
+        jax.config.update("jax_enable_x64", True)  # as the JAX backend's tests: float64
+    files = {f.name: f for f in render_files(model, have, functions=functions)}
+    for f in files.values():
+        path = tmp_path / f.name
+        path.write_bytes(f.content) if isinstance(f.content, bytes) else path.write_text(
+            f.content, encoding="utf-8")
+    loaded = {}
+    for name in have:
+        if name == "casadi":
+            loaded[name] = load_module_source(files["planar_2link_casadi.py"].content, "toy_ca")
+            continue
+        path = (next(tmp_path.glob("planar_2link_fast.*.so")) if name == "fast"
+                else tmp_path / f"planar_2link_{name}.py")
+        spec = importlib.util.spec_from_file_location(f"planar_2link_{name}" if name == "fast"
+                                                      else f"toy_{name}", path)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        loaded[name] = vars(module)
+    for name, module in loaded.items():
+        assert tuple(module["TOY_NAMES"]) == ("first", "second 'quoted'"), name
+        assert "TOY_NAMES" in module["__all__"] or name == "casadi", name
+        for function, result in expected.items():
+            if name == "casadi":  # by name: the parameters take their defaults
+                call = dict(zip(OUTPUTS[function].inputs, args[function]))
+                got = np.array(module[function].call(call)[OUTPUTS[function].symbol], dtype=float)
+                got = got.ravel() if OUTPUTS[function].is_vector else got
+            else:
+                got = module[function](*args[function])
+            got = np.asarray(got, dtype=float)
+            np.testing.assert_allclose(got, result, rtol=1e-12, atol=1e-14,
+                                       err_msg=f"{name} {function}")
+    # a batch of states gives a batch of results; a function of the parameters only, one result
+    batch = loaded["numpy"]["toy_b"](np.tile(q, (4, 1)), np.tile(qd, (4, 1)), np.tile(tau, (4, 1)))
+    np.testing.assert_allclose(batch, np.tile(expected["toy_b"], (4, 1)), rtol=1e-12)
+    np.testing.assert_allclose(loaded["numpy"]["toy_c"](m1=3.0), [3.0, 2 * 1.0 + 1 / 3])
+
+
+def test_cli_outputs_option_selects_and_refuses(tmp_path):
+    from click.testing import CliRunner
+
+    from eomgen.cli import main
+
+    out = tmp_path / "out"
+    result = CliRunner().invoke(main, ["generate", "--backend", "numpy", "--outputs", "g,taux",
+                                       "-o", str(out), "--no-cache"])
+    assert result.exit_code == 2, result.output
+    assert "--outputs: unknown output 'taux'" in result.output and "did you mean 'tau'" in result.output
+    assert not out.exists()
+    result = CliRunner().invoke(main, ["generate", "--backend", "numpy", "--outputs", "g",
+                                       "-o", str(out), "--no-cache", "--quiet"])
+    assert result.exit_code == 0, result.output
+    text = (out / "planar_2link_numpy.py").read_text()
+    assert "def gravity_vector(" in text and "def mass_matrix(" not in text

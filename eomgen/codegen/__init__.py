@@ -17,11 +17,12 @@ from .. import __version__
 from ..output import GeneratedFile  # noqa: F401  (backends import it from here)
 from ..dynamics import Dynamics
 from .functions import (
-    FUNCTION_NAMES,
+    DEFAULT_FUNCTIONS,
     FunctionSpec,
     ParameterArgument,
     function_specs,
     module_name,
+    module_constants,
     parameter_arguments,
     select_functions,
 )
@@ -37,8 +38,9 @@ class Job:
     stem: str                 # file-name stem, e.g. "planar_2link"
     source_name: str          # description file name (no directory: output is location-free)
     source_sha256: str        # hash of the description file's bytes
-    functions: tuple[str, ...] = FUNCTION_NAMES  # exported functions, in module order
+    functions: tuple[str, ...] = DEFAULT_FUNCTIONS  # exported functions, in module order
     notes: tuple[str, ...] = ()  # further header lines (e.g. the scene the model comes from)
+    constants: tuple[tuple[str, tuple[str, ...]], ...] = ()  # NAME tuples the module exports
 
     @property
     def model(self):
@@ -66,7 +68,8 @@ def make_job(dynamics: Dynamics, functions=None, notes=(), count_operations: boo
     chosen = select_functions(functions)
     return Job(dynamics, function_specs(dynamics, chosen, count_operations),
                parameter_arguments(dynamics),
-               module_name(dynamics.model.name), source.name, digest, chosen, tuple(notes))
+               module_name(dynamics.model.name), source.name, digest, chosen, tuple(notes),
+               module_constants(dynamics, chosen))
 
 
 @dataclass(frozen=True)

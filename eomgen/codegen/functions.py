@@ -14,7 +14,6 @@ A module may export a subset of these functions (:func:`select_functions`, e.g. 
 from __future__ import annotations
 
 import builtins
-import difflib
 import keyword
 import re
 from dataclasses import dataclass
@@ -22,7 +21,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..dynamics import Dynamics
-from ..outputs import BY_SYMBOL, OUTPUTS
+from ..outputs import BY_SYMBOL, INPUTS, OUTPUTS, function_names, resolve, select
 from ..symbolic.program import Program
 
 
@@ -76,7 +75,8 @@ def reserved_identifiers() -> frozenset[str]:
     parameter names in every backend's module."""
     from . import available_backends
 
-    return RESERVED_IDENTIFIERS.union(*(b.reserved for b in available_backends().values()))
+    return RESERVED_IDENTIFIERS.union(OUTPUTS, BY_SYMBOL,
+                                      *(b.reserved for b in available_backends().values()))
 
 
 _IDENTIFIER = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
@@ -115,17 +115,13 @@ def parameter_arguments(dynamics: Dynamics) -> tuple[ParameterArgument, ...]:
     return tuple(out)
 
 
-_ARG_DOCS = {
-    "q": "joint positions [rad or m]",
-    "qd": "joint velocities [rad/s or m/s]",
-    "qdd": "joint accelerations [rad/s^2 or m/s^2]",
-}
-
-
 #: Every function a generated module can export, in module order, with the derived outputs
 #: (see :data:`eomgen.dynamics.ALL_OUTPUTS`) it needs. Read from :data:`eomgen.outputs.OUTPUTS`.
 FUNCTION_OUTPUTS: dict[str, tuple[str, ...]] = {f: o.needs for f, o in OUTPUTS.items()}
 FUNCTION_NAMES: tuple[str, ...] = tuple(FUNCTION_OUTPUTS)
+#: The functions a module exports when the caller names none (the equations of motion; further
+#: outputs such as the regressor are exported when asked for).
+DEFAULT_FUNCTIONS: tuple[str, ...] = function_names(default_only=True)
 
 #: Functions a function is composed from, and so generated with it.
 FUNCTION_REQUIRES: dict[str, tuple[str, ...]] = {
@@ -136,55 +132,25 @@ FUNCTION_ALIASES: dict[str, str] = {s: o.function for s, o in BY_SYMBOL.items()}
 
 
 def select_functions(names=None) -> tuple[str, ...]:
-    """The functions to generate for the requested ``names``, in module order.
+    """The functions to generate for the requested ``names``, in module order: see
+    :func:`eomgen.outputs.select`.
 
-    Parameters
-    ----------
-    names:
-        Function names (:data:`eomgen.outputs.OUTPUTS`) or their short names, the symbols of
-        what they return (``M``, ``C``, ``g``, ``tau``); ``None`` for all of
-        :data:`FUNCTION_NAMES`. A function composed from others brings them along (forward
-        dynamics needs the mass-matrix and inverse-dynamics functions).
-
-    Raises
-    ------
-    ValueError
-        For an unknown name, or no name at all.
-
-    Examples
-    --------
     >>> from eomgen.outputs import FORWARD
     >>> [OUTPUTS[f].symbol for f in select_functions(["g", FORWARD.function])]
     ['M', 'g', 'tau', None]
     """
-    if names is None:
-        return FUNCTION_NAMES
-    wanted: set[str] = set()
-    for name in names:
-        function = FUNCTION_ALIASES.get(name, name)
-        if function not in FUNCTION_OUTPUTS:
-            known = list(FUNCTION_ALIASES) + list(FUNCTION_NAMES)
-            hint = difflib.get_close_matches(str(name), known, n=1)
-            raise ValueError(f"unknown output {name!r} (known: {', '.join(known)})"
-                             + (f"; did you mean '{hint[0]}'?" if hint else ""))
-        wanted.add(function)
-        wanted.update(FUNCTION_REQUIRES.get(function, ()))
-    if not wanted:
-        raise ValueError("no output asked for")
-    return tuple(f for f in FUNCTION_NAMES if f in wanted)
+    return select(names)
 
 
 def derived_outputs(functions=None) -> tuple[str, ...]:
-    """The outputs :func:`eomgen.derive` must build for ``functions`` (default: all), in
-    ``ALL_OUTPUTS`` order.
+    """The outputs :func:`eomgen.derive` must build for ``functions`` (default:
+    :data:`DEFAULT_FUNCTIONS`), in registry order.
 
     >>> derived_outputs(["g"])
     ('g',)
     """
-    from ..dynamics import ALL_OUTPUTS
-
-    needed = {o for f in select_functions(functions) for o in FUNCTION_OUTPUTS[f]}
-    return tuple(o for o in ALL_OUTPUTS if o in needed)
+    needed = {o for f in select_functions(functions) for o in OUTPUTS[f].needs}
+    return tuple(o for o in BY_SYMBOL if o in needed)
 
 
 def function_specs(dynamics: Dynamics, functions=None,
@@ -194,7 +160,7 @@ def function_specs(dynamics: Dynamics, functions=None,
     A composed function (forward dynamics) has no spec: backends compose it. Without ``count_operations`` the
     specs' ``operation_count`` is 0 (counting costs as much as printing; files need it for their
     header, in-memory modules do not)."""
-    vectors = {"q": dynamics.q, "qd": dynamics.qd, "qdd": dynamics.qdd}
+    vectors = dynamics.input_symbols
     chosen = select_functions(functions)
     specs = []
     for name in chosen:
@@ -209,7 +175,7 @@ def function_specs(dynamics: Dynamics, functions=None,
         specs.append(FunctionSpec(
             name=name,
             summary=summary,
-            arguments=tuple(Argument(a, vectors[a], _ARG_DOCS[a]) for a in args),
+            arguments=tuple(Argument(a, vectors[a], INPUTS[a]) for a in args),
             output_name=output,
             output=program.output(output),
             is_vector=is_vector,
@@ -218,3 +184,16 @@ def function_specs(dynamics: Dynamics, functions=None,
             units=units,
         ))
     return tuple(specs)
+
+
+def module_constants(dynamics: Dynamics, functions) -> tuple[tuple[str, tuple[str, ...]], ...]:
+    """The name tuples a module exporting ``functions`` exports besides ``JOINT_NAMES`` (e.g.
+    ``PARAMETER_NAMES``, the columns of the regressor): ``((NAME, (str, ...)), ...)`` from the
+    outputs' :attr:`~eomgen.outputs.Output.constants`, in module order."""
+    found: dict[str, tuple[str, ...]] = {}
+    for name in functions:
+        declared = OUTPUTS[name]
+        if declared.constants is not None:
+            for key, values in resolve(declared.constants)(dynamics).items():
+                found.setdefault(key, tuple(str(v) for v in values))
+    return tuple(found.items())

@@ -322,3 +322,12 @@ def _coriolis(tree, S, F, comp, qd, idx, b: ProgramBuilder) -> sp.Matrix:
                     terms.append(c_ijk * qd[idx[k]])
             C[idx[i], idx[j]] = b.define(sp.Add(*terms), f"C{idx[i] + 1}_{idx[j] + 1}")
     return C
+
+
+def build_lagrangian(derivation, wanted) -> dict:
+    """The builder of M, C and g in :mod:`eomgen.outputs`: :func:`derive_program` on the
+    derivation's body tree for the ``wanted`` ones, with the potential energy ``P`` [J] when g is
+    among them."""
+    result = derive_program(derivation.tree, derivation.q, derivation.qd,
+                            derivation.model.gravity, set(wanted), derivation.builder)
+    return {name: result[name] for name in ("M", "C", "g", "P") if name in result}

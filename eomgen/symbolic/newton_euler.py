@@ -306,3 +306,10 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
                 force[p][j] = force[p][j] + f_p[j]
                 moment[p][j] = moment[p][j] + n_p[j] + rf[j]
     return tau
+
+
+def build_inverse_dynamics(derivation, wanted) -> dict:
+    """The builder of ``tau`` in :mod:`eomgen.outputs`: :func:`inverse_dynamics_program`."""
+    return {"tau": inverse_dynamics_program(derivation.tree, derivation.q, derivation.qd,
+                                            derivation.qdd, derivation.model.gravity,
+                                            derivation.builder)}

@@ -203,7 +203,7 @@ def _build():
     m2 = ca.SX.sym("m2")
     parameters = [I1, I2, g_, l1, l2, lc1, lc2, m1, m2]
     names = ["I1", "I2", "g_", "l1", "l2", "lc1", "lc2", "m1", "m2"]
-    vectors = {"q": q, "qd": qd, "qdd": qdd}
+    vectors = {"q": q, "qd": qd, "qdd": qdd, "tau": tau}
     functions = {}
     args = [vectors["q"]]
     functions["mass_matrix"] = _function(

@@ -351,6 +351,7 @@ static int parse(const function_t *f, PyObject *const *args, Py_ssize_t nargs,
             call->p[j] = parameter_defaults[j];
         }
     call->single = 1;
+    call->states = 1;  /* a function without vector inputs is evaluated once */
     for (j = 0; j < f->n_in; ++j) {
         if (given[j] == NULL) {
             PyErr_Format(PyExc_TypeError, "%s() missing required argument '%s'", f->name,

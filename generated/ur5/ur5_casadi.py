@@ -974,7 +974,7 @@ def _build():
     tau = ca.SX.sym("tau", NQ)
     parameters = []
     names = []
-    vectors = {"q": q, "qd": qd, "qdd": qdd}
+    vectors = {"q": q, "qd": qd, "qdd": qdd, "tau": tau}
     functions = {}
     args = [vectors["q"]]
     functions["mass_matrix"] = _function(

@@ -21,7 +21,7 @@ from sympy.printing.pycode import PythonCodePrinter
 
 from ...compiler import c_compiler
 from .. import GeneratedFile, Job, register
-from ..functions import FUNCTION_NAMES as ALL_FUNCTIONS
+from ..functions import DEFAULT_FUNCTIONS
 from ..render import render
 from .common import python_module_context
 
@@ -82,7 +82,7 @@ def load_module_source(source: str, name: str) -> dict:
     return namespace
 
 
-FUNCTION_NAMES = ALL_FUNCTIONS  # every function a module can export (a job may ask fewer)
+FUNCTION_NAMES = DEFAULT_FUNCTIONS  # what a module exports unless a job asks for others
 
 
 class NoCompilerWarning(UserWarning):

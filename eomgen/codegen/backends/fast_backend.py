@@ -83,13 +83,15 @@ class FastConfig:
     flags: tuple[str, ...] = ("-O2", "-fPIC", "-shared", "-fno-math-errno")
 
 
+#: The names of the kernel's vector pointers (``<name>_one(q, qd, qdd, p, out)``): a function's
+#: first, second and third vector input, whatever its name (``forward_dynamics_aba(q, qd, tau)``
+#: reads tau through the third).
+_KERNEL_INPUTS = ("q", "qd", "qdd")
+
+
 def _render_source(job: Job, config: FastConfig) -> str:
     n = job.model.dof
     names: dict[sp.Symbol, sp.Symbol] = {}
-    for vector, symbols in (("q", job.dynamics.q), ("qd", job.dynamics.qd),
-                            ("qdd", job.dynamics.qdd)):
-        for k, symbol in enumerate(symbols):
-            names[symbol] = sp.Symbol(f"{vector}[{k}]", real=True)
     for k, parameter in enumerate(job.parameters):
         names[parameter.symbol] = sp.Symbol(f"p[{k}]", real=True)
     printer = FastCPrinter()
@@ -98,7 +100,14 @@ def _render_source(job: Job, config: FastConfig) -> str:
         # intermediates become C locals named t_<name> (never a C keyword nor q, p, out)
         local = {symbol: sp.Symbol("t_" + symbol.name, real=True)
                  for symbol, _ in spec.program.assignments}
-        rename = {**names, **local}
+        # the k-th vector input arrives in the kernel's k-th pointer, named as in _KERNEL_INPUTS
+        if len(spec.arguments) > len(_KERNEL_INPUTS):
+            raise ValueError(f"the fast backend takes at most {len(_KERNEL_INPUTS)} vector "
+                             f"inputs, {spec.name} has {len(spec.arguments)}")
+        vectors = {symbol: sp.Symbol(f"{slot}[{k}]", real=True)
+                   for slot, argument in zip(_KERNEL_INPUTS, spec.arguments)
+                   for k, symbol in enumerate(argument.symbols)}
+        rename = {**names, **vectors, **local}
 
         def doprint(expr: sp.Expr) -> str:
             return printer.doprint(expr.xreplace(rename))
@@ -108,6 +117,8 @@ def _render_source(job: Job, config: FastConfig) -> str:
                    for r in range(rows) for c in range(cols) if spec.output[r, c] != 0]
         functions.append(dict(
             name=spec.name, summary=spec.summary, inputs=[a.name for a in spec.arguments],
+            slots=[f'"{a.name}"' for a in spec.arguments]
+            + ["NULL"] * (len(_KERNEL_INPUTS) - len(spec.arguments)),
             rows=rows, cols=0 if spec.is_vector else cols, size=rows * cols,
             assignments=[(local[s].name, doprint(e)) for s, e in spec.program.assignments],
             entries=entries, operation_count=spec.operation_count, units=spec.units))
@@ -147,7 +158,10 @@ def _render_source(job: Job, config: FastConfig) -> str:
         joint_names=[c_string_literal(name) for name in job.dynamics.joint_names],
         parameters=parameters,
         functions=functions,
-        exports=list(job.functions) + (["IllConditionedWarning"]
+        constants=[(name, [c_string_literal(v) for v in values])
+                   for name, values in job.constants],
+        exports=[name for name, _ in job.constants] + list(job.functions)
+        + (["IllConditionedWarning"]
                                        if FORWARD.function in job.functions else []),
         forward_doc=forward_doc,
         forward_dynamics=FORWARD.function in job.functions,
