@@ -179,6 +179,17 @@ FORWARD = register_output(Output(
     "+ g(q)) by Cholesky.", ("q", "qd", "tau"), True, "rad/s^2 (revolute), m/s^2 (prismatic)",
     ("M", "tau"), composed_from=(MASS.function, INVERSE.function)))
 
+# Issue 18: O(n) algorithms, exported when asked for (``--outputs qdd_aba,h``).
+FORWARD_ABA = register_output(Output(
+    "forward_dynamics_aba", "qdd_aba", "Joint accelerations qdd of M(q) qdd + C(q, qd) qd + "
+    "g(q) = tau by the Articulated-Body Algorithm (O(n), straight-line, no factorisation).",
+    ("q", "qd", "tau"), True, "rad/s^2 (revolute), m/s^2 (prismatic)", ("qdd_aba",),
+    build="eomgen.symbolic.aba:build_forward_dynamics_aba", default=False))
+NONLINEAR = register_output(Output(
+    "nonlinear_effects", "h", "Nonlinear effects h(q, qd) = C(q, qd) qd + g(q) (Newton-Euler "
+    "with qdd = 0; C itself is not formed).", ("q", "qd"), True, _REVOLUTE_EFFORT, ("h",),
+    build="eomgen.symbolic.combined:build_nonlinear_effects", default=False))
+
 
 def derived_symbols(default_only: bool = False) -> tuple[str, ...]:
     """The symbols :func:`eomgen.derive` can build, in registry order (with ``default_only``,

@@ -339,3 +339,12 @@ def cholesky_program(model: RobotModel) -> ForwardDynamics:
         x[i] = _name(b, rhs * inv_diag[i], f"qdd{i + 1}")
     program = Program(tuple(b.assignments), (("qdd", sp.Matrix(x)),)).pruned(["qdd"])
     return ForwardDynamics(q, qd, tau, program)
+
+
+def build_forward_dynamics_aba(derivation, wanted) -> dict:
+    """The builder of ``qdd_aba`` in :mod:`eomgen.outputs` (``forward_dynamics_aba(q, qd,
+    tau)``): :func:`forward_dynamics_program` on the derivation's body tree, q̈ [rad/s² or m/s²]
+    in ``JOINT_NAMES`` order."""
+    return {"qdd_aba": forward_dynamics_program(derivation.tree, derivation.q, derivation.qd,
+                                                derivation.tau, derivation.model.gravity,
+                                                derivation.builder)}

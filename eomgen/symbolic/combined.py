@@ -48,3 +48,12 @@ def dynamics_program(model: RobotModel) -> tuple[tuple, tuple, Program]:
     Cqd = sp.Matrix([[_name(b, bias[k, 0] - g[k, 0], f"Cqd{k + 1}")] for k in range(n)])
     outputs = (("M", M), ("Cqd", Cqd), ("g", g))
     return q, qd, Program(tuple(b.assignments), outputs).pruned([o for o, _ in outputs])
+
+
+def build_nonlinear_effects(derivation, wanted) -> dict:
+    """The builder of ``h`` in :mod:`eomgen.outputs` (``nonlinear_effects(q, qd)``):
+    h = C(q, q̇) q̇ + g(q) = τ(q, q̇, 0), one Newton–Euler pass with q̈ = 0 [N m or N] (what
+    Pinocchio's ``nonLinearEffects`` returns), without forming C."""
+    zero = (sp.Integer(0),) * len(derivation.q)
+    return {"h": inverse_dynamics_program(derivation.tree, derivation.q, derivation.qd, zero,
+                                          derivation.model.gravity, derivation.builder)}

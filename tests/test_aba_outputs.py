@@ -1,0 +1,115 @@
+"""The O(n) outputs in generated modules (issue 18): ``forward_dynamics_aba(q, qd, tau)`` by the
+Articulated-Body Algorithm and ``nonlinear_effects(q, qd)`` = C q̇ + g by one Newton–Euler pass,
+printed by every backend and compared with independent computations:
+
+* Pinocchio's ``pin.aba`` and ``pin.nonLinearEffects`` on a random tree with prismatic joints and
+  fixed links (built joint by joint, :func:`reference.to_pinocchio`);
+* the same module's Cholesky ``forward_dynamics`` and ``inverse_dynamics(q, qd, 0)``;
+* the planar arm with its parameters symbolic: keyword arguments change the result as the
+  numeric Newton–Euler of :mod:`eomgen.numeric` says.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+
+import numpy as np
+import pytest
+
+import eomgen
+from eomgen.codegen.backends.casadi_backend import load_module_source
+from eomgen.codegen.generate import render_files
+from eomgen.codegen.functions import select_functions
+from eomgen.numeric import mass_matrix_rnea, numeric_model, rnea
+from reference import pin_q_order, random_robot, to_pinocchio
+
+FUNCTIONS = select_functions(["qdd_aba", "h", "forward_dynamics"])
+BACKENDS = ["numpy", "casadi", "fast"] + [b for b in ("jax", "torch")
+                                          if importlib.util.find_spec(b) is not None]
+
+
+def load_modules(model, folder):
+    """{backend: callable(name) -> function returning NumPy arrays} of every backend."""
+    if "jax" in BACKENDS:
+        import jax
+
+        jax.config.update("jax_enable_x64", True)
+    files = render_files(model, BACKENDS, functions=FUNCTIONS)
+    for f in files:
+        path = folder / f.name
+        path.write_bytes(f.content) if isinstance(f.content, bytes) else path.write_text(
+            f.content, encoding="utf-8")
+    stem = next(f.name for f in files if f.name.endswith("_numpy.py"))[:-len("_numpy.py")]
+    modules = {}
+    for backend in BACKENDS:
+        if backend == "casadi":
+            namespace = load_module_source((folder / f"{stem}_casadi.py").read_text(), "aba_ca")
+            modules[backend] = lambda name, ns=namespace: (
+                lambda *args: np.array(ns[name](*args), dtype=float).ravel())
+            continue
+        path = (next(folder.glob(f"{stem}_fast.*.so")) if backend == "fast"
+                else folder / f"{stem}_{backend}.py")
+        spec = importlib.util.spec_from_file_location(
+            f"{stem}_fast" if backend == "fast" else f"aba_{backend}_{stem}", path)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        modules[backend] = lambda name, m=module: (
+            lambda *args, **kwargs: np.asarray(getattr(m, name)(*args, **kwargs), dtype=float))
+    return modules
+
+
+def test_aba_and_nonlinear_effects_agree_with_pinocchio_in_every_backend(tmp_path):
+    pin = pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
+    model = random_robot(np.random.default_rng(4), 5, tree=True)
+    pmodel = to_pinocchio(model)
+    data = pmodel.createData()
+    perm = pin_q_order(model, pmodel)
+    inv = np.argsort(perm)
+    modules = load_modules(model, tmp_path)
+    rng = np.random.default_rng(11)
+    for _ in range(3):
+        q, qd, tau = (rng.uniform(-1.5, 1.5, model.dof) for _ in range(3))
+        expected_qdd = np.asarray(pin.aba(pmodel, data, q[perm], qd[perm], tau[perm]))[inv]
+        expected_h = np.asarray(pin.nonLinearEffects(pmodel, data, q[perm], qd[perm]))[inv]
+        scale_qdd, scale_h = max(1, np.abs(expected_qdd).max()), max(1, np.abs(expected_h).max())
+        for backend, get in modules.items():
+            qdd = get("forward_dynamics_aba")(q, qd, tau)
+            h = get("nonlinear_effects")(q, qd)
+            assert np.abs(qdd - expected_qdd).max() <= 1e-10 * scale_qdd, backend
+            assert np.abs(h - expected_h).max() <= 1e-10 * scale_h, backend
+    # within the module: the ABA equals the Cholesky route, h equals tau(q, qd, 0), on a batch
+    numpy = modules["numpy"]
+    Q, QD, TAU = (rng.uniform(-1.5, 1.5, (6, model.dof)) for _ in range(3))
+    np.testing.assert_allclose(numpy("forward_dynamics_aba")(Q, QD, TAU),
+                               numpy("forward_dynamics")(Q, QD, TAU), rtol=1e-9, atol=1e-10)
+    np.testing.assert_allclose(numpy("nonlinear_effects")(Q, QD),
+                               numpy("inverse_dynamics")(Q, QD, np.zeros_like(Q)),
+                               rtol=1e-10, atol=1e-10)
+
+
+def test_symbolic_parameters_are_keywords_of_the_aba(tmp_path):
+    model = eomgen.load(eomgen.example_path("planar_2link"))
+    module = load_modules(model, tmp_path)["numpy"]
+    values = {p.name: p.value for p in model.parameters} | {"m2": 2.5, "l1": 0.7}
+    nm = numeric_model(model.substitute({p.symbol: values[p.name] for p in model.parameters}))
+    q, qd, tau = np.array([0.3, -0.8]), np.array([1.1, 0.4]), np.array([2.0, -1.0])
+    M = mass_matrix_rnea(nm, q)
+    expected = np.linalg.solve(M, tau - rnea(nm, q, qd, np.zeros(2)))
+    np.testing.assert_allclose(module("forward_dynamics_aba")(q, qd, tau, m2=2.5, l1=0.7),
+                               expected, rtol=1e-12)
+    np.testing.assert_allclose(module("nonlinear_effects")(q, qd, m2=2.5, l1=0.7),
+                               rnea(nm, q, qd, np.zeros(2)), rtol=1e-12)
+
+
+def test_cli_generates_the_aba_on_request(tmp_path):
+    from click.testing import CliRunner
+
+    from eomgen.cli import main
+
+    result = CliRunner().invoke(main, ["generate", "--backend", "numpy", "--outputs",
+                                       "forward_dynamics_aba,h", "-o", str(tmp_path / "out"),
+                                       "--no-cache", "--quiet"])
+    assert result.exit_code == 0, result.output
+    text = (tmp_path / "out" / "planar_2link_numpy.py").read_text()
+    assert "def forward_dynamics_aba(q, qd, tau, *" in text
+    assert "def nonlinear_effects(q, qd, *" in text and "def mass_matrix(" not in text
