@@ -37,8 +37,7 @@ from typing import Callable
 
 #: The vector inputs a generated function may take, each of length n (the joints, in
 #: ``JOINT_NAMES`` order), with their docstring line. Their symbols are ``<name>1 … <name>n``
-#: (:attr:`eomgen.dynamics.Derivation.inputs`); adding an input is one line here (the fast
-#: backend's kernels take at most three vectors).
+#: (:attr:`eomgen.dynamics.Derivation.inputs`); adding an input is one line here.
 INPUTS: dict[str, str] = {
     "q": "joint positions [rad or m]",
     "qd": "joint velocities [rad/s or m/s]",

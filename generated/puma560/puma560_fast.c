@@ -24,6 +24,7 @@
 
 #define NQ 6
 #define NP 0
+#define MAX_IN 3  /* most vector inputs of a function */
 
 static const char *const joint_names[NQ + 1] = {
     "joint1",
@@ -41,14 +42,14 @@ static const int parameter_has_default[NP + 1] = {
     0};
 
 /* ---------------------------------------------------------------------------------------- */
-/* The functions of one state: inputs (NQ,) each, parameters p (NP,), output row-major.      */
+/* The functions of one state: inputs x[j] (NQ,) each, parameters p (NP,), output row-major. */
 
 /* Mass matrix M(q), symmetric positive definite.
  * Output 6x6, in kg m^2 (revolute rows/columns), kg (prismatic); 1004 operations. */
-static void mass_matrix_one(const double *q, const double *qd, const double *qdd,
-                             const double *p, double *out)
+static void mass_matrix_one(const double *const *x, const double *p, double *out)
 {
-    (void)q; (void)qd; (void)qdd; (void)p;
+    const double *q = x[0];
+    (void)x; (void)p; (void)q;
     const double t_s1 = sin(q[0]);
     const double t_c1 = cos(q[0]);
     const double t_s2 = sin(q[1]);
@@ -264,10 +265,11 @@ static void mass_matrix_one(const double *q, const double *qd, const double *qdd
 
 /* Coriolis matrix C(q, qd) from the Christoffel symbols of the first kind, so that Mdot - 2 C is skew-symmetric.
  * Output 6x6, in kg m^2/s (revolute); 2832 operations. */
-static void coriolis_matrix_one(const double *q, const double *qd, const double *qdd,
-                             const double *p, double *out)
+static void coriolis_matrix_one(const double *const *x, const double *p, double *out)
 {
-    (void)q; (void)qd; (void)qdd; (void)p;
+    const double *q = x[0];
+    const double *qd = x[1];
+    (void)x; (void)p; (void)q; (void)qd;
     const double t_s1 = sin(q[0]);
     const double t_c1 = cos(q[0]);
     const double t_s2 = sin(q[1]);
@@ -751,10 +753,10 @@ static void coriolis_matrix_one(const double *q, const double *qd, const double 
 
 /* Gravity vector g(q) = dP/dq.
  * Output 6, in N m (revolute), N (prismatic); 144 operations. */
-static void gravity_vector_one(const double *q, const double *qd, const double *qdd,
-                             const double *p, double *out)
+static void gravity_vector_one(const double *const *x, const double *p, double *out)
 {
-    (void)q; (void)qd; (void)qdd; (void)p;
+    const double *q = x[0];
+    (void)x; (void)p; (void)q;
     const double t_s1 = sin(q[0]);
     const double t_c1 = cos(q[0]);
     const double t_s2 = sin(q[1]);
@@ -820,10 +822,12 @@ static void gravity_vector_one(const double *q, const double *qd, const double *
 
 /* Joint efforts tau = M(q) qdd + C(q, qd) qd + g(q) (recursive Newton-Euler, straight-line).
  * Output 6, in N m (revolute), N (prismatic); 356 operations. */
-static void inverse_dynamics_one(const double *q, const double *qd, const double *qdd,
-                             const double *p, double *out)
+static void inverse_dynamics_one(const double *const *x, const double *p, double *out)
 {
-    (void)q; (void)qd; (void)qdd; (void)p;
+    const double *q = x[0];
+    const double *qd = x[1];
+    const double *qdd = x[2];
+    (void)x; (void)p; (void)q; (void)qd; (void)qdd;
     const double t_s2 = sin(q[1]);
     const double t_c2 = cos(q[1]);
     const double t_s3 = sin(q[2]);
@@ -951,8 +955,9 @@ static int forward_dynamics_one(const double *q, const double *qd, const double 
     double M[NQ * NQ], bias[NQ], y[NQ];
     double dmax = 0.0, dmin = HUGE_VAL;
     int i, j, k;
-    mass_matrix_one(q, NULL, NULL, p, M);
-    inverse_dynamics_one(q, qd, zero, p, bias);
+    const double *mass_in[MAX_IN] = {q}, *bias_in[MAX_IN] = {q, qd, zero};
+    mass_matrix_one(mass_in, p, M);
+    inverse_dynamics_one(bias_in, p, bias);
     for (i = 0; i < NQ; ++i) {
         y[i] = tau[i] - bias[i];
         if (!isfinite(y[i]))
@@ -996,12 +1001,12 @@ static int forward_dynamics_one(const double *q, const double *qd, const double 
 /* ---------------------------------------------------------------------------------------- */
 /* Python interface                                                                          */
 
-typedef void (*kernel_t)(const double *, const double *, const double *, const double *, double *);
+typedef void (*kernel_t)(const double *const *, const double *, double *);
 
 typedef struct {
     const char *name;
     int n_in;
-    const char *inputs[3];
+    const char *inputs[MAX_IN];
     int rows, cols;  /* cols 0: a vector of rows entries */
     kernel_t kernel;
 } function_t;
@@ -1011,7 +1016,7 @@ static PyObject *lin_alg_error = NULL;            /* numpy.linalg.LinAlgError */
 
 /* The parsed call: input arrays (float64, C-contiguous), parameters, number of states. */
 typedef struct {
-    PyArrayObject *arrays[3];
+    PyArrayObject *arrays[MAX_IN];
     double p[NP + 1];
     npy_intp states;
     int single;
@@ -1021,7 +1026,7 @@ typedef struct {
 static void release(call_t *call)
 {
     int i;
-    for (i = 0; i < 3; ++i)
+    for (i = 0; i < MAX_IN; ++i)
         Py_CLEAR(call->arrays[i]);
 }
 
@@ -1052,7 +1057,7 @@ static PyArrayObject *as_states(PyObject *object, const char *name)
 static int parse(const function_t *f, PyObject *const *args, Py_ssize_t nargs,
                  PyObject *kwnames, call_t *call, int may_return_condition)
 {
-    PyObject *given[3] = {NULL, NULL, NULL};
+    PyObject *given[MAX_IN] = {NULL};
     int set[NP + 1] = {0};
     Py_ssize_t i, nkw = kwnames ? PyTuple_GET_SIZE(kwnames) : 0;
     int j;
@@ -1147,7 +1152,7 @@ static PyObject *evaluate(const function_t *f, PyObject *const *args, Py_ssize_t
     npy_intp dims[3];
     int nd = 0, j;
     npy_intp k, size = (npy_intp)f->rows * (f->cols ? f->cols : 1);
-    const double *in[3] = {NULL, NULL, NULL};
+    const double *in[MAX_IN] = {NULL}, *at[MAX_IN] = {NULL};
     double *out;
     PyArrayObject *result;
     if (parse(f, args, nargs, kwnames, &call, 0) < 0)
@@ -1166,12 +1171,14 @@ static PyObject *evaluate(const function_t *f, PyObject *const *args, Py_ssize_t
     for (j = 0; j < f->n_in; ++j)
         in[j] = (const double *)PyArray_DATA(call.arrays[j]);
     if (call.states == 1) {
-        f->kernel(in[0], in[1], in[2], call.p, out);
+        f->kernel(in, call.p, out);
     } else {
         Py_BEGIN_ALLOW_THREADS
-        for (k = 0; k < call.states; ++k)
-            f->kernel(in[0] ? in[0] + k * NQ : NULL, in[1] ? in[1] + k * NQ : NULL,
-                      in[2] ? in[2] + k * NQ : NULL, call.p, out + k * size);
+        for (k = 0; k < call.states; ++k) {
+            for (j = 0; j < f->n_in; ++j)
+                at[j] = in[j] + k * NQ;
+            f->kernel(at, call.p, out + k * size);
+        }
         Py_END_ALLOW_THREADS
     }
     release(&call);

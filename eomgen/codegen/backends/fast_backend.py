@@ -83,30 +83,22 @@ class FastConfig:
     flags: tuple[str, ...] = ("-O2", "-fPIC", "-shared", "-fno-math-errno")
 
 
-#: The names of the kernel's vector pointers (``<name>_one(q, qd, qdd, p, out)``): a function's
-#: first, second and third vector input, whatever its name (``forward_dynamics_aba(q, qd, tau)``
-#: reads tau through the third).
-_KERNEL_INPUTS = ("q", "qd", "qdd")
-
-
 def _render_source(job: Job, config: FastConfig) -> str:
     n = job.model.dof
     names: dict[sp.Symbol, sp.Symbol] = {}
     for k, parameter in enumerate(job.parameters):
         names[parameter.symbol] = sp.Symbol(f"p[{k}]", real=True)
     printer = FastCPrinter()
+    # at least q, qd, tau of the composed forward dynamics
+    max_inputs = max([3] + [len(spec.arguments) for spec in job.specs])
     functions = []
     for spec in job.specs:
         # intermediates become C locals named t_<name> (never a C keyword nor q, p, out)
         local = {symbol: sp.Symbol("t_" + symbol.name, real=True)
                  for symbol, _ in spec.program.assignments}
-        # the k-th vector input arrives in the kernel's k-th pointer, named as in _KERNEL_INPUTS
-        if len(spec.arguments) > len(_KERNEL_INPUTS):
-            raise ValueError(f"the fast backend takes at most {len(_KERNEL_INPUTS)} vector "
-                             f"inputs, {spec.name} has {len(spec.arguments)}")
-        vectors = {symbol: sp.Symbol(f"{slot}[{k}]", real=True)
-                   for slot, argument in zip(_KERNEL_INPUTS, spec.arguments)
-                   for k, symbol in enumerate(argument.symbols)}
+        # the j-th vector input is the kernel's pointer x[j], bound to a local of its name
+        vectors = {symbol: sp.Symbol(f"{argument.name}[{k}]", real=True)
+                   for argument in spec.arguments for k, symbol in enumerate(argument.symbols)}
         rename = {**names, **vectors, **local}
 
         def doprint(expr: sp.Expr) -> str:
@@ -118,7 +110,7 @@ def _render_source(job: Job, config: FastConfig) -> str:
         functions.append(dict(
             name=spec.name, summary=spec.summary, inputs=[a.name for a in spec.arguments],
             slots=[f'"{a.name}"' for a in spec.arguments]
-            + ["NULL"] * (len(_KERNEL_INPUTS) - len(spec.arguments)),
+            + ["NULL"] * (max_inputs - len(spec.arguments)),
             rows=rows, cols=0 if spec.is_vector else cols, size=rows * cols,
             assignments=[(local[s].name, doprint(e)) for s, e in spec.program.assignments],
             entries=entries, operation_count=spec.operation_count, units=spec.units))
@@ -155,6 +147,7 @@ def _render_source(job: Job, config: FastConfig) -> str:
         module=module,
         module_literal=c_string_literal(module),
         nq=n,
+        max_inputs=max_inputs,
         joint_names=[c_string_literal(name) for name in job.dynamics.joint_names],
         parameters=parameters,
         functions=functions,
