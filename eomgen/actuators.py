@@ -44,8 +44,8 @@ straight-line program of ``τ_L`` is differentiated in forward mode along the tr
 (:func:`time_derivative_program`: each intermediate ``x = f(…)`` gets ``ẋ = Σ ∂f/∂s ṡ``), which
 keeps the program's size linear in the model (the 7-DOF Panda included).
 
-Nothing here is generated as code yet (the backends' ``M``, ``C``, ``g`` are the rigid
-bodies'); see docs/actuators.md.
+The generated modules export these on request (:mod:`eomgen.symbolic.drives`,
+``eomgen generate --outputs M_a,tau_f,...``); see docs/actuators.md.
 """
 
 from __future__ import annotations

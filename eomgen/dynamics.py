@@ -76,6 +76,31 @@ class Derivation:
     def tau(self) -> tuple[sp.Symbol, ...]:
         return self.inputs["tau"]
 
+    @property
+    def built(self) -> dict[str, sp.Matrix]:
+        """The outputs built so far, by symbol (extra symbols such as ``P`` included)."""
+        return self.shared.setdefault("outputs", {})
+
+    def output(self, symbol: str) -> sp.Matrix:
+        """The matrix of the registered output ``symbol``, built now if it was not yet (a
+        builder that needs M calls ``derivation.output("M")``: M is built once per program)."""
+        if symbol not in self.built:
+            self.build({symbol})
+        return self.built[symbol]
+
+    def build(self, symbols) -> None:
+        """Build the registered ``symbols`` not built yet, in registry order; outputs sharing a
+        builder are built in one call."""
+        symbols = set(symbols)
+        for symbol in BY_SYMBOL:
+            if symbol not in symbols or symbol in self.built:
+                continue
+            declared = BY_SYMBOL[symbol]
+            wanted = {s for s in symbols - set(self.built)
+                      if BY_SYMBOL[s].build == declared.build}
+            made = declared.builder()(self, wanted)
+            self.built.update({k: v for k, v in made.items() if k not in self.built})
+
 
 @dataclass(frozen=True)
 class Step:
@@ -283,14 +308,8 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     timings.append(("bodies", time.perf_counter() - start))
     start = time.perf_counter()
     derivation = Derivation(model, tree, inputs, builder)
-    result: dict[str, sp.Matrix] = {}
-    for symbol in known:  # registry order; outputs sharing a builder are built in one call
-        declared = BY_SYMBOL[symbol]
-        if symbol not in outputs or symbol in result:
-            continue
-        wanted = {s for s in outputs if BY_SYMBOL[s].build == declared.build}
-        built = declared.builder()(derivation, wanted)
-        result.update({name: value for name, value in built.items() if name not in result})
+    derivation.build(outputs)
+    result = derivation.built
     timings.append(("program", time.perf_counter() - start))
     names = list(result)
     program = Program(tuple(builder.assignments), tuple((n, result[n]) for n in names)).pruned(names)

@@ -43,6 +43,10 @@ INPUTS: dict[str, str] = {
     "qd": "joint velocities [rad/s or m/s]",
     "qdd": "joint accelerations [rad/s^2 or m/s^2]",
     "tau": "joint efforts [N m or N]",
+    "theta_m": "motor angles of the flexible joints, link side of the gear [rad] (entries of "
+             "rigid joints are ignored)",
+    "thetad_m": "motor velocities of the flexible joints, link side of the gear [rad/s] "
+              "(entries of rigid joints are ignored)",
 }
 
 
@@ -188,6 +192,39 @@ NONLINEAR = register_output(Output(
     "nonlinear_effects", "h", "Nonlinear effects h(q, qd) = C(q, qd) qd + g(q) (Newton-Euler "
     "with qdd = 0; C itself is not formed).", ("q", "qd"), True, _REVOLUTE_EFFORT, ("h",),
     build="eomgen.symbolic.combined:build_nonlinear_effects", default=False))
+
+# Issue 17: drives and flexible joints (docs/actuators.md), exported when asked for.
+_DRIVES = "eomgen.symbolic.drives:build_drives"
+DRIVE_MASS = register_output(Output(
+    "drive_mass_matrix", "M_a", "Mass matrix with the drives' armature, M(q) + diag(a) (every "
+    "joint stiff).", ("q",), False, "kg m^2 (revolute rows/columns), kg (prismatic)", ("M_a",),
+    build=_DRIVES, default=False))
+FRICTION = register_output(Output(
+    "friction_torque", "tau_f", "Friction torque of the drives d qd + f sign(qd) (exact sign, "
+    "for inverse dynamics).", ("qd",), True, _REVOLUTE_EFFORT, ("tau_f",), build=_DRIVES,
+    default=False))
+FRICTION_SMOOTH = register_output(Output(
+    "friction_torque_smooth", "tau_f_smooth", "Friction torque of the drives d qd + f tanh(qd / "
+    "w) (Coulomb smoothed with the width w, for simulation).", ("qd",), True, _REVOLUTE_EFFORT,
+    ("tau_f_smooth",), build=_DRIVES, default=False))
+DRIVE_INVERSE = register_output(Output(
+    "drive_inverse_dynamics", "tau_a", "Drive torques (M(q) + diag(a)) qdd + C(q, qd) qd + g(q) "
+    "+ d qd + f sign(qd).", ("q", "qd", "qdd"), True, _REVOLUTE_EFFORT, ("tau_a",),
+    build=_DRIVES, default=False))
+LINK_MASS = register_output(Output(
+    "link_mass_matrix", "M_l", "Link mass matrix of the flexible-joint model, M(q) + diag(a) of "
+    "the rigid joints only.", ("q",), False, "kg m^2 (revolute rows/columns), kg (prismatic)",
+    ("M_l",), build=_DRIVES, default=False))
+SPRING = register_output(Output(
+    "spring_torque", "tau_K", "Torque the joint springs pass to the links, K (theta_m - q) on "
+    "flexible joints, 0 on rigid ones.", ("q", "theta_m"), True, _REVOLUTE_EFFORT, ("tau_K",),
+    build=_DRIVES, default=False))
+MOTOR_FORWARD = register_output(Output(
+    "motor_forward_dynamics", "thetadd_m", "Motor accelerations (tau - K (theta_m - q) - d "
+    "thetad_m - f tanh(thetad_m / w)) / B of flexible joints (0 for rigid ones); tau is the "
+    "motor torque.",
+    ("q", "theta_m", "thetad_m", "tau"), True, "rad/s^2", ("thetadd_m",), build=_DRIVES,
+    default=False))
 
 
 def derived_symbols(default_only: bool = False) -> tuple[str, ...]:

@@ -61,7 +61,7 @@ class FunctionSpec:
 #: and the names each backend's modules import (``register(..., reserved=("np",))``), see
 #: :func:`reserved_identifiers`.
 RESERVED_IDENTIFIERS = frozenset(
-    {"math", "q", "qd", "qdd", "tau", "out", "single", "batch", "n",
+    {"math", *INPUTS, "out", "single", "batch", "n",
      "JOINT_NAMES", "NQ", "PARAMETERS", *OUTPUTS, *BY_SYMBOL,
      "self", "cls", "L", "x", "y", "d",
      "rhs", "bias", "args", "names", "vectors", "functions", "parameters", "q_columns",

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from .. import Job
-from ...outputs import FORWARD, composition_names
+from ...outputs import FORWARD, INPUTS, composition_names
 from ..functions import FunctionSpec
 
 
@@ -146,6 +146,9 @@ def python_module_context(job: Job, printer, template: str, extra_exports=()) ->
                      python_literal(p.doc)) for p in job.parameters],
         functions=[print_function(spec, job, doprint, None) for spec in job.specs],
         constants=[(name, [python_literal(v) for v in values]) for name, values in job.constants],
+        # q, qd, qdd and tau (forward dynamics takes tau), then any other input a function takes
+        vector_inputs=[name for name in INPUTS if name in ("q", "qd", "qdd", "tau") or any(
+            name == a.name for spec in job.specs for a in spec.arguments)],
         dunder_all=dunder_all_lines(["JOINT_NAMES", "NQ", "PARAMETERS",
                                      *(name for name, _ in job.constants), *job.functions,
                                      *extra_exports]),
