@@ -25,7 +25,7 @@ from ..functions import DEFAULT_FUNCTIONS
 from ..render import render
 from .common import python_module_context
 
-_FUNCTIONS = ("sin", "cos", "tan", "sqrt", "exp", "log", "asin", "acos", "atan", "atan2")
+_FUNCTIONS = ("sin", "cos", "tan", "sqrt", "exp", "log", "asin", "acos", "atan", "atan2", "sign")
 
 
 class CasADiPrinter(PythonCodePrinter):
@@ -37,7 +37,8 @@ class CasADiPrinter(PythonCodePrinter):
             return f"ca.{name}(" + ", ".join(self._print(a) for a in expr.args) + ")"
         raise ValueError(f"the CasADi backend cannot print function {name}")
 
-    _print_sin = _print_cos = _print_tan = _print_Function
+    # sign: Coulomb friction columns of the regressor (PythonCodePrinter prints math.copysign)
+    _print_sin = _print_cos = _print_tan = _print_sign = _print_Function
 
     def _print_Pow(self, expr, rational=False):
         base, exponent = expr.args
