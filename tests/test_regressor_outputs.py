@@ -221,3 +221,40 @@ def test_panda_base_regressor_is_small_and_has_the_published_count():
     ops = {s.name: s.operation_count for s in job.specs}
     assert ops["base_regressor"] <= 2700
     assert ops["base_regressor"] < ops["regressor"]
+
+
+# ----------------------------------------------------------------------------------------------
+# The command line
+# ----------------------------------------------------------------------------------------------
+
+def test_cli_generates_the_regressor_outputs_and_refuses_a_flexible_joint(tmp_path):
+    from click.testing import CliRunner
+
+    from eomgen.cli import main
+
+    out = tmp_path / "out"
+    result = CliRunner().invoke(main, ["generate", "--backend", "numpy", "--outputs",
+                                       "regressor,pi,base_regressor,beta", "-o", str(out),
+                                       "--no-cache", "--quiet"])
+    assert result.exit_code == 0, result.output
+    spec = importlib.util.spec_from_file_location("cli_regressor", out / "planar_2link_numpy.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    assert not hasattr(module, "mass_matrix")
+    assert module.PARAMETER_NAMES[:2] == ("M1", "MX1") and len(module.PARAMETER_NAMES) == 20
+    nm = numeric_model(eomgen.load(eomgen.example_path("planar_2link")))
+    for q, qd, qdd in states(2, 2):
+        tau = rnea(nm, q, qd, qdd)
+        np.testing.assert_allclose(module.regressor(q, qd, qdd) @ module.inertial_parameters(),
+                                   tau, rtol=1e-12)
+        np.testing.assert_allclose(module.base_regressor(q, qd, qdd) @ module.base_parameters(),
+                                   tau, rtol=1e-12)
+
+    flexible = Path(__file__).resolve().parents[1] / "examples/robots/flexible_2link.yaml"
+    bad = tmp_path / "bad"
+    result = CliRunner().invoke(main, ["generate", str(flexible), "--backend", "numpy",
+                                       "--outputs", "Y", "-o", str(bad), "--no-cache", "--quiet"])
+    assert result.exit_code == 2, result.output
+    lines = [line for line in result.output.splitlines() if line.strip()]
+    assert len(lines) == 1 and "joint 'joint1' actuator: a flexible joint" in lines[0]
+    assert not bad.exists()
