@@ -272,3 +272,25 @@ def test_base_outputs_are_byte_identical_when_generated_again():
         files = render_files(model, ["numpy"], functions=["base_regressor", "base_parameters"])
         texts.append(files[0].content)
     assert texts[0] == texts[1] and "BASE_PARAMETER_NAMES" in texts[0]
+
+
+def test_tilted_axes_take_the_numeric_route(tmp_path):
+    """A random tree (tilted revolute axes, prismatic joints, merged fixed links): the
+    closed-form grouping does not apply, the numeric route gives the base; Y π is
+    eomgen.numeric's Newton–Euler and Y_base β = Y π."""
+    from eomgen.regressor import generated_base
+    from reference import random_robot
+
+    model = random_robot(np.random.default_rng(1), 4, tree=True)
+    assert generated_base(model).route == "numeric"
+    calls, modules = generated(model, ("numpy",), tmp_path)
+    call, nm = calls["numpy"], numeric_model(model)
+    pi, beta = call("inertial_parameters"), call("base_parameters")
+    base_stack = []
+    for q, qd, qdd in states(model.dof, 12):
+        tau = rnea(nm, q, qd, qdd)
+        np.testing.assert_allclose(call("regressor", q, qd, qdd) @ pi, tau, rtol=1e-10,
+                                   atol=1e-10)
+        base_stack.append(call("base_regressor", q, qd, qdd))
+        np.testing.assert_allclose(base_stack[-1] @ beta, tau, rtol=1e-8, atol=1e-8)
+    assert rank(np.vstack(base_stack)) == len(beta) == len(modules["numpy"]["BASE_PARAMETER_NAMES"])
