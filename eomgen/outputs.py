@@ -226,6 +226,41 @@ MOTOR_FORWARD = register_output(Output(
     ("q", "theta_m", "thetad_m", "tau"), True, "rad/s^2", ("thetadd_m",), build=_DRIVES,
     default=False))
 
+# Issue 15: the joint torque regressor tau = Y(q, qd, qdd) pi, the description's parameters pi,
+# the base regressor and base parameters (Y pi = Y_base beta), and the energy regressors; all
+# built in one call by eomgen.regressor:build_outputs (see docs/regressor.md).
+_REGRESSOR = "eomgen.regressor:build_outputs"
+_PER_PARAMETER = "N m (revolute rows), N (prismatic) per unit of each column's parameter"
+_NAMES, _BASE_NAMES = "eomgen.regressor:parameter_names", "eomgen.regressor:base_parameter_names"
+REGRESSOR = register_output(Output(
+    "regressor", "Y", "Joint torque regressor Y(q, qd, qdd), n x p: tau = Y pi, columns "
+    "PARAMETER_NAMES (per body m, m c, inertia about the body origin; then actuator terms).",
+    ("q", "qd", "qdd"), False, _PER_PARAMETER, ("Y",), build=_REGRESSOR, default=False,
+    constants=_NAMES))
+INERTIAL_PARAMETERS = register_output(Output(
+    "inertial_parameters", "pi", "The description's standard parameters pi, (p,), in "
+    "PARAMETER_NAMES order.", (), True,
+    "kg, kg m, kg m^2; armature kg m^2, viscous N m s/rad, Coulomb N m", ("pi",),
+    build=_REGRESSOR, default=False, constants=_NAMES))
+BASE_REGRESSOR = register_output(Output(
+    "base_regressor", "Y_base", "Base regressor Y_base(q, qd, qdd), n x b, full column rank: "
+    "tau = Y_base beta, columns BASE_PARAMETER_NAMES.", ("q", "qd", "qdd"), False,
+    _PER_PARAMETER, ("Y_base",), build=_REGRESSOR, default=False, constants=_BASE_NAMES))
+BASE_PARAMETERS = register_output(Output(
+    "base_parameters", "beta", "The description's base parameters beta, (b,), in "
+    "BASE_PARAMETER_NAMES order: the identifiable combinations of pi.", (), True,
+    "the units of the parameter each groups into", ("beta",), build=_REGRESSOR, default=False,
+    constants=_BASE_NAMES))
+KINETIC_REGRESSOR = register_output(Output(
+    "kinetic_energy_regressor", "Y_K", "Kinetic energy regressor Y_K(q, qd), (p,): K = Y_K . pi "
+    "(actuator columns 0).", ("q", "qd"), True, "J per unit of each column's parameter",
+    ("Y_K",), build=_REGRESSOR, default=False, constants=_NAMES))
+POTENTIAL_REGRESSOR = register_output(Output(
+    "potential_energy_regressor", "Y_P", "Potential energy regressor Y_P(q), (p,): P = Y_P . pi "
+    "= -sum m g_vec . c over the moving bodies (actuator columns 0).", ("q",), True,
+    "J per unit of each column's parameter", ("Y_P",), build=_REGRESSOR, default=False,
+    constants=_NAMES))
+
 
 def derived_symbols(default_only: bool = False) -> tuple[str, ...]:
     """The symbols :func:`eomgen.derive` can build, in registry order (with ``default_only``,

@@ -38,6 +38,8 @@ class CasADiPrinter(PythonCodePrinter):
             return f"ca.{name}(" + ", ".join(self._print(a) for a in expr.args) + ")"
         raise ValueError(f"the CasADi backend cannot print function {name}")
 
+    # sign: Coulomb friction (regressor columns, drive friction); PythonCodePrinter would print
+    # math.copysign, which fails on CasADi symbols
     _print_sin = _print_cos = _print_tan = _print_tanh = _print_sign = _print_Function
 
     def _print_Pow(self, expr, rational=False):
