@@ -142,6 +142,55 @@ def test_positions_and_efforts_only_are_differentiated_through_a_filter(tmp_path
     assert np.max(np.abs(est.beta - beta)) < 1e-2 * np.abs(beta).max()
 
 
+def test_cutoff_filters_given_velocities_and_efforts_alike(tmp_path):
+    """With qd_, qdd_ columns, a cut-off filters q, q̇, q̈ and τ (it used to be ignored, the
+    file read as is): 5 % white noise on q̈ and τ is cut to well below half, the motion
+    (0.1–0.3 Hz) passes; the ends are trimmed and the rest decimated; no t, no filtering."""
+    data, _, beta = simulated("planar_2link", 1000)  # 100 Hz over 10 s
+    rng = np.random.default_rng(5)
+    noise = {name: 0.05 * np.sqrt(np.mean(getattr(data, name) ** 2, axis=0))
+             * rng.standard_normal(data.tau.shape) for name in ("qdd", "tau")}
+    noisy = Measurements(data.joint_names, data.t, data.q, data.qd, data.qdd + noise["qdd"],
+                         data.tau + noise["tau"])
+    path = tmp_path / "noisy.csv"
+    path.write_text(measurements_csv(noisy))
+    raw = read_measurements(path, data.joint_names)
+    assert raw.cutoff is None and np.array_equal(raw.tau, noisy.tau)  # no cut-off: as read
+    read = read_measurements(path, data.joint_names, cutoff=2.0)
+    assert read.cutoff == 2.0 and not read.differentiated
+    keep = np.arange(150, 850, 25)  # 3 periods of 2 Hz trimmed each end, every fs/(2 fc)
+    np.testing.assert_array_equal(read.t, data.t[keep])
+    for name in ("q", "qd"):  # noise-free signals pass the filter unchanged
+        clean = getattr(data, name)[keep]
+        np.testing.assert_allclose(getattr(read, name), clean, atol=1e-3 * np.abs(clean).max())
+    for name in ("qdd", "tau"):
+        clean = getattr(data, name)[keep]
+        before = np.sqrt(np.mean((getattr(noisy, name)[keep] - clean) ** 2))
+        after = np.sqrt(np.mean((getattr(read, name) - clean) ** 2))
+        assert after < 0.4 * before, (name, after / before)
+    model, reg, base, _ = setup("planar_2link")
+    W = observation_matrix(reg, base.base, read.q, read.qd, read.qdd)
+    est = weighted_least_squares(W, read.tau)
+    assert np.all(np.abs(est.beta - beta) < 3 * est.std), (est.beta - beta) / est.std
+    no_t = tmp_path / "no_t.csv"
+    no_t.write_text("\n".join(drop_column(path.read_text().splitlines(), "t")) + "\n")
+    with pytest.raises(IdentificationError, match="missing column 't' .needed to filter at "
+                                                  "the cut-off 2 Hz"):
+        read_measurements(no_t, data.joint_names, cutoff=2.0)
+
+
+def test_identify_cutoff_on_full_data_is_reported(tmp_path):
+    data, _, _ = simulated("planar_2link", 400)
+    path = tmp_path / "planar.csv"
+    path.write_text(measurements_csv(data))
+    out = tmp_path / "id"
+    done = run_process("identify", PLANAR, path, "-o", out, "--quiet", "--cutoff", 4)
+    assert done.returncode == 0, done.stderr
+    assert "q, q̇, q̈, τ zero-phase low-pass filtered at 4 Hz" in done.stdout
+    # 40 Hz sampling: 3 periods of 4 Hz (30 samples) trimmed each end, every 5th kept
+    assert f"{len(range(30, 370, 5))} samples × 2 joints" in done.stdout
+
+
 def test_csv_round_trip_is_exact(tmp_path):
     data, _, _ = simulated("planar_2link", 20, noise=0.01)
     path = tmp_path / "d.csv"

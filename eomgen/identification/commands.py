@@ -120,8 +120,10 @@ def add_commands(main: click.Group, handle_errors, strict_option, quiet_option, 
     @click.option("--friction", is_flag=True,
                   help="Add viscous and Coulomb friction columns (FV<k>, FC<k>).")
     @click.option("--cutoff", default=None, type=float,
-                  help="Low-pass cut-off [Hz] when q is differentiated (DATA without qd_, qdd_ "
-                       "columns) [default: sampling frequency / 10].")
+                  help="Cut-off [Hz] of the zero-phase low-pass filter. DATA without qd_, "
+                       "qdd_ columns: q is filtered and differentiated [default: sampling "
+                       "frequency / 10]. DATA with them: q, qd, qdd and tau are all filtered, "
+                       "ends trimmed, decimated [default: no filtering].")
     @scene_option()
     @quiet_option
     @strict_option
@@ -133,7 +135,8 @@ def add_commands(main: click.Group, handle_errors, strict_option, quiet_option, 
         DATA's header names its columns: t, q_<joint>, qd_<joint>, qdd_<joint>, tau_<joint>
         (t optional), or t, q_<joint>, tau_<joint> (q̇, q̈ then come from a zero-phase
         Butterworth filter and central differences), joints as in the description (after
-        --scene). Weighted least squares (Gautier) with standard deviations and the condition
+        --scene). With qd_, qdd_ columns and --cutoff, all four signals go through that filter
+        (t needed). Weighted least squares (Gautier) with standard deviations and the condition
         number; --physical adds a fit with positive semi-definite pseudo-inertias. Writes
         identify_<robot>.md (table), .csv (estimates) and .png (predicted against measured
         efforts) into OUTPUT.

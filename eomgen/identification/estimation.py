@@ -11,7 +11,9 @@ The pieces, each a plain function over plain data:
   SI units (s, rad or m, rad/s or m/s, rad/s² or m/s², N m or N). In the second form q̇ and q̈
   come from :func:`filtered_derivatives`: q and τ through the same zero-phase Butterworth
   low-pass filter (order 4, run forward and backward by ``scipy.signal.sosfiltfilt``), then
-  second-order central differences (``numpy.gradient``), then decimation.
+  second-order central differences (``numpy.gradient``), then decimation. In the first form
+  the columns are used as they are, unless a cut-off is given: then q, q̇, q̈ and τ all go
+  through that same filter, trimming and decimation (:func:`filtered_signals`).
 * **Estimation** (:func:`weighted_least_squares`): Gautier's weighted least squares, standard
   deviations, condition number; :func:`physical_fit` adds the constraint that every body's
   pseudo-inertia be positive semi-definite (an SDP, needs cvxpy).
@@ -74,6 +76,9 @@ class Measurements:
         True when q̇ and q̈ were computed by :func:`filtered_derivatives` (and τ filtered).
     source : str
         Where they came from (file name), for messages.
+    cutoff : float or None
+        Cut-off frequency [Hz] of the zero-phase low-pass filter the samples went through
+        (differentiated, or filtered at a given cut-off), None when they are as read.
     """
 
     joint_names: tuple[str, ...]
@@ -84,6 +89,7 @@ class Measurements:
     tau: np.ndarray
     differentiated: bool = False
     source: str = "<measurements>"
+    cutoff: float | None = None
 
     @property
     def N(self) -> int:
@@ -123,15 +129,19 @@ def read_measurements(path: Path | str, joint_names: Sequence[str],
     joint_names:
         JOINT_NAMES of the robot the data belong to (after any scene reduction).
     cutoff:
-        Cut-off frequency [Hz] of the low-pass filter when q̇ and q̈ are to be computed (default
-        a fifth of the Nyquist frequency); ignored when the file has them.
+        Cut-off frequency [Hz] of the zero-phase low-pass filter. When q̇ and q̈ are to be
+        computed, default a fifth of the Nyquist frequency (:func:`filtered_derivatives`).
+        When the file has them, None (default) uses every column as read; a number filters
+        q, q̇, q̈ and τ alike, drops the filter's transients at both ends and decimates
+        (:func:`filtered_signals`), which needs the ``t`` column.
 
     Raises
     ------
     IdentificationError
         For an unreadable file, a missing, unknown or repeated column, a line with the wrong
         number of fields, a field that is not a finite number (naming line and column), times
-        that are not increasing and evenly spaced when needed, too few samples to filter.
+        that are not increasing and evenly spaced when needed, too few samples to filter, a
+        cut-off with no ``t`` column.
     """
     path = Path(path)
     source = str(path)
@@ -189,10 +199,17 @@ def read_measurements(path: Path | str, joint_names: Sequence[str],
     t = column.get("t")
     q, tau = block("q"), block("tau")
     if not differentiate:
-        return Measurements(tuple(joint_names), t, q, block("qd"), block("qdd"), tau, False,
-                            source)
-    t, q, qd, qdd, tau = filtered_derivatives(t, q, tau, cutoff, source)
-    return Measurements(tuple(joint_names), t, q, qd, qdd, tau, True, source)
+        if cutoff is None:
+            return Measurements(tuple(joint_names), t, q, block("qd"), block("qdd"), tau, False,
+                                source)
+        if t is None:
+            raise IdentificationError(f"{source}: line 1: missing column 't' (needed to filter "
+                                      f"at the cut-off {cutoff:.6g} Hz)")
+        t, (q, qd, qdd, tau), used = filtered_signals(t, (q, block("qd"), block("qdd"), tau),
+                                                      cutoff, source)
+        return Measurements(tuple(joint_names), t, q, qd, qdd, tau, False, source, used)
+    t, q, qd, qdd, tau, used = _filtered_derivatives(t, q, tau, cutoff, source)
+    return Measurements(tuple(joint_names), t, q, qd, qdd, tau, True, source, used)
 
 
 def filtered_derivatives(t, q, tau, cutoff: float | None = None, source: str = "<data>"):
@@ -226,37 +243,89 @@ def filtered_derivatives(t, q, tau, cutoff: float | None = None, source: str = "
         Times not increasing and evenly spaced (to 1e-6 of the step), a cut-off at or above
         the Nyquist frequency, too few samples to filter.
     """
+    return _filtered_derivatives(t, q, tau, cutoff, source)[:5]
+
+
+def _filtered_derivatives(t, q, tau, cutoff, source):
+    """:func:`filtered_derivatives`, and the cut-off used."""
+    if np.asarray(t).size < 3:
+        raise IdentificationError(f"{source}: {np.asarray(t).size} samples; filtered "
+                                  "differentiation needs many more (give qd_ and qdd_ columns, "
+                                  "or record longer)")
+    filtered, keep, dt, cutoff = _lowpass(t, (q, tau), cutoff, source, "filtered differentiation")
+    qf, tauf = filtered
+    qd = np.gradient(qf, dt, axis=0, edge_order=2)
+    qdd = np.gradient(qd, dt, axis=0, edge_order=2)
+    t = np.asarray(t, dtype=float)
+    return t[keep], qf[keep], qd[keep], qdd[keep], tauf[keep], cutoff
+
+
+def filtered_signals(t, signals: Sequence, cutoff: float, source: str = "<data>"):
+    """Measured signals (q, q̇, q̈, τ as read) through the filter of
+    :func:`filtered_derivatives`, all alike.
+
+    The same zero-phase Butterworth low-pass filter (order :data:`FILTER_ORDER`, forward and
+    backward, cut-off ``cutoff`` [Hz]) on every signal, so that none is delayed against the
+    others and τ = Y(q, q̇, q̈) β still holds up to the filter's effect on the products in Y
+    (small when the motion's content lies well below the cut-off); the three cut-off periods
+    at each end are dropped and the rest decimated to every ⌊fs / (2 cutoff)⌋-th sample, as in
+    :func:`filtered_derivatives`. Nothing is differentiated: q̇ and q̈ stay the measured ones,
+    filtered.
+
+    Parameters
+    ----------
+    t : (N,) array, evenly spaced and increasing [s]
+    signals : sequence of (N, n) arrays
+    cutoff : float
+        [Hz], between 0 and the Nyquist frequency fs / 2.
+
+    Returns
+    -------
+    t, filtered, cutoff
+        The kept times, the kept filtered signals (a tuple in the order given) and the
+        cut-off.
+
+    Raises
+    ------
+    IdentificationError
+        As :func:`filtered_derivatives`.
+    """
+    filtered, keep, _, cutoff = _lowpass(t, signals, cutoff, source, "filtering")
+    return np.asarray(t, dtype=float)[keep], tuple(x[keep] for x in filtered), cutoff
+
+
+def _lowpass(t, signals, cutoff, source, what):
+    """Filter ``signals`` (each (N, n)) zero-phase at ``cutoff`` [Hz] (None: fs / 10).
+    Returns (filtered signals, slice of the samples to keep, time step, cut-off)."""
     from scipy import signal
 
     t = np.asarray(t, dtype=float)
-    if t.size < 3:
-        raise IdentificationError(f"{source}: {t.size} samples; filtered differentiation needs "
-                                  "many more (give qd_ and qdd_ columns, or record longer)")
     steps = np.diff(t)
-    dt = float(np.mean(steps))
+    dt = float(np.mean(steps)) if steps.size else 0.0
     bad = np.flatnonzero(~(np.abs(steps - dt) <= 1e-6 * abs(dt))) if dt > 0 else [0]
     if len(bad):
         raise IdentificationError(f"{source}: line {int(bad[0]) + 3}, column t: times must "
-                                  f"increase by a constant step to differentiate q (step "
-                                  f"{steps[bad[0]]:.6g} s, mean {dt:.6g} s)")
+                                  f"increase by a constant step for {what} (step "
+                                  f"{steps[bad[0]]:.6g} s, mean {dt:.6g} s)" if steps.size else
+                                  f"{source}: {t.size} samples; {what} needs many more")
     fs = 1.0 / dt
     cutoff = fs / 10 if cutoff is None else float(cutoff)
     if not 0 < cutoff < fs / 2:
         raise IdentificationError(f"{source}: cut-off {cutoff:.6g} Hz must be between 0 and the "
                                   f"Nyquist frequency {fs / 2:.6g} Hz")
     sos = signal.butter(FILTER_ORDER, cutoff, fs=fs, output="sos")
-    period = int(math.ceil(fs / cutoff))  # samples per period of the cut-off frequency
+    # samples per period of the cut-off frequency; the 1e-9 keeps fs / cutoff = 10 from
+    # reading as 10.000000000000002 (times from a CSV file)
+    period = int(math.ceil(fs / cutoff - 1e-9))
     trim = padlen = 3 * period
     needed = 2 * trim + 3
     if t.size < needed:
-        raise IdentificationError(f"{source}: {t.size} samples; filtered differentiation at "
-                                  f"{cutoff:.6g} Hz needs at least {needed}")
-    qf = signal.sosfiltfilt(sos, q, axis=0, padlen=padlen)
-    tauf = signal.sosfiltfilt(sos, tau, axis=0, padlen=padlen)
-    qd = np.gradient(qf, dt, axis=0, edge_order=2)
-    qdd = np.gradient(qd, dt, axis=0, edge_order=2)
-    keep = slice(trim, t.size - trim, max(1, int(fs / (2 * cutoff))))
-    return t[keep], qf[keep], qd[keep], qdd[keep], tauf[keep]
+        raise IdentificationError(f"{source}: {t.size} samples; {what} at {cutoff:.6g} Hz "
+                                  f"needs at least {needed}")
+    filtered = tuple(signal.sosfiltfilt(sos, np.asarray(x, dtype=float), axis=0, padlen=padlen)
+                     for x in signals)
+    keep = slice(trim, t.size - trim, max(1, int(fs / (2 * cutoff) + 1e-9)))
+    return filtered, keep, dt, cutoff
 
 
 # ----------------------------------------------------------------------------------------------
