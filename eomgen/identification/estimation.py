@@ -612,8 +612,99 @@ class FourierTrajectory:
 
     def bound(self) -> np.ndarray:
         """The largest possible |q_j(t)| per joint, |q0_j| + Σ_l (|a_jl| + |b_jl|) / (ω_f l)."""
+        return np.abs(self.q0) + self._sums(-1)
+
+    def velocity_bound(self) -> np.ndarray:
+        """The largest possible |q̇_j(t)| per joint, Σ_l (|a_jl| + |b_jl|)."""
+        return self._sums(0)
+
+    def acceleration_bound(self) -> np.ndarray:
+        """The largest possible |q̈_j(t)| per joint, Σ_l (|a_jl| + |b_jl|) ω_f l."""
+        return self._sums(1)
+
+    def _sums(self, power: int) -> np.ndarray:
         w = self.omega * np.arange(1, self.a.shape[1] + 1)
-        return np.abs(self.q0) + np.sum((np.abs(self.a) + np.abs(self.b)) / w, axis=1)
+        return np.sum((np.abs(self.a) + np.abs(self.b)) * w ** power, axis=1)
+
+
+@dataclass(frozen=True)
+class MotionBounds:
+    """What an excitation trajectory must respect, per joint (JOINT_NAMES order).
+
+    Attributes
+    ----------
+    lower, upper : (n,) arrays
+        Position range [rad or m]: lower ≤ q_j(t) ≤ upper.
+    velocity, acceleration : (n,) arrays
+        |q̇_j(t)| ≤ velocity [rad/s or m/s], |q̈_j(t)| ≤ acceleration [rad/s² or m/s²];
+        ``inf`` for no bound.
+    """
+
+    lower: np.ndarray
+    upper: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+
+
+def motion_bounds(joint_names: Sequence[str], amplitude: float = 1.0,
+                  limits: Mapping | None = None, max_velocity: float | None = None,
+                  max_acceleration: float | None = None, source: str = "<description>"
+                  ) -> MotionBounds:
+    """The bounds of :func:`excitation_trajectory` for each joint: the tighter of the options
+    and the description's limits.
+
+    Positions: within ±``amplitude`` and within the joint's ``lower``/``upper`` limits when
+    given. Velocities: ``max_velocity`` and the joint's ``velocity`` limit. Accelerations:
+    ``max_acceleration`` (descriptions have none).
+
+    Parameters
+    ----------
+    joint_names:
+        JOINT_NAMES (after any scene).
+    limits:
+        Joint name → an object with ``lower``, ``upper``, ``velocity`` attributes (None for
+        absent), e.g. :func:`eomgen.parsers.urdf.joint_limits`; joints not in it unbounded.
+    source:
+        The description, named in errors.
+
+    Raises
+    ------
+    IdentificationError
+        When a joint has no room to move: an empty or zero-width position range (its limits
+        outside ±amplitude, or lower ≥ upper), or a velocity or acceleration bound that is not
+        positive.
+    """
+    n = len(joint_names)
+    for name, value in (("--amplitude", amplitude), ("--max-velocity", max_velocity),
+                        ("--max-acceleration", max_acceleration)):
+        if value is not None and not (value > 0):
+            raise IdentificationError(f"{name} must be positive, got {value}")
+    lower, upper = np.full(n, -float(amplitude)), np.full(n, float(amplitude))
+    inf = math.inf
+    velocity = np.full(n, inf if max_velocity is None else float(max_velocity))
+    acceleration = np.full(n, inf if max_acceleration is None else float(max_acceleration))
+    for j, name in enumerate(joint_names):
+        limit = (limits or {}).get(name)
+        if limit is None:
+            continue
+        if limit.lower is not None:
+            lower[j] = max(lower[j], limit.lower)
+        if limit.upper is not None:
+            upper[j] = min(upper[j], limit.upper)
+        if limit.velocity is not None:
+            if not limit.velocity > 0:
+                raise IdentificationError(f"{source}: joint '{name}': velocity limit "
+                                          f"{limit.velocity:g} leaves no motion to excite")
+            velocity[j] = min(velocity[j], limit.velocity)
+        if not upper[j] > lower[j]:
+            raise IdentificationError(one_line(
+                f"{source}: joint '{name}': its limits [{_g(limit.lower)}, {_g(limit.upper)}] "
+                f"and ±--amplitude {amplitude:g} leave no room to move (raise --amplitude)"))
+    return MotionBounds(lower, upper, velocity, acceleration)
+
+
+def _g(value: float | None) -> str:
+    return "none" if value is None else f"{value:g}"
 
 
 @dataclass(frozen=True)
@@ -629,16 +720,26 @@ class Excitation:
 
 def excitation_trajectory(reg, base, period: float = 10.0, harmonics: int = 3,
                           amplitude: float = 1.0, samples: int | None = None, seed: int = 0,
-                          maxiter: int = 30, values: Mapping | None = None) -> Excitation:
-    """Fourier coefficients minimising cond(W_base) (Swevers et al. 1997), bounded amplitudes.
+                          maxiter: int = 30, values: Mapping | None = None,
+                          bounds: MotionBounds | None = None) -> Excitation:
+    """Fourier coefficients minimising cond(W_base) (Swevers et al. 1997) within bounds on
+    q, q̇ and q̈.
 
     Variables: q0 and the coefficients a, b of :class:`FourierTrajectory` (n (2 L + 1) of
-    them), with box bounds |q0_j| ≤ amplitude / 2 and |a_jl|, |b_jl| ≤ amplitude ω_f l / (4 L),
-    which guarantee |q_j(t)| ≤ amplitude for every t. Objective: log10 of the condition number
-    of the column-normalised base regressor stacked at ``samples`` evenly spaced times of one
-    period (default 3 b / n + 10). Start: uniform random inside the bounds from ``seed``;
-    minimiser: ``scipy.optimize.minimize(method="L-BFGS-B")`` with finite-difference
-    gradients, at most ``maxiter`` iterations. Deterministic for a given seed.
+    them), in boxes that guarantee every bound at every t, not only at samples. With joint j's
+    position range [lo, hi] (mid-point m, half-width h), velocity bound V and acceleration
+    bound A (``bounds``; default |q_j| ≤ ``amplitude``, no V or A)::
+
+        |q0_j − m| ≤ h / 2,   |a_jl|, |b_jl| ≤ min(h ω_f l / (4 L), V / (2 L), A / (2 L ω_f l))
+
+    so that Σ_l (|a_jl| + |b_jl|) / (ω_f l) ≤ h / 2 (q within [lo, hi]), Σ_l (|a_jl| + |b_jl|)
+    ≤ V and Σ_l (|a_jl| + |b_jl|) ω_f l ≤ A (:meth:`FourierTrajectory.bound` and its
+    siblings); the boxes are shrunk by 1e-9 so that rounding cannot reach a bound. Objective:
+    log10 of the condition number of the column-normalised base regressor stacked at
+    ``samples`` evenly spaced times of one period (default 3 b / n + 10). Start: uniform random
+    inside the boxes from ``seed``; minimiser: ``scipy.optimize.minimize(method="L-BFGS-B")``
+    with finite-difference gradients, at most ``maxiter`` iterations. Deterministic for a given
+    seed.
 
     Parameters
     ----------
@@ -649,22 +750,34 @@ def excitation_trajectory(reg, base, period: float = 10.0, harmonics: int = 3,
     harmonics:
         L, the number of harmonics per joint.
     amplitude:
-        Bound on |q_j(t)| [rad or m].
+        Bound on |q_j(t)| [rad or m] when ``bounds`` is None.
+    bounds:
+        Position ranges and velocity and acceleration bounds (:func:`motion_bounds`).
     """
     from scipy.optimize import minimize
 
     n, L, b = reg.n, int(harmonics), len(base.base)
     if n == 0:
         raise IdentificationError(f"{reg.model.source}: no movable joint to excite")
+    if bounds is None:
+        bounds = motion_bounds(reg.model.joint_names, amplitude, source=reg.model.source)
     omega = 2 * math.pi / period
     samples = samples or 3 * b // max(n, 1) + 10
     t = np.arange(samples) * (period / samples)
     f = reg.compiled(values, program=reg.base_program(list(base.base)))
     ws = omega * np.arange(1, L + 1)
-    coef_bound = np.tile(amplitude * ws / (4 * L), (n, 1))
-    upper = np.concatenate([np.full(n, amplitude / 2), coef_bound.ravel(), coef_bound.ravel()])
+    shrink = 1 - 1e-9
+    mid = (bounds.lower + bounds.upper) / 2
+    half = (bounds.upper - bounds.lower) / 2
+    coef = shrink * np.minimum.reduce([
+        half[:, None] * ws[None, :] / (4 * L),
+        np.broadcast_to(bounds.velocity[:, None] / (2 * L), (n, L)),
+        bounds.acceleration[:, None] / (2 * L * ws[None, :])])
+    low = np.concatenate([mid - shrink * half / 2, -coef.ravel(), -coef.ravel()])
+    high = np.concatenate([mid + shrink * half / 2, coef.ravel(), coef.ravel()])
 
     def unpack(x):
+        x = np.clip(x, low, high)
         return FourierTrajectory(x[:n], x[n:n + n * L].reshape(n, L),
                                  x[n + n * L:].reshape(n, L), omega)
 
@@ -678,9 +791,9 @@ def excitation_trajectory(reg, base, period: float = 10.0, harmonics: int = 3,
         return math.log10(c) if math.isfinite(c) and c < 1e300 else 300.0
 
     rng = np.random.default_rng(seed)
-    x0 = rng.uniform(-upper, upper)
+    x0 = rng.uniform(low, high)
     initial = 10 ** objective(x0)
-    result = minimize(objective, x0, method="L-BFGS-B", bounds=list(zip(-upper, upper)),
+    result = minimize(objective, x0, method="L-BFGS-B", bounds=list(zip(low, high)),
                       options={"maxiter": int(maxiter)})
     x = result.x if result.fun <= math.log10(initial) else x0
     return Excitation(unpack(x), initial, 10 ** objective(x), count[0])
