@@ -48,7 +48,7 @@ from eomgen.symbolic.textbook import (
     TEXTBOOK_MAX_DOF, christoffel_symbols, description_floats, fourier_form, textbook_derivation,
 )
 from conftest import erd_robots_dir
-from reference import random_robot
+from reference import planar_2link_by_hand, random_robot
 
 ALL = ("M", "C", "g", "tau")
 pytestmark = pytest.mark.filterwarnings("ignore::eomgen.errors.PhysicalConsistencyWarning")
@@ -413,11 +413,10 @@ def test_planar_document_has_the_textbook_entries_in_compact_form():
 
 
 def test_planar_document_prints_the_regressor_as_derived_by_hand():
-    """τ = Y π with the columns named: every non-zero entry of Y is the hand derivation of
-    test_regressor (printed in the document's notation), the zero columns are listed, and the
-    base parameters are the hand grouping, the column's own parameter first."""
+    """τ = Y π with the columns named: every non-zero entry of Y is the hand derivation
+    (reference.planar_2link_by_hand, printed in the document's notation), the zero columns
+    are listed, and the base parameters are the hand grouping, own parameter first."""
     from eomgen.regressor import regressor_form
-    from test_regressor import planar_2link_by_hand
 
     tex = document("planar_2link")
     hand, q, _ = planar_2link_by_hand()

@@ -300,14 +300,15 @@ def _lowpass(t, signals, cutoff, source, what):
     from scipy import signal
 
     t = np.asarray(t, dtype=float)
+    if t.size < 3:
+        raise IdentificationError(f"{source}: {t.size} samples; {what} needs many more")
     steps = np.diff(t)
-    dt = float(np.mean(steps)) if steps.size else 0.0
+    dt = float(np.mean(steps))
     bad = np.flatnonzero(~(np.abs(steps - dt) <= 1e-6 * abs(dt))) if dt > 0 else [0]
     if len(bad):
         raise IdentificationError(f"{source}: line {int(bad[0]) + 3}, column t: times must "
                                   f"increase by a constant step for {what} (step "
-                                  f"{steps[bad[0]]:.6g} s, mean {dt:.6g} s)" if steps.size else
-                                  f"{source}: {t.size} samples; {what} needs many more")
+                                  f"{steps[bad[0]]:.6g} s, mean {dt:.6g} s)")
     fs = 1.0 / dt
     cutoff = fs / 10 if cutoff is None else float(cutoff)
     if not 0 < cutoff < fs / 2:
