@@ -735,7 +735,10 @@ def excitation_trajectory(reg, base, period: float = 10.0, harmonics: int = 3,
 
     so that Σ_l (|a_jl| + |b_jl|) / (ω_f l) ≤ h / 2 (q within [lo, hi]), Σ_l (|a_jl| + |b_jl|)
     ≤ V and Σ_l (|a_jl| + |b_jl|) ω_f l ≤ A (:meth:`FourierTrajectory.bound` and its
-    siblings); the boxes are shrunk by 1e-9 so that rounding cannot reach a bound. Objective:
+    siblings); the boxes are shrunk by 1e-9 so that rounding cannot reach a bound. The boxes
+    split each bound evenly between the harmonics, so after the optimisation each joint's
+    a, b are scaled up until the tightest of those sums reaches its bound, kept if that does
+    not raise the condition number. Objective:
     log10 of the condition number of the column-normalised base regressor stacked at
     ``samples`` evenly spaced times of one period (default 3 b / n + 10). Start: uniform random
     inside the boxes from ``seed``; minimiser: ``scipy.optimize.minimize(method="L-BFGS-B")``
@@ -784,20 +787,40 @@ def excitation_trajectory(reg, base, period: float = 10.0, harmonics: int = 3,
 
     count = [0]
 
-    def objective(x):
+    def condition(trajectory):
         count[0] += 1
-        q, qd, qdd = unpack(x).states(t)
+        q, qd, qdd = trajectory.states(t)
         W = np.vstack([f(*row)["Y_base"] for row in zip(q, qd, qdd)])
         c = normalised_condition(W)
         return math.log10(c) if math.isfinite(c) and c < 1e300 else 300.0
+
+    def objective(x):
+        return condition(unpack(x))
+
+    def stretched(trajectory):
+        # each joint's oscillation scaled up until its tightest bound is reached (by the same
+        # sums that bound it): the boxes split each bound evenly between the harmonics, so
+        # the optimum usually leaves room
+        tr = trajectory
+        room = shrink * half - np.abs(tr.q0 - mid)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            scale = np.nanmin([room / tr._sums(-1), shrink * bounds.velocity / tr._sums(0),
+                               shrink * bounds.acceleration / tr._sums(1)], axis=0)
+        scale = np.where(np.isfinite(scale), np.maximum(scale, 1.0), 1.0)[:, None]
+        return FourierTrajectory(tr.q0, tr.a * scale, tr.b * scale, omega)
 
     rng = np.random.default_rng(seed)
     x0 = rng.uniform(low, high)
     initial = 10 ** objective(x0)
     result = minimize(objective, x0, method="L-BFGS-B", bounds=list(zip(low, high)),
                       options={"maxiter": int(maxiter)})
-    x = result.x if result.fun <= math.log10(initial) else x0
-    return Excitation(unpack(x), initial, 10 ** objective(x), count[0])
+    best = unpack(result.x if result.fun <= math.log10(initial) else x0)
+    value = condition(best)
+    wider = stretched(best)
+    wider_value = condition(wider)
+    if wider_value <= value:
+        best, value = wider, wider_value
+    return Excitation(best, initial, 10 ** value, count[0])
 
 
 def simulate_measurements(model, trajectory: FourierTrajectory, t, noise: float = 0.0,
