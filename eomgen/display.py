@@ -56,10 +56,10 @@ def model_html(model: RobotModel) -> str:
             + "\n</tbody>\n</table></div>")
 
 
-def _printer(dynamics: Dynamics):
+def _printer(dynamics: Dynamics, names: dict | None = None):
     from .codegen.backends.latex_backend import LatexConfig, printing
 
-    return printing(dynamics, LatexConfig(), compact_trig=True).printer
+    return printing(dynamics, LatexConfig(), compact_trig=True, extra_names=names).printer
 
 
 def _text(value: str) -> str:
@@ -152,16 +152,18 @@ def _unevaluated(e) -> bool:
     return e.args != sp.Add(*e.args).args
 
 
-def expression_latex(dynamics: Dynamics, expr) -> str:
+def expression_latex(dynamics: Dynamics, expr, names: dict | None = None) -> str:
     """LaTeX of one expression or matrix in the notation of :func:`dynamics_latex`; grouped
-    sums (:func:`grouped_matrices`) keep their order, as in :func:`dynamics_latex`.
+    sums (:func:`grouped_matrices`) keep their order, as in :func:`dynamics_latex`. ``names``
+    gives the LaTeX of further symbols (e.g. :attr:`eomgen.regressor.RegressorForm.
+    latex_names` for the inertial parameters).
 
     >>> import eomgen
     >>> dyn = eomgen.derive(eomgen.load(eomgen.example_path("planar_2link")))
     >>> expression_latex(dyn, dyn.g[1])
     'g l_{c2} m_{2} c_{12}'
     """
-    printer = _printer(dynamics)
+    printer = _printer(dynamics, names)
     if isinstance(expr, sp.MatrixBase):
         return _matrix_latex(printer, expr)
     if isinstance(expr, sp.Add) and _unevaluated(expr):

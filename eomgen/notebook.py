@@ -5,7 +5,9 @@ Sections, each a short explanation followed by a code cell using eomgen's API: l
 robot; for teaching-sized models (at most :data:`~eomgen.symbolic.textbook.TEXTBOOK_MAX_DOF`
 joints and :data:`~eomgen.symbolic.textbook.TEXTBOOK_MAX_OPERATIONS` program operations) the
 textbook derivation (centre-of-mass positions, Jacobians, kinetic and potential energy per link,
-M, Christoffel symbols, C, g); the equations of motion; the property checks of
+M, Christoffel symbols, C, g); the equations of motion; for the same models the regressor
+Y (τ = Y π, columns named) and the base parameters as expressions of the standard ones
+(:func:`eomgen.regressor.regressor_form`); the property checks of
 :func:`eomgen.verify`; a comparison with the numeric Newton–Euler algorithm at a sample state;
 and a short simulation (SciPy's ``solve_ivp``) with a plot.
 
@@ -183,6 +185,53 @@ size (`dyn.lambdify()` turns it into NumPy functions):
     md("## The equations of motion\n\n$M(q)\\,\\ddot q + C(q, \\dot q)\\,\\dot q + g(q) = "
        "\\tau$, in joint order:")
     code("print(dyn.joint_names)\ndyn")
+    if small:
+        md("""
+## Linear in the parameters: the regressor
+
+The equations of motion are linear in the inertial parameters of the bodies,
+$\\tau = Y(q, \\dot q, \\ddot q)\\,\\pi$. Body $k$ has ten, in its own frame (joint $k$'s frame
+after the joint has moved): mass $\\mathrm{M}_k$, first moment $(\\mathrm{MX}_k, \\mathrm{MY}_k,
+\\mathrm{MZ}_k) = m_k c_k$, and inertia $\\mathrm{XX}_k, \\mathrm{XY}_k, \\mathrm{YY}_k,
+\\mathrm{XZ}_k, \\mathrm{YZ}_k, \\mathrm{ZZ}_k$ about the frame's origin: one column of $Y$ each.
+Columns that are zero are listed; the others are shown one by one.
+""")
+        code("""
+from eomgen.regressor import parameter_latex, regressor_form
+
+form = regressor_form(model)
+reg = form.regressor
+print("zero columns:", ", ".join(reg.PARAMETER_NAMES[k] for k in form.zero))
+display(Math(r"\\pi = " + expression_latex(dyn, form.pi.T, form.latex_names) + "^T"))
+for c, name in enumerate(form.names):
+    display(Math(r"Y_{:,\\," + parameter_latex(name) + "} = "
+                 + expression_latex(dyn, form.Y[:, c], form.latex_names)))
+# the check, at a sample state: Y pi with the description's pi is M qdd + C qd + g
+at = dict(zip([*dyn.q, *dyn.qd, *dyn.qdd], np.linspace(0.3, 1.1, 3 * model.dof)))
+at.update(model.parameter_values)
+pi = reg.inertial_parameters().extract(list(form.columns), [0])
+tau = dyn.M * sp.Matrix(dyn.qdd) + dyn.C * sp.Matrix(dyn.qd) + dyn.g
+print("largest |Y pi - tau|:", max(abs(float(e)) for e in (form.Y * pi - tau).xreplace(at)))
+""")
+        md("""
+## Base parameters
+
+Some columns of $Y$ are combinations of others: only the base parameters $\\beta$ can be
+identified from joint efforts, $\\tau = Y_{base}\\,\\beta$, with $Y_{base}$ the base columns of
+$Y$. Each is a column's parameter with the parameters grouped into it (marked $R$), as
+expressions of the standard ones and of the geometry.
+""")
+        code("""
+for k, name, expr in zip(form.base, form.base_names, form.beta):
+    if expr != reg.parameter_symbols[k]:  # the grouped ones
+        display(Math(parameter_latex(name) + " = "
+                     + expression_latex(dyn, expr, form.latex_names)))
+print("base parameters:", ", ".join(form.base_names))
+# the check, at the same state and a random pi: Y_base beta = Y pi
+at.update(zip(reg.parameter_symbols, np.random.default_rng(0).uniform(0.5, 1.5, reg.p)))
+print("largest |Y_base beta - Y pi|:",
+      max(abs(float(e)) for e in (form.Y_base * sp.Matrix(form.beta) - form.Y * form.pi).xreplace(at)))
+""")
     md("""
 ## Property checks
 

@@ -11,6 +11,7 @@ import math
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
+import sympy as sp
 
 from eomgen.model import (
     Inertial,
@@ -326,3 +327,28 @@ def random_robot(
         gravity=g.tolist(),
     )
 
+
+def planar_2link_by_hand():
+    """The textbook closed form of the planar two-link arm's regressor, derived by hand
+    (Lagrange) with every parameter about its joint's origin, body axes (x along the link),
+    gravity γ along −y: body 2's point (x, y) sits at l1 e(q1) + R(q1 + q2) (x, y), so
+
+        τ1 = ZZ1 q̈1 + MX1 γ c1 − MY1 γ s1 + M2 (l1² q̈1 + l1 γ c1) + ZZ2 (q̈1 + q̈2)
+             + MX2 (l1 ((2 q̈1 + q̈2) c2 − (2 q̇1 q̇2 + q̇2²) s2) + γ c12)
+             − MY2 (l1 ((2 q̈1 + q̈2) s2 + (2 q̇1 q̇2 + q̇2²) c2) + γ s12)
+        τ2 = ZZ2 (q̈1 + q̈2) + MX2 (l1 (q̈1 c2 + q̇1² s2) + γ c12)
+             + MY2 (l1 (q̇1² c2 − q̈1 s2) − γ s12)
+
+    Returns the non-zero columns {name: (row 1, row 2)} and the symbols used."""
+    q1, q2, qd1, qd2, qdd1, qdd2, l1, g = sp.symbols("q1 q2 qd1 qd2 qdd1 qdd2 l1 g", real=True)
+    s1, c1, s2, c2 = sp.sin(q1), sp.cos(q1), sp.sin(q2), sp.cos(q2)
+    s12, c12 = sp.sin(q1 + q2), sp.cos(q1 + q2)
+    a, v = 2 * qdd1 + qdd2, 2 * qd1 * qd2 + qd2 ** 2
+    columns = {
+        "MX1": (g * c1, 0), "MY1": (-g * s1, 0), "ZZ1": (qdd1, 0),
+        "M2": (l1 ** 2 * qdd1 + l1 * g * c1, 0),
+        "MX2": (l1 * (a * c2 - v * s2) + g * c12, l1 * (qdd1 * c2 + qd1 ** 2 * s2) + g * c12),
+        "MY2": (-l1 * (a * s2 + v * c2) - g * s12, l1 * (qd1 ** 2 * c2 - qdd1 * s2) - g * s12),
+        "ZZ2": (qdd1 + qdd2, qdd1 + qdd2),
+    }
+    return columns, (q1, q2), l1

@@ -16,10 +16,13 @@ import numpy as np
 import pytest
 
 import eomgen
-from eomgen.identification import (IdentificationError, Measurements, excitation_trajectory,
-                                   measurements_csv, observation_matrix, physical_fit,
-                                   pseudo_inertia, read_measurements, simulate_measurements,
+from eomgen.errors import InvalidNumberError
+from eomgen.identification import (IdentificationError, Measurements, MotionBounds,
+                                   excitation_trajectory, measurements_csv, motion_bounds,
+                                   observation_matrix, physical_fit, pseudo_inertia,
+                                   read_measurements, simulate_measurements,
                                    weighted_least_squares)
+from eomgen.parsers.urdf import JointLimit, joint_limits
 from eomgen.regressor import base_parameters, derive_regressor
 
 from conftest import erd_robots_dir
@@ -74,6 +77,99 @@ def test_excitation_lowers_the_condition_number_and_keeps_the_amplitude_bound():
     np.testing.assert_allclose((qdp - qdm) / (2 * h), qdd1, atol=1e-7)
     again = excitation_trajectory(reg, base, period=10.0, harmonics=3, seed=0, maxiter=10)
     assert np.array_equal(again.trajectory.a, ex.trajectory.a)  # deterministic
+
+
+def within(data, bounds, rtol=1e-12):
+    """Whether sampled q, q̇, q̈ (N, n) respect ``bounds`` (checked on the samples alone)."""
+    q, qd, qdd = data
+    return (np.all(q >= bounds.lower) and np.all(q <= bounds.upper)
+            and np.all(np.abs(qd) <= bounds.velocity) and np.all(np.abs(qdd) <= bounds.acceleration))
+
+
+def test_excitation_respects_position_velocity_and_acceleration_bounds():
+    """Limits that the unbounded optimum breaks: the bounded trajectory, sampled finely and
+    checked on the samples, stays inside every one of them, and still excites β (rank 6)."""
+    model, reg, base, free = setup("planar_2link")
+    t = np.linspace(0, 10, 4001)
+    limits = {"joint1": JointLimit(lower=0.2, upper=0.9, velocity=0.3),
+              "joint2": JointLimit(lower=-0.5, upper=None)}
+    bounds = motion_bounds(model.joint_names, 1.0, limits, max_velocity=0.5,
+                           max_acceleration=0.15)
+    np.testing.assert_array_equal(bounds.lower, [0.2, -0.5])
+    np.testing.assert_array_equal(bounds.upper, [0.9, 1.0])
+    np.testing.assert_array_equal(bounds.velocity, [0.3, 0.5])
+    np.testing.assert_array_equal(bounds.acceleration, [0.15, 0.15])
+    assert not within(free.trajectory.states(t), bounds)  # the bounds bite
+    ex = excitation_trajectory(reg, base, period=10.0, harmonics=3, seed=0, maxiter=10,
+                               bounds=bounds)
+    states = ex.trajectory.states(t)
+    assert within(states, bounds)
+    # and not by standing still: each joint uses a fair part of its position range
+    q = states[0]
+    assert np.all(q.max(axis=0) - q.min(axis=0) > 0.1 * (bounds.upper - bounds.lower))
+    W = observation_matrix(reg, base.base, *(x[::40] for x in states))
+    assert np.linalg.matrix_rank(W) == len(base.base)
+
+
+def test_motion_bounds_refuse_a_joint_with_no_room():
+    names = ("joint1", "joint2")
+    with pytest.raises(IdentificationError, match=r"arm.urdf: joint 'joint2': its limits "
+                                                  r"\[1.5, 2\] and ±--amplitude 1 leave no room"):
+        motion_bounds(names, 1.0, {"joint2": JointLimit(1.5, 2.0)}, source="arm.urdf")
+    with pytest.raises(IdentificationError, match="joint 'joint1': velocity limit 0 leaves"):
+        motion_bounds(names, 1.0, {"joint1": JointLimit(velocity=0.0)})
+    with pytest.raises(IdentificationError, match="--max-acceleration must be positive"):
+        motion_bounds(names, 1.0, max_acceleration=-1.0)
+
+
+ARM_URDF = """<robot name="arm">
+  <link name="base"/>
+  <link name="link1"><inertial><mass value="1"/><origin xyz="0.5 0 0"/>
+    <inertia ixx="0" ixy="0" ixz="0" iyy="0.08" iyz="0" izz="0.08"/></inertial></link>
+  <link name="link2"><inertial><mass value="1"/><origin xyz="0.5 0 0"/>
+    <inertia ixx="0" ixy="0" ixz="0" iyy="0.08" iyz="0" izz="0.08"/></inertial></link>
+  <joint name="joint1" type="revolute"><parent link="base"/><child link="link1"/>
+    <axis xyz="0 0 1"/><limit lower="{lower}" upper="1.2" velocity="0.4" effort="10"/></joint>
+  <joint name="joint2" type="continuous"><parent link="link1"/><child link="link2"/>
+    <origin xyz="1 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="0" upper="0" velocity="2" effort="10"/></joint>
+</robot>
+"""
+
+
+def test_joint_limits_are_read_from_a_urdf(tmp_path):
+    path = tmp_path / "arm.urdf"
+    path.write_text(ARM_URDF.format(lower=0.3))
+    assert joint_limits(path) == {"joint1": JointLimit(0.3, 1.2, 0.4, 10.0),
+                                  "joint2": JointLimit(None, None, 2.0, 10.0)}  # continuous
+    path.write_text(ARM_URDF.format(lower="low"))
+    with pytest.raises(InvalidNumberError, match="joint 'joint1' <limit>.*lower 'low' is not a "
+                                                 "number"):
+        joint_limits(path)
+
+
+def test_excite_keeps_the_urdf_limits_and_the_options(tmp_path):
+    """eomgen excite on a URDF: the written samples (read back from the CSV, not from the
+    optimiser) stay within joint1's <limit> [0.3, 1.2] rad and 0.4 rad/s, ±--amplitude 0.8 for
+    the continuous joint2, --max-velocity 0.3 for joint2 and --max-acceleration 0.2."""
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text(ARM_URDF.format(lower=0.3))
+    data = tmp_path / "arm.csv"
+    done = run_process("excite", urdf, "-o", data, "--samples", 400, "--amplitude", 0.8,
+                       "--max-velocity", 0.3, "--max-acceleration", 0.2, "--quiet")
+    assert done.returncode == 0, done.stderr
+    read = read_measurements(data, ("joint1", "joint2"))
+    bounds = MotionBounds(np.array([0.3, -0.8]), np.array([0.8, 0.8]), np.array([0.3, 0.3]),
+                          np.array([0.2, 0.2]))  # written out, not from motion_bounds
+    assert within((read.q, read.qd, read.qdd), bounds)
+    assert read.q[:, 0].min() > 0.3 and read.q[:, 0].max() < 0.8
+    # no room: joint1's limits [1.5, 2] lie outside ±--amplitude 1; nothing written
+    urdf.write_text(ARM_URDF.format(lower=1.5).replace('upper="1.2"', 'upper="2"'))
+    out = tmp_path / "none.csv"
+    done = run_process("excite", urdf, "-o", out, "--quiet")
+    assert done.returncode == 2 and done.stderr.count("\n") == 1, done.stderr
+    assert done.stderr.startswith(f"eomgen: error: {urdf}: joint 'joint1': its limits [1.5, 2]")
+    assert not out.exists()
 
 
 def test_noise_free_puma_data_recover_the_base_parameters_to_1e_8():
@@ -140,6 +236,55 @@ def test_positions_and_efforts_only_are_differentiated_through_a_filter(tmp_path
     Wf = observation_matrix(reg, base.base, read.q, read.qd, read.qdd)
     est = weighted_least_squares(Wf, read.tau)
     assert np.max(np.abs(est.beta - beta)) < 1e-2 * np.abs(beta).max()
+
+
+def test_cutoff_filters_given_velocities_and_efforts_alike(tmp_path):
+    """With qd_, qdd_ columns, a cut-off filters q, q̇, q̈ and τ (it used to be ignored, the
+    file read as is): 5 % white noise on q̈ and τ is cut to well below half, the motion
+    (0.1–0.3 Hz) passes; the ends are trimmed and the rest decimated; no t, no filtering."""
+    data, _, beta = simulated("planar_2link", 1000)  # 100 Hz over 10 s
+    rng = np.random.default_rng(5)
+    noise = {name: 0.05 * np.sqrt(np.mean(getattr(data, name) ** 2, axis=0))
+             * rng.standard_normal(data.tau.shape) for name in ("qdd", "tau")}
+    noisy = Measurements(data.joint_names, data.t, data.q, data.qd, data.qdd + noise["qdd"],
+                         data.tau + noise["tau"])
+    path = tmp_path / "noisy.csv"
+    path.write_text(measurements_csv(noisy))
+    raw = read_measurements(path, data.joint_names)
+    assert raw.cutoff is None and np.array_equal(raw.tau, noisy.tau)  # no cut-off: as read
+    read = read_measurements(path, data.joint_names, cutoff=2.0)
+    assert read.cutoff == 2.0 and not read.differentiated
+    keep = np.arange(150, 850, 25)  # 3 periods of 2 Hz trimmed each end, every fs/(2 fc)
+    np.testing.assert_array_equal(read.t, data.t[keep])
+    for name in ("q", "qd"):  # noise-free signals pass the filter unchanged
+        clean = getattr(data, name)[keep]
+        np.testing.assert_allclose(getattr(read, name), clean, atol=1e-3 * np.abs(clean).max())
+    for name in ("qdd", "tau"):
+        clean = getattr(data, name)[keep]
+        before = np.sqrt(np.mean((getattr(noisy, name)[keep] - clean) ** 2))
+        after = np.sqrt(np.mean((getattr(read, name) - clean) ** 2))
+        assert after < 0.4 * before, (name, after / before)
+    model, reg, base, _ = setup("planar_2link")
+    W = observation_matrix(reg, base.base, read.q, read.qd, read.qdd)
+    est = weighted_least_squares(W, read.tau)
+    assert np.all(np.abs(est.beta - beta) < 3 * est.std), (est.beta - beta) / est.std
+    no_t = tmp_path / "no_t.csv"
+    no_t.write_text("\n".join(drop_column(path.read_text().splitlines(), "t")) + "\n")
+    with pytest.raises(IdentificationError, match="missing column 't' .needed to filter at "
+                                                  "the cut-off 2 Hz"):
+        read_measurements(no_t, data.joint_names, cutoff=2.0)
+
+
+def test_identify_cutoff_on_full_data_is_reported(tmp_path):
+    data, _, _ = simulated("planar_2link", 400)
+    path = tmp_path / "planar.csv"
+    path.write_text(measurements_csv(data))
+    out = tmp_path / "id"
+    done = run_process("identify", PLANAR, path, "-o", out, "--quiet", "--cutoff", 4)
+    assert done.returncode == 0, done.stderr
+    assert "q, q̇, q̈, τ zero-phase low-pass filtered at 4 Hz" in done.stdout
+    # 40 Hz sampling: 3 periods of 4 Hz (30 samples) trimmed each end, every 5th kept
+    assert f"{len(range(30, 370, 5))} samples × 2 joints" in done.stdout
 
 
 def test_csv_round_trip_is_exact(tmp_path):

@@ -31,7 +31,7 @@ import sympy as sp
 import eomgen
 from eomgen.codegen import available_backends, make_job
 from eomgen.codegen.backends.latex_backend import (
-    LatexConfig, generate_latex, render_document, symbol_names, textbook_for,
+    LatexConfig, generate_latex, printing, render_document, symbol_names, textbook_for,
 )
 from eomgen.codegen.backends.latex_printer import (
     TEXT_ESCAPES, DerivationLatexPrinter, display_width, latex_comment, latex_escape,
@@ -48,7 +48,7 @@ from eomgen.symbolic.textbook import (
     TEXTBOOK_MAX_DOF, christoffel_symbols, description_floats, fourier_form, textbook_derivation,
 )
 from conftest import erd_robots_dir
-from reference import random_robot
+from reference import planar_2link_by_hand, random_robot
 
 ALL = ("M", "C", "g", "tau")
 pytestmark = pytest.mark.filterwarnings("ignore::eomgen.errors.PhysicalConsistencyWarning")
@@ -410,6 +410,44 @@ def test_planar_document_has_the_textbook_entries_in_compact_form():
     assert "K_{1} &= " in tex and "P_{2} &= " in tex
     assert r"\begin{longtable}" in tex and "joint2 & revolute & link1 & link2" in tex
     assert "A large model" not in tex
+
+
+def test_planar_document_prints_the_regressor_as_derived_by_hand():
+    """τ = Y π with the columns named: every non-zero entry of Y is the hand derivation
+    (reference.planar_2link_by_hand, printed in the document's notation), the zero columns
+    are listed, and the base parameters are the hand grouping, own parameter first."""
+    from eomgen.regressor import regressor_form
+
+    tex = document("planar_2link")
+    hand, q, _ = planar_2link_by_hand()
+    dyn = dynamics("planar_2link")
+    form = regressor_form(dyn.model)
+    p = printing(dyn, LatexConfig(), compact_trig=True, extra_names=form.latex_names)
+    printed = 0
+    for name, rows in hand.items():
+        column = name.rstrip("0123456789")
+        for i, entry in enumerate(rows, start=1):
+            lhs = rf"\bigl[Y\bigr]_{{{i},\,\mathrm{{{column}}}_{{{name[-1]}}}}} &= "
+            if entry == 0:
+                assert lhs not in tex
+                continue
+            written = sp.factor_terms(fourier_form(entry, q), sign=False)
+            assert lhs + " ".join(p.printer.print_lines(written, 10 ** 6)) in tex, name
+            printed += 1
+    assert tex.count(r"\bigl[Y\bigr]_") == printed == 10
+    assert r"\pi = \left(\mathrm{MX}_{1}, \mathrm{MY}_{1}, \mathrm{ZZ}_{1}, \mathrm{M}_{2}, " in tex
+    assert r"$\mathrm{M}_{1}, \mathrm{MZ}_{1}, \mathrm{XX}_{1}," in tex  # zero columns
+    assert r"\mathrm{MX}_{1}^{R} &= \mathrm{MX}_{1} + \mathrm{M}_{2} l_{1}" + "\n" in tex
+    assert r"\mathrm{ZZ}_{1}^{R} &= \mathrm{ZZ}_{1} + \mathrm{M}_{2} l_{1}^{2}" + "\n" in tex
+    assert r"\mathrm{MY}_{1} &=" not in tex  # not grouped: named in β only
+    assert r"\section{Linear in the parameters: the regressor}" in tex
+
+
+def test_large_documents_skip_the_regressor_with_a_sentence():
+    tex = document("puma560_dh")
+    assert r"\section{Linear in the parameters}" in tex
+    assert "written out for teaching-sized models only" in tex
+    assert r"\bigl[Y\bigr]" not in tex and "Base parameters" not in tex
 
 
 def test_dh_document_has_the_table_and_the_program():

@@ -73,6 +73,13 @@ def test_cli_notebook_runs_without_errors(tmp_path, example):
     outputs = [o for cell in nb.cells if cell.cell_type == "code" for o in cell.outputs]
     assert not [o for o in outputs if o.output_type == "error"]
     assert any("image/png" in o.get("data", {}) for o in outputs)  # the simulation plot
+    printed = "".join(o.get("text", "") for o in outputs)
+    checks = ("largest |Y pi - tau|:", "largest |Y_base beta - Y pi|:")
+    if example == "puma560_dh":  # the regressor cells are for teaching-sized models only
+        assert not any(check in printed for check in checks)
+    else:  # Y π = M q̈ + C q̇ + g and Y_base β = Y π, checked in the notebook at a state
+        for check in checks:
+            assert float(printed.split(check)[1].split()[0]) < 1e-9, check
     if example != "puma560_dh":  # the textbook cells print M grouped by body mass, as the
         # document and the handout do: the same M, the same LaTeX as the rich display's
         dyn = eomgen.derive(eomgen.load(eomgen.example_path(example)))
@@ -83,6 +90,7 @@ def test_cli_notebook_runs_without_errors(tmp_path, example):
         assert tex[4:] in dynamics_latex(dyn)
         latex = [o.data["text/latex"] for o in outputs if "text/latex" in o.get("data", {})]
         assert any(tex in text for text in latex)
+        assert any(r"\mathrm{ZZ}_{1}^{R} = " in text for text in latex)  # a grouped β
 
 
 def test_cli_notebook_bad_description(tmp_path):

@@ -17,9 +17,10 @@ import eomgen
 from conftest import erd_robots_dir
 from eomgen.errors import UnsupportedError, UnsupportedFeatureWarning
 from eomgen.numeric import kinetic_energy, numeric_model, potential_energy, rnea
-from eomgen.regressor import (base_parameters, derive_regressor, identify,
+from eomgen.regressor import (base_parameters, derive_regressor, identify, regressor_form,
                               symbolic_base_parameters)
-from reference import pin_q_order, random_robot, to_pinocchio
+from eomgen.symbolic.textbook import fourier_form
+from reference import pin_q_order, planar_2link_by_hand, random_robot, to_pinocchio
 
 URDF = {
     "ur5": "ur_description/urdf/ur5_robot.urdf",
@@ -298,6 +299,55 @@ def test_planar_2link_Y_pi_is_the_lagrangian_tau_exactly():
     dyn = eomgen.derive(reg.model)
     difference = reg.Y * reg.inertial_parameters() - dyn.tau
     assert all(sp.simplify(sp.expand(e)) == 0 for e in difference)
+
+
+def test_written_out_planar_regressor_is_the_hand_derivation():
+    """regressor_form (what the LaTeX document and the notebook print): the non-zero columns
+    named and equal to the closed form by hand, the 13 others zero; β the hand grouping
+    MX1 + l1 M2, ZZ1 + l1² M2; Y_base β = Y π exactly in SymPy; and the hand form with the
+    description's π is M q̈ + C q̇ + g of eomgen.derive (a third computation)."""
+    model = load("planar_2link")
+    form = regressor_form(model)
+    hand, q, l1 = planar_2link_by_hand()
+    assert form.names == tuple(hand)
+    assert len(form.zero) == 13 and form.Y.shape == (2, 7)
+    for c, name in enumerate(form.names):
+        for i in range(2):
+            assert fourier_form(form.Y[i, c] - hand[name][i], q) == 0, (name, i)
+    P = {name: sp.Symbol(name, real=True) for name in form.regressor.PARAMETER_NAMES}
+    assert dict(zip(form.base_names, form.beta)) == {
+        "MX1R": P["MX1"] + l1 * P["M2"], "MY1": P["MY1"], "ZZ1R": P["ZZ1"] + l1 ** 2 * P["M2"],
+        "MX2": P["MX2"], "MY2": P["MY2"], "ZZ2": P["ZZ2"]}
+    assert form.exact
+    identity = form.Y_base * sp.Matrix(form.beta) - form.Y * form.pi
+    assert all(fourier_form(e, q) == 0 for e in identity)
+    dyn = eomgen.derive(model)
+    pi = form.regressor.inertial_parameters()
+    tau = dyn.M * sp.Matrix(dyn.qdd) + dyn.C * sp.Matrix(dyn.qd) + dyn.g
+    by_hand = [sum(hand[name][i] * pi[form.regressor.PARAMETER_NAMES.index(name)]
+                   for name in hand) for i in range(2)]
+    assert all(fourier_form(by_hand[i] - tau[i], q) == 0 for i in range(2))
+
+
+@pytest.mark.parametrize("name", ["elbow_rrr", "scara_rrp", "stanford_rrp"])
+def test_written_out_base_regressor_reproduces_Y_pi(name):
+    """Three-joint teaching arms (a residual dependency on the SCARA): Y_base β = Y π at
+    random states and parameters, and the zero columns are zero in the numeric Y."""
+    form = regressor_form(eomgen.load(eomgen.example_path(name)))
+    reg = form.regressor
+    rng = np.random.default_rng(2)
+    values = {**reg.model.parameter_values,
+              **dict(zip(reg.parameter_symbols, rng.uniform(0.5, 1.5, reg.p)))}
+    Y = reg.compiled()
+    for q, qd, qdd in states(reg.n, 2):
+        at = {**values, **dict(zip(reg.q + reg.qd + reg.qdd, [*q, *qd, *qdd]))}
+        lhs = np.array((form.Y_base * sp.Matrix(form.beta)).xreplace(at), dtype=float)
+        rhs = np.array((form.Y * form.pi).xreplace(at), dtype=float)
+        np.testing.assert_allclose(lhs, rhs, rtol=1e-10, atol=1e-10)
+        full = Y(q, qd, qdd)["Y"]
+        np.testing.assert_allclose(np.array(form.Y.xreplace(at), dtype=float),
+                                   full[:, list(form.columns)], rtol=1e-10, atol=1e-10)
+        assert np.all(np.abs(full[:, list(form.zero)]) < 1e-12)
 
 
 def test_identification_recovers_beta_from_newton_euler_torques():

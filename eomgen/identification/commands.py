@@ -49,7 +49,12 @@ def add_commands(main: click.Group, handle_errors, strict_option, quiet_option, 
     @click.option("--samples", default=500, show_default=True, help="Samples over the record.")
     @click.option("--harmonics", default=3, show_default=True, help="Harmonics per joint.")
     @click.option("--amplitude", default=1.0, show_default=True,
-                  help="Bound on |q_j(t)| [rad or m].")
+                  help="Bound on |q_j(t)| [rad or m]; a URDF's joint limits bound q too.")
+    @click.option("--max-velocity", type=float, default=None,
+                  help="Bound on |qd_j(t)| [rad/s or m/s] for every joint; a URDF's velocity "
+                       "limits too (the tighter applies) [default: only those].")
+    @click.option("--max-acceleration", type=float, default=None,
+                  help="Bound on |qdd_j(t)| [rad/s² or m/s²] for every joint [default: none].")
     @click.option("--noise", default=0.0, show_default=True,
                   help="Gaussian effort noise, as a fraction of each joint's RMS effort "
                        "(0.01: 1 %).")
@@ -64,13 +69,17 @@ def add_commands(main: click.Group, handle_errors, strict_option, quiet_option, 
     @quiet_option
     @strict_option
     @handle_errors
-    def excite(description, output, duration, samples, harmonics, amplitude, noise, seed,
-               positions_only, friction, scene_path, quiet, strict):
+    def excite(description, output, duration, samples, harmonics, amplitude, max_velocity,
+               max_acceleration, noise, seed, positions_only, friction, scene_path, quiet,
+               strict):
         """Simulate an exciting trajectory of DESCRIPTION and write it as identification data.
 
         A finite Fourier series per joint (Swevers et al. 1997) whose coefficients minimise the
-        condition number of the base regressor (L-BFGS-B from a seeded random start, |q_j| ≤
-        --amplitude), sampled evenly over --duration; efforts from eomgen's numeric
+        condition number of the base regressor (L-BFGS-B from a seeded random start), sampled
+        evenly over --duration. The coefficients are boxed so that at every instant |q_j| ≤
+        --amplitude, q_j within the joint's <limit> lower/upper (URDF), |qd_j| ≤
+        --max-velocity and the URDF velocity limit, |qdd_j| ≤ --max-acceleration; a joint with
+        no room to move is an error. Efforts from eomgen's numeric
         Newton-Euler with the description's parameters, plus --noise. Columns: t, q_<joint>,
         qd_<joint>, qdd_<joint>, tau_<joint> (JOINT_NAMES order).
 
@@ -81,7 +90,8 @@ def add_commands(main: click.Group, handle_errors, strict_option, quiet_option, 
         """
         if importlib.util.find_spec("scipy") is None:
             raise IdentificationError("eomgen excite needs scipy: pip install 'eomgen[identify]'")
-        from .estimation import excitation_trajectory, measurements_csv, simulate_measurements
+        from .estimation import (excitation_trajectory, measurements_csv, motion_bounds,
+                                 simulate_measurements)
 
         if not duration > 0 or duration == float("inf"):
             raise IdentificationError(f"--duration must be a positive number of seconds, got "
@@ -93,11 +103,18 @@ def add_commands(main: click.Group, handle_errors, strict_option, quiet_option, 
         check_output_file(output)
         progress = Progress(quiet)
         model, _ = load_reduced(description, scene_path, strict)
+        limits = {}
+        if description.suffix.lower() == ".urdf":
+            from ..parsers.urdf import joint_limits
+
+            limits = joint_limits(description)
+        bounds = motion_bounds(model.joint_names, amplitude, limits, max_velocity,
+                               max_acceleration, str(description))
         reg, base = _regressor(model, friction, progress)
         progress(f"optimising a {harmonics}-harmonic Fourier trajectory "
                  f"({model.dof * (2 * harmonics + 1)} coefficients)")
         ex = excitation_trajectory(reg, base, period=duration, harmonics=harmonics,
-                                   amplitude=amplitude, seed=seed)
+                                   seed=seed, bounds=bounds)
         progress(f"simulating {plural(samples, 'sample')}")
         t = [k * duration / samples for k in range(samples)]
         data = simulate_measurements(model, ex.trajectory, t, noise=noise, seed=seed)
@@ -120,8 +137,10 @@ def add_commands(main: click.Group, handle_errors, strict_option, quiet_option, 
     @click.option("--friction", is_flag=True,
                   help="Add viscous and Coulomb friction columns (FV<k>, FC<k>).")
     @click.option("--cutoff", default=None, type=float,
-                  help="Low-pass cut-off [Hz] when q is differentiated (DATA without qd_, qdd_ "
-                       "columns) [default: sampling frequency / 10].")
+                  help="Cut-off [Hz] of the zero-phase low-pass filter. DATA without qd_, "
+                       "qdd_ columns: q is filtered and differentiated [default: sampling "
+                       "frequency / 10]. DATA with them: q, qd, qdd and tau are all filtered, "
+                       "ends trimmed, decimated [default: no filtering].")
     @scene_option()
     @quiet_option
     @strict_option
@@ -133,7 +152,8 @@ def add_commands(main: click.Group, handle_errors, strict_option, quiet_option, 
         DATA's header names its columns: t, q_<joint>, qd_<joint>, qdd_<joint>, tau_<joint>
         (t optional), or t, q_<joint>, tau_<joint> (q̇, q̈ then come from a zero-phase
         Butterworth filter and central differences), joints as in the description (after
-        --scene). Weighted least squares (Gautier) with standard deviations and the condition
+        --scene). With qd_, qdd_ columns and --cutoff, all four signals go through that filter
+        (t needed). Weighted least squares (Gautier) with standard deviations and the condition
         number; --physical adds a fit with positive semi-definite pseudo-inertias. Writes
         identify_<robot>.md (table), .csv (estimates) and .png (predicted against measured
         efforts) into OUTPUT.

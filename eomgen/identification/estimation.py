@@ -11,7 +11,9 @@ The pieces, each a plain function over plain data:
   SI units (s, rad or m, rad/s or m/s, rad/s² or m/s², N m or N). In the second form q̇ and q̈
   come from :func:`filtered_derivatives`: q and τ through the same zero-phase Butterworth
   low-pass filter (order 4, run forward and backward by ``scipy.signal.sosfiltfilt``), then
-  second-order central differences (``numpy.gradient``), then decimation.
+  second-order central differences (``numpy.gradient``), then decimation. In the first form
+  the columns are used as they are, unless a cut-off is given: then q, q̇, q̈ and τ all go
+  through that same filter, trimming and decimation (:func:`filtered_signals`).
 * **Estimation** (:func:`weighted_least_squares`): Gautier's weighted least squares, standard
   deviations, condition number; :func:`physical_fit` adds the constraint that every body's
   pseudo-inertia be positive semi-definite (an SDP, needs cvxpy).
@@ -74,6 +76,9 @@ class Measurements:
         True when q̇ and q̈ were computed by :func:`filtered_derivatives` (and τ filtered).
     source : str
         Where they came from (file name), for messages.
+    cutoff : float or None
+        Cut-off frequency [Hz] of the zero-phase low-pass filter the samples went through
+        (differentiated, or filtered at a given cut-off), None when they are as read.
     """
 
     joint_names: tuple[str, ...]
@@ -84,6 +89,7 @@ class Measurements:
     tau: np.ndarray
     differentiated: bool = False
     source: str = "<measurements>"
+    cutoff: float | None = None
 
     @property
     def N(self) -> int:
@@ -123,15 +129,19 @@ def read_measurements(path: Path | str, joint_names: Sequence[str],
     joint_names:
         JOINT_NAMES of the robot the data belong to (after any scene reduction).
     cutoff:
-        Cut-off frequency [Hz] of the low-pass filter when q̇ and q̈ are to be computed (default
-        a fifth of the Nyquist frequency); ignored when the file has them.
+        Cut-off frequency [Hz] of the zero-phase low-pass filter. When q̇ and q̈ are to be
+        computed, default a fifth of the Nyquist frequency (:func:`filtered_derivatives`).
+        When the file has them, None (default) uses every column as read; a number filters
+        q, q̇, q̈ and τ alike, drops the filter's transients at both ends and decimates
+        (:func:`filtered_signals`), which needs the ``t`` column.
 
     Raises
     ------
     IdentificationError
         For an unreadable file, a missing, unknown or repeated column, a line with the wrong
         number of fields, a field that is not a finite number (naming line and column), times
-        that are not increasing and evenly spaced when needed, too few samples to filter.
+        that are not increasing and evenly spaced when needed, too few samples to filter, a
+        cut-off with no ``t`` column.
     """
     path = Path(path)
     source = str(path)
@@ -189,10 +199,17 @@ def read_measurements(path: Path | str, joint_names: Sequence[str],
     t = column.get("t")
     q, tau = block("q"), block("tau")
     if not differentiate:
-        return Measurements(tuple(joint_names), t, q, block("qd"), block("qdd"), tau, False,
-                            source)
-    t, q, qd, qdd, tau = filtered_derivatives(t, q, tau, cutoff, source)
-    return Measurements(tuple(joint_names), t, q, qd, qdd, tau, True, source)
+        if cutoff is None:
+            return Measurements(tuple(joint_names), t, q, block("qd"), block("qdd"), tau, False,
+                                source)
+        if t is None:
+            raise IdentificationError(f"{source}: line 1: missing column 't' (needed to filter "
+                                      f"at the cut-off {cutoff:.6g} Hz)")
+        t, (q, qd, qdd, tau), used = filtered_signals(t, (q, block("qd"), block("qdd"), tau),
+                                                      cutoff, source)
+        return Measurements(tuple(joint_names), t, q, qd, qdd, tau, False, source, used)
+    t, q, qd, qdd, tau, used = _filtered_derivatives(t, q, tau, cutoff, source)
+    return Measurements(tuple(joint_names), t, q, qd, qdd, tau, True, source, used)
 
 
 def filtered_derivatives(t, q, tau, cutoff: float | None = None, source: str = "<data>"):
@@ -226,18 +243,71 @@ def filtered_derivatives(t, q, tau, cutoff: float | None = None, source: str = "
         Times not increasing and evenly spaced (to 1e-6 of the step), a cut-off at or above
         the Nyquist frequency, too few samples to filter.
     """
+    return _filtered_derivatives(t, q, tau, cutoff, source)[:5]
+
+
+def _filtered_derivatives(t, q, tau, cutoff, source):
+    """:func:`filtered_derivatives`, and the cut-off used."""
+    if np.asarray(t).size < 3:
+        raise IdentificationError(f"{source}: {np.asarray(t).size} samples; filtered "
+                                  "differentiation needs many more (give qd_ and qdd_ columns, "
+                                  "or record longer)")
+    filtered, keep, dt, cutoff = _lowpass(t, (q, tau), cutoff, source, "filtered differentiation")
+    qf, tauf = filtered
+    qd = np.gradient(qf, dt, axis=0, edge_order=2)
+    qdd = np.gradient(qd, dt, axis=0, edge_order=2)
+    t = np.asarray(t, dtype=float)
+    return t[keep], qf[keep], qd[keep], qdd[keep], tauf[keep], cutoff
+
+
+def filtered_signals(t, signals: Sequence, cutoff: float, source: str = "<data>"):
+    """Measured signals (q, q̇, q̈, τ as read) through the filter of
+    :func:`filtered_derivatives`, all alike.
+
+    The same zero-phase Butterworth low-pass filter (order :data:`FILTER_ORDER`, forward and
+    backward, cut-off ``cutoff`` [Hz]) on every signal, so that none is delayed against the
+    others and τ = Y(q, q̇, q̈) β still holds up to the filter's effect on the products in Y
+    (small when the motion's content lies well below the cut-off); the three cut-off periods
+    at each end are dropped and the rest decimated to every ⌊fs / (2 cutoff)⌋-th sample, as in
+    :func:`filtered_derivatives`. Nothing is differentiated: q̇ and q̈ stay the measured ones,
+    filtered.
+
+    Parameters
+    ----------
+    t : (N,) array, evenly spaced and increasing [s]
+    signals : sequence of (N, n) arrays
+    cutoff : float
+        [Hz], between 0 and the Nyquist frequency fs / 2.
+
+    Returns
+    -------
+    t, filtered, cutoff
+        The kept times, the kept filtered signals (a tuple in the order given) and the
+        cut-off.
+
+    Raises
+    ------
+    IdentificationError
+        As :func:`filtered_derivatives`.
+    """
+    filtered, keep, _, cutoff = _lowpass(t, signals, cutoff, source, "filtering")
+    return np.asarray(t, dtype=float)[keep], tuple(x[keep] for x in filtered), cutoff
+
+
+def _lowpass(t, signals, cutoff, source, what):
+    """Filter ``signals`` (each (N, n)) zero-phase at ``cutoff`` [Hz] (None: fs / 10).
+    Returns (filtered signals, slice of the samples to keep, time step, cut-off)."""
     from scipy import signal
 
     t = np.asarray(t, dtype=float)
     if t.size < 3:
-        raise IdentificationError(f"{source}: {t.size} samples; filtered differentiation needs "
-                                  "many more (give qd_ and qdd_ columns, or record longer)")
+        raise IdentificationError(f"{source}: {t.size} samples; {what} needs many more")
     steps = np.diff(t)
     dt = float(np.mean(steps))
     bad = np.flatnonzero(~(np.abs(steps - dt) <= 1e-6 * abs(dt))) if dt > 0 else [0]
     if len(bad):
         raise IdentificationError(f"{source}: line {int(bad[0]) + 3}, column t: times must "
-                                  f"increase by a constant step to differentiate q (step "
+                                  f"increase by a constant step for {what} (step "
                                   f"{steps[bad[0]]:.6g} s, mean {dt:.6g} s)")
     fs = 1.0 / dt
     cutoff = fs / 10 if cutoff is None else float(cutoff)
@@ -245,18 +315,18 @@ def filtered_derivatives(t, q, tau, cutoff: float | None = None, source: str = "
         raise IdentificationError(f"{source}: cut-off {cutoff:.6g} Hz must be between 0 and the "
                                   f"Nyquist frequency {fs / 2:.6g} Hz")
     sos = signal.butter(FILTER_ORDER, cutoff, fs=fs, output="sos")
-    period = int(math.ceil(fs / cutoff))  # samples per period of the cut-off frequency
+    # samples per period of the cut-off frequency; the 1e-9 keeps fs / cutoff = 10 from
+    # reading as 10.000000000000002 (times from a CSV file)
+    period = int(math.ceil(fs / cutoff - 1e-9))
     trim = padlen = 3 * period
     needed = 2 * trim + 3
     if t.size < needed:
-        raise IdentificationError(f"{source}: {t.size} samples; filtered differentiation at "
-                                  f"{cutoff:.6g} Hz needs at least {needed}")
-    qf = signal.sosfiltfilt(sos, q, axis=0, padlen=padlen)
-    tauf = signal.sosfiltfilt(sos, tau, axis=0, padlen=padlen)
-    qd = np.gradient(qf, dt, axis=0, edge_order=2)
-    qdd = np.gradient(qd, dt, axis=0, edge_order=2)
-    keep = slice(trim, t.size - trim, max(1, int(fs / (2 * cutoff))))
-    return t[keep], qf[keep], qd[keep], qdd[keep], tauf[keep]
+        raise IdentificationError(f"{source}: {t.size} samples; {what} at {cutoff:.6g} Hz "
+                                  f"needs at least {needed}")
+    filtered = tuple(signal.sosfiltfilt(sos, np.asarray(x, dtype=float), axis=0, padlen=padlen)
+                     for x in signals)
+    keep = slice(trim, t.size - trim, max(1, int(fs / (2 * cutoff) + 1e-9)))
+    return filtered, keep, dt, cutoff
 
 
 # ----------------------------------------------------------------------------------------------
@@ -543,8 +613,99 @@ class FourierTrajectory:
 
     def bound(self) -> np.ndarray:
         """The largest possible |q_j(t)| per joint, |q0_j| + Σ_l (|a_jl| + |b_jl|) / (ω_f l)."""
+        return np.abs(self.q0) + self._sums(-1)
+
+    def velocity_bound(self) -> np.ndarray:
+        """The largest possible |q̇_j(t)| per joint, Σ_l (|a_jl| + |b_jl|)."""
+        return self._sums(0)
+
+    def acceleration_bound(self) -> np.ndarray:
+        """The largest possible |q̈_j(t)| per joint, Σ_l (|a_jl| + |b_jl|) ω_f l."""
+        return self._sums(1)
+
+    def _sums(self, power: int) -> np.ndarray:
         w = self.omega * np.arange(1, self.a.shape[1] + 1)
-        return np.abs(self.q0) + np.sum((np.abs(self.a) + np.abs(self.b)) / w, axis=1)
+        return np.sum((np.abs(self.a) + np.abs(self.b)) * w ** power, axis=1)
+
+
+@dataclass(frozen=True)
+class MotionBounds:
+    """What an excitation trajectory must respect, per joint (JOINT_NAMES order).
+
+    Attributes
+    ----------
+    lower, upper : (n,) arrays
+        Position range [rad or m]: lower ≤ q_j(t) ≤ upper.
+    velocity, acceleration : (n,) arrays
+        |q̇_j(t)| ≤ velocity [rad/s or m/s], |q̈_j(t)| ≤ acceleration [rad/s² or m/s²];
+        ``inf`` for no bound.
+    """
+
+    lower: np.ndarray
+    upper: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+
+
+def motion_bounds(joint_names: Sequence[str], amplitude: float = 1.0,
+                  limits: Mapping | None = None, max_velocity: float | None = None,
+                  max_acceleration: float | None = None, source: str = "<description>"
+                  ) -> MotionBounds:
+    """The bounds of :func:`excitation_trajectory` for each joint: the tighter of the options
+    and the description's limits.
+
+    Positions: within ±``amplitude`` and within the joint's ``lower``/``upper`` limits when
+    given. Velocities: ``max_velocity`` and the joint's ``velocity`` limit. Accelerations:
+    ``max_acceleration`` (descriptions have none).
+
+    Parameters
+    ----------
+    joint_names:
+        JOINT_NAMES (after any scene).
+    limits:
+        Joint name → an object with ``lower``, ``upper``, ``velocity`` attributes (None for
+        absent), e.g. :func:`eomgen.parsers.urdf.joint_limits`; joints not in it unbounded.
+    source:
+        The description, named in errors.
+
+    Raises
+    ------
+    IdentificationError
+        When a joint has no room to move: an empty or zero-width position range (its limits
+        outside ±amplitude, or lower ≥ upper), or a velocity or acceleration bound that is not
+        positive.
+    """
+    n = len(joint_names)
+    for name, value in (("--amplitude", amplitude), ("--max-velocity", max_velocity),
+                        ("--max-acceleration", max_acceleration)):
+        if value is not None and not (value > 0):
+            raise IdentificationError(f"{name} must be positive, got {value}")
+    lower, upper = np.full(n, -float(amplitude)), np.full(n, float(amplitude))
+    inf = math.inf
+    velocity = np.full(n, inf if max_velocity is None else float(max_velocity))
+    acceleration = np.full(n, inf if max_acceleration is None else float(max_acceleration))
+    for j, name in enumerate(joint_names):
+        limit = (limits or {}).get(name)
+        if limit is None:
+            continue
+        if limit.lower is not None:
+            lower[j] = max(lower[j], limit.lower)
+        if limit.upper is not None:
+            upper[j] = min(upper[j], limit.upper)
+        if limit.velocity is not None:
+            if not limit.velocity > 0:
+                raise IdentificationError(f"{source}: joint '{name}': velocity limit "
+                                          f"{limit.velocity:g} leaves no motion to excite")
+            velocity[j] = min(velocity[j], limit.velocity)
+        if not upper[j] > lower[j]:
+            raise IdentificationError(one_line(
+                f"{source}: joint '{name}': its limits [{_g(limit.lower)}, {_g(limit.upper)}] "
+                f"and ±--amplitude {amplitude:g} leave no room to move (raise --amplitude)"))
+    return MotionBounds(lower, upper, velocity, acceleration)
+
+
+def _g(value: float | None) -> str:
+    return "none" if value is None else f"{value:g}"
 
 
 @dataclass(frozen=True)
@@ -560,16 +721,29 @@ class Excitation:
 
 def excitation_trajectory(reg, base, period: float = 10.0, harmonics: int = 3,
                           amplitude: float = 1.0, samples: int | None = None, seed: int = 0,
-                          maxiter: int = 30, values: Mapping | None = None) -> Excitation:
-    """Fourier coefficients minimising cond(W_base) (Swevers et al. 1997), bounded amplitudes.
+                          maxiter: int = 30, values: Mapping | None = None,
+                          bounds: MotionBounds | None = None) -> Excitation:
+    """Fourier coefficients minimising cond(W_base) (Swevers et al. 1997) within bounds on
+    q, q̇ and q̈.
 
     Variables: q0 and the coefficients a, b of :class:`FourierTrajectory` (n (2 L + 1) of
-    them), with box bounds |q0_j| ≤ amplitude / 2 and |a_jl|, |b_jl| ≤ amplitude ω_f l / (4 L),
-    which guarantee |q_j(t)| ≤ amplitude for every t. Objective: log10 of the condition number
-    of the column-normalised base regressor stacked at ``samples`` evenly spaced times of one
-    period (default 3 b / n + 10). Start: uniform random inside the bounds from ``seed``;
-    minimiser: ``scipy.optimize.minimize(method="L-BFGS-B")`` with finite-difference
-    gradients, at most ``maxiter`` iterations. Deterministic for a given seed.
+    them), in boxes that guarantee every bound at every t, not only at samples. With joint j's
+    position range [lo, hi] (mid-point m, half-width h), velocity bound V and acceleration
+    bound A (``bounds``; default |q_j| ≤ ``amplitude``, no V or A)::
+
+        |q0_j − m| ≤ h / 2,   |a_jl|, |b_jl| ≤ min(h ω_f l / (4 L), V / (2 L), A / (2 L ω_f l))
+
+    so that Σ_l (|a_jl| + |b_jl|) / (ω_f l) ≤ h / 2 (q within [lo, hi]), Σ_l (|a_jl| + |b_jl|)
+    ≤ V and Σ_l (|a_jl| + |b_jl|) ω_f l ≤ A (:meth:`FourierTrajectory.bound` and its
+    siblings); the boxes are shrunk by 1e-9 so that rounding cannot reach a bound. The boxes
+    split each bound evenly between the harmonics, so after the optimisation each joint's
+    a, b are scaled up until the tightest of those sums reaches its bound, kept if that does
+    not raise the condition number. Objective:
+    log10 of the condition number of the column-normalised base regressor stacked at
+    ``samples`` evenly spaced times of one period (default 3 b / n + 10). Start: uniform random
+    inside the boxes from ``seed``; minimiser: ``scipy.optimize.minimize(method="L-BFGS-B")``
+    with finite-difference gradients, at most ``maxiter`` iterations. Deterministic for a given
+    seed.
 
     Parameters
     ----------
@@ -580,41 +754,73 @@ def excitation_trajectory(reg, base, period: float = 10.0, harmonics: int = 3,
     harmonics:
         L, the number of harmonics per joint.
     amplitude:
-        Bound on |q_j(t)| [rad or m].
+        Bound on |q_j(t)| [rad or m] when ``bounds`` is None.
+    bounds:
+        Position ranges and velocity and acceleration bounds (:func:`motion_bounds`).
     """
     from scipy.optimize import minimize
 
     n, L, b = reg.n, int(harmonics), len(base.base)
     if n == 0:
         raise IdentificationError(f"{reg.model.source}: no movable joint to excite")
+    if bounds is None:
+        bounds = motion_bounds(reg.model.joint_names, amplitude, source=reg.model.source)
     omega = 2 * math.pi / period
     samples = samples or 3 * b // max(n, 1) + 10
     t = np.arange(samples) * (period / samples)
     f = reg.compiled(values, program=reg.base_program(list(base.base)))
     ws = omega * np.arange(1, L + 1)
-    coef_bound = np.tile(amplitude * ws / (4 * L), (n, 1))
-    upper = np.concatenate([np.full(n, amplitude / 2), coef_bound.ravel(), coef_bound.ravel()])
+    shrink = 1 - 1e-9
+    mid = (bounds.lower + bounds.upper) / 2
+    half = (bounds.upper - bounds.lower) / 2
+    coef = shrink * np.minimum.reduce([
+        half[:, None] * ws[None, :] / (4 * L),
+        np.broadcast_to(bounds.velocity[:, None] / (2 * L), (n, L)),
+        bounds.acceleration[:, None] / (2 * L * ws[None, :])])
+    low = np.concatenate([mid - shrink * half / 2, -coef.ravel(), -coef.ravel()])
+    high = np.concatenate([mid + shrink * half / 2, coef.ravel(), coef.ravel()])
 
     def unpack(x):
+        x = np.clip(x, low, high)
         return FourierTrajectory(x[:n], x[n:n + n * L].reshape(n, L),
                                  x[n + n * L:].reshape(n, L), omega)
 
     count = [0]
 
-    def objective(x):
+    def condition(trajectory):
         count[0] += 1
-        q, qd, qdd = unpack(x).states(t)
+        q, qd, qdd = trajectory.states(t)
         W = np.vstack([f(*row)["Y_base"] for row in zip(q, qd, qdd)])
         c = normalised_condition(W)
         return math.log10(c) if math.isfinite(c) and c < 1e300 else 300.0
 
+    def objective(x):
+        return condition(unpack(x))
+
+    def stretched(trajectory):
+        # each joint's oscillation scaled up until its tightest bound is reached (by the same
+        # sums that bound it): the boxes split each bound evenly between the harmonics, so
+        # the optimum usually leaves room
+        tr = trajectory
+        room = shrink * half - np.abs(tr.q0 - mid)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            scale = np.nanmin([room / tr._sums(-1), shrink * bounds.velocity / tr._sums(0),
+                               shrink * bounds.acceleration / tr._sums(1)], axis=0)
+        scale = np.where(np.isfinite(scale), np.maximum(scale, 1.0), 1.0)[:, None]
+        return FourierTrajectory(tr.q0, tr.a * scale, tr.b * scale, omega)
+
     rng = np.random.default_rng(seed)
-    x0 = rng.uniform(-upper, upper)
+    x0 = rng.uniform(low, high)
     initial = 10 ** objective(x0)
-    result = minimize(objective, x0, method="L-BFGS-B", bounds=list(zip(-upper, upper)),
+    result = minimize(objective, x0, method="L-BFGS-B", bounds=list(zip(low, high)),
                       options={"maxiter": int(maxiter)})
-    x = result.x if result.fun <= math.log10(initial) else x0
-    return Excitation(unpack(x), initial, 10 ** objective(x), count[0])
+    best = unpack(result.x if result.fun <= math.log10(initial) else x0)
+    value = condition(best)
+    wider = stretched(best)
+    wider_value = condition(wider)
+    if wider_value <= value:
+        best, value = wider, wider_value
+    return Excitation(best, initial, 10 ** value, count[0])
 
 
 def simulate_measurements(model, trajectory: FourierTrajectory, t, noise: float = 0.0,

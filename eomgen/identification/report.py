@@ -52,8 +52,10 @@ class IdentificationReport:
         lines = [f"# Identification of {self.robot} from {self.source}", "",
                  f"{m.N} samples × {n} joints = {m.N * n} equations, {len(self.names)} base "
                  "parameters; weighted least squares (Gautier: joint j's rows weighted by 1/σ_j)"
-                 + ("; q̇, q̈ by zero-phase filtered differentiation of q" if m.differentiated
-                    else "") + ".", "",
+                 + (f"; q̇, q̈ by zero-phase filtered differentiation of q (cut-off "
+                    f"{m.cutoff:.4g} Hz)" if m.differentiated else
+                    f"; q, q̇, q̈, τ zero-phase low-pass filtered at {m.cutoff:.4g} Hz"
+                    if m.cutoff is not None else "") + ".", "",
                  f"Condition number of the column-normalised observation matrix: "
                  f"{e.condition:.4g}", ""]
         head = ["#", "parameter", "β(π)", "estimate", "std", "std %"]

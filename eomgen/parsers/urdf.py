@@ -57,7 +57,8 @@ Decisions
 * A singleton element (``<inertial>``, ``<origin>``, ``<axis>``, ...) given twice is an error
   rather than a silent choice of one of them.
 * ``<limit>`` is not required for revolute and prismatic joints (urdfdom requires it): limits
-  do not enter the equations of motion.
+  do not enter the equations of motion. :func:`joint_limits` reads them for ``eomgen excite``
+  (positions and velocities an excitation trajectory must respect).
 
 Safety
 ------
@@ -74,7 +75,7 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Iterable
 from xml.parsers import expat
@@ -321,6 +322,55 @@ def floating_base_notice(model: RobotModel) -> Notice | None:
         f"M, C and g are those of a robot held at '{model.root}' (a scene with "
         "'floating_base: true' gives it a free base, one with 'fixed_base: true' says bolted is "
         "meant; either silences this warning)")
+
+
+@dataclass(frozen=True)
+class JointLimit:
+    """The ``<limit>`` of a URDF joint, SI units (rad or m, rad/s or m/s, N m or N); None
+    where the attribute is absent (and ``lower``, ``upper`` always None for a continuous
+    joint, which has no position limits)."""
+
+    lower: float | None = None
+    upper: float | None = None
+    velocity: float | None = None
+    effort: float | None = None
+
+
+def joint_limits(path) -> dict[str, JointLimit]:
+    """The ``<limit>`` element of each revolute, continuous and prismatic joint of the URDF file
+    ``path``, by joint name (joints without one are left out).
+
+    Not part of :class:`~eomgen.model.RobotModel` (limits do not enter the equations of
+    motion); read for the excitation trajectories of ``eomgen excite``. Unlike urdfdom, an
+    absent ``lower`` or ``upper`` is no limit on that side (urdfdom reads 0).
+
+    Raises
+    ------
+    DescriptionError
+        Unreadable file, malformed XML, two ``<limit>`` elements in a joint, an attribute that
+        is not a finite number.
+    """
+    source = str(path)
+    try:
+        data = Path(path).read_bytes()
+    except OSError as exc:
+        raise UnreadableFileError(source, "", f"cannot read the file ({exc.strerror})") from None
+    limits = {}
+    for joint in _parse_xml(data, source).findall("joint"):
+        name, kind = joint.get("name", ""), joint.get("type", "")
+        if kind not in ("revolute", "continuous", "prismatic"):
+            continue
+        where = f"joint '{name}' <limit>"
+        element = _single_child(joint, "limit", source, f"joint '{name}'")
+        if element is None:
+            continue
+        values = {a: (_finite(element.get(a), a, source, where)
+                      if element.get(a) is not None else None)
+                  for a in ("lower", "upper", "velocity", "effort")}
+        if kind == "continuous":
+            values["lower"] = values["upper"] = None
+        limits[name] = JointLimit(**values)
+    return limits
 
 
 def _parse_xml(data: str | bytes, source: str) -> ET.Element:

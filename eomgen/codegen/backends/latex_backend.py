@@ -7,11 +7,13 @@ Two kinds of document, chosen by :func:`textbook_for`:
   and expressions of moderate size): the textbook derivation of :mod:`eomgen.symbolic.textbook`,
   body by body: centre-of-mass positions, Jacobians, K_i and P_i, then M, the Christoffel
   symbols, C, g and the equations of motion written out, in compact trigonometric notation
-  (s_1, c_12);
+  (s_1, c_12); then the linear parameterization τ = Y π with its columns named and the base
+  parameters β as expressions of π (:func:`eomgen.regressor.regressor_form`);
 * **large** models: the description, then the straight-line program of named subexpressions
   that computes M, g and C (grouped by the output that first needs them), the entries of M, C,
   g in terms of those names and the equations of motion per joint. At most
   :attr:`LatexConfig.max_program_lines` subexpressions are printed, so that pdflatex stays fast.
+  The regressor is not written out (a sentence says where to find it).
 
 Printer: :class:`~eomgen.codegen.backends.latex_printer.DerivationLatexPrinter`. Template:
 ``templates/latex/document.tex.jinja``. Every string that comes from the description (robot,
@@ -451,11 +453,55 @@ def program_sections(dyn: Dynamics, config: LatexConfig, p: Printing) -> dict:
     }
 
 
+# -- the regressor (teaching-sized models) --------------------------------------------------
+
+def _regressor_sections(form, p: Printing) -> dict:
+    """τ = Y π with the non-zero columns named, entry by entry, and β(π)."""
+    from ...regressor import parameter_latex
+
+    reg = form.regressor
+    entries = []
+    for c, k in enumerate(form.columns):
+        column = parameter_latex(reg.PARAMETER_NAMES[k])
+        for i in range(reg.n):
+            if form.Y[i, c] != 0:
+                entries.append(p.equation(rf"\bigl[Y\bigr]_{{{i + 1},\,{column}}}", form.Y[i, c]))
+    beta = []
+    for k, name, expr in zip(form.base, form.base_names, form.beta):
+        own = reg.parameter_symbols[k]
+        if expr != own:  # the column's own parameter first, then what is grouped into it
+            terms = ([own] + list(sp.Add.make_args(expr - own))
+                     if own in sp.Add.make_args(expr) else [expr])
+            beta.append(Equation(parameter_latex(name),
+                                 p.printer.print_sum_lines(terms, p.width)))
+
+    def names(indices):
+        return [parameter_latex(reg.PARAMETER_NAMES[k]) for k in indices]
+
+    return {
+        "pi": names(form.columns),
+        "zero": names(form.zero),
+        "Y_blocks": p.chunks(entries),
+        "base": names(form.base),
+        "beta": [parameter_latex(name) for name in form.base_names],
+        "beta_blocks": p.chunks(beta),
+        "exact": form.exact,
+        "p": reg.p,
+    }
+
+
 def render_document(job: Job, config: LatexConfig = LatexConfig()) -> str:
     """The text of the ``.tex`` document for ``job`` (see the module docstring)."""
     model = job.model
     book = textbook_for(job.dynamics, config)
-    p = printing(job.dynamics, config, compact_trig=book is not None)
+    form = None
+    extra_names = {}
+    if book is not None:  # same bound: the expanded Y of a model that small stays small
+        from ...regressor import regressor_form
+
+        form = regressor_form(model)
+        extra_names = form.latex_names
+    p = printing(job.dynamics, config, compact_trig=book is not None, extra_names=extra_names)
     context = {
         "header": [latex_comment(line) for line in job.header_lines(config.template)],
         "robot": latex_escape(model.name),
@@ -479,6 +525,7 @@ def render_document(job: Job, config: LatexConfig = LatexConfig()) -> str:
     }
     if book is not None:
         context.update(_textbook_sections(job, book, p))
+        context["regressor"] = _regressor_sections(form, p)
     else:
         context.update(program_sections(job.dynamics, config, p))
     return render(config.template, **context)
