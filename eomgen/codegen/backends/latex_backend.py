@@ -525,7 +525,7 @@ def render_document(job: Job, config: LatexConfig = LatexConfig()) -> str:
     }
     if book is not None:
         context.update(_textbook_sections(job, book, p))
-        context["regressor"] = _regressor_sections(form, p)
+        context["linear"] = _regressor_sections(form, p)
     else:
         context.update(program_sections(job.dynamics, config, p))
     return render(config.template, **context)
