@@ -48,6 +48,7 @@ from sympy.printing.pycode import MpmathPrinter
 
 from ..dynamics import Dynamics, derive
 from ..model import Inertial, JointType, RobotModel, Transform
+from ..symbolic.printing import program_function
 from ..symbolic.program import Program
 
 #: Significant digits of every reference evaluation.
@@ -166,29 +167,14 @@ def compile_program_mp(program: Program, inputs: Sequence[sp.Symbol],
     that holds only ``mpmath``.
     """
     names = list(outputs) if outputs is not None else [n for n, _ in program.outputs]
-    program = program.pruned(names)
     printer = _Printer({"fully_qualified_modules": True, "standard": "python3"})
-    arguments = [f"a{k}" for k in range(len(inputs))]
-    rename = {s: sp.Symbol(a) for s, a in zip(inputs, arguments)}
-    lines = ["def _program(" + ", ".join(arguments) + "):"]
-    for symbol, expr in program.assignments:
-        lines.append(f"    {symbol.name} = {printer.doprint(expr.xreplace(rename))}")
-    results = []
-    for name, matrix in program.outputs:
-        rows = ["[" + ", ".join(printer.doprint(e.xreplace(rename)) for e in matrix.row(r)) + "]"
-                for r in range(matrix.rows)]
-        results.append(f"{name!r}: [" + ", ".join(rows) + "]")
-    lines.append("    return {" + ", ".join(results) + "}")
-    namespace: dict = {}
-    exec(compile("\n".join(lines), "<eomgen mpmath program>", "exec"),  # noqa: S102 - ours
-         {"mpmath": mpmath}, namespace)
-    raw = namespace["_program"]
+    raw = program_function(program, inputs, printer, {"mpmath": mpmath}, names,
+                           filename="<eomgen mpmath program>")
 
     def evaluate(*values) -> dict[str, np.ndarray]:
         converted = [v if isinstance(v, mpmath.mpf) else mpmath.mpf(float(v)) for v in values]
-        out = raw(*converted)
         result = {}
-        for k, rows in out.items():
+        for k, rows in zip(names, raw(*converted)):
             array = np.empty((len(rows), len(rows[0]) if rows else 0), dtype=object)
             for r, row in enumerate(rows):
                 for c, e in enumerate(row):

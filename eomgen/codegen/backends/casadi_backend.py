@@ -21,6 +21,7 @@ from sympy.printing.pycode import PythonCodePrinter
 
 from ...compiler import c_compiler
 from .. import GeneratedFile, Job, register
+from ...symbolic.printing import FloatLiteralMixin
 from ..functions import FUNCTION_NAMES as ALL_FUNCTIONS
 from ..render import render
 from .common import python_module_context
@@ -28,7 +29,7 @@ from .common import python_module_context
 _FUNCTIONS = ("sin", "cos", "tan", "sqrt", "exp", "log", "asin", "acos", "atan", "atan2")
 
 
-class CasADiPrinter(PythonCodePrinter):
+class CasADiPrinter(FloatLiteralMixin, PythonCodePrinter):
     """Python code over CasADi SX symbols: ``ca.sin(x)``, exact float literals."""
 
     def _print_Function(self, expr):
@@ -44,12 +45,6 @@ class CasADiPrinter(PythonCodePrinter):
         if exponent == sp.Rational(1, 2):
             return f"ca.sqrt({self._print(base)})"
         return super()._print_Pow(expr, rational)
-
-    def _print_Float(self, expr):
-        return repr(float(expr))
-
-    def _print_Rational(self, expr):
-        return f"({int(expr.p)}/{int(expr.q)})"
 
     def _print_Pi(self, expr):
         return "ca.pi"
