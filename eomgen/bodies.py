@@ -13,6 +13,7 @@ the origin ``I_O = I_c + m (|c|² 1 − c cᵀ)`` [kg m²], all in body-frame co
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable, Iterable
 
 import sympy as sp
 
@@ -129,40 +130,77 @@ class BodyTree:
         return sorted(members)
 
 
-def body_tree(model: RobotModel) -> BodyTree:
-    """Group the links of ``model`` into moving rigid bodies (see module docstring)."""
-    q_index = {j.name: k for k, j in enumerate(model.movable_joints)}
-    bodies: list[RigidBody] = []
-    inertials: list[InertialParameters] = []
-    links_of: list[list[str]] = []
-    # where each link sits: (body index or -1 for the base, pose of the link in that body frame)
+@dataclass(frozen=True)
+class RigidAttachment:
+    """Where the fixed joints put every link: the one walk that merges fixed links, used by
+    :func:`body_tree` and by the scene reduction (:mod:`eomgen.reduction`).
+
+    Attributes
+    ----------
+    movers:
+        One entry per movable joint, in topological order (body ``k`` is ``movers[k]``):
+        ``(joint, parent body index or -1 for the world, placement)``, the placement being the
+        pose of the joint frame (before the joint moves) in the parent body frame, the fixed
+        joints in between composed into it.
+    site:
+        For every link, in topological order (the root first, a body's joint child before the
+        links fixed to it): ``(body index or -1 for the world, pose of the link frame in that
+        body frame)``.
+    """
+
+    movers: tuple[tuple[Joint, int, Transform], ...]
+    site: dict[str, tuple[int, Transform]]
+
+    def links_of(self, body: int) -> list[str]:
+        """Links rigidly attached to ``body`` (-1: the world), in topological order."""
+        return [link for link, (k, _) in self.site.items() if k == body]
+
+    def inertial_parts(self, model: RobotModel) -> list[list[tuple[Inertial, Transform]]]:
+        """Per body, the inertial data of its links (``model.links`` order) with their poses
+        in the body frame; links attached to the world are left out."""
+        parts: list[list[tuple[Inertial, Transform]]] = [[] for _ in self.movers]
+        for link in model.links:
+            body, pose = self.site[link.name]
+            if body >= 0 and link.inertial is not None:
+                parts[body].append((link.inertial, pose))
+        return parts
+
+
+def attach_fixed_links(model: RobotModel,
+                       tidy: Callable[[Transform], Transform] = lambda T: T) -> RigidAttachment:
+    """Walk the joints of ``model`` root to tips, composing the fixed joints: every link's
+    moving body and pose in it (see :class:`RigidAttachment`). ``tidy`` is applied to every
+    composed pose (the scene reduction snaps roundoff in rotations with it)."""
     site: dict[str, tuple[int, Transform]] = {model.root: (-1, Transform())}
-    fixed = [model.root]
+    movers: list[tuple[Joint, int, Transform]] = []
     for joint in model.topological_joints:
         body, pose = site[joint.parent]
         if joint.type.is_movable:
-            bodies.append(RigidBody(joint, q_index[joint.name], body, pose @ joint.origin,
-                                    InertialParameters(), (joint.child,)))
-            inertials.append(InertialParameters())
-            links_of.append([joint.child])
-            site[joint.child] = (len(bodies) - 1, Transform(IDENTITY3, ZERO3))
+            movers.append((joint, body, tidy(pose @ joint.origin)))
+            site[joint.child] = (len(movers) - 1, Transform())
         else:
-            child_pose = pose @ joint.origin
-            site[joint.child] = (body, child_pose)
-            if body < 0:
-                fixed.append(joint.child)
-            else:
-                links_of[body].append(joint.child)
-    for link in model.links:
-        body, pose = site[link.name]
-        if body < 0 or link.inertial is None:
-            continue
-        params = InertialParameters.from_inertial(link.inertial)
-        if pose != Transform(IDENTITY3, ZERO3):
-            params = params.transformed(pose)
-        inertials[body] = inertials[body] + params
-    final = tuple(
-        RigidBody(b.joint, b.q_index, b.parent, b.placement, inertials[k], tuple(links_of[k]))
-        for k, b in enumerate(bodies)
+            site[joint.child] = (body, tidy(pose @ joint.origin))
+    return RigidAttachment(tuple(movers), site)
+
+
+def merged_inertial(parts: Iterable[tuple[Inertial, Transform]]) -> InertialParameters:
+    """The inertial parameters, about the body origin, of parts given in frames with the given
+    poses in the body frame (summed in the given order)."""
+    total = InertialParameters()
+    for inertial, pose in parts:
+        params = InertialParameters.from_inertial(inertial)
+        total = total + (params if pose == Transform() else params.transformed(pose))
+    return total
+
+
+def body_tree(model: RobotModel) -> BodyTree:
+    """Group the links of ``model`` into moving rigid bodies (see module docstring)."""
+    q_index = {j.name: k for k, j in enumerate(model.movable_joints)}
+    rigid = attach_fixed_links(model)
+    parts = rigid.inertial_parts(model)
+    bodies = tuple(
+        RigidBody(joint, q_index[joint.name], parent, placement, merged_inertial(parts[k]),
+                  tuple(rigid.links_of(k)))
+        for k, (joint, parent, placement) in enumerate(rigid.movers)
     )
-    return BodyTree(final, model.gravity, model.joint_names, tuple(fixed))
+    return BodyTree(bodies, model.gravity, model.joint_names, tuple(rigid.links_of(-1)))

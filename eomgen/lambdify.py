@@ -78,6 +78,7 @@ def lambdify(dynamics: Dynamics) -> NumericDynamics:
     from .codegen.functions import FUNCTION_OUTPUTS
     from .outputs import BY_SYMBOL, FORWARD
     from .codegen.render import render
+    from .symbolic.printing import exec_source
 
     derived = set(dynamics.outputs)
     functions = [f for f, needs in FUNCTION_OUTPUTS.items() if set(needs) <= derived]
@@ -91,8 +92,7 @@ def lambdify(dynamics: Dynamics) -> NumericDynamics:
     content = render(config.template, **python_module_context(job, printer, config.template, extra))
     module = types.ModuleType(f"eomgen_lambdified_{job.stem}")
     module.__file__ = f"<eomgen lambdify {job.stem}>"
-    exec(compile(content, module.__file__, "exec"),  # noqa: S102 - our own generated module
-         module.__dict__)
+    exec_source(content, module.__file__, module.__dict__)
 
     def get(name):
         return getattr(module, name, None) if name in functions else None

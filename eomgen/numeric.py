@@ -44,7 +44,7 @@ A point mass ``m = 2`` kg hanging ``l = 0.5`` m below a joint about ``y`` (gravi
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Mapping
+from typing import Any, Callable, Mapping
 
 import numpy as np
 
@@ -59,6 +59,76 @@ _TYPE_CODE = {
     JointType.CONTINUOUS: REVOLUTE,
     JointType.PRISMATIC: PRISMATIC,
 }
+
+
+@dataclass(frozen=True)
+class Numbers:
+    """The number type an algorithm computes in, and the few operations it needs on it.
+
+    The algorithms of this module are written once over NumPy arrays whose entries are these
+    numbers (Pinocchio's algorithms are templated on ``Scalar`` in the same way): float64
+    arrays for :data:`FLOAT64`, object arrays of ``mpmath.mpf`` for
+    :data:`eomgen.analysis.precision.MPMATH` (the high-precision reference).
+
+    Attributes
+    ----------
+    name : str
+        What the numbers are, for messages.
+    dtype : type
+        The NumPy dtype of the arrays: ``float`` or ``object``.
+    convert : callable
+        A number of the description (SymPy or Python) as this type; TypeError when it is not
+        a number.
+    value : callable
+        A caller's value (float, int, or already this type) as this type.
+    sin, cos : callable
+        The trigonometric functions on this type.
+    finite : callable
+        True when a number is finite.
+    """
+
+    name: str
+    dtype: type
+    convert: Callable[[Any], Any]
+    value: Callable[[Any], Any]
+    sin: Callable[[Any], Any]
+    cos: Callable[[Any], Any]
+    finite: Callable[[Any], bool]
+
+    def zeros(self, shape) -> np.ndarray:
+        """An array of exact zeros of this type."""
+        if self.dtype is float:
+            return np.zeros(shape)
+        return np.full(shape, self.value(0), dtype=object)
+
+    def eye(self, n: int) -> np.ndarray:
+        """The ``n × n`` identity matrix of this type."""
+        if self.dtype is float:
+            return np.eye(n)
+        out = self.zeros((n, n))
+        for i in range(n):
+            out[i, i] = self.value(1)
+        return out
+
+    def vector(self, x) -> np.ndarray:
+        """A caller's sequence of values as a 1-D array of this type."""
+        if self.dtype is float:
+            return np.asarray(x, dtype=float)
+        a = np.asarray(x, dtype=object)
+        out = np.empty(a.shape, dtype=object)
+        for index, v in np.ndenumerate(a):
+            out[index] = self.value(v)
+        return out
+
+    def all_finite(self, a: np.ndarray) -> bool:
+        """True when every entry of ``a`` is finite."""
+        if self.dtype is float or a.dtype != object:
+            return bool(np.all(np.isfinite(a)))
+        return all(self.finite(x) for x in a.ravel())
+
+
+#: IEEE double precision: float64 NumPy arrays, NumPy's functions (the default everywhere).
+FLOAT64 = Numbers("float64", float, float, float, np.sin, np.cos, np.isfinite)
 
 
 @dataclass(frozen=True, eq=False)
@@ -99,6 +169,9 @@ class NumericModel:
         Rotational inertia [kg m²] about the centre of mass, in body frame axes.
     gravity : (3,) array
         Gravitational acceleration [m/s²] in the root frame.
+    numbers : Numbers
+        The number type of the arrays above (not of the index arrays) and of every result of
+        the algorithms: :data:`FLOAT64` unless built for another one.
     """
 
     name: str
@@ -115,6 +188,7 @@ class NumericModel:
     com: np.ndarray
     inertia: np.ndarray
     gravity: np.ndarray
+    numbers: Numbers = FLOAT64
 
     @property
     def n(self) -> int:
@@ -127,22 +201,23 @@ class NumericModel:
         return len(self.body_names)
 
 
-def _float(x, what: str) -> float:
+def _number(numbers: Numbers, x, what: str):
     try:
-        return float(x)
+        return numbers.convert(x)
     except TypeError:
         raise ValueError(f"{what} is not a number after substitution: {x}") from None
 
 
-def _vec(v, what: str) -> np.ndarray:
-    return np.array([_float(x, what) for x in v], dtype=float)
+def _vec(numbers: Numbers, v, what: str) -> np.ndarray:
+    return np.array([_number(numbers, x, what) for x in v], dtype=numbers.dtype)
 
 
-def _mat(m, what: str) -> np.ndarray:
-    return np.array([[_float(x, what) for x in row] for row in m], dtype=float)
+def _mat(numbers: Numbers, m, what: str) -> np.ndarray:
+    return np.array([[_number(numbers, x, what) for x in row] for row in m], dtype=numbers.dtype)
 
 
-def numeric_model(model: RobotModel, values: Mapping | None = None) -> NumericModel:
+def numeric_model(model: RobotModel, values: Mapping | None = None,
+                  numbers: Numbers = FLOAT64) -> NumericModel:
     """Build the numeric description of ``model``.
 
     Parameters
@@ -152,6 +227,8 @@ def numeric_model(model: RobotModel, values: Mapping | None = None) -> NumericMo
     values : mapping, optional
         Parameter values overriding the model's defaults, keyed by SymPy symbol or by
         parameter name.
+    numbers : Numbers, optional
+        The number type of the arrays (and of every algorithm's results): float64 by default.
 
     Returns
     -------
@@ -177,36 +254,37 @@ def numeric_model(model: RobotModel, values: Mapping | None = None) -> NumericMo
     parent = np.full(nb, -1, dtype=np.int64)
     joint_type = np.full(nb, FIXED, dtype=np.int64)
     q_index = np.full(nb, -1, dtype=np.int64)
-    axis = np.zeros((nb, 3))
-    axis[:, 2] = 1.0
-    rot = np.tile(np.eye(3), (nb, 1, 1))
-    trans = np.zeros((nb, 3))
+    axis = numbers.zeros((nb, 3))
+    axis[:, 2] = numbers.value(1)
+    rot = numbers.zeros((nb, 3, 3))
+    rot[:] = numbers.eye(3)
+    trans = numbers.zeros((nb, 3))
     for i, joint in enumerate(order, start=1):
         where = f"joint '{joint.name}'"
         parent[i] = index[joint.parent]
         joint_type[i] = _TYPE_CODE[joint.type]
         q_index[i] = q_of_joint.get(joint.name, -1)
-        axis[i] = _vec(joint.axis, where + " axis")
-        rot[i] = _mat(joint.origin.rotation, where + " origin")
-        trans[i] = _vec(joint.origin.translation, where + " origin")
+        axis[i] = _vec(numbers, joint.axis, where + " axis")
+        rot[i] = _mat(numbers, joint.origin.rotation, where + " origin")
+        trans[i] = _vec(numbers, joint.origin.translation, where + " origin")
 
-    mass = np.zeros(nb)
-    com = np.zeros((nb, 3))
-    inertia = np.zeros((nb, 3, 3))
+    mass = numbers.zeros(nb)
+    com = numbers.zeros((nb, 3))
+    inertia = numbers.zeros((nb, 3, 3))
     for i, name in enumerate(names):
         inertial = model.link_by_name[name].inertial
         if inertial is None:
             continue
         where = f"link '{name}' inertial"
-        mass[i] = _float(inertial.mass, where)
-        com[i] = _vec(inertial.com, where)
-        inertia[i] = _mat(inertial.inertia, where)
+        mass[i] = _number(numbers, inertial.mass, where)
+        com[i] = _vec(numbers, inertial.com, where)
+        inertia[i] = _mat(numbers, inertial.inertia, where)
 
     arrays = dict(parent=parent, joint_type=joint_type, q_index=q_index, axis=axis,
                   origin_rotation=rot, origin_translation=trans, mass=mass, com=com,
-                  inertia=inertia, gravity=_vec(model.gravity, "gravity"))
+                  inertia=inertia, gravity=_vec(numbers, model.gravity, "gravity"))
     for a in arrays.values():
-        if not np.all(np.isfinite(a)):
+        if not numbers.all_finite(a):
             raise ValueError(f"model '{model.name}' has a non-finite quantity")
         a.flags.writeable = False
     return NumericModel(
@@ -214,6 +292,7 @@ def numeric_model(model: RobotModel, values: Mapping | None = None) -> NumericMo
         body_names=names,
         joint_of_body=("",) + tuple(j.name for j in order),
         joint_names=model.joint_names,
+        numbers=numbers,
         **arrays,
     )
 
@@ -223,25 +302,25 @@ def numeric_model(model: RobotModel, values: Mapping | None = None) -> NumericMo
 # ----------------------------------------------------------------------------------------------
 
 def _check(nm: NumericModel, name: str, x) -> np.ndarray:
-    """``x`` as a float (n,) array, or a ValueError naming the argument."""
+    """``x`` as an (n,) array of the model's numbers, or a ValueError naming the argument."""
     if not isinstance(nm, NumericModel):
         raise ValueError(f"expected a NumericModel (see numeric_model), got {type(nm).__name__}")
-    a = np.asarray(x, dtype=float)
+    a = nm.numbers.vector(x)
     if a.shape != (nm.n,):
         raise ValueError(
             f"{name} must have shape ({nm.n},) (joints {', '.join(nm.joint_names) or 'none'}), "
             f"got shape {a.shape}"
         )
-    if not np.all(np.isfinite(a)):
+    if not nm.numbers.all_finite(a):
         raise ValueError(f"{name} has a non-finite entry")
     return a
 
 
-def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
+def _rotation(numbers: Numbers, axis: np.ndarray, angle) -> np.ndarray:
     """Rodrigues: rotation by ``angle`` [rad] about the unit vector ``axis``."""
     x, y, z = axis
-    K = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
-    return np.eye(3) + np.sin(angle) * K + (1.0 - np.cos(angle)) * (K @ K)
+    K = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]], dtype=numbers.dtype)
+    return numbers.eye(3) + numbers.sin(angle) * K + (1.0 - numbers.cos(angle)) * (K @ K)
 
 
 def _parent_transforms(nm: NumericModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -261,7 +340,7 @@ def _parent_transforms(nm: NumericModel, q: np.ndarray) -> tuple[np.ndarray, np.
         if k < 0:
             continue
         if nm.joint_type[i] == REVOLUTE:
-            R[i] = R[i] @ _rotation(nm.axis[i], q[k])
+            R[i] = R[i] @ _rotation(nm.numbers, nm.axis[i], q[k])
         else:  # prismatic: the child frame moves along the axis, without rotating
             p[i] = p[i] + R[i] @ (nm.axis[i] * q[k])
     return R, p
@@ -270,8 +349,8 @@ def _parent_transforms(nm: NumericModel, q: np.ndarray) -> tuple[np.ndarray, np.
 def _velocities(nm: NumericModel, R: np.ndarray, p: np.ndarray, qd: np.ndarray):
     """Angular velocity ``ω_i`` [rad/s] and origin velocity ``v_i`` [m/s] of every body,
     in body-``i`` coordinates (outward recursion)."""
-    w = np.zeros((nm.nb, 3))
-    v = np.zeros((nm.nb, 3))
+    w = nm.numbers.zeros((nm.nb, 3))
+    v = nm.numbers.zeros((nm.nb, 3))
     for i in range(1, nm.nb):
         j = nm.parent[i]
         Rt = R[i].T
@@ -341,13 +420,14 @@ def rnea(nm: NumericModel, q, qd, qdd) -> np.ndarray:
     qdd = _check(nm, "qdd", qdd)
     nb = nm.nb
     R, p = _parent_transforms(nm, q)
+    zeros = nm.numbers.zeros
 
-    w = np.zeros((nb, 3))
-    wd = np.zeros((nb, 3))
-    vd = np.zeros((nb, 3))
+    w = zeros((nb, 3))
+    wd = zeros((nb, 3))
+    vd = zeros((nb, 3))
     vd[0] = -nm.gravity
-    F = np.zeros((nb, 3))
-    N = np.zeros((nb, 3))
+    F = zeros((nb, 3))
+    N = zeros((nb, 3))
     for i in range(1, nb):
         j = nm.parent[i]
         Rt = R[i].T
@@ -370,7 +450,7 @@ def rnea(nm: NumericModel, q, qd, qdd) -> np.ndarray:
 
     f = F.copy()
     n = N + np.cross(nm.com, F)
-    tau = np.zeros(nm.n)
+    tau = zeros(nm.n)
     for i in range(nb - 1, 0, -1):
         k = nm.q_index[i]
         if k >= 0:
@@ -396,12 +476,12 @@ def mass_matrix_rnea(nm: NumericModel, q) -> np.ndarray:
     Column ``i`` is ``rnea(q, 0, e_i) - rnea(q, 0, 0)`` (n + 1 RNEA calls, O(n²) overall).
     """
     q = _check(nm, "q", q)
-    zero = np.zeros(nm.n)
+    zero = nm.numbers.zeros(nm.n)
     g = rnea(nm, q, zero, zero)
-    M = np.empty((nm.n, nm.n))
+    M = nm.numbers.zeros((nm.n, nm.n))
     for i in range(nm.n):
-        e = np.zeros(nm.n)
-        e[i] = 1.0
+        e = nm.numbers.zeros(nm.n)
+        e[i] = nm.numbers.value(1)
         M[:, i] = rnea(nm, q, zero, e) - g
     return M
 
@@ -435,8 +515,8 @@ def _world_poses(nm: NumericModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarra
     R, p = _parent_transforms(nm, q)
     Rw = np.empty_like(R)
     pw = np.empty_like(p)
-    Rw[0] = np.eye(3)
-    pw[0] = 0.0
+    Rw[0] = nm.numbers.eye(3)
+    pw[0] = nm.numbers.zeros(3)
     for i in range(1, nm.nb):
         j = nm.parent[i]
         Rw[i] = Rw[j] @ R[i]
@@ -481,6 +561,8 @@ def link_poses(nm: NumericModel, q) -> dict[str, tuple[np.ndarray, np.ndarray]]:
 
 
 __all__ = [
+    "Numbers",
+    "FLOAT64",
     "NumericModel",
     "numeric_model",
     "rnea",

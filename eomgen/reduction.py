@@ -64,7 +64,7 @@ from typing import Iterable, NamedTuple, Sequence
 
 import sympy as sp
 
-from .bodies import InertialParameters
+from .bodies import InertialParameters, attach_fixed_links, merged_inertial
 from .floating import EULER_JOINTS, add_floating_base
 from .errors import DescriptionError
 from .model import (
@@ -686,30 +686,19 @@ def _merge(model: RobotModel, payloads: Sequence[Payload]):
     Returns the reduced model (gravity still the description's), the merged bodies, the dropped
     link names and the names of payloads dropped with them.
     """
-    # where each link sits: (moving joint index or -1 for the world, pose in that body frame)
-    site: dict[str, tuple[int, Transform]] = {model.root: (-1, Transform())}
-    movers: list[tuple[Joint, int, Transform]] = []
-    for joint in model.topological_joints:
-        body, pose = site[joint.parent]
-        if joint.type.is_movable:
-            movers.append((joint, body, _clean(pose @ joint.origin)))
-            site[joint.child] = (len(movers) - 1, Transform())
-        else:
-            site[joint.child] = (body, _clean(pose @ joint.origin))
-    parts: list[list[tuple[Inertial, Transform]]] = [[] for _ in movers]
+    rigid = attach_fixed_links(model, tidy=_clean)
+    movers, site = rigid.movers, rigid.site
+    parts = rigid.inertial_parts(model)
     merged_links: list[list[str]] = [[] for _ in movers]
     merged_payloads: list[list[str]] = [[] for _ in movers]
     dropped: list[str] = [model.root]
     for link in model.links:
-        body, pose = site[link.name]
+        body = site[link.name][0]
         if body < 0:
             if link.name != model.root:
                 dropped.append(link.name)
-            continue
-        if link.name != movers[body][0].child:
+        elif link.name != movers[body][0].child:
             merged_links[body].append(link.name)
-        if link.inertial is not None:
-            parts[body].append((link.inertial, pose))
     dropped_payloads = []
     for payload in payloads:
         body, pose = site[payload.link]
@@ -764,11 +753,7 @@ def _combine(parts: list[tuple[Inertial, Transform]]) -> Inertial | None:
         return None
     if len(parts) == 1 and parts[0][1] == Transform():
         return parts[0][0]
-    total = InertialParameters()
-    for inertial, pose in parts:
-        params = InertialParameters.from_inertial(inertial)
-        total = total + (params if pose == Transform() else params.transformed(pose))
-    return _inertial(total)
+    return _inertial(merged_inertial(parts))
 
 
 def _inertial(p: InertialParameters) -> Inertial | None:

@@ -475,3 +475,37 @@ def test_example_robot_data(robot, erd_robots_dir):
             if name in frames:
                 assert_close(R, frames[name].rotation)
                 assert_close(p, frames[name].translation)
+
+
+@pytest.mark.parametrize("robot", sorted(ERD_ROBOTS))
+def test_one_rnea_in_float64_and_mpmath(robot, erd_robots_dir):
+    """rnea is one implementation generic over the number type: on the same model in mpmath
+    numbers at 50 digits (eomgen.analysis.precision.MPMATH) it gives the float64 result to
+    rounding (~1e-14 relative), and the mpmath values really carry more than double
+    precision (the float64 run is not what the mpmath run computes)."""
+    mpmath = pytest.importorskip("mpmath", reason="the mpmath number type needs mpmath")
+    import eomgen
+    from eomgen.analysis.precision import MPMATH
+    from eomgen.errors import UnsupportedFeatureWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UnsupportedFeatureWarning)
+        model = eomgen.load(erd_robots_dir / ERD_ROBOTS[robot])
+    nm = numeric_model(model)
+    mm = numeric_model(model, numbers=MPMATH)
+    assert mm.mass.dtype == object and isinstance(mm.mass[1], mpmath.mpf)
+    rng = np.random.default_rng(3)
+    q, qd, qdd = random_state(rng, nm.n)
+    with mpmath.workdps(50):
+        tau_mp = rnea(mm, q, qd, qdd)
+        M_mp = mass_matrix_rnea(mm, q)
+        assert all(isinstance(x, mpmath.mpf) for x in tau_mp)
+        # the same 50-digit run at 30 digits: the two agree far below double precision
+        with mpmath.workdps(30):
+            tau_30 = rnea(mm, q, qd, qdd)
+        assert max(abs(a - b) for a, b in zip(tau_mp, tau_30)) < mpmath.mpf(10) ** -25
+    assert_close(np.array(tau_mp, dtype=float), rnea(nm, q, qd, qdd), rtol=1e-14)
+    M_float = mass_matrix_rnea(nm, q)
+    assert_close(np.array(M_mp, dtype=float), M_float, rtol=1e-14)
+    assert np.any(np.array(tau_mp, dtype=float) != rnea(nm, q, qd, qdd)) or \
+        np.any(np.array(M_mp, dtype=float) != M_float)

@@ -6,9 +6,9 @@ Two independent evaluations at :data:`DPS` (40) significant digits with mpmath:
   generators print), printed once with SymPy's ``MpmathPrinter`` into a Python function over
   ``mpmath.mpf`` numbers (:func:`compile_program_mp`; our own printed program, never user
   text);
-* **a Newton–Euler recursion in mpmath** (:func:`mp_rnea`): the equations of
-  :func:`eomgen.numeric.rnea`, line by line, on 3-vectors and 3×3 matrices of ``mpf``
-  (NumPy object arrays).
+* **a Newton–Euler recursion in mpmath**: :func:`eomgen.numeric.rnea` itself, which is
+  generic over the number type, on a model of ``mpf`` numbers (:func:`mp_model`, the
+  :data:`MPMATH` numbers: 3-vectors and 3×3 matrices as NumPy object arrays).
 
 :class:`Reference` holds both and checks that they agree (:meth:`Reference.cross_check`; to
 about 1e-35 in practice, see ``tests/test_hard_cases.py``).
@@ -47,7 +47,9 @@ import sympy as sp
 from sympy.printing.pycode import MpmathPrinter
 
 from ..dynamics import Dynamics, derive
-from ..model import Inertial, JointType, RobotModel, Transform
+from ..model import Inertial, RobotModel, Transform
+from ..numeric import NumericModel, Numbers, mass_matrix_rnea, numeric_model, rnea
+from ..symbolic.printing import program_function
 from ..symbolic.program import Program
 
 #: Significant digits of every reference evaluation.
@@ -166,29 +168,14 @@ def compile_program_mp(program: Program, inputs: Sequence[sp.Symbol],
     that holds only ``mpmath``.
     """
     names = list(outputs) if outputs is not None else [n for n, _ in program.outputs]
-    program = program.pruned(names)
     printer = _Printer({"fully_qualified_modules": True, "standard": "python3"})
-    arguments = [f"a{k}" for k in range(len(inputs))]
-    rename = {s: sp.Symbol(a) for s, a in zip(inputs, arguments)}
-    lines = ["def _program(" + ", ".join(arguments) + "):"]
-    for symbol, expr in program.assignments:
-        lines.append(f"    {symbol.name} = {printer.doprint(expr.xreplace(rename))}")
-    results = []
-    for name, matrix in program.outputs:
-        rows = ["[" + ", ".join(printer.doprint(e.xreplace(rename)) for e in matrix.row(r)) + "]"
-                for r in range(matrix.rows)]
-        results.append(f"{name!r}: [" + ", ".join(rows) + "]")
-    lines.append("    return {" + ", ".join(results) + "}")
-    namespace: dict = {}
-    exec(compile("\n".join(lines), "<eomgen mpmath program>", "exec"),  # noqa: S102 - ours
-         {"mpmath": mpmath}, namespace)
-    raw = namespace["_program"]
+    raw = program_function(program, inputs, printer, {"mpmath": mpmath}, names,
+                           filename="<eomgen mpmath program>")
 
     def evaluate(*values) -> dict[str, np.ndarray]:
         converted = [v if isinstance(v, mpmath.mpf) else mpmath.mpf(float(v)) for v in values]
-        out = raw(*converted)
         result = {}
-        for k, rows in out.items():
+        for k, rows in zip(names, raw(*converted)):
             array = np.empty((len(rows), len(rows[0]) if rows else 0), dtype=object)
             for r, row in enumerate(rows):
                 for c, e in enumerate(row):
@@ -203,33 +190,23 @@ def compile_program_mp(program: Program, inputs: Sequence[sp.Symbol],
 # Newton–Euler in mpmath
 # ----------------------------------------------------------------------------------------------
 
-@dataclass(frozen=True, eq=False)
-class MpModel:
-    """:class:`eomgen.numeric.NumericModel` with every number an ``mpf`` (object arrays).
+def _mpf_value(v) -> mpmath.mpf:
+    """A caller's value as an mpf: an mpf as it is, anything else through its float (exact)."""
+    return v if isinstance(v, mpmath.mpf) else mpmath.mpf(float(v))
 
-    Bodies in topological order, body 0 the root; see :mod:`eomgen.numeric` for the meaning
-    of every field.
-    """
 
-    joint_names: tuple[str, ...]
-    parent: tuple[int, ...]
-    revolute: tuple[bool, ...]
-    q_index: tuple[int, ...]
-    axis: tuple[np.ndarray, ...]
-    origin_rotation: tuple[np.ndarray, ...]
-    origin_translation: tuple[np.ndarray, ...]
-    mass: tuple[mpmath.mpf, ...]
-    com: tuple[np.ndarray, ...]
-    inertia: tuple[np.ndarray, ...]
-    gravity: np.ndarray
+#: mpmath numbers for the algorithms of :mod:`eomgen.numeric` (object arrays of ``mpf``):
+#: the description's numbers carried at :data:`MODEL_DPS` digits, arithmetic at the mpmath
+#: precision current at call time (:func:`mpmath.workdps`).
+MPMATH = Numbers("mpmath", object, _to_mpf, _mpf_value, mpmath.sin, mpmath.cos, mpmath.isfinite)
 
-    @property
-    def n(self) -> int:
-        return len(self.joint_names)
 
-    @property
-    def nb(self) -> int:
-        return len(self.parent)
+def mp_model(model: RobotModel) -> NumericModel:
+    """The numbers of ``model`` (parameters at their values) as mpf: the
+    :class:`~eomgen.numeric.NumericModel` of :data:`MPMATH` numbers, on which
+    :func:`eomgen.numeric.rnea` and ``mass_matrix_rnea`` compute in mpmath. Use it on
+    :func:`high_precision_model`'s result."""
+    return numeric_model(model, numbers=MPMATH)
 
 
 def _obj(values) -> np.ndarray:
@@ -238,128 +215,17 @@ def _obj(values) -> np.ndarray:
     return array
 
 
-def _vec_mp(v) -> np.ndarray:
-    return _obj([_to_mpf(x) for x in v])
-
-
-def _mat_mp(m) -> np.ndarray:
-    out = np.empty((3, 3), dtype=object)
-    for r in range(3):
-        for c in range(3):
-            out[r, c] = _to_mpf(m[r][c])
-    return out
-
-
-def mp_model(model: RobotModel) -> MpModel:
-    """The numbers of ``model`` (parameters at their values) as mpf, in the body order of
-    :func:`eomgen.numeric.numeric_model`. Use it on :func:`high_precision_model`'s result."""
-    if model.free_symbols:
-        model = model.with_numeric_parameters()
-    order = model.topological_joints
-    names = (model.root,) + tuple(j.child for j in order)
-    index = {name: i for i, name in enumerate(names)}
-    q_of_joint = {j.name: k for k, j in enumerate(model.movable_joints)}
-    zero3 = _obj([mpmath.mpf(0)] * 3)
-    eye = _mat_mp(((1, 0, 0), (0, 1, 0), (0, 0, 1)))
-    zero33 = _mat_mp(((0, 0, 0),) * 3)
-    parent, revolute, q_index = [-1], [False], [-1]
-    axis, rot, trans = [zero3], [eye], [zero3]
-    for joint in order:
-        parent.append(index[joint.parent])
-        revolute.append(joint.type.is_revolute)
-        q_index.append(q_of_joint.get(joint.name, -1) if joint.type is not JointType.FIXED else -1)
-        axis.append(_vec_mp(joint.axis))
-        rot.append(_mat_mp(joint.origin.rotation))
-        trans.append(_vec_mp(joint.origin.translation))
-    mass, com, inertia = [], [], []
-    for name in names:
-        i = model.link_by_name[name].inertial
-        mass.append(_to_mpf(i.mass) if i else mpmath.mpf(0))
-        com.append(_vec_mp(i.com) if i else zero3)
-        inertia.append(_mat_mp(i.inertia) if i else zero33)
-    return MpModel(model.joint_names, tuple(parent), tuple(revolute), tuple(q_index), tuple(axis),
-                   tuple(rot), tuple(trans), tuple(mass), tuple(com), tuple(inertia),
-                   _vec_mp(model.gravity))
-
-
-def _rodrigues(axis: np.ndarray, angle) -> np.ndarray:
-    x, y, z = axis
-    zero = mpmath.mpf(0)
-    K = np.array([[zero, -z, y], [z, zero, -x], [-y, x, zero]], dtype=object)
-    eye = np.array([[mpmath.mpf(int(r == c)) for c in range(3)] for r in range(3)], dtype=object)
-    return eye + mpmath.sin(angle) * K + (1 - mpmath.cos(angle)) * (K @ K)
-
-
 def _mp_values(x, n: int) -> list:
-    values = [v if isinstance(v, mpmath.mpf) else mpmath.mpf(float(v)) for v in x]
+    values = [_mpf_value(v) for v in x]
     if len(values) != n:
         raise ValueError(f"expected {n} values, got {len(values)}")
     return values
 
 
-def mp_rnea(mm: MpModel, q, qd, qdd) -> np.ndarray:
-    """Inverse dynamics ``tau`` (object array of mpf) by the recursive Newton–Euler algorithm,
-    the equations of :func:`eomgen.numeric.rnea` at the current mpmath precision."""
-    q, qd, qdd = (_mp_values(x, mm.n) for x in (q, qd, qdd))
-    nb = mm.nb
-    zero = _obj([mpmath.mpf(0)] * 3)
-    R, p = [], []
-    for i in range(nb):
-        k = mm.q_index[i]
-        Ri, pi = mm.origin_rotation[i], mm.origin_translation[i]
-        if i > 0 and k >= 0:
-            if mm.revolute[i]:
-                Ri = Ri @ _rodrigues(mm.axis[i], q[k])
-            else:
-                pi = pi + Ri @ (mm.axis[i] * q[k])
-        R.append(Ri)
-        p.append(pi)
-    w, wd, vd = [zero] * nb, [zero] * nb, [zero] * nb
-    vd[0] = -mm.gravity
-    F, N = [zero] * nb, [zero] * nb
-    for i in range(1, nb):
-        j = mm.parent[i]
-        Rt = R[i].T
-        w[i] = Rt @ w[j]
-        wd[i] = Rt @ wd[j]
-        vd[i] = Rt @ (vd[j] + np.cross(wd[j], p[i]) + np.cross(w[j], np.cross(w[j], p[i])))
-        k = mm.q_index[i]
-        if k >= 0:
-            z = mm.axis[i]
-            if mm.revolute[i]:
-                wd[i] = wd[i] + np.cross(w[i], qd[k] * z) + qdd[k] * z
-                w[i] = w[i] + qd[k] * z
-            else:
-                vd[i] = vd[i] + 2 * np.cross(w[i], qd[k] * z) + qdd[k] * z
-        c = mm.com[i]
-        vdc = vd[i] + np.cross(wd[i], c) + np.cross(w[i], np.cross(w[i], c))
-        I = mm.inertia[i]
-        F[i] = mm.mass[i] * vdc
-        N[i] = I @ wd[i] + np.cross(w[i], I @ w[i])
-    f = list(F)
-    n = [N[i] + np.cross(mm.com[i], F[i]) for i in range(nb)]
-    tau = _obj([mpmath.mpf(0)] * mm.n)
-    for i in range(nb - 1, 0, -1):
-        k = mm.q_index[i]
-        if k >= 0:
-            tau[k] = (n[i] if mm.revolute[i] else f[i]) @ mm.axis[i]
-        j = mm.parent[i]
-        fj = R[i] @ f[i]
-        f[j] = f[j] + fj
-        n[j] = n[j] + R[i] @ n[i] + np.cross(p[i], fj)
-    return tau
-
-
-def mp_mass_matrix(mm: MpModel, q) -> np.ndarray:
-    """``M(q)`` (object array of mpf): column i is ``rnea(q, 0, e_i) − rnea(q, 0, 0)``."""
-    zero = [mpmath.mpf(0)] * mm.n
-    g = mp_rnea(mm, q, zero, zero)
-    M = np.empty((mm.n, mm.n), dtype=object)
-    for i in range(mm.n):
-        e = list(zero)
-        e[i] = mpmath.mpf(1)
-        M[:, i] = mp_rnea(mm, q, zero, e) - g
-    return M
+#: Inverse dynamics and the mass matrix by Newton–Euler in mpmath: the one implementation of
+#: :mod:`eomgen.numeric` (generic over the number type) on an :func:`mp_model`.
+mp_rnea = rnea
+mp_mass_matrix = mass_matrix_rnea
 
 
 # ----------------------------------------------------------------------------------------------
@@ -444,12 +310,12 @@ class Reference:
     def M_rnea(self, q) -> np.ndarray:
         """Mass matrix (n, n) from the mpmath Newton–Euler recursion."""
         with mpmath.workdps(self.dps):
-            return mp_mass_matrix(self.mp_model, q)
+            return mass_matrix_rnea(self.mp_model, q)
 
     def tau_rnea(self, q, qd, qdd) -> np.ndarray:
         """Inverse dynamics (n,) from the mpmath Newton–Euler recursion."""
         with mpmath.workdps(self.dps):
-            return mp_rnea(self.mp_model, q, qd, qdd)
+            return rnea(self.mp_model, q, qd, qdd)
 
     def forward_dynamics(self, q, qd, tau) -> np.ndarray:
         """q̈ (n,) solving M q̈ = τ − (C q̇ + g) at ``dps`` digits (mpmath Cholesky)."""
@@ -487,5 +353,5 @@ def _scalars(model: RobotModel):
 
 
 __all__ = ["DPS", "MODEL_DPS", "Reference", "high_precision_model", "compile_program_mp",
-           "MpModel", "mp_model", "mp_rnea", "mp_mass_matrix", "relative_error", "max_abs",
+           "MPMATH", "mp_model", "mp_rnea", "mp_mass_matrix", "relative_error", "max_abs",
            "to_float"]

@@ -46,8 +46,6 @@ from typing import Callable, Iterable, Sequence
 
 import numpy as np
 import sympy as sp
-from sympy.printing.numpy import NumPyPrinter
-from sympy.printing.pycode import PythonCodePrinter
 
 from ..codegen import available_backends, make_job
 from ..compiler import c_compiler
@@ -56,6 +54,9 @@ from ..model import RobotModel
 from ..progress import plural
 from ..numeric import mass_matrix_rnea, numeric_model, rnea
 from ..outputs import INVERSE, MASS
+from ..codegen.backends.numpy_backend import NumPyModulePrinter
+from ..symbolic.evaluate import FloatPrinter
+from ..symbolic.printing import program_function
 from ..symbolic.program import Program
 
 # ----------------------------------------------------------------------------------------------
@@ -63,59 +64,14 @@ from ..symbolic.program import Program
 # ----------------------------------------------------------------------------------------------
 
 
-class _ScalarPrinter(PythonCodePrinter):
-    """Python code over floats: ``sin(x)`` (``math``), floats with all 17 digits."""
-
-    def _print_Float(self, expr):
-        return repr(float(expr))
-
-    def _print_Rational(self, expr):
-        return f"({int(expr.p)}/{int(expr.q)})"
-
-
-class _BatchPrinter(NumPyPrinter):
+class _BatchPrinter(NumPyModulePrinter):
     """NumPy code over arrays of one dtype: every literal wrapped in ``_F`` (that dtype)."""
 
-    def _module_format(self, fqn, register=True):
-        text = super()._module_format(fqn, register)
-        return "np." + text[len("numpy."):] if text.startswith("numpy.") else text
-
-    def _print_Float(self, expr):
-        return f"_F({float(expr)!r})"
-
-    def _print_Rational(self, expr):
-        return f"(_F({int(expr.p)})/_F({int(expr.q)}))"
+    def _literal(self, value: float) -> str:
+        return f"_F({value!r})"
 
     def _print_Pi(self, expr):
         return "_F(np.pi)"
-
-
-def _source(program: Program, arguments: Sequence[str], printer, outputs: Sequence[str],
-            flat: bool) -> str:
-    lines = ["def _program(" + ", ".join(arguments) + "):"]
-    for symbol, expr in program.assignments:
-        lines.append(f"    {symbol.name} = {printer.doprint(expr)}")
-    parts = []
-    for name in outputs:
-        matrix = program.output(name)
-        entries = [printer.doprint(e) for e in matrix]
-        parts.append("[" + ", ".join(entries) + "]" if flat else
-                     "[" + ", ".join("[" + ", ".join(entries[r * matrix.cols:(r + 1) * matrix.cols])
-                                     + "]" for r in range(matrix.rows)) + "]")
-    lines.append("    return (" + ", ".join(parts) + ("," if len(parts) == 1 else "") + ")")
-    return "\n".join(lines)
-
-
-def _prepared(program: Program, inputs: Sequence[sp.Symbol], outputs: Sequence[str],
-              fixed: dict | None):
-    program = program.pruned(outputs)
-    names = [f"_a{k}" for k in range(len(inputs))]
-    rename = {s: sp.Symbol(a, real=True) for s, a in zip(inputs, names)}
-    if fixed:
-        rename.update({s: sp.sympify(v) for s, v in fixed.items()})
-    assignments = tuple((s, e.xreplace(rename)) for s, e in program.assignments)
-    outs = tuple((n, program.output(n).xreplace(rename)) for n in outputs)
-    return Program(assignments, outs), names
 
 
 def compile_scalar(program: Program, inputs: Sequence[sp.Symbol], outputs: Sequence[str],
@@ -126,13 +82,10 @@ def compile_scalar(program: Program, inputs: Sequence[sp.Symbol], outputs: Seque
     bias forces, which shortens the program). Outputs are flat row-major lists. The printed code
     is our own program, executed in a namespace holding ``math``'s functions only.
     """
-    program, names = _prepared(program, inputs, outputs, fixed)
-    printer = _ScalarPrinter({"fully_qualified_modules": False, "standard": "python3"})
-    namespace: dict = {}
+    printer = FloatPrinter()
     functions = {f: getattr(math, f) for f in ("sin", "cos", "tan", "sqrt", "pi")}
-    exec(compile(_source(program, names, printer, outputs, flat=True),  # noqa: S102 - ours
-                 "<eomgen scalar program>", "exec"), functions, namespace)
-    return namespace["_program"]
+    return program_function(program, inputs, printer, functions, outputs, fixed, flat=True,
+                            filename="<eomgen scalar program>")
 
 
 def compile_batch(program: Program, inputs: Sequence[sp.Symbol], outputs: Sequence[str],
@@ -140,13 +93,9 @@ def compile_batch(program: Program, inputs: Sequence[sp.Symbol], outputs: Sequen
     """``f(*columns) -> (array (N, rows, cols) per output)``: the program over arrays of
     ``dtype`` (each input a column of shape (N,)), every literal rounded to ``dtype``. With
     float32 this is the float32 evaluation of exactly the program the generators print."""
-    program, names = _prepared(program, inputs, outputs, None)
     printer = _BatchPrinter({"fully_qualified_modules": True, "standard": "python3"})
-    namespace: dict = {}
-    exec(compile(_source(program, names, printer, outputs, flat=False),  # noqa: S102 - ours
-                 "<eomgen batch program>", "exec"), {"np": np, "_F": np.dtype(dtype).type},
-         namespace)
-    raw = namespace["_program"]
+    raw = program_function(program, inputs, printer, {"np": np, "_F": np.dtype(dtype).type},
+                           outputs, filename="<eomgen batch program>")
     shapes = [program.output(n).shape for n in outputs]
 
     def evaluate(*columns) -> tuple[np.ndarray, ...]:

@@ -95,10 +95,10 @@ def _coriolis_matrix_expression(q, qd, I1, I2, g_, l1, l2, lc1, lc2, m1, m2):
     F2_3 = -hw2_1 + m2*o2_1
     F2_4 = hw2_0 - m2*o2_0
     dM1_1_2 = 2*hw2_0*o2_1 - 2*hw2_1*o2_0
-    C1_1 = ((1/2))*dM1_1_2*qd2
+    C1_1 = 0.5*dM1_1_2*qd2
     Y2_2_2 = F2_3*o2_0 + F2_4*o2_1
-    C1_2 = Y2_2_2*qd2 + ((1/2))*dM1_1_2*qd1
-    C2_1 = -(1/2)*dM1_1_2*qd1
+    C1_2 = Y2_2_2*qd2 + 0.5*dM1_1_2*qd1
+    C2_1 = -0.5*dM1_1_2*qd1
     out = ca.SX.zeros(2, 2)
     out[0, 0] = C1_1
     out[0, 1] = C1_2

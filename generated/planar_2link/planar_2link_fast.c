@@ -121,10 +121,10 @@ static void coriolis_matrix_one(const double *const *x, const double *p, double 
     const double t_F2_3 = p[8]*t_o2_1 - t_hw2_1;
     const double t_F2_4 = -p[8]*t_o2_0 + t_hw2_0;
     const double t_dM1_1_2 = 2.0*t_hw2_0*t_o2_1 - 2.0*t_hw2_1*t_o2_0;
-    const double t_C1_1 = ((1.0/2.0))*qd[1]*t_dM1_1_2;
+    const double t_C1_1 = 0.5*qd[1]*t_dM1_1_2;
     const double t_Y2_2_2 = t_F2_3*t_o2_0 + t_F2_4*t_o2_1;
-    const double t_C1_2 = ((1.0/2.0))*qd[0]*t_dM1_1_2 + qd[1]*t_Y2_2_2;
-    const double t_C2_1 = -(1.0/2.0)*qd[0]*t_dM1_1_2;
+    const double t_C1_2 = 0.5*qd[0]*t_dM1_1_2 + qd[1]*t_Y2_2_2;
+    const double t_C2_1 = -0.5*qd[0]*t_dM1_1_2;
     memset(out, 0, sizeof(double) * 4);
     out[0] = t_C1_1;
     out[1] = t_C1_2;

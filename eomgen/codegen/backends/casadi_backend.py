@@ -21,6 +21,7 @@ from sympy.printing.pycode import PythonCodePrinter
 
 from ...compiler import c_compiler
 from .. import GeneratedFile, Job, register
+from ...symbolic.printing import FloatLiteralMixin, exec_source
 from ..functions import DEFAULT_FUNCTIONS
 from ..render import render
 from .common import python_module_context
@@ -29,7 +30,7 @@ _FUNCTIONS = ("sin", "cos", "tan", "sqrt", "exp", "log", "asin", "acos", "atan",
               "tanh", "sign")
 
 
-class CasADiPrinter(PythonCodePrinter):
+class CasADiPrinter(FloatLiteralMixin, PythonCodePrinter):
     """Python code over CasADi SX symbols: ``ca.sin(x)``, exact float literals."""
 
     def _print_Function(self, expr):
@@ -47,12 +48,6 @@ class CasADiPrinter(PythonCodePrinter):
         if exponent == sp.Rational(1, 2):
             return f"ca.sqrt({self._print(base)})"
         return super()._print_Pow(expr, rational)
-
-    def _print_Float(self, expr):
-        return repr(float(expr))
-
-    def _print_Rational(self, expr):
-        return f"({int(expr.p)}/{int(expr.q)})"
 
     def _print_Pi(self, expr):
         return "ca.pi"
@@ -80,9 +75,7 @@ def generate_casadi(job: Job, config: CasADiConfig = CasADiConfig()) -> list[Gen
 
 def load_module_source(source: str, name: str) -> dict:
     """Execute a generated CasADi module's source in a fresh namespace (our own printed code)."""
-    namespace: dict = {"__name__": name}
-    exec(compile(source, f"<{name}>", "exec"), namespace)  # noqa: S102
-    return namespace
+    return exec_source(source, f"<{name}>", {"__name__": name})
 
 
 FUNCTION_NAMES = DEFAULT_FUNCTIONS  # what a module exports unless a job asks for others

@@ -28,6 +28,7 @@ from sympy.printing.precedence import PRECEDENCE
 from ...compiler import c_compiler
 from .. import GeneratedFile, Job, register
 from ...outputs import FORWARD, composition_names
+from ...symbolic.printing import FloatLiteralMixin
 from ..render import render
 
 
@@ -35,15 +36,13 @@ from ..render import render
 _BARE = PRECEDENCE["Atom"] - 1
 
 
-class FastCPrinter(C99CodePrinter):
-    """C99 over doubles: floats with all 17 significant digits, ``x*x`` for small powers."""
+class FastCPrinter(FloatLiteralMixin, C99CodePrinter):
+    """C99 over doubles: the literals of :class:`~eomgen.symbolic.printing.FloatLiteralMixin`
+    written as C doubles, ``x*x`` for small powers."""
 
-    def _print_Float(self, expr):
-        text = repr(float(expr))
+    def _literal(self, value: float) -> str:
+        text = repr(value)
         return text if any(c in text for c in ".en") else text + ".0"
-
-    def _print_Rational(self, expr):
-        return f"({int(expr.p)}.0/{int(expr.q)}.0)"
 
     def _print_Integer(self, expr):
         return f"{int(expr)}.0"

@@ -12,22 +12,18 @@ from sympy.printing.numpy import NumPyPrinter
 
 from .. import GeneratedFile, Job, register
 from ...outputs import FORWARD
+from ...symbolic.printing import FloatLiteralMixin
 from ..render import render
 from .common import python_module_context
 
 
-class NumPyModulePrinter(NumPyPrinter):
-    """NumPy code with ``np.`` as the module prefix and exact float literals."""
+class NumPyModulePrinter(FloatLiteralMixin, NumPyPrinter):
+    """NumPy code with ``np.`` as the module prefix and exact float literals
+    (:class:`~eomgen.symbolic.printing.FloatLiteralMixin`)."""
 
     def _module_format(self, fqn, register=True):
         text = super()._module_format(fqn, register)
         return "np." + text[len("numpy."):] if text.startswith("numpy.") else text
-
-    def _print_Float(self, expr):
-        return repr(float(expr))
-
-    def _print_Rational(self, expr):
-        return f"({int(expr.p)}/{int(expr.q)})"
 
 
 @dataclass(frozen=True)
