@@ -84,10 +84,11 @@ def main() -> None:
     for _ in range(args.repeat):
         with tempfile.TemporaryDirectory() as out:
             start = time.perf_counter()
-            subprocess.run([sys.executable, "-c", "from eomgen.cli import main; main()", "generate", str(urdf), "--scene",
-                            str(SCENE), "--outputs", ",".join(FUNCTIONS[1:]), "--backend",
-                            "numpy,casadi", "--no-cache", "--quiet", "-o", out], check=True,
-                           capture_output=True, env={"PYTHONPATH": str(ROOT), **_env()})
+            subprocess.run([sys.executable, "-c", "from eomgen.cli import main; main()",
+                            "generate", str(urdf), "--scene", str(SCENE), "--outputs",
+                            ",".join(FUNCTIONS[1:]), "--backend", "numpy,casadi", "--no-cache",
+                            "--quiet", "-o", out], check=True, capture_output=True,
+                           env={"PYTHONPATH": str(ROOT), **_env()})
             walls.append(time.perf_counter() - start)
             if len(walls) == 1:
                 module = _load(Path(out) / "panda_numpy.py")
