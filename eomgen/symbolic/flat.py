@@ -138,7 +138,8 @@ def build_flat(derivation, wanted) -> dict:
         For a model without a flexible joint (an actuator with a stiffness).
     """
     model = derivation.model
-    require_flexible(model, FLAT & set(wanted))
+    wanted = set(wanted)
+    require_flexible(model, FLAT & wanted)
     actuators = joint_actuators(model)
     flexible = flexible_indices(model)
     inputs = derivation.inputs
