@@ -281,9 +281,9 @@ FLAT_TORQUE = register_output(Output(
     "tau_L + a qdd + d qd + f sign(qd) on rigid ones.", ("q", "qd", "qdd", "qddd", "qdddd"), True,
     _REVOLUTE_EFFORT, ("tau_flat",), build=_FLAT, default=False))
 FLAT_TORQUE_SMOOTH = register_output(Output(
-    "flat_motor_torque_smooth", "tau_flat_smooth", "flat_motor_torque with Coulomb friction "
-    "f tanh(v / w) in place of f sign(v) (the law of motor_forward_dynamics: a simulation fed "
-    "with it follows q(t)).", ("q", "qd", "qdd", "qddd", "qdddd"), True, _REVOLUTE_EFFORT,
+    "flat_motor_torque_smooth", "tau_flat_smooth", "Inputs tau that make the links follow "
+    "q(t), as flat_motor_torque but with Coulomb friction f tanh(v / w) in place of f sign(v) "
+    "(the law of motor_forward_dynamics: a simulation fed with it follows q(t)).", ("q", "qd", "qdd", "qddd", "qdddd"), True, _REVOLUTE_EFFORT,
     ("tau_flat_smooth",), build=_FLAT, default=False))
 
 
