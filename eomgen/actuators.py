@@ -45,7 +45,8 @@ straight-line program of ``τ_L`` is differentiated in forward mode along the tr
 keeps the program's size linear in the model (the 7-DOF Panda included).
 
 The generated modules export these on request (:mod:`eomgen.symbolic.drives`,
-``eomgen generate --outputs M_a,tau_f,...``); see docs/actuators.md.
+``eomgen generate --outputs M_a,tau_f,...``; the flat inverse dynamics, :mod:`eomgen.symbolic.flat`,
+``--outputs motor_angles,motor_velocities,flat_motor_torque``); see docs/actuators.md.
 """
 
 from __future__ import annotations

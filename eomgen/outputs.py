@@ -47,6 +47,8 @@ INPUTS: dict[str, str] = {
              "rigid joints are ignored)",
     "thetad_m": "motor velocities of the flexible joints, link side of the gear [rad/s] "
               "(entries of rigid joints are ignored)",
+    "qddd": "third time derivatives of the joint positions (jerk) [rad/s^3 or m/s^3]",
+    "qdddd": "fourth time derivatives of the joint positions (snap) [rad/s^4 or m/s^4]",
 }
 
 
@@ -260,6 +262,29 @@ POTENTIAL_REGRESSOR = register_output(Output(
     "= -sum m g_vec . c over the moving bodies (actuator columns 0).", ("q",), True,
     "J per unit of each column's parameter", ("Y_P",), build=_REGRESSOR, default=False,
     constants=_NAMES))
+
+# Issue 17: the flat inverse dynamics of Spong's flexible-joint model (docs/actuators.md): motor
+# states and torques that make the links follow q(t), from q and its derivatives up to order 4.
+_FLAT = "eomgen.symbolic.flat:build_flat"
+MOTOR_ANGLES = register_output(Output(
+    "motor_angles", "theta_flat", "Motor angles (link side of the gear) that make the links "
+    "follow q(t): q + K^-1 tau_L on flexible joints, q on rigid ones; tau_L = M qdd + C qd + g.",
+    ("q", "qd", "qdd"), True, "rad (revolute), m (prismatic)", ("theta_flat",), build=_FLAT,
+    default=False))
+MOTOR_VELOCITIES = register_output(Output(
+    "motor_velocities", "thetad_flat", "Motor velocities that make the links follow q(t): qd + "
+    "K^-1 d/dt tau_L on flexible joints, qd on rigid ones.", ("q", "qd", "qdd", "qddd"), True,
+    "rad/s (revolute), m/s (prismatic)", ("thetad_flat",), build=_FLAT, default=False))
+FLAT_TORQUE = register_output(Output(
+    "flat_motor_torque", "tau_flat", "Inputs tau that make the links follow q(t) (flatness): "
+    "B thetadd + K (theta - q) + d thetad + f sign(thetad) on flexible joints (motor torque), "
+    "tau_L + a qdd + d qd + f sign(qd) on rigid ones.", ("q", "qd", "qdd", "qddd", "qdddd"), True,
+    _REVOLUTE_EFFORT, ("tau_flat",), build=_FLAT, default=False))
+FLAT_TORQUE_SMOOTH = register_output(Output(
+    "flat_motor_torque_smooth", "tau_flat_smooth", "Inputs tau that make the links follow "
+    "q(t), as flat_motor_torque but with Coulomb friction f tanh(v / w) in place of f sign(v) "
+    "(the law of motor_forward_dynamics: a simulation fed with it follows q(t)).", ("q", "qd", "qdd", "qddd", "qdddd"), True, _REVOLUTE_EFFORT,
+    ("tau_flat_smooth",), build=_FLAT, default=False))
 
 
 def derived_symbols(default_only: bool = False) -> tuple[str, ...]:

@@ -30,6 +30,15 @@ from ..errors import GenerationError
 FLEXIBLE = frozenset({"tau_K", "thetadd_m"})
 
 
+def require_flexible(model, symbols) -> None:
+    """Raise the one-line :class:`GenerationError` of flexible-joint outputs ``symbols`` asked
+    of ``model`` when it has no flexible joint (nothing to do for an empty ``symbols``)."""
+    if symbols and not flexible_indices(model):
+        raise GenerationError(
+            f"{model.source}: {', '.join(sorted(symbols))} need flexible joints, "
+            "but no joint has an actuator with a stiffness (docs/actuators.md)")
+
+
 def build_drives(derivation, wanted) -> dict:
     """The builder of ``M_a``, ``tau_f``, ``tau_f_smooth``, ``tau_a``, ``M_l``, ``tau_K`` and
     ``thetadd_m`` in :mod:`eomgen.outputs` (see the module docstring).
@@ -43,10 +52,7 @@ def build_drives(derivation, wanted) -> dict:
     model = derivation.model
     actuators = joint_actuators(model)
     flexible = flexible_indices(model)
-    if FLEXIBLE & set(wanted) and not flexible:
-        raise GenerationError(
-            f"{model.source}: {', '.join(sorted(FLEXIBLE & set(wanted)))} need flexible joints, "
-            "but no joint has an actuator with a stiffness (docs/actuators.md)")
+    require_flexible(model, FLEXIBLE & set(wanted))
     q, qd, qdd = derivation.q, derivation.qd, derivation.qdd
     armature = [a.armature for a in actuators]
     out = {}
