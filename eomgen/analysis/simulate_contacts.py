@@ -216,7 +216,7 @@ class ContactStudy:
                 f"({', '.join(f'{x:g}' for x in self.q0)}), q̇0 = "
                 f"({', '.join(f'{x:g}' for x in self.qd0)}), zero torque; "
                 f"‖J_c q̇0‖∞ = {self.initial_velocity_error:.3g}; contact forces at t = 0: "
-                f"({', '.join(f'{x:.6g}' for x in self.initial_force)}).")
+                f"({', '.join(f'{x + 0.0:.6g}' for x in self.initial_force)}).")
         if self.dependent:
             text += (" The contact rows are dependent (a direction no joint moves a contact "
                      f"in): damped KKT solve, ε = {DEPENDENT_DAMPING:g}.")
