@@ -86,6 +86,9 @@ def test_bad_scene_actuators_are_one_line_naming_the_scene_and_the_joint(text, e
     message = str(caught.value)
     assert "\n" not in message and message.startswith(f"bad.yaml: {element}: "), message
     assert problem in message
+    # drive values that are not physical are InvalidActuatorErrors in a scene too
+    assert isinstance(caught.value, InvalidActuatorError) == any(
+        p in problem for p in ("stiffness", "motor inertia", "gear_ratio is 0"))
 
 
 # ----------------------------------------------------------------------------------------------

@@ -484,7 +484,9 @@ def run_study(model: RobotModel, integrators: Sequence, duration: float, q0=None
             warnings.warn(ill_conditioned_message(info["max_condition"],
                                                   f" during {integrator.name}"),
                           IllConditionedWarning, stacklevel=2)
-    return Study(system.model.name, n, float(duration), tuple(q0.tolist()), tuple(qd0.tolist()),
+    joints = getattr(system, "links", n)  # a flexible system has n joints and m motors
+    return Study(system.model.name, joints, float(duration), tuple(q0.tolist()),
+                 tuple(qd0.tolist()),
                  scale, reference_seconds, tuple(runs))
 
 
