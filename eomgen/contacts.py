@@ -12,8 +12,18 @@ A :class:`Contact` holds a named frame (a link, see :mod:`eomgen.symbolic.frames
   the contact normal is the frame's +z axis.
 
 Baumgarte stabilisation (optional gains ``kd`` [1/s], ``kp`` [1/s²]) adds
-``γ = kd J q̇ + kp e`` to the constraint, ``e`` the position error of a point contact from its
-``anchor`` (world position; none: no position term); surfaces take ``kd`` only.
+``γ = kd J q̇ + kp e`` to the constraint, so that the constraint error obeys
+``ë + kd ė + kp e = 0`` (to first order in ``e``). The error ``e``:
+
+* point contact: ``e = p − p*`` [m], world axes, ``p*`` its ``anchors[frame]`` (none: no
+  position term);
+* surface contact: ``e = (Rᵀ (p − p*), log(R*ᵀ R))`` [m, rad], both in the **frame's** axes
+  (the rows of its body Jacobian): the position error rotated into the frame, and the rotation
+  vector (axis × angle, angle in [0, π]) of the relative rotation ``R*ᵀ R`` that takes the
+  anchor frame to the frame (:func:`rotation_log`; its axis has the same coordinates in both
+  frames). ``p*`` is ``anchors[frame]``, ``R*`` is ``orientations[frame]`` (world axes); a
+  missing one leaves its three rows without a position term. This is the error on SO(3) × R³,
+  not the SE(3) logarithm (Pinocchio's ``log6``): the two agree to first order.
 
 :class:`ContactDynamics` computes, from eomgen's own M and h (Newton–Euler,
 :mod:`eomgen.numeric`) and the frame kinematics program:
@@ -65,6 +75,31 @@ def derived_mass_and_bias(model: RobotModel) -> Callable:
     return mass_and_bias
 
 
+def rotation_log(R) -> np.ndarray:
+    """The rotation vector ``θ u`` (3,) [rad] of a rotation matrix: ``R = exp([θ u]×)``,
+    ``θ ∈ [0, π]`` (the logarithm of SO(3)). Near ``θ = π`` the axis comes from the symmetric
+    part ``(R + Rᵀ)/2 = cos θ 1 + (1 − cos θ) u uᵀ``, whose sign the skew part fixes.
+
+    >>> np.round(rotation_log(np.array([[0., -1, 0], [1, 0, 0], [0, 0, 1]])), 6)
+    array([0.      , 0.      , 1.570796])
+    """
+    R = np.asarray(R, dtype=float)
+    w = 0.5 * np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])  # sin θ u
+    c = min(1.0, max(-1.0, 0.5 * (np.trace(R) - 1.0)))
+    s = float(np.linalg.norm(w))
+    theta = float(np.arctan2(s, c))
+    if theta < 1e-6:
+        return w * (1.0 + theta * theta / 6.0)  # θ / sin θ to second order
+    if theta < np.pi - 1e-6 and s > 1e-6:
+        return w * (theta / s)
+    B = 0.5 * (R + R.T) - c * np.eye(3)  # (1 − cos θ) u uᵀ
+    k = int(np.argmax(np.diag(B)))
+    u = B[k] / np.sqrt(B[k, k] * (1.0 - c))
+    if u @ w < 0:
+        u = -u
+    return theta * u
+
+
 @dataclass(frozen=True)
 class Contact:
     """A contact on ``frame``: ``kind`` point (3D) or surface (6D), friction coefficient
@@ -107,7 +142,10 @@ class ContactDynamics:
     contacts:
         The contacts, in the order of the rows of ``J_c`` and of ``F_c``.
     anchors:
-        ``{frame: world position}`` for the ``kp`` term of point contacts.
+        ``{frame: world position p*}`` [m] for the ``kp`` term of point and surface contacts.
+    orientations:
+        ``{frame: world rotation R*}`` (3×3) for the rotational ``kp`` term of surface
+        contacts (module docstring).
     mass_and_bias:
         A function ``(q, qd) -> (M, h)`` with ``h = C q̇ + g``; None for eomgen's numeric
         Newton–Euler (:mod:`eomgen.numeric`, n + 2 passes). :func:`derived_mass_and_bias`
@@ -117,6 +155,7 @@ class ContactDynamics:
     model: RobotModel
     contacts: tuple[Contact, ...]
     anchors: Mapping[str, np.ndarray] = field(default_factory=dict)
+    orientations: Mapping[str, np.ndarray] = field(default_factory=dict)
     mass_and_bias: Callable | None = None
 
     @cached_property
@@ -153,6 +192,8 @@ class ContactDynamics:
             else:
                 Jc, b = f["Jb"], f["dJbqd"]
                 g = c.kd * (Jc @ qd)
+                if c.kp:
+                    g = g + c.kp * self.surface_error(c.frame, f)
             J.append(Jc)
             bias.append(b)
             gamma.append(g)
@@ -160,6 +201,20 @@ class ContactDynamics:
         if not J:
             return np.zeros((0, n)), np.zeros(0), np.zeros(0)
         return np.vstack(J), np.concatenate(bias), np.concatenate(gamma)
+
+    def surface_error(self, frame: str, kinematics: Mapping | None = None, q=None
+                      ) -> np.ndarray:
+        """``(Rᵀ (p − p*), log(R*ᵀ R))`` (6,) [m, rad] of a surface contact on ``frame``, in the
+        frame's axes (module docstring); zero rows where no anchor or orientation is given.
+        ``kinematics``: the frame's entry of the frame program at the state, or give ``q``."""
+        f = kinematics if kinematics is not None else \
+            self._kinematics(np.asarray(q, float), np.zeros(self.model.dof))[frame]
+        e = np.zeros(6)
+        if frame in self.anchors:
+            e[:3] = f["R"].T @ (f["p"] - np.asarray(self.anchors[frame], dtype=float))
+        if frame in self.orientations:
+            e[3:] = rotation_log(np.asarray(self.orientations[frame], dtype=float).T @ f["R"])
+        return e
 
     def contact_jacobian(self, q) -> np.ndarray:
         """``J_c(q)``, (m, n): contact rows in ``contacts`` order, columns ``JOINT_NAMES``."""
@@ -242,4 +297,4 @@ class ContactDynamics:
 
 
 __all__ = ["POINT", "SURFACE", "RANK_TOLERANCE", "Contact", "ContactDynamics",
-           "derived_mass_and_bias"]
+           "derived_mass_and_bias", "rotation_log"]

@@ -22,6 +22,10 @@ tests) can tell them apart without reading messages::
     │   ├── InvalidInertiaError   negative or non-finite mass, inertia not symmetric positive
     │   │                         semi-definite, triangle inequality (under strict)
     │   ├── InvalidAxisError      zero or non-finite joint axis
+    │   ├── InvalidActuatorError  a joint's drive that is not physical: negative armature,
+    │   │                         rotor inertia, damping or friction, a friction width or
+    │   │                         stiffness ≤ 0, gear ratio 0, a flexible joint without
+    │   │                         motor inertia
     │   ├── KinematicTreeError    duplicate names, undefined links or joints, two parents,
     │   │                         cycles, disconnected links, no root
     │   ├── UnsupportedError      floating and planar joints; mimic joints under strict
@@ -128,6 +132,13 @@ class InvalidInertiaError(DescriptionError):
 
 class InvalidAxisError(DescriptionError):
     """A joint axis is zero or not finite."""
+
+
+class InvalidActuatorError(DescriptionError):
+    """A joint's actuator (:class:`eomgen.model.Actuator`, URDF ``<dynamics>``) reads well but
+    is not physical: a negative armature, rotor inertia, viscous or Coulomb friction, a
+    friction width or stiffness that is not positive, a gear ratio of 0, or zero motor inertia
+    on a flexible joint. The element names the joint (``joint 'shoulder' actuator``)."""
 
 
 class KinematicTreeError(DescriptionError):

@@ -35,6 +35,7 @@ import sympy as sp
 
 from .errors import (
     DescriptionError,
+    InvalidActuatorError,
     InvalidAxisError,
     InvalidInertiaError,
     InvalidNumberError,
@@ -758,12 +759,10 @@ def check_actuator(source: str, joint: Joint, values: Mapping[sp.Symbol, sp.Expr
     ------
     KinematicTreeError
         An actuator on a fixed joint.
-    InvalidNumberError
-        Negative damping or Coulomb friction, a friction width or stiffness that is not
-        positive (negative stiffness), a gear ratio of 0.
-    InvalidInertiaError
-        Negative armature or rotor inertia, or zero motor inertia (armature) on a flexible
-        joint: Spong's motor equation ``B θ̈_m + K (θ_m − q) = τ_m`` needs ``B > 0``.
+    InvalidActuatorError
+        Negative armature, rotor inertia, damping or Coulomb friction, a friction width or
+        stiffness that is not positive, a gear ratio of 0, or zero motor inertia (armature) on
+        a flexible joint: Spong's motor equation ``B θ̈_m + K (θ_m − q) = τ_m`` needs ``B > 0``.
     """
     a = joint.actuator
     if a is None:
@@ -781,26 +780,26 @@ def check_actuator(source: str, joint: Joint, values: Mapping[sp.Symbol, sp.Expr
     for name in ("armature", "rotor_inertia"):
         v = number(name)
         if v is not None and v < 0:
-            raise InvalidInertiaError(source, where, f"{name} {v:g} is negative")
+            raise InvalidActuatorError(source, where, f"{name} {v:g} is negative")
     for name in ("damping", "friction"):
         v = number(name)
         if v is not None and v < 0:
-            raise InvalidNumberError(source, where, f"{name} {v:g} is negative")
+            raise InvalidActuatorError(source, where, f"{name} {v:g} is negative")
     v = number("friction_width")
     if v is not None and v <= 0:
-        raise InvalidNumberError(source, where, f"friction_width {v:g} is not positive")
+        raise InvalidActuatorError(source, where, f"friction_width {v:g} is not positive")
     v = number("gear_ratio")
     if v is not None and v == 0:
-        raise InvalidNumberError(source, where, "gear_ratio is 0 (the motor would not move "
+        raise InvalidActuatorError(source, where, "gear_ratio is 0 (the motor would not move "
                                  "the joint)")
     v = number("stiffness")
     if v is not None and v <= 0:
-        raise InvalidNumberError(source, where, f"stiffness {v:g} is "
+        raise InvalidActuatorError(source, where, f"stiffness {v:g} is "
                                  + ("negative" if v < 0 else "zero")
                                  + " (a flexible joint needs K > 0)")
     B = number("armature")
     if a.flexible and B is not None and B == 0:
-        raise InvalidInertiaError(source, where, "zero motor inertia on a flexible joint (give "
+        raise InvalidActuatorError(source, where, "zero motor inertia on a flexible joint (give "
                                   "armature or rotor_inertia and gear_ratio > 0)")
 
 

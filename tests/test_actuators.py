@@ -19,7 +19,7 @@ import sympy as sp
 
 import eomgen
 from eomgen import actuators as A
-from eomgen.errors import InvalidNumberError, SceneError, SchemaError
+from eomgen.errors import InvalidActuatorError, SceneError, SchemaError
 from eomgen.model import Actuator
 from eomgen.numeric import numeric_model, rnea
 from eomgen.parsers.urdf import parse_urdf_string
@@ -86,6 +86,9 @@ def test_bad_scene_actuators_are_one_line_naming_the_scene_and_the_joint(text, e
     message = str(caught.value)
     assert "\n" not in message and message.startswith(f"bad.yaml: {element}: "), message
     assert problem in message
+    # drive values that are not physical are InvalidActuatorErrors in a scene too
+    assert isinstance(caught.value, InvalidActuatorError) == any(
+        p in problem for p in ("stiffness", "motor inertia", "gear_ratio is 0"))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -424,8 +427,8 @@ def test_full_model_with_configuration_dependent_coupling_conserves_energy(tmp_p
 
 @pytest.mark.parametrize("actuator, error, problem", [
     ({"gear_ratio": 100}, SchemaError, "'gear_ratio' given without 'rotor_inertia'"),
-    ({"damping": -1}, InvalidNumberError, "damping -1 is negative"),
-    ({"friction": 1, "friction_width": 0}, InvalidNumberError, "friction_width 0 is not"),
+    ({"damping": -1}, InvalidActuatorError, "damping -1 is negative"),
+    ({"friction": 1, "friction_width": 0}, InvalidActuatorError, "friction_width 0 is not"),
     ({"stiffnes": 1}, SchemaError, "did you mean 'stiffness'?"),
 ])
 def test_bad_yaml_actuators_name_the_file_and_the_joint(actuator, error, problem):

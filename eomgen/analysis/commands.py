@@ -16,6 +16,7 @@ import importlib.util
 from pathlib import Path
 
 import click
+import numpy as np
 
 from ..errors import EomgenError
 from ..output import check_output_folder
@@ -129,13 +130,19 @@ def add_commands(main: click.Group, handle_errors, description_argument, strict_
     @click.option("--q0", default=None, help="Initial joint positions, comma-separated "
                                              "(default: 1 rad or m per joint).")
     @click.option("--qd0", default=None, help="Initial joint velocities (default: zero).")
+    @click.option("--baumgarte", "gains", default=None, metavar="KP,KD",
+                  help="Contacts: Baumgarte gains [1/s², 1/s] of the stabilised runs, for "
+                       "every contact (default: the scene's, else 100,20).")
+    @click.option("--step-torque", default=5.0, show_default=True,
+                  help="Flexible joints: the step in the first motor's torque [N m] of the "
+                       "link-against-motor-angle plot.")
     @click.option("--quiet", is_flag=True, help="No progress on stderr (stage lines in a log, "
                                                 "a bar on a terminal).")
     @_scene_option
     @strict_option
     @handle_errors
-    def simulate(description, outdir, duration, dts, rtols, names, q0, qd0, quiet, strict,
-                 scene_path=None):
+    def simulate(description, outdir, duration, dts, rtols, names, q0, qd0, gains, step_torque,
+                 quiet, strict, scene_path=None):
         """Integrate DESCRIPTION's dynamics (zero torque, no damping) with several integrators.
 
         Explicit Euler, semi-implicit Euler, RK4 and the implicit midpoint rule at every --dt;
@@ -143,10 +150,19 @@ def add_commands(main: click.Group, handle_errors, description_argument, strict_
         against the error of q versus a DOP853 reference at rtol = atol = 1e-12. Writes
         simulate_<robot>.md, .csv and .png into OUTPUT.
 
+        With a scene that has contacts, the contacts are held (bilateral) where they are at
+        q0, and each integrator (not the implicit midpoint) runs without and with Baumgarte
+        stabilisation: constraint drift (position, orientation, velocity) and energy drift.
+        With flexible joints (actuators with a stiffness), the 2n-state Spong model is
+        integrated (SciPy's implicit Radau and BDF join the list), and flexible_step_<robot>.png
+        plots link against motor angle after a step of --step-torque in the first motor.
+
         \b
         Examples:
           eomgen simulate --q0 2,2.5
           eomgen simulate panda.urdf --scene examples/scenes/panda_fingers_locked.yaml
+          eomgen simulate --scene examples/contacts/planar_2link_wall.yaml --qd0 0.2,-0.1
+          eomgen simulate examples/robots/flexible_2link.yaml --duration 1
         """
         _require("matplotlib", "scipy")
         from .simulate import integrators_named, run_study, write_outputs
@@ -157,29 +173,84 @@ def add_commands(main: click.Group, handle_errors, description_argument, strict_
         rtol_list = _floats(rtols, "--rtol")
         if min(step_list) <= 0 or min(rtol_list) <= 0:
             raise AnalysisError("--dt and --rtol must be positive")
+        gain_list = _floats(gains, "--baumgarte")
+        if gain_list is not None and (len(gain_list) != 2 or min(gain_list) < 0):
+            raise AnalysisError(f"--baumgarte: expected two non-negative numbers KP,KD, "
+                                f"got {gains!r}")
+        if not abs(step_torque) < float("inf"):
+            raise AnalysisError(f"--step-torque must be a finite number, got {step_torque}")
+        chosen = [n.strip() for n in names.split(",") if n.strip()]
         try:
-            integrators = integrators_named([n.strip() for n in names.split(",") if n.strip()],
-                                            step_list, rtol_list)
+            integrators_named(chosen, step_list, rtol_list)
         except ValueError as exc:
             raise AnalysisError(f"--integrators: {exc}") from None
         check_output_folder(outdir)
         progress = Progress(quiet)
-        model = load_reduced(description, scene_path, strict)[0]
+        model, report = load_reduced(description, scene_path, strict)
+        contacts = report.contacts if report is not None else ()
+        from ..actuators import flexible_indices
+
+        flexible = bool(flexible_indices(model)) and not contacts
+        integrators = integrators_named(chosen, step_list, rtol_list, stiff=flexible)
         start = _floats(q0, "--q0")
         velocity = _floats(qd0, "--qd0")
         for values, option in ((start, "--q0"), (velocity, "--qd0")):
             if values is not None and len(values) != model.dof:
                 raise AnalysisError(f"{option}: {model.name} has {plural(model.dof, 'joint')} "
                                     f"({', '.join(model.joint_names)}), got {len(values)} values")
+        if contacts:
+            _simulate_contacts(model, contacts, integrators, duration, start, velocity,
+                               gain_list, outdir, progress)
+            return
         progress(f"deriving M, C, g and tau of {model.name} ({plural(model.dof, 'joint')})")
         from .simulate import System
 
-        system = System(model)
+        header = []
+        if flexible:
+            from .simulate_flexible import (FlexibleSystem, describe_stiffness, flexible_start,
+                                            plot_step, step_response)
+
+            system = FlexibleSystem(model)
+            links = np.full(model.dof, 1.0) if start is None else np.array(start)
+            header.append(describe_stiffness(system, links))
+            start = flexible_start(system, links)
+            if velocity is not None:
+                velocity = velocity + [0.0] * len(system.flexible)
+        else:
+            system = System(model)
         with progress.steps(len(integrators) + 1, "integrating") as steps:
             study = run_study(model, integrators, duration, start, velocity,
                               progress=lambda name: steps.update(1, name), system=system)
         progress("writing the report and plot")
         paths = write_outputs([study], outdir, f"simulate_{_stem(model)}")
+        if flexible:
+            progress(f"step of {step_torque:g} N m in the first motor torque")
+            response = step_response(model, links, step_torque, duration)
+            png = Path(outdir) / f"flexible_step_{_stem(model)}.png"
+            plot_step(response, png)
+            paths.append(png)
+            md = paths[0]
+            md.write_text("\n\n".join(header) + "\n\n" + md.read_text(encoding="utf-8")
+                          + f"\n![link and motor angle after a step]({png.name})\n",
+                          encoding="utf-8")
+        progress.clear()
+        for line in header:
+            click.echo(line)
+        click.echo(study.describe())
+        click.echo(study.markdown_table())
+        for path in paths:
+            click.echo(str(path))
+
+    def _simulate_contacts(model, contacts, integrators, duration, start, velocity, gains,
+                           outdir, progress):
+        from .simulate_contacts import run_contact_study, write_contact_outputs
+
+        with progress.steps(2 * len(integrators) + 1, "integrating") as steps:
+            study = run_contact_study(model, contacts, integrators, duration, start, velocity,
+                                      None if gains is None else tuple(gains),
+                                      progress=lambda name: steps.update(1, name))
+        progress("writing the report and plot")
+        paths = write_contact_outputs(study, outdir, f"simulate_{_stem(model)}")
         progress.clear()
         click.echo(study.describe())
         click.echo(study.markdown_table())

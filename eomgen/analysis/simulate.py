@@ -116,8 +116,8 @@ class System:
         """Solve ``M x = b`` (M flat, row-major) by Cholesky in plain Python: for the few joints
         of a robot this beats NumPy's per-call overhead several times over. Same rules as
         :func:`~eomgen.analysis.conditioning.cholesky_solve`; the worst condition is kept for
-        :attr:`max_condition` rather than warned about at every step."""
-        n = self.n
+        :attr:`max_condition` rather than warned about at every step. The size is ``len(b)``."""
+        n = len(b)
         L = [[0.0] * n for _ in range(n)]
         for j in range(n):
             Lj = L[j]
@@ -484,7 +484,9 @@ def run_study(model: RobotModel, integrators: Sequence, duration: float, q0=None
             warnings.warn(ill_conditioned_message(info["max_condition"],
                                                   f" during {integrator.name}"),
                           IllConditionedWarning, stacklevel=2)
-    return Study(system.model.name, n, float(duration), tuple(q0.tolist()), tuple(qd0.tolist()),
+    joints = getattr(system, "links", n)  # a flexible system has n joints and m motors
+    return Study(system.model.name, joints, float(duration), tuple(q0.tolist()),
+                 tuple(qd0.tolist()),
                  scale, reference_seconds, tuple(runs))
 
 
@@ -498,13 +500,20 @@ def default_integrators(dts: Sequence[float] = (1e-2, 3e-3, 1e-3),
 
 #: Integrator families by command-line name.
 INTEGRATORS = {"euler": ExplicitEuler, "semi-implicit-euler": SemiImplicitEuler, "rk4": RK4,
-               "implicit-midpoint": ImplicitMidpoint, "rk45": "RK45", "dop853": "DOP853"}
+               "implicit-midpoint": ImplicitMidpoint, "rk45": "RK45", "dop853": "DOP853",
+               "radau": "Radau", "bdf": "BDF"}
+#: The implicit solvers for stiff systems (SciPy's Radau IIA and BDF, finite-difference
+#: Jacobians): in ``all`` only for stiff systems (flexible joints).
+STIFF = ("radau", "bdf")
 
 
-def integrators_named(names: Sequence[str], dts: Sequence[float], rtols: Sequence[float]) -> list:
-    """The integrators of :data:`INTEGRATORS` named in ``names`` (or ``all``), at every step /
-    tolerance; raises ValueError for an unknown name."""
-    names = list(INTEGRATORS) if list(names) == ["all"] else list(names)
+def integrators_named(names: Sequence[str], dts: Sequence[float], rtols: Sequence[float],
+                      stiff: bool = False) -> list:
+    """The integrators of :data:`INTEGRATORS` named in ``names`` (or ``all``: every one, the
+    :data:`STIFF` ones only when ``stiff``), at every step / tolerance; raises ValueError for
+    an unknown name."""
+    names = ([k for k in INTEGRATORS if stiff or k not in STIFF] if list(names) == ["all"]
+             else list(names))
     unknown = [n for n in names if n not in INTEGRATORS]
     if unknown:
         raise ValueError(f"unknown integrator {', '.join(unknown)}; choose from "
@@ -571,4 +580,5 @@ def write_outputs(studies: Sequence[Study], outdir, stem: str = "simulate") -> l
 
 __all__ = ["System", "ExplicitEuler", "SemiImplicitEuler", "RK4", "ImplicitMidpoint", "Adaptive",
            "Diverged", "Run", "Study", "Trajectory", "simulate", "run_study", "energies",
-           "default_integrators", "integrators_named", "INTEGRATORS", "plot", "write_outputs"]
+           "default_integrators", "integrators_named", "INTEGRATORS", "STIFF", "plot",
+           "write_outputs"]

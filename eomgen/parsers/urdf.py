@@ -87,6 +87,7 @@ import sympy as sp
 
 from ..errors import (
     ForbiddenXMLError,
+    InvalidActuatorError,
     InvalidNumberError,
     KinematicTreeError,
     SchemaError,
@@ -489,7 +490,7 @@ def _read_dynamics(element: ET.Element, source: str, where: str) -> Actuator | N
         if element.get(attribute) is not None:
             value = _number_attribute(element, attribute, source, where)
             if value < 0:
-                raise InvalidNumberError(source, where, f"{attribute} {value:g} is negative")
+                raise InvalidActuatorError(source, where, f"{attribute} {value:g} is negative")
             values[attribute] = scalar(value)
     if not any(values.values()):
         return None
