@@ -22,6 +22,7 @@ from fractions import Fraction
 from typing import Iterable, Mapping, Sequence
 
 import sympy as sp
+from sympy.core.basic import _args_sortkey
 
 #: :meth:`ProgramMatrix.expand` stops when an intermediate result passes this many terms, unless
 #: called with ``max_terms=None``.
@@ -32,8 +33,12 @@ EXPAND_MAX_TERMS = 200_000
 NOISE_RTOL = 1e-12
 
 #: ``dyn.M`` (and C, g, P, tau) of :func:`eomgen.derive` beyond teaching size is written out when
-#: that takes at most this many term operations (about half a second), else left named.
-AUTO_EXPAND_WORK = 400_000
+#: that takes at most this many term operations (about a second), else left named.
+AUTO_EXPAND_WORK = 1_000_000
+
+#: The work of building one term of a result as a SymPy expression, in term operations (a
+#: SymPy object costs about as much as 300 polynomial term operations).
+TERM_COST = 300
 
 #: Subexpressions shown by :meth:`ProgramMatrix._repr_latex_` before "… and k more".
 LATEX_MAX_SUBEXPRESSIONS = 40
@@ -93,15 +98,12 @@ class _Polynomials:
     def generator(self, g) -> dict:
         return {1 << (self.BITS * self.position[g]): 1}
 
-    def add(self, a: dict, b: dict) -> dict:
-        out = dict(a)
+    def add_to(self, out: dict, b: dict, what: str) -> None:
+        """``out += b``, in place."""
+        self.spend(len(b), 0, what)
+        get = out.get
         for m, c in b.items():
-            v = out.get(m, 0) + c
-            if v:
-                out[m] = v
-            else:
-                out.pop(m, None)
-        return out
+            out[m] = get(m, 0) + c
 
     def multiply(self, a: dict, b: dict, what: str) -> dict:
         if len(a) < len(b):
@@ -120,6 +122,7 @@ class _Polynomials:
     def reduce(self, f: dict) -> dict:
         """``f`` with ``sin² q = 1 − cos² q`` applied until no ``sin q`` has degree two."""
         mask = self.square_mask
+        self.work += len(f)
         if not mask or not any(m & mask for m in f):
             return {m: c for m, c in f.items() if c}
         out: dict = {}
@@ -137,7 +140,10 @@ class _Polynomials:
         return {m: c for m, c in out.items() if c}
 
     def to_expr(self, f: dict) -> sp.Expr:
+        """``f`` as a SymPy sum of products, built as SymPy would (coefficient first, then the
+        factors in SymPy's canonical order) without re-deriving it for every term."""
         field = (1 << self.BITS) - 1
+        powers: dict = {}
         terms = []
         for m, c in f.items():
             factors = []
@@ -145,12 +151,21 @@ class _Polynomials:
             while m:
                 e = m & field
                 if e:
-                    factors.append(self.generators[k] ** e)
+                    if (k, e) not in powers:
+                        powers[k, e] = self.generators[k] ** e
+                    factors.append(powers[k, e])
                 m >>= self.BITS
                 k += 1
             number = (sp.Rational(c.numerator, c.denominator) if isinstance(c, Fraction)
                       else sp.Integer(c) if isinstance(c, int) else sp.Float(c))
-            terms.append(sp.Mul(number, *factors))
+            factors.sort(key=_args_sortkey)
+            if not factors:
+                terms.append(number)
+            elif number == 1 and len(factors) == 1:
+                terms.append(factors[0])
+            else:
+                terms.append(sp.Mul._from_args(factors if number == 1 else [number] + factors,
+                                               is_commutative=True))
         return sp.Add(*terms)
 
 
@@ -169,7 +184,8 @@ def expand_program(subexpressions: Sequence[tuple[sp.Symbol, sp.Expr]],
         Stop when a product or a result passes this many terms (``None``: no limit).
     max_work:
         Stop when the term operations done pass this (``None``: no limit): a bound on the time
-        (about a second per 10⁶ here).
+        (about a second per 10⁶ on a 2020s laptop core), checked before each product and before
+        the result is built as SymPy expressions (:data:`TERM_COST` per term).
 
     Raises
     ------
@@ -222,8 +238,9 @@ def expand_program(subexpressions: Sequence[tuple[sp.Symbol, sp.Expr]],
         if expr.is_Add:
             out: dict = {}
             for a in expr.args:
-                out = P.add(out, convert(a, what))
-            P.spend(len(out), len(out), what)
+                P.add_to(out, convert(a, what), what)
+            out = {m: c for m, c in out.items() if c}
+            P.spend(0, len(out), what)
             return out
         if expr.is_Mul:
             out = {0: 1}
@@ -247,6 +264,7 @@ def expand_program(subexpressions: Sequence[tuple[sp.Symbol, sp.Expr]],
         largest = max((abs(c) for f in results for c in f.values()), default=0.0)
         results = [{m: c for m, c in f.items() if abs(c) >= NOISE_RTOL * largest}
                    for f in results]
+    P.spend(TERM_COST * sum(len(f) for f in results), 0, "the result")  # before building it
     return [P.to_expr(f) for f in results]
 
 
