@@ -18,6 +18,8 @@ product (so they stay small), not through SymPy's ``expand``.
 
 from __future__ import annotations
 
+import functools
+import operator
 from fractions import Fraction
 from typing import Iterable, Mapping, Sequence
 
@@ -73,7 +75,6 @@ class _Polynomials:
         self.pairs = [(self.BITS * self.position[s], self.BITS * self.position[c])
                       for s, c in pairs]
         field = (1 << self.BITS) - 1
-        self.square_mask = sum((field - 1) << shift for shift, _ in self.pairs)  # sin exponent ≥ 2
         self.max_terms, self.max_work, self.work = max_terms, max_work, 0
 
     def spend(self, work: int, size: int, what: str) -> None:
@@ -120,24 +121,30 @@ class _Polynomials:
         return out
 
     def reduce(self, f: dict) -> dict:
-        """``f`` with ``sin² q = 1 − cos² q`` applied until no ``sin q`` has degree two."""
-        mask = self.square_mask
+        """``f`` with ``sin² q = 1 − cos² q`` applied until no ``sin q`` has degree two: one
+        pass over the terms per angle whose sine appears squared."""
+        field = (1 << self.BITS) - 1
         self.work += len(f)
-        if not mask or not any(m & mask for m in f):
-            return {m: c for m, c in f.items() if c}
-        out: dict = {}
-        todo = list(f.items())
-        while todo:
-            m, c = todo.pop()
-            if not m & mask:
-                out[m] = out.get(m, 0) + c
-                continue
-            for s, cos in self.pairs:
-                if (m >> s) & ((1 << self.BITS) - 1) >= 2:
-                    rest = m - (2 << s)
-                    todo += [(rest, c), (rest + (2 << cos), -c)]
-                    break
-        return {m: c for m, c in out.items() if c}
+        f = {m: c for m, c in f.items() if c}
+        seen = functools.reduce(operator.or_, f, 0)  # a sin exponent ≥ 2 sets a bit above bit 0
+        for s, cos in self.pairs:
+            square = 2 << s
+            mask = (field - 1) << s
+            while seen & mask:
+                self.work += len(f)
+                out: dict = {}
+                get = out.get
+                for m, c in f.items():
+                    if m & mask:  # s^e with e ≥ 2: s^(e−2) (1 − c²)
+                        rest = m - square
+                        out[rest] = get(rest, 0) + c
+                        rest += 2 << cos
+                        out[rest] = get(rest, 0) - c
+                    else:
+                        out[m] = get(m, 0) + c
+                f = {m: c for m, c in out.items() if c}
+                seen = functools.reduce(operator.or_, f, 0)
+        return f
 
     def to_expr(self, f: dict) -> sp.Expr:
         """``f`` as a SymPy sum of products, built as SymPy would (coefficient first, then the
