@@ -1,8 +1,8 @@
 """Results of a straight-line program as SymPy-friendly objects: :class:`ProgramMatrix`.
 
 Beyond teaching size, ``dyn.M``, ``dyn.C``, ``dyn.g`` and ``dyn.tau`` of :func:`eomgen.derive`
-are not written out: the expanded entries of a 5-joint spatial arm have thousands of terms
-each, and substituting the program's intermediates back into each other gives trees that
+cannot always be written out: the expanded M of a 5-joint spatial arm has thousands of terms,
+the Panda's τ tens of thousands, and substituting the program's intermediates back into each other gives trees that
 SymPy's tools (``lambdify(..., cse=True)``, ``count_ops``, ``simplify``) walk for minutes. A
 :class:`ProgramMatrix` is the honest form of such a result: the output matrix in terms of named
 intermediates ``x_k`` plus their definitions (:attr:`ProgramMatrix.subexpressions`, each small),
@@ -47,7 +47,7 @@ LATEX_MAX_SUBEXPRESSIONS = 40
 
 
 class ExpansionTooLargeError(ValueError):
-    """:meth:`ProgramMatrix.expand` was asked for more terms than its ``max_terms``."""
+    """An expansion passed its ``max_terms`` or ``max_work`` (:func:`expand_program`)."""
 
 
 def _polynomial_node(expr: sp.Expr) -> bool:
