@@ -123,8 +123,8 @@ class Dynamics:
         """Output ``name`` as :attr:`M` and the others give it: the textbook form when
         ``simplified``; else written out (:meth:`ProgramMatrix.expand
         <eomgen.symbolic.named.ProgramMatrix.expand>`) when that takes at most
-        :data:`~eomgen.symbolic.named.AUTO_EXPAND_WORK` term operations (a fraction of a
-        second), else the named form."""
+        :data:`~eomgen.symbolic.named.AUTO_EXPAND_WORK` term operations (about a
+        second at most), else the named form."""
         from .symbolic.named import AUTO_EXPAND_WORK, ExpansionTooLargeError
 
         if name not in self.outputs:
@@ -149,8 +149,8 @@ class Dynamics:
 
         An ordinary SymPy Matrix when it is cheap to write out: the reduced textbook form for
         teaching-sized models (see :func:`derive`'s ``simplify``), else the entries multiplied
-        out in ``sin q_i``, ``cos q_i`` with ``sin² + cos² = 1`` applied, when that takes a
-        fraction of a second (the 6-joint PUMA 560: 262 terms). Otherwise (a general 5-joint
+        out in ``sin q_i``, ``cos q_i`` with ``sin² + cos² = 1`` applied, when that takes about a
+        second at most (the 6-joint PUMA 560: 262 terms). Otherwise (a general 5-joint
         arm, the Panda) a :class:`~eomgen.symbolic.named.ProgramMatrix`: the matrix in terms
         of named intermediates with their definitions (``.subexpressions``), which indexes,
         adds and multiplies like a matrix, substitutes (``.subs``; all inputs given: an
