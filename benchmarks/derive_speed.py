@@ -8,8 +8,11 @@ Usage::
 What is measured, per case, each in a fresh Python process (so that SymPy's caches start cold,
 a timed-out peer can be killed cleanly, and peak memory is per case):
 
-* **eomgen**: ``derive(model)`` (the straight-line program), then the *expansion*: first access
-  of ``dyn.M``, ``dyn.C`` and ``dyn.g`` as explicit SymPy matrices in ``q``, ``qd``. "total" is
+* **eomgen**: ``derive(model)`` (the straight-line program), then the *expansion*: M, C and g
+  as explicit SymPy matrices in ``q``, ``qd``: ``dyn.M``, ``.C``, ``.g`` for teaching-sized
+  models, else the program's intermediates substituted into each other (``Program.expand``;
+  what ``dyn.M`` was before it became a written-out polynomial or a ``ProgramMatrix`` for
+  large models, see docs/teaching.md). "total" is
   their sum; loading the description is not included. The best of ``--repeat`` runs (default
   3) is reported, as timeit does: the others measure the machine's other load. ``ops`` is
   ``dyn.operation_count(("M", "C", "g"))``: SymPy ``count_ops`` over the program that computes
@@ -338,7 +341,12 @@ def work_eomgen(case: str) -> dict:
     dyn = derive(model)
     derive_s, derive_cpu = time.perf_counter() - start, time.process_time() - cpu
     start, cpu = time.perf_counter(), time.process_time()
-    dyn.M, dyn.C, dyn.g  # noqa: B018  (first access expands them)
+    if dyn.simplified:  # teaching-sized: the reduced textbook matrices
+        dyn.M, dyn.C, dyn.g  # noqa: B018  (first access computes them)
+    else:  # the substituted program (dyn.M before its written-out or named forms)
+        full = dyn.program.expanded()
+        for name in ("M", "C", "g"):
+            dyn.program.expand(dyn.program.output(name), full)
     expand_s, expand_cpu = time.perf_counter() - start, time.process_time() - cpu
     ops = {name: dyn.operation_count((name,)) for name in ("M", "C", "g")}
     return {"dof": model.dof, "load_s": load_s,
@@ -692,7 +700,7 @@ def main(argv: list[str] | None = None) -> int:
     print()
     clock = "wall-clock" if args.clock == "wall" else "CPU"
     print(f"Seconds of {clock} time, each measurement in a fresh process (eomgen: best of "
-          f"{repeat}). total = derive + expand (dyn.M, dyn.C, dyn.g as explicit expressions). "
+          f"{repeat}). total = derive + expand (M, C, g as explicit expressions). "
           "ops = operation count of the straight-line program for M, C, g. peak MB = peak RSS "
           "of the eomgen process (interpreter and imports included). Peers: "
           "sympy.physics.mechanics, model construction + equations + mass_matrix/forcing. "

@@ -14,8 +14,11 @@ user) and times only the step named, not the interpreter start-up or the imports
 * **display**: ``derive`` + ``_repr_latex_()`` for a random 3-joint arm with general axes
   (the robot of the issue whose display did not finish in 20 minutes) and random 5- and
   7-joint arms. Target: ≤ 10 s for the display.
+* **symbolic access**: first access of ``dyn.M``, ``.C``, ``.g``, ``.tau`` of larger models
+  (PUMA 560, random 5- and 7-joint arms, Panda): an ordinary matrix when written out within
+  the work bound, else the named form (``ProgramMatrix``). Target: ≤ 2 s each.
 * **lambdify**: ``dyn.lambdify()`` for the Panda (7 joints, fingers locked; needs
-  example-robot-data), against ``sympy.lambdify(dyn.M, cse=True)`` of the expanded matrix for
+  example-robot-data), against ``sympy.lambdify(M, cse=True)`` of the substituted program tree for
   a 3-joint arm as a reference of the old route; its M, C, g are checked against the generated
   NumPy module's at random states. Target: ≤ 2 s.
 * **notebook**: ``eomgen notebook`` and its execution with nbclient (elbow, random 3-joint
@@ -136,12 +139,31 @@ def sympy_lambdify_reference(n: int) -> dict:
     return run(f"""
     import sympy as sp
     dyn = eomgen.derive(random_arm({n}), simplify=False)
+    tree = dyn.program.expand(dyn.program.output("M"))  # what dyn.M was before the named form
     start = time.perf_counter()
-    f = sp.lambdify(list(dyn.q), dyn.M, cse=True)
+    f = sp.lambdify(list(dyn.q), tree, cse=True)
     sympy_seconds = time.perf_counter() - start
     start = time.perf_counter()
     dyn.lambdify()
     print(json.dumps({{"sympy": sympy_seconds, "eomgen": time.perf_counter() - start}}))
+    """)
+
+
+def symbolic_access(name: str) -> dict:
+    return run(f"""
+    from eomgen.symbolic.named import ProgramMatrix
+    model = model_named({name!r})
+    if model is None:
+        print(json.dumps({{"skipped": "example-robot-data is not installed"}}))
+        raise SystemExit(0)
+    dyn = eomgen.derive(model, outputs=("M", "C", "g", "tau"))
+    out = {{"dof": model.dof}}
+    for key in ("M", "C", "g", "tau"):
+        start = time.perf_counter()
+        value = getattr(dyn, key)
+        out[key] = [time.perf_counter() - start,
+                    "named" if isinstance(value, ProgramMatrix) else "Matrix"]
+    print(json.dumps(out))
     """)
 
 
@@ -207,6 +229,21 @@ def main() -> int:
         print(f"  {name:16s} display {summary(display)}  "
               f"({'textbook form' if runs[0]['textbook'] else 'summary'})  "
               f"{'ok' if ok else 'MISSED'}")
+
+    print("dyn.M, C, g, tau of larger models (first access: written out or named), target "
+          "<= 2 s each")
+    for name in (["random5"] if args.quick else ["puma560_dh", "random5", "random7", "panda"]):
+        runs = [symbolic_access(name) for _ in range(repeat)]
+        if "skipped" in runs[0]:
+            print(f"  {name}: skipped ({runs[0]['skipped']})")
+            continue
+        parts = []
+        for key in ("M", "C", "g", "tau"):
+            seconds = [r[key][0] for r in runs]
+            ok = statistics.median(seconds) <= 2.0
+            failed += [] if ok else [f"{name} dyn.{key}"]
+            parts.append(f"{key} {summary(seconds).strip()} {runs[0][key][1]}")
+        print(f"  {name:16s} ({runs[0]['dof']} joints) " + ";  ".join(parts))
 
     print("dyn.lambdify(), target <= 2 s for the Panda")
     runs = [lambdify_panda() for _ in range(repeat)]

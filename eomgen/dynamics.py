@@ -180,7 +180,25 @@ class Dynamics:
 
         return textbook_derivation(self.model, max_dof=MAX_SIMPLIFY_JOINTS)
 
-    def _expanded(self, name: str) -> sp.Matrix:
+    def named(self, name: str):
+        """Output ``name`` (``"M"``, ``"C"``, ``"g"``, ``"P"``, ``"tau"``) in terms of the
+        program's named intermediates, with their definitions: a
+        :class:`~eomgen.symbolic.named.ProgramMatrix`, whatever the model's size (nothing is
+        expanded; ``.expand()`` writes it out)."""
+        from .symbolic.named import ProgramMatrix
+
+        if name not in self.outputs:
+            raise KeyError(f"{name} was not derived (outputs: {', '.join(self.outputs)})")
+        return ProgramMatrix(name, self.program.output(name), self.program.assignments)
+
+    def _expanded(self, name: str):
+        """Output ``name`` as :attr:`M` and the others give it: the textbook form when
+        ``simplified``; else written out (:meth:`ProgramMatrix.expand
+        <eomgen.symbolic.named.ProgramMatrix.expand>`) when that takes at most
+        :data:`~eomgen.symbolic.named.AUTO_EXPAND_WORK` term operations (about a
+        second at most), else the named form."""
+        from .symbolic.named import AUTO_EXPAND_WORK, ExpansionTooLargeError
+
         if name not in self.outputs:
             raise KeyError(f"{name} was not derived (outputs: {', '.join(self.outputs)})")
         if self.simplified:
@@ -191,40 +209,57 @@ class Dynamics:
                 tau = book.M * sp.Matrix(self.qdd) + book.C * sp.Matrix(self.qd) + book.g
                 return tau.applyfunc(lambda e: sp.factor_terms(sp.expand(e)))
             return getattr(book, name)
-        return self.program.expand(self.program.output(name), self._full)
+        value = self.named(name)
+        try:
+            return value.expand(max_work=AUTO_EXPAND_WORK)
+        except (ExpansionTooLargeError, NotImplementedError):
+            return value
 
     @cached_property
-    def M(self) -> sp.Matrix:
-        """Mass matrix M(q), n×n, symmetric positive definite [kg m², kg m, kg]."""
+    def M(self):
+        """Mass matrix M(q), n×n, symmetric positive definite [kg m², kg m, kg].
+
+        An ordinary SymPy Matrix when it is cheap to write out: the reduced textbook form for
+        teaching-sized models (see :func:`derive`'s ``simplify``), else the entries multiplied
+        out in ``sin q_i``, ``cos q_i`` with ``sin² + cos² = 1`` applied, when that takes about a
+        second at most (the 6-joint PUMA 560: 262 terms). Otherwise (a general 5-joint
+        arm, the Panda) a :class:`~eomgen.symbolic.named.ProgramMatrix`: the matrix in terms
+        of named intermediates with their definitions (``.subexpressions``), which indexes,
+        adds and multiplies like a matrix, substitutes (``.subs``; all inputs given: an
+        ordinary matrix of numbers), evaluates (``.evalf``), lambdifies, displays, and
+        ``.expand()`` writes out on request. For numbers, :meth:`lambdify` is the fast route.
+        The same holds for :attr:`C`, :attr:`g`, :attr:`P`, :attr:`K` and :attr:`tau`."""
         return self._expanded("M")
 
     @cached_property
-    def C(self) -> sp.Matrix:
-        """Coriolis matrix C(q, q̇), n×n, from Christoffel symbols of the first kind."""
+    def C(self):
+        """Coriolis matrix C(q, q̇), n×n, from Christoffel symbols of the first kind (a SymPy
+        Matrix or a ProgramMatrix: see :attr:`M`)."""
         return self._expanded("C")
 
     @cached_property
-    def g(self) -> sp.Matrix:
-        """Gravity vector g(q) = ∂P/∂q, n×1 [N m or N]."""
+    def g(self):
+        """Gravity vector g(q) = ∂P/∂q, n×1 [N m or N] (see :attr:`M`)."""
         return self._expanded("g")
 
     @cached_property
-    def P(self) -> sp.Expr:
-        """Potential energy P(q) = −Σ m_l g_vecᵀ c_l [J] (zero at the world origin)."""
+    def P(self):
+        """Potential energy P(q) = −Σ m_l g_vecᵀ c_l [J] (zero at the world origin; see
+        :attr:`M`)."""
         return self._expanded("P")[0, 0]
 
     @cached_property
-    def K(self) -> sp.Expr:
-        """Kinetic energy K = ½ q̇ᵀ M(q) q̇ [J]."""
+    def K(self):
+        """Kinetic energy K = ½ q̇ᵀ M(q) q̇ [J] (see :attr:`M`)."""
         qd = sp.Matrix(self.qd)
         value = (qd.T * self.M * qd)[0, 0] / 2
         return sp.factor_terms(sp.expand(value)) if self.simplified else value
 
     @cached_property
-    def tau(self) -> sp.Matrix:
+    def tau(self):
         """Inverse dynamics τ = M q̈ + C q̇ + g, n×1: from the Newton–Euler program when it was
         derived (``outputs`` with ``"tau"``), else formed from M, C and g; in reduced textbook
-        form (from :attr:`textbook`'s M, C, g) when ``simplified``."""
+        form (from :attr:`textbook`'s M, C, g) when ``simplified`` (see :attr:`M`)."""
         if "tau" in self.outputs:
             return self._expanded("tau")
         return self.M * sp.Matrix(self.qdd) + self.C * sp.Matrix(self.qd) + self.g

@@ -630,3 +630,35 @@ def test_rounded_digits_remain_an_option():
     assert "numbers are shown with 6 significant digits" in rounded
     assert "shortest decimals that read back as the same doubles" in full
     assert "1.03119 R_{2,00}" in rounded and "1.03118515 R_{2,00}" in full
+
+
+def test_program_legend_reads_tags_not_names():
+    """Every intermediate of the Lagrangian program carries a Tag set where it is defined; the
+    document's legend groups by those tags, so renaming every intermediate to a neutral name
+    (x0, x1, …, tags kept) leaves the legend as it was."""
+    from reference import random_robot
+
+    from eomgen.codegen.backends.latex_backend import (LatexConfig, PROGRAM_NAMES, printing,
+                                                       program_sections)
+    from eomgen.symbolic.program import Assignment, Program
+
+    dyn = eomgen.derive(random_robot(np.random.default_rng(0), 3), outputs=("M", "C", "g"))
+    tags = dyn.program.tags()
+    assert set(tags) == {s for s, _ in dyn.program.assignments}  # every one tagged
+    for symbol, tag in tags.items():
+        if tag.family == "P":  # the potential energy, a scalar of the whole robot
+            continue
+        assert tag.family in PROGRAM_NAMES, tag
+        assert symbol.name.startswith(tag.family) and tag.index and tag.index[0] >= 1, (symbol, tag)
+    config = LatexConfig()
+    legend = program_sections(dyn, config, printing(dyn, config, False))["legend"]
+    assert len(legend) >= 10
+
+    rename = {s: sp.Symbol(f"x{k}", real=True) for k, (s, _) in enumerate(dyn.program.assignments)}
+    program = Program(
+        tuple(Assignment(rename[s], e.xreplace(rename), tags[s]) for s, e in dyn.program.assignments),
+        tuple((name, m.xreplace(rename)) for name, m in dyn.program.outputs))
+    renamed = replace(dyn, program=program)
+    again = program_sections(renamed, config, printing(renamed, config, False))["legend"]
+    assert [meaning for _, meaning in again] == [meaning for _, meaning in legend]
+    assert [tex for tex, _ in again] != [tex for tex, _ in legend]  # printed with the new names

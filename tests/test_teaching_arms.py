@@ -269,6 +269,42 @@ def test_display_and_documents_share_the_reduced_form():
         assert line[len(lhs + " &= "):] in tex
 
 
+#: Forms a textbook writes that the grouping must find: a monomial times a sum, a square beside
+#: other terms, a sign and a monomial pulled out (LaTeX of the display).
+GROUPED_FORMS = {
+    "elbow_rrr": [r"m_{3} l_{c3} \left(a_{2} c_{3} + l_{c3}\right)",
+                  r"m_{3} \left(a_{2} c_{2} + l_{c3} c_{23}\right)^{2}"],
+    "scara_rrp": [r"m_{2} l_{c2} \left(a_{1} c_{2} + l_{c2}\right)",
+                  r"m_{3} a_{2} \left(a_{1} c_{2} + a_{2}\right)"],
+    "stanford_rrp": [r"m_{3} \left(- l_{c3} + q_{3}\right)^{2} s_{2}^{2}"],
+    "cylindrical_rpp": [r"g \left(m_{2} + m_{3}\right)"],
+    "puma560_arm3": [r"- m_{3} d_{3} \left(a_{2} s_{2} + a_{3} s_{23} + l_{c3} c_{23}\right)",
+                     r"\left(a_{2} c_{2} + a_{3} c_{23} - l_{c3} s_{23}\right)^{2}",
+                     r"2 a_{2} \left(a_{3} c_{3} - l_{c3} s_{3}\right)"],
+}
+
+
+@pytest.mark.parametrize("name", list(ARMS))
+def test_grouped_forms_are_exact_and_textbook_like(name):
+    """The grouped M and g every document prints equal the derived ones exactly
+    (expand(grouped − derived) = 0), and show the textbook's groupings."""
+    from eomgen.display import readable_matrices
+    from eomgen.teach import readability as rd
+
+    dyn = dynamics(name)
+    book = dyn.textbook
+    shown = readable_matrices(dyn)
+    for key, derived in (("M", book.M), ("g", book.g)):
+        difference = shown[key].applyfunc(lambda e: e.doit()) - derived
+        assert difference.applyfunc(sp.expand) == sp.zeros(*derived.shape), key
+    masses = [b.mass for b in book.bodies]
+    for entry in book.M:  # the term lists of the LaTeX document and the handout
+        assert sp.expand(sp.Add(*rd.by_mass(entry, masses)).doit() - entry) == 0
+    tex = dyn._repr_latex_()
+    for form in GROUPED_FORMS[name]:
+        assert form in tex, form
+
+
 def test_numbers_print_as_short_decimals():
     """A model with decimal numbers: floats come out rounded to 15 digits (0.3 * 0.03 prints
     0.009, not 0.0090000000000000018) and unit factors 1.0 are gone."""

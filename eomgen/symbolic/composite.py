@@ -138,24 +138,26 @@ def forward_kinematics(tree: BodyTree, q, b: ProgramBuilder) -> Kinematics:
             p0 = tuple(sp.sympify(x) - o for x, o in zip(body.placement.translation, origin))
         else:
             Rp, pp = kin.R[body.parent], kin.p[body.parent]
-            R0 = tuple(b.define_all(row, f"A{n}_{r}") for r, row in
+            R0 = tuple(b.define_all(row, f"A{n}_{r}", ("A", n, r)) for r, row in
                        enumerate(_matmul(Rp, body.placement.rotation)))
             p0 = b.define_all(tuple(pp[r] + e for r, e in
-                                    enumerate(_matvec(Rp, body.placement.translation))), f"o{n}_")
-        z = b.define_all(_matvec(R0, joint.axis), f"z{n}_")
+                                    enumerate(_matvec(Rp, body.placement.translation))), f"o{n}_",
+                                ("o", n))
+        z = b.define_all(_matvec(R0, joint.axis), f"z{n}_", ("z", n))
         qi = q[body.q_index]
         if joint.type.is_revolute:
-            s = b.define(sp.sin(qi), f"s{n}")
-            c = b.define(sp.cos(qi), f"c{n}")
+            s = b.define(sp.sin(qi), f"s{n}", ("s", n))
+            c = b.define(sp.cos(qi), f"c{n}", ("c", n))
             kin.sin_cos.append((s, c))
-            R = tuple(b.define_all(row, f"R{n}_{r}") for r, row in
+            R = tuple(b.define_all(row, f"R{n}_{r}", ("R", n, r)) for r, row in
                       enumerate(_matmul(R0, _rotation(joint.axis, c, s))))
             p = p0
-            S = z + b.define_all(_cross(p, z), f"v{n}_")
+            S = z + b.define_all(_cross(p, z), f"v{n}_", ("v", n))
         else:
             kin.sin_cos.append(None)
             R = R0
-            p = b.define_all(tuple(p0[r] + z[r] * qi for r in range(3)), f"p{n}_")
+            p = b.define_all(tuple(p0[r] + z[r] * qi for r in range(3)), f"p{n}_",
+                             ("p", n))
             S = (0, 0, 0) + z
         kin.R.append(R)
         kin.p.append(p)
@@ -170,7 +172,8 @@ def body_inertia_in_world(tree: BodyTree, kin: Kinematics, b: ProgramBuilder) ->
         n = body.q_index + 1
         par = body.inertial
         R, p, m = kin.R[i], kin.p[i], par.mass
-        Rh = b.define_all(_matvec(R, par.first_moment), f"Rh{n}_")
+        Rh = b.define_all(_matvec(R, par.first_moment), f"Rh{n}_",
+                          ("Rh", n))
         RI = _matmul(R, par.inertia)
         RIRt = [[sp.Add(*[RI[r][k] * R[c][k] for k in range(3)]) for c in range(3)] for r in range(3)]
         pp = sp.Add(*[x * x for x in p])
@@ -180,8 +183,8 @@ def body_inertia_in_world(tree: BodyTree, kin: Kinematics, b: ProgramBuilder) ->
             for c in range(r, 3):
                 value = (RIRt[r][c] + m * ((pp if r == c else 0) - p[r] * p[c])
                          + (2 * pRh if r == c else 0) - p[r] * Rh[c] - Rh[r] * p[c])
-                I[r][c] = I[c][r] = b.define(value, f"Iw{n}_{r}{c}")
-        h = b.define_all(tuple(m * p[r] + Rh[r] for r in range(3)), f"hw{n}_")
+                I[r][c] = I[c][r] = b.define(value, f"Iw{n}_{r}{c}", ("Iw", n, r, c))
+        h = b.define_all(tuple(m * p[r] + Rh[r] for r in range(3)), f"hw{n}_", ("hw", n))
         out.append(SpatialInertia(m, h, tuple(tuple(row) for row in I)))
     return out
 
@@ -193,9 +196,10 @@ def composite_inertias(tree: BodyTree, bodies: list[SpatialInertia], b: ProgramB
         n = tree.bodies[i].q_index + 1
         ci = comp[i]
         comp[i] = SpatialInertia(
-            b.define(ci.mass, f"mc{n}"),
-            b.define_all(ci.h, f"hc{n}_"),
-            tuple(tuple(b.define(ci.I[r][c], f"Ic{n}_{min(r, c)}{max(r, c)}") for c in range(3))
+            b.define(ci.mass, f"mc{n}", ("mc", n)),
+            b.define_all(ci.h, f"hc{n}_", ("hc", n)),
+            tuple(tuple(b.define(ci.I[r][c], f"Ic{n}_{min(r, c)}{max(r, c)}",
+                                  ("Ic", n, min(r, c), max(r, c))) for c in range(3))
                   for r in range(3)),
         )
         parent = tree.bodies[i].parent
@@ -223,7 +227,8 @@ def derive_program(tree: BodyTree, q, qd, gravity: Vec3, outputs: set[str], b: P
     world = body_inertia_in_world(tree, kin, b)
     comp = composite_inertias(tree, world, b)
     S = kin.S
-    F = [b.define_all(comp[j].apply(S[j]), f"F{tree.bodies[j].q_index + 1}_") for j in range(n)]
+    F = [b.define_all(comp[j].apply(S[j]), f"F{tree.bodies[j].q_index + 1}_",
+                      ("F", tree.bodies[j].q_index + 1)) for j in range(n)]
     idx = [body.q_index for body in tree.bodies]
     result: dict = {"kinematics": kin, "composite": comp}
 
@@ -231,18 +236,20 @@ def derive_program(tree: BodyTree, q, qd, gravity: Vec3, outputs: set[str], b: P
         M = sp.zeros(n, n)
         for j in range(n):
             for i in [j] + tree.ancestors(j):
-                value = b.define(_dot(S[i], F[j]), f"M{idx[i] + 1}_{idx[j] + 1}")
+                value = b.define(_dot(S[i], F[j]), f"M{idx[i] + 1}_{idx[j] + 1}",
+                                 ("M", idx[i] + 1, idx[j] + 1))
                 M[idx[i], idx[j]] = M[idx[j], idx[i]] = value
         result["M"] = M
     if "g" in outputs:
         gvec = gravity
         result["g"] = sp.Matrix([[0]] * n)
         for i in range(n):
-            result["g"][idx[i], 0] = b.define(-_dot(gvec, F[i][3:]), f"g{idx[i] + 1}")
+            result["g"][idx[i], 0] = b.define(-_dot(gvec, F[i][3:]), f"g{idx[i] + 1}",
+                                              ("g", idx[i] + 1))
         h_total = comp_total_first_moment(tree, comp)  # about o
         mass = sp.Add(*[comp[i].mass for i, body in enumerate(tree.bodies) if body.parent < 0])
         P_total = -_dot(gvec, tuple(h + mass * o for h, o in zip(h_total, kin.origin)))
-        result["P"] = sp.Matrix([[b.define(P_total, "P")]])
+        result["P"] = sp.Matrix([[b.define(P_total, "P", ("P",))]])
     if "C" in outputs:
         result["C"] = _coriolis(tree, S, F, comp, qd, idx, b)
     return result
@@ -263,7 +270,8 @@ def _coriolis(tree, S, F, comp, qd, idx, b: ProgramBuilder) -> sp.Matrix:
     def SxS(k, a):  # S_k × S_a
         key = (k, a)
         if key not in cross_cache:
-            cross_cache[key] = b.define_all(motion_cross(S[k], S[a]), f"X{idx[k] + 1}_{idx[a] + 1}_")
+            cross_cache[key] = b.define_all(motion_cross(S[k], S[a]), f"X{idx[k] + 1}_{idx[a] + 1}_",
+                                            ("X", idx[k] + 1, idx[a] + 1))
         return cross_cache[key]
 
     def IS(k, a):  # I^c_k S_a
@@ -271,13 +279,15 @@ def _coriolis(tree, S, F, comp, qd, idx, b: ProgramBuilder) -> sp.Matrix:
             return F[k]
         key = (k, a)
         if key not in inertia_cache:
-            inertia_cache[key] = b.define_all(comp[k].apply(S[a]), f"G{idx[k] + 1}_{idx[a] + 1}_")
+            inertia_cache[key] = b.define_all(comp[k].apply(S[a]), f"G{idx[k] + 1}_{idx[a] + 1}_",
+                                              ("G", idx[k] + 1, idx[a] + 1))
         return inertia_cache[key]
 
     def SxF(k, j):  # S_k ×* F_j
         key = (k, j)
         if key not in force_cache:
-            force_cache[key] = b.define_all(force_cross(S[k], F[j]), f"Y{idx[k] + 1}_{idx[j] + 1}_")
+            force_cache[key] = b.define_all(force_cross(S[k], F[j]), f"Y{idx[k] + 1}_{idx[j] + 1}_",
+                                            ("Y", idx[k] + 1, idx[j] + 1))
         return force_cache[key]
 
     anc = [[is_ancestor_or_self(tree, a, c) for c in range(n)] for a in range(n)]
@@ -300,7 +310,8 @@ def _coriolis(tree, S, F, comp, qd, idx, b: ProgramBuilder) -> sp.Matrix:
                            *[-x * y for x, y in zip(c, d) if x != 0 and y != 0])
         else:
             value = sp.Integer(0)
-        value = b.define(value, f"dM{idx[i] + 1}_{idx[j] + 1}_{idx[k] + 1}")
+        value = b.define(value, f"dM{idx[i] + 1}_{idx[j] + 1}_{idx[k] + 1}",
+                         ("dM", idx[i] + 1, idx[j] + 1, idx[k] + 1))
         dM_cache[key] = value
         return value
 
@@ -316,11 +327,13 @@ def _coriolis(tree, S, F, comp, qd, idx, b: ProgramBuilder) -> sp.Matrix:
                 else:
                     parts = [x for x in (dM(i, j, k), dM(i, k, j), -dM(j, k, i)) if x != 0]
                     c_ijk = b.define(sp.Add(*[half * x for x in parts]),
-                                     f"Gamma{idx[i] + 1}_{idx[j] + 1}_{idx[k] + 1}") if parts else 0
+                                     f"Gamma{idx[i] + 1}_{idx[j] + 1}_{idx[k] + 1}",
+                                     ("Gamma", idx[i] + 1, idx[j] + 1, idx[k] + 1)) if parts else 0
                     christoffel[(i, j, k)] = c_ijk
                 if c_ijk != 0:
                     terms.append(c_ijk * qd[idx[k]])
-            C[idx[i], idx[j]] = b.define(sp.Add(*terms), f"C{idx[i] + 1}_{idx[j] + 1}")
+            C[idx[i], idx[j]] = b.define(sp.Add(*terms), f"C{idx[i] + 1}_{idx[j] + 1}",
+                                          ("C", idx[i] + 1, idx[j] + 1))
     return C
 
 

@@ -15,9 +15,51 @@ back when full expressions in ``q`` are wanted (small teaching models, exact che
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Iterable, Mapping, Sequence
+from typing import Iterable, Mapping, NamedTuple, Sequence
 
 import sympy as sp
+
+
+class Tag(NamedTuple):
+    """What an intermediate is, set where it is defined (never read back from its name).
+
+    Attributes
+    ----------
+    family:
+        The kind of quantity, e.g. ``"R"`` (an entry of a body's world rotation), ``"Ic"`` (of
+        a composite inertia), ``"Gamma"`` (a Christoffel symbol): the keys of
+        :data:`eomgen.codegen.backends.latex_backend.PROGRAM_NAMES` for the Lagrangian
+        program.
+    index:
+        The joint numbers it belongs to (1-based, as in ``q_1``), then 0-based vector or
+        matrix entries: ``Tag("R", (3, 0, 2))`` is entry (0, 2) of ``R_3``.
+    """
+
+    family: str
+    index: tuple[int, ...] = ()
+
+
+def _tag(tag) -> Tag | None:
+    """A :class:`Tag` from a Tag, ``(family, index...)`` or ``(family, (index...))``."""
+    if tag is None or isinstance(tag, Tag):
+        return tag
+    family, *index = tag
+    if len(index) == 1 and isinstance(index[0], tuple):
+        index = index[0]
+    return Tag(family, tuple(int(i) for i in index))
+
+
+class Assignment(tuple):
+    """One ``(symbol, expression)`` step of a program, with the :class:`Tag` its builder gave
+    it (``tag``, or None). Unpacks, compares and hashes as the pair."""
+
+    def __new__(cls, symbol: sp.Symbol, expr: sp.Expr, tag: Tag | None = None):
+        self = super().__new__(cls, (symbol, expr))
+        self.tag = tag
+        return self
+
+    def __reduce__(self):
+        return (Assignment, (self[0], self[1], self.tag))
 
 
 def _is_trivial(expr: sp.Expr) -> bool:
@@ -51,8 +93,12 @@ class ProgramBuilder:
         self._names.add(name)
         return sp.Symbol(name, real=True)
 
-    def define(self, expr, hint: str = "x") -> sp.Expr:
-        """Name ``expr`` unless it is trivial or already named; return what to use in its place."""
+    def define(self, expr, hint: str = "x", tag=None) -> sp.Expr:
+        """Name ``expr`` unless it is trivial or already named; return what to use in its place.
+
+        ``hint`` is the name wanted (made unique); ``tag`` says what the quantity is
+        (:class:`Tag`, or ``(family, index...)``), for documents that group intermediates.
+        An expression already named keeps its first name and tag."""
         expr = sp.sympify(expr) if not isinstance(expr, sp.Basic) else expr
         if _is_trivial(expr):
             return expr
@@ -66,12 +112,16 @@ class ProgramBuilder:
             return -neg
         symbol = self._fresh(hint)
         self._by_value[expr] = symbol
-        self.assignments.append((symbol, expr))
+        self.assignments.append(Assignment(symbol, expr, _tag(tag)))
         return symbol
 
-    def define_all(self, exprs: Sequence, hint: str) -> tuple:
-        """Define each entry of a vector, hinting names ``hint0, hint1, …``."""
-        return tuple(self.define(e, f"{hint}{k}") for k, e in enumerate(exprs))
+    def define_all(self, exprs: Sequence, hint: str, tag=None) -> tuple:
+        """Define each entry of a vector, hinting names ``hint0, hint1, …``; entry ``k`` is
+        tagged with ``tag``'s index followed by ``k``."""
+        tag = _tag(tag)
+        return tuple(self.define(e, f"{hint}{k}",
+                                 None if tag is None else Tag(tag.family, tag.index + (k,)))
+                     for k, e in enumerate(exprs))
 
 
 @dataclass(frozen=True)
@@ -101,11 +151,17 @@ class Program:
         for _, matrix in outs:
             needed |= matrix.free_symbols
         kept = []
-        for symbol, expr in reversed(self.assignments):
+        for assignment in reversed(self.assignments):
+            symbol, expr = assignment
             if symbol in needed:
-                kept.append((symbol, expr))
+                kept.append(assignment)  # as it is, with its tag
                 needed |= expr.free_symbols
         return Program(tuple(reversed(kept)), outs)
+
+    def tags(self) -> dict[sp.Symbol, Tag]:
+        """The :class:`Tag` of every intermediate its builder tagged."""
+        return {a[0]: a.tag for a in self.assignments
+                if isinstance(a, Assignment) and a.tag is not None}
 
     def expanded(self) -> dict[sp.Symbol, sp.Expr]:
         """Map every intermediate to its full expression in the inputs.

@@ -64,7 +64,7 @@ def group_by_factor(expr: sp.Expr, key: Callable[[sp.Expr], sp.Expr | None],
     out = []
     for k, parts in groups.items():
         inner = sp.Add(*parts)
-        inner = sp.factor_terms(inner) if factor else perfect_power(inner)
+        inner = sp.factor_terms(inner) if factor else readable_sum(inner)
         if inner.is_Number:  # a number goes first, as usual: 8.08 c_1, -2 m_2
             out.append(inner * k)
             continue
@@ -77,7 +77,86 @@ def group_by_factor(expr: sp.Expr, key: Callable[[sp.Expr], sp.Expr | None],
         else:
             term = sp.Mul(k, sp.UnevaluatedExpr(inner), evaluate=False)
         out.append(sp.Mul(-1, term, evaluate=False) if negative else term)
+    if factor and len(rest) >= 2:  # g m_2 + g m_3 → g (m_2 + m_3)
+        common = sp.factor_terms(sp.Add(*rest))
+        if common.is_Mul:
+            rest = [common]
     return out + rest
+
+
+def common_monomial(expr: sp.Expr) -> tuple[sp.Expr, sp.Expr]:
+    """``(monomial, rest)`` with ``expr = monomial · rest``: the product of the powers of the
+    factors every term of the sum ``expr`` has (``m_3 l_{c3}``, ``s_2^2``), with the sign when
+    every term is negative and, for exact numbers, their common rational factor. Floats stay
+    in ``rest`` (``0.3 (x + 2.0 y)`` would print numbers the description did not write).
+
+    >>> a, b, c = sp.symbols("a b c")
+    >>> common_monomial(-2*a*b*c - 4*a**2*b)
+    (-2*a*b, 2*a + c)
+    >>> common_monomial(a + b)
+    (1, a + b)
+    """
+    terms = sp.Add.make_args(expr)
+    if len(terms) < 2:
+        return sp.Integer(1), expr
+    shared = None
+    for term in terms:
+        powers = {base: e for base, e in term.as_coeff_Mul()[1].as_powers_dict().items()
+                  if e.is_Integer and e > 0 and not base.is_Number}
+        shared = powers if shared is None else {
+            base: min(e, powers[base]) for base, e in shared.items() if base in powers}
+    monomial = sp.Mul(*[base ** e for base, e in shared.items()])
+    if not expr.has(sp.Float):
+        monomial *= sp.Add(*terms).as_content_primitive()[0]
+    if all(term.could_extract_minus_sign() for term in terms):
+        monomial = -monomial
+    if monomial == 1:
+        return monomial, expr
+    return monomial, sp.Add(*[term / monomial for term in terms])
+
+
+def readable_sum(expr: sp.Expr) -> sp.Expr:
+    """``expr`` (a sum) in the shape a textbook writes it, with the same value:
+
+    * a monomial times a sum, a power or a product of sums (:func:`common_monomial`, then
+      :func:`perfect_power`): ``m_3 (a_2 l_{c3} c_3 + l_{c3}^2)`` → ``m_3 l_{c3} (a_2 c_3 + l_{c3})``;
+    * else the terms with sines and cosines, written so, beside the others:
+      ``(a_2 c_2 + a_3 c_{23} − l_{c3} s_{23})^2 + d_3^2``,
+      ``2 a_2 (a_3 c_3 − l_{c3} s_3) + a_2^2 + a_3^2 + l_{c3}^2``;
+    * else ``expr`` unchanged.
+
+    Products are built unevaluated (``.doit()`` gives an ordinary expression).
+
+    >>> a, b, c, x = sp.symbols("a b c x")
+    >>> readable_sum(a*b*sp.cos(x) + b**2)
+    b*(a*cos(x) + b)
+    >>> readable_sum(a**2*sp.cos(x)**2 + 2*a*b*sp.cos(x)*sp.sin(x) + b**2*sp.sin(x)**2 + c**2)
+    c**2 + (a*cos(x) + b*sin(x))**2
+    """
+    if not expr.is_Add:
+        return expr
+    monomial, rest = common_monomial(expr)
+    if monomial.is_Number:  # 2 (a + b) is no easier to read than 2 a + 2 b
+        monomial, rest = sp.Integer(1), expr
+    shaped = perfect_power(rest)
+    if monomial.could_extract_minus_sign():  # − m_3 d_3 (…), not m_3 (−d_3) (…)
+        return sp.Mul(-1, sp.Mul(-monomial, shaped, evaluate=False), evaluate=False)
+    if monomial != 1:
+        return sp.Mul(monomial, shaped, evaluate=False)
+    if shaped is not rest:
+        return shaped
+    trig = [t for t in expr.args if t.has(sp.sin, sp.cos)]
+    plain = [t for t in expr.args if not t.has(sp.sin, sp.cos)]
+    if not plain or len(trig) < 2:
+        return expr
+    part = sp.Add(*trig)
+    shaped = perfect_power(part)
+    if shaped is part:
+        monomial, inner = common_monomial(part)
+        if monomial.is_Number or monomial.has(sp.sin, sp.cos):
+            return expr
+        shaped = sp.Mul(monomial, inner, evaluate=False)
+    return sp.Add(shaped, *plain, evaluate=False)
 
 
 def perfect_power(expr: sp.Expr) -> sp.Expr:

@@ -46,8 +46,9 @@ _NOTATION_NAMES = re.compile(
     r"|[sc][0-9]+(?:_[0-9]+)*)$"
 )
 
-#: The families of named subexpressions of eomgen's straight-line program (the name prefixes of
-#: :mod:`eomgen.symbolic.composite`) and what they are, in LaTeX, for the legend of large
+#: The families of named subexpressions of eomgen's straight-line program (the
+#: :class:`~eomgen.symbolic.program.Tag` families :mod:`eomgen.symbolic.composite` sets) and what
+#: they are, in LaTeX, for the legend of large
 #: documents. Vectors and matrices are in world coordinates; spatial 6-vectors are
 #: [angular; linear] about the reference point o, the first moving joint's origin.
 PROGRAM_NAMES = {
@@ -414,6 +415,7 @@ def program_sections(dyn: Dynamics, config: LatexConfig, p: Printing) -> dict:
     groups, omitted = [], []
     legend: dict[str, str] = {}
     budget = config.max_program_lines
+    tags = program.tags()  # what each intermediate is, set where it was defined
     for output, title in _PROGRAM_GROUPS:
         assignments = [(s, e) for s, e in program.pruned([output]).assignments if s not in shown]
         if len(assignments) > budget:
@@ -422,9 +424,9 @@ def program_sections(dyn: Dynamics, config: LatexConfig, p: Printing) -> dict:
         budget -= len(assignments)
         shown |= {s for s, _ in assignments}
         for symbol, _ in assignments:
-            family = re.match(r"[A-Za-z]+", symbol.name)
-            if family and family[0] in PROGRAM_NAMES and family[0] not in legend:
-                legend[family[0]] = p.tex(symbol)
+            family = tags[symbol].family if symbol in tags else None
+            if family in PROGRAM_NAMES and family not in legend:
+                legend[family] = p.tex(symbol)
         equations = [p.equation(p.tex(symbol), expr) for symbol, expr in assignments]
         groups.append({"title": title, "count": len(assignments), "blocks": p.chunks(equations)})
 

@@ -1,0 +1,556 @@
+"""Results of a straight-line program as SymPy-friendly objects: :class:`ProgramMatrix`.
+
+Beyond teaching size, ``dyn.M``, ``dyn.C``, ``dyn.g`` and ``dyn.tau`` of :func:`eomgen.derive`
+cannot always be written out: the expanded M of a 5-joint spatial arm has thousands of terms,
+the Panda's τ tens of thousands, and substituting the program's intermediates back into each other gives trees that
+SymPy's tools (``lambdify(..., cse=True)``, ``count_ops``, ``simplify``) walk for minutes. A
+:class:`ProgramMatrix` is the honest form of such a result: the output matrix in terms of named
+intermediates ``x_k`` plus their definitions (:attr:`ProgramMatrix.subexpressions`, each small),
+which is what the code printers use. It indexes and multiplies like a matrix, substitutes,
+evaluates numerically, lambdifies with its named subexpressions as the common subexpressions,
+displays in a notebook, and :meth:`ProgramMatrix.expand` writes it out as an ordinary SymPy
+matrix on request, stopping with a clear message when it grows past a limit.
+
+Expansion (:func:`expand_program`) multiplies sparse polynomials in ``sin q_i``, ``cos q_i``,
+the velocities and the parameters, reducing with ``sin² q_i + cos² q_i = 1`` after every
+product (so they stay small), not through SymPy's ``expand``.
+"""
+
+from __future__ import annotations
+
+import functools
+import operator
+from fractions import Fraction
+from typing import Iterable, Mapping, Sequence
+
+import sympy as sp
+from sympy.core.basic import _args_sortkey
+
+#: :meth:`ProgramMatrix.expand` stops when an intermediate result passes this many terms, unless
+#: called with ``max_terms=None``.
+EXPAND_MAX_TERMS = 200_000
+
+#: In an expansion with floating-point numbers, terms whose coefficient is below this fraction
+#: of the largest coefficient of the result are rounding noise (``1e-17*sin(q1)``), dropped.
+NOISE_RTOL = 1e-12
+
+#: ``dyn.M`` (and C, g, P, tau) of :func:`eomgen.derive` beyond teaching size is written out when
+#: that takes at most this many term operations (about a second), else left named.
+AUTO_EXPAND_WORK = 1_000_000
+
+#: The work of building one term of a result as a SymPy expression, in term operations (a
+#: SymPy object costs about as much as 300 polynomial term operations).
+TERM_COST = 300
+
+#: Subexpressions shown by :meth:`ProgramMatrix._repr_latex_` before "… and k more".
+LATEX_MAX_SUBEXPRESSIONS = 40
+
+
+class ExpansionTooLargeError(ValueError):
+    """An expansion passed its ``max_terms`` or ``max_work`` (:func:`expand_program`)."""
+
+
+def _polynomial_node(expr: sp.Expr) -> bool:
+    return expr.is_Add or expr.is_Mul or (
+        expr.is_Pow and expr.exp.is_Integer and expr.exp > 0)
+
+
+class _Polynomials:
+    """Sparse polynomials in the generators of one expansion, as ``{monomial: coefficient}``
+    dicts: a monomial is one integer holding every exponent in a field of :attr:`BITS` bits
+    (so multiplying monomials is adding integers), a coefficient a Python float (a model with
+    decimal numbers) or an exact int / Fraction. After every product, ``sin² q_i`` is replaced
+    by ``1 − cos² q_i``, which keeps the degree in ``sin q_i`` at most one.
+
+    ``work`` counts the term operations done; :meth:`spend` stops the expansion past
+    ``max_work`` or when a result passes ``max_terms``.
+    """
+
+    BITS = 16
+
+    def __init__(self, generators, pairs, exact, max_terms, max_work):
+        self.generators = list(generators)
+        self.position = {g: k for k, g in enumerate(self.generators)}
+        self.exact = exact
+        self.pairs = [(self.BITS * self.position[s], self.BITS * self.position[c])
+                      for s, c in pairs]
+        field = (1 << self.BITS) - 1
+        self.max_terms, self.max_work, self.work = max_terms, max_work, 0
+
+    def spend(self, work: int, size: int, what: str) -> None:
+        self.work += work
+        if self.max_work is not None and self.work > self.max_work:
+            raise ExpansionTooLargeError(f"expanding {what} passed the work limit of "
+                                         f"{self.max_work} term operations")
+        if self.max_terms is not None and size > self.max_terms:
+            raise ExpansionTooLargeError(
+                f"expanding {what} passed {self.max_terms} terms; use the named form, "
+                "or expand(max_terms=None) to force it")
+
+    def number(self, x: sp.Expr) -> dict:
+        if x.is_Integer:
+            value = int(x)
+        elif self.exact:
+            value = Fraction(int(x.p), int(x.q))
+        else:
+            value = float(x)
+        return {0: value} if value else {}
+
+    def generator(self, g) -> dict:
+        return {1 << (self.BITS * self.position[g]): 1}
+
+    def add_to(self, out: dict, b: dict, what: str) -> None:
+        """``out += b``, in place."""
+        self.spend(len(b), 0, what)
+        get = out.get
+        for m, c in b.items():
+            out[m] = get(m, 0) + c
+
+    def multiply(self, a: dict, b: dict, what: str) -> dict:
+        if len(a) < len(b):
+            a, b = b, a
+        self.spend(len(a) * len(b), 0, what)
+        out: dict = {}
+        get = out.get
+        for mb, cb in b.items():
+            for ma, ca in a.items():
+                m = ma + mb
+                out[m] = get(m, 0) + ca * cb
+        out = self.reduce(out)
+        self.spend(0, len(out), what)
+        return out
+
+    def reduce(self, f: dict) -> dict:
+        """``f`` with ``sin² q = 1 − cos² q`` applied until no ``sin q`` has degree two: one
+        pass over the terms per angle whose sine appears squared."""
+        field = (1 << self.BITS) - 1
+        self.work += len(f)
+        f = {m: c for m, c in f.items() if c}
+        seen = functools.reduce(operator.or_, f, 0)  # a sin exponent ≥ 2 sets a bit above bit 0
+        for s, cos in self.pairs:
+            square = 2 << s
+            mask = (field - 1) << s
+            while seen & mask:
+                self.work += len(f)
+                out: dict = {}
+                get = out.get
+                for m, c in f.items():
+                    if m & mask:  # s^e with e ≥ 2: s^(e−2) (1 − c²)
+                        rest = m - square
+                        out[rest] = get(rest, 0) + c
+                        rest += 2 << cos
+                        out[rest] = get(rest, 0) - c
+                    else:
+                        out[m] = get(m, 0) + c
+                f = {m: c for m, c in out.items() if c}
+                seen = functools.reduce(operator.or_, f, 0)
+        return f
+
+    def to_expr(self, f: dict) -> sp.Expr:
+        """``f`` as a SymPy sum of products, built as SymPy would (coefficient first, then the
+        factors in SymPy's canonical order) without re-deriving it for every term."""
+        field = (1 << self.BITS) - 1
+        powers: dict = {}
+        terms = []
+        for m, c in f.items():
+            factors = []
+            k = 0
+            while m:
+                e = m & field
+                if e:
+                    if (k, e) not in powers:
+                        powers[k, e] = self.generators[k] ** e
+                    factors.append(powers[k, e])
+                m >>= self.BITS
+                k += 1
+            number = (sp.Rational(c.numerator, c.denominator) if isinstance(c, Fraction)
+                      else sp.Integer(c) if isinstance(c, int) else sp.Float(c))
+            factors.sort(key=_args_sortkey)
+            if not factors:
+                terms.append(number)
+            elif number == 1 and len(factors) == 1:
+                terms.append(factors[0])
+            else:
+                terms.append(sp.Mul._from_args(factors if number == 1 else [number] + factors,
+                                               is_commutative=True))
+        return sp.Add(*terms)
+
+
+def expand_program(subexpressions: Sequence[tuple[sp.Symbol, sp.Expr]],
+                   exprs: Sequence[sp.Expr], max_terms: int | None = None,
+                   max_work: int | None = None) -> list[sp.Expr]:
+    """``exprs`` with the ``subexpressions`` substituted and everything multiplied out: sums of
+    products of ``sin q_i``, ``cos q_i`` (reduced with ``sin² + cos² = 1``: degree at most one
+    in ``sin q_i``), velocities and parameters. Floats (a model with decimal numbers) are
+    computed in double precision, and terms below :data:`NOISE_RTOL` of the largest
+    coefficient of a result (rounding noise) dropped; exact numbers stay exact.
+
+    Parameters
+    ----------
+    max_terms:
+        Stop when a product or a result passes this many terms (``None``: no limit).
+    max_work:
+        Stop when the term operations done pass this (``None``: no limit): a bound on the time
+        (about a second per 10⁶ on a 2020s laptop core), checked before each product and before
+        the result is built as SymPy expressions (:data:`TERM_COST` per term).
+
+    Raises
+    ------
+    ExpansionTooLargeError
+        When a limit is passed.
+    NotImplementedError
+        When the program is not polynomial in its inputs and ``sin``/``cos`` of them (a
+        division by an intermediate, a function of one).
+    """
+    defined = {symbol for symbol, _ in subexpressions}
+    leaves: set = set()
+    floats = False
+
+    def collect(expr):
+        nonlocal floats
+        if expr in defined:
+            return
+        if expr.is_Number:
+            floats = floats or expr.is_Float
+            if not expr.is_Rational and not expr.is_Float:
+                raise NotImplementedError(f"cannot expand the number {expr}")
+        elif _polynomial_node(expr):
+            for a in expr.args:
+                collect(a)
+        elif expr.free_symbols & defined:
+            raise NotImplementedError(f"cannot expand {expr}: not a polynomial in the program's "
+                                      "intermediates")
+        else:
+            leaves.add(expr)
+
+    for _, expr in subexpressions:
+        collect(expr)
+    for expr in exprs:
+        collect(expr)
+    angles = sorted({x.args[0] for x in leaves if isinstance(x, (sp.sin, sp.cos))},
+                    key=sp.default_sort_key)
+    leaves.update(f(a) for a in angles for f in (sp.sin, sp.cos))
+    P = _Polynomials(sorted(leaves, key=sp.default_sort_key),
+                     [(sp.sin(a), sp.cos(a)) for a in angles], not floats, max_terms, max_work)
+    value: dict = {}
+
+    def convert(expr, what):
+        found = value.get(expr)
+        if found is not None:
+            return found
+        if expr.is_Number:
+            return P.number(expr)
+        if expr in P.position:
+            return P.generator(expr)
+        if expr.is_Add:
+            out: dict = {}
+            for a in expr.args:
+                P.add_to(out, convert(a, what), what)
+            out = {m: c for m, c in out.items() if c}
+            P.spend(0, len(out), what)
+            return out
+        if expr.is_Mul:
+            out = {0: 1}
+            for a in expr.args:
+                out = P.multiply(out, convert(a, what), what)
+            return out
+        base = convert(expr.base, what)
+        out = {0: 1}
+        for _ in range(int(expr.exp)):
+            out = P.multiply(out, base, what)
+        return out
+
+    for symbol, expr in subexpressions:
+        f = convert(expr, symbol.name)
+        if floats and f:
+            largest = max(abs(c) for c in f.values())
+            f = {m: c for m, c in f.items() if abs(c) >= 1e-3 * NOISE_RTOL * largest}
+        value[symbol] = f
+    results = [convert(expr, "the result") for expr in exprs]
+    if floats:
+        largest = max((abs(c) for f in results for c in f.values()), default=0.0)
+        results = [{m: c for m, c in f.items() if abs(c) >= NOISE_RTOL * largest}
+                   for f in results]
+    P.spend(TERM_COST * sum(len(f) for f in results), 0, "the result")  # before building it
+    return [P.to_expr(f) for f in results]
+
+
+def _prune(definitions: Sequence[tuple[sp.Symbol, sp.Expr]], exprs: Iterable[sp.Expr]):
+    """The definitions ``exprs`` need (directly or through other definitions), in order."""
+    needed: set = set()
+    for expr in exprs:
+        needed |= expr.free_symbols
+    kept = []
+    for symbol, expr in reversed(definitions):
+        if symbol in needed:
+            kept.append((symbol, expr))
+            needed |= expr.free_symbols
+    return tuple(reversed(kept))
+
+
+def _entries(value) -> list[sp.Expr]:
+    return list(value) if isinstance(value, sp.MatrixBase) else [value]
+
+
+class ProgramMatrix:
+    """A matrix (or, from indexing, a scalar) of SymPy expressions in named intermediates,
+    with their definitions: a result of :func:`eomgen.derive` too large to write out.
+
+    ``M = ProgramMatrix("M", entries, definitions)`` stands for ``entries`` with every
+    intermediate ``x_k`` replaced by its definition, in order. Operations that stay cheap keep
+    that form: indexing and slicing, ``.T``, ``+``, ``-``, ``*`` with SymPy matrices, numbers and
+    other results of the same program, :meth:`subs` / :meth:`xreplace` (numbers fold through
+    the definitions; with every input given the result is an ordinary SymPy matrix of numbers),
+    :meth:`evalf`, :meth:`lambdify`. :meth:`expand` writes it out as an ordinary SymPy matrix
+    after checking the size.
+
+    Parameters
+    ----------
+    name:
+        What it is (``"M"``, ``"C"``, ``"g"``, ``"tau"``), for messages and display.
+    value:
+        A SymPy Matrix (or scalar expression) in the inputs and the intermediates.
+    definitions:
+        ``(symbol, expression)`` pairs in evaluation order (a program's assignments; those the
+        value does not need are ignored).
+
+    Examples
+    --------
+    >>> x0, q1 = sp.symbols("x0 q1")
+    >>> A = ProgramMatrix("A", sp.Matrix([[x0, 1], [1, x0 ** 2]]), [(x0, sp.cos(q1) + 1)])
+    >>> A.shape, A.free_symbols
+    ((2, 2), {q1})
+    >>> A.expand()
+    Matrix([
+    [cos(q1) + 1,                          1],
+    [          1, cos(q1)**2 + 2*cos(q1) + 1]])
+    >>> A.subs(q1, 0)
+    Matrix([
+    [2, 1],
+    [1, 4]])
+    """
+
+    #: Above a SymPy Matrix's (10.01), so that ``Matrix * program_matrix`` calls our ``__rmul__``.
+    _op_priority = 20.0
+
+    def __init__(self, name: str, value, definitions: Sequence[tuple[sp.Symbol, sp.Expr]]):
+        self.name = name
+        self.value = sp.ImmutableMatrix(value) if isinstance(value, sp.MatrixBase) else sp.sympify(value)
+        self.definitions = tuple(definitions)
+        self._pruned = None
+
+    # --- what it is --------------------------------------------------------------------------
+    @property
+    def is_Matrix(self) -> bool:
+        return isinstance(self.value, sp.MatrixBase)
+
+    @property
+    def subexpressions(self) -> tuple[tuple[sp.Symbol, sp.Expr], ...]:
+        """The ``(symbol, definition)`` pairs the value needs, in evaluation order."""
+        if self._pruned is None:
+            self._pruned = _prune(self.definitions, _entries(self.value))
+        return self._pruned
+
+    @property
+    def free_symbols(self) -> set[sp.Symbol]:
+        """The inputs (joint variables, parameters) it depends on; intermediates excluded."""
+        defined = {s for s, _ in self.subexpressions}
+        out = set(self.value.free_symbols)
+        for _, expr in self.subexpressions:
+            out |= expr.free_symbols
+        return out - defined
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return self.value.shape if self.is_Matrix else ()
+
+    @property
+    def rows(self) -> int:
+        return self.value.rows
+
+    @property
+    def cols(self) -> int:
+        return self.value.cols
+
+    def __len__(self) -> int:
+        return len(self.value)
+
+    def __iter__(self):
+        return (self._wrap(e) for e in self.value)
+
+    def __getitem__(self, key):
+        return self._wrap(self.value[key])
+
+    @property
+    def T(self) -> "ProgramMatrix":
+        return self._wrap(self.value.T)
+
+    def _wrap(self, value, definitions=None):
+        """``value`` as a ProgramMatrix over these definitions, or plain SymPy when it needs
+        none (a structural zero, an entry in the inputs only)."""
+        definitions = self.definitions if definitions is None else definitions
+        defined = {s for s, _ in definitions}
+        if not any(e.free_symbols & defined for e in _entries(value)):
+            return value
+        return ProgramMatrix(self.name, value, definitions)
+
+    # --- arithmetic ----------------------------------------------------------------------------
+    def _other(self, other):
+        """``(value, definitions)`` of an operand: a ProgramMatrix of the same program (or of
+        one whose definitions agree) or anything SymPy takes."""
+        if isinstance(other, ProgramMatrix):
+            if other.definitions is self.definitions:
+                return other.value, self.definitions
+            mine = dict(self.definitions)
+            merged = list(self.definitions)
+            for symbol, expr in other.definitions:
+                if symbol not in mine:
+                    merged.append((symbol, expr))
+                elif mine[symbol] != expr:
+                    raise ValueError(f"{self.name} and {other.name} define {symbol} differently")
+            return other.value, tuple(merged)
+        if isinstance(other, (list, tuple)):
+            other = sp.Matrix(other)
+        return (other if isinstance(other, sp.MatrixBase) else sp.sympify(other)), self.definitions
+
+    def __add__(self, other):
+        value, definitions = self._other(other)
+        return self._wrap(self.value + value, definitions)
+
+    __radd__ = __add__
+
+    def __sub__(self, other):
+        value, definitions = self._other(other)
+        return self._wrap(self.value - value, definitions)
+
+    def __rsub__(self, other):
+        value, definitions = self._other(other)
+        return self._wrap(value - self.value, definitions)
+
+    def __mul__(self, other):
+        value, definitions = self._other(other)
+        return self._wrap(self.value * value, definitions)
+
+    def __rmul__(self, other):
+        value, definitions = self._other(other)
+        return self._wrap(value * self.value, definitions)
+
+    def __matmul__(self, other):
+        return self.__mul__(other)
+
+    def __rmatmul__(self, other):
+        return self.__rmul__(other)
+
+    def __truediv__(self, other):
+        return self._wrap(self.value / sp.sympify(other))
+
+    def __neg__(self):
+        return self._wrap(-self.value)
+
+    def __getattr__(self, attribute):
+        if attribute.startswith("_"):
+            raise AttributeError(attribute)
+        raise AttributeError(
+            f"ProgramMatrix ({self.name}, in named subexpressions) has no {attribute!r}: call "
+            ".expand() for an ordinary SymPy matrix first")
+
+    # --- substitution and numbers ------------------------------------------------------------
+    def xreplace(self, rule: Mapping):
+        """Replace inputs (symbols) by values through the definitions: definitions that become
+        numbers are folded into the ones after them. An ordinary SymPy matrix (or expression)
+        when nothing named is left, else a smaller ProgramMatrix."""
+        rule = {sp.sympify(k): sp.sympify(v) for k, v in dict(rule).items()}
+        defined = {s for s, _ in self.subexpressions}
+        if rule.keys() & defined:
+            raise ValueError("substitute inputs (joint variables, parameters), not intermediates")
+        kept = []
+        for symbol, expr in self.subexpressions:
+            new = expr.xreplace(rule)
+            if new.is_Number:
+                rule[symbol] = new
+            else:
+                kept.append((symbol, new))
+        value = self.value.xreplace(rule)
+        return self._wrap(value, tuple(kept))
+
+    def subs(self, *args, **kwargs):
+        """Like SymPy's ``subs`` (``subs(x, 1)``, ``subs({x: 1})``, ``subs([(x, 1)])``) for
+        inputs: see :meth:`xreplace`."""
+        if len(args) == 2:
+            rule = {args[0]: args[1]}
+        elif len(args) == 1:
+            rule = dict(args[0])
+        else:
+            raise TypeError("subs takes a mapping, a list of pairs, or old and new")
+        return self.xreplace(rule)
+
+    def evalf(self, n: int = 15, subs: Mapping | None = None):
+        """Numerical value with ``n`` digits, the inputs given in ``subs`` (all of them: else a
+        ValueError naming those missing)."""
+        value = self.xreplace(subs or {})
+        if isinstance(value, ProgramMatrix):
+            missing = ", ".join(sorted(str(s) for s in value.free_symbols))
+            raise ValueError(f"{self.name}: evalf needs values for {missing}")
+        return value.evalf(n)
+
+    n = evalf
+
+    def lambdify(self, args, modules="numpy", **kwargs):
+        """``sympy.lambdify(args, self)`` with the named subexpressions as its common
+        subexpressions: a function that evaluates the program, not the expanded matrix."""
+        subexpressions = list(self.subexpressions)
+        return sp.lambdify(args, self.value, modules,
+                           cse=lambda exprs: (subexpressions, exprs), **kwargs)
+
+    # --- written out ---------------------------------------------------------------------------
+    def expand(self, max_terms: int | None = EXPAND_MAX_TERMS, max_work: int | None = None):
+        """The ordinary SymPy matrix (or expression): every intermediate substituted, products
+        multiplied out, ``sin² q_i + cos² q_i = 1`` applied (see :func:`expand_program`).
+
+        The size of the result is not known before: it depends on cancellations (the M of the
+        6-joint PUMA 560 expands to 262 terms, that of a 5-joint arm with general axes and
+        offsets to tens of thousands). So the expansion checks as it goes, and stops.
+
+        Parameters
+        ----------
+        max_terms:
+            Stop when an intermediate result passes this many terms; ``None`` forces the
+            expansion whatever its size.
+        max_work:
+            Stop after this many term operations (about a second per 10⁶); ``None``: no limit.
+
+        Raises
+        ------
+        ExpansionTooLargeError
+            Naming the limit passed and the way out.
+        """
+        try:
+            entries = expand_program(self.subexpressions, _entries(self.value), max_terms,
+                                     max_work)
+        except ExpansionTooLargeError as error:
+            raise ExpansionTooLargeError(
+                f"{self.name}: {error}. The named form (.subexpressions, .subs, .evalf, "
+                ".lambdify, dyn.lambdify()) needs no expansion; .expand(max_terms=None) "
+                "forces it") from None
+        if not self.is_Matrix:
+            return entries[0]
+        return sp.Matrix(self.rows, self.cols, entries)
+
+    as_explicit = expand
+
+    def __repr__(self) -> str:
+        shape = "×".join(map(str, self.shape)) if self.is_Matrix else "scalar"
+        return (f"ProgramMatrix({self.name}, {shape}, in {len(self.subexpressions)} named "
+                "subexpressions; .expand() writes it out)")
+
+    def _repr_latex_(self) -> str:
+        shown = self.subexpressions[:LATEX_MAX_SUBEXPRESSIONS]
+        lines = [f"{sp.latex(sp.Symbol(self.name))} = {sp.latex(self.value)}"]
+        if shown:
+            lines.append(r"\text{where}")
+            lines += [f"{sp.latex(s)} = {sp.latex(e)}" for s, e in shown]
+        more = len(self.subexpressions) - len(shown)
+        if more:
+            lines.append(rf"\text{{… and {more} more (.subexpressions)}}")
+        return "$$\\begin{aligned}" + r"\\ ".join("&" + line for line in lines) + \
+            r"\end{aligned}$$"
