@@ -4,16 +4,16 @@ Printer: the NumPy backend's printer with ``jnp.`` (``jax.numpy``) as the module
 arithmetic is printed exactly as in the NumPy module. Template: ``templates/jax/module.py.jinja``.
 The generated module imports only ``jax``; generating it does not.
 
-How a function assembles its output decides XLA's CPU speed more than its arithmetic does
+How a function assembles its output changes XLA's CPU speed several-fold
 (benchmarks/backend_speed.py, Panda, jaxlib 0.10):
 
-* a matrix (M, C) is one ``jnp.stack`` of all its entries, row by row: XLA fuses each distinct
-  entry's expression into one loop and concatenates them. With one ``.at[i, j].set`` per entry
-  it made one in-place update per entry, each recomputing that entry's whole expression, and M
-  took 2-3 times as long;
+* a matrix (M, C) is one ``jnp.stack`` of all its entries, row by row. XLA builds one loop per
+  distinct entry (28 for the Panda's M) and concatenates them; with one ``.at[i, j].set`` per
+  entry it built 49 in-place updates, and M took 1.75 times as long. Either way each loop
+  recomputes the intermediates its entry needs, which keeps M several times slower than NumPy;
 * a vector (tau, g) is one ``.at[i].set`` per entry: stacked, XLA fused the whole program into
-  a single concatenation whose CPU code recomputed the shared intermediates for every entry,
-  40-90 times slower than the updates.
+  one concatenation whose CPU code recomputed the shared intermediates for every entry, 40-90
+  times slower than the updates.
 """
 
 from __future__ import annotations
