@@ -12,8 +12,12 @@ are generated into a temporary folder, then on the same random batch of ``--stat
 
 * **numpy**: ``inverse_dynamics(q, qd, qdd)`` and ``mass_matrix(q)`` on the batch (the
   reference);
-* **jax**: ``jax.jit(jax.vmap(f))`` on the same arrays as JAX arrays (compiled once before
-  timing; ``block_until_ready`` in the time), on the device JAX chooses;
+* **jax**: ``jax.jit(jax.vmap(f))`` on the same arrays as JAX arrays, compiled before timing
+  (``lower(...).compile()``, its time reported apart) and run once more as warm-up;
+  ``block_until_ready`` is inside the time; on the device JAX chooses. Once with jax.jit's
+  defaults (the target) and once with ``compiler_options={"xla_disable_hlo_passes":
+  "fusion"}`` (no target): XLA's CPU fusion copies the intermediates an output entry needs into
+  every entry's loop, which for M costs more than fusing saves;
 * **torch**: the functions on CPU tensors (no autograd recording), on one thread as NumPy's
   element-wise operations (the target), and on torch's default number of threads;
 * **dask**: ``eomgen.batch.dask_map`` of the NumPy functions over ``--dask-states`` states in
@@ -50,6 +54,11 @@ from eomgen.codegen.scene_generate import generate_scene  # noqa: E402
 from eomgen.scene import load_scene  # noqa: E402
 
 TARGETS = {"jax": 1.0, "torch": 2.0}
+# (route, XLA compiler options, note): jax.jit's defaults (the target), and XLA's fusion pass
+# turned off for this one function (each operation its own loop over the batch, as in NumPy)
+JAX_ROUTES = (("jax jit+vmap", None, ""),
+              ("(jax jit+vmap)", {"xla_disable_hlo_passes": "fusion"},
+               "XLA fusion off (no target); "))
 
 
 def panda_modules(outdir: Path):
@@ -112,23 +121,27 @@ def main(argv=None) -> int:
         jq, jqd, jqdd = (jax.device_put(a) for a in (q, qd, qdd))
         tq, tqd, tqdd = (torch.from_numpy(a) for a in (q, qd, qdd))
         rows = []
-        for label, numpy_call, jax_f, jax_args, torch_call in (
-                ("tau", lambda: npm.inverse_dynamics(q, qd, qdd),
-                 jax.jit(jax.vmap(jxm.inverse_dynamics)), (jq, jqd, jqdd),
-                 lambda: thm.inverse_dynamics(tq, tqd, tqdd)),
-                ("M", lambda: npm.mass_matrix(q), jax.jit(jax.vmap(jxm.mass_matrix)), (jq,),
+        for label, numpy_call, jax_function, jax_args, torch_call in (
+                ("tau", lambda: npm.inverse_dynamics(q, qd, qdd), jxm.inverse_dynamics,
+                 (jq, jqd, jqdd), lambda: thm.inverse_dynamics(tq, tqd, tqdd)),
+                ("M", lambda: npm.mass_matrix(q), jxm.mass_matrix, (jq,),
                  lambda: thm.mass_matrix(tq))):
             expected = numpy_call()
-            start = time.perf_counter()
-            check(jax_f(*jax_args), expected, f"jax {label}")
-            compile_s = time.perf_counter() - start
+            compiled = []
+            for route, options, note in JAX_ROUTES:
+                start = time.perf_counter()  # compile time apart from the timings
+                jax_f = jax.jit(jax.vmap(jax_function), compiler_options=options).lower(
+                    *jax_args).compile()
+                compiled.append((route, jax_f, time.perf_counter() - start, note))
+                check(jax_f(*jax_args), expected, f"{route} {label}")
             with torch.no_grad():
                 check(torch_call(), expected, f"torch {label}")
             base = timings(numpy_call, args.repeat)
             rows.append((label, "numpy", base, base, ""))
-            jax_t = timings(lambda: jax_f(*jax_args).block_until_ready(), args.repeat)
-            rows.append((label, "jax jit+vmap", jax_t, base,
-                         f"compiled in {compile_s:.1f} s on {jax.devices()[0]}"))
+            for route, jax_f, compile_s, note in compiled:
+                jax_t = timings(lambda: jax_f(*jax_args).block_until_ready(), args.repeat)
+                rows.append((label, route, jax_t, base,
+                             f"{note}compiled in {compile_s:.1f} s on {jax.devices()[0]}"))
             threads = torch.get_num_threads()
             with torch.no_grad():
                 torch.set_num_threads(1)  # as NumPy's element-wise operations

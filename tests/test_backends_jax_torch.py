@@ -217,6 +217,26 @@ def test_parameters_left_out_take_the_descriptions_values(robot):
                     expected)
 
 
+def test_jax_matrices_take_per_state_parameters_and_keep_float32(robot):
+    """M and C are one jnp.stack of their entries (not one scatter per entry): entries that
+    are scalars (structural zeros, C_22 of the planar arm) must still fill every state,
+    per-state parameter arrays must stay per state, and float32 states stay float32."""
+    modules = robot("planar_2link")
+    q, qd, _ = states(2, seed=6)
+    masses = np.linspace(0.5, 2.0, len(q))
+    for function, args in (("mass_matrix", (q,)), ("coriolis_matrix", (q, qd))):
+        expected = getattr(modules.numpy, function)(*args, m2=masses)
+        f = getattr(modules.jax, function)
+        assert_relative(f(*args, m2=masses), expected, what=function)
+        assert_relative(jax.jit(jax.vmap(f))(*args, m2=masses), expected, what=function)
+        low = f(*(a.astype(np.float32) for a in args), m2=masses)
+        assert low.dtype == jnp.float32
+        assert_relative(low, expected, tol=1e-5, what=f"{function} float32")
+    C = modules.jax.coriolis_matrix(q, qd)
+    assert C.shape == (len(q), 2, 2) and np.all(np.asarray(C)[:, 1, 1] == 0.0)
+    assert modules.jax.coriolis_matrix(q[0], qd[0]).shape == (2, 2)
+
+
 def test_torch_keeps_the_inputs_dtype_and_device(robot):
     modules = robot("planar_2link")
     q, qd, qdd = (torch.from_numpy(a) for a in states(2, seed=5))

@@ -59,6 +59,16 @@ def _states(*named):
     return (*[x.astype(d) for x in arrays], all(singles))
 
 
+def _stack(x, shape, entries):
+    """The entries (arrays of shape (N,) or scalars, in row-major order) as one array of shape
+    (N,) + shape in the dtype of x, an (N, NQ) state; one jnp.stack, which XLA compiles to
+    faster CPU code than one scatter per entry."""
+    if not entries:
+        return jnp.zeros((x.shape[0],) + shape, x.dtype)
+    columns = [jnp.broadcast_to(jnp.asarray(e, x.dtype), x.shape[:1]) for e in entries]
+    return jnp.stack(columns, axis=-1).reshape((x.shape[0],) + shape)
+
+
 def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
     """Mass matrix M(q), symmetric positive definite.
 
@@ -96,11 +106,10 @@ def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l
     F2_3 = -hw2_1 + m2*o2_1
     F2_4 = hw2_0 - m2*o2_0
     M2_2 = F2_2 + F2_3*o2_1 - F2_4*o2_0
-    out = jnp.zeros((q.shape[0],) + (2, 2), q.dtype)
-    out = out.at[:, 0, 0].set(Ic1_22)
-    out = out.at[:, 0, 1].set(F2_2)
-    out = out.at[:, 1, 0].set(F2_2)
-    out = out.at[:, 1, 1].set(M2_2)
+    out = _stack(q, (2, 2), [
+        Ic1_22, F2_2,
+        F2_2, M2_2,
+    ])
     return out[0] if single else out
 
 
@@ -145,10 +154,10 @@ def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_
     Y2_2_2 = F2_3*o2_0 + F2_4*o2_1
     C1_2 = Y2_2_2*qd2 + 0.5*dM1_1_2*qd1
     C2_1 = -0.5*dM1_1_2*qd1
-    out = jnp.zeros((q.shape[0],) + (2, 2), q.dtype)
-    out = out.at[:, 0, 0].set(C1_1)
-    out = out.at[:, 0, 1].set(C1_2)
-    out = out.at[:, 1, 0].set(C2_1)
+    out = _stack(q, (2, 2), [
+        C1_1, C1_2,
+        C2_1, 0.0,
+    ])
     return out[0] if single else out
 
 

@@ -3,6 +3,17 @@
 Printer: the NumPy backend's printer with ``jnp.`` (``jax.numpy``) as the module prefix, so the
 arithmetic is printed exactly as in the NumPy module. Template: ``templates/jax/module.py.jinja``.
 The generated module imports only ``jax``; generating it does not.
+
+How a function assembles its output changes XLA's CPU speed several-fold
+(benchmarks/backend_speed.py, Panda, jaxlib 0.10):
+
+* a matrix (M, C) is one ``jnp.stack`` of all its entries, row by row. XLA builds one loop per
+  distinct entry (28 for the Panda's M) and concatenates them; with one ``.at[i, j].set`` per
+  entry it built 49 in-place updates, and M took 1.75 times as long. Either way each loop
+  recomputes the intermediates its entry needs, which keeps M several times slower than NumPy;
+* a vector (tau, g) is one ``.at[i].set`` per entry: stacked, XLA fused the whole program into
+  one concatenation whose CPU code recomputed the shared intermediates for every entry, 40-90
+  times slower than the updates.
 """
 
 from __future__ import annotations
@@ -13,7 +24,7 @@ from sympy.printing.numpy import NumPyPrinter
 
 from .. import GeneratedFile, Job, register
 from ..render import render
-from .common import python_module_context
+from .common import PrintedFunction, python_module_context
 from .numpy_backend import NumPyModulePrinter
 
 
@@ -46,5 +57,16 @@ class JaxConfig:
           config=JaxConfig, order=60, reserved=("jnp", "jax"))
 def generate_jax(job: Job, config: JaxConfig = JaxConfig()) -> list[GeneratedFile]:
     printer = JaxModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
-    text = render(config.template, **python_module_context(job, printer, config.template))
+    context = python_module_context(job, printer, config.template)
+    context["stacked"] = {f.name: stacked_rows(f) for f in context["functions"]
+                          if len(f.output_shape) == 2}
+    text = render(config.template, **context)
     return [GeneratedFile(job.stem + config.suffix, text)]
+
+
+def stacked_rows(f: PrintedFunction) -> list[list[str]]:
+    """The rows of the matrix output of ``f``, structural zeros as ``0.0``: the entries the
+    generated ``_stack`` receives, in row-major order."""
+    rows, cols = f.output_shape
+    entries = dict(f.output_entries)
+    return [[entries.get((r, c), "0.0") for c in range(cols)] for r in range(rows)]
