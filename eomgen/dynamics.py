@@ -308,7 +308,11 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     Returns
     -------
     Dynamics
-        With ``M``, ``C``, ``g`` as SymPy matrices in ``q``, ``qd`` and the parameters.
+        Its ``program`` holds every output asked for; ``M``, ``C``, ``g``, ``tau`` read as
+        SymPy matrices in ``q``, ``qd`` (``qdd``) and the parameters: reduced textbook forms for
+        teaching-sized models, multiplied out where that is cheap, else
+        :class:`~eomgen.symbolic.named.ProgramMatrix` (the matrix in named intermediates,
+        ``.expand()`` on request).
 
     Raises
     ------
@@ -357,19 +361,31 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     return Dynamics(model, q, qd, qdd, program, steps, tuple(timings), bool(simplify), vectors)
 
 
-def _steps(program: Program, result: dict) -> tuple[Step, ...]:
+#: The tag families (:class:`eomgen.symbolic.program.Tag`, set where the Lagrangian program
+#: defines its intermediates) of each derivation step.
+STEP_FAMILIES = {
+    "kinematics": ("s", "c", "A", "R", "o", "z", "p", "v"),
+    "inertia": ("Rh", "Iw", "hw", "mc", "hc", "Ic", "F"),
+    "christoffel": ("X", "G", "Y", "dM", "Gamma"),
+}
 
-    def named(prefix: str) -> tuple[tuple[str, sp.Expr], ...]:
-        return tuple((s.name, e) for s, e in program.assignments if s.name.startswith(prefix))
+
+def _steps(program: Program, result: dict) -> tuple[Step, ...]:
+    tags = program.tags()
+
+    def named(step: str) -> tuple[tuple[str, sp.Expr], ...]:
+        families = STEP_FAMILIES[step]
+        return tuple((s.name, e) for s, e in program.assignments
+                     if s in tags and tags[s].family in families)
 
     steps = [
         Step("kinematics", "Forward kinematics",
-             "World rotation R_i, origin p_i and motion axis S_i of every body.",
-             named("R") + named("o") + named("p") + named("z") + named("v")),
+             "Sines and cosines, world rotation R_i, origin p_i and motion axis S_i of every "
+             "body.", named("kinematics")),
         Step("inertia", "Composite inertias",
-             "Mass m, first moment h and rotational inertia of each subtree about the first moving "
-             "joint's origin.",
-             named("mc") + named("hc") + named("Ic")),
+             "Each body's inertia in world axes, then mass m, first moment h and rotational "
+             "inertia of each subtree about the first moving joint's origin, and F_j = I^c_j S_j.",
+             named("inertia")),
     ]
     if "M" in result:
         steps.append(Step("M", "Mass matrix", "M_ij = S_iᵀ I^c_j S_j for i an ancestor of j.",
@@ -377,7 +393,8 @@ def _steps(program: Program, result: dict) -> tuple[Step, ...]:
                                 for j in range(i, result["M"].cols))))
     if "C" in result:
         steps.append(Step("christoffel", "Christoffel symbols",
-                          "c_ijk = ½(∂M_ij/∂q_k + ∂M_ik/∂q_j − ∂M_jk/∂q_i).", named("Gamma")))
+                          "∂M/∂q in closed form, then c_ijk = ½(∂M_ij/∂q_k + ∂M_ik/∂q_j − "
+                          "∂M_jk/∂q_i).", named("christoffel")))
         steps.append(Step("C", "Coriolis matrix", "C_ij = Σ_k c_ijk q̇_k.",
                           tuple((f"C[{i},{j}]", result["C"][i, j]) for i in range(result["C"].rows)
                                 for j in range(result["C"].cols))))

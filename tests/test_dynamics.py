@@ -564,3 +564,20 @@ def test_joint_order_is_description_order_not_tree_order(tmp_path):
     # the slider (listed second) is q2: the (2, 2) entry is the mass it carries
     assert shuffled.M[1, 1] == 3
     assert shuffled.g[1, 0] == 0  # it slides horizontally
+
+
+def test_derivation_steps_group_intermediates_by_their_tags_not_their_names():
+    from eomgen.dynamics import STEP_FAMILIES
+
+    dyn = derive(eomgen.load(eomgen.example_path("puma560_dh")), outputs=("M", "C", "g"),
+                 simplify=False)
+    tags = dyn.program.tags()
+    by_step = {s.key: [name for name, _ in s.results] for s in dyn.steps}
+    for step, families in STEP_FAMILIES.items():
+        expected = [s.name for s, _ in dyn.program.assignments
+                    if s in tags and tags[s].family in families]
+        assert expected and by_step[step] == expected, step
+    # "Rh" (a rotated first moment) starts with "R" but is an inertia quantity: a grouping by
+    # name prefix put it among the rotations
+    rotated = [n for n in by_step["inertia"] if tags[sp.Symbol(n, real=True)].family == "Rh"]
+    assert rotated and not set(rotated) & set(by_step["kinematics"])
