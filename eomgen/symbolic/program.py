@@ -44,6 +44,11 @@ class ProgramBuilder:
         self._by_value: dict[sp.Expr, sp.Symbol] = {}
         self.assignments: list[tuple[sp.Symbol, sp.Expr]] = []
 
+    @property
+    def reserved(self) -> frozenset[str]:
+        """The names intermediates never take."""
+        return frozenset(self._reserved)
+
     def _fresh(self, hint: str) -> sp.Symbol:
         name = hint
         while name in self._names or name in self._reserved:
@@ -69,9 +74,36 @@ class ProgramBuilder:
         self.assignments.append((symbol, expr))
         return symbol
 
+    def absorb(self, other: "ProgramBuilder", matrix: sp.Matrix) -> sp.Matrix:
+        """Define ``other``'s assignments here (renamed where taken, shared where already
+        defined) and return ``matrix``, built in ``other``, in terms of this builder's names."""
+        mapping: dict = {}
+        for symbol, expr in other.assignments:
+            mapping[symbol] = self.define(expr.xreplace(mapping), symbol.name)
+        return matrix.xreplace(mapping)
+
     def define_all(self, exprs: Sequence, hint: str) -> tuple:
         """Define each entry of a vector, hinting names ``hint0, hint1, …``."""
         return tuple(self.define(e, f"{hint}{k}") for k, e in enumerate(exprs))
+
+
+def rough_operation_count(exprs: Iterable[sp.Expr]) -> int:
+    """A fast estimate of the arithmetic operations of ``exprs``: one per argument of a sum or
+    product beyond the first, per power and per function call (what :meth:`Program.operation_count`
+    counts exactly with SymPy's slower ``count_ops``)."""
+    total = 0
+    stack = list(exprs)
+    while stack:
+        e = stack.pop()
+        if e.is_Atom:
+            continue
+        args = e.args
+        if e.is_Add or e.is_Mul:
+            total += len(args) - 1 - (1 if e.is_Mul and args[0] in (-1, 1) else 0)
+        else:
+            total += 1
+        stack.extend(args)
+    return total
 
 
 @dataclass(frozen=True)
