@@ -1,7 +1,7 @@
 """The two exact programs of each of M, C and g that ``derive`` chooses from (issue 18).
 
 ``derive_program`` builds, for each output, whichever of two programs has fewer operations for
-the robot at hand (:func:`eomgen.symbolic.composite.cheapest_route`), so every route must give
+the robot at hand (:func:`eomgen.symbolic.composite.cheapest_routes`), so every route must give
 the same matrices on every robot, not only on those where it wins. Each route is forced here and
 checked against independent computations:
 

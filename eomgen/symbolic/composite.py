@@ -34,6 +34,7 @@ Units: SI (rad, m, kg, s). Sign convention: M q̈ + C q̇ + g = τ.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Iterable
 
 import sympy as sp
 
@@ -234,10 +235,11 @@ def _routes() -> dict:
 
 
 #: Above this many joints the Christoffel-symbol C is not tried: its O(n³) program was larger
-#: than the recursion's O(n²) one on every robot measured from 5 joints on (random 5- and
-#: 6-joint arms with general axes: 3,163–3,512 against 3,120–3,351 operations and 4,222–5,007
-#: against 3,701–4,140), and building it dominates ``derive``'s time for long chains.
-CHRISTOFFEL_MAX_JOINTS = 6
+#: than the recursion's O(n²) one on every robot measured with 6 joints (random arms with
+#: general axes: 4,222–5,007 against 3,701–4,140 operations; the 6-link spatial chain of
+#: benchmarks/complexity.py 4,059 against 3,354; 5 joints: 3,163–3,512 against 3,120–3,351),
+#: and building it dominates ``derive``'s time for long chains.
+CHRISTOFFEL_MAX_JOINTS = 5
 
 
 def _christoffel_route(tree, q, qd, gravity, b):
@@ -246,29 +248,39 @@ def _christoffel_route(tree, q, qd, gravity, b):
     return christoffel_coriolis_program(tree, q, qd, b)
 
 
-def cheapest_route(tree: BodyTree, q, qd, gravity: Vec3, output: str,
-                   reserved=()) -> tuple[str, ProgramBuilder, sp.Matrix]:
-    """The route (see :func:`derive_program`) whose program for ``output`` has the fewest
-    operations (:func:`~eomgen.symbolic.program.rough_operation_count`; the first route on a
-    tie): ``(name, the builder it was built in, the output's matrix)``."""
-    best = None
-    for name, build in _routes()[output]:
-        scratch = ProgramBuilder(reserved)
-        matrix = build(tree, q, qd, gravity, scratch)
-        if matrix is None:  # route not tried for this robot
-            continue
-        used = Program(tuple(scratch.assignments), ((output, matrix),)).pruned([output])
-        count = rough_operation_count([e for _, e in used.assignments] + list(matrix))
-        if best is None or count < best[0]:
-            best = (count, name, scratch, matrix)
-    return best[1:]
+def cheapest_routes(tree: BodyTree, q, qd, gravity: Vec3, outputs: Iterable[str],
+                    reserved=()) -> tuple[dict[str, str], Program]:
+    """Build every route (see :func:`derive_program`) of each of ``outputs`` into one scratch
+    builder, where they share their common work (the world-frame composites, sines and
+    cosines), and keep for each output the route whose own program has the fewest operations
+    (:func:`~eomgen.symbolic.program.rough_operation_count`; the first route on a tie).
+
+    Returns ``({output: route name}, the program of the chosen outputs, pruned)``.
+    """
+    scratch = ProgramBuilder(reserved)
+    routes = _routes()
+    chosen, best_matrices = {}, []
+    for output in outputs:
+        best = None
+        for name, build in routes[output]:
+            matrix = build(tree, q, qd, gravity, scratch)
+            if matrix is None:  # route not tried for this robot
+                continue
+            used = Program(tuple(scratch.assignments), ((output, matrix),)).pruned([output])
+            count = rough_operation_count([e for _, e in used.assignments] + list(matrix))
+            if best is None or count < best[0]:
+                best = (count, name, matrix)
+        chosen[output] = best[1]
+        best_matrices.append((output, best[2]))
+    program = Program(tuple(scratch.assignments), tuple(best_matrices))
+    return chosen, program.pruned([o for o, _ in best_matrices])
 
 
 def derive_program(tree: BodyTree, q, qd, gravity: Vec3, outputs: set[str], b: ProgramBuilder) -> dict:
     """Build M, C and/or g (as asked in ``outputs``) into the program builder ``b``.
 
     Each output has two exact programs, and the one with fewer operations for this robot is
-    built (:func:`cheapest_route`):
+    built (:func:`cheapest_routes`):
 
     * ``M``: the body-frame CRBA (:func:`eomgen.symbolic.crba.mass_matrix_program`), cheapest
       for joint axes along the link frames' axes (the Panda: 641 operations against 1,784), or
@@ -287,27 +299,28 @@ def derive_program(tree: BodyTree, q, qd, gravity: Vec3, outputs: set[str], b: P
     Returns a dict with SymPy matrices in terms of intermediates: ``"M"`` (n×n), ``"C"`` (n×n),
     ``"g"`` (n×1), plus ``"P"`` (1×1 potential energy, when g is asked).
     """
-    result: dict = {}
-    for output in ("M", "g", "C"):
-        if output not in outputs:
-            continue
-        _, scratch, matrix = cheapest_route(tree, q, qd, gravity, output, b.reserved)
-        result[output] = b.absorb(scratch, matrix)
-        if output == "g":
-            kin = forward_kinematics(tree, q, b)
-            result["P"] = sp.Matrix([[b.define(potential_energy(tree, kin, gravity), "P")]])
+    _, program = cheapest_routes(tree, q, qd, gravity,
+                                 [o for o in ("M", "g", "C") if o in outputs], b.reserved)
+    result = b.absorb(program)
+    if "g" in outputs:
+        kin = forward_kinematics(tree, q, b)
+        result["P"] = sp.Matrix([[b.define(potential_energy(tree, kin, gravity), "P")]])
     return result
 
 
 def _world_composites(tree: BodyTree, q, b: ProgramBuilder) -> tuple:
     """World-frame kinematics, body and composite inertias and ``F_j = I^c_j S_j`` of every
-    body."""
+    body (built once per builder, tree and q)."""
+    key = ("world composites", id(tree), tuple(q))
+    if key in b.memo:
+        return b.memo[key][1]
     kin = forward_kinematics(tree, q, b)
     world = body_inertia_in_world(tree, kin, b)
     comp = composite_inertias(tree, world, b)
     F = [b.define_all(comp[j].apply(kin.S[j]), f"F{tree.bodies[j].q_index + 1}_")
          for j in range(len(tree.bodies))]
-    return kin, world, comp, F
+    b.memo[key] = (tree, (kin, world, comp, F))  # the tree kept alive: its id stays its own
+    return b.memo[key][1]
 
 
 def composite_mass_matrix_program(tree: BodyTree, q, b: ProgramBuilder) -> sp.Matrix:

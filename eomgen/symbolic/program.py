@@ -43,6 +43,9 @@ class ProgramBuilder:
         self._names: set[str] = set()
         self._by_value: dict[sp.Expr, sp.Symbol] = {}
         self.assignments: list[tuple[sp.Symbol, sp.Expr]] = []
+        #: Work shared between programs built into this builder (e.g. the world-frame
+        #: composites of :mod:`eomgen.symbolic.composite`), by a key of the caller's choice.
+        self.memo: dict = {}
 
     @property
     def reserved(self) -> frozenset[str]:
@@ -74,13 +77,28 @@ class ProgramBuilder:
         self.assignments.append((symbol, expr))
         return symbol
 
-    def absorb(self, other: "ProgramBuilder", matrix: sp.Matrix) -> sp.Matrix:
-        """Define ``other``'s assignments here (renamed where taken, shared where already
-        defined) and return ``matrix``, built in ``other``, in terms of this builder's names."""
-        mapping: dict = {}
-        for symbol, expr in other.assignments:
-            mapping[symbol] = self.define(expr.xreplace(mapping), symbol.name)
-        return matrix.xreplace(mapping)
+    def absorb(self, program: "Program") -> dict[str, sp.Matrix]:
+        """Define ``program``'s assignments here and return its outputs in terms of this
+        builder's names. Each keeps its name where free (a name another builder had to suffix
+        with ``_`` loses the suffix first); a definition already made here is shared. The
+        expressions are taken as they are (``program`` was built by a builder too)."""
+        changed: dict = {}
+
+        def moved(expr):
+            return expr.xreplace(changed) if changed and expr.free_symbols & changed.keys() else expr
+
+        for symbol, expr in program.assignments:
+            expr = moved(expr)
+            known = self._by_value.get(expr)
+            if known is not None:
+                changed[symbol] = known
+                continue
+            new = self._fresh(symbol.name.rstrip("_"))
+            if new != symbol:
+                changed[symbol] = new
+            self._by_value[expr] = new
+            self.assignments.append((new, expr))
+        return {name: matrix.applyfunc(moved) for name, matrix in program.outputs}
 
     def define_all(self, exprs: Sequence, hint: str) -> tuple:
         """Define each entry of a vector, hinting names ``hint0, hint1, …``."""
