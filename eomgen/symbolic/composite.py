@@ -1,6 +1,14 @@
-"""Lagrangian dynamics through composite bodies, as a straight-line program.
+"""M, C and g as straight-line programs: composite bodies, the CRBA, Newton–Euler at rest and
+Echeandia and Wensing's Coriolis recursion, whichever is cheaper for the robot.
 
-This is the Lagrangian method, M = Σ_l J_lᵀ I_l J_l and c_ijk = ½(∂M_ij/∂q_k + ∂M_ik/∂q_j −
+:func:`derive_program` (what :func:`eomgen.derive` calls) builds each asked output by the
+cheaper of two exact programs (:func:`cheapest_routes`): M by the body-frame CRBA
+(:mod:`eomgen.symbolic.crba`) or by the world-frame composite bodies below; C by the O(n²)
+recursion of :func:`coriolis_program` or by the Christoffel symbols below; g by the
+Newton–Euler program at rest (:mod:`eomgen.symbolic.newton_euler`) or from the composite
+bodies below. Every route gives the same matrices; C is always the Christoffel C.
+
+The world-frame routes are the Lagrangian method, M = Σ_l J_lᵀ I_l J_l and c_ijk = ½(∂M_ij/∂q_k + ∂M_ik/∂q_j −
 ∂M_jk/∂q_i), with the sums over links regrouped by subtree so that no expression grows with the
 number of links:
 
