@@ -15,13 +15,16 @@ What is measured, for each n (a chain of n revolute joints, see :func:`spatial_c
 * ``tau``  — the Newton–Euler program τ(q, q̇, q̈) (:mod:`eomgen.symbolic.newton_euler`);
 * ``crba`` — the mass matrix by the body-frame Composite-Rigid-Body Algorithm
   (:mod:`eomgen.symbolic.crba`);
-* ``M``    — the mass matrix program the generated modules use today
-  (:mod:`eomgen.symbolic.composite`: M_ij = S_iᵀ I^c_j S_j with everything referred to the root
-  origin);
+* ``M``    — the mass matrix as M_ij = S_iᵀ I^c_j S_j with everything in world axes
+  (:func:`eomgen.symbolic.composite.composite_mass_matrix_program`; ``derive`` builds whichever
+  of it and the CRBA is cheaper for the robot);
 * ``aba``  — the Articulated-Body Algorithm program q̈(q, q̇, τ) (:mod:`eomgen.symbolic.aba`);
 * ``chol`` — the Cholesky route to q̈ as one program (the CRBA's M, bias τ(q, q̇, 0),
   M = L Lᵀ, two triangular solves);
-* ``C``    — the Coriolis matrix from the Christoffel symbols (the Lagrangian derivation's C);
+* ``C``    — the Coriolis matrix from the Christoffel symbols of the closed-form ∂M/∂q
+  (:func:`eomgen.symbolic.composite.christoffel_coriolis_program`, O(n³));
+* ``Crec`` — the same matrix by Echeandia and Wensing's recursion
+  (:func:`eomgen.symbolic.composite.coriolis_program`, O(n²)); ``derive`` builds the cheaper;
 * ``derive`` — ``eomgen.derive(model)`` (M, C, g): seconds and assignments of its program (the
   Lagrangian derivation's own cost).
 
@@ -61,7 +64,8 @@ from eomgen.bodies import body_tree  # noqa: E402
 from eomgen.dynamics import derive, joint_symbols  # noqa: E402
 from eomgen.model import Inertial, Joint, JointType, Link, Transform, build_model, vec3  # noqa: E402
 from eomgen.symbolic.aba import aba_program, cholesky_program  # noqa: E402
-from eomgen.symbolic.composite import derive_program  # noqa: E402
+from eomgen.symbolic.composite import (christoffel_coriolis_program, coriolis_program,  # noqa: E402
+                                       composite_mass_matrix_program)
 from eomgen.symbolic.crba import crba_program  # noqa: E402
 from eomgen.symbolic.evaluate import compile_program  # noqa: E402
 from eomgen.symbolic.newton_euler import inverse_dynamics_program  # noqa: E402
@@ -71,7 +75,7 @@ from eomgen.symbolic.program import Program, ProgramBuilder  # noqa: E402
 FULL_NS = (2, 3, 4, 6, 8, 10, 12, 15, 20, 25, 30)
 QUICK_NS = (2, 4, 8, 12)
 FIT_FROM = 8
-QUANTITIES = ("tau", "crba", "M", "aba", "chol", "C")
+QUANTITIES = ("tau", "crba", "M", "aba", "chol", "C", "Crec")
 
 
 def featherstone(name: str, n: int) -> int | None:
@@ -122,10 +126,10 @@ def programs(model, with_C: bool) -> dict:
         out = inverse_dynamics_program(tree, q, qd, qdd, model.gravity, b)
         return Program(tuple(b.assignments), (("tau", out),)).pruned(["tau"]), q + qd + qdd
 
-    def lagrangian(name):
+    def lagrangian(name, make):
         def build():
             b = ProgramBuilder({s.name for s in q + qd})
-            out = derive_program(tree, q, qd, model.gravity, {name}, b)[name]
+            out = make(b)
             return Program(tuple(b.assignments), ((name, out),)).pruned([name]), q + qd
         return build
 
@@ -139,10 +143,12 @@ def programs(model, with_C: bool) -> dict:
         q_sym, program = crba_program(model)
         return program, q_sym
 
-    builders = {"tau": tau, "crba": crba, "M": lagrangian("M"), "aba": forward(aba_program),
-                "chol": forward(cholesky_program)}
+    builders = {"tau": tau, "crba": crba,
+                "M": lagrangian("M", lambda b: composite_mass_matrix_program(tree, q, b)),
+                "aba": forward(aba_program), "chol": forward(cholesky_program)}
     if with_C:
-        builders["C"] = lagrangian("C")
+        builders["C"] = lagrangian("C", lambda b: christoffel_coriolis_program(tree, q, qd, b))
+        builders["Crec"] = lagrangian("C", lambda b: coriolis_program(tree, q, qd, b))
     return {name: _program(build) for name, build in builders.items()}
 
 
@@ -207,10 +213,10 @@ def print_table(rows) -> None:
     print("cells: operations (µs per evaluation over Python floats; µs per state in a NumPy "
           f"batch of {BATCH})")
     head = ("| n | τ RNEA | M CRBA | M composite | q̈ ABA "
-            "| q̈ CRBA + Cholesky | C Christoffel | derive M,C,g s (assignments) "
+            "| q̈ CRBA + Cholesky | C Christoffel | C recursion | derive M,C,g s (assignments) "
             "| Featherstone RNEA / CRBA / ABA |")
     print(head)
-    print("|" + "---|" * 9)
+    print("|" + "---|" * 10)
     for r in rows:
         cells = [str(r["n"])]
         for q in QUANTITIES:
@@ -259,7 +265,7 @@ def plot(rows, path: Path) -> None:
     import matplotlib.pyplot as plt
 
     labels = {"tau": "τ (RNEA)", "crba": "M (CRBA, body frames)", "M": "M (composite, root frame)", "aba": "q̈ (ABA)", "chol": "q̈ (CRBA + Cholesky)",
-              "C": "C (Christoffel)"}
+              "C": "C (Christoffel symbols)", "Crec": "C (Echeandia–Wensing recursion)"}
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     for q in QUANTITIES:
         have = [r for r in rows if f"{q}_ops" in r]
@@ -304,9 +310,15 @@ def robots() -> None:
     for name, model in cases:
         dyn = derive(model, outputs=("M", "C", "g", "tau"), simplify=False)
         counts = {o: program_operation_count(dyn.program, [o]) for o in ("tau", "M", "C", "g")}
+        separate = {o: program_operation_count(derive(model, outputs=(o,), simplify=False).program,
+                                               [o]) for o in ("M", "C", "g")}
+        counts["M+C+g separately"] = sum(separate.values())
         counts["crba"] = program_operation_count(crba_program(model)[1])
         counts["aba"] = program_operation_count(aba_program(model).program)
         counts["chol"] = program_operation_count(cholesky_program(model).program)
+        built = programs(model, True)
+        for label, quantity in (("M composite", "M"), ("C Christoffel", "C"), ("C recursion", "Crec")):
+            counts[label] = program_operation_count(built[quantity][0])
         print(f"{name}: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
 
 

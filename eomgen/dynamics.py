@@ -180,6 +180,16 @@ class Dynamics:
 
         return textbook_derivation(self.model, max_dof=MAX_SIMPLIFY_JOINTS)
 
+    @cached_property
+    def regressor_form(self):
+        """The regressor written out for teaching (:func:`eomgen.regressor.regressor_form`):
+        the named columns of Y(q, q̇, q̈) in compact trigonometric notation and the base
+        parameters as formulas of the standard ones, on first use. Meant for teaching-sized
+        models (the LaTeX document and the notebook use it below the textbook bound)."""
+        from .regressor import regressor_form
+
+        return regressor_form(self.model)
+
     def named(self, name: str):
         """Output ``name`` (``"M"``, ``"C"``, ``"g"``, ``"P"``, ``"tau"``) in terms of the
         program's named intermediates, with their definitions: a

@@ -87,8 +87,10 @@ def _exact(dynamics: Dynamics, name: str) -> sp.Matrix:
 def _identically_zero(matrix: sp.Matrix, q) -> bool:
     """True when every entry is zero as a function of q (and everything else).
 
-    Entries are polynomials in sin q_i, cos q_i and the other symbols; they are reduced modulo
-    sin² + cos² − 1 per joint, which decides zero exactly (no heuristic simplification).
+    Entries are polynomials in sin q_i, cos q_i and the other symbols (prismatic q_i, and q_i
+    itself, which is algebraically independent of sin q_i and cos q_i, among them); they are
+    reduced modulo sin² + cos² − 1 per joint, which decides zero exactly (no heuristic
+    simplification). An entry that is not such a polynomial is reported as not zero.
     """
     sines = [sp.Symbol(f"_s{k}") for k in range(len(q))]
     cosines = [sp.Symbol(f"_c{k}") for k in range(len(q))]
@@ -98,8 +100,8 @@ def _identically_zero(matrix: sp.Matrix, q) -> bool:
         trig[sp.cos(qk)] = cosines[k]
     for entry in matrix:
         e = sp.expand(sp.expand_trig(entry)).xreplace(trig)
-        if e.free_symbols & set(q):
-            return False  # q outside sin/cos: not a trig polynomial, cannot vanish identically here
+        if not e.is_polynomial(*e.free_symbols):
+            return False  # not a polynomial in sin q_i, cos q_i, q_i and the rest: undecided
         for s_k, c_k in zip(sines, cosines):
             e = sp.rem(e, s_k**2 + c_k**2 - 1, s_k) if e.has(s_k) else e
         if sp.expand(e) != 0:

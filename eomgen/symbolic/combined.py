@@ -6,7 +6,7 @@ the gravity part of the accelerations): M by the body-frame CRBA
 Newton–Euler program (:mod:`eomgen.symbolic.newton_euler`), so ``C q̇ = τ(q, q̇, 0) − g``.
 The Coriolis *matrix* C (Christoffel symbols, Ṁ − 2C skew-symmetric) is not produced here: its
 product with q̇ is what forward dynamics and computed-torque control need, and it costs O(n)
-instead of O(n³).
+instead of the O(n²) of the matrix (:func:`eomgen.symbolic.composite.coriolis_program`).
 
 Outputs: ``"M"`` (n×n), ``"Cqd"`` (n×1, C(q, q̇) q̇), ``"g"`` (n×1), in ``JOINT_NAMES`` order,
 SI units (N m or N for the vectors).

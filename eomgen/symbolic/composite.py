@@ -1,6 +1,14 @@
-"""Lagrangian dynamics through composite bodies, as a straight-line program.
+"""M, C and g as straight-line programs: composite bodies, the CRBA, Newton–Euler at rest and
+Echeandia and Wensing's Coriolis recursion, whichever is cheaper for the robot.
 
-This is the Lagrangian method, M = Σ_l J_lᵀ I_l J_l and c_ijk = ½(∂M_ij/∂q_k + ∂M_ik/∂q_j −
+:func:`derive_program` (what :func:`eomgen.derive` calls) builds each asked output by the
+cheaper of two exact programs (:func:`cheapest_routes`): M by the body-frame CRBA
+(:mod:`eomgen.symbolic.crba`) or by the world-frame composite bodies below; C by the O(n²)
+recursion of :func:`coriolis_program` or by the Christoffel symbols below; g by the
+Newton–Euler program at rest (:mod:`eomgen.symbolic.newton_euler`) or from the composite
+bodies below. Every route gives the same matrices; C is always the Christoffel C.
+
+The world-frame routes are the Lagrangian method, M = Σ_l J_lᵀ I_l J_l and c_ijk = ½(∂M_ij/∂q_k + ∂M_ik/∂q_j −
 ∂M_jk/∂q_i), with the sums over links regrouped by subtree so that no expression grows with the
 number of links:
 
@@ -34,12 +42,13 @@ Units: SI (rad, m, kg, s). Sign convention: M q̈ + C q̇ + g = τ.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Iterable
 
 import sympy as sp
 
 from ..bodies import BodyTree
 from ..model import Mat3, Vec3
-from .program import ProgramBuilder
+from .program import Program, ProgramBuilder, rough_operation_count
 
 
 def _cross(a: Vec3, b: Vec3) -> tuple:
@@ -216,48 +225,239 @@ def is_ancestor_or_self(tree: BodyTree, a: int, j: int) -> bool:
     return False
 
 
+def _routes() -> dict:
+    """The programs of each output: ``{output: ((name, build), …)}`` with
+    ``build(tree, q, qd, gravity, b)`` returning the output's matrix."""
+    from .crba import mass_matrix_program
+    from .newton_euler import inverse_dynamics_program
+
+    def rnea_gravity(tree, q, qd, gravity, b):
+        zero = (sp.Integer(0),) * len(tree.bodies)
+        return inverse_dynamics_program(tree, q, zero, zero, gravity, b, hint="g")
+
+    return {
+        "M": (("CRBA", lambda tree, q, qd, gravity, b: mass_matrix_program(tree, q, b)),
+              ("composite", lambda tree, q, qd, gravity, b: composite_mass_matrix_program(tree, q, b))),
+        "C": (("recursion", lambda tree, q, qd, gravity, b: coriolis_program(tree, q, qd, b)),
+              ("Christoffel", _christoffel_route)),
+        "g": (("Newton-Euler", rnea_gravity),
+              ("composite", lambda tree, q, qd, gravity, b:
+               composite_gravity_program(tree, q, gravity, b))),
+    }
+
+
+#: Above this many joints the Christoffel-symbol C is not tried: its O(n³) program was larger
+#: than the recursion's O(n²) one on every robot measured with 6 joints (random arms with
+#: general axes: 4,222–5,007 against 3,701–4,140 operations; the 6-link spatial chain of
+#: benchmarks/complexity.py 4,059 against 3,354; 5 joints: 3,163–3,512 against 3,120–3,351),
+#: and building it dominates ``derive``'s time for long chains.
+CHRISTOFFEL_MAX_JOINTS = 5
+
+
+def _christoffel_route(tree, q, qd, gravity, b):
+    if len(tree.bodies) > CHRISTOFFEL_MAX_JOINTS:
+        return None
+    return christoffel_coriolis_program(tree, q, qd, b)
+
+
+def cheapest_routes(tree: BodyTree, q, qd, gravity: Vec3, outputs: Iterable[str],
+                    reserved=()) -> tuple[dict[str, str], Program]:
+    """Build every route (see :func:`derive_program`) of each of ``outputs`` into one scratch
+    builder, where they share their common work (the world-frame composites, sines and
+    cosines), and keep for each output the route whose own program has the fewest operations
+    (:func:`~eomgen.symbolic.program.rough_operation_count`; the first route on a tie).
+
+    Returns ``({output: route name}, the program of the chosen outputs, pruned)``.
+    """
+    scratch = ProgramBuilder(reserved)
+    routes = _routes()
+    chosen, best_matrices = {}, []
+    for output in outputs:
+        best = None
+        for name, build in routes[output]:
+            matrix = build(tree, q, qd, gravity, scratch)
+            if matrix is None:  # route not tried for this robot
+                continue
+            used = Program(tuple(scratch.assignments), ((output, matrix),)).pruned([output])
+            count = rough_operation_count([e for _, e in used.assignments] + list(matrix))
+            if best is None or count < best[0]:
+                best = (count, name, matrix)
+        chosen[output] = best[1]
+        best_matrices.append((output, best[2]))
+    program = Program(tuple(scratch.assignments), tuple(best_matrices))
+    return chosen, program.pruned([o for o, _ in best_matrices])
+
+
 def derive_program(tree: BodyTree, q, qd, gravity: Vec3, outputs: set[str], b: ProgramBuilder) -> dict:
     """Build M, C and/or g (as asked in ``outputs``) into the program builder ``b``.
 
-    Returns a dict with SymPy matrices in terms of intermediates: ``"M"`` (n×n), ``"C"`` (n×n),
-    ``"g"`` (n×1), plus ``"P"`` (1×1 potential energy, when g is asked) and the kinematics.
-    """
-    n = len(tree.bodies)
-    kin = forward_kinematics(tree, q, b)
-    world = body_inertia_in_world(tree, kin, b)
-    comp = composite_inertias(tree, world, b)
-    S = kin.S
-    F = [b.define_all(comp[j].apply(S[j]), f"F{tree.bodies[j].q_index + 1}_",
-                      ("F", tree.bodies[j].q_index + 1)) for j in range(n)]
-    idx = [body.q_index for body in tree.bodies]
-    result: dict = {"kinematics": kin, "composite": comp}
+    Each output has two exact programs, and the one with fewer operations for this robot is
+    built (:func:`cheapest_routes`):
 
-    if "M" in outputs:
-        M = sp.zeros(n, n)
-        for j in range(n):
-            for i in [j] + tree.ancestors(j):
-                value = b.define(_dot(S[i], F[j]), f"M{idx[i] + 1}_{idx[j] + 1}",
-                                 ("M", idx[i] + 1, idx[j] + 1))
-                M[idx[i], idx[j]] = M[idx[j], idx[i]] = value
-        result["M"] = M
+    * ``M``: the body-frame CRBA (:func:`eomgen.symbolic.crba.mass_matrix_program`), cheapest
+      for joint axes along the link frames' axes (the Panda: 641 operations against 1,784), or
+      ``M_ij = S_iᵀ I^c_j S_j`` in world axes (:func:`composite_mass_matrix_program`), cheaper
+      for general axes, whose body-frame rotations cost more than one world rotation per body;
+    * ``C``: Echeandia and Wensing's recursion (:func:`coriolis_program`, O(n²)) or the
+      Christoffel symbols of ∂M/∂q (:func:`christoffel_coriolis_program`, O(n³) but fewer
+      intermediates for two to four joints; tried up to :data:`CHRISTOFFEL_MAX_JOINTS`
+      joints): the same matrix;
+    * ``g``: the Newton–Euler program at rest, ``g = τ(q, 0, 0)``
+      (:func:`eomgen.symbolic.newton_euler.inverse_dynamics_program`), or ``g_i = −g_vecᵀ f_i``
+      from the composite bodies (:func:`composite_gravity_program`);
+
+    and ``P`` (with g) from the world-frame kinematics (:func:`potential_energy`).
+
+    Returns a dict with SymPy matrices in terms of intermediates: ``"M"`` (n×n), ``"C"`` (n×n),
+    ``"g"`` (n×1), plus ``"P"`` (1×1 potential energy, when g is asked).
+    """
+    _, program = cheapest_routes(tree, q, qd, gravity,
+                                 [o for o in ("M", "g", "C") if o in outputs], b.reserved)
+    result = b.absorb(program)
     if "g" in outputs:
-        gvec = gravity
-        result["g"] = sp.Matrix([[0]] * n)
-        for i in range(n):
-            result["g"][idx[i], 0] = b.define(-_dot(gvec, F[i][3:]), f"g{idx[i] + 1}",
-                                              ("g", idx[i] + 1))
-        h_total = comp_total_first_moment(tree, comp)  # about o
-        mass = sp.Add(*[comp[i].mass for i, body in enumerate(tree.bodies) if body.parent < 0])
-        P_total = -_dot(gvec, tuple(h + mass * o for h, o in zip(h_total, kin.origin)))
-        result["P"] = sp.Matrix([[b.define(P_total, "P", ("P",))]])
-    if "C" in outputs:
-        result["C"] = _coriolis(tree, S, F, comp, qd, idx, b)
+        kin = forward_kinematics(tree, q, b)
+        result["P"] = sp.Matrix([[b.define(potential_energy(tree, kin, gravity), "P", ("P",))]])
     return result
 
 
-def comp_total_first_moment(tree: BodyTree, comp: list[SpatialInertia]) -> tuple:
-    roots = [i for i, body in enumerate(tree.bodies) if body.parent < 0]
-    return tuple(sp.Add(*[comp[i].h[r] for i in roots]) for r in range(3))
+def _world_composites(tree: BodyTree, q, b: ProgramBuilder) -> tuple:
+    """World-frame kinematics, body and composite inertias and ``F_j = I^c_j S_j`` of every
+    body (built once per builder, tree and q)."""
+    key = ("world composites", id(tree), tuple(q))
+    if key in b.memo:
+        return b.memo[key][1]
+    kin = forward_kinematics(tree, q, b)
+    world = body_inertia_in_world(tree, kin, b)
+    comp = composite_inertias(tree, world, b)
+    F = [b.define_all(comp[j].apply(kin.S[j]), f"F{tree.bodies[j].q_index + 1}_")
+         for j in range(len(tree.bodies))]
+    b.memo[key] = (tree, (kin, world, comp, F))  # the tree kept alive: its id stays its own
+    return b.memo[key][1]
+
+
+def composite_mass_matrix_program(tree: BodyTree, q, b: ProgramBuilder) -> sp.Matrix:
+    """M(q) as ``M_ij = S_iᵀ F_j`` in world axes (module docstring), n×n, ``JOINT_NAMES``
+    order [kg m², kg m, kg]."""
+    n = len(tree.bodies)
+    kin, _, _, F = _world_composites(tree, q, b)
+    idx = [body.q_index for body in tree.bodies]
+    M = sp.zeros(n, n)
+    for j in range(n):
+        for i in [j] + tree.ancestors(j):
+            value = b.define(_dot(kin.S[i], F[j]), f"M{idx[i] + 1}_{idx[j] + 1}")
+            M[idx[i], idx[j]] = M[idx[j], idx[i]] = value
+    return M
+
+
+def composite_gravity_program(tree: BodyTree, q, gravity: Vec3, b: ProgramBuilder) -> sp.Matrix:
+    """g(q) as ``g_i = −g_vecᵀ f_i``, ``f_i`` the linear part of ``F_i`` (module docstring),
+    n×1 [N m or N]."""
+    _, _, _, F = _world_composites(tree, q, b)
+    g = sp.zeros(len(tree.bodies), 1)
+    for i, body in enumerate(tree.bodies):
+        g[body.q_index, 0] = b.define(-_dot(gravity, F[i][3:]), f"g{body.q_index + 1}")
+    return g
+
+
+def christoffel_coriolis_program(tree: BodyTree, q, qd, b: ProgramBuilder) -> sp.Matrix:
+    """C(q, q̇) from the Christoffel symbols of the first kind and the closed-form ∂M/∂q of the
+    module docstring, n×n, ``JOINT_NAMES`` order."""
+    kin, _, comp, F = _world_composites(tree, q, b)
+    return _coriolis(tree, kin.S, F, comp, qd, [body.q_index for body in tree.bodies], b)
+
+
+def potential_energy(tree: BodyTree, kin: Kinematics, gravity: Vec3) -> sp.Expr:
+    """``P = −g_vecᵀ Σ_l m_l c_l`` [J], ``c_l`` the centre of mass of body l from the root
+    origin: ``m_l c_l = m_l (o + p_l) + R_l h_l`` with the body's own first moment ``h_l``."""
+    moment = [sp.Integer(0)] * 3
+    for i, body in enumerate(tree.bodies):
+        par = body.inertial
+        Rh = _matvec(kin.R[i], par.first_moment)
+        for r in range(3):
+            moment[r] += par.mass * (kin.origin[r] + kin.p[i][r]) + Rh[r]
+    return -_dot(gravity, moment)
+
+
+def coriolis_program(tree: BodyTree, q, qd, b: ProgramBuilder) -> sp.Matrix:
+    """The Christoffel-consistent Coriolis matrix C(q, q̇) (n×n, ``JOINT_NAMES`` order).
+
+    Echeandia and Wensing's recursion ("Numerical methods to compute the Coriolis matrix and
+    Christoffel symbols for rigid-body systems", J. Comput. Nonlinear Dyn. 16(9), 2021), here
+    with every quantity in world axes about the reference point ``o``. With ``V_k`` the spatial
+    velocity of body k, ``Ṡ_k = V_k × S_k`` and, per body,
+    ``B_k = ½ (V_k ×* I_k − I_k V_k × + (I_k V_k) ×̄*)`` (``f ×̄* u = u ×* f``), the matrix
+
+        C = Σ_k J_kᵀ (I_k J̇_k + B_k J_k)
+
+    has ``C q̇`` the Coriolis and centrifugal efforts and ``C + Cᵀ = Ṁ`` (``B_k + B_kᵀ = İ_k``),
+    and it is exactly the matrix of the Christoffel symbols of the first kind,
+    ``C_ij = Σ_k c_ijk q̇_k`` (their Theorem). Summed over subtrees, ``B^c_j = ½ (İ^c_j +
+    (h^c_j) ×̄*)`` needs only the composite inertia's rate ``İ^c_j`` (a first-moment rate and a
+    symmetric 3×3, the mass being constant) and the subtree's momentum ``h^c_j = Σ I_k V_k``.
+    For i an ancestor of (or equal to) j:
+
+        C_ij = S_iᵀ (I^c_j Ṡ_j + B^c_j S_j),    C_ji = Ṡ_iᵀ I^c_j S_j + S_iᵀ B^c_jᵀ S_j,
+
+    and 0 for joints on different branches. O(n²) operations for a chain, against O(n³) for
+    the Christoffel symbols themselves. Inertial parameters are the grouped ones of
+    :func:`~eomgen.symbolic.newton_euler.grouped_inertials`, which give the same M and so the
+    same C.
+    """
+    n = len(tree.bodies)
+    idx = [body.q_index + 1 for body in tree.bodies]
+    kin, world, comp, F_all = _world_composites(tree, q, b)
+    S = kin.S
+    zero6 = (sp.Integer(0),) * 6
+    V, Sd = [], []
+    for i, body in enumerate(tree.bodies):
+        V_p = V[body.parent] if body.parent >= 0 else zero6
+        Sd.append(b.define_all(motion_cross(V_p, S[i]), f"Sd{idx[i]}_"))
+        V.append(b.define_all(tuple(V_p[r] + S[i][r] * qd[body.q_index] for r in range(6)),
+                              f"V{idx[i]}_"))
+    # per body: momentum I_k V_k, rates of the first moment and of the rotational inertia
+    momentum, h_rate, I_rate = [], [], []
+    for i, par in enumerate(world):
+        w, v = V[i][:3], V[i][3:]
+        momentum.append(list(par.apply(V[i])))
+        wh = _cross(w, par.h)
+        h_rate.append([par.mass * v[r] + wh[r] for r in range(3)])
+        A = [_cross(w, tuple(par.I[r][c] for r in range(3))) for c in range(3)]  # columns of [ω]× Ī
+        hv = 2 * _dot(par.h, v)
+        I_rate.append([[A[c][r] + A[r][c] - v[r] * par.h[c] - par.h[r] * v[c]
+                        + (hv if r == c else 0) for c in range(3)] for r in range(3)])
+    for i in reversed(range(n)):
+        tag = idx[i]
+        momentum[i] = b.define_all(momentum[i], f"hV{tag}_")
+        h_rate[i] = b.define_all(h_rate[i], f"hd{tag}_")
+        for r in range(3):
+            for c in range(r, 3):
+                I_rate[i][r][c] = I_rate[i][c][r] = b.define(I_rate[i][r][c], f"Id{tag}_{r}{c}")
+        parent = tree.bodies[i].parent
+        if parent >= 0:
+            momentum[parent] = [x + y for x, y in zip(momentum[parent], momentum[i])]
+            h_rate[parent] = [x + y for x, y in zip(h_rate[parent], h_rate[i])]
+            I_rate[parent] = [[x + y for x, y in zip(r1, r2)]
+                              for r1, r2 in zip(I_rate[parent], I_rate[i])]
+    half = sp.Rational(1, 2)
+    C = sp.zeros(n, n)
+    for j in range(n):
+        tag = idx[j]
+        F = F_all[j]  # I^c_j S_j
+        rate = SpatialInertia(sp.Integer(0), tuple(h_rate[j]), tuple(tuple(r) for r in I_rate[j]))
+        IdS = rate.apply(S[j])                                # İ^c_j S_j
+        X = force_cross(S[j], momentum[j])                    # S_j ×* h^c_j
+        ISd = comp[j].apply(Sd[j])
+        F1 = b.define_all(tuple(ISd[r] + half * (IdS[r] + X[r]) for r in range(6)), f"Fa{tag}_")
+        C[tag - 1, tag - 1] = b.define(_dot(S[j], F1), f"C{tag}_{tag}")
+        ancestors = tree.ancestors(j)
+        if not ancestors:
+            continue
+        F3 = b.define_all(tuple(half * (IdS[r] - X[r]) for r in range(6)), f"Fb{tag}_")
+        for i in ancestors:
+            a, c = tree.bodies[i].q_index, tree.bodies[j].q_index
+            C[a, c] = b.define(_dot(S[i], F1), f"C{idx[i]}_{tag}")
+            C[c, a] = b.define(_dot(Sd[i], F) + _dot(S[i], F3), f"C{tag}_{idx[i]}")
+    return C
 
 
 def _coriolis(tree, S, F, comp, qd, idx, b: ProgramBuilder) -> sp.Matrix:

@@ -228,8 +228,12 @@ class _Frames:
         return tuple(r[j] + k[j] * self.q[body.q_index] for j in range(3))
 
 
-def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: ProgramBuilder) -> sp.Matrix:
-    """Build τ(q, q̇, q̈) into ``b``; returns the n×1 matrix of joint efforts [N m or N]."""
+def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: ProgramBuilder,
+                             hint: str = "tau") -> sp.Matrix:
+    """Build τ(q, q̇, q̈) into ``b``; returns the n×1 matrix of joint efforts [N m or N].
+
+    ``qd`` and ``qdd`` may hold zeros: at ``q̇ = q̈ = 0`` the program is the gravity vector
+    ``g(q) = τ(q, 0, 0)``. ``hint`` names the efforts (``tau1`` …, or ``g1`` … for g)."""
     n = len(tree.bodies)
     omega, domega, acc, sincos, khalil = [], [], [], [], []
     zero = (sp.Integer(0),) * 3
@@ -296,7 +300,7 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
         nn = _name_all(b, moment[i], f"n{tag}_")
         axis = body.joint.axis
         tau[body.q_index, 0] = _name(b, _dot(axis, nn if body.joint.type.is_revolute else f),
-                                        f"tau{tag}")
+                                        f"{hint}{tag}")
         p = body.parent
         if p >= 0:
             f_p = _name_all(b, to_parent(i, f), f"fp{tag}_")

@@ -85,6 +85,14 @@ class ProgramBuilder:
         self._names: set[str] = set()
         self._by_value: dict[sp.Expr, sp.Symbol] = {}
         self.assignments: list[tuple[sp.Symbol, sp.Expr]] = []
+        #: Work shared between programs built into this builder (e.g. the world-frame
+        #: composites of :mod:`eomgen.symbolic.composite`), by a key of the caller's choice.
+        self.memo: dict = {}
+
+    @property
+    def reserved(self) -> frozenset[str]:
+        """The names intermediates never take."""
+        return frozenset(self._reserved)
 
     def _fresh(self, hint: str) -> sp.Symbol:
         name = hint
@@ -115,6 +123,31 @@ class ProgramBuilder:
         self.assignments.append(Assignment(symbol, expr, _tag(tag)))
         return symbol
 
+    def absorb(self, program: "Program") -> dict[str, sp.Matrix]:
+        """Define ``program``'s assignments here and return its outputs in terms of this
+        builder's names. Each keeps its name where free (a name another builder had to suffix
+        with ``_`` loses the suffix first); a definition already made here is shared. The
+        expressions are taken as they are (``program`` was built by a builder too), with their
+        tags."""
+        changed: dict = {}
+
+        def moved(expr):
+            return expr.xreplace(changed) if changed and expr.free_symbols & changed.keys() else expr
+
+        for assignment in program.assignments:
+            symbol, expr = assignment
+            expr = moved(expr)
+            known = self._by_value.get(expr)
+            if known is not None:
+                changed[symbol] = known
+                continue
+            new = self._fresh(symbol.name.rstrip("_"))
+            if new != symbol:
+                changed[symbol] = new
+            self._by_value[expr] = new
+            self.assignments.append(Assignment(new, expr, getattr(assignment, "tag", None)))
+        return {name: matrix.applyfunc(moved) for name, matrix in program.outputs}
+
     def define_all(self, exprs: Sequence, hint: str, tag=None) -> tuple:
         """Define each entry of a vector, hinting names ``hint0, hint1, …``; entry ``k`` is
         tagged with ``tag``'s index followed by ``k``."""
@@ -122,6 +155,25 @@ class ProgramBuilder:
         return tuple(self.define(e, f"{hint}{k}",
                                  None if tag is None else Tag(tag.family, tag.index + (k,)))
                      for k, e in enumerate(exprs))
+
+
+def rough_operation_count(exprs: Iterable[sp.Expr]) -> int:
+    """A fast estimate of the arithmetic operations of ``exprs``: one per argument of a sum or
+    product beyond the first, per power and per function call (what :meth:`Program.operation_count`
+    counts exactly with SymPy's slower ``count_ops``)."""
+    total = 0
+    stack = list(exprs)
+    while stack:
+        e = stack.pop()
+        if e.is_Atom:
+            continue
+        args = e.args
+        if e.is_Add or e.is_Mul:
+            total += len(args) - 1 - (1 if e.is_Mul and args[0] in (-1, 1) else 0)
+        else:
+            total += 1
+        stack.extend(args)
+    return total
 
 
 @dataclass(frozen=True)

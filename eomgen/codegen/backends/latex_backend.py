@@ -8,7 +8,7 @@ Two kinds of document, chosen by :func:`textbook_for`:
   body by body: centre-of-mass positions, Jacobians, K_i and P_i, then M, the Christoffel
   symbols, C, g and the equations of motion written out, in compact trigonometric notation
   (s_1, c_12); then the linear parameterization τ = Y π with its columns named and the base
-  parameters β as expressions of π (:func:`eomgen.regressor.regressor_form`);
+  parameters β as expressions of π (:attr:`eomgen.dynamics.Dynamics.regressor_form`);
 * **large** models: the description, then the straight-line program of named subexpressions
   that computes M, g and C (grouped by the output that first needs them), the entries of M, C,
   g in terms of those names and the equations of motion per joint. At most
@@ -499,9 +499,7 @@ def render_document(job: Job, config: LatexConfig = LatexConfig()) -> str:
     form = None
     extra_names = {}
     if book is not None:  # same bound: the expanded Y of a model that small stays small
-        from ...regressor import regressor_form
-
-        form = regressor_form(model)
+        form = job.dynamics.regressor_form
         extra_names = form.latex_names
     p = printing(job.dynamics, config, compact_trig=book is not None, extra_names=extra_names)
     context = {
