@@ -16,7 +16,6 @@ import importlib.util
 from pathlib import Path
 
 import click
-import numpy as np
 
 from ..errors import EomgenError
 from ..output import check_output_folder
@@ -207,6 +206,8 @@ def add_commands(main: click.Group, handle_errors, description_argument, strict_
 
         header = []
         if flexible:
+            import numpy as np
+
             from .simulate_flexible import (FlexibleSystem, describe_stiffness, flexible_start,
                                             plot_step, step_response)
 
