@@ -486,6 +486,11 @@ class RobotModel:
     source: str = "<memory>"
     info: tuple[tuple[str, object], ...] = ()
     notices: tuple[Notice, ...] = field(default=(), compare=False, repr=False)
+    #: The scene's contacts (:class:`eomgen.contacts.Contact`, rows of ``J_c`` in this order)
+    #: and the frames it names (``frames:``), carried so that the output builders see them
+    #: (:mod:`eomgen.symbolic.frames`); empty for a model without a scene.
+    contacts: tuple = ()
+    frames: tuple[str, ...] = ()
 
     @cached_property
     def link_by_name(self) -> dict[str, Link]:

@@ -46,5 +46,5 @@ class JaxConfig:
           config=JaxConfig, order=60, reserved=("jnp", "jax"))
 def generate_jax(job: Job, config: JaxConfig = JaxConfig()) -> list[GeneratedFile]:
     printer = JaxModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
-    text = render(config.template, **python_module_context(job, printer, config.template))
+    text = render(config.template, **python_module_context(job, printer, config.template, backend="jax"))
     return [GeneratedFile(job.stem + config.suffix, text)]
