@@ -305,3 +305,22 @@ def test_cli_generates_contact_outputs_and_refuses_them_without_contacts(tmp_pat
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and "planar_2link.yaml" in lines[0] and "has none" in lines[0]
     assert not bare.exists()
+
+
+def test_documented_frame_errors_are_what_eomgen_prints():
+    if erd_robots_dir() is None:
+        pytest.skip("example-robot-data is not installed")
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robot = eomgen.load(erd_robots_dir() / "solo_description/robots/solo12.urdf")
+    text = (ROOT / "docs/scenes.md").read_text(encoding="utf-8")
+    documented = [line[len("eomgen: error: "):] for line in text.splitlines()
+                  if line.startswith("eomgen: error: solo_frames.yaml")]
+    printed = []
+    for body in ("frames: [FL_FOOT, FL_FOT]", "frames: [FL_FOOT, FL_FOOT]"):
+        with pytest.raises(SceneError) as caught:
+            apply_scene(robot, load_scene("solo_frames.yaml", text="version: 1\n" + body))
+        printed.append(str(caught.value))
+    assert printed == documented and len(printed) == 2
