@@ -136,6 +136,9 @@ class Scene:
         for all.
     contacts:
         Frames held still (:class:`eomgen.contacts.Contact`), in file order.
+    frames:
+        Links whose kinematics the ``frame_*`` outputs give (``FRAME_NAMES``), in file order;
+        empty for the default (the contact frames, else the leaf links).
     """
 
     source: str = "<scene>"
