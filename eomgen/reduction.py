@@ -914,7 +914,9 @@ def _reroot(model: RobotModel) -> tuple[RobotModel, str]:
     links = (Link(root, None),) + tuple(l for l in model.links if l.name != model.root)
     joints = tuple(replace(j, parent=root, origin=Transform()) if j is joint else j
                    for j in model.joints)
-    return (replace(model, links=links, joints=joints, root=root, gravity=gravity),
+    pose = joint.origin if model.root_pose is None else model.root_pose @ joint.origin
+    return (replace(model, links=links, joints=joints, root=root, gravity=gravity,
+                    root_pose=pose),
             f"the frame of joint '{joint.name}' at q = 0 (link '{root}'), where gravity is "
             "(" + ", ".join(f"{float(x):.6g}" if x.is_number else str(x) for x in gravity)
             + ") m/s²; joint-space M, C, g and τ do not depend on the fixed frame")

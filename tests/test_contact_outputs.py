@@ -324,3 +324,45 @@ def test_documented_frame_errors_are_what_eomgen_prints():
             apply_scene(robot, load_scene("solo_frames.yaml", text="version: 1\n" + body))
         printed.append(str(caught.value))
     assert printed == documented and len(printed) == 2
+
+
+def test_fixed_base_frames_are_pinocchios_local_world_aligned_jacobians(tmp_path):
+    """On a fixed-base arm (UR5) block k of frame_jacobians is Pinocchio's
+    getFrameJacobian(LOCAL_WORLD_ALIGNED) as it stands ([v; ω], linear rows first). The
+    tolerance is that of the two readers' rotations of the URDF's rounded rpy values
+    (differences of 5e-12 observed)."""
+    pin = pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
+    if erd_robots_dir() is None:
+        pytest.skip("example-robot-data is not installed")
+    import warnings
+
+    path = erd_robots_dir() / "ur_description/urdf/ur5_robot.urdf"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        arm = apply_scene(eomgen.load(path), load_scene(
+            "f.yaml", text="version: 1\nframes: [tool0, forearm_link]\n")).model
+    files = render_files(arm, ["numpy"], functions=select_functions(FRAME_FUNCTIONS))
+    _write(files, tmp_path)
+    module = _load(files, tmp_path, "numpy", arm.name)
+    assert tuple(module["FRAME_NAMES"]) == ("tool0", "forearm_link")
+    pm = pin.buildModelFromUrdf(str(path))
+    pd = pm.createData()
+    assert tuple(pm.names)[1:] == arm.joint_names
+    rng = np.random.default_rng(4)
+    q, qd = rng.uniform(-2, 2, 6), rng.uniform(-1, 1, 6)
+    pin.forwardKinematics(pm, pd, q, qd, np.zeros(6))
+    pin.updateFramePlacements(pm, pd)
+    pin.computeJointJacobians(pm, pd, q)
+    J, Jb, dJqd = (module["frame_jacobians"](q), module["frame_body_jacobians"](q),
+                   module["frame_jacobians_dot_qd"](q, qd))
+    for k, name in enumerate(module["FRAME_NAMES"]):
+        fid = pm.getFrameId(name)
+        rows = slice(6 * k, 6 * k + 6)
+        np.testing.assert_allclose(
+            J[rows], pin.getFrameJacobian(pm, pd, fid, pin.LOCAL_WORLD_ALIGNED), atol=1e-10)
+        np.testing.assert_allclose(Jb[rows], pin.getFrameJacobian(pm, pd, fid, pin.LOCAL),
+                                   atol=1e-10)
+        acc = pin.getFrameClassicalAcceleration(pm, pd, fid, pin.LOCAL_WORLD_ALIGNED)
+        np.testing.assert_allclose(dJqd[rows], np.r_[acc.linear, acc.angular], atol=1e-10)
+        np.testing.assert_allclose(module["frame_positions"](q)[k], pd.oMf[fid].translation,
+                                   atol=1e-12)

@@ -1,7 +1,9 @@
 """Frame kinematics of named links: pose, Jacobians and J̇ q̇, as a straight-line program.
 
 For every frame ``f`` asked for (any link of the model: a body, or a frame fixed to one such as
-a foot or a tool), :func:`derive_frames` builds, in the model's root (world) frame:
+a foot or a tool), :func:`derive_frames` builds, in the world frame: the frame of the model's
+root link, or, when a scene moved the fixed frame (:attr:`RobotModel.root_pose
+<eomgen.model.RobotModel.root_pose>`), the description's root link frame again:
 
 * ``p_f`` (3×1): the frame origin [m] in world coordinates;
 * ``R_f`` (3×3): the frame axes in world coordinates (``x_world = R_f x_f + p_f``);
@@ -221,6 +223,18 @@ def frame_kinematics(model: RobotModel, tree, q, qd, b: ProgramBuilder,
         wxv_b = _cross(w_b, v_b)
         dJbqd = (tuple(b.define(a_b[r] - wxv_b[r], f"ab{k}_{r}") for r in range(3))
                  + b.define_all(_matvec(Rt, dJqd[3:]), f"wdb{k}_"))
+        if model.root_pose is not None:  # to the description's root frame (Jb, dJbqd stay)
+            R0, t0 = model.root_pose.rotation, model.root_pose.translation
+            p = b.define_all(tuple(t0[r] + e for r, e in enumerate(_matvec(R0, p))), f"pw{k}_")
+            R = tuple(b.define_all(row, f"Rw{k}_{r}") for r, row in enumerate(_matmul(R0, R)))
+            Jw = sp.zeros(6, n)
+            for col in range(n):
+                for half in (0, 3):
+                    rotated = _matvec(R0, tuple(J[half + r, col] for r in range(3)))
+                    for r in range(3):
+                        Jw[half + r, col] = b.define(rotated[r], f"Jw{k}_{half + r}_{col + 1}")
+            J = Jw
+            dJqd = b.define_all(_matvec(R0, dJqd[:3]) + _matvec(R0, dJqd[3:]), f"dJw{k}_")
         result.append({
             "p": sp.Matrix(3, 1, list(p)),
             "R": sp.Matrix(3, 3, [x for row in R for x in row]),
