@@ -148,6 +148,15 @@ def test_planar_wall_outputs_in_every_backend(tmp_path):
         q, qd, tau, *casadi_module["PARAMETERS"].values(), 1e-9)  # positional: PARAMETERS order
     assert relative(np.array(out[0]).ravel(), qdd_ref) < 1e-10
     assert relative(np.array(out[1]).ravel(), F_ref) < 1e-10
+    for backend in set(loaded) & {"jax", "torch"}:
+        args = (q, qd, tau)
+        if backend == "torch":
+            import torch
+
+            args = tuple(torch.tensor(x, dtype=torch.float64) for x in args)
+        qdd, F = loaded[backend]["constrained_forward_dynamics"](*args, damping=1e-9)
+        assert relative(np.asarray(qdd, dtype=float), qdd_ref) < 1e-10, backend
+        assert relative(np.asarray(F, dtype=float), F_ref) < 1e-10, backend
 
 
 # --- solo12 with a floating base and four feet held (Pinocchio) -------------------------------
