@@ -2,6 +2,7 @@
 
     python benchmarks/floating_contacts.py            # 10 random states, generation timed
     python benchmarks/floating_contacts.py --quick    # 3 states, no generation
+    python benchmarks/floating_contacts.py --generated  # only the generated contact code
 
 Prints, for the floating-base solo12 and Talos (legs only, everything else locked at 0), the
 largest relative difference over random states between eomgen and Pinocchio's free flyer
@@ -13,8 +14,18 @@ largest relative difference over random states between eomgen and Pinocchio's fr
 
 and the derivation time of the floating solo12 (M, C, g; the frame kinematics of its feet),
 and the wall-clock time of ``eomgen generate`` with examples/contacts/solo12_standing.yaml
-(all backends, no cache; contacts are not generated as code yet). Targets: ≤ 1e-10 (M, C q̇,
-g), ≤ 1e-8 (q̈, F_c), generation ≤ 60 s. Exit status 2 when one is missed.
+(all backends, no cache; the scene's outputs M, C, g).
+
+The generated contact code (:func:`generated_contacts`, also alone with ``--generated``):
+the wall-clock time of ``eomgen generate`` (fresh process, no cache) of solo12 with its 4
+feet held, NumPy + CasADi, outputs M, C, g, frame_jacobians, contact_jacobian, contact_bias and
+constrained_forward_dynamics; the operation counts of each printed function (and the CasADi
+instructions of the composed KKT solve); and the one-state time of the compiled constrained
+forward dynamics (CasADi's C code as a shared library, called through ``Function.buffer()``
+on preallocated arrays) against ``pinocchio.constraintDynamics`` (its plain Python call, on
+Pinocchio's own q, v, τ arrays), interleaved in the same run: medians and quartiles of
+repeated batches, and the ratio of the medians. Targets: ≤ 1e-10 (M, C q̇, g), ≤ 1e-8 (q̈,
+F_c), generation ≤ 60 s. Exit status 2 when one is missed.
 """
 
 from __future__ import annotations
@@ -128,9 +139,109 @@ def contact_agreement(path, model, count):
     return ok
 
 
+def _timed(function, number: int, repeats: int) -> np.ndarray:
+    """Microseconds per call of ``function`` over ``repeats`` batches of ``number`` calls."""
+    import timeit
+
+    timer = timeit.Timer(function)
+    return np.array([timer.timeit(number) / number * 1e6 for _ in range(repeats)])
+
+
+def generated_contacts(solo_path) -> bool:
+    """Generation time, operation counts and compiled speed of the generated contact code."""
+    import casadi as ca
+    import pinocchio as pin
+
+    from eomgen.codegen import make_job
+    from eomgen.codegen.functions import derived_outputs, select_functions
+    from eomgen.codegen.generate import render_files
+
+    scene = ROOT / "examples/contacts/solo12_standing.yaml"
+    outputs = "M,C,g,frame_jacobians,contact_jacobian,contact_bias,constrained_forward_dynamics"
+    env = {**__import__("os").environ, "PYTHONPATH": str(ROOT)}
+    with tempfile.TemporaryDirectory() as out:
+        start = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "eomgen.cli", "generate", str(solo_path),
+                        "--scene", str(scene), "--backend", "numpy,casadi", "--outputs",
+                        outputs, "-o", out, "--no-cache", "--quiet"], check=True, env=env)
+        seconds = time.perf_counter() - start
+    print(f"eomgen generate solo12 floating, 4 point contacts, NumPy + CasADi ({outputs}): "
+          f"{seconds:.1f} s (target ≤ 60 s)")
+    model = apply_scene(load(solo_path), load_scene(scene)).model
+    functions = select_functions(outputs.split(","))
+    dyn = eomgen.derive(model, outputs=derived_outputs(functions), simplify=False)
+    job = make_job(dyn, functions)
+    print("operation counts (SymPy count_ops of the straight-line programs): "
+          + ", ".join(f"{s.name} {s.operation_count}" for s in job.specs))
+    with tempfile.TemporaryDirectory() as out:
+        files = render_files(model, ["casadi", "c"], functions=functions)
+        from eomgen.codegen.backends.casadi_backend import load_module_source
+
+        sx = load_module_source(next(f.content for f in files if f.name.endswith("casadi.py")),
+                                "solo_contacts_casadi")["constrained_forward_dynamics"]
+        for f in files:
+            path = Path(out, f.name)
+            path.write_bytes(f.content) if isinstance(f.content, bytes) else path.write_text(
+                f.content)
+        library = next(Path(out).glob("*.so"))
+        f = ca.external("constrained_forward_dynamics", str(library))
+        print(f"CasADi constrained_forward_dynamics: {sx.n_instructions()} SX instructions "
+              "(M, C q̇ + g, J_c, J̇_c q̇ and the Cholesky-Schur KKT solve)")
+        ref = floating.PinocchioFreeFlyer(solo_path, model.joint_names)
+        pm, pd, idx = ref.model, ref.data, ref.idx
+        models = pin.StdVec_RigidConstraintModel()
+        for c in model.contacts:
+            fr = pm.frames[pm.getFrameId(c.frame)]
+            models.append(pin.RigidConstraintModel(pin.ContactType.CONTACT_3D, pm,
+                                                   fr.parentJoint, fr.placement,
+                                                   pin.LOCAL_WORLD_ALIGNED))
+        datas = pin.StdVec_RigidConstraintData([c.createData() for c in models])
+        pin.initConstraintDynamics(pm, pd, models, datas)
+        settings = pin.ProximalSettings(1e-14, 1e-12, 1)
+        (q, qd), = states(18, 1, 7)
+        tau = np.random.default_rng(8).uniform(-2, 2, 18)
+        q_pin, v = ref.state(q, qd)
+        T = floating.velocity_map(q)
+        tau_pin = np.linalg.solve(T.T, tau)[idx]
+        n_in = f.n_in()
+        args = [np.array(q), np.array(qd), np.array(tau)] + [np.zeros(1)] * (n_in - 3)
+        qdd, F = np.zeros(18), np.zeros(12)
+        buffer, evaluate = f.buffer()
+        for i, x in enumerate(args):
+            buffer.set_arg(i, memoryview(x))
+        buffer.set_res(0, memoryview(qdd))
+        buffer.set_res(1, memoryview(F))
+        evaluate()
+        a = pin.constraintDynamics(pm, pd, q_pin, v, tau_ff := tau_pin, models, datas, settings)
+        a_ours = np.empty(18)
+        a_ours[idx] = a
+        qdd_pin = np.linalg.solve(T, a_ours - floating.velocity_map_dot_qd(q, qd))
+        agree = max(rel(qdd, qdd_pin), rel(F, pd.lambda_c))
+        print(f"compiled constrained_forward_dynamics vs constraintDynamics: {agree:.1e} "
+              "(largest relative difference of q̈, F_c)")
+        ours, theirs = [], []
+        for _ in range(15):  # interleaved batches
+            ours.append(_timed(evaluate, 2000, 1)[0])
+            theirs.append(_timed(lambda: pin.constraintDynamics(pm, pd, q_pin, v, tau_ff, models,
+                                                                datas, settings), 2000, 1)[0])
+        ours, theirs = np.array(ours), np.array(theirs)
+
+        def summary(x):
+            q1, med, q3 = np.percentile(x, [25, 50, 75])
+            return f"median {med:.2f} µs (quartiles {q1:.2f}–{q3:.2f})"
+
+        print(f"one state, solo12 + 4 contacts: eomgen CasADi C (buffer) {summary(ours)}; "
+              f"Pinocchio constraintDynamics {summary(theirs)}; ratio eomgen/Pinocchio "
+              f"{np.median(ours) / np.median(theirs):.2f}")
+        del buffer
+    return seconds <= 60 and agree <= 1e-8
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--generated", action="store_true",
+                        help="only the generated contact code (generation, op counts, speed)")
     args = parser.parse_args()
     count = 3 if args.quick else 10
     robots = erd_robots_dir()
@@ -138,6 +249,8 @@ def main() -> int:
         print("example-robot-data is not installed")
         return 1
     solo_path = robots / "solo_description/robots/solo12.urdf"
+    if args.generated:
+        return 0 if generated_contacts(solo_path) else 2
     solo = floating.add_floating_base(load(solo_path))
     ok = dynamics_agreement("solo12", solo,
                             floating.PinocchioFreeFlyer(solo_path, solo.joint_names), count)
@@ -165,6 +278,7 @@ def main() -> int:
         print(f"eomgen generate solo12 floating, 4 contacts (all backends): {seconds:.1f} s "
               "(target ≤ 60 s)")
         ok &= seconds <= 60
+        ok &= generated_contacts(solo_path)
     return 0 if ok else 2
 
 

@@ -37,7 +37,9 @@ Baumgarte stabilisation (optional gains ``kd`` [1/s], ``kp`` [1/s²]) adds
 * ``friction_cone(F_c)``: whether each contact's force lies in its Coulomb cone
   ``f_n ≥ 0, |f_t| ≤ μ f_n``, and by how much.
 
-Nothing here is generated as code yet (docs/contact.md says what is and is not).
+The generated modules have ``contact_jacobian``, ``contact_bias`` and (NumPy, CasADi, C)
+``constrained_forward_dynamics`` with the same rows and signs, built from the scene contacts the
+model carries (:mod:`eomgen.symbolic.frames`); docs/contact.md says what is and is not generated.
 """
 
 from __future__ import annotations

@@ -487,6 +487,15 @@ class RobotModel:
     source: str = "<memory>"
     info: tuple[tuple[str, object], ...] = ()
     notices: tuple[Notice, ...] = field(default=(), compare=False, repr=False)
+    #: The scene's contacts (:class:`eomgen.contacts.Contact`, rows of ``J_c`` in this order)
+    #: and the frames it names (``frames:``), carried so that the output builders see them
+    #: (:mod:`eomgen.symbolic.frames`); empty for a model without a scene.
+    contacts: tuple = ()
+    frames: tuple[str, ...] = ()
+    #: Pose of the root link's frame in the frame of the description's root link, when a scene
+    #: moved the fixed frame (:func:`eomgen.reduction.apply_scene`); None when they coincide.
+    #: Frame kinematics are given in the description's frame.
+    root_pose: Transform | None = None
 
     @cached_property
     def link_by_name(self) -> dict[str, Link]:

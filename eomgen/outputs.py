@@ -90,6 +90,9 @@ class Output:
         ``"module:function"`` or ``None``: ``function(dynamics) -> {NAME: (str, ...)}``, tuples
         of names a module exporting this output also exports (e.g. ``PARAMETER_NAMES``, the
         columns of the regressor).
+    backends:
+        For a composed output, the backends whose templates compose it (``None``: every one);
+        the others leave it out of their modules.
     """
 
     function: str
@@ -103,6 +106,7 @@ class Output:
     build: str | None = None
     default: bool = True
     constants: str | None = None
+    backends: tuple[str, ...] | None = None
 
     @property
     def composed(self) -> bool:
@@ -287,6 +291,67 @@ FLAT_TORQUE_SMOOTH = register_output(Output(
     ("tau_flat_smooth",), build=_FLAT, default=False))
 
 
+# --- issue 16: frame kinematics and contacts (eomgen.symbolic.frames) -----------------------
+_FRAMES = "eomgen.symbolic.frames:build_frames"
+_FRAME_NAMES = "eomgen.symbolic.frames:frame_constants"
+_CONTACTS = "eomgen.symbolic.frames:build_contacts"
+_CONTACT_NAMES = "eomgen.symbolic.frames:contact_constants"
+FRAME_POSITIONS = register_output(Output(
+    "frame_positions", "p_f", "Frame origins in world coordinates, one row per frame of "
+    "FRAME_NAMES: (nf, 3).", ("q",), False, "m", ("p_f",), build=_FRAMES, default=False,
+    constants=_FRAME_NAMES))
+FRAME_ROTATIONS = register_output(Output(
+    "frame_rotations", "R_f", "Frame rotations R (x_world = R x_frame + p), 3x3 blocks stacked "
+    "in FRAME_NAMES order: (3 nf, 3).", ("q",), False, "1", ("R_f",), build=_FRAMES,
+    default=False, constants=_FRAME_NAMES))
+FRAME_JACOBIANS = register_output(Output(
+    "frame_jacobians", "J_f", "World-aligned frame Jacobians at the frame origins, [linear; "
+    "angular]: [pdot; omega] = J qd, 6xn blocks in FRAME_NAMES order: (6 nf, n).", ("q",), False,
+    "m/rad (linear rows), 1 (angular rows)", ("J_f",), build=_FRAMES, default=False,
+    constants=_FRAME_NAMES))
+FRAME_BODY_JACOBIANS = register_output(Output(
+    "frame_body_jacobians", "Jb_f", "Body frame Jacobians, [linear; angular] in frame axes: "
+    "[R^T pdot; R^T omega] = Jb qd, 6xn blocks in FRAME_NAMES order: (6 nf, n).", ("q",), False,
+    "m/rad (linear rows), 1 (angular rows)", ("Jb_f",), build=_FRAMES, default=False,
+    constants=_FRAME_NAMES))
+FRAME_JACOBIANS_DOT_QD = register_output(Output(
+    "frame_jacobians_dot_qd", "dJqd_f", "Jdot qd of the world-aligned frame Jacobians: the "
+    "frame accelerations [pddot; omegadot] at qdd = 0, FRAME_NAMES order: (6 nf,).",
+    ("q", "qd"), True, "m/s^2, rad/s^2", ("dJqd_f",), build=_FRAMES, default=False,
+    constants=_FRAME_NAMES))
+CONTACT_JACOBIAN = register_output(Output(
+    "contact_jacobian", "J_c", "Contact Jacobian J_c (m, n): the rows of the scene's contacts "
+    "(point: world-aligned linear rows; surface: body rows), CONTACT_ROWS order.", ("q",), False,
+    "m/rad (force rows), 1 (moment rows)", ("J_c",), build=_CONTACTS, default=False,
+    constants=_CONTACT_NAMES))
+CONTACT_BIAS = register_output(Output(
+    "contact_bias", "dJqd_c", "Contact bias J_c-dot qd (m,): the constraint accelerations at "
+    "qdd = 0, CONTACT_ROWS order.", ("q", "qd"), True, "m/s^2, rad/s^2", ("dJqd_c",),
+    build=_CONTACTS, default=False, constants=_CONTACT_NAMES))
+CONSTRAINED_FORWARD = register_output(Output(
+    "constrained_forward_dynamics", None, "(qdd, F_c) holding every contact: the KKT system "
+    "[[M, -J_c^T], [J_c, 0]] [qdd; F_c] = [tau - (C qd + g); -J_c-dot qd].",
+    ("q", "qd", "tau"), True, "rad/s^2, m/s^2; N, N m", ("M", "tau", "J_c", "dJqd_c"),
+    composed_from=(MASS.function, INVERSE.function, CONTACT_JACOBIAN.function,
+                   CONTACT_BIAS.function), default=False, constants=_CONTACT_NAMES,
+    backends=("numpy", "casadi", "c", "jax", "torch")))
+
+
+def exported(functions, backend: str) -> tuple[str, ...]:
+    """``functions`` less the composed ones ``backend`` does not compose
+    (:attr:`Output.backends`)."""
+    return tuple(f for f in functions
+                 if OUTPUTS[f].backends is None or backend in OUTPUTS[f].backends)
+
+
+def constrained_names() -> dict[str, str]:
+    """The names a template needs to compose ``constrained_forward_dynamics``: ``name``,
+    ``mass``, ``bias`` (τ(q, q̇, 0) = C q̇ + g), ``jacobian`` (J_c) and ``drift`` (J̇_c q̇)."""
+    mass, bias, jacobian, drift = CONSTRAINED_FORWARD.composed_from
+    return {"name": CONSTRAINED_FORWARD.function, "mass": mass, "bias": bias,
+            "jacobian": jacobian, "drift": drift}
+
+
 def derived_symbols(default_only: bool = False) -> tuple[str, ...]:
     """The symbols :func:`eomgen.derive` can build, in registry order (with ``default_only``,
     those of the outputs exported by default: ``("M", "C", "g", "tau")``)."""
@@ -347,4 +412,4 @@ def composition_names(output: Output = FORWARD) -> dict[str, str]:
 
 __all__ = ["INPUTS", "Output", "OUTPUTS", "resolve", "BY_SYMBOL", "register_output", "derived_symbols",
            "function_names", "select", "composition_names", "MASS", "CORIOLIS", "GRAVITY", "INVERSE",
-           "FORWARD"]
+           "FORWARD", "exported", "constrained_names", "CONSTRAINED_FORWARD"]

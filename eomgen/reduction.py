@@ -363,8 +363,9 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
                                                  "along the normal" else ""))
     reduced, world = _reroot(reduced)
     reduced = _keep_contact_frames(locked_model, reduced, scene, set(dropped))
+    reduced = replace(reduced, contacts=scene.contacts, frames=scene.frames)
     if scene.contacts:
-        notes.append("contacts (eomgen.contacts.ContactDynamics; not generated as code yet): "
+        notes.append("contacts (generated with --outputs contact_jacobian, contact_bias, constrained_forward_dynamics; numerically eomgen.contacts.ContactDynamics): "
                      + ", ".join(f"{c.name} on '{c.frame}' ({c.kind}"
                                  + (f", μ = {c.mu:g}" if c.mu is not None else "") + ")"
                                  for c in scene.contacts))
@@ -412,23 +413,26 @@ def _keep_contact_frames(locked: RobotModel, reduced: RobotModel, scene: Scene,
     present = reduced.link_by_name
     links, joints = list(reduced.links), list(reduced.joints)
     names = {l.name for l in links} | {j.name for j in joints}
-    for k, contact in enumerate(scene.contacts):
-        where = f"contacts[{k}] '{contact.name}' frame"
-        if contact.frame not in locked.link_by_name:
-            raise scene.error(where, f"no link '{contact.frame}' in robot '{locked.name}'"
-                              + did_you_mean(contact.frame, locked.link_by_name))
-        if contact.frame in dropped:
-            raise scene.error(where, f"link '{contact.frame}' is fixed to the world once the "
-                              "scene locks its joints (dropped): a contact there holds nothing")
-        if contact.frame in present or contact.frame in names:
+    wanted = [(f"contacts[{k}] '{c.name}' frame", c.frame, "a contact there holds nothing")
+              for k, c in enumerate(scene.contacts)]
+    wanted += [(f"frames[{k}]", name, "its pose is constant")
+               for k, name in enumerate(scene.frames)]
+    for where, frame, moot in wanted:
+        if frame not in locked.link_by_name:
+            raise scene.error(where, f"no link '{frame}' in robot '{locked.name}'"
+                              + did_you_mean(frame, locked.link_by_name))
+        if frame in dropped:
+            raise scene.error(where, f"link '{frame}' is fixed to the world once the "
+                              f"scene locks its joints (dropped): {moot}")
+        if frame in present or frame in names:
             continue
-        body, pose = frame_site(locked, contact.frame)
-        joint = f"{contact.frame}_contact_frame"
+        body, pose = frame_site(locked, frame)
+        joint = f"{frame}_contact_frame"
         while joint in names:
             joint += "_"
-        links.append(Link(contact.frame, None))
-        joints.append(Joint(joint, JointType.FIXED, body, contact.frame, _clean(pose)))
-        names |= {contact.frame, joint}
+        links.append(Link(frame, None))
+        joints.append(Joint(joint, JointType.FIXED, body, frame, _clean(pose)))
+        names |= {frame, joint}
     if len(links) == len(reduced.links):
         return reduced
     return replace(reduced, links=tuple(links), joints=tuple(joints))
@@ -895,7 +899,9 @@ def _reroot(model: RobotModel) -> tuple[RobotModel, str]:
     links = (Link(root, None),) + tuple(l for l in model.links if l.name != model.root)
     joints = tuple(replace(j, parent=root, origin=Transform()) if j is joint else j
                    for j in model.joints)
-    return (replace(model, links=links, joints=joints, root=root, gravity=gravity),
+    pose = joint.origin if model.root_pose is None else model.root_pose @ joint.origin
+    return (replace(model, links=links, joints=joints, root=root, gravity=gravity,
+                    root_pose=pose),
             f"the frame of joint '{joint.name}' at q = 0 (link '{root}'), where gravity is "
             "(" + ", ".join(f"{float(x):.6g}" if x.is_number else str(x) for x in gravity)
             + ") m/s²; joint-space M, C, g and τ do not depend on the fixed frame")

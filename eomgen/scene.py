@@ -36,6 +36,8 @@ Version 1 of the format (every key but ``version`` is optional)::
         type: point               # point (3D, default) or surface (6D)
         mu: 0.7                   # friction coefficient, >= 0 (optional)
         baumgarte: {kp: 0, kd: 0} # optional stabilisation gains [1/s², 1/s]
+    frames: [FL_FOOT, base_link] # links whose pose, Jacobians and J̇ q̇ frame_* outputs give
+                                 #   (default: the contact frames, else the leaf links)
 
 The file is read like eomgen's robot YAML (:mod:`eomgen.parsers._yaml`): safe loading, no
 aliases, size and depth limits, and an unknown key is an error that lists the known ones. Keys
@@ -70,7 +72,7 @@ SCENE_VERSION = 1
 #: Top-level keys of a version-1 scene, in documentation order.
 SCENE_KEYS = ("version", "robot", "description", "fixed_base", "floating_base", "base", "tips",
               "locked", "payloads", "actuators", "gravity", "parameters", "symbolic", "outputs",
-              "contacts")
+              "contacts", "frames")
 
 #: Keys reserved for later versions of the format; refused with a message saying so (those of
 #: :data:`ACTUATOR_ALIASES` with a pointer to ``actuators``, which holds them per joint now).
@@ -134,6 +136,9 @@ class Scene:
         for all.
     contacts:
         Frames held still (:class:`eomgen.contacts.Contact`), in file order.
+    frames:
+        Links whose kinematics the ``frame_*`` outputs give (``FRAME_NAMES``), in file order;
+        empty for the default (the contact frames, else the leaf links).
     """
 
     source: str = "<scene>"
@@ -152,6 +157,7 @@ class Scene:
     outputs: tuple[str, ...] | None = None
     floating_base: bool = False
     contacts: tuple[Contact, ...] = ()
+    frames: tuple[str, ...] = ()
 
     @property
     def locked_positions(self) -> dict[str, float]:
@@ -304,8 +310,9 @@ def _read(data: dict, source: str, strict: bool) -> Scene:
         for c in contacts:
             if names.count(c.name) > 1:
                 raise r.error(f"contacts '{c.name}'", "two contacts have this name")
+    frames = _frames(r, data["frames"]) if data.get("frames") is not None else ()
     declared = tuple(r.declared.values())
-    return Scene(source=source, version=version, robot=robot, description=description,
+    return Scene(frames=frames, source=source, version=version, robot=robot, description=description,
                  floating_base=floating_base, contacts=tuple(contacts),
                  fixed_base=fixed_base, base=base, tips=tuple(tips), locked=tuple(locked),
                  payloads=tuple(payloads), actuators=tuple(actuators),
@@ -392,6 +399,17 @@ def _symbolic(r: _SceneReader, value) -> tuple[str, ...]:
     for k, entry in enumerate(r.sequence(value, "symbolic", allow_empty=True)):
         if not isinstance(entry, str):
             raise r.error(f"symbolic[{k}]", "expected a parameter name")
+        names.append(entry)
+    return tuple(names)
+
+
+def _frames(r: _SceneReader, value) -> tuple[str, ...]:
+    names: list[str] = []
+    for k, entry in enumerate(r.sequence(value, "frames")):
+        if not isinstance(entry, str) or not entry:
+            raise r.error(f"frames[{k}]", "expected a link name")
+        if entry in names:
+            raise r.error(f"frames[{k}]", f"frame '{entry}' is listed twice")
         names.append(entry)
     return tuple(names)
 

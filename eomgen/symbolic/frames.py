@@ -1,7 +1,9 @@
 """Frame kinematics of named links: pose, Jacobians and J̇ q̇, as a straight-line program.
 
 For every frame ``f`` asked for (any link of the model: a body, or a frame fixed to one such as
-a foot or a tool), :func:`derive_frames` builds, in the model's root (world) frame:
+a foot or a tool), :func:`derive_frames` builds, in the world frame: the frame of the model's
+root link, or, when a scene moved the fixed frame (:attr:`RobotModel.root_pose
+<eomgen.model.RobotModel.root_pose>`), the description's root link frame again:
 
 * ``p_f`` (3×1): the frame origin [m] in world coordinates;
 * ``R_f`` (3×3): the frame axes in world coordinates (``x_world = R_f x_f + p_f``);
@@ -146,15 +148,25 @@ def derive_frames(model: RobotModel, frames: Iterable[str] | None = None) -> Fra
     from ..dynamics import joint_symbols
 
     frames = tuple(frames) if frames is not None else tuple(l.name for l in model.links)
-    sites = [frame_site(model, name) for name in frames]
-    tree = body_tree(model)
-    body_of = {body.joint.child: i for i, body in enumerate(tree.bodies)}
-    n = model.dof
-    q, qd, _ = joint_symbols(n)
+    q, qd, _ = joint_symbols(model.dof)
     reserved = {s.name for s in q + qd} | {p.name for p in model.parameters}
     b = ProgramBuilder(reserved)
+    kinematics = frame_kinematics(model, body_tree(model), q, qd, b, frames)
+    outputs = [(f"{kind}_{k}", values[kind]) for k, values in enumerate(kinematics)
+               for kind in FRAME_OUTPUTS]
+    program = Program(tuple(b.assignments), tuple(outputs)).pruned([n_ for n_, _ in outputs])
+    return FrameKinematics(model, frames, q, qd, program)
+
+
+def frame_kinematics(model: RobotModel, tree, q, qd, b: ProgramBuilder,
+                     frames: tuple[str, ...]) -> list[dict[str, sp.Matrix]]:
+    """For each of ``frames``, ``{kind: sympy.Matrix}`` for the kinds of :data:`FRAME_OUTPUTS`
+    (module docstring; ``p`` and the J̇ q̇ are columns), in intermediates defined in ``b``."""
+    sites = [frame_site(model, name) for name in frames]
+    body_of = {body.joint.child: i for i, body in enumerate(tree.bodies)}
+    n = model.dof
     kin = forward_kinematics(tree, q, b)
-    outputs: list[tuple[str, sp.Matrix]] = []
+    result: list[dict[str, sp.Matrix]] = []
     velocity: dict[int, tuple] = {}  # body -> spatial velocity V_i (world origin)
     bias: dict[int, tuple] = {}      # body -> spatial acceleration at q̈ = 0
 
@@ -211,16 +223,132 @@ def derive_frames(model: RobotModel, frames: Iterable[str] | None = None) -> Fra
         wxv_b = _cross(w_b, v_b)
         dJbqd = (tuple(b.define(a_b[r] - wxv_b[r], f"ab{k}_{r}") for r in range(3))
                  + b.define_all(_matvec(Rt, dJqd[3:]), f"wdb{k}_"))
-        outputs += [
-            (f"p_{k}", sp.Matrix(3, 1, list(p))),
-            (f"R_{k}", sp.Matrix(3, 3, [x for row in R for x in row])),
-            (f"J_{k}", J),
-            (f"Jb_{k}", Jb),
-            (f"dJqd_{k}", sp.Matrix(6, 1, list(dJqd))),
-            (f"dJbqd_{k}", sp.Matrix(6, 1, list(dJbqd))),
-        ]
-    program = Program(tuple(b.assignments), tuple(outputs)).pruned([n_ for n_, _ in outputs])
-    return FrameKinematics(model, frames, q, qd, program)
+        if model.root_pose is not None:  # to the description's root frame (Jb, dJbqd stay)
+            R0, t0 = model.root_pose.rotation, model.root_pose.translation
+            p = b.define_all(tuple(t0[r] + e for r, e in enumerate(_matvec(R0, p))), f"pw{k}_")
+            R = tuple(b.define_all(row, f"Rw{k}_{r}") for r, row in enumerate(_matmul(R0, R)))
+            Jw = sp.zeros(6, n)
+            for col in range(n):
+                for half in (0, 3):
+                    rotated = _matvec(R0, tuple(J[half + r, col] for r in range(3)))
+                    for r in range(3):
+                        Jw[half + r, col] = b.define(rotated[r], f"Jw{k}_{half + r}_{col + 1}")
+            J = Jw
+            dJqd = b.define_all(_matvec(R0, dJqd[:3]) + _matvec(R0, dJqd[3:]), f"dJw{k}_")
+        result.append({
+            "p": sp.Matrix(3, 1, list(p)),
+            "R": sp.Matrix(3, 3, [x for row in R for x in row]),
+            "J": J,
+            "Jb": Jb,
+            "dJqd": sp.Matrix(6, 1, list(dJqd)),
+            "dJbqd": sp.Matrix(6, 1, list(dJbqd)),
+        })
+    return result
 
 
-__all__ = ["FRAME_OUTPUTS", "FrameKinematics", "derive_frames", "frame_site"]
+def output_frames(model: RobotModel) -> tuple[str, ...]:
+    """The frames of the ``frame_*`` outputs, in the order of their blocks (``FRAME_NAMES``):
+    the scene's ``frames:`` (:attr:`RobotModel.frames <eomgen.model.RobotModel.frames>`), else
+    the frames of its contacts (first appearance), else every leaf link of the tree (a link no
+    joint hangs from), in description order."""
+    if model.frames:
+        return tuple(model.frames)
+    if model.contacts:
+        return tuple(dict.fromkeys(c.frame for c in model.contacts))
+    parents = {j.parent for j in model.joints}
+    return tuple(l.name for l in model.links if l.name not in parents)
+
+
+#: What each frame output stacks, by symbol: (kind of :data:`FRAME_OUTPUTS`, rows per frame).
+FRAME_SYMBOLS = {"p_f": ("p", 3), "R_f": ("R", 3), "J_f": ("J", 6), "Jb_f": ("Jb", 6),
+                 "dJqd_f": ("dJqd", 6)}
+
+
+def build_frames(derivation, wanted) -> dict:
+    """The builder of the ``frame_*`` outputs (:mod:`eomgen.outputs`), stacked over the frames
+    of :func:`output_frames` (``FRAME_NAMES`` order), frame k in rows ``k r … k r + r − 1``:
+
+    * ``p_f`` (nf×3): row k the origin of frame k [m], world coordinates;
+    * ``R_f`` (3 nf×3): block k its rotation (``x_world = R x_frame + p``);
+    * ``J_f`` (6 nf×n): block k its world-aligned Jacobian at the frame origin, **linear rows
+      first**: ``[ṗ; ω] = J q̇`` (Pinocchio's ``getFrameJacobian(..., LOCAL_WORLD_ALIGNED)``,
+      whose rows are also ``[v; ω]``, when q̇ is Pinocchio's velocity);
+    * ``Jb_f`` (6 nf×n): the body Jacobian ``[R ᵀṗ; Rᵀω]`` (Pinocchio's ``LOCAL``);
+    * ``dJqd_f`` (6 nf,): ``J̇ q̇`` of ``J_f``, the classical acceleration ``[p̈; ω̇]`` at q̈ = 0.
+    """
+    frames = output_frames(derivation.model)
+    kin = frame_kinematics(derivation.model, derivation.tree, derivation.q, derivation.qd,
+                           derivation.builder, frames)
+    result = {}
+    for symbol in wanted:
+        kind, _ = FRAME_SYMBOLS[symbol]
+        blocks = [values[kind].T if kind == "p" else values[kind] for values in kin]
+        result[symbol] = sp.Matrix.vstack(*blocks)
+    return result
+
+
+def frame_constants(dynamics) -> dict[str, tuple[str, ...]]:
+    """``FRAME_NAMES``: the frames of the ``frame_*`` outputs, in block order."""
+    return {"FRAME_NAMES": output_frames(dynamics.model)}
+
+
+def contact_rows(model: RobotModel) -> tuple[str, ...]:
+    """Names of the rows of ``J_c`` and of ``F_c``: ``<contact>.f_x`` … (a point contact: force
+    in world axes; a surface contact: force then moment ``n_x`` … in its frame's axes)."""
+    from ..contacts import POINT
+
+    rows = []
+    for c in model.contacts:
+        axes = ("f_x", "f_y", "f_z") if c.kind == POINT else (
+            "f_x", "f_y", "f_z", "n_x", "n_y", "n_z")
+        rows += [f"{c.name}.{a}" for a in axes]
+    return tuple(rows)
+
+
+def build_contacts(derivation, wanted) -> dict:
+    """The builder of ``J_c`` (m×n) and ``dJqd_c`` (``J̇_c q̇``, (m,)): the rows of the model's
+    contacts as :class:`eomgen.contacts.ContactDynamics` stacks them, in contact order. A
+    point contact gives the linear rows of the world-aligned frame Jacobian (its force in world
+    axes); a surface contact the six rows of the body Jacobian (its wrench in the frame's
+    axes). Baumgarte gains are not part of these rows.
+
+    Raises
+    ------
+    GenerationError
+        When the model carries no contacts (a scene's ``contacts:``).
+    """
+    from ..contacts import POINT
+    from ..errors import GenerationError
+
+    model = derivation.model
+    if not model.contacts:
+        raise GenerationError(
+            f"{model.source}: contact outputs (contact_jacobian, contact_bias, "
+            f"constrained_forward_dynamics) need contacts, and robot '{model.name}' has none: "
+            "declare them in a scene (contacts: [{frame: <link>}])")
+    frames = tuple(dict.fromkeys(c.frame for c in model.contacts))
+    kin = frame_kinematics(model, derivation.tree, derivation.q, derivation.qd,
+                           derivation.builder, frames)
+    J, bias = [], []
+    for c in model.contacts:
+        values = kin[frames.index(c.frame)]
+        if c.kind == POINT:
+            J.append(values["J"][:3, :])
+            bias.append(values["dJqd"][:3, :])
+        else:
+            J.append(values["Jb"])
+            bias.append(values["dJbqd"])
+    result = {"J_c": sp.Matrix.vstack(*J), "dJqd_c": sp.Matrix.vstack(*bias)}
+    return {k: v for k, v in result.items() if k in wanted}
+
+
+def contact_constants(dynamics) -> dict[str, tuple[str, ...]]:
+    """``CONTACT_NAMES`` (the contacts, in order) and ``CONTACT_ROWS`` (:func:`contact_rows`)."""
+    model = dynamics.model
+    return {"CONTACT_NAMES": tuple(c.name for c in model.contacts),
+            "CONTACT_ROWS": contact_rows(model)}
+
+
+__all__ = ["FRAME_OUTPUTS", "FRAME_SYMBOLS", "FrameKinematics", "derive_frames", "frame_site",
+           "frame_kinematics", "output_frames", "build_frames", "frame_constants", "contact_rows",
+           "build_contacts", "contact_constants"]

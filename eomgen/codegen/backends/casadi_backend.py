@@ -19,6 +19,7 @@ from pathlib import Path
 import sympy as sp
 from sympy.printing.pycode import PythonCodePrinter
 
+from ...outputs import exported
 from ...compiler import c_compiler
 from .. import GeneratedFile, Job, register
 from ...symbolic.printing import FloatLiteralMixin, exec_source
@@ -64,7 +65,7 @@ def _render_module(job: Job, config: CasADiConfig) -> str:
     # Parameters without a value have no default: the module refuses calls that leave them out.
     required = [p.identifier for p in job.parameters if p.default is None]
     return render(config.template, required=required,
-                  **python_module_context(job, printer, config.template))
+                  **python_module_context(job, printer, config.template, backend="casadi"))
 
 
 @register("casadi", "CasADi module: casadi.Function objects (SX) with named inputs and outputs",
@@ -105,7 +106,7 @@ def generate_c(job: Job, config: CasADiConfig = CasADiConfig()) -> list[Generate
     # keep the stem.
     prefix = re.sub(r"__+", "_", stem)
     generator = ca.CodeGenerator(prefix + ".c", {"with_header": True, "with_mem": False})
-    for name in job.functions:
+    for name in exported(job.functions, "c"):
         generator.add(namespace[name])
     with tempfile.TemporaryDirectory() as tmp:
         generator.generate(tmp + os.sep)

@@ -8,7 +8,8 @@ from dataclasses import dataclass
 import sympy as sp
 
 from .. import Job
-from ...outputs import FORWARD, INPUTS, composition_names
+from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUTS, composition_names,
+                       constrained_names, exported)
 from ..functions import FunctionSpec
 
 
@@ -129,9 +130,13 @@ def dunder_all_lines(names, width: int = 79) -> list[str]:
     return lines
 
 
-def python_module_context(job: Job, printer, template: str, extra_exports=()) -> dict:
+def python_module_context(job: Job, printer, template: str, extra_exports=(),
+                          backend: str | None = None) -> dict:
     """What the Python-source templates (NumPy, CasADi) receive: the printed functions and the
-    escaped module metadata. ``printer`` prints one SymPy expression (``printer.doprint``)."""
+    escaped module metadata. ``printer`` prints one SymPy expression (``printer.doprint``);
+    ``backend`` names the backend, whose module leaves out the composed functions it does not
+    compose (:func:`eomgen.outputs.exported`)."""
+    functions = exported(job.functions, backend) if backend else job.functions
     renames = parameter_renames(job)
 
     def doprint(expr: sp.Expr) -> str:
@@ -150,9 +155,11 @@ def python_module_context(job: Job, printer, template: str, extra_exports=()) ->
         vector_inputs=[name for name in INPUTS if name in ("q", "qd", "qdd", "tau") or any(
             name == a.name for spec in job.specs for a in spec.arguments)],
         dunder_all=dunder_all_lines(["JOINT_NAMES", "NQ", "PARAMETERS",
-                                     *(name for name, _ in job.constants), *job.functions,
+                                     *(name for name, _ in job.constants), *functions,
                                      *extra_exports]),
-        exports=list(job.functions),
+        exports=list(functions),
         forward_dynamics=FORWARD.function in job.functions,
         fd=composition_names(FORWARD),
+        constrained_forward_dynamics=CONSTRAINED_FORWARD.function in functions,
+        cfd=constrained_names(),
     )

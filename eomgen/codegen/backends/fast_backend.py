@@ -27,7 +27,7 @@ from sympy.printing.precedence import PRECEDENCE
 
 from ...compiler import c_compiler
 from .. import GeneratedFile, Job, register
-from ...outputs import FORWARD, composition_names
+from ...outputs import FORWARD, composition_names, exported
 from ...symbolic.printing import FloatLiteralMixin
 from ..render import render
 
@@ -152,7 +152,7 @@ def _render_source(job: Job, config: FastConfig) -> str:
         functions=functions,
         constants=[(name, [c_string_literal(v) for v in values])
                    for name, values in job.constants],
-        exports=[name for name, _ in job.constants] + list(job.functions)
+        exports=[name for name, _ in job.constants] + list(exported(job.functions, "fast"))
         + (["IllConditionedWarning"]
                                        if FORWARD.function in job.functions else []),
         forward_doc=forward_doc,

@@ -57,7 +57,7 @@ class JaxConfig:
           config=JaxConfig, order=60, reserved=("jnp", "jax"))
 def generate_jax(job: Job, config: JaxConfig = JaxConfig()) -> list[GeneratedFile]:
     printer = JaxModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
-    context = python_module_context(job, printer, config.template)
+    context = python_module_context(job, printer, config.template, backend="jax")
     context["stacked"] = {f.name: stacked_rows(f) for f in context["functions"]
                           if len(f.output_shape) == 2}
     text = render(config.template, **context)

@@ -39,5 +39,5 @@ class NumPyConfig:
 def generate_numpy(job: Job, config: NumPyConfig = NumPyConfig()) -> list[GeneratedFile]:
     printer = NumPyModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
     extra = ["IllConditionedWarning"] if FORWARD.function in job.functions else []
-    text = render(config.template, **python_module_context(job, printer, config.template, extra))
+    text = render(config.template, **python_module_context(job, printer, config.template, extra, backend="numpy"))
     return [GeneratedFile(job.stem + config.suffix, text)]

@@ -39,5 +39,5 @@ class TorchConfig:
 def generate_torch(job: Job, config: TorchConfig = TorchConfig()) -> list[GeneratedFile]:
     printer = TorchModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
     extra = ["IllConditionedWarning"] if FORWARD.function in job.functions else []
-    text = render(config.template, **python_module_context(job, printer, config.template, extra))
+    text = render(config.template, **python_module_context(job, printer, config.template, extra, backend="torch"))
     return [GeneratedFile(job.stem + config.suffix, text)]
