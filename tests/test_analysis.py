@@ -189,10 +189,10 @@ def test_momentum_rate_is_the_derivative_of_M_qd(pendulum_system):
 
     def momentum(t):
         qt, qdt = q + t * qd + t * t / 2 * qdd, qd + t * qdd
-        return system.mass_matrix(qt) @ qdt
+        return system.M(qt) @ qdt
 
     numeric = (momentum(h) - momentum(-h)) / (2 * h)
-    _, pdot = system.velocity_and_momentum_rate(q, system.mass_matrix(q) @ qd)
+    _, pdot = system.velocity_and_momentum_rate(q, system.M(q) @ qd)
     np.testing.assert_allclose(pdot, numeric, rtol=1e-7, atol=1e-7)
 
 
@@ -241,7 +241,7 @@ def test_energy_is_the_numeric_one(planar, pendulum_system):
     q, qd = np.array([0.2, 0.3]), np.array([1.0, 2.0])
     K, P = pendulum_system.energy(q, qd)
     assert K == kinetic_energy(nm, q, qd) and P == potential_energy(nm, q)
-    assert K == pytest.approx(0.5 * qd @ pendulum_system.mass_matrix(q) @ qd, rel=1e-12)
+    assert K == pytest.approx(0.5 * qd @ pendulum_system.M(q) @ qd, rel=1e-12)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -231,7 +231,7 @@ def test_flexible_system_is_the_reduced_spong_model(flexible):
     got = system.forward_dynamics(Q, Qd)
     assert np.allclose(got, np.concatenate([expected[2:4], expected[6:8]]), rtol=1e-11)
     assert np.isclose(sum(system.energy(Q, Qd)), A.flexible_energy(am, x), rtol=1e-12)
-    P = system.mass_matrix(Q) @ Qd  # the canonical form agrees with the forward dynamics
+    P = system.M(Q) @ Qd  # the canonical form agrees with the forward dynamics
     assert np.allclose(system.velocity(Q, P), Qd, rtol=1e-12)
 
 

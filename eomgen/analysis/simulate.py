@@ -154,7 +154,7 @@ class System:
             return max(estimate, eigenvalues[-1] / max(eigenvalues[0], np.finfo(float).tiny))
         return estimate
 
-    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+    def M(self, q: np.ndarray) -> np.ndarray:
         """M(q), (n, n)."""
         return np.reshape(self._M(*q.tolist())[0], self._shape)
 
@@ -279,7 +279,7 @@ class ImplicitMidpoint(FixedStep):
     name = "implicit midpoint"
 
     def start(self, system, q, qd):
-        return q, system.mass_matrix(q) @ qd
+        return q, system.M(q) @ qd
 
     def output(self, system, state):
         q, p = state

@@ -101,7 +101,7 @@ class FlexibleSystem(System):
         thdd = (self.tau[self.flexible] - spring) / self.B
         return np.concatenate([qdd, thdd])
 
-    def mass_matrix(self, Q) -> np.ndarray:
+    def M(self, Q) -> np.ndarray:
         """``diag(M_a(q), B)`` (n + m, n + m)."""
         nl = self.links
         M = np.zeros((self.n, self.n))

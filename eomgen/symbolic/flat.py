@@ -3,7 +3,7 @@ functions: the motor angles, rates and torques that make the links follow a traj
 from ``q`` and its time derivatives up to order 4.
 
 With ``τ_L = M(q) q̈ + C(q, q̇) q̇ + g(q)`` the rigid-body inverse dynamics (the Newton–Euler
-program of ``inverse_dynamics``), on every flexible joint ``j`` (stiffness ``K_j``, motor inertia
+program of the generated τ), on every flexible joint ``j`` (stiffness ``K_j``, motor inertia
 ``B_j``, motor friction ``d_j θ̇_j + f_j sign(θ̇_j)``)::
 
     θ_j  = q_j  + τ_L,j / K_j

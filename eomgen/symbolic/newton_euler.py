@@ -1,7 +1,7 @@
 """Inverse dynamics τ = M q̈ + C q̇ + g by a symbolic recursive Newton–Euler pass.
 
 The recursion is O(n) and yields far fewer operations than forming M q̈ + C q̇ + g from the
-matrices, so generated ``inverse_dynamics`` functions use it; verification checks that it equals
+matrices, so the generated τ functions use it; verification checks that it equals
 the Lagrangian M q̈ + C q̇ + g.
 
 Frames and conventions: every body quantity is in its own body frame (the joint frame after the
