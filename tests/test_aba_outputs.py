@@ -11,51 +11,25 @@ printed by every backend and compared with independent computations:
 
 from __future__ import annotations
 
-import importlib.util
 
 import numpy as np
 import pytest
 
 import eomgen
-from eomgen.codegen.backends.casadi_backend import load_module_source
-from eomgen.codegen.generate import render_files
 from eomgen.codegen.functions import select_functions
 from eomgen.numeric import mass_matrix_rnea, numeric_model, rnea
+from generated import generated
 from reference import pin_q_order, random_robot, to_pinocchio
 
 FUNCTIONS = select_functions(["qdd_aba", "h", "forward_dynamics"])
-BACKENDS = ["numpy", "casadi", "fast"] + [b for b in ("jax", "torch")
-                                          if importlib.util.find_spec(b) is not None]
 
 
 def load_modules(model, folder):
-    """{backend: callable(name) -> function returning NumPy arrays} of every backend."""
-    if "jax" in BACKENDS:
-        import jax
-
-        jax.config.update("jax_enable_x64", True)
-    files = render_files(model, BACKENDS, functions=FUNCTIONS)
-    for f in files:
-        path = folder / f.name
-        path.write_bytes(f.content) if isinstance(f.content, bytes) else path.write_text(
-            f.content, encoding="utf-8")
-    stem = next(f.name for f in files if f.name.endswith("_numpy.py"))[:-len("_numpy.py")]
-    modules = {}
-    for backend in BACKENDS:
-        if backend == "casadi":
-            namespace = load_module_source((folder / f"{stem}_casadi.py").read_text(), "aba_ca")
-            modules[backend] = lambda name, ns=namespace: (
-                lambda *args: np.array(ns[name](*args), dtype=float).ravel())
-            continue
-        path = (next(folder.glob(f"{stem}_fast.*.so")) if backend == "fast"
-                else folder / f"{stem}_{backend}.py")
-        spec = importlib.util.spec_from_file_location(
-            f"{stem}_fast" if backend == "fast" else f"aba_{backend}_{stem}", path)
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        modules[backend] = lambda name, m=module: (
-            lambda *args, **kwargs: np.asarray(getattr(m, name)(*args, **kwargs), dtype=float))
-    return modules
+    """{backend: get(name) -> function returning NumPy arrays} of every backend (the functions
+    of :mod:`generated`, called positionally or by name alike)."""
+    calls = generated(model, FUNCTIONS, folder)[0]
+    return {backend: (lambda name, call=call: (lambda *args, **kwargs: call(name, *args, **kwargs)))
+            for backend, call in calls.items()}
 
 
 def test_aba_and_nonlinear_effects_agree_with_pinocchio_in_every_backend(tmp_path):

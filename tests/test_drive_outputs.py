@@ -11,7 +11,6 @@ joints printed by every backend, against independent computations:
 
 from __future__ import annotations
 
-import importlib.util
 import re
 from dataclasses import replace
 from pathlib import Path
@@ -21,20 +20,15 @@ import pytest
 
 import eomgen
 from eomgen import actuators as A
-from eomgen.codegen.backends.casadi_backend import load_module_source
-from eomgen.codegen.functions import select_functions
-from eomgen.codegen.generate import render_files
 from eomgen.model import Actuator
-from eomgen.outputs import OUTPUTS
 from eomgen.numeric import mass_matrix_rnea, numeric_model, rnea
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from conftest import erd_robots_dir
+from generated import BACKENDS, generated  # noqa: F401  (BACKENDS: test_flat_outputs)
 
 RIGID = ("M_a", "tau_f", "tau_f_smooth", "tau_a")
 FLEXIBLE = ("M_l", "tau_K", "thetadd_m", "h", "M")
-BACKENDS = ["numpy", "casadi", "fast"] + [b for b in ("jax", "torch")
-                                          if importlib.util.find_spec(b) is not None]
 
 
 def arm():
@@ -50,32 +44,8 @@ def arm():
 
 
 def load(model, names, folder):
-    """{backend: call(function, *args) -> NumPy array}."""
-    if "jax" in BACKENDS:
-        import jax
-
-        jax.config.update("jax_enable_x64", True)
-    files = render_files(model, BACKENDS, functions=select_functions(names))
-    for f in files:
-        path = folder / f.name
-        path.write_bytes(f.content) if isinstance(f.content, bytes) else path.write_text(
-            f.content, encoding="utf-8")
-    stem = next(f.name for f in files if f.name.endswith("_numpy.py"))[:-len("_numpy.py")]
-    calls = {}
-    for backend in BACKENDS:
-        if backend == "casadi":
-            ns = load_module_source((folder / f"{stem}_casadi.py").read_text(), "drives_ca")
-            calls[backend] = lambda f, *a, ns=ns: np.array(  # by name: parameter defaults
-                ns[f].call(dict(zip(OUTPUTS[f].inputs, a))).popitem()[1], dtype=float).squeeze()
-            continue
-        path = (next(folder.glob(f"{stem}_fast.*.so")) if backend == "fast"
-                else folder / f"{stem}_{backend}.py")
-        spec = importlib.util.spec_from_file_location(
-            f"{stem}_fast" if backend == "fast" else f"drives_{backend}_{stem}", path)
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        calls[backend] = lambda f, *a, m=module: np.asarray(getattr(m, f)(*a), dtype=float)
-    return calls
+    """{backend: call(function, *args) -> NumPy array} (see :mod:`generated`)."""
+    return generated(model, names, folder)[0]
 
 
 def test_rigid_drive_outputs_in_every_backend(tmp_path):

@@ -15,12 +15,10 @@ import pytest
 
 import eomgen
 from conftest import erd_robots_dir
-from eomgen.codegen.backends.casadi_backend import load_module_source
-from eomgen.codegen.functions import module_name
 from eomgen.codegen.generate import render_files
 from eomgen.errors import UnsupportedFeatureWarning
 from eomgen.numeric import kinetic_energy, numeric_model, potential_energy, rnea
-from eomgen.outputs import OUTPUTS
+from generated import generated as generate_all
 from reference import pin_q_order
 
 FUNCTIONS = ("regressor", "inertial_parameters", "base_regressor", "base_parameters",
@@ -39,43 +37,8 @@ ARMATURE, DAMPING, COULOMB = np.array([0.3, 0.5]), np.array([0.5, 0.0]), np.arra
 
 
 def generated(model, backends, folder, functions=FUNCTIONS) -> tuple[dict, dict]:
-    """``({backend: call}, numpy module namespace)``: ``call(function, *vectors, **parameters)``
-    runs the generated function and returns a NumPy array (CasADi: called by name, parameters
-    left out take their defaults)."""
-    have = [b for b in backends if b not in ("jax", "torch") or importlib.util.find_spec(b)]
-    if "jax" in have:
-        import jax
-
-        jax.config.update("jax_enable_x64", True)  # float64, as the JAX backend's tests
-    stem = module_name(model.name)
-    files = {f.name: f for f in render_files(model, have, functions=functions)}
-    for f in files.values():
-        path = folder / f.name
-        path.write_bytes(f.content) if isinstance(f.content, bytes) else path.write_text(
-            f.content, encoding="utf-8")
-    calls, modules = {}, {}
-    for name in have:
-        if name == "casadi":
-            module = load_module_source(files[f"{stem}_casadi.py"].content, f"{stem}_ca_reg")
-
-            def call(function, *vectors, _module=module, **parameters):
-                declared = OUTPUTS[function]
-                named = {**dict(zip(declared.inputs, vectors)), **parameters}
-                out = np.array(_module[function].call(named)[declared.symbol], dtype=float)
-                return out.ravel() if declared.is_vector else out
-        else:
-            path = (next(folder.glob(f"{stem}_fast.*.so")) if name == "fast"
-                    else folder / f"{stem}_{name}.py")
-            spec = importlib.util.spec_from_file_location(
-                f"{stem}_fast" if name == "fast" else f"{stem}_{name}_reg", path)
-            module = importlib.util.module_from_spec(spec)
-            spec.loader.exec_module(module)
-            module = vars(module)
-
-            def call(function, *vectors, _module=module, **parameters):
-                return np.asarray(_module[function](*vectors, **parameters), dtype=float)
-        calls[name], modules[name] = call, module
-    return calls, modules
+    """``({backend: call}, {backend: module namespace})``: see :mod:`generated`."""
+    return generate_all(model, functions, folder, backends)
 
 
 def states(n: int, count: int = 3, seed: int = 11):
