@@ -16,7 +16,7 @@ What is measured, for each n (a chain of n revolute joints, see :func:`spatial_c
 * ``crba`` — the mass matrix by the body-frame Composite-Rigid-Body Algorithm
   (:mod:`eomgen.symbolic.crba`);
 * ``M``    — the mass matrix as M_ij = S_iᵀ I^c_j S_j with everything in world axes
-  (:func:`eomgen.symbolic.composite.composite_mass_matrix_program`; ``derive`` builds whichever
+  (:func:`eomgen.symbolic.composite.composite_M_program`; ``derive`` builds whichever
   of it and the CRBA is cheaper for the robot);
 * ``aba``  — the Articulated-Body Algorithm program q̈(q, q̇, τ) (:mod:`eomgen.symbolic.aba`);
 * ``chol`` — the Cholesky route to q̈ as one program (the CRBA's M, bias τ(q, q̇, 0),
@@ -65,7 +65,7 @@ from eomgen.dynamics import derive, joint_symbols  # noqa: E402
 from eomgen.model import Inertial, Joint, JointType, Link, Transform, build_model, vec3  # noqa: E402
 from eomgen.symbolic.aba import aba_program, cholesky_program  # noqa: E402
 from eomgen.symbolic.composite import (christoffel_coriolis_program, coriolis_program,  # noqa: E402
-                                       composite_mass_matrix_program)
+                                       composite_M_program)
 from eomgen.symbolic.crba import crba_program  # noqa: E402
 from eomgen.symbolic.evaluate import compile_program  # noqa: E402
 from eomgen.symbolic.newton_euler import inverse_dynamics_program  # noqa: E402
@@ -144,7 +144,7 @@ def programs(model, with_C: bool) -> dict:
         return program, q_sym
 
     builders = {"tau": tau, "crba": crba,
-                "M": lagrangian("M", lambda b: composite_mass_matrix_program(tree, q, b)),
+                "M": lagrangian("M", lambda b: composite_M_program(tree, q, b)),
                 "aba": forward(aba_program), "chol": forward(cholesky_program)}
     if with_C:
         builders["C"] = lagrangian("C", lambda b: christoffel_coriolis_program(tree, q, qd, b))

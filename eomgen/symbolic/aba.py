@@ -300,7 +300,7 @@ def aba_program(model: RobotModel) -> ForwardDynamics:
 def cholesky_program(model: RobotModel) -> ForwardDynamics:
     """The Cholesky route to q̈ as one straight-line program, for comparison with the ABA.
 
-    M(q) from the body-frame CRBA (:func:`eomgen.symbolic.crba.mass_matrix_program`, O(n²)),
+    M(q) from the body-frame CRBA (:func:`eomgen.symbolic.crba.M_program`, O(n²)),
     the bias ``C q̇ + g = τ(q, q̇, 0)`` from the Newton–Euler program, then ``M = L Lᵀ``
     (``L_jj = √(M_jj − Σ_k L_jk²)``, ``L_ij = (M_ij − Σ_k L_ik L_jk) / L_jj``) and two triangular
     solves, unrolled: Featherstone's CRBA-plus-Cholesky route, whose factorisation is O(n³).
@@ -308,7 +308,7 @@ def cholesky_program(model: RobotModel) -> ForwardDynamics:
     M (the root-frame composite program) and a numeric Cholesky factorisation.
     """
     from ..dynamics import joint_symbols
-    from .crba import mass_matrix_program
+    from .crba import M_program
     from .newton_euler import inverse_dynamics_program
 
     tree = body_tree(model)
@@ -317,7 +317,7 @@ def cholesky_program(model: RobotModel) -> ForwardDynamics:
     tau = tuple(sp.Symbol(f"tau{k + 1}", real=True) for k in range(n))
     reserved = {s.name for s in q + qd + tau} | {p.name for p in model.parameters}
     b = ProgramBuilder(reserved)
-    M = mass_matrix_program(tree, q, b)
+    M = M_program(tree, q, b)
     bias = inverse_dynamics_program(tree, q, qd, (_ZERO,) * n, model.gravity, b)
     L = [[_ZERO] * n for _ in range(n)]
     inv_diag = [_ZERO] * n

@@ -18,7 +18,7 @@ import sympy as sp
 
 from ..bodies import body_tree
 from ..model import RobotModel
-from .crba import mass_matrix_program
+from .crba import M_program
 from .newton_euler import _name, inverse_dynamics_program
 from .program import Program, ProgramBuilder
 
@@ -42,7 +42,7 @@ def dynamics_program(model: RobotModel) -> tuple[tuple, tuple, Program]:
     b = ProgramBuilder(reserved)
     tree = body_tree(model)
     zero = (sp.Integer(0),) * n
-    M = mass_matrix_program(tree, q, b)
+    M = M_program(tree, q, b)
     g = inverse_dynamics_program(tree, q, zero, zero, model.gravity, b)
     bias = inverse_dynamics_program(tree, q, qd, zero, model.gravity, b)
     Cqd = sp.Matrix([[_name(b, bias[k, 0] - g[k, 0], f"Cqd{k + 1}")] for k in range(n)])

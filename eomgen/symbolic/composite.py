@@ -228,7 +228,7 @@ def is_ancestor_or_self(tree: BodyTree, a: int, j: int) -> bool:
 def _routes() -> dict:
     """The programs of each output: ``{output: ((name, build), …)}`` with
     ``build(tree, q, qd, gravity, b)`` returning the output's matrix."""
-    from .crba import mass_matrix_program
+    from .crba import M_program
     from .newton_euler import inverse_dynamics_program
 
     def rnea_gravity(tree, q, qd, gravity, b):
@@ -236,8 +236,8 @@ def _routes() -> dict:
         return inverse_dynamics_program(tree, q, zero, zero, gravity, b, hint="g")
 
     return {
-        "M": (("CRBA", lambda tree, q, qd, gravity, b: mass_matrix_program(tree, q, b)),
-              ("composite", lambda tree, q, qd, gravity, b: composite_mass_matrix_program(tree, q, b))),
+        "M": (("CRBA", lambda tree, q, qd, gravity, b: M_program(tree, q, b)),
+              ("composite", lambda tree, q, qd, gravity, b: composite_M_program(tree, q, b))),
         "C": (("recursion", lambda tree, q, qd, gravity, b: coriolis_program(tree, q, qd, b)),
               ("Christoffel", _christoffel_route)),
         "g": (("Newton-Euler", rnea_gravity),
@@ -294,9 +294,9 @@ def derive_program(tree: BodyTree, q, qd, gravity: Vec3, outputs: set[str], b: P
     Each output has two exact programs, and the one with fewer operations for this robot is
     built (:func:`cheapest_routes`):
 
-    * ``M``: the body-frame CRBA (:func:`eomgen.symbolic.crba.mass_matrix_program`), cheapest
+    * ``M``: the body-frame CRBA (:func:`eomgen.symbolic.crba.M_program`), cheapest
       for joint axes along the link frames' axes (the Panda: 641 operations against 1,784), or
-      ``M_ij = S_iᵀ I^c_j S_j`` in world axes (:func:`composite_mass_matrix_program`), cheaper
+      ``M_ij = S_iᵀ I^c_j S_j`` in world axes (:func:`composite_M_program`), cheaper
       for general axes, whose body-frame rotations cost more than one world rotation per body;
     * ``C``: Echeandia and Wensing's recursion (:func:`coriolis_program`, O(n²)) or the
       Christoffel symbols of ∂M/∂q (:func:`christoffel_coriolis_program`, O(n³) but fewer
@@ -335,7 +335,7 @@ def _world_composites(tree: BodyTree, q, b: ProgramBuilder) -> tuple:
     return b.memo[key][1]
 
 
-def composite_mass_matrix_program(tree: BodyTree, q, b: ProgramBuilder) -> sp.Matrix:
+def composite_M_program(tree: BodyTree, q, b: ProgramBuilder) -> sp.Matrix:
     """M(q) as ``M_ij = S_iᵀ F_j`` in world axes (module docstring), n×n, ``JOINT_NAMES``
     order [kg m², kg m, kg]."""
     n = len(tree.bodies)

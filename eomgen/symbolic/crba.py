@@ -27,7 +27,7 @@ from .program import Program, ProgramBuilder
 _ZERO = sp.Integer(0)
 
 
-def mass_matrix_program(tree: BodyTree, q, b: ProgramBuilder, grouped: bool = True) -> sp.Matrix:
+def M_program(tree: BodyTree, q, b: ProgramBuilder, grouped: bool = True) -> sp.Matrix:
     """Build M(q) into ``b`` by the body-frame CRBA; returns the symmetric n×n matrix
     [kg m², kg m, kg] in ``JOINT_NAMES`` order."""
     n = len(tree.bodies)
@@ -96,6 +96,6 @@ def crba_program(model: RobotModel) -> tuple[tuple[sp.Symbol, ...], Program]:
     q, _, _ = joint_symbols(model.dof)
     reserved = {s.name for s in q} | {p.name for p in model.parameters}
     b = ProgramBuilder(reserved)
-    M = mass_matrix_program(body_tree(model), q, b)
+    M = M_program(body_tree(model), q, b)
     return q, Program(tuple(b.assignments), (("M", M),)).pruned(["M"])
 
