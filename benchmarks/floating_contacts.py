@@ -85,7 +85,7 @@ def dynamics_agreement(name, model, ref, count, derived=True):
         f = compile_program(dyn.program, dyn.q + dyn.qd)
     for q, qd in states(model.dof, count, 1):
         M, Cqd, g = ref.dynamics(q, qd)
-        ours = {"numeric": (numeric.mass_matrix_rnea(nm, q), numeric.coriolis_times_qd(nm, q, qd),
+        ours = {"numeric": (numeric.M_rnea(nm, q), numeric.coriolis_times_qd(nm, q, qd),
                             numeric.gravity_torques(nm, q))}
         if f is not None:
             out = f(*q, *qd)

@@ -67,7 +67,7 @@ from .symbolic.program import Program
 __all__ = [
     "joint_actuators", "flexible_indices", "friction_torque_expr", "RigidActuatorDynamics",
     "rigid_with_actuators", "SpongDynamics", "spong_dynamics", "time_derivative_program",
-    "ActuatedModel", "actuated_model", "rigid_mass_matrix", "friction_torque",
+    "ActuatedModel", "actuated_model", "rigid_M", "friction_torque",
     "rigid_inverse_dynamics", "rigid_forward_dynamics", "flexible_forward_dynamics",
     "flexible_energy", "flexible_inverse_dynamics", "flexible_rest_state",
 ]
@@ -609,7 +609,7 @@ def actuated_model(dynamics: Dynamics, values: Mapping[str | sp.Symbol, float] |
         tuple(numbers[s] for s in params))
 
 
-def rigid_mass_matrix(am: ActuatedModel, q) -> np.ndarray:
+def rigid_M(am: ActuatedModel, q) -> np.ndarray:
     """``M(q) + diag(a)`` (n×n), every joint's armature added (the rigid model)."""
     M, _, _ = am.rigid_terms(np.asarray(q, float), np.zeros(am.n))
     return M + np.diag(am.armature)

@@ -230,10 +230,10 @@ class ContactDynamics:
     def _mh(self, q, qd):
         if self.mass_and_bias is not None:
             return self.mass_and_bias(q, qd)
-        from .numeric import coriolis_times_qd, gravity_torques, mass_matrix_rnea
+        from .numeric import coriolis_times_qd, gravity_torques, M_rnea
 
         nm = self._numeric
-        return (mass_matrix_rnea(nm, q),
+        return (M_rnea(nm, q),
                 coriolis_times_qd(nm, q, qd) + gravity_torques(nm, q))
 
     def constrained_forward_dynamics(self, q, qd, tau, damping: float = 0.0

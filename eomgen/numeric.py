@@ -470,7 +470,7 @@ def gravity_torques(nm: NumericModel, q) -> np.ndarray:
     return rnea(nm, q, zero, zero)
 
 
-def mass_matrix_rnea(nm: NumericModel, q) -> np.ndarray:
+def M_rnea(nm: NumericModel, q) -> np.ndarray:
     """Joint-space mass matrix ``M(q)``, (n, n), rows and columns in ``nm.joint_names`` order.
 
     Column ``i`` is ``rnea(q, 0, e_i) - rnea(q, 0, 0)`` (n + 1 RNEA calls, O(n²) overall).
@@ -567,7 +567,7 @@ __all__ = [
     "numeric_model",
     "rnea",
     "gravity_torques",
-    "mass_matrix_rnea",
+    "M_rnea",
     "coriolis_times_qd",
     "kinetic_energy",
     "potential_energy",

@@ -17,7 +17,7 @@ import pytest
 
 import eomgen
 from eomgen.codegen.functions import select_functions
-from eomgen.numeric import mass_matrix_rnea, numeric_model, rnea
+from eomgen.numeric import M_rnea, numeric_model, rnea
 from generated import generated
 from reference import pin_q_order, random_robot, to_pinocchio
 
@@ -67,7 +67,7 @@ def test_symbolic_parameters_are_keywords_of_the_aba(tmp_path):
     values = {p.name: p.value for p in model.parameters} | {"m2": 2.5, "l1": 0.7}
     nm = numeric_model(model.substitute({p.symbol: values[p.name] for p in model.parameters}))
     q, qd, tau = np.array([0.3, -0.8]), np.array([1.1, 0.4]), np.array([2.0, -1.0])
-    M = mass_matrix_rnea(nm, q)
+    M = M_rnea(nm, q)
     expected = np.linalg.solve(M, tau - rnea(nm, q, qd, np.zeros(2)))
     np.testing.assert_allclose(module("forward_dynamics_aba")(q, qd, tau, m2=2.5, l1=0.7),
                                expected, rtol=1e-12)

@@ -143,7 +143,7 @@ def test_mass_matrix_bias_and_damping_match_mujoco(robot, scene_head):
             mujoco.mj_fullM(m, full, data.qM)
         M_ref = full[np.ix_(vadr, vadr)]
         M, h, _ = am.rigid_terms(q, qd)
-        M_a = A.rigid_mass_matrix(am, q)
+        M_a = A.rigid_M(am, q)
         assert np.abs(M_a - M_ref).max() <= 1e-10 * np.abs(M_ref).max()
         assert np.allclose(M_a - M, np.diag([armature[n] for n in names]), rtol=0, atol=1e-14)
         bias = data.qfrc_bias[vadr]
@@ -362,7 +362,7 @@ def test_rigid_actuator_program_prints_m_plus_armature(flexible_arm):
     run = compile_program(rigid.program(), tuple(dyn.q) + tuple(dyn.qd) + tuple(params))
     q, qd = np.array([0.2, 1.1]), np.array([0.0, 0.0])
     out = run(*q, *qd, *[p.value for p in dyn.model.parameters])
-    assert np.allclose(out["M"], A.rigid_mass_matrix(am, q), rtol=1e-14)
+    assert np.allclose(out["M"], A.rigid_M(am, q), rtol=1e-14)
     assert np.allclose(out["tau_f"], 0)
 
 

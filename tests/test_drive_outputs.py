@@ -21,7 +21,7 @@ import pytest
 import eomgen
 from eomgen import actuators as A
 from eomgen.model import Actuator
-from eomgen.numeric import mass_matrix_rnea, numeric_model, rnea
+from eomgen.numeric import M_rnea, numeric_model, rnea
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from conftest import erd_robots_dir
@@ -58,7 +58,7 @@ def test_rigid_drive_outputs_in_every_backend(tmp_path):
     for _ in range(3):
         q, qd, qdd = (rng.uniform(-2, 2, 2) for _ in range(3))
         expected = {
-            "drive_mass_matrix": mass_matrix_rnea(nm, q) + np.diag(a),
+            "drive_mass_matrix": M_rnea(nm, q) + np.diag(a),
             "friction_torque": d * qd + f * np.sign(qd),
             "friction_torque_smooth": d * qd + f * np.tanh(qd / w),
             "drive_inverse_dynamics": rnea(nm, q, qd, qdd) + a * qdd + d * qd + f * np.sign(qd),

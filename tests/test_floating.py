@@ -67,7 +67,7 @@ def test_solo12_matches_pinocchio_free_flyer(solo):
     nm = numeric.numeric_model(model)
     for q, qd in random_states(18, 4):
         M, Cqd, g = ref.dynamics(q, qd)
-        assert relative(numeric.mass_matrix_rnea(nm, q), M) <= 1e-10
+        assert relative(numeric.M_rnea(nm, q), M) <= 1e-10
         assert relative(numeric.coriolis_times_qd(nm, q, qd), Cqd) <= 1e-10
         assert relative(numeric.gravity_torques(nm, q), g) <= 1e-10
 
@@ -105,7 +105,7 @@ def test_talos_legs_scene_matches_pinocchio():
     nm = numeric.numeric_model(legs)
     for q, qd in random_states(18, 3, seed=2):
         M, Cqd, g = ref.dynamics(q, qd)
-        assert relative(numeric.mass_matrix_rnea(nm, q), M) <= 1e-10
+        assert relative(numeric.M_rnea(nm, q), M) <= 1e-10
         assert relative(numeric.coriolis_times_qd(nm, q, qd), Cqd) <= 1e-10
         assert relative(numeric.gravity_torques(nm, q), g) <= 1e-10
 
@@ -161,7 +161,7 @@ def test_singularity_is_detected_and_real(solo):
     with pytest.raises(floating.EulerSingularityError):
         floating.from_free_flyer(q_ff, v)
     # the mass matrix in Euler coordinates is singular there: yaw and roll move alike
-    M = numeric.mass_matrix_rnea(numeric.numeric_model(model), q)
+    M = numeric.M_rnea(numeric.numeric_model(model), q)
     assert np.linalg.eigvalsh(M).min() < 1e-12 * np.linalg.eigvalsh(M).max()
     q[4] = 0.5
     floating.check_euler(q)
@@ -223,6 +223,6 @@ def test_small_floating_robot_symbolic_matches_numeric():
     nm = numeric.numeric_model(model)
     for q, qd in random_states(7, 3, seed=6):
         out = f(*q, *qd)
-        assert relative(out["M"], numeric.mass_matrix_rnea(nm, q)) <= 1e-12
+        assert relative(out["M"], numeric.M_rnea(nm, q)) <= 1e-12
         assert relative(out["C"] @ qd, numeric.coriolis_times_qd(nm, q, qd)) <= 1e-12
         assert relative(out["g"].ravel(), numeric.gravity_torques(nm, q)) <= 1e-12

@@ -27,7 +27,7 @@ Evaluation of M(q) and τ(q, q̇, q̈)
     where it is cheaper, keeps them (see ``docs/numerics.md``,
     :func:`test_a_long_link_before_a_short_one_keeps_the_digits_of_its_small_entries`).
 
-RNEA's M (``eomgen.numeric.mass_matrix_rnea``)
+RNEA's M (``eomgen.numeric.M_rnea``)
     Column i is ``RNEA(q, 0, e_i) − RNEA(q, 0, 0)``: a difference, so its absolute error is
     eps times the size of the terms, ``|M| + |g|`` (N m against kg m² per rad/s²). Bound:
     ``EVAL_BOUND (1 + |g|/|M|)``.
@@ -66,7 +66,7 @@ from eomgen.analysis.routes import compile_batch
 from eomgen.codegen import available_backends, make_job
 from eomgen.dynamics import derive
 from eomgen.model import Inertial, Joint, JointType, Link, Transform, build_model
-from eomgen.numeric import mass_matrix_rnea, numeric_model, rnea
+from eomgen.numeric import M_rnea, numeric_model, rnea
 
 EPS = float(np.finfo(np.float64).eps)
 EPS32 = float(np.finfo(np.float32).eps)
@@ -184,7 +184,7 @@ def rnea_M_error(case: Case, q) -> float:
     M_ref = case.reference.M(q)
     g_ref = case.reference.tau(q, np.zeros(case.n), np.zeros(case.n))
     scale = max_abs(M_ref) + max_abs(g_ref)
-    return float(max_abs(np.array([float(x) for x in mass_matrix_rnea(case.nm, q).ravel()],
+    return float(max_abs(np.array([float(x) for x in M_rnea(case.nm, q).ravel()],
                                   dtype=object) - M_ref.ravel()) / scale)
 
 
@@ -323,7 +323,7 @@ def test_condition_estimate_is_a_lower_bound_on_random_robots():
         model = random_robot(rng, int(rng.integers(2, 7)))
         nm = numeric_model(model)
         for _ in range(3):
-            M = mass_matrix_rnea(nm, rng.uniform(-np.pi, np.pi, model.dof))
+            M = M_rnea(nm, rng.uniform(-np.pi, np.pi, model.dof))
             try:
                 L = np.linalg.cholesky(M)
             except np.linalg.LinAlgError:

@@ -74,7 +74,7 @@ def test_named_form_evaluates_to_the_numeric_model():
     f = M.lambdify([dyn.q])
     for q, qd, qdd in states(5):
         at = values(dyn, q, qd, qdd)
-        M_ref = numeric.mass_matrix_rnea(nm, q)
+        M_ref = numeric.M_rnea(nm, q)
         numbers = M.subs(at)
         assert isinstance(numbers, sp.MatrixBase) and not numbers.free_symbols
         close(numbers, M_ref)
@@ -130,7 +130,7 @@ def test_expanded_M_of_the_spatial_arm_is_the_numeric_M():
     f = sp.lambdify([dyn.q], M)
     nm = numeric.numeric_model(dyn.model)
     for q, _, _ in states(5):
-        close(f(q), numeric.mass_matrix_rnea(nm, q))
+        close(f(q), numeric.M_rnea(nm, q))
 
 
 def test_a_six_joint_arm_that_expands_cheaply_is_an_ordinary_matrix():
@@ -144,7 +144,7 @@ def test_a_six_joint_arm_that_expands_cheaply_is_an_ordinary_matrix():
     f = sp.lambdify([dyn.q], dyn.M)
     nm = numeric.numeric_model(model)
     for q, _, _ in states(6):
-        close(f(q), numeric.mass_matrix_rnea(nm, q))
+        close(f(q), numeric.M_rnea(nm, q))
 
 
 def test_teaching_sized_models_keep_the_textbook_matrix():

@@ -30,7 +30,7 @@ from eomgen.numeric import (
     gravity_torques,
     kinetic_energy,
     link_poses,
-    mass_matrix_rnea,
+    M_rnea,
     numeric_model,
     potential_energy,
     rnea,
@@ -147,7 +147,7 @@ def test_matches_pinocchio(case):
     for _ in range(4):
         q, qd, qdd = random_state(rng, nm.n)
         assert_close(rnea(nm, q, qd, qdd), ref.rnea(q, qd, qdd))
-        assert_close(mass_matrix_rnea(nm, q), ref.mass_matrix(q))
+        assert_close(M_rnea(nm, q), ref.mass_matrix(q))
         assert_close(gravity_torques(nm, q), ref.gravity(q))
         assert_close(coriolis_times_qd(nm, q, qd), ref.coriolis_times_qd(q, qd))
         assert_close(kinetic_energy(nm, q, qd), ref.kinetic_energy(q, qd))
@@ -265,7 +265,7 @@ def test_cart_pole_closed_form():
         T = -m * l * math.cos(th) * xdd + m * l * l * thdd + m * g * l * math.sin(th)
         assert_close(rnea(nm, [th, x], [thd, xd], [thdd, xdd]), [T, F])
         M = np.array([[m * l * l, -m * l * math.cos(th)], [-m * l * math.cos(th), mc + m]])
-        assert_close(mass_matrix_rnea(nm, [th, x]), M)
+        assert_close(M_rnea(nm, [th, x]), M)
         K = 0.5 * (mc + m) * xd ** 2 - m * l * math.cos(th) * xd * thd + 0.5 * m * l * l * thd ** 2
         assert_close(kinetic_energy(nm, [th, x], [thd, xd]), K)
 
@@ -307,7 +307,7 @@ def test_planar_two_link_textbook():
             m2 * lc2 * g * math.cos(q1 + q2),
         ])
         q, qd = np.array([q1, q2]), np.array([qd1, qd2])
-        assert_close(mass_matrix_rnea(nm, q), M)
+        assert_close(M_rnea(nm, q), M)
         assert_close(coriolis_times_qd(nm, q, qd), C @ qd)
         assert_close(gravity_torques(nm, q), gv)
         assert_close(rnea(nm, q, qd, qdd), M @ qdd + C @ qd + gv)
@@ -361,7 +361,7 @@ def test_energy_forms(case):
     rng, model = make_robot(*case)
     nm = numeric_model(model)
     q, qd, _ = random_state(rng, nm.n)
-    M = mass_matrix_rnea(nm, q)
+    M = M_rnea(nm, q)
     assert_close(M, M.T, rtol=1e-12)
     assert np.linalg.eigvalsh(0.5 * (M + M.T)).min() >= -1e-12 * max(1.0, np.abs(M).max())
     assert_close(kinetic_energy(nm, q, qd), 0.5 * qd @ M @ qd, rtol=1e-12)
@@ -373,7 +373,7 @@ def test_energy_forms(case):
     ])
     assert_close(grad, gravity_torques(nm, q), rtol=1e-6)
 
-    Mdot = (mass_matrix_rnea(nm, q + h * qd) - mass_matrix_rnea(nm, q - h * qd)) / (2 * h)
+    Mdot = (M_rnea(nm, q + h * qd) - M_rnea(nm, q - h * qd)) / (2 * h)
     assert_close(qd @ coriolis_times_qd(nm, q, qd), 0.5 * qd @ Mdot @ qd, rtol=1e-6)
 
 
@@ -389,7 +389,7 @@ def test_zero_dof_robot():
     nm = numeric_model(model)
     assert nm.n == 0 and nm.nb == 2
     assert rnea(nm, [], [], []).shape == (0,)
-    assert mass_matrix_rnea(nm, []).shape == (0, 0)
+    assert M_rnea(nm, []).shape == (0, 0)
     assert_close(potential_energy(nm, []), 9.81 * 3.0)
     assert_close(link_poses(nm, [])["head"][1], [0, 0, 2])
 
@@ -469,7 +469,7 @@ def test_example_robot_data(robot, erd_robots_dir):
     for _ in range(3):
         q, qd, qdd = random_state(rng, nm.n)
         assert_close(rnea(nm, q, qd, qdd), ref.rnea(q, qd, qdd))
-        assert_close(mass_matrix_rnea(nm, q), ref.mass_matrix(q))
+        assert_close(M_rnea(nm, q), ref.mass_matrix(q))
         frames = ref.frame_poses(q)
         for name, (R, p) in link_poses(nm, q).items():
             if name in frames:
@@ -498,14 +498,14 @@ def test_one_rnea_in_float64_and_mpmath(robot, erd_robots_dir):
     q, qd, qdd = random_state(rng, nm.n)
     with mpmath.workdps(50):
         tau_mp = rnea(mm, q, qd, qdd)
-        M_mp = mass_matrix_rnea(mm, q)
+        M_mp = M_rnea(mm, q)
         assert all(isinstance(x, mpmath.mpf) for x in tau_mp)
         # the same 50-digit run at 30 digits: the two agree far below double precision
         with mpmath.workdps(30):
             tau_30 = rnea(mm, q, qd, qdd)
         assert max(abs(a - b) for a, b in zip(tau_mp, tau_30)) < mpmath.mpf(10) ** -25
     assert_close(np.array(tau_mp, dtype=float), rnea(nm, q, qd, qdd), rtol=1e-14)
-    M_float = mass_matrix_rnea(nm, q)
+    M_float = M_rnea(nm, q)
     assert_close(np.array(M_mp, dtype=float), M_float, rtol=1e-14)
     assert np.any(np.array(tau_mp, dtype=float) != rnea(nm, q, qd, qdd)) or \
         np.any(np.array(M_mp, dtype=float) != M_float)

@@ -22,7 +22,7 @@ import sympy as sp
 import eomgen
 from eomgen.bodies import body_tree
 from eomgen.dynamics import derive, joint_symbols
-from eomgen.numeric import coriolis_times_qd, gravity_torques, mass_matrix_rnea, numeric_model
+from eomgen.numeric import coriolis_times_qd, gravity_torques, M_rnea, numeric_model
 from eomgen.symbolic.composite import _routes, coriolis_program
 from eomgen.symbolic.evaluate import compile_program
 from eomgen.symbolic.opcount import program_operation_count
@@ -62,7 +62,7 @@ def test_every_route_of_M_and_g_equals_numeric_newton_euler(case):
     for _ in range(2):
         q, qd = rng.uniform(-2, 2, (2, model.dof))
         for name, M in M_routes.items():
-            assert close(M(q, qd), mass_matrix_rnea(nm, q)), name
+            assert close(M(q, qd), M_rnea(nm, q)), name
         for name, g in g_routes.items():
             assert close(g(q, qd)[:, 0], gravity_torques(nm, q)), name
 

@@ -254,7 +254,7 @@ def _rigid_reflected(model, q0, tau, duration):
 
     def f(t, x):
         q, qd = x[:2], x[2:]
-        M = numeric.mass_matrix_rnea(nm, q) + np.diag(B)
+        M = numeric.M_rnea(nm, q) + np.diag(B)
         h = numeric.rnea(nm, q, qd, np.zeros(2))
         return np.concatenate([qd, np.linalg.solve(M, tau - h)])
 

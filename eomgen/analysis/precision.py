@@ -48,7 +48,7 @@ from sympy.printing.pycode import MpmathPrinter
 
 from ..dynamics import Dynamics, derive
 from ..model import Inertial, RobotModel, Transform
-from ..numeric import NumericModel, Numbers, mass_matrix_rnea, numeric_model, rnea
+from ..numeric import NumericModel, Numbers, M_rnea, numeric_model, rnea
 from ..symbolic.printing import program_function
 from ..symbolic.program import Program
 
@@ -204,7 +204,7 @@ MPMATH = Numbers("mpmath", object, _to_mpf, _mpf_value, mpmath.sin, mpmath.cos, 
 def mp_model(model: RobotModel) -> NumericModel:
     """The numbers of ``model`` (parameters at their values) as mpf: the
     :class:`~eomgen.numeric.NumericModel` of :data:`MPMATH` numbers, on which
-    :func:`eomgen.numeric.rnea` and ``mass_matrix_rnea`` compute in mpmath. Use it on
+    :func:`eomgen.numeric.rnea` and ``M_rnea`` compute in mpmath. Use it on
     :func:`high_precision_model`'s result."""
     return numeric_model(model, numbers=MPMATH)
 
@@ -225,7 +225,7 @@ def _mp_values(x, n: int) -> list:
 #: Inverse dynamics and the mass matrix by Newton–Euler in mpmath: the one implementation of
 #: :mod:`eomgen.numeric` (generic over the number type) on an :func:`mp_model`.
 mp_rnea = rnea
-mp_mass_matrix = mass_matrix_rnea
+mp_M = M_rnea
 
 
 # ----------------------------------------------------------------------------------------------
@@ -310,7 +310,7 @@ class Reference:
     def M_rnea(self, q) -> np.ndarray:
         """Mass matrix (n, n) from the mpmath Newton–Euler recursion."""
         with mpmath.workdps(self.dps):
-            return mass_matrix_rnea(self.mp_model, q)
+            return M_rnea(self.mp_model, q)
 
     def tau_rnea(self, q, qd, qdd) -> np.ndarray:
         """Inverse dynamics (n,) from the mpmath Newton–Euler recursion."""
@@ -353,5 +353,5 @@ def _scalars(model: RobotModel):
 
 
 __all__ = ["DPS", "MODEL_DPS", "Reference", "high_precision_model", "compile_program_mp",
-           "MPMATH", "mp_model", "mp_rnea", "mp_mass_matrix", "relative_error", "max_abs",
+           "MPMATH", "mp_model", "mp_rnea", "mp_M", "relative_error", "max_abs",
            "to_float"]
