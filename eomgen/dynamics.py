@@ -20,7 +20,7 @@ import sympy as sp
 from .bodies import BodyTree, body_tree
 from .errors import TooLargeError
 from .model import Parameter, RobotModel
-from .outputs import BY_SYMBOL, INPUTS, derived_symbols
+from .outputs import BY_SYMBOL, INPUTS, derived_symbols, input_size
 from .symbolic.program import Program, ProgramBuilder
 from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS
 
@@ -350,7 +350,7 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     timings = []
     start = time.perf_counter()
     tree = body_tree(model)
-    inputs = {name: vector_symbols(name, model.dof) for name in INPUTS}
+    inputs = {name: vector_symbols(name, input_size(name, model)) for name in INPUTS}
     q, qd, qdd = inputs["q"], inputs["qd"], inputs["qdd"]
     reserved = {s.name for v in inputs.values() for s in v} | {p.name for p in model.parameters}
     builder = ProgramBuilder(reserved)

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 #: The vector inputs a generated function may take, each of length n (the joints, in
-#: ``JOINT_NAMES`` order), with their docstring line. Their symbols are ``<name>1 … <name>n``
+#: ``JOINT_NAMES`` order) unless :data:`INPUT_SIZES` gives another length, with their docstring line. Their symbols are ``<name>1 … <name>n``
 #: (:attr:`eomgen.dynamics.Derivation.inputs`); adding an input is one line here.
 INPUTS: dict[str, str] = {
     "q": "joint positions [rad or m]",
@@ -49,7 +49,21 @@ INPUTS: dict[str, str] = {
               "(entries of rigid joints are ignored)",
     "qddd": "third time derivatives of the joint positions (jerk) [rad/s^3 or m/s^3]",
     "qdddd": "fourth time derivatives of the joint positions (snap) [rad/s^4 or m/s^4]",
+    "F_c": "contact forces on the robot, rows CONTACT_ROWS (point contacts: force [N] in world "
+           "axes; surface contacts: force [N] and moment [N m] in the contact frame's axes)",
 }
+
+#: The inputs whose length is not the number of joints: ``"module:function"`` of
+#: ``function(model) -> int``, their length for a model (``F_c``: the contact rows).
+INPUT_SIZES: dict[str, str] = {
+    "F_c": "eomgen.symbolic.frames:contact_row_count",
+}
+
+
+def input_size(name: str, model) -> int:
+    """The length of input ``name`` (:data:`INPUTS`) for ``model``: its number of joints unless
+    :data:`INPUT_SIZES` says otherwise."""
+    return resolve(INPUT_SIZES[name])(model) if name in INPUT_SIZES else model.dof
 
 
 @dataclass(frozen=True)
@@ -328,6 +342,28 @@ CONTACT_BIAS = register_output(Output(
     "contact_bias", "dJqd_c", "Contact bias J_c-dot qd (m,): the constraint accelerations at "
     "qdd = 0, CONTACT_ROWS order.", ("q", "qd"), True, "m/s^2, rad/s^2", ("dJqd_c",),
     build=_CONTACTS, default=False, constants=_CONTACT_NAMES))
+FRAME_BODY_JACOBIANS_DOT_QD = register_output(Output(
+    "frame_body_jacobians_dot_qd", "dJbqd_f", "Jdot qd of the body frame Jacobians: the time "
+    "derivative of the body twist [v_b; omega_b] at qdd = 0, [R^T pddot - omega_b x v_b; R^T "
+    "omegadot], FRAME_NAMES order: (6 nf,).", ("q", "qd"), True, "m/s^2, rad/s^2", ("dJbqd_f",),
+    build=_FRAMES, default=False, constants=_FRAME_NAMES))
+CONTACT_INVERSE = register_output(Output(
+    "contact_inverse_dynamics", "tau_c", "Joint efforts tau = M(q) qdd + C(q, qd) qd + g(q) - "
+    "J_c(q)^T F_c giving qdd while the contacts push on the robot with F_c (CONTACT_ROWS, the "
+    "axes of contact_jacobian's rows).", ("q", "qd", "qdd", "F_c"), True, _REVOLUTE_EFFORT,
+    ("tau_c",), build="eomgen.symbolic.frames:build_contact_inverse_dynamics", default=False,
+    constants=_CONTACT_NAMES))
+_CONES = "eomgen.symbolic.frames:build_friction_cones"
+FRICTION_CONE = register_output(Output(
+    "friction_cone_margin", "cone_c", "Exact friction-cone margins mu f_n - |f_t| of the "
+    "contact forces F_c, one per contact (CONTACT_NAMES): >= 0 inside the cone.", ("F_c",),
+    True, "N", ("cone_c",), build=_CONES, default=False,
+    constants="eomgen.symbolic.frames:pyramid_constants"))
+FRICTION_PYRAMID = register_output(Output(
+    "friction_pyramid_margins", "pyramid_c", "Margins of the inscribed four-sided friction "
+    "pyramid, mu/sqrt(2) f_n -/+ f_t1 and -/+ f_t2 per contact (PYRAMID_ROWS), linear in F_c: "
+    "all >= 0 inside.", ("F_c",), True, "N", ("pyramid_c",), build=_CONES, default=False,
+    constants="eomgen.symbolic.frames:pyramid_constants"))
 CONSTRAINED_FORWARD = register_output(Output(
     "constrained_forward_dynamics", None, "(qdd, F_c) holding every contact: the KKT system "
     "[[M, -J_c^T], [J_c, 0]] [qdd; F_c] = [tau - (C qd + g); -J_c-dot qd].",
@@ -410,6 +446,6 @@ def composition_names(output: Output = FORWARD) -> dict[str, str]:
     return {"name": output.function, "mass": mass, "bias": bias}
 
 
-__all__ = ["INPUTS", "Output", "OUTPUTS", "resolve", "BY_SYMBOL", "register_output", "derived_symbols",
+__all__ = ["INPUTS", "INPUT_SIZES", "input_size", "Output", "OUTPUTS", "resolve", "BY_SYMBOL", "register_output", "derived_symbols",
            "function_names", "select", "composition_names", "MASS", "CORIOLIS", "GRAVITY", "INVERSE",
            "FORWARD", "exported", "constrained_names", "CONSTRAINED_FORWARD"]

@@ -350,7 +350,8 @@ def test_fixed_base_frames_are_pinocchios_local_world_aligned_jacobians(tmp_path
         warnings.simplefilter("ignore")
         arm = apply_scene(eomgen.load(path), load_scene(
             "f.yaml", text="version: 1\nframes: [tool0, forearm_link]\n")).model
-    files = render_files(arm, ["numpy"], functions=select_functions(FRAME_FUNCTIONS))
+    files = render_files(arm, ["numpy"], functions=select_functions(
+        FRAME_FUNCTIONS + ["frame_body_jacobians_dot_qd"]))
     _write(files, tmp_path)
     module = _load(files, tmp_path, "numpy", arm.name)
     assert tuple(module["FRAME_NAMES"]) == ("tool0", "forearm_link")
@@ -373,5 +374,9 @@ def test_fixed_base_frames_are_pinocchios_local_world_aligned_jacobians(tmp_path
                                    atol=1e-10)
         acc = pin.getFrameClassicalAcceleration(pm, pd, fid, pin.LOCAL_WORLD_ALIGNED)
         np.testing.assert_allclose(dJqd[rows], np.r_[acc.linear, acc.angular], atol=1e-10)
+        # the body J̇ q̇: Pinocchio's spatial frame acceleration in LOCAL at q̈ = 0
+        acc = pin.getFrameAcceleration(pm, pd, fid, pin.LOCAL)
+        np.testing.assert_allclose(module["frame_body_jacobians_dot_qd"](q, qd)[rows],
+                                   np.r_[acc.linear, acc.angular], atol=1e-10)
         np.testing.assert_allclose(module["frame_positions"](q)[k], pd.oMf[fid].translation,
                                    atol=1e-12)

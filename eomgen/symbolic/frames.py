@@ -261,7 +261,7 @@ def output_frames(model: RobotModel) -> tuple[str, ...]:
 
 #: What each frame output stacks, by symbol: (kind of :data:`FRAME_OUTPUTS`, rows per frame).
 FRAME_SYMBOLS = {"p_f": ("p", 3), "R_f": ("R", 3), "J_f": ("J", 6), "Jb_f": ("Jb", 6),
-                 "dJqd_f": ("dJqd", 6)}
+                 "dJqd_f": ("dJqd", 6), "dJbqd_f": ("dJbqd", 6)}
 
 
 def build_frames(derivation, wanted) -> dict:
@@ -274,7 +274,10 @@ def build_frames(derivation, wanted) -> dict:
       first**: ``[ṗ; ω] = J q̇`` (Pinocchio's ``getFrameJacobian(..., LOCAL_WORLD_ALIGNED)``,
       whose rows are also ``[v; ω]``, when q̇ is Pinocchio's velocity);
     * ``Jb_f`` (6 nf×n): the body Jacobian ``[R ᵀṗ; Rᵀω]`` (Pinocchio's ``LOCAL``);
-    * ``dJqd_f`` (6 nf,): ``J̇ q̇`` of ``J_f``, the classical acceleration ``[p̈; ω̇]`` at q̈ = 0.
+    * ``dJqd_f`` (6 nf,): ``J̇ q̇`` of ``J_f``, the classical acceleration ``[p̈; ω̇]`` at q̈ = 0;
+    * ``dJbqd_f`` (6 nf,): ``J̇ q̇`` of ``Jb_f``, the time derivative of the body twist at q̈ = 0,
+      ``[Rᵀp̈ − ω_b × v_b; Rᵀω̇]`` (Pinocchio's spatial ``getFrameAcceleration(..., LOCAL)`` at
+      q̈ = 0).
     """
     frames = output_frames(derivation.model)
     kin = frame_kinematics(derivation.model, derivation.tree, derivation.q, derivation.qd,
@@ -305,6 +308,23 @@ def contact_rows(model: RobotModel) -> tuple[str, ...]:
     return tuple(rows)
 
 
+def contact_row_count(model: RobotModel) -> int:
+    """m, the length of ``F_c`` and the rows of ``J_c``: 3 per point contact, 6 per surface
+    contact (0 without contacts)."""
+    return len(contact_rows(model))
+
+
+def _require_contacts(model: RobotModel) -> None:
+    from ..errors import GenerationError
+
+    if not model.contacts:
+        raise GenerationError(
+            f"{model.source}: contact outputs (contact_jacobian, contact_bias, "
+            f"constrained_forward_dynamics, contact_inverse_dynamics, friction cone margins) "
+            f"need contacts, and robot '{model.name}' has none: declare them in a scene "
+            "(contacts: [{frame: <link>}])")
+
+
 def build_contacts(derivation, wanted) -> dict:
     """The builder of ``J_c`` (m×n) and ``dJqd_c`` (``J̇_c q̇``, (m,)): the rows of the model's
     contacts as :class:`eomgen.contacts.ContactDynamics` stacks them, in contact order. A
@@ -318,14 +338,9 @@ def build_contacts(derivation, wanted) -> dict:
         When the model carries no contacts (a scene's ``contacts:``).
     """
     from ..contacts import POINT
-    from ..errors import GenerationError
 
     model = derivation.model
-    if not model.contacts:
-        raise GenerationError(
-            f"{model.source}: contact outputs (contact_jacobian, contact_bias, "
-            f"constrained_forward_dynamics) need contacts, and robot '{model.name}' has none: "
-            "declare them in a scene (contacts: [{frame: <link>}])")
+    _require_contacts(model)
     frames = tuple(dict.fromkeys(c.frame for c in model.contacts))
     kin = frame_kinematics(model, derivation.tree, derivation.q, derivation.qd,
                            derivation.builder, frames)
@@ -342,6 +357,96 @@ def build_contacts(derivation, wanted) -> dict:
     return {k: v for k, v in result.items() if k in wanted}
 
 
+def build_contact_inverse_dynamics(derivation, wanted) -> dict:
+    """The builder of ``tau_c`` (n,): the joint efforts ``τ = M q̈ + C q̇ + g − J_cᵀ F_c`` that
+    give the accelerations ``q̈`` while the contacts push on the robot with ``F_c`` (rows
+    ``CONTACT_ROWS``, in the axes of :func:`build_contacts`' rows: a point contact's force in
+    world axes at the frame origin, a surface contact's force and moment in the frame's axes).
+    It reuses the Newton–Euler ``tau`` and ``J_c`` already in the program."""
+    _require_contacts(derivation.model)
+    tau = derivation.output("tau")
+    J = derivation.output("J_c")
+    F = sp.Matrix(derivation.inputs["F_c"])
+    return {"tau_c": tau - J.T * F}
+
+
+def _friction_contacts(model: RobotModel) -> list:
+    """``(contact, first row, unit normal in the axes of its force rows)`` of every contact,
+    refusing contacts without a friction coefficient."""
+    from ..contacts import POINT
+    from ..errors import GenerationError
+
+    _require_contacts(model)
+    missing = [c.name for c in model.contacts if c.mu is None]
+    if missing:
+        raise GenerationError(
+            f"{model.source}: contact '{missing[0]}' has no friction coefficient: the friction "
+            "cone outputs need 'mu' on every contact of the scene")
+    out, row = [], 0
+    for c in model.contacts:
+        normal = np.asarray(c.normal if c.kind == POINT else (0.0, 0.0, 1.0), dtype=float)
+        out.append((c, row, normal / np.linalg.norm(normal)))
+        row += c.size
+    return out
+
+
+def _tangents(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit tangents ``t1, t2`` with ``(t1, t2, normal)`` right-handed: ``t1`` is the
+    coordinate axis least aligned with the normal, made orthogonal to it."""
+    axis = np.eye(3)[int(np.argmin(np.abs(normal)))]
+    t1 = axis - (axis @ normal) * normal
+    t1 /= np.linalg.norm(t1)
+    return t1, np.cross(normal, t1)
+
+
+def _exact(x: float):
+    """``x`` as a SymPy number: an integer when it is one (so that 0 drops out), else the
+    float."""
+    return sp.Integer(int(x)) if float(x).is_integer() else sp.Float(float(x))
+
+
+def build_friction_cones(derivation, wanted) -> dict:
+    """The builders of the friction-cone margins of the contact forces ``F_c`` (rows
+    ``CONTACT_ROWS``), one friction coefficient μ per contact (the scene's ``mu``):
+
+    * ``cone_c`` (nc,), the exact (second-order) cone: ``μ f_n − ‖f_t‖`` [N] per contact, with
+      ``f_n = f · n`` and ``f_t = f − f_n n``; ``≥ 0`` inside the cone (a pulling contact,
+      ``f_n < 0``, is outside);
+    * ``pyramid_c`` (4 nc,), the inscribed four-sided pyramid, linear in ``F_c`` (what a QP
+      takes): for each contact ``μ/√2 f_n − f_t1``, ``μ/√2 f_n + f_t1``, ``μ/√2 f_n − f_t2``,
+      ``μ/√2 f_n + f_t2`` [N], all ``≥ 0`` inside. Inside the pyramid implies inside the cone.
+
+    The normal ``n`` is a point contact's ``normal`` (world axes, like its force) or a surface
+    contact's frame +z axis (its force rows are in frame axes); ``f`` is the force part of the
+    contact's rows (a surface contact's moment is not checked). The tangents ``t1, t2`` complete
+    ``n`` to a right-handed frame, ``t1`` from the coordinate axis least aligned with ``n``
+    (for ``n = +z``: ``t1 = x``, ``t2 = y``).
+    """
+    F = derivation.inputs["F_c"]
+    cone, pyramid = [], []
+    for c, row, normal in _friction_contacts(derivation.model):
+        f = F[row:row + 3]
+        t1, t2 = _tangents(normal)
+        fn = sum(_exact(a) * x for a, x in zip(normal, f))
+        ft1 = sum(_exact(a) * x for a, x in zip(t1, f))
+        ft2 = sum(_exact(a) * x for a, x in zip(t2, f))
+        mu = _exact(c.mu)
+        cone.append(mu * fn - sp.sqrt(ft1 ** 2 + ft2 ** 2))
+        k = _exact(c.mu / np.sqrt(2))
+        pyramid += [k * fn - ft1, k * fn + ft1, k * fn - ft2, k * fn + ft2]
+    result = {"cone_c": sp.Matrix(cone), "pyramid_c": sp.Matrix(pyramid)}
+    return {k: v for k, v in result.items() if k in wanted}
+
+
+def pyramid_constants(dynamics) -> dict[str, tuple[str, ...]]:
+    """``CONTACT_NAMES`` and ``PYRAMID_ROWS``, the rows of ``friction_pyramid_margins``:
+    ``<contact>.-t1``, ``<contact>.+t1``, ``<contact>.-t2``, ``<contact>.+t2``."""
+    names = tuple(c.name for c in dynamics.model.contacts)
+    return {"CONTACT_NAMES": names,
+            "PYRAMID_ROWS": tuple(f"{name}.{side}" for name in names
+                                  for side in ("-t1", "+t1", "-t2", "+t2"))}
+
+
 def contact_constants(dynamics) -> dict[str, tuple[str, ...]]:
     """``CONTACT_NAMES`` (the contacts, in order) and ``CONTACT_ROWS`` (:func:`contact_rows`)."""
     model = dynamics.model
@@ -351,4 +456,5 @@ def contact_constants(dynamics) -> dict[str, tuple[str, ...]]:
 
 __all__ = ["FRAME_OUTPUTS", "FRAME_SYMBOLS", "FrameKinematics", "derive_frames", "frame_site",
            "frame_kinematics", "output_frames", "build_frames", "frame_constants", "contact_rows",
-           "build_contacts", "contact_constants"]
+           "build_contacts", "contact_constants", "contact_row_count", "build_contact_inverse_dynamics",
+           "build_friction_cones", "pyramid_constants"]

@@ -42,7 +42,8 @@ static const int parameter_has_default[NP + 1] = {
     0};
 
 /* ---------------------------------------------------------------------------------------- */
-/* The functions of one state: inputs x[j] (NQ,) each, parameters p (NP,), output row-major. */
+/* The functions of one state: inputs x[j] (NQ,) each (F_c: the contact rows), parameters p
+ * (NP,), output row-major. */
 
 /* Mass matrix M(q), symmetric positive definite.
  * Output 6x6, in kg m^2 (revolute rows/columns), kg (prismatic); 308 operations. */
@@ -768,6 +769,7 @@ typedef struct {
     const char *inputs[MAX_IN];
     int rows, cols;  /* cols 0: a vector of rows entries */
     kernel_t kernel;
+    int sizes[MAX_IN];  /* length of each input (0: NQ) */
 } function_t;
 
 static PyObject *ill_conditioned_warning = NULL;  /* IllConditionedWarning */
@@ -789,7 +791,7 @@ static void release(call_t *call)
         Py_CLEAR(call->arrays[i]);
 }
 
-static PyArrayObject *as_states(PyObject *object, const char *name)
+static PyArrayObject *as_states(PyObject *object, const char *name, int size)
 {
     PyArrayObject *array;
     if (PyArray_CheckExact(object) && PyArray_TYPE((PyArrayObject *)object) == NPY_DOUBLE &&
@@ -801,11 +803,11 @@ static PyArrayObject *as_states(PyObject *object, const char *name)
         if (array == NULL)
             return NULL;
     }
-    if (!((PyArray_NDIM(array) == 1 && PyArray_DIM(array, 0) == NQ) ||
-          (PyArray_NDIM(array) == 2 && PyArray_DIM(array, 1) == NQ))) {
+    if (!((PyArray_NDIM(array) == 1 && PyArray_DIM(array, 0) == size) ||
+          (PyArray_NDIM(array) == 2 && PyArray_DIM(array, 1) == size))) {
         PyObject *shape = PyObject_GetAttrString((PyObject *)array, "shape");
-        PyErr_Format(PyExc_ValueError, "%s must have shape (%d,) or (N, %d), got %R", name, NQ,
-                     NQ, shape);
+        PyErr_Format(PyExc_ValueError, "%s must have shape (%d,) or (N, %d), got %R", name, size,
+                     size, shape);
         Py_XDECREF(shape);
         Py_DECREF(array);
         return NULL;
@@ -882,7 +884,7 @@ static int parse(const function_t *f, PyObject *const *args, Py_ssize_t nargs,
             release(call);
             return -1;
         }
-        call->arrays[j] = as_states(given[j], f->inputs[j]);
+        call->arrays[j] = as_states(given[j], f->inputs[j], f->sizes[j] ? f->sizes[j] : NQ);
         if (call->arrays[j] == NULL) {
             release(call);
             return -1;
@@ -935,7 +937,7 @@ static PyObject *evaluate(const function_t *f, PyObject *const *args, Py_ssize_t
         Py_BEGIN_ALLOW_THREADS
         for (k = 0; k < call.states; ++k) {
             for (j = 0; j < f->n_in; ++j)
-                at[j] = in[j] + k * NQ;
+                at[j] = in[j] + k * (f->sizes[j] ? f->sizes[j] : NQ);
             f->kernel(at, call.p, out + k * size);
         }
         Py_END_ALLOW_THREADS
@@ -946,7 +948,7 @@ static PyObject *evaluate(const function_t *f, PyObject *const *args, Py_ssize_t
 
 static const function_t mass_matrix_function = {
     "mass_matrix", 1, {"q", NULL, NULL},
-    6, 6, mass_matrix_one};
+    6, 6, mass_matrix_one, {NQ, 0, 0}};
 
 static PyObject *mass_matrix(PyObject *self, PyObject *const *args, Py_ssize_t nargs,
                               PyObject *kwnames)
@@ -957,7 +959,7 @@ static PyObject *mass_matrix(PyObject *self, PyObject *const *args, Py_ssize_t n
 
 static const function_t coriolis_matrix_function = {
     "coriolis_matrix", 2, {"q", "qd", NULL},
-    6, 6, coriolis_matrix_one};
+    6, 6, coriolis_matrix_one, {NQ, NQ, 0}};
 
 static PyObject *coriolis_matrix(PyObject *self, PyObject *const *args, Py_ssize_t nargs,
                               PyObject *kwnames)
@@ -968,7 +970,7 @@ static PyObject *coriolis_matrix(PyObject *self, PyObject *const *args, Py_ssize
 
 static const function_t gravity_vector_function = {
     "gravity_vector", 1, {"q", NULL, NULL},
-    6, 0, gravity_vector_one};
+    6, 0, gravity_vector_one, {NQ, 0, 0}};
 
 static PyObject *gravity_vector(PyObject *self, PyObject *const *args, Py_ssize_t nargs,
                               PyObject *kwnames)
@@ -979,7 +981,7 @@ static PyObject *gravity_vector(PyObject *self, PyObject *const *args, Py_ssize_
 
 static const function_t inverse_dynamics_function = {
     "inverse_dynamics", 3, {"q", "qd", "qdd"},
-    6, 0, inverse_dynamics_one};
+    6, 0, inverse_dynamics_one, {NQ, NQ, NQ}};
 
 static PyObject *inverse_dynamics(PyObject *self, PyObject *const *args, Py_ssize_t nargs,
                               PyObject *kwnames)

@@ -34,19 +34,20 @@ PARAMETERS = {
 
 
 def _states(*named):
-    """The (array, name) inputs as floating JAX arrays of shape (N, NQ), then whether all of
-    them were single states. Shapes are static under jax.jit, so the checks run at tracing."""
+    """The (array, name) or (array, name, size) inputs as floating JAX arrays of shape (N, NQ)
+    or (N, size), then whether all of them were single states. Shapes are static under jax.jit, so the checks run at tracing."""
     arrays, singles = [], []
-    for x, name in named:
+    for x, name, *size in named:
+        size = size[0] if size else NQ
         x = jnp.asarray(x)
         if not jnp.issubdtype(x.dtype, jnp.floating):
             x = x.astype(jnp.result_type(float))
-        if x.ndim not in (1, 2) or x.shape[-1] != NQ:
-            raise ValueError(f"{name} must have shape ({NQ},) or (N, {NQ}), got {x.shape}")
+        if x.ndim not in (1, 2) or x.shape[-1] != size:
+            raise ValueError(f"{name} must have shape ({size},) or (N, {size}), got {x.shape}")
         arrays.append(x if x.ndim == 2 else x[jnp.newaxis, :])
         singles.append(x.ndim == 1)
     if len({x.shape[0] for x in arrays}) != 1:
-        got = ", ".join(f"{x.shape[0]} ({name})" for x, (_, name) in zip(arrays, named))
+        got = ", ".join(f"{x.shape[0]} ({name})" for x, (_, name, *_) in zip(arrays, named))
         raise ValueError(f"the inputs must hold the same number of states, got {got}")
     d = jnp.result_type(*arrays)
     return (*[x.astype(d) for x in arrays], all(singles))

@@ -35,19 +35,20 @@ PARAMETERS = {
 
 
 def _states(*named):
-    """The (tensor, name) inputs as floating tensors of shape (N, NQ) and one dtype, then
-    whether all of them were single states."""
+    """The (tensor, name) or (tensor, name, size) inputs as floating tensors of shape (N, NQ) or
+    (N, size) and one dtype, then whether all of them were single states."""
     arrays, singles = [], []
-    for x, name in named:
+    for x, name, *size in named:
+        size = size[0] if size else NQ
         x = torch.as_tensor(x)
         if not x.is_floating_point():
             x = x.to(torch.get_default_dtype())
-        if x.dim() not in (1, 2) or x.shape[-1] != NQ:
-            raise ValueError(f"{name} must have shape ({NQ},) or (N, {NQ}), got {tuple(x.shape)}")
+        if x.dim() not in (1, 2) or x.shape[-1] != size:
+            raise ValueError(f"{name} must have shape ({size},) or (N, {size}), got {tuple(x.shape)}")
         arrays.append(x if x.dim() == 2 else x.unsqueeze(0))
         singles.append(x.dim() == 1)
     if len({x.shape[0] for x in arrays}) != 1:
-        got = ", ".join(f"{x.shape[0]} ({name})" for x, (_, name) in zip(arrays, named))
+        got = ", ".join(f"{x.shape[0]} ({name})" for x, (_, name, *_) in zip(arrays, named))
         raise ValueError(f"the inputs must hold the same number of states, got {got}")
     d = arrays[0].dtype
     for x in arrays[1:]:

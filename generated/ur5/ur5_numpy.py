@@ -30,26 +30,26 @@ PARAMETERS = {
 }
 
 
-def _batch(x, name):
-    """x as a float array of shape (N, NQ), and whether it was a single state."""
+def _batch(x, name, size=NQ):
+    """x as a float array of shape (N, size), and whether it was a single state."""
     x = np.asarray(x, dtype=float)
-    if x.ndim == 1 and x.shape[0] == NQ:
+    if x.ndim == 1 and x.shape[0] == size:
         return x[np.newaxis, :], True
-    if x.ndim == 2 and x.shape[1] == NQ:
+    if x.ndim == 2 and x.shape[1] == size:
         return x, False
-    raise ValueError(f"{name} must have shape ({NQ},) or (N, {NQ}), got {x.shape}")
+    raise ValueError(f"{name} must have shape ({size},) or (N, {size}), got {x.shape}")
 
 
 def _states(*named):
-    """The (array, name) inputs as float arrays of shape (N, NQ), then whether all of them were
-    single states."""
+    """The (array, name) or (array, name, size) inputs as float arrays of shape (N, NQ) or
+    (N, size), then whether all of them were single states."""
     arrays, singles = [], []
-    for x, name in named:
-        x, one = _batch(x, name)
+    for x, name, *size in named:
+        x, one = _batch(x, name, *size)
         arrays.append(x)
         singles.append(one)
     if len({x.shape[0] for x in arrays}) != 1:
-        got = ", ".join(f"{x.shape[0]} ({name})" for x, (_, name) in zip(arrays, named))
+        got = ", ".join(f"{x.shape[0]} ({name})" for x, (_, name, *_) in zip(arrays, named))
         raise ValueError(f"the inputs must hold the same number of states, got {got}")
     return (*arrays, all(singles))
 

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from .. import Job
-from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUTS, composition_names,
+from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, INPUTS, composition_names,
                        constrained_names, exported)
 from ..functions import FunctionSpec
 
@@ -28,6 +28,7 @@ class PrintedFunction:
     operation_count: int
     units: str
     releases: list[list[str]]  # names no longer needed after each assignment
+    sizes: dict[str, int] | None = None  # lengths of the inputs not NQ long (INPUT_SIZES)
 
 
 def last_uses(assignments, outputs) -> list[list[str]]:
@@ -86,6 +87,7 @@ def print_function(spec: FunctionSpec, job: Job, doprint, element_name) -> Print
         operation_count=spec.operation_count,
         units=spec.units,
         releases=last_uses(spec.program.assignments, list(spec.output)),
+        sizes={a.name: len(a.symbols) for a in spec.arguments if a.name in INPUT_SIZES},
     )
 
 
@@ -154,6 +156,8 @@ def python_module_context(job: Job, printer, template: str, extra_exports=(),
         # q, qd, qdd and tau (forward dynamics takes tau), then any other input a function takes
         vector_inputs=[name for name in INPUTS if name in ("q", "qd", "qdd", "tau") or any(
             name == a.name for spec in job.specs for a in spec.arguments)],
+        input_sizes={name: len(job.dynamics.input_symbols[name]) for name in INPUT_SIZES
+                     if name in job.dynamics.input_symbols},
         dunder_all=dunder_all_lines(["JOINT_NAMES", "NQ", "PARAMETERS",
                                      *(name for name, _ in job.constants), *functions,
                                      *extra_exports]),

@@ -27,7 +27,7 @@ from sympy.printing.precedence import PRECEDENCE
 
 from ...compiler import c_compiler
 from .. import GeneratedFile, Job, register
-from ...outputs import FORWARD, composition_names, exported
+from ...outputs import FORWARD, INPUT_SIZES, composition_names, exported
 from ...symbolic.printing import FloatLiteralMixin
 from ..render import render
 
@@ -110,6 +110,9 @@ def _render_source(job: Job, config: FastConfig) -> str:
             name=spec.name, summary=spec.summary, inputs=[a.name for a in spec.arguments],
             slots=[f'"{a.name}"' for a in spec.arguments]
             + ["NULL"] * (max_inputs - len(spec.arguments)),
+            # lengths of the inputs (NQ for the joint vectors; F_c has the contact rows)
+            sizes=[str(len(a.symbols)) if a.name in INPUT_SIZES else "NQ" for a in spec.arguments]
+            + ["0"] * (max_inputs - len(spec.arguments)),
             rows=rows, cols=0 if spec.is_vector else cols, size=rows * cols,
             assignments=[(local[s].name, doprint(e)) for s, e in spec.program.assignments],
             entries=entries, operation_count=spec.operation_count, units=spec.units))
@@ -122,7 +125,10 @@ def _render_source(job: Job, config: FastConfig) -> str:
         keywords = ", *" + signature if signature else ""
         f["doc"] = c_string_literal(
             f"{f['name']}({', '.join(f['inputs'])}{keywords})\n--\n\n"
-            f"{f['summary']}\n\nInputs of shape (NQ,) or (N, NQ) in JOINT_NAMES order; returns "
+            f"{f['summary']}\n\nInputs of shape (NQ,) or (N, NQ) in JOINT_NAMES order"
+            + "".join(f", {name} of shape ({size},) or (N, {size})" for name, size
+                      in zip(f["inputs"], f["sizes"]) if size != "NQ")
+            + "; returns "
             f"shape {shape} or (N,) + that, in {f['units']}. {f['operation_count']} arithmetic "
             "operations per state.")
     forward_doc = c_string_literal(
