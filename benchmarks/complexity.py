@@ -313,6 +313,11 @@ def robots() -> None:
         separate = {o: program_operation_count(derive(model, outputs=(o,), simplify=False).program,
                                                [o]) for o in ("M", "C", "g")}
         counts["M+C+g separately"] = sum(separate.values())
+        # the several-result functions dynamics(q, qd) -> (M, C, g) and
+        # mass_matrix_and_bias(q, qd) -> (M, h): one program each
+        for symbol in ("MCg", "Mh"):
+            counts[symbol + " in one call"] = program_operation_count(
+                derive(model, outputs=(symbol,), simplify=False).program, [symbol])
         counts["crba"] = program_operation_count(crba_program(model)[1])
         counts["aba"] = program_operation_count(aba_program(model).program)
         counts["chol"] = program_operation_count(cholesky_program(model).program)

@@ -107,6 +107,11 @@ class Output:
     backends:
         For a composed output, the backends whose templates compose it (``None``: every one);
         the others leave it out of their modules.
+    returns:
+        For a function returning several results from one program (sharing its intermediates):
+        the symbols of the printed outputs it returns, in order. Its own ``symbol`` is then the
+        side-by-side matrix of those results (each n rows; a vector is one column), which the
+        module splits into the tuple it returns. Empty for a function of one result.
     """
 
     function: str
@@ -121,6 +126,7 @@ class Output:
     default: bool = True
     constants: str | None = None
     backends: tuple[str, ...] | None = None
+    returns: tuple[str, ...] = ()
 
     @property
     def composed(self) -> bool:
@@ -164,6 +170,9 @@ def register_output(output: Output) -> Output:
     missing = [f for f in output.composed_from if f not in OUTPUTS]
     if output.symbol is not None and output.build is None:
         raise ValueError(f"printed output {output.function!r} has no builder")
+    strangers = [s for s in output.returns if s not in BY_SYMBOL]
+    if strangers:
+        raise ValueError(f"{output.function!r} returns unregistered outputs {strangers}")
     unknown = [name for name in output.inputs if name not in INPUTS]
     if unknown:
         raise ValueError(f"{output.function!r} takes unknown inputs {unknown}; known: "
@@ -303,6 +312,35 @@ FLAT_TORQUE_SMOOTH = register_output(Output(
     "q(t), as flat_motor_torque but with Coulomb friction f tanh(v / w) in place of f sign(v) "
     "(the law of motor_forward_dynamics: a simulation fed with it follows q(t)).", ("q", "qd", "qdd", "qddd", "qdddd"), True, _REVOLUTE_EFFORT,
     ("tau_flat_smooth",), build=_FLAT, default=False))
+
+
+# Issue 18: several results from one program, sharing its work (``--outputs dynamics``).
+_COMBINED = "eomgen.symbolic.combined:build_combined"
+DYNAMICS = register_output(Output(
+    "dynamics", "MCg", "M(q), C(q, qd) and g(q) in one call: one program shares their work "
+    "(sines, rotations, recursions).", ("q", "qd"), False,
+    "the units of mass_matrix, coriolis_matrix and gravity_vector", ("MCg",), build=_COMBINED,
+    default=False,
+    returns=(MASS.symbol, CORIOLIS.symbol, GRAVITY.symbol)))
+MASS_AND_BIAS = register_output(Output(
+    "mass_matrix_and_bias", "Mh", "M(q) and h(q, qd) = C(q, qd) qd + g(q) in one call (what "
+    "forward dynamics and computed-torque control need): one program shares their work.",
+    ("q", "qd"), False, "the units of mass_matrix and nonlinear_effects", ("Mh",),
+    build=_COMBINED, default=False, returns=(MASS.symbol, NONLINEAR.symbol)))
+
+
+def splits(output: Output, n: int) -> tuple[tuple[str, int, int | None], ...]:
+    """How the module splits a several-result function's matrix (:attr:`Output.returns`):
+    ``(symbol, first column, end column or None for a vector's single column)`` per result."""
+    out, column = [], 0
+    for symbol in output.returns:
+        if BY_SYMBOL[symbol].is_vector:
+            out.append((symbol, column, None))
+            column += 1
+        else:
+            out.append((symbol, column, column + n))
+            column += n
+    return tuple(out)
 
 
 # --- issue 16: frame kinematics and contacts (eomgen.symbolic.frames) -----------------------
@@ -446,6 +484,6 @@ def composition_names(output: Output = FORWARD) -> dict[str, str]:
     return {"name": output.function, "mass": mass, "bias": bias}
 
 
-__all__ = ["INPUTS", "INPUT_SIZES", "input_size", "Output", "OUTPUTS", "resolve", "BY_SYMBOL", "register_output", "derived_symbols",
+__all__ = ["INPUTS", "splits", "DYNAMICS", "MASS_AND_BIAS", "INPUT_SIZES", "input_size", "Output", "OUTPUTS", "resolve", "BY_SYMBOL", "register_output", "derived_symbols",
            "function_names", "select", "composition_names", "MASS", "CORIOLIS", "GRAVITY", "INVERSE",
            "FORWARD", "exported", "constrained_names", "CONSTRAINED_FORWARD"]

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..dynamics import Dynamics
-from ..outputs import BY_SYMBOL, INPUTS, OUTPUTS, function_names, resolve, select
+from ..outputs import BY_SYMBOL, INPUTS, OUTPUTS, function_names, resolve, select, splits
 from ..symbolic.program import Program
 
 
@@ -55,6 +55,9 @@ class FunctionSpec:
     program: Program
     operation_count: int
     units: str
+    #: a several-result function (:attr:`eomgen.outputs.Output.returns`): ``(symbol, first
+    #: column, end column or None)`` of each result in ``output``; empty otherwise
+    returns: tuple[tuple[str, int, int | None], ...] = ()
 
 
 #: Identifiers every generated module uses itself, whatever its backend; parameters avoid them,
@@ -182,6 +185,7 @@ def function_specs(dynamics: Dynamics, functions=None,
             program=program,
             operation_count=program.operation_count() if count_operations else 0,
             units=units,
+            returns=splits(declared, dynamics.model.dof),
         ))
     return tuple(specs)
 

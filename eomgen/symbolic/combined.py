@@ -57,3 +57,18 @@ def build_nonlinear_effects(derivation, wanted) -> dict:
     zero = (sp.Integer(0),) * len(derivation.q)
     return {"h": inverse_dynamics_program(derivation.tree, derivation.q, derivation.qd, zero,
                                           derivation.model.gravity, derivation.builder)}
+
+
+def build_combined(derivation, wanted) -> dict:
+    """The builder of the several-result functions of :mod:`eomgen.outputs` (``returns``):
+    ``MCg`` = [M | C | g] (n × (2n + 1)) for ``dynamics(q, qd)`` and ``Mh`` = [M | h]
+    (n × (n + 1)) for ``mass_matrix_and_bias(q, qd)``, side by side from the outputs already in
+    the program (``derivation.output``), so that they are the separate functions' own results
+    and share every intermediate; the generated module splits them into tuples."""
+    from ..outputs import BY_SYMBOL
+
+    result = {}
+    for symbol in wanted:
+        parts = BY_SYMBOL[symbol].returns
+        result[symbol] = sp.Matrix.hstack(*(derivation.output(p) for p in parts))
+    return result

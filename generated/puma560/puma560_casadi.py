@@ -737,12 +737,13 @@ def _cholesky_solve(M, b):
     return ca.vertcat(*x)
 
 
-def _function(name, inputs, output, input_names, output_name):
-    """casadi.Function ``name`` of ``inputs`` (vectors, then parameters) with one output. By
-    name, a parameter left out takes its PARAMETERS value, a vector left out is zero."""
+def _function(name, inputs, outputs, input_names, output_names):
+    """casadi.Function ``name`` of ``inputs`` (vectors, then parameters) with ``outputs`` (one,
+    or several results of one program). By name, a parameter left out takes its PARAMETERS
+    value, a vector left out is zero."""
     vectors = len(inputs) - len(_PARAMETER_DEFAULTS)
     options = {"default_in": [0.0] * vectors + _PARAMETER_DEFAULTS}
-    return ca.Function(name, inputs, [output], input_names, [output_name], options)
+    return ca.Function(name, inputs, outputs, input_names, output_names, options)
 
 
 def _build():
@@ -756,25 +757,25 @@ def _build():
     functions = {}
     args = [vectors["q"]]
     functions["mass_matrix"] = _function(
-        "mass_matrix", args + parameters, _mass_matrix_expression(*args, *parameters),
-        ["q"] + names, "M")
+        "mass_matrix", args + parameters, [_mass_matrix_expression(*args, *parameters)],
+        ["q"] + names, ["M"])
     args = [vectors["q"], vectors["qd"]]
     functions["coriolis_matrix"] = _function(
-        "coriolis_matrix", args + parameters, _coriolis_matrix_expression(*args, *parameters),
-        ["q", "qd"] + names, "C")
+        "coriolis_matrix", args + parameters, [_coriolis_matrix_expression(*args, *parameters)],
+        ["q", "qd"] + names, ["C"])
     args = [vectors["q"]]
     functions["gravity_vector"] = _function(
-        "gravity_vector", args + parameters, _gravity_vector_expression(*args, *parameters),
-        ["q"] + names, "g")
+        "gravity_vector", args + parameters, [_gravity_vector_expression(*args, *parameters)],
+        ["q"] + names, ["g"])
     args = [vectors["q"], vectors["qd"], vectors["qdd"]]
     functions["inverse_dynamics"] = _function(
-        "inverse_dynamics", args + parameters, _inverse_dynamics_expression(*args, *parameters),
-        ["q", "qd", "qdd"] + names, "tau")
+        "inverse_dynamics", args + parameters, [_inverse_dynamics_expression(*args, *parameters)],
+        ["q", "qd", "qdd"] + names, ["tau"])
     M = _mass_matrix_expression(q, *parameters)
     bias = _inverse_dynamics_expression(q, qd, ca.SX.zeros(NQ, 1), *parameters)
     functions["forward_dynamics"] = _function(
-        "forward_dynamics", [q, qd, tau] + parameters, _cholesky_solve(M, tau - bias),
-        ["q", "qd", "tau"] + names, "qdd")
+        "forward_dynamics", [q, qd, tau] + parameters, [_cholesky_solve(M, tau - bias)],
+        ["q", "qd", "tau"] + names, ["qdd"])
     return functions
 
 

@@ -29,6 +29,7 @@ class PrintedFunction:
     units: str
     releases: list[list[str]]  # names no longer needed after each assignment
     sizes: dict[str, int] | None = None  # lengths of the inputs not NQ long (INPUT_SIZES)
+    returns: tuple = ()  # (symbol, start, stop or None) of a several-result function
 
 
 def last_uses(assignments, outputs) -> list[list[str]]:
@@ -88,6 +89,7 @@ def print_function(spec: FunctionSpec, job: Job, doprint, element_name) -> Print
         units=spec.units,
         releases=last_uses(spec.program.assignments, list(spec.output)),
         sizes={a.name: len(a.symbols) for a in spec.arguments if a.name in INPUT_SIZES},
+        returns=spec.returns,
     )
 
 

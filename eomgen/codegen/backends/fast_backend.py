@@ -115,21 +115,25 @@ def _render_source(job: Job, config: FastConfig) -> str:
             + ["0"] * (max_inputs - len(spec.arguments)),
             rows=rows, cols=0 if spec.is_vector else cols, size=rows * cols,
             assignments=[(local[s].name, doprint(e)) for s, e in spec.program.assignments],
-            entries=entries, operation_count=spec.operation_count, units=spec.units))
+            entries=entries, operation_count=spec.operation_count, units=spec.units,
+            returns=spec.returns))
     # the docstrings open with a text signature (inspect.signature reads it)
     signature = "".join(", " + p.identifier
                         + ("" if p.default is None else f"={float(p.default)!r}")
                         for p in job.parameters)
     for f in functions:
         shape = f"({f['rows']}, {f['cols']})" if f["cols"] else f"({f['rows']},)"
+        if f["returns"]:  # a tuple of results, each (NQ, NQ) or (NQ,)
+            shape = "(" + ", ".join(f"{symbol} (NQ, NQ)" if stop is not None else
+                                    f"{symbol} (NQ,)" for symbol, _, stop in f["returns"]) + ")"
         keywords = ", *" + signature if signature else ""
         f["doc"] = c_string_literal(
             f"{f['name']}({', '.join(f['inputs'])}{keywords})\n--\n\n"
             f"{f['summary']}\n\nInputs of shape (NQ,) or (N, NQ) in JOINT_NAMES order"
             + "".join(f", {name} of shape ({size},) or (N, {size})" for name, size
                       in zip(f["inputs"], f["sizes"]) if size != "NQ")
-            + "; returns "
-            f"shape {shape} or (N,) + that, in {f['units']}. {f['operation_count']} arithmetic "
+            + ("; returns the tuple " if f["returns"] else "; returns shape ")
+            + f"{shape} or (N,) + that, in {f['units']}. {f['operation_count']} arithmetic "
             "operations per state.")
     forward_doc = c_string_literal(
         f"{FORWARD.function}({', '.join(FORWARD.inputs)}, *{signature}, "
