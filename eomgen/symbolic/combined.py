@@ -45,7 +45,8 @@ def dynamics_program(model: RobotModel) -> tuple[tuple, tuple, Program]:
     M = M_program(tree, q, b)
     g = inverse_dynamics_program(tree, q, zero, zero, model.gravity, b)
     bias = inverse_dynamics_program(tree, q, qd, zero, model.gravity, b)
-    Cqd = sp.Matrix([[_name(b, bias[k, 0] - g[k, 0], f"Cqd{k + 1}")] for k in range(n)])
+    Cqd = sp.Matrix([[_name(b, bias[k, 0] - g[k, 0], f"Cqd{k + 1}", ("Cqd", k + 1))]
+                     for k in range(n)])
     outputs = (("M", M), ("Cqd", Cqd), ("g", g))
     return q, qd, Program(tuple(b.assignments), outputs).pruned([o for o, _ in outputs])
 

@@ -329,8 +329,8 @@ def _world_composites(tree: BodyTree, q, b: ProgramBuilder) -> tuple:
     kin = forward_kinematics(tree, q, b)
     world = body_inertia_in_world(tree, kin, b)
     comp = composite_inertias(tree, world, b)
-    F = [b.define_all(comp[j].apply(kin.S[j]), f"F{tree.bodies[j].q_index + 1}_")
-         for j in range(len(tree.bodies))]
+    F = [b.define_all(comp[j].apply(kin.S[j]), f"F{tree.bodies[j].q_index + 1}_",
+                      ("F", tree.bodies[j].q_index + 1)) for j in range(len(tree.bodies))]
     b.memo[key] = (tree, (kin, world, comp, F))  # the tree kept alive: its id stays its own
     return b.memo[key][1]
 
@@ -344,7 +344,8 @@ def composite_M_program(tree: BodyTree, q, b: ProgramBuilder) -> sp.Matrix:
     M = sp.zeros(n, n)
     for j in range(n):
         for i in [j] + tree.ancestors(j):
-            value = b.define(_dot(kin.S[i], F[j]), f"M{idx[i] + 1}_{idx[j] + 1}")
+            value = b.define(_dot(kin.S[i], F[j]), f"M{idx[i] + 1}_{idx[j] + 1}",
+                             ("M", idx[i] + 1, idx[j] + 1))
             M[idx[i], idx[j]] = M[idx[j], idx[i]] = value
     return M
 
@@ -355,7 +356,8 @@ def composite_gravity_program(tree: BodyTree, q, gravity: Vec3, b: ProgramBuilde
     _, _, _, F = _world_composites(tree, q, b)
     g = sp.zeros(len(tree.bodies), 1)
     for i, body in enumerate(tree.bodies):
-        g[body.q_index, 0] = b.define(-_dot(gravity, F[i][3:]), f"g{body.q_index + 1}")
+        g[body.q_index, 0] = b.define(-_dot(gravity, F[i][3:]), f"g{body.q_index + 1}",
+                                      ("g", body.q_index + 1))
     return g
 
 
@@ -411,9 +413,9 @@ def coriolis_program(tree: BodyTree, q, qd, b: ProgramBuilder) -> sp.Matrix:
     V, Sd = [], []
     for i, body in enumerate(tree.bodies):
         V_p = V[body.parent] if body.parent >= 0 else zero6
-        Sd.append(b.define_all(motion_cross(V_p, S[i]), f"Sd{idx[i]}_"))
+        Sd.append(b.define_all(motion_cross(V_p, S[i]), f"Sd{idx[i]}_", ("Sd", idx[i])))
         V.append(b.define_all(tuple(V_p[r] + S[i][r] * qd[body.q_index] for r in range(6)),
-                              f"V{idx[i]}_"))
+                              f"V{idx[i]}_", ("V", idx[i])))
     # per body: momentum I_k V_k, rates of the first moment and of the rotational inertia
     momentum, h_rate, I_rate = [], [], []
     for i, par in enumerate(world):
@@ -427,11 +429,12 @@ def coriolis_program(tree: BodyTree, q, qd, b: ProgramBuilder) -> sp.Matrix:
                         + (hv if r == c else 0) for c in range(3)] for r in range(3)])
     for i in reversed(range(n)):
         tag = idx[i]
-        momentum[i] = b.define_all(momentum[i], f"hV{tag}_")
-        h_rate[i] = b.define_all(h_rate[i], f"hd{tag}_")
+        momentum[i] = b.define_all(momentum[i], f"hV{tag}_", ("hV", tag))
+        h_rate[i] = b.define_all(h_rate[i], f"hd{tag}_", ("hd", tag))
         for r in range(3):
             for c in range(r, 3):
-                I_rate[i][r][c] = I_rate[i][c][r] = b.define(I_rate[i][r][c], f"Id{tag}_{r}{c}")
+                I_rate[i][r][c] = I_rate[i][c][r] = b.define(I_rate[i][r][c], f"Id{tag}_{r}{c}",
+                                                             ("Id", tag, r, c))
         parent = tree.bodies[i].parent
         if parent >= 0:
             momentum[parent] = [x + y for x, y in zip(momentum[parent], momentum[i])]
@@ -447,16 +450,19 @@ def coriolis_program(tree: BodyTree, q, qd, b: ProgramBuilder) -> sp.Matrix:
         IdS = rate.apply(S[j])                                # İ^c_j S_j
         X = force_cross(S[j], momentum[j])                    # S_j ×* h^c_j
         ISd = comp[j].apply(Sd[j])
-        F1 = b.define_all(tuple(ISd[r] + half * (IdS[r] + X[r]) for r in range(6)), f"Fa{tag}_")
-        C[tag - 1, tag - 1] = b.define(_dot(S[j], F1), f"C{tag}_{tag}")
+        F1 = b.define_all(tuple(ISd[r] + half * (IdS[r] + X[r]) for r in range(6)), f"Fa{tag}_",
+                          ("Fa", tag))
+        C[tag - 1, tag - 1] = b.define(_dot(S[j], F1), f"C{tag}_{tag}", ("C", tag, tag))
         ancestors = tree.ancestors(j)
         if not ancestors:
             continue
-        F3 = b.define_all(tuple(half * (IdS[r] - X[r]) for r in range(6)), f"Fb{tag}_")
+        F3 = b.define_all(tuple(half * (IdS[r] - X[r]) for r in range(6)), f"Fb{tag}_",
+                          ("Fb", tag))
         for i in ancestors:
             a, c = tree.bodies[i].q_index, tree.bodies[j].q_index
-            C[a, c] = b.define(_dot(S[i], F1), f"C{idx[i]}_{tag}")
-            C[c, a] = b.define(_dot(Sd[i], F) + _dot(S[i], F3), f"C{tag}_{idx[i]}")
+            C[a, c] = b.define(_dot(S[i], F1), f"C{idx[i]}_{tag}", ("C", idx[i], tag))
+            C[c, a] = b.define(_dot(Sd[i], F) + _dot(S[i], F3), f"C{tag}_{idx[i]}",
+                               ("C", tag, idx[i]))
     return C
 
 

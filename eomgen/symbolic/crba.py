@@ -50,26 +50,27 @@ def M_program(tree: BodyTree, q, b: ProgramBuilder, grouped: bool = True) -> sp.
     for i in reversed(range(n)):
         body = tree.bodies[i]
         tag = body.q_index + 1
-        A = _symmetric(b, IC[i][0], f"Ic{tag}_A")
-        B = _full(b, IC[i][1], f"Ic{tag}_B")
-        C = _symmetric(b, IC[i][2], f"Ic{tag}_C")
+        A = _symmetric(b, IC[i][0], f"Ic{tag}_A", ("Icb", tag, 0))
+        B = _full(b, IC[i][1], f"Ic{tag}_B", ("Icb", tag, 1))
+        C = _symmetric(b, IC[i][2], f"Ic{tag}_C", ("Icb", tag, 2))
         S_ang, S_lin = subspace(i)
         Bt = tuple(tuple(B[c][r] for c in range(3)) for r in range(3))
         F_n = _name_all(b, tuple(x + y for x, y in zip(_matvec(A, S_ang), _matvec(B, S_lin))),
-                        f"F{tag}_{tag}n")
+                        f"F{tag}_{tag}n", ("Fbody", tag, tag, 0))
         F_f = _name_all(b, tuple(x + y for x, y in zip(_matvec(Bt, S_ang), _matvec(C, S_lin))),
-                        f"F{tag}_{tag}f")
+                        f"F{tag}_{tag}f", ("Fbody", tag, tag, 1))
         M[body.q_index, body.q_index] = _name(b, _dot(S_ang, F_n) + _dot(S_lin, F_f),
-                                              f"M{tag}_{tag}")
+                                              f"M{tag}_{tag}", ("M", tag, tag))
         j = i
         while tree.bodies[j].parent >= 0:
             F_n, F_f = _force_to_parent(frames, j, F_n, F_f)
             j = tree.bodies[j].parent
             other = tree.bodies[j].q_index
-            F_n = _name_all(b, F_n, f"F{other + 1}_{tag}n")
-            F_f = _name_all(b, F_f, f"F{other + 1}_{tag}f")
+            F_n = _name_all(b, F_n, f"F{other + 1}_{tag}n", ("Fbody", other + 1, tag, 0))
+            F_f = _name_all(b, F_f, f"F{other + 1}_{tag}f", ("Fbody", other + 1, tag, 1))
             S_ang, S_lin = subspace(j)
-            value = _name(b, _dot(S_ang, F_n) + _dot(S_lin, F_f), f"M{other + 1}_{tag}")
+            value = _name(b, _dot(S_ang, F_n) + _dot(S_lin, F_f), f"M{other + 1}_{tag}",
+                          ("M", other + 1, tag))
             M[other, body.q_index] = M[body.q_index, other] = value
         if body.parent >= 0:
             A_p, B_p, C_p = _inertia_to_parent(frames, i, A, B, C, b, tag)

@@ -37,7 +37,7 @@ import sympy as sp
 from ..bodies import BodyTree, InertialParameters
 from ..model import Transform, Vec3
 from .composite import _cross, _dot, _matvec
-from .program import ProgramBuilder
+from .program import ProgramBuilder, Tag, _tag
 
 
 def _rotate_back(axis: Vec3, c, s, v) -> tuple:
@@ -82,18 +82,23 @@ def _leads_negative(expr: sp.Expr) -> bool:
     return expr.is_Mul and expr.could_extract_minus_sign()
 
 
-def _name(b: ProgramBuilder, expr, hint: str) -> sp.Expr:
-    """``b.define(expr)``, but an expression that leads with a minus sign is named negated and
-    used as ``−name``: the sign then folds into the products and sums that use it."""
+def _name(b: ProgramBuilder, expr, hint: str, tag=None) -> sp.Expr:
+    """``b.define(expr, hint, tag)``, but an expression that leads with a minus sign is named
+    negated and used as ``−name``: the sign then folds into the products and sums that use it
+    (its tag then says what the negated entry is: documents print the name's definition)."""
     expr = sp.sympify(expr)
     if _leads_negative(expr):
         negated = sp.Add(*[-t for t in expr.args]) if expr.is_Add else -expr
-        return -b.define(negated, hint)
-    return b.define(expr, hint)
+        return -b.define(negated, hint, tag)
+    return b.define(expr, hint, tag)
 
 
-def _name_all(b: ProgramBuilder, exprs, hint: str) -> tuple:
-    return tuple(_name(b, e, f"{hint}{k}") for k, e in enumerate(exprs))
+def _name_all(b: ProgramBuilder, exprs, hint: str, tag=None) -> tuple:
+    """:func:`_name` of each entry, hinted ``hint0, hint1, …``; entry k is tagged with ``tag``
+    (``(family, index...)``) followed by k."""
+    tag = _tag(tag)
+    return tuple(_name(b, e, f"{hint}{k}", None if tag is None else
+                       Tag(tag.family, tag.index + (k,))) for k, e in enumerate(exprs))
 
 
 def _invariant_part(axis: Vec3, revolute: bool, par: InertialParameters) -> InertialParameters:
@@ -155,7 +160,8 @@ def _folded(par: InertialParameters) -> InertialParameters:
 
 def _khalil_U(w, dw, b: ProgramBuilder, tag) -> tuple:
     """U = [ω̇]× + [ω]×[ω]× = [ω̇]× + ω ωᵀ − |ω|² 1, entries named (only those used survive)."""
-    ww = [[_name(b, w[r] * w[c], f"ww{tag}_{r}{c}") for c in range(3)] for r in range(3)]
+    ww = [[_name(b, w[r] * w[c], f"ww{tag}_{r}{c}", ("ww", tag, r, c)) for c in range(3)]
+          for r in range(3)]
     for r in range(3):
         for c in range(r):
             ww[r][c] = ww[c][r]
@@ -166,9 +172,9 @@ def _khalil_U(w, dw, b: ProgramBuilder, tag) -> tuple:
         for c in range(3):
             if r == c:  # −(ω_j² + ω_k²), named without its sign
                 e = -b.define(sum((ww[x][x] for x in range(3) if x != r), sp.Integer(0)),
-                              f"U{tag}_{r}{c}")
+                              f"U{tag}_{r}{c}", ("U", tag, r, c))
             else:
-                e = _name(b, ww[r][c] + skew[r][c], f"U{tag}_{r}{c}")
+                e = _name(b, ww[r][c] + skew[r][c], f"U{tag}_{r}{c}", ("U", tag, r, c))
             row.append(e)
         U.append(tuple(row))
     return tuple(U)
@@ -187,8 +193,8 @@ class _Frames:
         for body in tree.bodies:
             k = body.q_index
             if body.joint.type.is_revolute:
-                sincos.append((_name(b, sp.sin(q[k]), f"s{k + 1}"),
-                               _name(b, sp.cos(q[k]), f"c{k + 1}")))
+                sincos.append((_name(b, sp.sin(q[k]), f"s{k + 1}", ("s", k + 1)),
+                               _name(b, sp.cos(q[k]), f"c{k + 1}", ("c", k + 1))))
             else:
                 sincos.append(None)
         return cls(tree, q, sincos)
@@ -249,7 +255,8 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
         tag = k + 1
         z = body.joint.axis
         if body.joint.type.is_revolute:
-            sincos.append((_name(b, sp.sin(q[k]), f"s{tag}"), _name(b, sp.cos(q[k]), f"c{tag}")))
+            sincos.append((_name(b, sp.sin(q[k]), f"s{tag}", ("s", tag)),
+                           _name(b, sp.cos(q[k]), f"c{tag}", ("c", tag))))
         else:
             sincos.append(None)
         if body.parent < 0:
@@ -259,20 +266,21 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
             w_p, dw_p, a_p, U_p = omega[p], domega[p], acc[p], khalil[p]
         # origin acceleration of this body in the parent frame: a_p + U_p r
         Ur = _matvec(U_p, offset(i))
-        a_o = _name_all(b, tuple(a_p[j] + Ur[j] for j in range(3)), f"ap{tag}_")
+        a_o = _name_all(b, tuple(a_p[j] + Ur[j] for j in range(3)), f"ap{tag}_", ("ap", tag))
         if body.joint.type.is_revolute:
-            a = _name_all(b, to_body(i, a_o), f"a{tag}_")
-            w_in = _name_all(b, to_body(i, w_p), f"wp{tag}_")
-            w = _name_all(b, tuple(w_in[j] + z[j] * qd[k] for j in range(3)), f"w{tag}_")
+            a = _name_all(b, to_body(i, a_o), f"a{tag}_", ("a", tag))
+            w_in = _name_all(b, to_body(i, w_p), f"wp{tag}_", ("wp", tag))
+            w = _name_all(b, tuple(w_in[j] + z[j] * qd[k] for j in range(3)), f"w{tag}_",
+                          ("w", tag))
             dw_rel = _cross(w_in, tuple(z[j] * qd[k] for j in range(3)))
             dw = _name_all(b, tuple(e + dw_rel[j] + z[j] * qdd[k] for j, e in
-                                    enumerate(to_body(i, dw_p))), f"dw{tag}_")
+                                    enumerate(to_body(i, dw_p))), f"dw{tag}_", ("dw", tag))
         else:
-            w = _name_all(b, to_body(i, w_p), f"w{tag}_")
-            dw = _name_all(b, to_body(i, dw_p), f"dw{tag}_")
+            w = _name_all(b, to_body(i, w_p), f"w{tag}_", ("w", tag))
+            dw = _name_all(b, to_body(i, dw_p), f"dw{tag}_", ("dw", tag))
             cor = _cross(w, tuple(2 * z[j] * qd[k] for j in range(3)))
             a = _name_all(b, tuple(e + cor[j] + z[j] * qdd[k] for j, e in
-                                   enumerate(to_body(i, a_o))), f"a{tag}_")
+                                   enumerate(to_body(i, a_o))), f"a{tag}_", ("a", tag))
         omega.append(w)
         domega.append(dw)
         acc.append(a)
@@ -287,7 +295,7 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
         w, dw, a = omega[i], domega[i], acc[i]
         Uh = _matvec(khalil[i], h)
         f = tuple(m * a[j] + Uh[j] for j in range(3))
-        Iw = _name_all(b, _matvec(I, w), f"Iw{tag}_")
+        Iw = _name_all(b, _matvec(I, w), f"Iw{tag}_", ("Iomega", tag))
         nn = tuple(x + y + z_ for x, y, z_ in zip(_matvec(I, dw), _cross(w, Iw), _cross(h, a)))
         force[i] = list(f)
         moment[i] = list(nn)
@@ -296,14 +304,14 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
     for i in reversed(range(n)):
         body = tree.bodies[i]
         tag = body.q_index + 1
-        f = _name_all(b, force[i], f"f{tag}_")
-        nn = _name_all(b, moment[i], f"n{tag}_")
+        f = _name_all(b, force[i], f"f{tag}_", ("f", tag))
+        nn = _name_all(b, moment[i], f"n{tag}_", ("n", tag))
         axis = body.joint.axis
         tau[body.q_index, 0] = _name(b, _dot(axis, nn if body.joint.type.is_revolute else f),
-                                        f"{hint}{tag}")
+                                        f"{hint}{tag}", ("effort", tag))
         p = body.parent
         if p >= 0:
-            f_p = _name_all(b, to_parent(i, f), f"fp{tag}_")
+            f_p = _name_all(b, to_parent(i, f), f"fp{tag}_", ("fp", tag))
             n_p = to_parent(i, nn)
             rf = _cross(offset(i), f_p)
             for j in range(3):
