@@ -301,3 +301,33 @@ def test_cli_bench_runs(tmp_path):
     assert result.exit_code == 0, result.output
     assert "## inverse dynamics" in result.output and "NumPy, batch" in result.output
     assert (tmp_path / "bench_planar_2link.png").is_file()
+
+
+def test_generated_numpy_modules_include_the_one_cholesky_runtime(tmp_path):
+    """One copy of the forward-dynamics solve: a generated NumPy module holds the text of
+    eomgen.runtime.cholesky verbatim, and its solve and eomgen's give the same q̈ and condition
+    number and both warn on the same ill-conditioned M (built with a known condition number)."""
+    from eomgen.codegen.functions import select_functions
+    from eomgen.codegen.generate import render_files
+    from eomgen.runtime.cholesky import included_source
+
+    arm = eomgen.load(eomgen.example_path("planar_2link"))
+    (numpy_file,) = render_files(arm, ["numpy"], functions=select_functions(None))
+    text = numpy_file.content
+    assert included_source() in text and "import eomgen" not in text
+    namespace: dict = {}
+    exec(compile(text, "planar_2link_numpy.py", "exec"), namespace)  # noqa: S102
+    rng = np.random.default_rng(0)
+    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    for cond in (1e3, 1e11):
+        M = Q @ np.diag([1.0, 0.5, 1.0 / cond]) @ Q.T
+        b = rng.normal(size=3)
+        with warnings.catch_warnings(record=True) as ours:
+            warnings.simplefilter("always")
+            x, c = cholesky_solve(M, b)
+        with warnings.catch_warnings(record=True) as theirs:
+            warnings.simplefilter("always")
+            x_gen, c_gen = namespace["_cholesky_solve"](M, b)
+        assert np.array_equal(x, x_gen) and c == c_gen
+        np.testing.assert_allclose(M @ x, b, rtol=0, atol=1e-15 * cond)
+        assert (len(ours) == 1) == (len(theirs) == 1) == (cond > 1e10)

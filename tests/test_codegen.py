@@ -789,7 +789,10 @@ def hostile_star(robot_name: str) -> RobotModel:
 
 NUMPY_CALLS = {"_batch", "_states", "mass_matrix", "inverse_dynamics", "ValueError", "len", "range",
                "reversed", "zip", "all", "int", "_at", "_not_positive_definite",
-               "FloatingPointError"}
+               "FloatingPointError",
+               # the Cholesky runtime (eomgen/runtime/cholesky.py), included verbatim
+               "_cholesky_solve", "_condition_number", "_condition_estimate",
+               "_ill_conditioned_message"}
 NUMPY_LOCAL_OBJECTS = {"arrays", "singles", "_warnings"}
 CASADI_LOCAL_OBJECTS = {"PARAMETERS"}  # the module's dict literal: PARAMETERS.values()
 CASADI_CALLS = {"_build", "_function", "_cholesky_solve", "sum", "range", "reversed", "len",

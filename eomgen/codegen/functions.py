@@ -69,7 +69,10 @@ RESERVED_IDENTIFIERS = frozenset(
      "self", "cls", "L", "x", "y", "d",
      "rhs", "bias", "args", "names", "vectors", "functions", "parameters", "q_columns",
      "qd_columns", "qdd_columns", "k", "finite", "condition", "return_condition",
-     "close", "eigenvalues", "IllConditionedWarning"}
+     "close", "eigenvalues", "IllConditionedWarning",
+     # the Cholesky runtime NumPy modules include (eomgen.runtime.cholesky)
+     "_CONDITION_LIMIT", "_EXACT_FROM", "_condition_estimate", "_condition_number",
+     "_ill_conditioned_message", "_cholesky_solve", "_at", "_not_positive_definite"}
 ) | frozenset(keyword.kwlist) | frozenset(keyword.softkwlist) | frozenset(dir(builtins))
 
 

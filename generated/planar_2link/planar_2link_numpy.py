@@ -261,13 +261,96 @@ def inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.083333333333333
     return out[0] if single else out
 
 
-#: forward_dynamics warns when its condition estimate of M exceeds this (cond(M) * eps > 1e-6).
+#: forward_dynamics warns when the condition number of M exceeds this (cond(M) * eps > 1e-6).
 _CONDITION_LIMIT = 1e-6 / np.finfo(float).eps
+#: Above this estimate the exact condition number is computed (eigenvalues of M).
+_EXACT_FROM = 1e-4 * _CONDITION_LIMIT
 
 
 class IllConditionedWarning(RuntimeWarning):
-    """forward_dynamics: M(q) is so ill-conditioned (cond(M) * eps > 1e-6) that qdd may carry a
-    relative error up to about cond(M) * eps."""
+    """M(q) is so ill-conditioned (cond(M) * eps > 1e-6) that qdd may carry a relative error
+    up to about cond(M) * eps."""
+
+
+def _condition_estimate(L):
+    """(max L_ii / min L_ii)^2 of Cholesky factors L, (n, n) or (N, n, n): a lower bound of
+    the 2-norm condition number of L L^T; 1 for n = 0."""
+    d = np.abs(np.diagonal(L, axis1=-2, axis2=-1))
+    if d.shape[-1] == 0:
+        return np.ones(d.shape[:-1])
+    with np.errstate(divide="ignore"):
+        return (np.max(d, axis=-1) / np.min(d, axis=-1)) ** 2
+
+
+def _condition_number(M, L):
+    """The 2-norm condition number of M (n, n) or (N, n, n) with Cholesky factors L: the
+    estimate, replaced by the exact value (eigenvalues) where it exceeds _EXACT_FROM."""
+    condition = np.array(_condition_estimate(L), dtype=float)
+    close = condition > _EXACT_FROM
+    if np.any(close):
+        eigenvalues = np.linalg.eigvalsh(M[close] if M.ndim == 3 else M)
+        exact = eigenvalues[..., -1] / np.maximum(eigenvalues[..., 0], np.finfo(float).tiny)
+        condition[close] = np.maximum(condition[close], exact)
+    return condition
+
+
+def _ill_conditioned_message(condition, where="", who=""):
+    """The IllConditionedWarning text (``who``: the function's name and a colon, or empty)."""
+    return (f"{who}M(q) is ill-conditioned{where}: cond(M) >= {condition:.2e}, so qdd may "
+            f"carry a relative error up to about cond(M)*eps = "
+            f"{condition * np.finfo(float).eps:.1e}")
+
+
+def _cholesky_solve(M, b, warn=True, who="", stacklevel=1):
+    """Solve M x = b for symmetric positive definite M: one system ((n, n), (n,)) or a batch
+    ((N, n, n), (N, n)). Returns (x, condition), condition the condition number of each M.
+
+    Raises numpy.linalg.LinAlgError when M is not positive definite and FloatingPointError when
+    M or b is not finite, naming the first such state of a batch; warns IllConditionedWarning
+    (when ``warn``) when the condition number exceeds _CONDITION_LIMIT. ``who`` prefixes the
+    messages (e.g. "forward_dynamics: ")."""
+    M = np.asarray(M, dtype=float)
+    b = np.asarray(b, dtype=float)
+    single = M.ndim == 2
+    Mb, bb = (M[np.newaxis], b[np.newaxis]) if single else (M, b)
+    finite = np.all(np.isfinite(Mb), axis=(1, 2)) & np.all(np.isfinite(bb), axis=1)
+    if not np.all(finite):
+        raise FloatingPointError(
+            f"{who}M(q) or the right-hand side (C(q, qd) qd + g(q), tau) is not finite"
+            f"{_at(int(np.argmin(finite)), single)} (overflow, or non-finite input)")
+    try:
+        L = np.linalg.cholesky(Mb)
+    except np.linalg.LinAlgError:
+        raise np.linalg.LinAlgError(
+            f"{who}M(q) is not positive definite{_at(_not_positive_definite(Mb), single)}: a "
+            "joint moves no mass or inertia, or the inertias are not physical") from None
+    condition = _condition_number(Mb, L)
+    k = int(np.argmax(condition)) if condition.size else 0
+    if warn and condition.size and condition[k] > _CONDITION_LIMIT:
+        _warnings.warn(_ill_conditioned_message(condition[k], _at(k, single), who),
+                       IllConditionedWarning, stacklevel=stacklevel + 1)
+    n = Mb.shape[-1]
+    y = np.zeros_like(bb)
+    for i in range(n):  # L y = b, then L^T x = y: one pass over the batch per row
+        y[:, i] = (bb[:, i] - np.einsum("nj,nj->n", L[:, i, :i], y[:, :i])) / L[:, i, i]
+    x = np.zeros_like(bb)
+    for i in reversed(range(n)):
+        x[:, i] = (y[:, i] - np.einsum("nj,nj->n", L[:, i + 1:, i], x[:, i + 1:])) / L[:, i, i]
+    return (x[0], condition[0]) if single else (x, condition)
+
+
+def _at(k, single):
+    return "" if single else f" at state {k}"
+
+
+def _not_positive_definite(M):
+    """The first of the (N, n, n) matrices M whose Cholesky factorisation fails."""
+    for k in range(M.shape[0]):
+        try:
+            np.linalg.cholesky(M[k])
+        except np.linalg.LinAlgError:
+            return k
+    return 0
 
 
 def forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0, return_condition=False):
@@ -313,50 +396,6 @@ def forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.083333333333333
     M = mass_matrix(q_batch, I1=I1, I2=I2, g_=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
     bias = inverse_dynamics(q_batch, qd_batch, np.zeros_like(q_batch), I1=I1, I2=I2, g_=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
     rhs = tau_batch - bias
-    finite = np.all(np.isfinite(M), axis=(1, 2)) & np.all(np.isfinite(rhs), axis=1)
-    if not np.all(finite):
-        raise FloatingPointError(
-            f"forward_dynamics: M(q), C(q, qd) qd + g(q) or tau is not finite{_at(int(np.argmin(finite)), single)}"
-            " (overflow, or non-finite input)")
-    try:
-        L = np.linalg.cholesky(M)
-    except np.linalg.LinAlgError:
-        raise np.linalg.LinAlgError(
-            f"forward_dynamics: M(q) is not positive definite{_at(_not_positive_definite(M), single)}:"
-            " a joint moves no mass or inertia, or the inertias are not physical") from None
-    d = np.diagonal(L, axis1=1, axis2=2)
-    condition = (np.max(d, axis=1) / np.min(d, axis=1)) ** 2 if NQ else np.ones(M.shape[0])
-    close = condition > 1e-4 * _CONDITION_LIMIT
-    if np.any(close):  # near the limit: the exact 2-norm condition number, from eigenvalues
-        eigenvalues = np.linalg.eigvalsh(M[close])
-        condition[close] = np.maximum(condition[close], eigenvalues[:, -1] / np.maximum(
-            eigenvalues[:, 0], np.finfo(float).tiny))
-    k = int(np.argmax(condition)) if condition.size else 0
-    if condition.size and condition[k] > _CONDITION_LIMIT:
-        _warnings.warn(
-            f"forward_dynamics: M(q) is ill-conditioned{_at(k, single)}: cond(M) >= "
-            f"{condition[k]:.2e}, so qdd may carry a relative error up to about cond(M)*eps = "
-            f"{condition[k] * np.finfo(float).eps:.1e}", IllConditionedWarning, stacklevel=2)
-    y = np.zeros_like(rhs)
-    for i in range(NQ):
-        y[:, i] = (rhs[:, i] - np.einsum("nj,nj->n", L[:, i, :i], y[:, :i])) / L[:, i, i]
-    x = np.zeros_like(rhs)
-    for i in reversed(range(NQ)):
-        x[:, i] = (y[:, i] - np.einsum("nj,nj->n", L[:, i + 1:, i], x[:, i + 1:])) / L[:, i, i]
-    if return_condition:
-        return (x[0], condition[0]) if single else (x, condition)
-    return x[0] if single else x
-
-
-def _at(k, single):
-    return "" if single else f" at state {k}"
-
-
-def _not_positive_definite(M):
-    """The first of the (N, NQ, NQ) matrices M whose Cholesky factorisation fails."""
-    for k in range(M.shape[0]):
-        try:
-            np.linalg.cholesky(M[k])
-        except np.linalg.LinAlgError:
-            return k
-    return 0
+    qdd, condition = _cholesky_solve(M[0] if single else M, rhs[0] if single else rhs,
+                                     who="forward_dynamics: ", stacklevel=2)
+    return (qdd, condition) if return_condition else qdd

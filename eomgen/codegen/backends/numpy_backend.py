@@ -14,6 +14,7 @@ from .. import GeneratedFile, Job, register
 from ...outputs import FORWARD
 from ...symbolic.printing import FloatLiteralMixin
 from ..render import render
+from ...runtime.cholesky import included_source
 from .common import python_module_context
 
 
@@ -39,5 +40,6 @@ class NumPyConfig:
 def generate_numpy(job: Job, config: NumPyConfig = NumPyConfig()) -> list[GeneratedFile]:
     printer = NumPyModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
     extra = ["IllConditionedWarning"] if FORWARD.function in job.functions else []
-    text = render(config.template, **python_module_context(job, printer, config.template, extra, backend="numpy"))
+    text = render(config.template, cholesky_runtime=included_source(),
+                  **python_module_context(job, printer, config.template, extra, backend="numpy"))
     return [GeneratedFile(job.stem + config.suffix, text)]
