@@ -6,7 +6,9 @@ The module exports the same names as the NumPy module (``JOINT_NAMES``, ``NQ``, 
 the functions of :data:`eomgen.outputs.OUTPUTS`, ``IllConditionedWarning``), each function
 taking one state ``(NQ,)`` or a batch ``(N, NQ)`` and looping over the batch in C. It is the route for one state at a time
 from Python: a call costs the C arithmetic plus a few hundred nanoseconds of argument parsing
-and one NumPy array allocation (no CasADi call layer, no ctypes).
+and one NumPy array allocation (no CasADi call layer, no ctypes). The composed
+``forward_dynamics`` and ``constrained_forward_dynamics`` are solved in C by one shared Cholesky
+routine on stack arrays (docs/contact.md has the constrained solve and its errors).
 
 Printer: SymPy's :class:`~sympy.printing.c.C99CodePrinter` with exact float literals and
 small integer powers written as products. Template: ``templates/fast/module.c.jinja``.
