@@ -22,7 +22,8 @@ feet held, NumPy + CasADi, outputs M, C, g, frame_jacobians, contact_jacobian, c
 constrained_forward_dynamics; the operation counts of each printed function (and the CasADi
 instructions of the composed KKT solve); and the one-state time of the compiled constrained
 forward dynamics (CasADi's C code as a shared library, called through ``Function.buffer()``
-on preallocated arrays) against ``pinocchio.constraintDynamics`` (its plain Python call, on
+on preallocated arrays; and the fast C extension module's ``constrained_forward_dynamics(q, qd,
+tau)``, which allocates its result arrays) against ``pinocchio.constraintDynamics`` (its plain Python call, on
 Pinocchio's own q, v, τ arrays), interleaved in the same run: medians and quartiles of
 repeated batches, and the ratio of the medians. Targets: ≤ 1e-10 (M, C q̇, g), ≤ 1e-8 (q̈,
 F_c), generation ≤ 60 s. Exit status 2 when one is missed.
@@ -31,6 +32,7 @@ F_c), generation ≤ 60 s. Exit status 2 when one is missed.
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import subprocess
 import sys
 import tempfile
@@ -174,7 +176,7 @@ def generated_contacts(solo_path) -> bool:
     print("operation counts (SymPy count_ops of the straight-line programs): "
           + ", ".join(f"{s.name} {s.operation_count}" for s in job.specs))
     with tempfile.TemporaryDirectory() as out:
-        files = render_files(model, ["casadi", "c"], functions=functions)
+        files = render_files(model, ["casadi", "c", "fast"], functions=functions)
         from eomgen.codegen.backends.casadi_backend import load_module_source
 
         sx = load_module_source(next(f.content for f in files if f.name.endswith("casadi.py")),
@@ -183,8 +185,12 @@ def generated_contacts(solo_path) -> bool:
             path = Path(out, f.name)
             path.write_bytes(f.content) if isinstance(f.content, bytes) else path.write_text(
                 f.content)
-        library = next(Path(out).glob("*.so"))
+        library = next(p for p in Path(out).glob("*.so") if "_fast." not in p.name)
         f = ca.external("constrained_forward_dynamics", str(library))
+        spec = importlib.util.spec_from_file_location(
+            f"{model.name}_fast", next(Path(out).glob(f"{model.name}_fast.*.so")))
+        fast = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(fast)
         print(f"CasADi constrained_forward_dynamics: {sx.n_instructions()} SX instructions "
               "(M, C q̇ + g, J_c, J̇_c q̇ and the Cholesky-Schur KKT solve)")
         ref = floating.PinocchioFreeFlyer(solo_path, model.joint_names)
@@ -219,12 +225,20 @@ def generated_contacts(solo_path) -> bool:
         agree = max(rel(qdd, qdd_pin), rel(F, pd.lambda_c))
         print(f"compiled constrained_forward_dynamics vs constraintDynamics: {agree:.1e} "
               "(largest relative difference of q̈, F_c)")
-        ours, theirs = [], []
+        q_, qd_, tau_ = np.array(q), np.array(qd), np.array(tau)
+        qdd_fast, F_fast = fast.constrained_forward_dynamics(q_, qd_, tau_)
+        agree_fast = max(rel(qdd_fast, qdd_pin), rel(F_fast, pd.lambda_c))
+        print(f"fast module constrained_forward_dynamics vs constraintDynamics: "
+              f"{agree_fast:.1e} (largest relative difference of q̈, F_c)")
+        agree = max(agree, agree_fast)
+        ours, mine, theirs = [], [], []
         for _ in range(15):  # interleaved batches
             ours.append(_timed(evaluate, 2000, 1)[0])
+            mine.append(_timed(lambda: fast.constrained_forward_dynamics(q_, qd_, tau_),
+                               2000, 1)[0])
             theirs.append(_timed(lambda: pin.constraintDynamics(pm, pd, q_pin, v, tau_ff, models,
                                                                 datas, settings), 2000, 1)[0])
-        ours, theirs = np.array(ours), np.array(theirs)
+        ours, mine, theirs = np.array(ours), np.array(mine), np.array(theirs)
 
         def summary(x):
             q1, med, q3 = np.percentile(x, [25, 50, 75])
@@ -233,6 +247,9 @@ def generated_contacts(solo_path) -> bool:
         print(f"one state, solo12 + 4 contacts: eomgen CasADi C (buffer) {summary(ours)}; "
               f"Pinocchio constraintDynamics {summary(theirs)}; ratio eomgen/Pinocchio "
               f"{np.median(ours) / np.median(theirs):.2f}")
+        print(f"one state, solo12 + 4 contacts: eomgen fast module (its Python call, new "
+              f"result arrays) {summary(mine)}; ratio fast/Pinocchio "
+              f"{np.median(mine) / np.median(theirs):.2f}")
         del buffer
     return seconds <= 60 and agree <= 1e-8
 

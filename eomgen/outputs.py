@@ -408,7 +408,7 @@ CONSTRAINED_FORWARD = register_output(Output(
     ("q", "qd", "tau"), True, "rad/s^2, m/s^2; N, N m", ("M", "tau", "J_c", "dJqd_c"),
     composed_from=(MASS.function, INVERSE.function, CONTACT_JACOBIAN.function,
                    CONTACT_BIAS.function), default=False, constants=_CONTACT_NAMES,
-    backends=("numpy", "casadi", "c", "jax", "torch")))
+    backends=("numpy", "casadi", "c", "fast", "jax", "torch")))
 
 
 def exported(functions, backend: str) -> tuple[str, ...]:

@@ -171,6 +171,58 @@ static void inverse_dynamics_one(const double *const *x, const double *p, double
     out[1] = -t_n2_2_;
 }
 
+/* Cholesky factor of the symmetric n x n matrix A (row-major), in place: A = L L^T with L in
+ * A's lower triangle (the strict upper triangle is left as it was). Returns 0, or 2 when a
+ * pivot is not above tol (A not positive definite, or numerically singular when tol > 0).
+ * *dmax, *dmin: the largest and smallest L_ii. */
+static int cholesky(double *A, int n, double tol, double *dmax, double *dmin)
+{
+    int i, j, k;
+    *dmax = 0.0;
+    *dmin = HUGE_VAL;
+    for (j = 0; j < n; ++j) {
+        double d = A[j * n + j];
+        for (k = 0; k < j; ++k)
+            d -= A[j * n + k] * A[j * n + k];
+        if (!(d > tol))
+            return 2;
+        d = sqrt(d);
+        A[j * n + j] = d;
+        if (d > *dmax) *dmax = d;
+        if (d < *dmin) *dmin = d;
+        for (i = j + 1; i < n; ++i) {
+            double s = A[i * n + j];
+            for (k = 0; k < j; ++k)
+                s -= A[i * n + k] * A[j * n + k];
+            A[i * n + j] = s / d;
+        }
+    }
+    return 0;
+}
+
+/* y <- L^-1 y (forward substitution), L the n x n Cholesky factor of cholesky(). */
+static void solve_lower(const double *L, int n, double *y)
+{
+    int i, k;
+    for (i = 0; i < n; ++i) {
+        for (k = 0; k < i; ++k)
+            y[i] -= L[i * n + k] * y[k];
+        y[i] /= L[i * n + i];
+    }
+}
+
+/* y <- L^-T y (back substitution), L the n x n Cholesky factor of cholesky(). */
+static void solve_upper(const double *L, int n, double *y)
+{
+    int i, k;
+    for (i = n - 1; i >= 0; --i) {
+        double s = y[i];
+        for (k = i + 1; k < n; ++k)
+            s -= L[k * n + i] * y[k];
+        y[i] = s / L[i * n + i];
+    }
+}
+
 /* qdd solving M(q) qdd = tau - (C(q, qd) qd + g(q)) by Cholesky, M = L L^T (L in M's lower
  * triangle). Returns 0, 1 when M, the bias or tau is not finite, 2 when M is not positive
  * definite. *condition: (max L_ii / min L_ii)^2, a lower bound of cond(M). */
@@ -178,48 +230,24 @@ static int forward_dynamics_one(const double *q, const double *qd, const double 
                                 const double *p, double *qdd, double *condition)
 {
     static const double zero[NQ] = {0.0};
-    double M[NQ * NQ], bias[NQ], y[NQ];
-    double dmax = 0.0, dmin = HUGE_VAL;
-    int i, j, k;
+    double M[NQ * NQ], bias[NQ];
+    double dmax, dmin;
+    int i, j;
     const double *mass_in[MAX_IN] = {q}, *bias_in[MAX_IN] = {q, qd, zero};
     mass_matrix_one(mass_in, p, M);
     inverse_dynamics_one(bias_in, p, bias);
     for (i = 0; i < NQ; ++i) {
-        y[i] = tau[i] - bias[i];
-        if (!isfinite(y[i]))
+        qdd[i] = tau[i] - bias[i];
+        if (!isfinite(qdd[i]))
             return 1;
         for (j = 0; j < NQ; ++j)
             if (!isfinite(M[i * NQ + j]))
                 return 1;
     }
-    for (j = 0; j < NQ; ++j) {
-        double d = M[j * NQ + j];
-        for (k = 0; k < j; ++k)
-            d -= M[j * NQ + k] * M[j * NQ + k];
-        if (!(d > 0.0))
-            return 2;
-        d = sqrt(d);
-        M[j * NQ + j] = d;
-        if (d > dmax) dmax = d;
-        if (d < dmin) dmin = d;
-        for (i = j + 1; i < NQ; ++i) {
-            double s = M[i * NQ + j];
-            for (k = 0; k < j; ++k)
-                s -= M[i * NQ + k] * M[j * NQ + k];
-            M[i * NQ + j] = s / d;
-        }
-    }
-    for (i = 0; i < NQ; ++i) {  /* L y = rhs */
-        for (k = 0; k < i; ++k)
-            y[i] -= M[i * NQ + k] * y[k];
-        y[i] /= M[i * NQ + i];
-    }
-    for (i = NQ - 1; i >= 0; --i) {  /* L^T qdd = y */
-        double s = y[i];
-        for (k = i + 1; k < NQ; ++k)
-            s -= M[k * NQ + i] * qdd[k];
-        qdd[i] = s / M[i * NQ + i];
-    }
+    if (cholesky(M, NQ, 0.0, &dmax, &dmin))
+        return 2;
+    solve_lower(M, NQ, qdd);
+    solve_upper(M, NQ, qdd);
     *condition = NQ ? (dmax / dmin) * (dmax / dmin) : 1.0;
     return 0;
 }
@@ -248,7 +276,12 @@ typedef struct {
     npy_intp states;
     int single;
     int return_condition;
+    double damping;
 } call_t;
+
+/* The keywords a composed function takes besides its inputs and parameters (parse()). */
+#define TAKES_RETURN_CONDITION 1
+#define TAKES_DAMPING 2
 
 static void release(call_t *call)
 {
@@ -282,7 +315,7 @@ static PyArrayObject *as_states(PyObject *object, const char *name, int size)
 }
 
 static int parse(const function_t *f, PyObject *const *args, Py_ssize_t nargs,
-                 PyObject *kwnames, call_t *call, int may_return_condition)
+                 PyObject *kwnames, call_t *call, int takes)
 {
     PyObject *given[MAX_IN] = {NULL};
     int set[NP + 1] = {0};
@@ -317,12 +350,24 @@ static int parse(const function_t *f, PyObject *const *args, Py_ssize_t nargs,
                 set[j] = 1;
                 found = 1;
             }
-        if (!found && may_return_condition &&
+        if (!found && (takes & TAKES_RETURN_CONDITION) &&
                 PyUnicode_CompareWithASCIIString(key, "return_condition") == 0) {
             int truth = PyObject_IsTrue(value);
             if (truth < 0)
                 return -1;
             call->return_condition = truth;
+            found = 1;
+        }
+        if (!found && (takes & TAKES_DAMPING) &&
+                PyUnicode_CompareWithASCIIString(key, "damping") == 0) {
+            call->damping = PyFloat_AsDouble(value);
+            if (call->damping == -1.0 && PyErr_Occurred())
+                return -1;
+            if (!(call->damping >= 0.0 && isfinite(call->damping))) {
+                PyErr_Format(PyExc_ValueError, "%s(): damping must be a finite number >= 0, "
+                             "got %R", f->name, value);
+                return -1;
+            }
             found = 1;
         }
         if (!found) {
@@ -469,7 +514,7 @@ static PyObject *forward_dynamics(PyObject *self, PyObject *const *args, Py_ssiz
     double *qdd, *condition;
     PyArrayObject *result, *conditions;
     (void)self;
-    if (parse(&forward_dynamics_function, args, nargs, kwnames, &call, 1) < 0)
+    if (parse(&forward_dynamics_function, args, nargs, kwnames, &call, TAKES_RETURN_CONDITION) < 0)
         return NULL;
     dims[0] = call.states;
     dims[1] = NQ;
@@ -536,6 +581,7 @@ static PyObject *forward_dynamics(PyObject *self, PyObject *const *args, Py_ssiz
     }
     return Py_BuildValue("(NN)", result, conditions);
 }
+
 
 static PyMethodDef methods[] = {
     {"mass_matrix", (PyCFunction)(void (*)(void))mass_matrix, METH_FASTCALL | METH_KEYWORDS,

@@ -6,7 +6,9 @@ The module exports the same names as the NumPy module (``JOINT_NAMES``, ``NQ``, 
 the functions of :data:`eomgen.outputs.OUTPUTS`, ``IllConditionedWarning``), each function
 taking one state ``(NQ,)`` or a batch ``(N, NQ)`` and looping over the batch in C. It is the route for one state at a time
 from Python: a call costs the C arithmetic plus a few hundred nanoseconds of argument parsing
-and one NumPy array allocation (no CasADi call layer, no ctypes).
+and one NumPy array allocation (no CasADi call layer, no ctypes). The composed
+``forward_dynamics`` and ``constrained_forward_dynamics`` are solved in C by one shared Cholesky
+routine on stack arrays (docs/contact.md has the constrained solve and its errors).
 
 Printer: SymPy's :class:`~sympy.printing.c.C99CodePrinter` with exact float literals and
 small integer powers written as products. Template: ``templates/fast/module.c.jinja``.
@@ -27,7 +29,8 @@ from sympy.printing.precedence import PRECEDENCE
 
 from ...compiler import c_compiler
 from .. import GeneratedFile, Job, register
-from ...outputs import FORWARD, INPUT_SIZES, composition_names, exported
+from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, composition_names,
+                       constrained_names, exported)
 from ...symbolic.printing import FloatLiteralMixin
 from ..render import render
 
@@ -142,6 +145,22 @@ def _render_source(job: Job, config: FastConfig) -> str:
         "exceeds 1e-6 / eps; return_condition=True also returns that estimate. Raises "
         "numpy.linalg.LinAlgError when M is not positive definite and FloatingPointError when "
         "M, C qd + g or tau is not finite.")
+    cfd = constrained_names()
+    constrained = CONSTRAINED_FORWARD.function in exported(job.functions, "fast")
+    # the contact rows m: the contact Jacobian's (its spec is generated whenever the composed
+    # function is, CONSTRAINED_FORWARD.composed_from)
+    nc = next((f["rows"] for f in functions if f["name"] == cfd["jacobian"]), 0)
+    constrained_doc = c_string_literal(
+        f"{cfd['name']}({', '.join(CONSTRAINED_FORWARD.inputs)}, *{signature}, damping=0.0)"
+        f"\n--\n\n{CONSTRAINED_FORWARD.summary}\n\nReturns (qdd, F_c) of shapes (NQ,), "
+        f"({nc},) for one state, (N, NQ), (N, {nc}) for a batch; F_c in CONTACT_ROWS order "
+        "(forces on the robot). Solved by Cholesky factors: M = L L^T, A = J_c M^-1 J_c^T + "
+        "damping 1 = L_A L_A^T, F_c = A^-1 (-J_c-dot qd - J_c M^-1 (tau - C qd - g)), qdd = "
+        "M^-1 (tau - C qd - g + J_c^T F_c). Raises numpy.linalg.LinAlgError when M is not "
+        "positive definite, or at damping 0 when A is numerically singular (a Cholesky pivot "
+        "<= 1e-10 of A's largest diagonal entry: dependent contact rows, use damping > 0); "
+        "FloatingPointError when M, C qd + g, tau, J_c or J_c-dot qd is not finite; "
+        "ValueError for a damping not finite or < 0.")
     parameters = [dict(name=c_string_literal(p.identifier),
                        default=("NAN" if p.default is None
                                 else printer.doprint(sp.Float(p.default))),
@@ -168,6 +187,10 @@ def _render_source(job: Job, config: FastConfig) -> str:
         forward_doc=forward_doc,
         forward_dynamics=FORWARD.function in job.functions,
         fd=composition_names(FORWARD),
+        constrained_forward_dynamics=constrained,
+        cfd=cfd,
+        nc=nc,
+        constrained_doc=constrained_doc,
     )
 
 
