@@ -73,11 +73,9 @@ def lambdify(dynamics: Dynamics) -> NumericDynamics:
     array([34.335,  9.81 ])
     """
     from .codegen import make_job
-    from .codegen.backends.common import python_module_context
-    from .codegen.backends.numpy_backend import NumPyConfig, NumPyModulePrinter
+    from .codegen.backends.numpy_backend import NumPyConfig, NumPyModulePrinter, numpy_source
     from .codegen.functions import FUNCTION_OUTPUTS
     from .outputs import BY_SYMBOL, FORWARD
-    from .codegen.render import render
     from .symbolic.printing import exec_source
 
     derived = set(dynamics.outputs)
@@ -88,8 +86,7 @@ def lambdify(dynamics: Dynamics) -> NumericDynamics:
     printer = NumPyModulePrinter({"fully_qualified_modules": True, "standard": "python3",
                                   "order": "none"})
     config = NumPyConfig()
-    extra = ["IllConditionedWarning"] if FORWARD.function in functions else []
-    content = render(config.template, **python_module_context(job, printer, config.template, extra))
+    content = numpy_source(job, printer, config)
     module = types.ModuleType(f"eomgen_lambdified_{job.stem}")
     module.__file__ = f"<eomgen lambdify {job.stem}>"
     exec_source(content, module.__file__, module.__dict__)

@@ -407,8 +407,7 @@ CONSTRAINED_FORWARD = register_output(Output(
     "[[M, -J_c^T], [J_c, 0]] [qdd; F_c] = [tau - (C qd + g); -J_c-dot qd].",
     ("q", "qd", "tau"), True, "rad/s^2, m/s^2; N, N m", ("M", "tau", "J_c", "dJqd_c"),
     composed_from=(MASS.function, INVERSE.function, CONTACT_JACOBIAN.function,
-                   CONTACT_BIAS.function), default=False, constants=_CONTACT_NAMES,
-    backends=("numpy", "casadi", "c", "fast", "jax", "torch")))
+                   CONTACT_BIAS.function), default=False, constants=_CONTACT_NAMES))
 
 
 def exported(functions, backend: str) -> tuple[str, ...]:

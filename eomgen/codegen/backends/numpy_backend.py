@@ -39,7 +39,13 @@ class NumPyConfig:
           config=NumPyConfig, order=10, reserved=("np",))
 def generate_numpy(job: Job, config: NumPyConfig = NumPyConfig()) -> list[GeneratedFile]:
     printer = NumPyModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
+    return [GeneratedFile(job.stem + config.suffix, numpy_source(job, printer, config))]
+
+
+def numpy_source(job: Job, printer, config: NumPyConfig = NumPyConfig()) -> str:
+    """The NumPy module's text for ``job`` printed with ``printer`` (also what
+    :func:`eomgen.lambdify` executes): the template, with the Cholesky runtime
+    (:mod:`eomgen.runtime.cholesky`) included where forward dynamics needs it."""
     extra = ["IllConditionedWarning"] if FORWARD.function in job.functions else []
-    text = render(config.template, cholesky_runtime=included_source(),
+    return render(config.template, cholesky_runtime=included_source(),
                   **python_module_context(job, printer, config.template, extra, backend="numpy"))
-    return [GeneratedFile(job.stem + config.suffix, text)]
