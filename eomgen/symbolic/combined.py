@@ -62,8 +62,8 @@ def build_nonlinear_effects(derivation, wanted) -> dict:
 
 def build_combined(derivation, wanted) -> dict:
     """The builder of the several-result functions of :mod:`eomgen.outputs` (``returns``):
-    ``MCg`` = [M | C | g] (n × (2n + 1)) for ``dynamics(q, qd)`` and ``Mh`` = [M | h]
-    (n × (n + 1)) for ``mass_matrix_and_bias(q, qd)``, side by side from the outputs already in
+    ``MCg`` = [M | C | g] (n × (2n + 1)), returned as (M, C, g), and ``Mh`` = [M | h]
+    (n × (n + 1)), returned as (M, h): the results side by side from the outputs already in
     the program (``derivation.output``), so that they are the separate functions' own results
     and share every intermediate; the generated module splits them into tuples."""
     from ..outputs import BY_SYMBOL
