@@ -202,6 +202,7 @@ def expand_program(subexpressions: Sequence[tuple[sp.Symbol, sp.Expr]],
         When the program is not polynomial in its inputs and ``sin``/``cos`` of them (a
         division by an intermediate, a function of one).
     """
+    subexpressions, exprs = _angle_sums(subexpressions, exprs)
     defined = {symbol for symbol, _ in subexpressions}
     leaves: set = set()
     floats = False
@@ -273,6 +274,28 @@ def expand_program(subexpressions: Sequence[tuple[sp.Symbol, sp.Expr]],
                    for f in results]
     P.spend(TERM_COST * sum(len(f) for f in results), 0, "the result")  # before building it
     return [P.to_expr(f) for f in results]
+
+
+def _angle_sums(subexpressions, exprs):
+    """``sin``/``cos`` of an intermediate defined as an input plus a constant (a joint angle
+    with a phase, ``qp = q + φ``) written by the angle-sum formulas in ``sin q`` and ``cos q``,
+    and such intermediates dropped: the expansion stays a polynomial in the joints' sines and
+    cosines."""
+    defined = {symbol for symbol, _ in subexpressions}
+    sums = {}
+    for symbol, expr in subexpressions:
+        if expr.is_Add and len(expr.args) == 2 and not expr.free_symbols & defined:
+            constant, angle = expr.as_coeff_Add()
+            if constant.is_Number and angle.is_Symbol:
+                c, s = sp.cos(constant), sp.sin(constant)
+                sums[sp.sin(symbol)] = sp.sin(angle) * c + sp.cos(angle) * s
+                sums[sp.cos(symbol)] = sp.cos(angle) * c - sp.sin(angle) * s
+    if not sums:
+        return subexpressions, exprs
+    phased = {f.args[0] for f in sums}
+    kept = [(symbol, expr.xreplace(sums)) for symbol, expr in subexpressions
+            if symbol not in phased]
+    return kept, [expr.xreplace(sums) for expr in exprs]
 
 
 def _prune(definitions: Sequence[tuple[sp.Symbol, sp.Expr]], exprs: Iterable[sp.Expr]):

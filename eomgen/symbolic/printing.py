@@ -53,6 +53,16 @@ class FloatLiteralMixin:
     def _print_Rational(self, expr):
         return self._literal(int(expr.p) / int(expr.q))
 
+    def _as_ordered_terms(self, expr, order=None):
+        """SymPy's order of a sum's terms, but a term without a minus sign first when there
+        is one: ``y - 2*x`` rather than ``-2*x + y``, which spends a negation."""
+        terms = super()._as_ordered_terms(expr, order=order)
+        if terms and terms[0].could_extract_minus_sign():
+            for k, term in enumerate(terms):
+                if not term.could_extract_minus_sign():
+                    return [term] + terms[:k] + terms[k + 1:]
+        return terms
+
     def parenthesize(self, item, level, strict=False):
         if isinstance(item, sp.Rational) and not item.is_Integer and item.is_positive:
             return self._print(item)

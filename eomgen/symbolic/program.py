@@ -101,14 +101,16 @@ class ProgramBuilder:
         self._names.add(name)
         return sp.Symbol(name, real=True)
 
-    def define(self, expr, hint: str = "x", tag=None) -> sp.Expr:
+    def define(self, expr, hint: str = "x", tag=None, scaled: bool = False) -> sp.Expr:
         """Name ``expr`` unless it is trivial or already named; return what to use in its place.
 
         ``hint`` is the name wanted (made unique); ``tag`` says what the quantity is
         (:class:`Tag`, or ``(family, index...)``), for documents that group intermediates.
-        An expression already named keeps its first name and tag."""
+        An expression already named keeps its first name and tag. ``scaled``: name a number
+        times an atom too (worth it when the quantity will be multiplied again, e.g. rotated:
+        ``c·(k x)`` and ``s·(k x)`` then cost one product each instead of two)."""
         expr = sp.sympify(expr) if not isinstance(expr, sp.Basic) else expr
-        if _is_trivial(expr):
+        if expr.is_Atom or (_is_trivial(expr) and not scaled):
             return expr
         if expr.is_Mul and expr.args[0] == -1 and len(expr.args) == 2 and expr.args[1].is_Atom:
             return expr

@@ -81,12 +81,16 @@ PROGRAM_NAMES = {
     "wp": r"angular velocity of the parent of body $i$, in body $i$ axes",
     "w": r"angular velocity $\omega_{i}$ of body $i$",
     "dw": r"angular acceleration $\dot\omega_{i}$ of body $i$",
-    "ap": r"acceleration of the origin of body $i$ (gravity as a base acceleration), parent axes",
-    "a": r"acceleration of the origin of body $i$ (gravity as a base acceleration)",
+    "ap": r"acceleration of the origin of body $i$ (gravity as a base acceleration; over a "
+          r"length $L$ when all numbers are known), parent axes",
+    "a": r"acceleration of the origin of body $i$ (gravity as a base acceleration; over a "
+         r"length $L$ when all numbers are known)",
     "ww": r"product $\omega_{r} \omega_{c}$ of the angular velocity of body $i$",
     "U": r"entry $(r, c)$ of $U_{i} = [\dot\omega_{i}]_\times + [\omega_{i}]_\times^{2}$",
-    "Iomega": r"$I_{i} \omega_{i}$, angular momentum of body $i$ about its origin (grouped "
-              r"inertia)",
+    "wd": r"difference of squares $\omega_{j}^{2} - \omega_{k}^{2}$ of the angular velocity of "
+          r"body $i$ ($(i, j, k)$ cyclic), for $I \dot\omega + \omega \times I \omega$",
+    "qp": r"angle $q_{i} + \varphi_{i}$ of a last body described in axes turned by $\varphi_{i}$ "
+          r"about its joint axis",
     "f": r"force on body $i$ from its parent, body $i$ axes",
     "n": r"moment on body $i$ from its parent, about its origin",
     "fp": r"force of body $i$ on its parent, parent axes",
