@@ -142,6 +142,27 @@ def test_jax_jit_and_vmap_agree_with_numpy(robot, name):
         assert_relative(jax.jit(jax.vmap(f))(*args), expected, what=f"jit vmap {function}")
 
 
+def test_xla_computes_each_sine_and_cosine_once(robot):
+    """Compiled for the CPU under jax.jit(jax.vmap(f)), each named sine and cosine is one
+    instruction: XLA's fusion counts sin and cos as cheap and copied them into every output loop
+    (the Panda's M: 112 sines for 6 joints), which made M three times slower than NumPy; the
+    generated ``_kept`` makes XLA compute each once (jax_backend's docstring)."""
+    import inspect
+    import re
+
+    modules = robot("puma560")
+    q, qd, qdd = states(modules.numpy.NQ, seed=3)
+    for function in ("mass_matrix", "coriolis_matrix", "inverse_dynamics"):
+        f = getattr(modules.jax, function)
+        source = inspect.getsource(f)
+        args = [jnp.asarray(x) for x in (q, qd, qdd)[:ARGUMENTS[function]]]
+        hlo = jax.jit(jax.vmap(f)).lower(*args).compile().as_text()
+        for op, name in (("sine", "sin"), ("cosine", "cos")):
+            named = source.count(f"_kept(jnp.{name}(")
+            assert named > 0, function
+            assert len(re.findall(rf"\b{op}\(", hlo)) == named, (function, op)
+
+
 # ----------------------------------------------------------------------------------------------
 # Derivatives: JAX grad and torch autograd against central differences of the NumPy module
 # ----------------------------------------------------------------------------------------------

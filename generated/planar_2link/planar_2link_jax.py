@@ -60,6 +60,13 @@ def _states(*named):
     return (*[x.astype(d) for x in arrays], all(singles))
 
 
+def _kept(x, like):
+    """x, computed once: x / (1 + 0*like), exactly x. XLA's CPU fusion counts sin and cos as
+    cheap and recomputes them inside every loop that uses them; a division it counts as costly
+    and computes once (1 + 0*like is not folded to 1: 0*inf is nan)."""
+    return x / (1.0 + 0.0 * like)
+
+
 def _stack(x, shape, entries):
     """The entries (arrays of shape (N,) or scalars, in row-major order) as one array of shape
     (N,) + shape in the dtype of x, an (N, NQ) state; one jnp.stack, which XLA compiles to
@@ -87,7 +94,7 @@ def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l
     """
     q, single = _states((q, "q"))
     q2 = q[:, 1]
-    c2 = jnp.cos(q2)
+    c2 = _kept(jnp.cos(q2), q2)
     Ic2_A22 = I2 + lc2**2*m2
     Ic2_B12 = lc2*m2
     F1_2n2 = Ic2_A22 + Ic2_B12*c2*l1
@@ -123,10 +130,10 @@ def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_
     q2 = q[:, 1]
     qd1 = qd[:, 0]
     qd2 = qd[:, 1]
-    s1 = jnp.sin(q1)
-    c1 = jnp.cos(q1)
-    s2 = jnp.sin(q2)
-    c2 = jnp.cos(q2)
+    s1 = _kept(jnp.sin(q1), q1)
+    c1 = _kept(jnp.cos(q1), q1)
+    s2 = _kept(jnp.sin(q2), q2)
+    c2 = _kept(jnp.cos(q2), q2)
     o2_0 = c1*l1
     o2_1 = l1*s1
     R2_00 = c1*c2 - s1*s2
@@ -167,10 +174,10 @@ def gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81
     q, single = _states((q, "q"))
     q1 = q[:, 0]
     q2 = q[:, 1]
-    s1 = jnp.sin(q1)
-    c1 = jnp.cos(q1)
-    s2 = jnp.sin(q2)
-    c2 = jnp.cos(q2)
+    s1 = _kept(jnp.sin(q1), q1)
+    c1 = _kept(jnp.cos(q1), q1)
+    s2 = _kept(jnp.sin(q2), q2)
+    c2 = _kept(jnp.cos(q2), q2)
     a1_0 = g_*s1
     a1_1 = c1*g_
     a2_1 = a1_1*c2 - a1_0*s2
@@ -208,10 +215,10 @@ def inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.083333333333333
     qd2 = qd[:, 1]
     qdd1 = qdd[:, 0]
     qdd2 = qdd[:, 1]
-    s1 = jnp.sin(q1)
-    c1 = jnp.cos(q1)
-    s2 = jnp.sin(q2)
-    c2 = jnp.cos(q2)
+    s1 = _kept(jnp.sin(q1), q1)
+    c1 = _kept(jnp.cos(q1), q1)
+    s2 = _kept(jnp.sin(q2), q2)
+    c2 = _kept(jnp.cos(q2), q2)
     a1_0 = g_*s1
     a1_1 = c1*g_
     ww1_22 = qd1**2

@@ -53,6 +53,13 @@ def _states(*named):
     return (*[x.astype(d) for x in arrays], all(singles))
 
 
+def _kept(x, like):
+    """x, computed once: x / (1 + 0*like), exactly x. XLA's CPU fusion counts sin and cos as
+    cheap and recomputes them inside every loop that uses them; a division it counts as costly
+    and computes once (1 + 0*like is not folded to 1: 0*inf is nan)."""
+    return x / (1.0 + 0.0 * like)
+
+
 def _stack(x, shape, entries):
     """The entries (arrays of shape (N,) or scalars, in row-major order) as one array of shape
     (N,) + shape in the dtype of x, an (N, NQ) state; one jnp.stack, which XLA compiles to
@@ -83,14 +90,14 @@ def mass_matrix(q):
     q3 = q[:, 2]
     q4 = q[:, 3]
     q5 = q[:, 4]
-    s2 = jnp.sin(q2)
-    c2 = jnp.cos(q2)
-    s3 = jnp.sin(q3)
-    c3 = jnp.cos(q3)
-    s4 = jnp.sin(q4)
-    c4 = jnp.cos(q4)
-    s5 = jnp.sin(q5)
-    c5 = jnp.cos(q5)
+    s2 = _kept(jnp.sin(q2), q2)
+    c2 = _kept(jnp.cos(q2), q2)
+    s3 = _kept(jnp.sin(q3), q3)
+    c3 = _kept(jnp.cos(q3), q3)
+    s4 = _kept(jnp.sin(q4), q4)
+    c4 = _kept(jnp.cos(q4), q4)
+    s5 = _kept(jnp.sin(q5), q5)
+    c5 = _kept(jnp.cos(q5), q5)
     F3_6n0 = 4e-05*c4*s5
     F3_6n2 = 4e-05*s4*s5
     F2_6n0 = F3_6n0*c3 + 4e-05*c5*s3
@@ -216,18 +223,18 @@ def coriolis_matrix(q, qd):
     qd4 = qd[:, 3]
     qd5 = qd[:, 4]
     qd6 = qd[:, 5]
-    s1 = jnp.sin(q1)
-    c1 = jnp.cos(q1)
-    s2 = jnp.sin(q2)
-    c2 = jnp.cos(q2)
-    s3 = jnp.sin(q3)
-    c3 = jnp.cos(q3)
-    s4 = jnp.sin(q4)
-    c4 = jnp.cos(q4)
-    s5 = jnp.sin(q5)
-    c5 = jnp.cos(q5)
-    s6 = jnp.sin(q6)
-    c6 = jnp.cos(q6)
+    s1 = _kept(jnp.sin(q1), q1)
+    c1 = _kept(jnp.cos(q1), q1)
+    s2 = _kept(jnp.sin(q2), q2)
+    c2 = _kept(jnp.cos(q2), q2)
+    s3 = _kept(jnp.sin(q3), q3)
+    c3 = _kept(jnp.cos(q3), q3)
+    s4 = _kept(jnp.sin(q4), q4)
+    c4 = _kept(jnp.cos(q4), q4)
+    s5 = _kept(jnp.sin(q5), q5)
+    c5 = _kept(jnp.cos(q5), q5)
+    s6 = _kept(jnp.sin(q6), q6)
+    c6 = _kept(jnp.cos(q6), q6)
     R2_00 = c1*c2
     R2_01 = -c1*s2
     R2_10 = c2*s1
@@ -568,14 +575,14 @@ def gravity_vector(q):
     q3 = q[:, 2]
     q4 = q[:, 3]
     q5 = q[:, 4]
-    s2 = jnp.sin(q2)
-    c2 = jnp.cos(q2)
-    s3 = jnp.sin(q3)
-    c3 = jnp.cos(q3)
-    s4 = jnp.sin(q4)
-    c4 = jnp.cos(q4)
-    s5 = jnp.sin(q5)
-    c5 = jnp.cos(q5)
+    s2 = _kept(jnp.sin(q2), q2)
+    c2 = _kept(jnp.cos(q2), q2)
+    s3 = _kept(jnp.sin(q3), q3)
+    c3 = _kept(jnp.cos(q3), q3)
+    s4 = _kept(jnp.sin(q4), q4)
+    c4 = _kept(jnp.cos(q4), q4)
+    s5 = _kept(jnp.sin(q5), q5)
+    c5 = _kept(jnp.cos(q5), q5)
     ap3_0 = 22.71885132005558*s2
     ap3_1 = 22.71885132005558*c2
     a3_0 = ap3_0*c3 + ap3_1*s3
@@ -639,16 +646,16 @@ def inverse_dynamics(q, qd, qdd):
     qdd4 = qdd[:, 3]
     qdd5 = qdd[:, 4]
     qdd6 = qdd[:, 5]
-    s2 = jnp.sin(q2)
-    c2 = jnp.cos(q2)
-    s3 = jnp.sin(q3)
-    c3 = jnp.cos(q3)
-    s4 = jnp.sin(q4)
-    c4 = jnp.cos(q4)
-    s5 = jnp.sin(q5)
-    c5 = jnp.cos(q5)
-    s6 = jnp.sin(q6)
-    c6 = jnp.cos(q6)
+    s2 = _kept(jnp.sin(q2), q2)
+    c2 = _kept(jnp.cos(q2), q2)
+    s3 = _kept(jnp.sin(q3), q3)
+    c3 = _kept(jnp.cos(q3), q3)
+    s4 = _kept(jnp.sin(q4), q4)
+    c4 = _kept(jnp.cos(q4), q4)
+    s5 = _kept(jnp.sin(q5), q5)
+    c5 = _kept(jnp.cos(q5), q5)
+    s6 = _kept(jnp.sin(q6), q6)
+    c6 = _kept(jnp.cos(q6), q6)
     wp2_0 = qd1*s2
     wp2_1 = c2*qd1
     ww2_00 = wp2_0**2
