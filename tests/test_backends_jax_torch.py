@@ -384,3 +384,19 @@ def test_parameters_named_like_the_frameworks_do_not_shadow_them(tmp_path):
     assert_relative(torch_module.gravity_vector(torch.from_numpy(q)), expected)
     assert_relative(torch_module.gravity_vector(torch.from_numpy(q), torch_=3.0),
                     numpy_module.gravity_vector(q, torch_=3.0))
+
+
+def test_dask_map_takes_dask_inputs_and_jax_functions(robot):
+    """eomgen.batch.dask_map over a JAX function (issue 12, item 7): chunks of a dask array,
+    the joints of a state joined into one chunk, equal to the NumPy batch."""
+    da = pytest.importorskip("dask.array", reason="dask_map needs dask: pip install 'eomgen[dask]'")
+    from eomgen.batch import dask_map
+
+    modules = robot("planar_2link")
+    rng = np.random.default_rng(1)
+    q, qd, qdd = (rng.uniform(-np.pi, np.pi, (500, 2)) for _ in range(3))
+    lazy_q = da.from_array(q, chunks=(128, 1))  # joints split too: dask_map joins them
+    lazy = dask_map(jax.jit(modules.jax.inverse_dynamics), lazy_q, qd, qdd)
+    assert lazy.chunks[0] == (128, 128, 128, 116)
+    np.testing.assert_allclose(lazy.compute(scheduler="threads"),
+                               modules.numpy.inverse_dynamics(q, qd, qdd), rtol=1e-12, atol=1e-12)

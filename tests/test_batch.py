@@ -1,5 +1,6 @@
 """eomgen.batch.dask_map: generated functions over dask arrays, on a distributed.LocalCluster of
-worker processes, equal to the NumPy module on the whole batch (the ``dask`` extra)."""
+worker processes, equal to the NumPy module on the whole batch (the ``dask`` extra). Other
+backends' functions through dask_map: with their own tests."""
 
 from __future__ import annotations
 
@@ -20,7 +21,7 @@ da = pytest.importorskip("dask.array", reason="dask_map needs dask: pip install 
 def planar(tmp_path_factory):
     """The planar arm's NumPy module, importable by name (workers import it by name too)."""
     outdir = tmp_path_factory.mktemp("planar")
-    generate(eomgen.load(eomgen.example_path("planar_2link")), outdir, "numpy,jax", cache=False)
+    generate(eomgen.load(eomgen.example_path("planar_2link")), outdir, "numpy", cache=False)
     sys.path.insert(0, str(outdir))
     try:
         yield outdir, importlib.import_module("planar_2link_numpy")
@@ -57,22 +58,6 @@ def test_dask_map_on_a_local_cluster_equals_the_numpy_batch(planar):
             workers = {task["worker"] for task in stream.data if task["key"][0] == lazy.name}
             assert len([t for t in stream.data if t["key"][0] == lazy.name]) == 4
             assert workers <= set(cluster.workers[k].worker_address for k in cluster.workers)
-
-
-def test_dask_map_takes_dask_inputs_and_jax_functions(planar):
-    jax = pytest.importorskip("jax", reason="needs eomgen[jax]")
-    jax.config.update("jax_enable_x64", True)
-    outdir, module = planar
-    spec = importlib.util.spec_from_file_location("planar_2link_jax_batch",
-                                                  outdir / "planar_2link_jax.py")
-    jax_module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(jax_module)
-    q, qd, qdd = batch(500, seed=1)
-    lazy_q = da.from_array(q, chunks=(128, 1))  # joints split too: dask_map joins them
-    lazy = dask_map(jax.jit(jax_module.inverse_dynamics), lazy_q, qd, qdd)
-    assert lazy.chunks[0] == (128, 128, 128, 116)
-    np.testing.assert_allclose(lazy.compute(scheduler="threads"),
-                               module.inverse_dynamics(q, qd, qdd), rtol=1e-12, atol=1e-12)
 
 
 def test_dask_map_rejects_mismatched_inputs(planar):

@@ -65,9 +65,7 @@ def test_a_batch_gives_the_batch_of_tuples(robot):
     n = model.dof
     rng = np.random.default_rng(2)
     q, qd = rng.uniform(-1, 1, (2, 4, n))
-    for backend in ("numpy", "fast", "jax", "torch"):
-        if backend not in modules:
-            continue
+    for backend in sorted(set(modules) - {"casadi"}):  # CasADi: one state per call
         M, C, g = (np.asarray(x, dtype=float) for x in modules[backend]["dynamics"](q, qd))
         assert M.shape == (4, n, n) and C.shape == (4, n, n) and g.shape == (4, n), backend
         for k in range(4):

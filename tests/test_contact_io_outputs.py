@@ -151,7 +151,7 @@ def test_body_jacobian_dot_qd_is_the_time_derivative_of_the_body_twist(arm):
 
 def test_wrong_force_length_is_a_one_line_error(arm):
     model, calls, modules = arm
-    for backend in ("numpy", "fast") + tuple(b for b in ("jax", "torch") if b in BACKENDS):
+    for backend in sorted(set(BACKENDS) - {"casadi"}):  # CasADi checks its input sizes itself
         with pytest.raises(ValueError, match=r"F_c must have shape \(6,\)"):
             modules[backend]["friction_cone_margin"](np.zeros(2))
 

@@ -12,17 +12,17 @@ import pytest
 import sympy as sp
 
 from eomgen.analysis.routes import _BatchPrinter, compile_batch, compile_scalar
-from eomgen.codegen.backends.casadi_backend import CasADiPrinter
+from eomgen.codegen import available_backends
 from eomgen.codegen.backends.fast_backend import FastCPrinter
-from eomgen.codegen.backends.jax_backend import JaxModulePrinter
-from eomgen.codegen.backends.numpy_backend import NumPyModulePrinter
-from eomgen.codegen.backends.torch_backend import TorchModulePrinter
 from eomgen.symbolic.evaluate import FloatPrinter, compile_program
 from eomgen.symbolic.printing import FloatLiteralMixin, print_program
 from eomgen.symbolic.program import Program
 
-PRINTERS = [FloatPrinter, NumPyModulePrinter, JaxModulePrinter, TorchModulePrinter,
-            CasADiPrinter, FastCPrinter, _BatchPrinter]
+#: Every code backend's registered printer (the registry: a new backend is tested too), and
+#: the printers of the numeric routes.
+PRINTERS = [FloatPrinter, _BatchPrinter] + [
+    b.printer for b in available_backends().values()
+    if b.printer is not None and issubclass(b.printer, FloatLiteralMixin)]
 
 
 def _rationals(count: int = 2000) -> list[sp.Rational]:

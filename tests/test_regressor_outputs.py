@@ -18,12 +18,11 @@ from conftest import erd_robots_dir
 from eomgen.codegen.generate import render_files
 from eomgen.errors import UnsupportedFeatureWarning
 from eomgen.numeric import kinetic_energy, numeric_model, potential_energy, rnea
-from generated import generated as generate_all
+from generated import BACKENDS, generated as generate_all
 from reference import pin_q_order
 
 FUNCTIONS = ("regressor", "inertial_parameters", "base_regressor", "base_parameters",
              "kinetic_energy_regressor", "potential_energy_regressor", "inverse_dynamics")
-BACKENDS = ("numpy", "casadi", "fast", "jax", "torch")
 
 #: Drives of the planar arm (scene below) and the actuator terms they give each joint row:
 #: armature a q̈ + viscous d q̇ + Coulomb f sign q̇ (joint 2: a = 50² · 2e-4 = 0.5, d = 0).
@@ -116,11 +115,10 @@ def test_parameters_kept_symbolic_are_keywords_of_pi_and_beta(actuated_arm):
 def test_a_batch_of_states_gives_a_batch_of_regressors(actuated_arm):
     model, calls, _ = actuated_arm
     q, qd, qdd = (np.array(x) for x in zip(*states(model.dof, 4)))
-    for backend in ("numpy", "fast", "torch"):
-        if backend in calls:
-            batch = calls[backend]("base_regressor", q, qd, qdd)
-            single = [calls[backend]("base_regressor", *x) for x in zip(q, qd, qdd)]
-            np.testing.assert_allclose(batch, np.array(single), rtol=1e-14, err_msg=backend)
+    for backend in sorted(set(calls) - {"casadi"}):  # CasADi: one state per call
+        batch = calls[backend]("base_regressor", q, qd, qdd)
+        single = [calls[backend]("base_regressor", *x) for x in zip(q, qd, qdd)]
+        np.testing.assert_allclose(batch, np.array(single), rtol=1e-14, err_msg=backend)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -11,7 +11,7 @@ from __future__ import annotations
 import hashlib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable, Mapping
 
 from .. import __version__
 from ..output import GeneratedFile  # noqa: F401  (backends import it from here)
@@ -81,7 +81,14 @@ class Backend:
     just the asked functions. ``config`` is the backend's config dataclass (its defaults are used
     when a caller passes none; ``config().suffix`` names its main file); ``order`` places it in
     :func:`available_backends` (and so in ``--backend all``). ``reserved`` are names its modules
-    bind themselves (``np``); no parameter of any backend's module takes them.
+    bind themselves (``np``); no parameter of any backend's module takes them. ``printer`` is
+    its SymPy printer class, when it has one.
+
+    ``load(folder, stem) -> Loaded`` imports the code the backend wrote into ``folder`` for the
+    module stem ``stem`` and says how to call its functions (None: nothing callable from
+    Python, e.g. LaTeX); ``requires`` are the Python packages that needs (optional extras).
+    Tests and benchmarks loop over the backends that have ``load`` and whose ``requires`` are
+    installed (:func:`loadable_backends`), so a new backend is tested without being listed.
     """
 
     name: str
@@ -91,20 +98,39 @@ class Backend:
     config: type | None = None
     order: int = 1000
     reserved: tuple[str, ...] = ()
+    printer: type | None = None
+    load: Callable[[Path, str], "Loaded"] | None = None
+    requires: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Loaded:
+    """A generated module imported by its backend's ``load``.
+
+    ``namespace`` holds the module's names (functions, ``JOINT_NAMES`` …; for CasADi the
+    ``casadi.Function`` objects by name). ``call(function, *inputs, **parameters)`` runs one of
+    its functions on the input vectors in the registry's order (``eomgen.outputs.OUTPUTS``) and
+    returns an array-like result: what a user's plain call gives (a CasADi function is called
+    by name, so a parameter left out takes its default, as in the others)."""
+
+    namespace: Mapping[str, Any]
+    call: Callable[..., Any]
 
 
 BACKENDS: dict[str, Backend] = {}
 
 
 def register(name: str, description: str, needs: tuple[str, ...] = (), config: type | None = None,
-             order: int = 1000, reserved: tuple[str, ...] = ()):
+             order: int = 1000, reserved: tuple[str, ...] = (), printer: type | None = None,
+             load: Callable[[Path, str], Loaded] | None = None, requires: tuple[str, ...] = ()):
     """Decorator registering ``generate(job, config=...) -> list[GeneratedFile]`` as backend
-    ``name``, with its config dataclass ``config`` and the identifiers its modules bind
-    (``reserved``). Backends are listed by ``order``, then name."""
+    ``name``, with its config dataclass ``config``, the identifiers its modules bind
+    (``reserved``), its printer class and how to load what it wrote (``load``, ``requires``:
+    see :class:`Backend`). Backends are listed by ``order``, then name."""
 
     def decorate(function: Callable[..., list[GeneratedFile]]):
         BACKENDS[name] = Backend(name, description, function, tuple(needs), config, order,
-                                 tuple(reserved))
+                                 tuple(reserved), printer, load, tuple(requires))
         ordered = sorted(BACKENDS.items(), key=lambda item: (item[1].order, item[0]))
         BACKENDS.clear()
         BACKENDS.update(ordered)
@@ -119,3 +145,12 @@ def available_backends() -> dict[str, Backend]:
     from . import backends  # noqa: F401  (registration)
 
     return dict(BACKENDS)
+
+
+def loadable_backends() -> dict[str, Backend]:
+    """The backends whose generated code can be imported and called here: those with a
+    ``load`` whose ``requires`` are installed, by ``order`` then name."""
+    from importlib.util import find_spec
+
+    return {name: b for name, b in available_backends().items()
+            if b.load is not None and all(find_spec(r) is not None for r in b.requires)}

@@ -21,7 +21,7 @@ from sympy.printing.pycode import PythonCodePrinter
 
 from ...outputs import exported
 from ...compiler import c_compiler
-from .. import GeneratedFile, Job, register
+from .. import GeneratedFile, Job, Loaded, register
 from ...symbolic.printing import FloatLiteralMixin, exec_source
 from ..functions import DEFAULT_FUNCTIONS
 from ..render import render
@@ -68,8 +68,31 @@ def _render_module(job: Job, config: CasADiConfig) -> str:
                   **python_module_context(job, printer, config.template, backend="casadi"))
 
 
+def load_casadi(folder: Path, stem: str) -> Loaded:
+    """The CasADi module written into ``folder``; a function is called by name (a parameter
+    left out takes the description's value) and gives its output as a NumPy array (a vector
+    output flattened, as the other backends give it)."""
+    import numpy as np
+
+    from ...outputs import OUTPUTS
+
+    path = folder / (stem + CasADiConfig.suffix)
+    namespace = load_module_source(path.read_text(encoding="utf-8"),
+                                   f"{stem}_ca_{abs(hash(str(folder)))}")
+
+    def call(function, *inputs, **parameters):
+        declared = OUTPUTS[function]
+        result = namespace[function].call({**dict(zip(declared.inputs, inputs)), **parameters})
+        out = np.array(result[declared.symbol] if declared.symbol in result
+                       else next(iter(result.values())), dtype=float)
+        return out.ravel() if declared.is_vector else out
+
+    return Loaded(namespace, call)
+
+
 @register("casadi", "CasADi module: casadi.Function objects (SX) with named inputs and outputs",
-          config=CasADiConfig, order=20, reserved=("ca", "casadi"))
+          config=CasADiConfig, order=20, reserved=("ca", "casadi"), printer=CasADiPrinter,
+          load=load_casadi, requires=("casadi",))
 def generate_casadi(job: Job, config: CasADiConfig = CasADiConfig()) -> list[GeneratedFile]:
     return [GeneratedFile(job.stem + config.suffix, _render_module(job, config))]
 

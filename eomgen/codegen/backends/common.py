@@ -3,11 +3,14 @@ a straight-line program into ``(lhs, rhs)`` pairs for the templates."""
 
 from __future__ import annotations
 
+import importlib.util
 from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
 
 import sympy as sp
 
-from .. import Job
+from .. import Job, Loaded
 from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, INPUTS, composition_names,
                        constrained_names, exported)
 from ..functions import FunctionSpec
@@ -169,3 +172,28 @@ def python_module_context(job: Job, printer, template: str, extra_exports=(),
         constrained_forward_dynamics=CONSTRAINED_FORWARD.function in functions,
         cfd=constrained_names(),
     )
+
+
+def import_file(path: Path, name: str) -> dict:
+    """The namespace of the Python module or extension at ``path``, imported as ``name`` (not
+    put in ``sys.modules``): what a backend's ``load`` gives."""
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return vars(module)
+
+
+def python_loader(suffix: str, before: Callable[[], None] | None = None):
+    """A backend's ``load`` for a generated Python module ``<stem><suffix>`` whose functions
+    take the input vectors positionally (NumPy, JAX, PyTorch). ``before`` runs first (JAX:
+    float64)."""
+
+    def load(folder: Path, stem: str) -> Loaded:
+        if before is not None:
+            before()
+        namespace = import_file(folder / (stem + suffix),
+                                f"{stem}{suffix[:-3]}_{abs(hash(str(folder)))}")
+        return Loaded(namespace, lambda function, *inputs, **parameters:
+                      namespace[function](*inputs, **parameters))
+
+    return load

@@ -28,11 +28,12 @@ from sympy.printing.c import C99CodePrinter
 from sympy.printing.precedence import PRECEDENCE
 
 from ...compiler import c_compiler
-from .. import GeneratedFile, Job, register
+from .. import GeneratedFile, Job, Loaded, register
 from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, composition_names,
                        constrained_names, exported)
 from ...symbolic.printing import FloatLiteralMixin
 from ..render import render
+from .common import import_file
 
 
 #: parenthesize(x, _BARE) leaves only atoms (symbols, numbers) without parentheses
@@ -228,8 +229,22 @@ def compile_module(source: str, module: str, config: FastConfig = FastConfig()
         return library.read_bytes()
 
 
+def load_fast(folder: Path, stem: str) -> Loaded:
+    """The compiled fast module written into ``folder`` (imported under its own name, which
+    its init function carries); functions take the input vectors positionally. A
+    FileNotFoundError when it was not compiled (no C compiler)."""
+    suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
+    path = folder / (stem + FastConfig.suffix + suffix)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: the fast module was not compiled (no C compiler?)")
+    namespace = import_file(path, stem + FastConfig.suffix)
+    return Loaded(namespace, lambda function, *inputs, **parameters:
+                  namespace[function](*inputs, **parameters))
+
+
 @register("fast", "C extension module for Python (one state or a batch looped in C), "
-          "compiled when a C compiler is found", config=FastConfig, order=40)
+          "compiled when a C compiler is found", config=FastConfig, order=40,
+          printer=FastCPrinter, load=load_fast)
 def generate_fast(job: Job, config: FastConfig = FastConfig()) -> list[GeneratedFile]:
     module = job.stem + config.suffix
     source = _render_source(job, config)

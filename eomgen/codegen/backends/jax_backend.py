@@ -28,23 +28,10 @@ from __future__ import annotations
 import ast
 from dataclasses import dataclass, replace
 
-from sympy.printing.numpy import NumPyPrinter
-
 from .. import GeneratedFile, Job, register
 from ..render import render
-from .common import PrintedFunction, python_module_context
-from .numpy_backend import NumPyModulePrinter
-
-
-class ArrayModulePrinter(NumPyModulePrinter):
-    """NumPy-style code whose ``numpy.<name>`` calls go to another array module, ``alias``
-    (``jnp`` for ``jax.numpy``, ``torch``): the same expressions, the same float literals."""
-
-    alias = "np"
-
-    def _module_format(self, fqn, register=True):
-        text = NumPyPrinter._module_format(self, fqn, register)
-        return f"{self.alias}.{text[len('numpy.'):]}" if text.startswith("numpy.") else text
+from .common import PrintedFunction, python_loader, python_module_context
+from .numpy_backend import ArrayModulePrinter
 
 
 class JaxModulePrinter(ArrayModulePrinter):
@@ -61,8 +48,17 @@ class JaxConfig:
     suffix: str = "_jax.py"
 
 
+def _float64() -> None:
+    """JAX in float64, as the tests compare the module with NumPy to 1e-12 (a process-wide
+    setting of JAX's)."""
+    import jax
+
+    jax.config.update("jax_enable_x64", True)
+
+
 @register("jax", "JAX module: pure functions for jax.jit, jax.vmap and jax.grad (needs jax)",
-          config=JaxConfig, order=60, reserved=("jnp", "jax"))
+          config=JaxConfig, order=60, reserved=("jnp", "jax"), printer=JaxModulePrinter,
+          load=python_loader(JaxConfig.suffix, before=_float64), requires=("jax",))
 def generate_jax(job: Job, config: JaxConfig = JaxConfig()) -> list[GeneratedFile]:
     printer = JaxModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
     context = python_module_context(job, printer, config.template, backend="jax")

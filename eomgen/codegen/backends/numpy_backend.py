@@ -15,7 +15,7 @@ from ...outputs import FORWARD
 from ...symbolic.printing import FloatLiteralMixin
 from ..render import render
 from ...runtime.cholesky import included_source
-from .common import python_module_context
+from .common import python_loader, python_module_context
 
 
 class NumPyModulePrinter(FloatLiteralMixin, NumPyPrinter):
@@ -35,8 +35,20 @@ class NumPyConfig:
     suffix: str = "_numpy.py"
 
 
+class ArrayModulePrinter(NumPyModulePrinter):
+    """NumPy-style code whose ``numpy.<name>`` calls go to another array module, ``alias``
+    (``jnp`` for ``jax.numpy``, ``torch``): the same expressions, the same float literals."""
+
+    alias = "np"
+
+    def _module_format(self, fqn, register=True):
+        text = NumPyPrinter._module_format(self, fqn, register)
+        return f"{self.alias}.{text[len('numpy.'):]}" if text.startswith("numpy.") else text
+
+
 @register("numpy", "NumPy module: single states (n,) and batches (N, n), NumPy only",
-          config=NumPyConfig, order=10, reserved=("np",))
+          config=NumPyConfig, order=10, reserved=("np",), printer=NumPyModulePrinter,
+          load=python_loader(NumPyConfig.suffix), requires=("numpy",))
 def generate_numpy(job: Job, config: NumPyConfig = NumPyConfig()) -> list[GeneratedFile]:
     printer = NumPyModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
     return [GeneratedFile(job.stem + config.suffix, numpy_source(job, printer, config))]

@@ -15,8 +15,8 @@ from dataclasses import dataclass
 from .. import GeneratedFile, Job, register
 from ...outputs import FORWARD
 from ..render import render
-from .common import python_module_context
-from .jax_backend import ArrayModulePrinter
+from .common import python_loader, python_module_context
+from .numpy_backend import ArrayModulePrinter
 
 
 class TorchModulePrinter(ArrayModulePrinter):
@@ -35,7 +35,8 @@ class TorchConfig:
 
 @register("torch", "PyTorch module: tensors (n,) or (N, n), any device and dtype, autograd "
                    "(needs torch)", config=TorchConfig, order=70,
-          reserved=("torch",))
+          reserved=("torch",), printer=TorchModulePrinter,
+          load=python_loader(TorchConfig.suffix), requires=("torch",))
 def generate_torch(job: Job, config: TorchConfig = TorchConfig()) -> list[GeneratedFile]:
     printer = TorchModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
     extra = ["IllConditionedWarning"] if FORWARD.function in job.functions else []
