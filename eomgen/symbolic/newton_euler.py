@@ -50,7 +50,7 @@ from mpmath.libmp import prec_to_dps
 
 from ..bodies import BodyTree, InertialParameters
 from ..model import Transform, Vec3
-from .composite import _cross, _dot, _matvec
+from .composite import _cross, _dot, _matvec, _rotation
 from .program import ProgramBuilder, Tag, _tag
 
 
@@ -196,7 +196,7 @@ def leaf_phases(tree: BodyTree, inertials: list) -> tuple[list, dict]:
         digits = prec_to_dps(min(v._prec for v in (h[x], h[y]) if v.is_Float) if
                              h[x].is_Float or h[y].is_Float else 53)
         phi = (sign * sp.atan2(h[y], h[x])).evalf(digits)
-        turn = _axis_rotation(body.joint.axis, h[x] / length, sign * h[y] / length)
+        turn = _rotation(body.joint.axis, h[x] / length, sign * h[y] / length)
         turned = inertials[i].transformed(Transform(tuple(zip(*turn)), (0, 0, 0)))
         first = [sp.Integer(0)] * 3
         first[x] = length  # and h[y] is now exactly 0
@@ -248,18 +248,6 @@ def _scaled(x, length):
     return x / length
 
 
-def _axis_rotation(axis: Vec3, c, s) -> tuple:
-    """Rot(axis, φ) as rows, from c = cos φ and s = sin φ (Rodrigues)."""
-    k = tuple(axis)
-    return tuple(tuple((c if r == col else 0) + (1 - c) * k[r] * k[col]
-                       - s * sum(_levi(r, col, j) * k[j] for j in range(3))
-                       for col in range(3)) for r in range(3))
-
-
-def _levi(i: int, j: int, k: int) -> int:
-    return (i - j) * (j - k) * (k - i) // 2
-
-
 def _negated(par: InertialParameters) -> InertialParameters:
     return InertialParameters(-par.mass, tuple(-x for x in par.first_moment),  # type: ignore
                               tuple(tuple(-x for x in row) for row in par.inertia))  # type: ignore
@@ -282,9 +270,15 @@ def _omega_products(w, b: ProgramBuilder, tag) -> tuple:
     return tuple(tuple(row) for row in ww)
 
 
-def _renamed_terms(expr, names: dict) -> sp.Expr:
-    """``expr`` with each term ``c·t`` (c a number) whose ``t`` is a key of ``names`` written
-    ``c·names[t]``."""
+def _renamed_terms(expr, w, ww) -> sp.Expr:
+    """``expr`` with each term ``c·t`` (c a number) whose ``t`` is a product ``ω_r ω_c`` of
+    ``w`` (up to a number) written with its name from ``ww``."""
+    names = {}
+    for r in range(3):
+        for c in range(3):
+            coeff, product = (w[r] * w[c]).as_coeff_Mul()
+            if coeff != 0:
+                names[product] = ww[r][c] / coeff
     out = []
     for term in sp.Add.make_args(expr):
         coeff, rest = term.as_coeff_Mul()
@@ -432,13 +426,7 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
             ww = _omega_products(w, b, tag)
             # q̇ (ω_in × k): a product that is also some ω_r ω_c (ω's component along k is q̇
             # alone when the parent's ω has none there) uses that product's name
-            same = {}
-            for r in range(3):
-                for c in range(3):
-                    coeff, product = (w[r] * w[c]).as_coeff_Mul()
-                    if coeff != 0:
-                        same[product] = ww[r][c] / coeff
-            dw_rel = tuple(_renamed_terms(e, same) for e in
+            dw_rel = tuple(_renamed_terms(e, w, ww) for e in
                            _cross(w_in, tuple(z[j] * qd[k] for j in range(3))))
             dw = _name_all(b, tuple(e + dw_rel[j] + z[j] * qdd[k] for j, e in
                                     enumerate(to_body(i, dw_p))), f"dw{tag}_", ("dw", tag))

@@ -19,8 +19,9 @@ How a function assembles its output changes XLA's CPU speed several-fold
   as cheap and copies them into every loop that uses them (for the Panda's M, all 14 into most
   of its 28 output loops); it counts a division as costly and computes it once, so each sine
   and cosine is computed once. ``1 + 0·x`` is not folded to 1 (``0·x`` is NaN for x = ±inf).
-  With it, ``jax.jit(jax.vmap(f))`` on 10,000 Panda states takes 0.2-0.7 times NumPy's time
-  per state for τ, M, C and g, against 0.9-3 times without (benchmarks/backend_speed.py).
+  With it, ``jax.jit(jax.vmap(f))`` on 10,000 Panda states took 0.3-0.75 times NumPy's time
+  per state for τ and M (benchmarks/backend_speed.py, six runs) and 0.4 and 0.7 times for C and
+  g (one run), against 0.9-5 times without.
 """
 
 from __future__ import annotations
