@@ -87,3 +87,5 @@ class _Package(types.ModuleType):
 
 
 sys.modules[__name__].__class__ = _Package
+
+from . import display  # noqa: E402,F401  (registers the notebook display of models and dynamics)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import html
 from typing import TYPE_CHECKING
 
-import sympy as sp
+from . import reprs
 
 if TYPE_CHECKING:
     from .dynamics import Dynamics
@@ -91,6 +91,8 @@ def grouped_matrices(book) -> dict:
     built unevaluated, so their order is kept; print them with :func:`expression_latex`)."""
     from .teach import readability as rd
 
+    import sympy as sp  # imported when displaying: `import eomgen` registers this module
+
     masses = [b.mass for b in book.bodies if isinstance(b.mass, sp.Symbol)]
     angles = list(book.q)
     return {"M": book.M.applyfunc(lambda e: rd.mass_grouped(e, masses)),
@@ -149,6 +151,8 @@ def _matrix_latex(printer, matrix) -> str:
 
 def _unevaluated(e) -> bool:
     """Whether the sum ``e`` was built with ``evaluate=False`` (a grouped sum)."""
+    import sympy as sp  # imported when displaying: `import eomgen` registers this module
+
     return e.args != sp.Add(*e.args).args
 
 
@@ -163,9 +167,16 @@ def expression_latex(dynamics: Dynamics, expr, names: dict | None = None) -> str
     >>> expression_latex(dyn, dyn.g[1])
     'g l_{c2} m_{2} c_{12}'
     """
+    import sympy as sp  # imported when displaying: `import eomgen` registers this module
+
     printer = _printer(dynamics, names)
     if isinstance(expr, sp.MatrixBase):
         return _matrix_latex(printer, expr)
     if isinstance(expr, sp.Add) and _unevaluated(expr):
         return printer.print_sum_lines(list(expr.args), 10 ** 9)[0]
     return printer.doprint(expr)
+
+
+# What RobotModel._repr_html_ and Dynamics._repr_latex_ show (eomgen.reprs).
+reprs.register("model", "text/html", model_html)
+reprs.register("dynamics", "text/latex", dynamics_latex)

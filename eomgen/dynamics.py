@@ -11,17 +11,20 @@ the Christoffel symbols of the first kind, ``C_ij = Σ_k c_ijk q̇_k`` with
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import cached_property
 from typing import Iterable
 
 import sympy as sp
 
-from .bodies import BodyTree, body_tree
+from . import reprs
 from .errors import TooLargeError
 from .model import Parameter, RobotModel
-from .outputs import BY_SYMBOL, INPUTS, derived_symbols, input_size
-from .symbolic.program import Program, ProgramBuilder
+from .outputs import derived_symbols
+# Derivation, joint_symbols and vector_symbols live in eomgen.symbolic.derivation; re-exported here
+# because the docs and earlier code import them from eomgen.dynamics.
+from .symbolic.derivation import Derivation, joint_symbols, new_derivation, vector_symbols  # noqa: F401
+from .symbolic.program import Program
 from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS
 
 #: What generated modules export by default: the mass matrix, Coriolis matrix, gravity vector
@@ -33,73 +36,6 @@ DEFAULT_OUTPUTS = ("M", "C", "g")
 #: simplification of the expanded expressions grows exponentially with the number of joints
 #: (hours beyond this size), while the unsimplified program stays linear.
 MAX_SIMPLIFY_JOINTS = 6
-
-
-def joint_symbols(n: int) -> tuple[tuple[sp.Symbol, ...], tuple[sp.Symbol, ...], tuple[sp.Symbol, ...]]:
-    """Symbols ``q1…qn``, ``qd1…qdn``, ``qdd1…qddn`` (real)."""
-    return vector_symbols("q", n), vector_symbols("qd", n), vector_symbols("qdd", n)
-
-
-def vector_symbols(prefix: str, n: int) -> tuple[sp.Symbol, ...]:
-    """Symbols ``<prefix>1 … <prefix>n`` (real): the entries of an input vector."""
-    return tuple(sp.Symbol(f"{prefix}{k + 1}", real=True) for k in range(n))
-
-
-@dataclass(frozen=True)
-class Derivation:
-    """What an output's builder (:attr:`eomgen.outputs.Output.build`) works with: the model,
-    its body tree (fixed links merged), the symbols of every input vector of
-    :data:`eomgen.outputs.INPUTS` in ``JOINT_NAMES`` order (``inputs["q"]`` is ``q1 … qn``; also
-    as the attributes ``q``, ``qd``, ``qdd``, ``tau``) and the program builder to define
-    intermediates in. ``shared`` lets builders keep what another builder may reuse (keyed by
-    the builder's own module name)."""
-
-    model: RobotModel
-    tree: BodyTree
-    inputs: dict[str, tuple[sp.Symbol, ...]]
-    builder: ProgramBuilder
-    shared: dict = field(default_factory=dict)
-
-    @property
-    def q(self) -> tuple[sp.Symbol, ...]:
-        return self.inputs["q"]
-
-    @property
-    def qd(self) -> tuple[sp.Symbol, ...]:
-        return self.inputs["qd"]
-
-    @property
-    def qdd(self) -> tuple[sp.Symbol, ...]:
-        return self.inputs["qdd"]
-
-    @property
-    def tau(self) -> tuple[sp.Symbol, ...]:
-        return self.inputs["tau"]
-
-    @property
-    def built(self) -> dict[str, sp.Matrix]:
-        """The outputs built so far, by symbol (extra symbols such as ``P`` included)."""
-        return self.shared.setdefault("outputs", {})
-
-    def output(self, symbol: str) -> sp.Matrix:
-        """The matrix of the registered output ``symbol``, built now if it was not yet (a
-        builder that needs M calls ``derivation.output("M")``: M is built once per program)."""
-        if symbol not in self.built:
-            self.build({symbol})
-        return self.built[symbol]
-
-    def build(self, symbols) -> None:
-        """Build the registered ``symbols`` not built yet, in registry order; outputs sharing a
-        builder are built in one call."""
-        symbols = set(symbols)
-        for symbol in BY_SYMBOL:
-            if symbol not in symbols or symbol in self.built:
-                continue
-            declared = BY_SYMBOL[symbol]
-            wanted = {s for s in symbols - set(self.built)
-                      if BY_SYMBOL[s].build == declared.build}
-            made = declared.builder()(self, wanted)
-            self.built.update({k: v for k, v in made.items() if k not in self.built})
 
 
 @dataclass(frozen=True)
@@ -287,10 +223,8 @@ class Dynamics:
 
         return lambdify(self)
 
-    def _repr_latex_(self) -> str:  # rich display in notebooks: see eomgen.display
-        from .display import dynamics_latex
-
-        return dynamics_latex(self)
+    def _repr_latex_(self) -> str | None:  # rich display in notebooks: registered by eomgen.display
+        return reprs.render("dynamics", self, "text/latex")
 
 
 def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify: bool | None = None) -> Dynamics:
@@ -349,19 +283,15 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
             "simplify=False (the default for large models)")
     timings = []
     start = time.perf_counter()
-    tree = body_tree(model)
-    inputs = {name: vector_symbols(name, input_size(name, model)) for name in INPUTS}
-    q, qd, qdd = inputs["q"], inputs["qd"], inputs["qdd"]
-    reserved = {s.name for v in inputs.values() for s in v} | {p.name for p in model.parameters}
-    builder = ProgramBuilder(reserved)
+    derivation = new_derivation(model)
+    inputs = derivation.inputs
+    q, qd, qdd = derivation.q, derivation.qd, derivation.qdd
     timings.append(("bodies", time.perf_counter() - start))
     start = time.perf_counter()
-    derivation = Derivation(model, tree, inputs, builder)
     derivation.build(outputs)
     result = derivation.built
     timings.append(("program", time.perf_counter() - start))
-    names = list(result)
-    program = Program(tuple(builder.assignments), tuple((n, result[n]) for n in names)).pruned(names)
+    program = derivation.program(result.items())
     steps = _steps(program, result)
     if simplify is None:  # teaching-sized: few joints and a small program (a cheap estimate)
         counted = [o for o in ("M", "C", "g") if o in outputs]

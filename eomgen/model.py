@@ -33,6 +33,8 @@ from typing import Iterable, Mapping
 
 import sympy as sp
 
+from . import reprs
+
 from .errors import (
     DescriptionError,
     InvalidActuatorError,
@@ -534,10 +536,8 @@ class RobotModel:
             stack.extend(reversed(children.get(joint.child, [])))
         return tuple(order)
 
-    def _repr_html_(self) -> str:  # rich display in notebooks: see eomgen.display
-        from .display import model_html
-
-        return model_html(self)
+    def _repr_html_(self) -> str | None:  # rich display in notebooks: registered by eomgen.display
+        return reprs.render("model", self, "text/html")
 
     @property
     def parameter_values(self) -> dict[sp.Symbol, float]:

@@ -37,7 +37,7 @@ from typing import Callable
 
 #: The vector inputs a generated function may take, each of length n (the joints, in
 #: ``JOINT_NAMES`` order) unless :data:`INPUT_SIZES` gives another length, with their docstring line. Their symbols are ``<name>1 … <name>n``
-#: (:attr:`eomgen.dynamics.Derivation.inputs`); adding an input is one line here.
+#: (:attr:`eomgen.symbolic.derivation.Derivation.inputs`); adding an input is one line here.
 INPUTS: dict[str, str] = {
     "q": "joint positions [rad or m]",
     "qd": "joint velocities [rad/s or m/s]",
@@ -93,7 +93,7 @@ class Output:
     build:
         ``"module:function"``, the builder of ``symbol``, imported when first needed:
         ``function(derivation, wanted) -> dict`` takes a
-        :class:`~eomgen.dynamics.Derivation` (the model, its body tree, the joint symbols and
+        :class:`~eomgen.symbolic.derivation.Derivation` (the model, its body tree, the joint symbols and
         the program builder) and the set of symbols wanted of those it builds, and returns
         ``{symbol: sympy.Matrix}`` in terms of the builder's intermediates. Outputs sharing a
         builder are built in one call. A returned symbol no output declares (the potential

@@ -33,12 +33,12 @@ from typing import Iterable, Mapping, Sequence
 import numpy as np
 import sympy as sp
 
-from .bodies import BodyTree, body_tree
-from .dynamics import joint_symbols
+from .bodies import BodyTree
 from .errors import ParameterError, UnsupportedError
 from .model import RobotModel, parameter_symbol
 from .symbolic.evaluate import compile_program
-from .symbolic.program import Program, ProgramBuilder
+from .symbolic.derivation import new_derivation
+from .symbolic.program import Program
 from .symbolic.regressor import (ACTUATOR_NAMES, ACTUATOR_TERMS, INERTIAL_NAMES,
                                  regressor_program)
 
@@ -204,14 +204,11 @@ def derive_regressor(model: RobotModel, actuators: Iterable[str] = ()) -> Regres
     if bad or len(set(actuators)) != len(actuators):
         raise ValueError(f"actuator terms must be distinct ones of {ACTUATOR_TERMS}, got {actuators}")
     start = time.perf_counter()
-    tree = body_tree(model)
-    q, qd, qdd = joint_symbols(model.dof)
-    reserved = {s.name for s in q + qd + qdd} | {p.name for p in model.parameters}
-    b = ProgramBuilder(reserved)
-    out = regressor_program(tree, q, qd, qdd, model.gravity, b, actuators)
-    names = ("Y", "K", "P")
-    program = Program(tuple(b.assignments), tuple((k, out[k]) for k in names)).pruned(names)
-    return Regressor(model, tree, q, qd, qdd, program, actuators, time.perf_counter() - start)
+    d = new_derivation(model, ("q", "qd", "qdd"))
+    out = regressor_program(d.tree, d.q, d.qd, d.qdd, model.gravity, d.builder, actuators)
+    program = d.program((k, out[k]) for k in ("Y", "K", "P"))
+    return Regressor(model, d.tree, d.q, d.qd, d.qdd, program, actuators,
+                     time.perf_counter() - start)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -35,11 +35,12 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..bodies import BodyTree, body_tree
+from ..bodies import BodyTree
 from ..model import RobotModel, Vec3
 from .composite import _cross, _dot, _matvec
 from .newton_euler import _Frames, _name, _name_all, grouped_inertials
 from .program import Tag, _tag
+from .derivation import new_derivation
 from .program import Program, ProgramBuilder
 
 _ZERO = sp.Integer(0)
@@ -302,16 +303,9 @@ def aba_program(model: RobotModel) -> ForwardDynamics:
     >>> fd.program.output("qdd").shape
     (2, 1)
     """
-    from ..dynamics import joint_symbols
-
-    tree = body_tree(model)
-    q, qd, _ = joint_symbols(model.dof)
-    tau = tuple(sp.Symbol(f"tau{k + 1}", real=True) for k in range(model.dof))
-    reserved = {s.name for s in q + qd + tau} | {p.name for p in model.parameters}
-    builder = ProgramBuilder(reserved)
-    qdd = forward_dynamics_program(tree, q, qd, tau, model.gravity, builder)
-    program = Program(tuple(builder.assignments), (("qdd", qdd),)).pruned(["qdd"])
-    return ForwardDynamics(q, qd, tau, program)
+    d = new_derivation(model, ("q", "qd", "tau"))
+    qdd = forward_dynamics_program(d.tree, d.q, d.qd, d.tau, model.gravity, d.builder)
+    return ForwardDynamics(d.q, d.qd, d.tau, d.program([("qdd", qdd)]))
 
 
 def cholesky_program(model: RobotModel) -> ForwardDynamics:
@@ -324,16 +318,12 @@ def cholesky_program(model: RobotModel) -> ForwardDynamics:
     A generated module's ``forward_dynamics`` does the same arithmetic with its own
     M (the root-frame composite program) and a numeric Cholesky factorisation.
     """
-    from ..dynamics import joint_symbols
     from .crba import M_program
     from .newton_euler import inverse_dynamics_program
 
-    tree = body_tree(model)
+    d = new_derivation(model, ("q", "qd", "tau"))
+    tree, q, qd, tau, b = d.tree, d.q, d.qd, d.tau, d.builder
     n = model.dof
-    q, qd, _ = joint_symbols(n)
-    tau = tuple(sp.Symbol(f"tau{k + 1}", real=True) for k in range(n))
-    reserved = {s.name for s in q + qd + tau} | {p.name for p in model.parameters}
-    b = ProgramBuilder(reserved)
     M = M_program(tree, q, b)
     bias = inverse_dynamics_program(tree, q, qd, (_ZERO,) * n, model.gravity, b)
     L = [[_ZERO] * n for _ in range(n)]
@@ -354,8 +344,7 @@ def cholesky_program(model: RobotModel) -> ForwardDynamics:
     for i in reversed(range(n)):
         rhs = y[i] - sp.Add(*[L[k][i] * x[k] for k in range(i + 1, n)])
         x[i] = _name(b, rhs * inv_diag[i], f"qdd{i + 1}", ("qdd", i + 1))
-    program = Program(tuple(b.assignments), (("qdd", sp.Matrix(x)),)).pruned(["qdd"])
-    return ForwardDynamics(q, qd, tau, program)
+    return ForwardDynamics(q, qd, tau, d.program([("qdd", sp.Matrix(x))]))
 
 
 def build_forward_dynamics_aba(derivation, wanted) -> dict:

@@ -16,11 +16,11 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..bodies import body_tree
 from ..model import RobotModel
 from .crba import M_program
 from .newton_euler import _name, inverse_dynamics_program
-from .program import Program, ProgramBuilder
+from .derivation import new_derivation
+from .program import Program
 
 
 def dynamics_program(model: RobotModel) -> tuple[tuple, tuple, Program]:
@@ -34,13 +34,8 @@ def dynamics_program(model: RobotModel) -> tuple[tuple, tuple, Program]:
     >>> [name for name, _ in program.outputs]
     ['M', 'Cqd', 'g']
     """
-    from ..dynamics import joint_symbols
-
-    n = model.dof
-    q, qd, _ = joint_symbols(n)
-    reserved = {s.name for s in q + qd} | {p.name for p in model.parameters}
-    b = ProgramBuilder(reserved)
-    tree = body_tree(model)
+    d = new_derivation(model, ("q", "qd"))
+    n, q, qd, b, tree = model.dof, d.q, d.qd, d.builder, d.tree
     zero = (sp.Integer(0),) * n
     M = M_program(tree, q, b)
     g = inverse_dynamics_program(tree, q, zero, zero, model.gravity, b)
@@ -48,7 +43,7 @@ def dynamics_program(model: RobotModel) -> tuple[tuple, tuple, Program]:
     Cqd = sp.Matrix([[_name(b, bias[k, 0] - g[k, 0], f"Cqd{k + 1}", ("Cqd", k + 1))]
                      for k in range(n)])
     outputs = (("M", M), ("Cqd", Cqd), ("g", g))
-    return q, qd, Program(tuple(b.assignments), outputs).pruned([o for o, _ in outputs])
+    return q, qd, d.program(outputs)
 
 
 def build_nonlinear_effects(derivation, wanted) -> dict:

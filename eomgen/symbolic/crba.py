@@ -17,11 +17,12 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..bodies import BodyTree, body_tree
+from ..bodies import BodyTree
 from ..model import RobotModel
 from .aba import _force_to_parent, _Frames, _full, _inertia_to_parent, _symmetric
 from .composite import _dot, _matvec
 from .newton_euler import _name, _name_all, grouped_inertials
+from .derivation import new_derivation
 from .program import Program, ProgramBuilder
 
 _ZERO = sp.Integer(0)
@@ -92,11 +93,6 @@ def crba_program(model: RobotModel) -> tuple[tuple[sp.Symbol, ...], Program]:
     >>> program.output("M").shape
     (2, 2)
     """
-    from ..dynamics import joint_symbols
-
-    q, _, _ = joint_symbols(model.dof)
-    reserved = {s.name for s in q} | {p.name for p in model.parameters}
-    b = ProgramBuilder(reserved)
-    M = M_program(body_tree(model), q, b)
-    return q, Program(tuple(b.assignments), (("M", M),)).pruned(["M"])
+    d = new_derivation(model, ("q",))
+    return d.q, d.program([("M", M_program(d.tree, d.q, d.builder))])
 

@@ -34,10 +34,10 @@ from typing import Iterable
 import numpy as np
 import sympy as sp
 
-from ..bodies import body_tree
 from ..errors import KinematicTreeError
 from ..model import IDENTITY3, RobotModel, Transform, ZERO3
 from .composite import forward_kinematics, motion_cross
+from .derivation import new_derivation
 from .program import Program, ProgramBuilder
 
 def _cross(a, b) -> tuple:
@@ -145,17 +145,12 @@ def derive_frames(model: RobotModel, frames: Iterable[str] | None = None) -> Fra
     KinematicTreeError
         For a name that is not a link of the model.
     """
-    from ..dynamics import joint_symbols
-
     frames = tuple(frames) if frames is not None else tuple(l.name for l in model.links)
-    q, qd, _ = joint_symbols(model.dof)
-    reserved = {s.name for s in q + qd} | {p.name for p in model.parameters}
-    b = ProgramBuilder(reserved)
-    kinematics = frame_kinematics(model, body_tree(model), q, qd, b, frames)
+    d = new_derivation(model, ("q", "qd"))
+    kinematics = frame_kinematics(model, d.tree, d.q, d.qd, d.builder, frames)
     outputs = [(f"{kind}_{k}", values[kind]) for k, values in enumerate(kinematics)
                for kind in FRAME_OUTPUTS]
-    program = Program(tuple(b.assignments), tuple(outputs)).pruned([n_ for n_, _ in outputs])
-    return FrameKinematics(model, frames, q, qd, program)
+    return FrameKinematics(model, frames, d.q, d.qd, d.program(outputs))
 
 
 def frame_kinematics(model: RobotModel, tree, q, qd, b: ProgramBuilder,

@@ -35,6 +35,7 @@ import sympy as sp
 
 from ..bodies import body_tree
 from ..model import IDENTITY3, RobotModel, Transform, ZERO3, joint_motion
+from .derivation import joint_symbols
 
 #: Largest number of joints for which the textbook derivation is computed by default.
 TEXTBOOK_MAX_DOF = 3
@@ -303,7 +304,6 @@ def textbook_derivation(model: RobotModel, max_dof: int = TEXTBOOK_MAX_DOF) -> T
     >>> book.bodies[0].P
     g*lc1*m1*sin(q1)
     """
-    from ..dynamics import joint_symbols  # the one place joint symbols are made
 
     n = model.dof
     if n > max_dof:

@@ -1,0 +1,135 @@
+"""The derivation: what every symbolic algorithm works on, made in one place.
+
+A :class:`Derivation` holds a model, its body tree (fixed links merged, :mod:`eomgen.bodies`),
+the symbols of each input vector in ``JOINT_NAMES`` order and the program builder the
+algorithms define their intermediates in. :func:`new_derivation` is the only function that
+builds one; :func:`eomgen.derive`, the algorithm entry points (CRBA, ABA, Newton–Euler, the
+regressor, frames, the combined programs) and the output builders of :mod:`eomgen.outputs` all
+start from it, so that the symbols, the reserved names and the sizes of the inputs are decided
+once.
+
+Symbols: ``q1 … qn`` [rad or m], ``qd1 … qdn`` [rad/s or m/s], ``qdd1 … qddn`` [rad/s² or
+m/s²], ``tau1 … taun`` [N m or N]; an input of :data:`eomgen.outputs.INPUTS` is
+``<name>1 … <name>k`` with ``k`` its own size (:func:`eomgen.outputs.input_size`: the number of
+joints unless the registry says otherwise, e.g. the contact rows of ``F_c``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Iterable
+
+import sympy as sp
+
+from ..bodies import BodyTree, body_tree
+from ..model import RobotModel
+from ..outputs import BY_SYMBOL, INPUTS, input_size
+from .program import Program, ProgramBuilder
+
+
+def vector_symbols(prefix: str, n: int) -> tuple[sp.Symbol, ...]:
+    """Symbols ``<prefix>1 … <prefix>n`` (real): the entries of an input vector."""
+    return tuple(sp.Symbol(f"{prefix}{k + 1}", real=True) for k in range(n))
+
+
+def joint_symbols(n: int) -> tuple[tuple[sp.Symbol, ...], tuple[sp.Symbol, ...], tuple[sp.Symbol, ...]]:
+    """Symbols ``q1…qn``, ``qd1…qdn``, ``qdd1…qddn`` (real)."""
+    return vector_symbols("q", n), vector_symbols("qd", n), vector_symbols("qdd", n)
+
+
+@dataclass(frozen=True)
+class Derivation:
+    """What an algorithm or an output's builder (:attr:`eomgen.outputs.Output.build`) works
+    with: the model, its body tree (fixed links merged), the symbols of every input vector it
+    was made with, in ``JOINT_NAMES`` order (``inputs["q"]`` is ``q1 … qn``; also as the
+    attributes ``q``, ``qd``, ``qdd``, ``tau``), and the program builder to define
+    intermediates in. ``shared`` lets builders keep what another builder may reuse (keyed by
+    the builder's own module name). Made by :func:`new_derivation` only."""
+
+    model: RobotModel
+    tree: BodyTree
+    inputs: dict[str, tuple[sp.Symbol, ...]]
+    builder: ProgramBuilder
+    shared: dict = field(default_factory=dict)
+
+    @property
+    def q(self) -> tuple[sp.Symbol, ...]:
+        return self.inputs["q"]
+
+    @property
+    def qd(self) -> tuple[sp.Symbol, ...]:
+        return self.inputs["qd"]
+
+    @property
+    def qdd(self) -> tuple[sp.Symbol, ...]:
+        return self.inputs["qdd"]
+
+    @property
+    def tau(self) -> tuple[sp.Symbol, ...]:
+        return self.inputs["tau"]
+
+    def size(self, name: str) -> int:
+        """The length of input vector ``name`` (``size("q")`` is the number of joints)."""
+        return len(self.inputs[name])
+
+    @property
+    def built(self) -> dict[str, sp.Matrix]:
+        """The outputs built so far, by symbol (extra symbols such as ``P`` included)."""
+        return self.shared.setdefault("outputs", {})
+
+    def output(self, symbol: str) -> sp.Matrix:
+        """The matrix of the registered output ``symbol``, built now if it was not yet (a
+        builder that needs M calls ``derivation.output("M")``: M is built once per program)."""
+        if symbol not in self.built:
+            self.build({symbol})
+        return self.built[symbol]
+
+    def build(self, symbols) -> None:
+        """Build the registered ``symbols`` not built yet, in registry order; outputs sharing a
+        builder are built in one call."""
+        symbols = set(symbols)
+        for symbol in BY_SYMBOL:
+            if symbol not in symbols or symbol in self.built:
+                continue
+            declared = BY_SYMBOL[symbol]
+            wanted = {s for s in symbols - set(self.built)
+                      if BY_SYMBOL[s].build == declared.build}
+            made = declared.builder()(self, wanted)
+            self.built.update({k: v for k, v in made.items() if k not in self.built})
+
+    def program(self, outputs: Iterable[tuple[str, sp.Matrix]]) -> Program:
+        """The straight-line program of ``outputs`` (``(name, matrix)`` pairs, in order): the
+        builder's intermediates, pruned to those the outputs need."""
+        outputs = tuple(outputs)
+        return Program(tuple(self.builder.assignments), outputs).pruned([n for n, _ in outputs])
+
+
+def new_derivation(model: RobotModel, inputs: Iterable[str] | None = None) -> Derivation:
+    """Start a derivation of ``model``: its body tree, the symbols of the input vectors
+    ``inputs`` (names of :data:`eomgen.outputs.INPUTS`; all of them by default) and a program
+    builder that never names an intermediate after an input or a parameter of the model.
+
+    ``q``, ``qd`` and ``qdd`` are always made (every algorithm indexes joints by them); only
+    the ``inputs`` asked for are reserved as names, so an algorithm that takes fewer inputs
+    names its intermediates as before.
+
+    Examples
+    --------
+    >>> import eomgen
+    >>> d = new_derivation(eomgen.load(eomgen.example_path("planar_2link")), ("q", "qd"))
+    >>> d.q, d.size("qd")
+    ((q1, q2), 2)
+    """
+    names = tuple(INPUTS) if inputs is None else tuple(inputs)
+    unknown = [name for name in names if name not in INPUTS]
+    if unknown:
+        raise ValueError(f"unknown inputs {unknown}; choose from {tuple(INPUTS)}")
+    symbols = {name: vector_symbols(name, input_size(name, model)) for name in names}
+    reserved = {s.name for v in symbols.values() for s in v} | {p.name for p in model.parameters}
+    for name in ("q", "qd", "qdd"):
+        symbols.setdefault(name, vector_symbols(name, model.dof))
+    ordered = {name: symbols[name] for name in INPUTS if name in symbols}
+    return Derivation(model, body_tree(model), ordered, ProgramBuilder(reserved))
+
+
+__all__ = ["Derivation", "joint_symbols", "new_derivation", "vector_symbols"]
