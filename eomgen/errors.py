@@ -33,6 +33,8 @@ tests) can tell them apart without reading messages::
     │                             the robot: unknown key, link or joint, a lock on a joint that
     │                             is not movable, a tip not below the base, a bad payload
     ├── GenerationError           a code generation request that cannot be carried out
+    ├── AnalysisError             a bench or simulation request that cannot be carried out
+    ├── IdentificationError       measurements that cannot be used (``eomgen identify``)
     └── VerificationError
 
 The classes split problems by *kind*: text that does not read as a number is an
@@ -170,6 +172,11 @@ class UnsupportedFeatureWarning(UserWarning):
 class GenerationError(EomgenError):
     """A code generation request that cannot be carried out (unknown backend, unknown parameter
     for ``--symbolic``, a parameter fixed without a value)."""
+
+
+class AnalysisError(EomgenError):
+    """A bench or simulation request that cannot be carried out (``eomgen bench``,
+    ``eomgen simulate``): a missing optional dependency, a malformed list of numbers."""
 
 
 class IdentificationError(EomgenError):

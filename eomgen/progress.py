@@ -126,7 +126,7 @@ class Progress:
             yield Steps(self, total, label, None)
             return
         if self.tty:
-            import click
+            import click  # only for the terminal bar: library callers of Progress need no click
 
             self.clear()
             with click.progressbar(length=total, label=f"eomgen: {label}",

@@ -1,0 +1,198 @@
+"""``eomgen generate`` (code and a derivation, answered from the derivation cache when it can)
+and ``eomgen verify`` (the derived dynamics against Newton–Euler).
+
+SymPy, the parsers and the code generators are imported inside the commands, after the cache
+is asked: a cached ``eomgen generate`` imports neither SymPy nor the parsers.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import sys
+import time
+from pathlib import Path
+
+import click
+
+from ..errors import GenerationError, VerificationError
+from ..output import check_output_folder, write_atomically
+from ..progress import Progress, plural
+from .handling import handle_errors, recorded_warnings
+from .loading import default_description, load, load_reduced
+from .options import (description_argument, output_folder_option, quiet_option, scene_option,
+                      strict_option)
+
+
+@click.command()
+@description_argument()
+@click.option("--samples", default=20, show_default=True, help="Random states for numeric checks.")
+@click.option("--seed", default=0, show_default=True, help="Seed of the random states.")
+@click.option("--tolerance", default=1e-9, show_default=True, help="Relative tolerance.")
+@scene_option()
+@quiet_option()
+@strict_option
+@handle_errors
+def verify(description, samples, seed, tolerance, scene_path, quiet, strict):
+    """Derive DESCRIPTION's dynamics and check them against Newton–Euler.
+
+    DESCRIPTION is a URDF, DH-table YAML or eomgen YAML file (default: the bundled planar
+    2-link arm). Checks: M symmetric positive definite, Ṁ − 2C skew-symmetric, g, the columns of
+    M and the whole equation against the numeric recursive Newton–Euler algorithm.
+
+    \b
+    Examples:
+      eomgen verify
+      eomgen verify ur5.urdf --samples 100 --seed 3
+      eomgen verify panda.urdf --scene examples/scenes/panda_two_joints.yaml
+    """
+    # SymPy: imported when the command runs, not when the CLI starts
+    from ..dynamics import ALL_OUTPUTS, derive
+    from ..verify import verify as run_verify
+
+    if samples < 1:
+        raise VerificationError(f"--samples must be at least 1, got {samples}")
+    progress = Progress(quiet)
+    model, _ = load_reduced(description, scene_path, strict)
+    start = time.perf_counter()
+    progress(f"deriving M, C, g and tau of {model.name} ({plural(model.dof, 'joint')})")
+    dynamics = derive(model, outputs=ALL_OUTPUTS)
+    seconds = time.perf_counter() - start
+    progress(f"checking at {plural(samples, 'random state')}")
+    report = run_verify(dynamics, samples=samples, seed=seed, tolerance=tolerance)
+    progress.clear()
+    click.echo(f"derived {model.name} ({plural(model.dof, 'joint')}: "
+               f"{', '.join(model.joint_names)}) in {seconds:.2f} s")
+    click.echo(report.format())
+    sys.exit(0 if report.passed else 1)
+
+
+class BackendOption(click.Option):
+    """``--backend``, whose help lists the registered backends (looked up when help is shown,
+    so that ``eomgen`` starts without importing the code generators)."""
+
+    def get_help_record(self, ctx):
+        from ..codegen import available_backends  # SymPy: only when the help is shown
+
+        template = self.help
+        self.help = template.format(backends=", ".join(available_backends()))
+        try:
+            return super().get_help_record(ctx)
+        finally:
+            self.help = template
+
+
+def functions_option(text: str | None) -> tuple[str, ...] | None:
+    """The functions ``--outputs`` names (None when not given), or a one-line error."""
+    if text is None:
+        return None
+    from ..outputs import select  # start-up time: only when --outputs is given
+
+    try:
+        return select([n.strip() for n in text.split(",") if n.strip()])
+    except ValueError as exc:
+        raise GenerationError(f"--outputs: {exc}") from None
+
+
+def answer_from_cache(request, outdir: Path, quiet: bool, cache_dir: Path | None) -> bool:
+    """Write the files of a cached ``eomgen generate`` run and list them, as the run did;
+    False when the cache holds no (valid) entry. Imports neither SymPy nor the parsers."""
+    from ..cache import Cache  # start-up time (certifi, ~0.15 s): only when asked
+
+    entry = Cache(cache_dir).get(request.key)
+    if entry is None:
+        return False
+    for notice in entry.notices:
+        click.echo(f"eomgen: warning: {notice}", err=True)
+    if not quiet:
+        click.echo(f"eomgen: using cached result (key {request.key[:16]}…)", err=True)
+    for path in write_atomically(entry.files, outdir):
+        click.echo(str(path))
+    return True
+
+
+@click.command()
+@description_argument()
+@click.option("--backend", "backends", default="all", show_default=True, cls=BackendOption,
+              help="Comma-separated backends among {backends}; or all.")
+@output_folder_option("eomgen_output")
+@click.option("--symbolic", default=None,
+              help="Comma-separated parameters to keep symbolic (default: all the description "
+                   "declares; 'none' for none). The others take their values.")
+@quiet_option()
+@scene_option("Scene file (YAML, docs/scenes.md): the part that moves, locked joints, "
+              "payloads, gravity, outputs. Writes <robot>_scene_report.md too.")
+@click.option("--explain", is_flag=True,
+              help="Print what was merged, locked and dropped, and derive the whole "
+                   "description too to compare operation counts and times.")
+@click.option("--no-cache", is_flag=True,
+              help="Derive afresh: neither read nor write the derivation cache.")
+@click.option("--cache-dir", default=None, type=click.Path(file_okay=False, path_type=Path),
+              help="Derivation cache folder (default: $EOMGEN_CACHE_DIR, else "
+                   "$XDG_CACHE_HOME/eomgen, else ~/.cache/eomgen).")
+@click.option("--no-snap", is_flag=True,
+              help="Keep rotation and axis entries exactly as the description's floats give "
+                   "them (default: entries within 1e-11 of 0 or ±1 are made exact).")
+@click.option("--outputs", default=None,
+              help="Comma-separated functions to export, by name or symbol (default: M, C, g, "
+                   "tau and forward dynamics; docs/outputs.md lists the others, e.g. Y). "
+                   "Replaces a scene's outputs.")
+@strict_option
+@handle_errors
+def generate(description, backends, outdir, symbolic, quiet, scene_path, explain, no_cache,
+             cache_dir, no_snap, outputs, strict):
+    """Generate code and a derivation for DESCRIPTION (default: the bundled planar 2-link arm).
+
+    Writes <robot>_numpy.py (NumPy, single states and batches), <robot>_casadi.py (CasADi
+    functions), <robot>_casadi.c/.h (C through CasADi, plus a .so when a C compiler is found) and
+    <robot>.tex (the derivation) into OUTPUT, all files or none. A request made before (same
+    file bytes, options and eomgen) is answered from the derivation cache.
+
+    \b
+    Examples:
+      eomgen generate
+      eomgen generate robot.urdf --backend numpy -o build/
+      eomgen generate eomgen/robots/planar_2link.yaml --symbolic m2,g
+      eomgen generate talos_reduced.urdf --scene examples/scenes/talos_left_arm.yaml --explain
+    """
+    check_output_folder(outdir)
+    functions = functions_option(outputs)
+    progress = Progress(quiet)
+    request = None
+    if not no_cache:
+        from ..cache import command_request  # start-up time (certifi): only when asked
+
+        request = command_request(description or default_description(),
+                                  click.get_current_context().params)
+        if request is not None and answer_from_cache(request, outdir, quiet, cache_dir):
+            return
+    # SymPy and the code generators: only when the cache did not answer
+    from ..codegen.generate import generate as run_generate
+
+    with recorded_warnings() as notices:
+        scene = None
+        if scene_path is not None:
+            from ..scene import load_scene  # YAML and SymPy, as above
+
+            scene = load_scene(scene_path, strict=strict)
+            if functions is not None:
+                scene = dataclasses.replace(scene, outputs=functions)
+        model = load(description, strict, scene, snap=not no_snap)
+    cache = dataclasses.replace(request, notices=notices) if request else not no_cache
+    names = None
+    if symbolic is not None:
+        names = [] if symbolic.strip().lower() == "none" else [
+            n.strip() for n in symbolic.split(",") if n.strip()]
+    if scene_path is not None or explain:
+        from ..codegen.scene_generate import generate_scene  # SymPy, as above
+
+        paths, produced = generate_scene(model, scene, outdir, backends, names, progress,
+                                         explain, cache=cache, cache_dir=cache_dir)
+        progress.clear()
+        if explain:
+            click.echo(produced.markdown)
+    else:
+        paths = run_generate(model, outdir, backends, names, progress, functions, cache=cache,
+                             cache_dir=cache_dir)
+        progress.clear()
+    for path in paths:
+        click.echo(str(path))

@@ -1,0 +1,48 @@
+"""From the shared arguments to a model: DESCRIPTION (default the bundled planar 2-link arm),
+reduced by ``--scene``, checked under ``--strict``; and the file-name stem of a model's outputs.
+
+The parsers, the scene reduction and the code generators import SymPy, so each is imported
+when a command needs it: ``import eomgen.cli`` stays light (a cached ``eomgen generate`` is
+answered without SymPy).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..robots import example_path
+
+
+def default_description() -> Path:
+    """The description a command reads without DESCRIPTION: the bundled planar 2-link arm."""
+    return example_path("planar_2link")
+
+
+def load(description: Path | None, strict: bool, scene=None, snap: bool = True):
+    """The whole model; warns (refuses under ``strict``) only about what ``scene`` (a loaded
+    :class:`eomgen.scene.Scene`, applied by the caller) keeps. ``snap=False`` keeps the
+    description's floats exactly (``--no-snap``)."""
+    from ..reduction import load_for_scene  # SymPy: only when a command loads a model
+
+    return load_for_scene(description or default_description(), scene, strict, snap=snap)
+
+
+def load_reduced(description: Path | None, scene_path: Path | None, strict: bool):
+    """``(model, report)``: the description reduced by the scene file (report None without
+    one). The scene is read first, so that warnings concern only what it keeps."""
+    if scene_path is None:
+        return load(description, strict), None
+    # SymPy and YAML: only when a command loads a model with a scene
+    from ..reduction import apply_scene
+    from ..scene import load_scene
+
+    scene = load_scene(scene_path, strict=strict)
+    return apply_scene(load(description, strict, scene), scene)
+
+
+def output_stem(model) -> str:
+    """The file-name stem of ``model``'s outputs (``bench_<stem>.md``, ``identify_<stem>.csv``):
+    the generated modules' name."""
+    from ..codegen.functions import module_name  # SymPy: only when a command writes outputs
+
+    return module_name(model.name)

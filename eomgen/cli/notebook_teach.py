@@ -1,0 +1,106 @@
+"""``eomgen notebook`` (a Jupyter notebook deriving the equations step by step) and
+``eomgen teach`` (a handout for students): the command-line side of :mod:`eomgen.notebook` and
+:mod:`eomgen.teach`, imported when a command runs (they import SymPy).
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import click
+
+from ..errors import GenerationError
+from ..output import check_output_file, check_output_folder
+from ..progress import Progress
+from .handling import handle_errors
+from .loading import load_reduced
+from .options import (description_argument, output_file_option, output_folder_option,
+                      quiet_option, scene_option, strict_option)
+
+
+@click.command()
+@description_argument()
+@output_file_option("Notebook file to write (default: <robot>_derivation.ipynb).")
+@scene_option()
+@quiet_option()
+@strict_option
+@handle_errors
+def notebook(description, output, scene_path, quiet, strict):
+    """Write a Jupyter notebook deriving DESCRIPTION's equations of motion step by step.
+
+    The notebook (saved without outputs) loads the robot, derives positions, Jacobians,
+    energies, M, the Christoffel symbols, C and g (textbook form for at most 3 joints), checks
+    them, compares them with Newton–Euler and simulates the robot.
+
+    \b
+    Examples:
+      eomgen notebook                        # the bundled planar 2-link arm
+      eomgen notebook ur5.urdf -o ur5.ipynb
+      eomgen notebook panda.urdf --scene examples/scenes/panda_two_joints.yaml
+    """
+    from ..notebook import build_notebook, write_notebook  # SymPy: when the command runs
+
+    if output is not None:
+        check_output_file(output)
+    progress = Progress(quiet)
+    model, _ = load_reduced(description, scene_path, strict)
+    path = output or Path(f"{model.name}_derivation.ipynb")
+    if output is None:
+        check_output_file(path)
+    progress(f"building the notebook of {model.name}")
+    nb = build_notebook(model, description, scene=scene_path)
+    progress.clear()
+    click.echo(str(write_notebook(nb, path)))
+
+
+@click.command()
+@description_argument()
+@click.option("--format", "formats", default=None,
+              help="Comma-separated handout formats among pdf, html, md, tex; or all. "
+                   "[default: pdf; html, with a note, when pdflatex is not installed]")
+@output_folder_option("eomgen_handout")
+@scene_option("Scene file (YAML, docs/scenes.md): derive only what it moves, e.g. two "
+              "joints of a real arm (examples/scenes/panda_two_joints.yaml).")
+@click.option("--no-check", is_flag=True,
+              help="Leave out the numeric verification (the handout says so).")
+@quiet_option()
+@strict_option
+@handle_errors
+def teach(description, formats, outdir, scene_path, no_check, quiet, strict):
+    """Write a handout deriving DESCRIPTION's equations of motion for students.
+
+    The robot (tables and a kinematic sketch), the Lagrangian derivation step by step
+    (positions, velocities, kinetic and potential energy, M, Christoffel symbols and C, g,
+    the equations of motion; named subexpressions for models too large to print expanded) and
+    the verified properties with their numbers. Formats: pdf (through pdflatex), html (one
+    self-contained file, math as MathML), md (Markdown with $...$ math, plus the sketch as SVG),
+    tex (LaTeX source, plus the sketch as PDF). All files or none are written. The pdf format
+    needs pdflatex (TeX Live); without it the default is html, and asking for pdf is an error.
+
+    \b
+    Examples:
+      eomgen teach                                  # the bundled planar 2-link arm, PDF
+      eomgen teach robot.urdf --format html,md -o handouts/
+      eomgen teach panda.urdf --scene examples/scenes/panda_two_joints.yaml
+    """
+    from ..teach import parse_formats, write_handout  # SymPy: when the command runs
+
+    progress = Progress(quiet)
+    have_pdflatex = shutil.which("pdflatex") is not None
+    if formats is None:
+        chosen = ["pdf"] if have_pdflatex else ["html"]
+        if not have_pdflatex:
+            progress.note("pdflatex not found: writing the html handout instead of the pdf "
+                          "(install TeX Live for pdf, or choose with --format)")
+    else:
+        chosen = parse_formats(formats)
+        if "pdf" in chosen and not have_pdflatex:
+            raise GenerationError("--format pdf needs pdflatex, which is not installed (TeX "
+                                  "Live: apt install texlive-latex-base); choose html, md or tex")
+    check_output_folder(outdir)
+    model, report = load_reduced(description, scene_path, strict)
+    paths = write_handout(model, outdir, chosen, progress, check=not no_check, scene=report)
+    progress.clear()
+    for path in paths:
+        click.echo(str(path))

@@ -1,0 +1,62 @@
+"""The arguments and options several ``eomgen`` commands take, declared once.
+
+Each is a click decorator (or a function making one, where commands differ in a default or a
+help text): the DESCRIPTION argument, ``--scene``, ``--quiet``, ``--strict`` and ``-o/--output``
+(a folder or a file). Whether an output can be written is checked by the command itself
+(:mod:`eomgen.output`: one error line, not click's usage text). ``--debug`` comes with the error
+handling (:func:`eomgen.cli.handling.handle_errors`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+#: ``--scene`` of most commands.
+SCENE_HELP = ("Scene file (YAML, docs/scenes.md): reduce the robot to what the scene moves "
+              "first (e.g. examples/scenes/panda_two_joints.yaml).")
+
+#: ``--quiet`` of most commands.
+QUIET_HELP = ("No progress on stderr (stage lines in a log, an updating line or bar on a "
+              "terminal).")
+
+
+def description_argument(required: bool = False):
+    """DESCRIPTION: a URDF, DH-table YAML or eomgen YAML file; optional (the bundled planar
+    2-link arm, :func:`eomgen.cli.loading.default_description`) unless ``required``."""
+    return click.argument("description", required=required,
+                          type=click.Path(dir_okay=False, path_type=Path))
+
+
+strict_option = click.option(
+    "--strict", is_flag=True,
+    help="Refuse inertias that break the triangle inequality, URDF <mimic> joints and a URDF "
+         "root that looks like a floating base, instead of warning (only about what a "
+         "--scene keeps).")
+
+
+def quiet_option(help: str = QUIET_HELP):
+    """``--quiet``: no :class:`eomgen.progress.Progress` lines."""
+    return click.option("--quiet", is_flag=True, help=help)
+
+
+def scene_option(help: str = SCENE_HELP):
+    """``--scene`` (parameter ``scene_path``): a scene file that reduces the model first."""
+    return click.option("--scene", "scene_path", default=None,
+                        type=click.Path(dir_okay=False, path_type=Path), help=help)
+
+
+def output_folder_option(default: str):
+    """``-o/--output`` (parameter ``outdir``) for a folder (see
+    :func:`eomgen.output.check_output_folder`)."""
+    return click.option("-o", "--output", "outdir", default=default, show_default=True,
+                        type=click.Path(path_type=Path), help="Output folder.")
+
+
+def output_file_option(help: str, default: str | None = None):
+    """``-o/--output`` (parameter ``output``) for one file (see
+    :func:`eomgen.output.check_output_file`); the default is shown when there is one."""
+    return click.option("-o", "--output", "output", default=default,
+                        show_default=default is not None, type=click.Path(path_type=Path),
+                        help=help)
