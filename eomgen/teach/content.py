@@ -5,7 +5,7 @@ Control*, the planar two-link arm):
 
 1. the robot: a kinematic sketch, the joint, link and parameter tables, gravity;
 2. the method and notation (Lagrangian, Euler–Lagrange equations, ``s_1``, ``c_{12}``);
-3. for teaching-sized models (see :func:`eomgen.codegen.backends.latex_backend.textbook_for`):
+3. for teaching-sized models (see :func:`eomgen.present.notation.textbook_for`):
    positions of the centres of mass, velocities (Jacobians), kinetic energy, potential energy,
    the mass matrix (symmetric entries once, terms grouped by body mass), the Christoffel
    symbols and C (common factors named, e.g. ``h = m_2 l_1 l_{c2} s_2``), the gravity vector
@@ -18,7 +18,7 @@ Control*, the planar two-link arm):
 5. the verified properties, with the numbers of :func:`eomgen.verify`.
 
 Every expression is printed by eomgen's LaTeX printer
-(:class:`~eomgen.codegen.backends.latex_printer.DerivationLatexPrinter`); user text (names,
+(:class:`~eomgen.present.printer.DerivationLatexPrinter`); user text (names,
 descriptions) travels as :func:`~eomgen.teach.document.code` or
 :func:`~eomgen.teach.document.plain` spans and is escaped by each renderer.
 """
@@ -33,21 +33,22 @@ import sympy as sp
 
 from .. import __version__
 from ..actuators import SpongDynamics, joint_actuators, spong_dynamics
-from ..codegen.backends import latex_backend as lb
 from ..codegen.functions import module_name
 from ..dynamics import Dynamics, derive
 from ..errors import ParameterError
 from ..model import IDENTITY3, RobotModel
+from ..present import notation as nt
+from ..present import readability as rd
+from ..present.sections import program_sections
 from ..progress import plural
 from ..symbolic.textbook import TextbookDerivation
 from ..verify import VerificationReport, verify
-from . import readability as rd
 from .document import (Equation, Equations, Figure, Handout, Paragraph, Section, Span, Table,
                        code, math, plain, prose)
 
 #: Options of the printed derivation: the LaTeX backend's, with fewer named subexpressions
 #: for large models (a handout is read, not searched).
-HANDOUT_CONFIG = lb.LatexConfig(max_program_lines=300)
+HANDOUT_CONFIG = nt.LatexConfig(max_program_lines=300)
 
 #: States sampled by the property checks.
 VERIFY_SAMPLES = 20
@@ -56,7 +57,7 @@ VERIFY_SAMPLES = 20
 class _Writer:
     """Builds equations with the document's printer."""
 
-    def __init__(self, p: lb.Printing):
+    def __init__(self, p: nt.Printing):
         self.p = p
 
     def tex(self, expr) -> str:
@@ -71,7 +72,7 @@ class _Writer:
         return Equation(lhs, tuple(lines))
 
     def matrix(self, lhs: str, matrix: sp.Matrix) -> tuple[Equation, ...]:
-        return self.convert(lb.matrix_equations(self.p, lhs, matrix))
+        return self.convert(nt.matrix_equations(self.p, lhs, matrix))
 
     @staticmethod
     def convert(equations) -> tuple[Equation, ...]:
@@ -80,7 +81,7 @@ class _Writer:
 
 
 def _vector(w: _Writer, values) -> Span:
-    return math(lb.vector(w.p, values))
+    return math(nt.vector(w.p, values))
 
 
 # -- the robot ------------------------------------------------------------------------------
@@ -111,7 +112,7 @@ def _robot_section(model: RobotModel, w: _Writer, sketch_caption: tuple,
     blocks.append(Paragraph(prose(
         code(model.name), f" has {model.dof} movable joint{'s' if model.dof != 1 else ''}; "
         "the gravitational acceleration in its base frame is ",
-        math(r"g_{\mathrm{vec}} = " + lb.vector(w.p, model.gravity)),
+        math(r"g_{\mathrm{vec}} = " + nt.vector(w.p, model.gravity)),
         " (m/s$^{2}$). Figure 1 sketches the robot; the tables list what the description "
         "gives.")))
     blocks.append(Figure("sketch", sketch_caption))
@@ -120,7 +121,7 @@ def _robot_section(model: RobotModel, w: _Writer, sketch_caption: tuple,
         if joint.origin.rotation == IDENTITY3:
             rpy = prose("$0$")
         else:
-            angles = lb.rpy(joint.origin.rotation)
+            angles = nt.rpy(joint.origin.rotation)
             rpy = (_vector(w, angles),) if angles is not None else prose("symbolic")
         rows.append((
             prose(f"$q_{{{movable[joint.name]}}}$") if joint.name in movable else (),
@@ -144,7 +145,7 @@ def _robot_section(model: RobotModel, w: _Writer, sketch_caption: tuple,
             "Denavit–Hartenberg table (", plain(str(info.get("convention", ""))),
             " convention); the joint variable is added to $\\theta$ (revolute) or $d$ "
             "(prismatic).")))
-        blocks.append(Table(tuple(prose(lb.DH_HEADINGS.get(c, c)) for c in columns),
+        blocks.append(Table(tuple(prose(nt.DH_HEADINGS.get(c, c)) for c in columns),
                             tuple(dh_rows),
                             small=True))
     link_rows = []
@@ -575,9 +576,9 @@ def _drives_section(spong: SpongDynamics, book: TextbookDerivation | None, corio
             Equation(r"B\, \ddot{\theta} + K (\theta - q)", (r"\tau_{m},",)))))
         blocks.append(Paragraph(prose(
             "with the stiffness matrix $K = \\operatorname{diag}"
-            + lb.vector(w.p, stiffness) + "$ (not the kinetic energy of step 3), the motor "
-            "inertia matrix $B = \\operatorname{diag}" + lb.vector(w.p, inertia) + "$, the "
-            "motor angles $\\theta = " + lb.vector(w.p, spong.theta) + "$ and the motor "
+            + nt.vector(w.p, stiffness) + "$ (not the kinetic energy of step 3), the motor "
+            "inertia matrix $B = \\operatorname{diag}" + nt.vector(w.p, inertia) + "$, the "
+            "motor angles $\\theta = " + nt.vector(w.p, spong.theta) + "$ and the motor "
             "torques $\\tau_{m}$" + rigid_note + ". Joint by joint, with " + entries
             + ", the link equations read")))
         blocks.append(Equations(tuple(w.terms(w.tex(lhs), terms) for lhs, terms in links)))
@@ -595,8 +596,8 @@ def _drives_section(spong: SpongDynamics, book: TextbookDerivation | None, corio
             r"\bigl(M(q) + \operatorname{diag}(a)\bigr)\, \ddot{q} + C(q, \dot{q})\, \dot{q} "
             r"+ g(q) + \tau_{f}(\dot{q})", (r"\tau,",)),)))
         blocks.append(Paragraph(prose(
-            "with $a = " + lb.vector(w.p, armature) + "$ and the friction torques "
-            "$\\tau_{f} = " + lb.vector(w.p, [sp.Add(*_friction_terms(a, v)) for a, v in
+            "with $a = " + nt.vector(w.p, armature) + "$ and the friction torques "
+            "$\\tau_{f} = " + nt.vector(w.p, [sp.Add(*_friction_terms(a, v)) for a, v in
                                               zip(spong.actuators, spong.dynamics.qd)])
             + "$. Joint by joint, with " + entries + ":")))
         blocks.append(Equations(tuple(w.terms(w.tex(lhs), terms) for lhs, terms in links)))
@@ -669,7 +670,7 @@ def _contact_section(dyn: Dynamics, contacts, book: TextbookDerivation | None, c
     for k, c in enumerate(contacts):
         described += ([", "] if k else []) + [code(c.frame)]
         if c.kind == POINT:
-            normal = lb.vector(w.p, [sp.Float(v, 15) for v in c.normal])
+            normal = nt.vector(w.p, [sp.Float(v, 15) for v in c.normal])
             described.append(" (a point: its origin is held still; force in world axes, N; "
                              f"normal ${normal}$)")
         else:
@@ -697,7 +698,7 @@ def _contact_section(dyn: Dynamics, contacts, book: TextbookDerivation | None, c
     Jc, dJqd, F, equations = contact_equations(dyn, contacts, book, coriolis)
     angles = list(dyn.q)
     blocks.append(Paragraph(prose(
-        "Here $F_{c} = " + lb.vector(w.p, F) + "$ and, differentiating the position of the "
+        "Here $F_{c} = " + nt.vector(w.p, F) + "$ and, differentiating the position of the "
         "contact frame (rows: the held directions; columns: the joints),")))
     blocks.append(Equations(w.matrix("J_{c}", Jc)))
     blocks.append(Paragraph(prose(
@@ -726,7 +727,7 @@ def _contact_section(dyn: Dynamics, contacts, book: TextbookDerivation | None, c
 # -- large models ---------------------------------------------------------------------------
 
 def _program_section(dyn: Dynamics, w: _Writer) -> Section:
-    context = lb.program_sections(dyn, HANDOUT_CONFIG, w.p)
+    context = program_sections(dyn, HANDOUT_CONFIG, w.p)
     ops = dyn.operation_count(["M", "C", "g"])
     c = HANDOUT_CONFIG
     blocks = [Paragraph(prose(
@@ -833,16 +834,16 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
 
     progress(f"deriving the equations of motion of {model.name} ({plural(model.dof, 'joint')})")
     dyn = derive(model, outputs=("M", "C", "g"), simplify=False)
-    book = lb.textbook_for(dyn, HANDOUT_CONFIG)
+    book = nt.textbook_for(dyn, HANDOUT_CONFIG)
     extra_names = {HALF: r"\tfrac{1}{2}"}
-    w = _Writer(lb.printing(dyn, HANDOUT_CONFIG, compact_trig=book is not None,
+    w = _Writer(nt.printing(dyn, HANDOUT_CONFIG, compact_trig=book is not None,
                             extra_names=extra_names))
     spong = spong_dynamics(dyn) if has_drives(model) else None
     contacts = tuple(getattr(scene, "contacts", ()) or ())
     extra_names.update(contact_symbol_names(contacts))
     if spong is not None:  # the drives' own symbols, printed by the document's printer
         extra_names.update(drive_symbol_names(spong, w.tex))
-    w = _Writer(lb.printing(dyn, HANDOUT_CONFIG, compact_trig=book is not None,
+    w = _Writer(nt.printing(dyn, HANDOUT_CONFIG, compact_trig=book is not None,
                             extra_names=extra_names))
     geometry = sketch_geometry(model)
     pose = ", ".join(f"{v:.3g}" for v in geometry.q)

@@ -27,10 +27,10 @@ import tempfile
 from pathlib import Path
 from typing import Callable
 
-from ..codegen.backends.latex_printer import latex_comment, latex_escape
 from ..codegen.render import render
 from ..errors import GenerationError
 from ..output import GeneratedFile
+from ..present.printer import latex_comment, latex_escape
 from .document import Equations, Figure, Handout, Inline, Paragraph, Table
 
 #: The figures, numbered in order of appearance.
