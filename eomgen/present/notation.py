@@ -4,8 +4,8 @@ the handout, the notebook and the Jupyter display.
 * :class:`LatexConfig`: the document options (template, sizes, digits) and the bounds of a
   teaching-sized model; :func:`teaching_sized` and :func:`textbook_for` apply those bounds;
 * :func:`printing`: the :class:`~eomgen.present.printer.DerivationLatexPrinter` of one
-  derivation (joint variables ``q_{1}``, ``\\dot{q}_{1}``, compact ``s_{1}``, ``c_{12}``, parameters
-  that would read like the document's own quantities as upright text), with the helpers
+  derivation (joint variables ``q_{1}``, ``\\dot{q}_{1}``, compact ``s_{1}``, ``c_{12}``,
+  parameters that would read like the document's own quantities as upright text), with the helpers
   :func:`vector`, :func:`rpy` and :func:`matrix_equations` that lay out equations.
 
 The dynamics these functions take is an :class:`eomgen.dynamics.Dynamics`; it is passed in,
