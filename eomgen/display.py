@@ -88,7 +88,7 @@ def grouped_matrices(book) -> dict:
     """M, C and g of a :class:`~eomgen.symbolic.textbook.TextbookDerivation` as every document
     prints them: entries of M grouped by body mass, those of g by trigonometric factor (sums
     built unevaluated, so their order is kept; print them with :func:`expression_latex`)."""
-    import sympy as sp  # imported when displaying: `import eomgen` registers this module
+    import sympy as sp  # start-up time: `import eomgen` imports this module
 
     from .present import readability as rd  # start-up time (SymPy)
 
@@ -150,7 +150,7 @@ def _matrix_latex(printer, matrix) -> str:
 
 def _unevaluated(e) -> bool:
     """Whether the sum ``e`` was built with ``evaluate=False`` (a grouped sum)."""
-    import sympy as sp  # imported when displaying: `import eomgen` registers this module
+    import sympy as sp  # start-up time: `import eomgen` imports this module
 
     return e.args != sp.Add(*e.args).args
 
@@ -166,7 +166,7 @@ def expression_latex(dynamics: Dynamics, expr, names: dict | None = None) -> str
     >>> expression_latex(dyn, dyn.g[1])
     'g l_{c2} m_{2} c_{12}'
     """
-    import sympy as sp  # imported when displaying: `import eomgen` registers this module
+    import sympy as sp  # start-up time: `import eomgen` imports this module
 
     printer = _printer(dynamics, names)
     if isinstance(expr, sp.MatrixBase):

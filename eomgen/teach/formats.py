@@ -173,7 +173,7 @@ class HtmlFormat(_Format):
     template = "teach/handout.html.jinja"
 
     def __init__(self):
-        from latex2mathml.converter import convert
+        from latex2mathml.converter import convert  # start-up time: HTML handouts only
 
         self._convert = convert
 
