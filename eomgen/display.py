@@ -87,16 +87,11 @@ def readable_matrices(dynamics: Dynamics) -> dict | None:
 def grouped_matrices(book) -> dict:
     """M, C and g of a :class:`~eomgen.symbolic.textbook.TextbookDerivation` as every document
     prints them: entries of M grouped by body mass, those of g by trigonometric factor (sums
-    built unevaluated, so their order is kept; print them with :func:`expression_latex`)."""
-    import sympy as sp  # start-up time: `import eomgen` imports this module
+    built unevaluated, so their order is kept; print them with :func:`expression_latex`). Kept
+    here for notebooks; the grouping is :func:`eomgen.present.grouping.grouped_matrices`."""
+    from .present import grouping  # start-up time (SymPy)
 
-    from .present import readability as rd  # start-up time (SymPy)
-
-    masses = [b.mass for b in book.bodies if isinstance(b.mass, sp.Symbol)]
-    angles = list(book.q)
-    return {"M": book.M.applyfunc(lambda e: rd.mass_grouped(e, masses)),
-            "C": book.C,
-            "g": book.g.applyfunc(lambda e: rd.trig_grouped(e, angles))}
+    return grouping.grouped_matrices(book)
 
 
 def dynamics_latex(dynamics: Dynamics, max_dof: int = DISPLAY_MAX_DOF) -> str:

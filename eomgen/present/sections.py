@@ -24,6 +24,7 @@ from ..model import IDENTITY3, RobotModel
 from ..regressor import parameter_latex
 from ..symbolic.textbook import TextbookDerivation
 from . import readability as rd
+from .grouping import body_masses
 from .notation import (DH_HEADINGS, Equation, LatexConfig, Printing, printing, rpy,
                        matrix_equations, textbook_for, vector)
 from .printer import latex_comment, latex_escape, written_number
@@ -217,7 +218,7 @@ def textbook_sections(dyn: Dynamics, book: TextbookDerivation, p: Printing) -> d
     def grouped(lhs, terms):
         return Equation(lhs, p.printer.print_sum_lines(terms or [sp.Integer(0)], p.width))
 
-    masses = [b.mass for b in book.bodies if isinstance(b.mass, sp.Symbol)]
+    masses = body_masses(book)
     M = [grouped(f"M_{{{i + 1},{j + 1}}}", rd.by_mass(book.M[i, j], masses))
          for i in range(n) for j in range(i, n)]
     christoffel = []

@@ -39,6 +39,7 @@ from ..errors import ParameterError
 from ..model import IDENTITY3, RobotModel
 from ..present import notation as nt
 from ..present import readability as rd
+from ..present.grouping import body_masses
 from ..present.sections import program_sections
 from ..progress import plural
 from ..symbolic.textbook import TextbookDerivation
@@ -185,15 +186,11 @@ def _method_section(model: RobotModel, teaching: bool) -> Section:
 
 # -- the textbook derivation ----------------------------------------------------------------
 
-def _masses(book: TextbookDerivation) -> list[sp.Symbol]:
-    return [b.mass for b in book.bodies if isinstance(b.mass, sp.Symbol)]
-
-
 def _textbook_sections(dyn: Dynamics, book: TextbookDerivation, coriolis,
                        w: Writer) -> list[Section]:
     model = dyn.model
     n = model.dof
-    masses = _masses(book)
+    masses = body_masses(book)
     angles = list(dyn.q)
     index = {b.joint: model.joint_names.index(b.joint) + 1 for b in book.bodies}
 
@@ -329,7 +326,7 @@ def _coriolis_section(book: TextbookDerivation, coriolis, w: Writer) -> Section:
         blocks.append(Paragraph(prose(
             "They are all multiples of " + ("one expression" if len(names) == 1 else
                                               f"{len(names)} expressions") + ", named:")))
-        masses = _masses(book)
+        masses = body_masses(book)
         blocks.append(Equations(tuple(w.terms(w.tex(nf.symbol), rd.by_mass(nf.value, masses))
                                       for nf in names)))
     equations = []
@@ -351,7 +348,7 @@ def _equations_section(dyn: Dynamics, book: TextbookDerivation, coriolis,
                        w: Writer) -> Section:
     n = dyn.model.dof
     names = coriolis[0]
-    masses = _masses(book)
+    masses = body_masses(book)
     qdd = dyn.qdd
     compact, full = [], []
     for i in range(n):
