@@ -6,6 +6,8 @@ generation.
   of long sums into display lines;
 * :mod:`~eomgen.present.readability`: regrouping that makes small derivations read like a
   textbook (terms by body mass, by trigonometric factor, named Christoffel factors);
+* :mod:`~eomgen.present.grouping`: that regrouping applied to the M, C and g of a textbook
+  derivation, as every document prints them;
 * :mod:`~eomgen.present.notation`: the document options and the teaching-sized bounds
   (:class:`~eomgen.present.notation.LatexConfig`, ``textbook_for``), the printer of one
   derivation and the layout of equations;
