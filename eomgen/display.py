@@ -6,18 +6,17 @@
   derivation documents (``s_{1}``, ``c_{12}``, ``\\dot{q}_{1}``) for models of at most
   :data:`DISPLAY_MAX_DOF` joints; larger models show a short summary (joints, operation counts)
   instead of pages of algebra.
+
+The printing is :mod:`eomgen.present`'s, shared with the LaTeX document, the handout and the
+notebook. The model and dynamics shown (``RobotModel``, ``Dynamics`` in annotations) are passed
+in, not imported: the data classes find these renderers through :mod:`eomgen.reprs`.
 """
 
 from __future__ import annotations
 
 import html
-from typing import TYPE_CHECKING
 
 from . import reprs
-
-if TYPE_CHECKING:
-    from .dynamics import Dynamics
-    from .model import RobotModel
 
 #: Models with more joints display a summary instead of M, C and g.
 DISPLAY_MAX_DOF = 3
@@ -57,13 +56,13 @@ def model_html(model: RobotModel) -> str:
 
 
 def _printer(dynamics: Dynamics, names: dict | None = None):
-    from .codegen.backends.latex_backend import LatexConfig, printing
+    from .present.notation import LatexConfig, printing  # start-up time (SymPy)
 
     return printing(dynamics, LatexConfig(), compact_trig=True, extra_names=names).printer
 
 
 def _text(value: str) -> str:
-    from .codegen.backends.latex_printer import latex_escape
+    from .present.printer import latex_escape  # start-up time (SymPy)
 
     return r"\text{" + latex_escape(value) + "}"
 
@@ -72,9 +71,9 @@ def readable_matrices(dynamics: Dynamics) -> dict | None:
     """M, C and g of ``dynamics`` as the LaTeX document and the handout print them (the
     textbook derivation, entries of M grouped by body mass, those of g by trigonometric
     factor), or None when the model is not teaching-sized (the bounds of
-    :func:`eomgen.codegen.backends.latex_backend.textbook_for`, checked on the program's size
-    before anything is expanded) and ``derive(..., simplify=True)`` did not force it."""
-    from .codegen.backends.latex_backend import textbook_for
+    :func:`eomgen.present.notation.textbook_for`, checked on the program's size before anything
+    is expanded) and ``derive(..., simplify=True)`` did not force it."""
+    from .present.notation import textbook_for  # start-up time (SymPy)
 
     if dynamics.simplified:  # derive(..., simplify=True) asked for it whatever the size
         book = dynamics.textbook
@@ -88,16 +87,11 @@ def readable_matrices(dynamics: Dynamics) -> dict | None:
 def grouped_matrices(book) -> dict:
     """M, C and g of a :class:`~eomgen.symbolic.textbook.TextbookDerivation` as every document
     prints them: entries of M grouped by body mass, those of g by trigonometric factor (sums
-    built unevaluated, so their order is kept; print them with :func:`expression_latex`)."""
-    from .teach import readability as rd
+    built unevaluated, so their order is kept; print them with :func:`expression_latex`). Kept
+    here for notebooks; the grouping is :func:`eomgen.present.grouping.grouped_matrices`."""
+    from .present import grouping  # start-up time (SymPy)
 
-    import sympy as sp  # imported when displaying: `import eomgen` registers this module
-
-    masses = [b.mass for b in book.bodies if isinstance(b.mass, sp.Symbol)]
-    angles = list(book.q)
-    return {"M": book.M.applyfunc(lambda e: rd.mass_grouped(e, masses)),
-            "C": book.C,
-            "g": book.g.applyfunc(lambda e: rd.trig_grouped(e, angles))}
+    return grouping.grouped_matrices(book)
 
 
 def dynamics_latex(dynamics: Dynamics, max_dof: int = DISPLAY_MAX_DOF) -> str:
@@ -151,7 +145,7 @@ def _matrix_latex(printer, matrix) -> str:
 
 def _unevaluated(e) -> bool:
     """Whether the sum ``e`` was built with ``evaluate=False`` (a grouped sum)."""
-    import sympy as sp  # imported when displaying: `import eomgen` registers this module
+    import sympy as sp  # start-up time: `import eomgen` imports this module
 
     return e.args != sp.Add(*e.args).args
 
@@ -167,7 +161,7 @@ def expression_latex(dynamics: Dynamics, expr, names: dict | None = None) -> str
     >>> expression_latex(dyn, dyn.g[1])
     'g l_{c2} m_{2} c_{12}'
     """
-    import sympy as sp  # imported when displaying: `import eomgen` registers this module
+    import sympy as sp  # start-up time: `import eomgen` imports this module
 
     printer = _printer(dynamics, names)
     if isinstance(expr, sp.MatrixBase):

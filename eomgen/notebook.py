@@ -25,8 +25,10 @@ from pathlib import Path
 import nbformat
 from nbformat import v4
 
+from .dynamics import derive
 from .errors import ParameterError
 from .model import RobotModel
+from .present.notation import teaching_sized
 from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS
 
 
@@ -44,9 +46,6 @@ def _load_code(description: Path | None, scene: Path | None = None) -> str:
 def _teaching_sized(model: RobotModel) -> bool:
     """Whether the notebook shows the textbook derivation: the bound of the LaTeX document and
     the display, checked on the straight-line program before anything is expanded."""
-    from .codegen.backends.latex_backend import teaching_sized
-    from .dynamics import derive
-
     return teaching_sized(derive(model, simplify=False))
 
 

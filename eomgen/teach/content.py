@@ -5,7 +5,7 @@ Control*, the planar two-link arm):
 
 1. the robot: a kinematic sketch, the joint, link and parameter tables, gravity;
 2. the method and notation (Lagrangian, Euler–Lagrange equations, ``s_1``, ``c_{12}``);
-3. for teaching-sized models (see :func:`eomgen.codegen.backends.latex_backend.textbook_for`):
+3. for teaching-sized models (see :func:`eomgen.present.notation.textbook_for`):
    positions of the centres of mass, velocities (Jacobians), kinetic energy, potential energy,
    the mass matrix (symmetric entries once, terms grouped by body mass), the Christoffel
    symbols and C (common factors named, e.g. ``h = m_2 l_1 l_{c2} s_2``), the gravity vector
@@ -18,7 +18,7 @@ Control*, the planar two-link arm):
 5. the verified properties, with the numbers of :func:`eomgen.verify`.
 
 Every expression is printed by eomgen's LaTeX printer
-(:class:`~eomgen.codegen.backends.latex_printer.DerivationLatexPrinter`); user text (names,
+(:class:`~eomgen.present.printer.DerivationLatexPrinter`); user text (names,
 descriptions) travels as :func:`~eomgen.teach.document.code` or
 :func:`~eomgen.teach.document.plain` spans and is escaped by each renderer.
 """
@@ -32,55 +32,34 @@ from typing import Callable
 import sympy as sp
 
 from .. import __version__
-from ..actuators import SpongDynamics, joint_actuators, spong_dynamics
-from ..codegen.backends import latex_backend as lb
+from ..actuators import spong_dynamics
 from ..codegen.functions import module_name
 from ..dynamics import Dynamics, derive
 from ..errors import ParameterError
 from ..model import IDENTITY3, RobotModel
+from ..present import notation as nt
+from ..present import readability as rd
+from ..present.grouping import body_masses
+from ..present.sections import program_sections
 from ..progress import plural
 from ..symbolic.textbook import TextbookDerivation
 from ..verify import VerificationReport, verify
-from . import readability as rd
-from .document import (Equation, Equations, Figure, Handout, Paragraph, Section, Span, Table,
-                       code, math, plain, prose)
+from .contacts import (contact_equations, contact_forces,  # noqa: F401  (re-exported)
+                       contact_section, contact_symbol_names)
+from .document import (Equation, Equations, Figure, Handout, Paragraph, Section, Table, code, math,
+                       plain, prose)
+from .drives import (drive_equations, drive_symbol_names, drives_section,  # noqa: F401
+                     has_drives, spring_values)
+from .sketch import render_sketch, sketch_geometry
+from .writer import (Writer, abbreviation_values, code_names,  # noqa: F401  (re-exported)
+                     compact_terms, vector_span)
 
 #: Options of the printed derivation: the LaTeX backend's, with fewer named subexpressions
 #: for large models (a handout is read, not searched).
-HANDOUT_CONFIG = lb.LatexConfig(max_program_lines=300)
+HANDOUT_CONFIG = nt.LatexConfig(max_program_lines=300)
 
 #: States sampled by the property checks.
 VERIFY_SAMPLES = 20
-
-
-class _Writer:
-    """Builds equations with the document's printer."""
-
-    def __init__(self, p: lb.Printing):
-        self.p = p
-
-    def tex(self, expr) -> str:
-        return self.p.tex(expr)
-
-    def eq(self, lhs: str, expr) -> Equation:
-        return self.convert([self.p.equation(lhs, expr)])[0]
-
-    def terms(self, lhs: str, terms: list) -> Equation:
-        """``lhs =`` the sum of ``terms`` in the given order."""
-        lines = self.p.printer.print_sum_lines(terms or [sp.Integer(0)], self.p.width)
-        return Equation(lhs, tuple(lines))
-
-    def matrix(self, lhs: str, matrix: sp.Matrix) -> tuple[Equation, ...]:
-        return self.convert(lb.matrix_equations(self.p, lhs, matrix))
-
-    @staticmethod
-    def convert(equations) -> tuple[Equation, ...]:
-        """The LaTeX backend's equations as the handout's."""
-        return tuple(Equation(e.lhs, tuple(e.lines)) for e in equations)
-
-
-def _vector(w: _Writer, values) -> Span:
-    return math(lb.vector(w.p, values))
 
 
 # -- the robot ------------------------------------------------------------------------------
@@ -99,7 +78,7 @@ def _scene_paragraph(report) -> Paragraph:
     return Paragraph(prose(*parts))
 
 
-def _robot_section(model: RobotModel, w: _Writer, sketch_caption: tuple,
+def _robot_section(model: RobotModel, w: Writer, sketch_caption: tuple,
                    scene=None) -> Section:
     blocks: list = []
     info = dict(model.info)
@@ -111,7 +90,7 @@ def _robot_section(model: RobotModel, w: _Writer, sketch_caption: tuple,
     blocks.append(Paragraph(prose(
         code(model.name), f" has {model.dof} movable joint{'s' if model.dof != 1 else ''}; "
         "the gravitational acceleration in its base frame is ",
-        math(r"g_{\mathrm{vec}} = " + lb.vector(w.p, model.gravity)),
+        math(r"g_{\mathrm{vec}} = " + nt.vector(w.p, model.gravity)),
         " (m/s$^{2}$). Figure 1 sketches the robot; the tables list what the description "
         "gives.")))
     blocks.append(Figure("sketch", sketch_caption))
@@ -120,14 +99,14 @@ def _robot_section(model: RobotModel, w: _Writer, sketch_caption: tuple,
         if joint.origin.rotation == IDENTITY3:
             rpy = prose("$0$")
         else:
-            angles = lb.rpy(joint.origin.rotation)
-            rpy = (_vector(w, angles),) if angles is not None else prose("symbolic")
+            angles = nt.rpy(joint.origin.rotation)
+            rpy = (vector_span(w, angles),) if angles is not None else prose("symbolic")
         rows.append((
             prose(f"$q_{{{movable[joint.name]}}}$") if joint.name in movable else (),
             (code(joint.name),), (plain(joint.type.value),),
             (code(joint.parent),), (code(joint.child),),
-            (_vector(w, joint.axis),) if joint.type.is_movable else (),
-            (_vector(w, joint.origin.translation),), rpy))
+            (vector_span(w, joint.axis),) if joint.type.is_movable else (),
+            (vector_span(w, joint.origin.translation),), rpy))
     blocks.append(Paragraph(prose(
         "Joints, in the order of the joint vector $q$. A joint's origin is the pose of its "
         "frame in the parent link's frame (translation in m; roll, pitch, yaw in rad); the "
@@ -144,7 +123,7 @@ def _robot_section(model: RobotModel, w: _Writer, sketch_caption: tuple,
             "Denavit–Hartenberg table (", plain(str(info.get("convention", ""))),
             " convention); the joint variable is added to $\\theta$ (revolute) or $d$ "
             "(prismatic).")))
-        blocks.append(Table(tuple(prose(lb.DH_HEADINGS.get(c, c)) for c in columns),
+        blocks.append(Table(tuple(prose(nt.DH_HEADINGS.get(c, c)) for c in columns),
                             tuple(dh_rows),
                             small=True))
     link_rows = []
@@ -154,8 +133,9 @@ def _robot_section(model: RobotModel, w: _Writer, sketch_caption: tuple,
             continue
         I = link.inertial.inertia
         link_rows.append(((code(link.name),), (math(w.tex(link.inertial.mass)),),
-                          (_vector(w, link.inertial.com),),
-                          (_vector(w, [I[0][0], I[1][1], I[2][2], I[0][1], I[0][2], I[1][2]]),)))
+                          (vector_span(w, link.inertial.com),),
+                          (vector_span(w, [I[0][0], I[1][1], I[2][2],
+                                           I[0][1], I[0][2], I[1][2]]),)))
     blocks.append(Paragraph(prose(
         "Links: mass (kg), centre of mass in the link frame (m) and rotational inertia about "
         "the centre of mass in link axes, $(I_{xx}, I_{yy}, I_{zz}, I_{xy}, I_{xz}, I_{yz})$ "
@@ -206,15 +186,11 @@ def _method_section(model: RobotModel, teaching: bool) -> Section:
 
 # -- the textbook derivation ----------------------------------------------------------------
 
-def _masses(book: TextbookDerivation) -> list[sp.Symbol]:
-    return [b.mass for b in book.bodies if isinstance(b.mass, sp.Symbol)]
-
-
 def _textbook_sections(dyn: Dynamics, book: TextbookDerivation, coriolis,
-                       w: _Writer) -> list[Section]:
+                       w: Writer) -> list[Section]:
     model = dyn.model
     n = model.dof
-    masses = _masses(book)
+    masses = body_masses(book)
     angles = list(dyn.q)
     index = {b.joint: model.joint_names.index(b.joint) + 1 for b in book.bodies}
 
@@ -229,7 +205,7 @@ def _textbook_sections(dyn: Dynamics, book: TextbookDerivation, coriolis,
     for b in book.bodies:
         positions.append(Paragraph(prose(
             f"Body {index[b.joint]} (joint ", code(b.joint), ", links ",
-            *_names(b.links), f"), mass ${w.tex(b.mass)}$:")))
+            *code_names(b.links), f"), mass ${w.tex(b.mass)}$:")))
         positions.append(Equations(w.matrix(f"p_{{c{index[b.joint]}}}", b.com)))
     sections.append(Section("Step 1: positions of the centres of mass", (
         Paragraph(prose(
@@ -291,13 +267,6 @@ def _textbook_sections(dyn: Dynamics, book: TextbookDerivation, coriolis,
     return sections
 
 
-def _names(names) -> list:
-    out: list = []
-    for k, name in enumerate(names):
-        out += ([", "] if k else []) + [code(name)]
-    return out
-
-
 #: The factor ½ of the kinetic energy, printed as ``\tfrac{1}{2}`` in front of its term.
 HALF = sp.Symbol("eomgen_one_half", positive=True)
 
@@ -346,7 +315,7 @@ def named_coriolis(dyn: Dynamics, book: TextbookDerivation):
     return names, christoffel, C
 
 
-def _coriolis_section(book: TextbookDerivation, coriolis, w: _Writer) -> Section:
+def _coriolis_section(book: TextbookDerivation, coriolis, w: Writer) -> Section:
     names, christoffel, C = coriolis
     blocks = [Paragraph(prose(
         "The Christoffel symbols of the first kind are "
@@ -357,7 +326,7 @@ def _coriolis_section(book: TextbookDerivation, coriolis, w: _Writer) -> Section
         blocks.append(Paragraph(prose(
             "They are all multiples of " + ("one expression" if len(names) == 1 else
                                               f"{len(names)} expressions") + ", named:")))
-        masses = _masses(book)
+        masses = body_masses(book)
         blocks.append(Equations(tuple(w.terms(w.tex(nf.symbol), rd.by_mass(nf.value, masses))
                                       for nf in names)))
     equations = []
@@ -375,54 +344,15 @@ def _coriolis_section(book: TextbookDerivation, coriolis, w: _Writer) -> Section
     return Section("Step 6: Christoffel symbols and the Coriolis matrix", tuple(blocks))
 
 
-def _compact_terms(dyn: Dynamics, book: TextbookDerivation | None, coriolis, i: int):
-    """Row ``i`` of ``M q̈ + C q̇ + g`` as a student writes it with the entries' names: the
-    terms ``M_{i,j} q̈_j``, the velocity terms and ``g_i`` (three lists). With the textbook
-    derivation (``book`` and ``coriolis``) the velocity terms are those of step 6, grouped by
-    its named factors and zero entries are left out; without it (large models) they are
-    ``C_{i,j} q̇_j``. The names are the symbols ``M<i>_<j>`` (``i ≤ j``), ``C<i>_<j>``,
-    ``g<i>`` (see :func:`abbreviation_values`)."""
-    n = dyn.model.dof
-    qd, qdd = dyn.qd, dyn.qdd
-    M = book.M if book is not None else None
-    entry = [sp.Symbol(f"M{min(i, j) + 1}_{max(i, j) + 1}") * qdd[j]
-             for j in range(n) if M is None or M[i, j] != 0]
-    if book is None:
-        velocity = [sp.Symbol(f"C{i + 1}_{j + 1}") * qd[j] for j in range(n)]
-        return entry, velocity, [sp.Symbol(f"g{i + 1}")]
-    names, _, C = coriolis
-    symbols = [nf.symbol for nf in names]
-    Cqd = sp.expand(sum((C[i, j] * qd[j] for j in range(n)), sp.Integer(0)))
-    velocity = rd.group_by_factor(Cqd, lambda t: next((h for h in symbols if t.has(h)), None))
-    return entry, velocity, ([sp.Symbol(f"g{i + 1}")] if book.g[i] != 0 else [])
-
-
-def abbreviation_values(dyn: Dynamics, coriolis=None) -> dict[sp.Symbol, sp.Expr]:
-    """What the names of :func:`_compact_terms` stand for: ``M<i>_<j>``, ``C<i>_<j>``,
-    ``g<i>`` of ``dyn`` and the named Christoffel factors of ``coriolis`` (for checks:
-    ``expr.subs(values)`` is in joint variables and parameters only)."""
-    n = dyn.model.dof
-    values: dict[sp.Symbol, sp.Expr] = {}
-    for i in range(n):
-        values[sp.Symbol(f"g{i + 1}")] = dyn.g[i]
-        for j in range(n):
-            values[sp.Symbol(f"C{i + 1}_{j + 1}")] = dyn.C[i, j]
-            if i <= j:
-                values[sp.Symbol(f"M{i + 1}_{j + 1}")] = dyn.M[i, j]
-    if coriolis is not None:
-        values.update({nf.symbol: nf.value for nf in coriolis[0]})
-    return values
-
-
 def _equations_section(dyn: Dynamics, book: TextbookDerivation, coriolis,
-                       w: _Writer) -> Section:
+                       w: Writer) -> Section:
     n = dyn.model.dof
     names = coriolis[0]
-    masses = _masses(book)
+    masses = body_masses(book)
     qdd = dyn.qdd
     compact, full = [], []
     for i in range(n):
-        entry, velocity_terms, gi = _compact_terms(dyn, book, coriolis, i)
+        entry, velocity_terms, gi = compact_terms(dyn, book, coriolis, i)
         compact.append(w.terms(rf"\tau_{{{i + 1}}}", entry + velocity_terms + gi))
         written = []
         for j in range(n):
@@ -444,289 +374,10 @@ def _equations_section(dyn: Dynamics, book: TextbookDerivation, coriolis,
     return Section("Step 8: the equations of motion", tuple(blocks))
 
 
-# -- drives: armature, friction, flexible joints --------------------------------------------
-
-def has_drives(model: RobotModel) -> bool:
-    """Whether any joint's actuator adds to the rigid-body equations (armature, friction or
-    a stiffness): the handout then gets :func:`_drives_section`."""
-    return any(a.flexible or a.armature != 0 or a.damping != 0 or a.friction != 0
-               for a in joint_actuators(model))
-
-
-def _spring(k: int) -> sp.Symbol:
-    """Stands for the spring torque ``K_k (θ_k − q_k)`` of flexible joint ``k`` (0-based) in the
-    printed equations, so that it prints in this order (:func:`spring_values` gives its value)."""
-    return sp.Symbol(f"eomgen_spring_{k + 1}", real=True)
-
-
-def spring_values(spong: SpongDynamics) -> dict[sp.Symbol, sp.Expr]:
-    """The value ``K_k (θ_k − q_k)`` of each :func:`_spring` placeholder."""
-    q = spong.dynamics.q
-    return {_spring(k): spong.actuators[k].stiffness * (th - q[k])
-            for k, th in zip(spong.flexible, spong.theta)}
-
-
-def drive_symbol_names(spong: SpongDynamics, tex: Callable[[sp.Expr], str]
-                       ) -> dict[sp.Symbol, str]:
-    """LaTeX of the motor states ``θ_k``, ``θ̇_k``, ``θ̈_k``, of the inputs (``τ_{m,k}``, the motor
-    torque, for a flexible joint ``k``; ``τ_k`` for a rigid one) and of the spring torques
-    (``tex`` prints the stiffness)."""
-    names: dict[sp.Symbol, str] = {}
-    q = spong.dynamics.q
-    for k, th, thd, thdd in zip(spong.flexible, spong.theta, spong.thetad, spong.thetadd):
-        names[th] = rf"\theta_{{{k + 1}}}"
-        names[thd] = rf"\dot{{\theta}}_{{{k + 1}}}"
-        names[thdd] = rf"\ddot{{\theta}}_{{{k + 1}}}"
-        stiffness = spong.actuators[k].stiffness
-        factor = tex(stiffness)
-        if not (stiffness.is_Symbol or stiffness.is_Number):
-            factor = r"\left(" + factor + r"\right)"
-        names[_spring(k)] = (factor + r" \left(" + names[th] + " - " + tex(q[k]) + r"\right)")
-    for k, tau in enumerate(spong.tau):
-        names[tau] = rf"\tau_{{m,{k + 1}}}" if k in spong.flexible else rf"\tau_{{{k + 1}}}"
-    return names
-
-
-def _friction_terms(actuator, velocity) -> list[sp.Expr]:
-    """``d v`` and ``f sign(v)`` (those that are not zero)."""
-    terms = [actuator.damping * velocity] if actuator.damping != 0 else []
-    return terms + ([actuator.friction * sp.sign(velocity)] if actuator.friction != 0 else [])
-
-
-def drive_equations(spong: SpongDynamics, book: TextbookDerivation | None, coriolis):
-    """The equations of Spong's model (every joint rigid when none has a stiffness: then the
-    rigid equations with armature and friction) joint by joint, as the handout prints them.
-
-    Returns
-    -------
-    links, motors:
-        Lists of ``(lhs, terms)``: ``lhs = Σ terms``. A link equation has the input on the
-        left, ``K_k (θ_k − q_k)`` for a flexible joint and ``τ_k`` for a rigid one, and on the
-        right the row of ``M q̈ + C q̇ + g`` in the names of :func:`_compact_terms`, plus
-        ``a_k q̈_k`` and the friction of a rigid joint (the spring torque is the placeholder
-        :func:`_spring`). A motor equation reads
-        ``τ_{m,k} = B_k θ̈_k + K_k (θ_k − q_k) + τ_f,k(θ̇_k)``. With
-        :func:`abbreviation_values` and :func:`spring_values` substituted, ``terms − lhs``
-        are the residuals of
-        :meth:`~eomgen.actuators.SpongDynamics.link_equations` and
-        :meth:`~eomgen.actuators.SpongDynamics.motor_equations` (exact friction).
-    """
-    dyn = spong.dynamics
-    links, motors = [], []
-    for k, a in enumerate(spong.actuators):
-        entry, velocity, gk = _compact_terms(dyn, book, coriolis, k)
-        if k in spong.flexible:
-            column = spong.flexible.index(k)
-            links.append((_spring(k), entry + velocity + gk))
-            motors.append((spong.tau[k], [a.armature * spong.thetadd[column], _spring(k)]
-                           + _friction_terms(a, spong.thetad[column])))
-        else:
-            armature = [a.armature * dyn.qdd[k]] if a.armature != 0 else []
-            links.append((spong.tau[k], entry + armature + velocity + gk
-                          + _friction_terms(a, dyn.qd[k])))
-    return links, motors
-
-
-def _drives_section(spong: SpongDynamics, book: TextbookDerivation | None, coriolis,
-                    w: _Writer) -> Section:
-    model = spong.dynamics.model
-    links, motors = drive_equations(spong, book, coriolis)
-    names = [j.name for j in model.movable_joints]
-    friction = any(a.damping != 0 or a.friction != 0 for a in spong.actuators)
-    entries = ("the entries of steps 5 to 7" if book is not None else
-               "the entries $M_{i,j}$, $C_{i,j}$ and $g_{i}$ of the program above")
-    friction_text = (
-        " Friction takes the torque $d\\, v + f \\operatorname{sign}(v)$ from a drive turning "
-        "at the rate $v$ (viscous coefficient $d$ in N m s/rad, Coulomb torque $f$ in N m)"
-        + ("; it acts on the motor of a flexible joint and on the joint of a rigid one."
-           if spong.flexible else ".") if friction else "")
-    blocks: list = []
-    if spong.flexible:
-        flexible = [names[k] for k in spong.flexible]
-        stiffness = [spong.actuators[k].stiffness for k in spong.flexible]
-        inertia = [spong.actuators[k].armature for k in spong.flexible]
-        blocks.append(Paragraph(prose(
-            "The description makes " + ("joints " if len(flexible) > 1 else "joint "),
-            *_names(flexible), f" flexible: an elastic transmission (a spring, stiffness in "
-            "N m/rad) sits between the joint and its motor. The motor angle $\\theta_{i}$ "
-            "(rad, on the link side of the gear: the rotor angle divided by the gear ratio) "
-            "becomes a state of its own beside the link angle $q_{i}$, and the spring passes "
-            "its stiffness times $\\theta_{i} - q_{i}$ from the motor to the link. This is "
-            "Spong's reduced model: it assumes that the kinetic energy of each motor comes only "
-            "from its own spin, one half its motor inertia (the rotor inertia reflected through "
-            "the gear, kg m$^{2}$) times $\\dot{\\theta}_{i}^{2}$; the part of the rotor's "
-            "angular velocity due to the links that carry it is neglected (the rotor's mass "
-            "belongs to the link that carries it)." + friction_text)))
-        rows = tuple(((code(names[k]),), prose(f"$q_{{{k + 1}}}$"),
-                      (math(w.tex(spong.theta[c])),), (math(w.tex(stiffness[c])),),
-                      (math(w.tex(inertia[c])),))
-                     for c, k in enumerate(spong.flexible))
-        blocks.append(Table(tuple(prose(h) for h in (
-            "joint", "link angle", "motor angle", "stiffness", "motor inertia")), rows))
-        rigid_note = ("" if not spong.rigid else
-                      "; the rows of a rigid joint have its joint torque $\\tau_{i}$ on the "
-                      "right (and its armature adds to $M$)")
-        blocks.append(Paragraph(prose(
-            "The Euler–Lagrange equations of the links and of the motors, the link equations "
-            "and the motor equations, are")))
-        blocks.append(Equations((
-            Equation(r"M(q)\, \ddot{q} + C(q, \dot{q})\, \dot{q} + g(q)",
-                     (r"K (\theta - q),",)),
-            Equation(r"B\, \ddot{\theta} + K (\theta - q)", (r"\tau_{m},",)))))
-        blocks.append(Paragraph(prose(
-            "with the stiffness matrix $K = \\operatorname{diag}"
-            + lb.vector(w.p, stiffness) + "$ (not the kinetic energy of step 3), the motor "
-            "inertia matrix $B = \\operatorname{diag}" + lb.vector(w.p, inertia) + "$, the "
-            "motor angles $\\theta = " + lb.vector(w.p, spong.theta) + "$ and the motor "
-            "torques $\\tau_{m}$" + rigid_note + ". Joint by joint, with " + entries
-            + ", the link equations read")))
-        blocks.append(Equations(tuple(w.terms(w.tex(lhs), terms) for lhs, terms in links)))
-        blocks.append(Paragraph(prose("and the motor equations")))
-        blocks.append(Equations(tuple(w.terms(w.tex(lhs), terms) for lhs, terms in motors)))
-        title = "Flexible joints"
-    else:
-        armature = [a.armature for a in spong.actuators]
-        blocks.append(Paragraph(prose(
-            "The description gives the joints' drives. A motor behind a gear of ratio $r$ adds "
-            "its reflected rotor inertia, the armature $a_{i} = r_{i}^{2} I_{\\mathrm{rotor},i}$ "
-            "(kg m$^{2}$), to the diagonal of the mass matrix." + friction_text
-            + " The equations of motion become")))
-        blocks.append(Equations((Equation(
-            r"\bigl(M(q) + \operatorname{diag}(a)\bigr)\, \ddot{q} + C(q, \dot{q})\, \dot{q} "
-            r"+ g(q) + \tau_{f}(\dot{q})", (r"\tau,",)),)))
-        blocks.append(Paragraph(prose(
-            "with $a = " + lb.vector(w.p, armature) + "$ and the friction torques "
-            "$\\tau_{f} = " + lb.vector(w.p, [sp.Add(*_friction_terms(a, v)) for a, v in
-                                              zip(spong.actuators, spong.dynamics.qd)])
-            + "$. Joint by joint, with " + entries + ":")))
-        blocks.append(Equations(tuple(w.terms(w.tex(lhs), terms) for lhs, terms in links)))
-        title = "Drives: armature and friction"
-    blocks.append(Paragraph(prose(
-        "The properties verified below are those of the rigid-body terms $M$, $C$ and "
-        "$g$.")))
-    return Section(title, tuple(blocks))
-
-
-# -- contacts -----------------------------------------------------------------------------
-
-_FORCE_AXES = ("f_x", "f_y", "f_z", "n_x", "n_y", "n_z")
-
-
-def contact_forces(contacts) -> list[sp.Symbol]:
-    """The symbols of ``F_c``, in the order of the rows of ``J_c``: ``f_x, f_y, f_z`` per
-    point contact, ``f_x … n_z`` per surface contact (``eomgen_<axis>_<k>``, k 1-based)."""
-    return [sp.Symbol(f"eomgen_{axis}_{k}", real=True)
-            for k, c in enumerate(contacts, start=1) for axis in _FORCE_AXES[:c.size]]
-
-
-def contact_symbol_names(contacts) -> dict[sp.Symbol, str]:
-    """LaTeX of :func:`contact_forces`: ``f_{x}`` for one contact, ``f_{2,x}`` for several."""
-    names = {}
-    for symbol in contact_forces(contacts):
-        _, letter, axis, k = symbol.name.split("_")
-        names[symbol] = f"{letter}_{{{axis}}}" if len(contacts) == 1 else \
-            f"{letter}_{{{k},{axis}}}"
-    return names
-
-
-def contact_equations(dyn: Dynamics, contacts, book: TextbookDerivation | None, coriolis):
-    """The contact Jacobian ``J_c`` (m×n), ``J̇_c q̇`` (m×1), the forces ``F_c`` and the rows
-    ``τ_i = (M q̈ + C q̇ + g)_i − (J_cᵀ F_c)_i`` as ``(lhs, terms)`` (names of
-    :func:`_compact_terms`), the contact terms grouped by force component. ``J_c`` and
-    ``J̇_c q̇`` are the point contacts' linear rows of the world-aligned frame Jacobian and the
-    surface contacts' body Jacobian (:func:`eomgen.symbolic.frames.derive_frames`), written out
-    in the joint variables in the textbook form (small models only)."""
-    from ..contacts import POINT
-    from ..symbolic.frames import derive_frames
-    from ..symbolic.textbook import simplify_trig
-
-    model = dyn.model
-    fk = derive_frames(model, list(dict.fromkeys(c.frame for c in contacts)))
-    full = fk.program.expanded()
-    rows, bias = [], []
-    for c in contacts:
-        kinds = ("J", "dJqd") if c.kind == POINT else ("Jb", "dJbqd")
-        J, b = (fk.program.expand(fk.output(kind, c.frame), full) for kind in kinds)
-        rows += [J[r, :] for r in range(c.size)]
-        bias += [b[r] for r in range(c.size)]
-    # fk's joint symbols are dyn's (same names and assumptions)
-    Jc = sp.Matrix.vstack(*rows).applyfunc(lambda e: simplify_trig(e, fk.q))
-    dJqd = sp.Matrix(bias).applyfunc(lambda e: simplify_trig(e, fk.q))
-    F = contact_forces(contacts)
-    equations = []
-    for i in range(model.dof):
-        entry, velocity, gi = _compact_terms(dyn, book, coriolis, i)
-        force = [-(F[r] * Jc[r, i]) for r in range(len(F)) if Jc[r, i] != 0]
-        equations.append((sp.Symbol(f"tau{i + 1}", real=True), entry + velocity + gi + force))
-    return Jc, dJqd, F, equations
-
-
-def _contact_section(dyn: Dynamics, contacts, book: TextbookDerivation | None, coriolis,
-                     w: _Writer) -> Section:
-    from ..contacts import POINT
-
-    described = []
-    for k, c in enumerate(contacts):
-        described += ([", "] if k else []) + [code(c.frame)]
-        if c.kind == POINT:
-            normal = lb.vector(w.p, [sp.Float(v, 15) for v in c.normal])
-            described.append(" (a point: its origin is held still; force in world axes, N; "
-                             f"normal ${normal}$)")
-        else:
-            described.append(" (a surface: the frame is held still; force and moment in the "
-                             "frame's axes, N and N m)")
-    blocks: list = [
-        Paragraph(prose(
-            "The scene holds ", *described, ". The contact force $F_{c}$ acts on the robot "
-            "at the contact frame and enters the equations of motion through the contact "
-            "Jacobian $J_{c}$ (the rows of the frame's Jacobian that the contact holds, "
-            "$\\dot{p} = J_{c} \\dot{q}$ for a point), and the contact adds the constraint "
-            "that the frame does not accelerate:")),
-        Equations((
-            Equation(r"M(q)\, \ddot{q} + C(q, \dot{q})\, \dot{q} + g(q)",
-                     (r"\tau + J_{c}^{T} F_{c},",)),
-            Equation(r"J_{c}(q)\, \ddot{q} + \dot{J}_{c}\, \dot{q}", (r"0.",)))),
-    ]
-    if book is None:
-        blocks.append(Paragraph(prose(
-            "For a robot of this size $J_{c}$ and $\\dot{J}_{c} \\dot{q}$ are not written out "
-            "here; eomgen derives them as a program of named subexpressions "
-            "(eomgen.symbolic.frames.derive_frames) and evaluates them numerically "
-            "(eomgen.contacts).")))
-        return Section("Contact", tuple(blocks))
-    Jc, dJqd, F, equations = contact_equations(dyn, contacts, book, coriolis)
-    angles = list(dyn.q)
-    blocks.append(Paragraph(prose(
-        "Here $F_{c} = " + lb.vector(w.p, F) + "$ and, differentiating the position of the "
-        "contact frame (rows: the held directions; columns: the joints),")))
-    blocks.append(Equations(w.matrix("J_{c}", Jc)))
-    blocks.append(Paragraph(prose(
-        "$\\dot{J}_{c} \\dot{q}$ is the acceleration of the contact frame at "
-        "$\\ddot{q} = 0$:")))
-    blocks.append(Equations(tuple(
-        w.terms(rf"(\dot{{J}}_{{c}} \dot{{q}})_{{{r + 1}}}", rd.by_trig(dJqd[r], angles))
-        for r in range(len(F)))))
-    zero = [r for r in range(len(F)) if all(v == 0 for v in Jc[r, :])]
-    if zero:
-        blocks.append(Paragraph(prose(
-            "Row" + ("s " if len(zero) > 1 else " ")
-            + ", ".join(str(r + 1) for r in zero) + " of $J_{c}$ "
-            + ("are" if len(zero) > 1 else "is") + " zero: no joint moves the frame in that "
-            "direction, so the constraint holds by itself there and the force "
-            + ", ".join(f"${w.tex(F[r])}$" for r in zero) + " is not determined by the "
-            "motion (it does no work).")))
-    blocks.append(Paragraph(prose(
-        "Joint by joint, the torques that produce a motion $q(t)$ that keeps the contact, "
-        "with the force $F_{c}$ the contact exerts, are $\\tau = M \\ddot{q} + C \\dot{q} + g - "
-        "J_{c}^{T} F_{c}$ (entries as in step 8):")))
-    blocks.append(Equations(tuple(w.terms(w.tex(lhs), terms) for lhs, terms in equations)))
-    return Section("Contact", tuple(blocks))
-
-
 # -- large models ---------------------------------------------------------------------------
 
-def _program_section(dyn: Dynamics, w: _Writer) -> Section:
-    context = lb.program_sections(dyn, HANDOUT_CONFIG, w.p)
+def _program_section(dyn: Dynamics, w: Writer) -> Section:
+    context = program_sections(dyn, HANDOUT_CONFIG, w.p)
     ops = dyn.operation_count(["M", "C", "g"])
     c = HANDOUT_CONFIG
     blocks = [Paragraph(prose(
@@ -829,20 +480,18 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
     >>> [s.title for s in handout.sections][:4]
     ['The robot', 'Method and notation', 'Step 1: positions of the centres of mass', 'Step 2: velocities']
     """
-    from .sketch import render_sketch, sketch_geometry
-
     progress(f"deriving the equations of motion of {model.name} ({plural(model.dof, 'joint')})")
     dyn = derive(model, outputs=("M", "C", "g"), simplify=False)
-    book = lb.textbook_for(dyn, HANDOUT_CONFIG)
+    book = nt.textbook_for(dyn, HANDOUT_CONFIG)
     extra_names = {HALF: r"\tfrac{1}{2}"}
-    w = _Writer(lb.printing(dyn, HANDOUT_CONFIG, compact_trig=book is not None,
+    w = Writer(nt.printing(dyn, HANDOUT_CONFIG, compact_trig=book is not None,
                             extra_names=extra_names))
     spong = spong_dynamics(dyn) if has_drives(model) else None
     contacts = tuple(getattr(scene, "contacts", ()) or ())
     extra_names.update(contact_symbol_names(contacts))
     if spong is not None:  # the drives' own symbols, printed by the document's printer
         extra_names.update(drive_symbol_names(spong, w.tex))
-    w = _Writer(lb.printing(dyn, HANDOUT_CONFIG, compact_trig=book is not None,
+    w = Writer(nt.printing(dyn, HANDOUT_CONFIG, compact_trig=book is not None,
                             extra_names=extra_names))
     geometry = sketch_geometry(model)
     pose = ", ".join(f"{v:.3g}" for v in geometry.q)
@@ -851,7 +500,7 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
                     "(prismatic), centres of mass $c_{k}$, gravity $g$.")
     if geometry.placeholder_parameters:
         caption += prose(" Drawn with 1 for the parameters without a value: ",
-                         *_names(geometry.placeholder_parameters), ".")
+                         *code_names(geometry.placeholder_parameters), ".")
     sections = [_robot_section(model, w, caption, scene), _method_section(model, book is not None)]
     coriolis = named_coriolis(dyn, book) if book is not None else None
     if book is not None:
@@ -859,9 +508,9 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
     else:
         sections.append(_program_section(dyn, w))
     if spong is not None:
-        sections.append(_drives_section(spong, book, coriolis, w))
+        sections.append(drives_section(spong, book, coriolis, w))
     if contacts:
-        sections.append(_contact_section(dyn, contacts, book, coriolis, w))
+        sections.append(contact_section(dyn, contacts, book, coriolis, w))
     report, missing = None, "the check was switched off"
     if check:
         progress("checking the derivation against Newton-Euler")

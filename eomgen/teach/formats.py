@@ -27,10 +27,10 @@ import tempfile
 from pathlib import Path
 from typing import Callable
 
-from ..codegen.backends.latex_printer import latex_comment, latex_escape
 from ..codegen.render import render
 from ..errors import GenerationError
 from ..output import GeneratedFile
+from ..present.printer import latex_comment, latex_escape
 from .document import Equations, Figure, Handout, Inline, Paragraph, Table
 
 #: The figures, numbered in order of appearance.
@@ -173,7 +173,7 @@ class HtmlFormat(_Format):
     template = "teach/handout.html.jinja"
 
     def __init__(self):
-        from latex2mathml.converter import convert
+        from latex2mathml.converter import convert  # start-up time: HTML handouts only
 
         self._convert = convert
 

@@ -204,7 +204,7 @@ def _motion_plane(model: RobotModel) -> tuple[int, int] | None:
     """The ``(i, j)`` root-frame plane of a planar robot: the plane of
     :func:`eomgen.reduction.planar_motion` when its normal is a root axis (the view is drawn in
     root coordinates), else None."""
-    from ..reduction import planar_motion
+    from ..reduction import planar_motion  # start-up time: it imports SymPy; this needs NumPy
 
     planar = planar_motion(model)
     if planar is None:
@@ -256,7 +256,7 @@ def sketch_figure(model: RobotModel, q=None):
         yourself uses your rcParams at save time; :func:`render_sketch` gives reproducible
         bytes.
     """
-    import matplotlib
+    import matplotlib  # start-up time: only drawing needs matplotlib
 
     with matplotlib.rc_context():
         matplotlib.rcdefaults()  # independent of the user's matplotlibrc and style
@@ -282,7 +282,7 @@ def render_sketch(model: RobotModel, fmt: str, q=None) -> bytes:
     """
     if fmt not in _METADATA:
         raise ValueError(f"unknown sketch format {fmt!r}; expected one of svg, png, pdf")
-    import matplotlib
+    import matplotlib  # start-up time: only drawing needs matplotlib
 
     with matplotlib.rc_context():
         matplotlib.rcdefaults()
@@ -345,7 +345,7 @@ def _merged(items, tol: float):
 
 def _com_marker():
     """The textbook centre-of-mass symbol's black part: two opposite quadrants of a circle."""
-    from matplotlib.path import Path
+    from matplotlib.path import Path  # start-up time: only drawing needs matplotlib
 
     return Path.make_compound_path(Path.wedge(0, 90), Path.wedge(180, 270))
 
@@ -385,6 +385,7 @@ def _gravity_arrow(ax, down2d: np.ndarray) -> None:
 
 
 def _figure(model: RobotModel, geo: SketchGeometry):
+    # start-up time: only drawing needs matplotlib
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -428,7 +429,7 @@ def _fit_limits(ax, pts: np.ndarray, pad: float, box: tuple[float, float]) -> No
 
 
 def _draw_planar(fig, model: RobotModel, geo: SketchGeometry, scale: float, gravity) -> None:
-    from matplotlib.patches import Polygon
+    from matplotlib.patches import Polygon  # start-up time: only drawing needs matplotlib
 
     i, j = geo.plane
     rect = (0.03, 0.03, 0.94, 0.8)
@@ -531,7 +532,7 @@ def _angle_arc(ax, p, direction, angle: float, radius: float, label: str) -> lis
 
 
 def _draw_3d(fig, model: RobotModel, geo: SketchGeometry, scale: float, gravity) -> None:
-    from mpl_toolkits.mplot3d import proj3d
+    from mpl_toolkits.mplot3d import proj3d  # start-up time: only drawing needs matplotlib
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     ax = fig.add_axes((0.0, 0.0, 1.0, 0.86), projection="3d")
