@@ -46,6 +46,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from ..errors import IdentificationError, one_line
+from ..regressor.least_squares import normalised_condition, observation_matrix  # noqa: F401  (re-exported)
 
 
 #: Column prefixes of a CSV file, in the order written: positions, velocities, accelerations,
@@ -332,24 +333,6 @@ def _lowpass(t, signals, cutoff, source, what):
 # ----------------------------------------------------------------------------------------------
 # Estimation
 # ----------------------------------------------------------------------------------------------
-
-
-def observation_matrix(reg, columns: Sequence[int], q, qd, qdd,
-                       values: Mapping | None = None) -> np.ndarray:
-    """W = the base regressor stacked over the samples, (N n, b), sample-major: rows
-    ``k n … k n + n − 1`` are sample k's joints (so joint j's rows are ``W[j::n]``)."""
-    f = reg.compiled(values, program=reg.base_program(list(columns)))
-    q, qd, qdd = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (q, qd, qdd))
-    if len(q) == 0:
-        return np.zeros((0, len(columns)))
-    return np.vstack([f(*row)["Y_base"] for row in zip(q, qd, qdd)])
-
-
-def normalised_condition(W: np.ndarray) -> float:
-    """Condition number of W with its columns scaled to unit norm (zero columns left out of
-    the scaling): how well the samples excite the parameters, whatever their units."""
-    norms = np.linalg.norm(W, axis=0)
-    return float(np.linalg.cond(W / np.where(norms > 0, norms, 1.0)))
 
 
 @dataclass(frozen=True)
