@@ -1,13 +1,14 @@
-"""The generated regressor functions (registered in :mod:`eomgen.outputs`): ``regressor``,
-``inertial_parameters``, ``base_regressor``, ``base_parameters`` and the module constants
-``PARAMETER_NAMES``, ``BASE_PARAMETER_NAMES``; the actuator columns a model declares."""
+"""The builders of the generated regressor functions (registered in :mod:`eomgen.outputs`):
+``regressor``, ``inertial_parameters``, ``base_regressor``, ``base_parameters``, the
+kinetic and potential energy regressors and the module constants ``PARAMETER_NAMES``,
+``BASE_PARAMETER_NAMES``, with the actuator columns a model declares."""
 
 from __future__ import annotations
 
 import functools
+from dataclasses import dataclass
 
 import sympy as sp
-from dataclasses import dataclass
 
 from ..errors import UnsupportedError
 from ..model import RobotModel
