@@ -33,7 +33,7 @@ then, if asked, one group of n actuator columns per term: ``IA`` (armature, τ_k
 from __future__ import annotations
 
 from ..symbolic.regressor import ACTUATOR_NAMES, ACTUATOR_TERMS, INERTIAL_NAMES  # noqa: F401
-from .derive import Regressor, derive_regressor
+from .derive import Regressor, by_symbol, derive_regressor
 from .form import PARAMETER_MEANINGS, RegressorForm, regressor_form
 from .generated import (DECLARED_TERMS, GeneratedBase, base_parameter_names, build_outputs,
                         declared_actuator_terms, description_parameters, generated_base,
@@ -46,7 +46,7 @@ from .symbolic_base import SymbolicBase, symbolic_base_parameters
 
 __all__ = [
     "ACTUATOR_NAMES", "ACTUATOR_TERMS", "INERTIAL_NAMES",
-    "Regressor", "derive_regressor",
+    "Regressor", "derive_regressor", "by_symbol",
     "RANK_TOLERANCE", "ZERO_COLUMN", "BaseParameters", "base_parameters", "sample_regressor",
     "SymbolicBase", "symbolic_base_parameters",
     "parameter_latex", "by_coefficient",

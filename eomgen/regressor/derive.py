@@ -23,6 +23,13 @@ from ..symbolic.regressor import (ACTUATOR_NAMES, ACTUATOR_TERMS, INERTIAL_NAMES
                                   regressor_program)
 
 
+def by_symbol(values: Mapping | None) -> dict:
+    """``values`` (parameter symbol or name → value) keyed by symbols (:func:`~eomgen.model.
+    parameter_symbol` of a name)."""
+    return {(parameter_symbol(k) if isinstance(k, str) else k): v
+            for k, v in (values or {}).items()}
+
+
 @dataclass(frozen=True)
 class Regressor:
     """The regressor of one model. Immutable.
@@ -93,15 +100,17 @@ class Regressor:
         pi += [sp.sympify((actuator or {}).get(name, 0)) for name in self.PARAMETER_NAMES[10 * self.n:]]
         out = sp.Matrix(pi)
         if values is not None:
-            subs = {(parameter_symbol(k) if isinstance(k, str) else k): v for k, v in values.items()}
-            out = out.xreplace({k: sp.sympify(v) for k, v in subs.items()})
+            out = out.xreplace({k: sp.sympify(v) for k, v in by_symbol(values).items()})
         return out
+
+    def parameter_values(self, values: Mapping | None = None) -> dict:
+        """The model's default parameter values by symbol, ``values`` (symbol or name → value)
+        overriding."""
+        return {**self.model.parameter_values, **by_symbol(values)}
 
     def numeric_parameters(self, values: Mapping | None = None) -> np.ndarray:
         """π as floats at the model's default parameter values (``values`` overriding)."""
-        merged = dict(self.model.parameter_values)
-        merged.update({(parameter_symbol(k) if isinstance(k, str) else k): v
-                       for k, v in (values or {}).items()})
+        merged = self.parameter_values(values)
         return np.array([float(x) for x in self.inertial_parameters(merged)], dtype=float)
 
     @cached_property
@@ -140,9 +149,7 @@ class Regressor:
         Geometry parameters take their default values (``values`` overriding, symbol or name).
         """
         program = self.program if program is None else program
-        merged = dict(self.model.parameter_values)
-        merged.update({(parameter_symbol(k) if isinstance(k, str) else k): v
-                       for k, v in (values or {}).items()})
+        merged = self.parameter_values(values)
         signs = tuple(sp.Symbol(f"sign_{s.name}", real=True) for s in self.qd)
         swap = {sp.sign(s): t for s, t in zip(self.qd, signs)}
         subs = {k: sp.Float(v) for k, v in merged.items()}

@@ -11,9 +11,8 @@ import numpy as np
 import sympy as sp
 
 from ..errors import UnsupportedError
-from ..model import parameter_symbol
 from ..symbolic.grouping import group_parameters
-from .derive import Regressor
+from .derive import Regressor, by_symbol
 from .notation import by_coefficient, parameter_latex
 from .numeric_base import RANK_TOLERANCE, ZERO_COLUMN, independent_columns, sample_regressor
 
@@ -56,9 +55,7 @@ class SymbolicBase:
 
     def beta(self, pi, values: Mapping | None = None) -> np.ndarray:
         """β(π) as floats; geometry symbols at the model's defaults (``values`` overriding)."""
-        subs = dict(self.geometry)
-        subs.update({(parameter_symbol(k) if isinstance(k, str) else k): v
-                     for k, v in (values or {}).items()})
+        subs = {**dict(self.geometry), **by_symbol(values)}
         subs.update(zip(self.parameter_symbols, (float(x) for x in pi)))
         return np.array([float(e.xreplace(subs)) for e in self.expressions], dtype=float)
 
@@ -107,9 +104,7 @@ def symbolic_base_parameters(reg: Regressor, samples: int | None = None, seed: i
     kept = list(grouping.kept) + list(range(10 * reg.n, reg.p))
     expressions = list(grouping.expressions) + [reg.parameter_symbols[k]
                                                 for k in range(10 * reg.n, reg.p)]
-    geometry = dict(reg.model.parameter_values)
-    geometry.update({(parameter_symbol(k) if isinstance(k, str) else k): v
-                     for k, v in (values or {}).items()})
+    geometry = reg.parameter_values(values)
     W = sample_regressor(reg, samples, seed, values)
     rng = np.random.default_rng(seed + 1)
     pi = rng.uniform(0.5, 1.5, reg.p)
