@@ -60,10 +60,11 @@ Examples
 from __future__ import annotations
 
 from .apply import SCENE_WORLD, apply_scene, load_for_scene
-from .cost import MEASURE_TIMEOUT, DerivationCost, derivation_cost, measure_derivation
+from .cost import MEASURE_TIMEOUT, derivation_cost, measure_derivation
 from .inertia import ROUNDOFF
 from .planar import PlanarMotion, planar_motion
-from .report import LockedJoint, MergedBody, ModelSize, Reduction, ReductionReport
+from .report import (DerivationCost, LockedJoint, MergedBody, ModelSize, Reduction,
+                     ReductionReport)
 
 __all__ = [
     "apply_scene", "load_for_scene", "SCENE_WORLD", "Reduction", "ReductionReport", "ModelSize",

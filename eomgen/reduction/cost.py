@@ -1,6 +1,7 @@
-"""What a derivation costs (:class:`DerivationCost`): of a finished derivation
-(:func:`derivation_cost`), or measured in a fresh Python process (:func:`measure_derivation`,
-whose subprocess runs :func:`measure_main` through ``python -m eomgen.reduction``)."""
+"""Measuring what a derivation costs (a :class:`~eomgen.reduction.report.DerivationCost`): of a
+finished derivation (:func:`derivation_cost`), or in a fresh Python process
+(:func:`measure_derivation`, whose subprocess runs :func:`measure_main` through
+``python -m eomgen.reduction``)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,6 @@ import pickle
 import subprocess
 import sys
 import time
-from dataclasses import dataclass
 from typing import Sequence
 
 from ..dynamics import derive
@@ -17,31 +17,10 @@ from ..model import RobotModel
 from ..outputs import derived_symbols
 from ..parsers import load
 from ..robots import example_path
+from .report import DerivationCost
 
 #: Default time limit [s] of :func:`measure_derivation`.
 MEASURE_TIMEOUT = 300.0
-
-
-@dataclass(frozen=True)
-class DerivationCost:
-    """What deriving a model cost: seconds (None when not measured or not finished) and the
-    operation count of each derived output (``("M", 1878)``, …)."""
-
-    seconds: float | None
-    operations: tuple[tuple[str, int], ...] = ()
-    timeout: float | None = None  # set when the derivation did not finish within it
-    error: str = ""
-
-    @property
-    def total_operations(self) -> int | None:
-        return sum(n for _, n in self.operations) if self.operations else None
-
-    def describe_time(self) -> str:
-        if self.timeout is not None:
-            return f"> {self.timeout:g} s (timeout)"
-        if self.error:
-            return f"failed ({self.error})"
-        return "not measured" if self.seconds is None else f"{self.seconds:.2f} s"
 
 
 def derivation_cost(dynamics) -> DerivationCost:

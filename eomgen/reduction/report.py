@@ -1,5 +1,6 @@
 """The report of a reduction (:class:`ReductionReport`, with the model: :class:`Reduction`):
-sizes before and after, what was locked, merged and dropped, as data and as Markdown."""
+sizes before and after, what was locked, merged and dropped, derivation costs when measured
+(:class:`DerivationCost`, measured by :mod:`eomgen.reduction.cost`), as data and as Markdown."""
 
 from __future__ import annotations
 
@@ -7,7 +8,6 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 from ..model import RobotModel
-from .cost import DerivationCost
 from .inertia import is_zero_inertial
 from .planar import PlanarMotion
 
@@ -47,6 +47,28 @@ class MergedBody:
     joint: str
     links: tuple[str, ...]
     payloads: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class DerivationCost:
+    """What deriving a model cost: seconds (None when not measured or not finished) and the
+    operation count of each derived output (``("M", 1878)``, …)."""
+
+    seconds: float | None
+    operations: tuple[tuple[str, int], ...] = ()
+    timeout: float | None = None  # set when the derivation did not finish within it
+    error: str = ""
+
+    @property
+    def total_operations(self) -> int | None:
+        return sum(n for _, n in self.operations) if self.operations else None
+
+    def describe_time(self) -> str:
+        if self.timeout is not None:
+            return f"> {self.timeout:g} s (timeout)"
+        if self.error:
+            return f"failed ({self.error})"
+        return "not measured" if self.seconds is None else f"{self.seconds:.2f} s"
 
 
 @dataclass(frozen=True)
