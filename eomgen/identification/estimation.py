@@ -3,8 +3,9 @@
 The pieces, each a plain function over plain data, each in a module of its own and all
 importable from here (and from :mod:`eomgen.identification`):
 
-* **Data** (:mod:`~eomgen.identification.measurements`; :func:`read_measurements`, :func:`measurements_csv`): a CSV file with a header
-  naming its columns after JOINT_NAMES, in any order::
+* **Data** (:mod:`~eomgen.identification.measurements`: :func:`read_measurements`,
+  :func:`measurements_csv`): a CSV file with a header naming its columns after JOINT_NAMES,
+  in any order::
 
       t, q_<joint>, qd_<joint>, qdd_<joint>, tau_<joint>      (t optional)
       t, q_<joint>, tau_<joint>                               (positions and efforts only)
@@ -15,14 +16,15 @@ importable from here (and from :mod:`eomgen.identification`):
   second-order central differences (``numpy.gradient``), then decimation. In the first form
   the columns are used as they are, unless a cut-off is given: then q, q̇, q̈ and τ all go
   through that same filter, trimming and decimation (:func:`filtered_signals`).
-* **Estimation** (:mod:`~eomgen.identification.fit`; :func:`weighted_least_squares`;
-  the observation matrix W is :func:`eomgen.regressor.observation_matrix`): Gautier's weighted least squares, standard
-  deviations, condition number; :func:`physical_fit` adds the constraint that every body's
-  pseudo-inertia be positive semi-definite (an SDP, needs cvxpy).
-* **Excitation** (:mod:`~eomgen.identification.excitation`; :class:`FourierTrajectory`, :func:`excitation_trajectory`): a finite
-  Fourier series per joint (Swevers et al. 1997) whose coefficients minimise the condition
-  number of the base regressor; :func:`simulate_measurements` turns it into data with efforts
-  from eomgen.numeric's Newton–Euler, plus noise if asked.
+* **Estimation** (:mod:`~eomgen.identification.fit`: :func:`weighted_least_squares`; the
+  observation matrix W is :func:`eomgen.regressor.observation_matrix`): Gautier's weighted
+  least squares, standard deviations, condition number; :func:`physical_fit` adds the
+  constraint that every body's pseudo-inertia be positive semi-definite (an SDP, needs cvxpy).
+* **Excitation** (:mod:`~eomgen.identification.excitation`: :class:`FourierTrajectory`,
+  :func:`excitation_trajectory`): a finite Fourier series per joint (Swevers et al. 1997)
+  whose coefficients minimise the condition number of the base regressor;
+  :func:`simulate_measurements` turns it into data with efforts from eomgen.numeric's
+  Newton–Euler, plus noise if asked.
 
 References
 ----------
@@ -41,7 +43,8 @@ from __future__ import annotations
 from ..regressor.least_squares import normalised_condition, observation_matrix
 from .excitation import (Excitation, FourierTrajectory, MotionBounds, excitation_trajectory,
                          motion_bounds, simulate_measurements)
-from .fit import Estimate, PhysicalFit, base_map, physical_fit, pseudo_inertia, weighted_least_squares
+from .fit import (Estimate, PhysicalFit, base_map, physical_fit, pseudo_inertia,
+                  weighted_least_squares)
 from .measurements import (FILTER_ORDER, PREFIXES, Measurements, column_names,
                            filtered_derivatives, filtered_signals, measurements_csv,
                            read_measurements)

@@ -21,8 +21,8 @@ with a :class:`ReductionReport` of every step:
    are dropped. The reduced model has one massless link for the world and one link per
    moving joint, whose joint is placed by the composed fixed transforms.
 6. **Fixed frame**: when a single moving body hangs from the world, the fixed frame is moved to
-   its joint frame at q = 0 (:func:`~eomgen.reduction.apply._reroot`): no constant rotation or offset multiplies every
-   later quantity; gravity is re-expressed in that frame. Joint-space M, C, g and τ are the same
+   its joint frame at q = 0 (in :mod:`eomgen.reduction.apply`): no constant rotation or offset
+   multiplies every later quantity; gravity is re-expressed in that frame. Joint-space M, C, g and τ are the same
    in any fixed frame.
 7. **Notices**: of the description's findings that warn (or refuse under ``--strict``,
    :class:`~eomgen.model.Notice`), the reduced model keeps those that still matter: not those
