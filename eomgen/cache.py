@@ -44,7 +44,8 @@ read-only folder, a full disk) never fail a generation: a notice, and the result
 The folder is ``--cache-dir``, else ``$EOMGEN_CACHE_DIR``, else ``$XDG_CACHE_HOME/eomgen``, else
 ``~/.cache/eomgen`` (:func:`default_cache_dir`).
 
-Only the standard library is imported here (no SymPy, NumPy or CasADi).
+Only the standard library and eomgen's light modules (output, compiler) are imported at the top
+(no SymPy, NumPy or CasADi); the backend registry is imported by :func:`generation_key` alone.
 """
 
 from __future__ import annotations
@@ -68,6 +69,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Callable, Mapping, Sequence
 
+from .compiler import c_compiler_path
 from .output import GeneratedFile
 
 #: Version of the entry layout; entries of another format are stale.
@@ -142,8 +144,6 @@ def toolchain() -> dict[str, str | bool | None]:
     (:func:`eomgen.compiler.c_compiler_path`), and for the fast backend's compiled extension
     the Python it is built for (its ``EXT_SUFFIX`` names the ABI) and whether Python's headers are there. (NumPy's C API is backward compatible: an
     extension built against NumPy 2 headers targets the oldest supported NumPy by default.)"""
-    from .compiler import c_compiler_path
-
     compiler = c_compiler_path()
     include = sysconfig.get_paths().get("include")
     return {"cc": compiler, "ext_suffix": sysconfig.get_config_var("EXT_SUFFIX"),
@@ -177,7 +177,8 @@ def canonical(value) -> object:
     if isinstance(value, (set, frozenset)):
         return sorted((canonical(v) for v in value), key=json.dumps)
     if type(value).__module__.startswith("sympy"):
-        import sympy
+        import sympy  # only for SymPy values, already imported by whoever made them: the
+        # cached ``eomgen generate`` path must not load SymPy (start-up time)
 
         return ["sympy", sympy.srepr(value)]
     return ["repr", repr(value)]
@@ -269,6 +270,8 @@ def generation_key(model, backends: Sequence[str], options: Mapping[str, object]
     """The key of a library call ``render(model, backends, **options)`` (see the module
     docstring): the model's fingerprint, the backends and the functions implementing them,
     the options, the toolchain, and the description file's bytes."""
+    # imported here, not at the top: eomgen.codegen loads SymPy, which the cached
+    # ``eomgen generate`` path (command_request) must not (start-up time)
     from .codegen import available_backends
 
     registry = available_backends()

@@ -60,10 +60,10 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Iterable
 
-from .codegen.functions import select_functions
 from .contacts import POINT, SURFACE, Contact
 from .errors import DescriptionError, SceneError
 from .model import Inertial, Parameter, Vec3, check_inertial, mat3, vec3
+from .outputs import select
 from .parsers._yaml import Reader, read_document
 
 #: The scene format version this eomgen reads.
@@ -132,7 +132,7 @@ class Scene:
     symbolic:
         Names of the parameters kept symbolic; None keeps every parameter symbolic.
     outputs:
-        The functions wanted (:func:`eomgen.codegen.functions.select_functions` names); None
+        The functions wanted (:func:`eomgen.outputs.select` names); None
         for all.
     contacts:
         Frames held still (:class:`eomgen.contacts.Contact`), in file order.
@@ -421,6 +421,6 @@ def _outputs(r: _SceneReader, value) -> tuple[str, ...]:
             raise r.error(f"outputs[{k}]", "expected an output name (M, C, g, tau, ...)")
         names.append(entry)
     try:
-        return select_functions(names)
+        return select(names)
     except ValueError as exc:
         raise r.error("outputs", str(exc)) from None

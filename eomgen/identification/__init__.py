@@ -13,9 +13,11 @@ from ..errors import IdentificationError  # noqa: F401  (re-exported)
 
 
 def __getattr__(name: str):
-    import importlib
+    # imported on first use (start-up time): the command line imports this package and must
+    # not load NumPy for a cached ``eomgen generate``
+    import eomgen.identification.estimation as estimation  # not "from . import": that asks
+    # this __getattr__ for the submodule before importing it
 
-    estimation = importlib.import_module(f"{__name__}.estimation")
     try:
         return getattr(estimation, name)
     except AttributeError:

@@ -11,7 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..output import GeneratedFile
-from .estimation import Estimate, Measurements, PhysicalFit
+from .fit import Estimate, PhysicalFit
+from .measurements import Measurements
 
 #: rcParams applied on top of matplotlib's defaults while drawing and saving (as
 #: eomgen.teach.sketch does), so the PNG does not depend on the user's configuration.
@@ -104,6 +105,7 @@ class IdentificationReport:
 
     def png(self) -> bytes:
         """Measured and predicted effort of every joint against time (or sample index)."""
+        # matplotlib: an optional dependency (eomgen[analysis]), needed only for the plot
         import matplotlib
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
