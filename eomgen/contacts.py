@@ -1,6 +1,7 @@
 """Rigid contacts, numerically: ``M q̈ + C q̇ + g = τ + J_cᵀ F_c`` with ``J_c q̈ + J̇_c q̇ = −γ``.
 
-A :class:`Contact` holds a named frame (a link, see :mod:`eomgen.symbolic.frames`) still:
+A :class:`~eomgen.model.Contact` (plain data of the model layer, re-exported here) holds a named
+frame (a link, see :mod:`eomgen.symbolic.frames`) still:
 
 * a **point** contact (3 rows) holds the frame origin: ``p̈_f = 0``. Its rows of ``J_c`` are
   the linear rows of the world-aligned frame Jacobian, and its force ``F = (f_x, f_y, f_z)``
@@ -50,9 +51,7 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from .model import RobotModel
-
-POINT, SURFACE = "point", "surface"
+from .model import POINT, SURFACE, Contact, RobotModel  # Contact: re-exported (it lives in the model)
 
 #: ``constrained_forward_dynamics`` without damping refuses a contact Jacobian whose smallest
 #: singular value is below this fraction of its largest.
@@ -100,37 +99,6 @@ def rotation_log(R) -> np.ndarray:
     if u @ w < 0:
         u = -u
     return theta * u
-
-
-@dataclass(frozen=True)
-class Contact:
-    """A contact on ``frame``: ``kind`` point (3D) or surface (6D), friction coefficient
-    ``mu`` (None: no cone check), Baumgarte gains ``kp`` [1/s²] and ``kd`` [1/s], the contact
-    ``normal`` (point contacts, world axes) and a ``name``."""
-
-    frame: str
-    kind: str = POINT
-    mu: float | None = None
-    kp: float = 0.0
-    kd: float = 0.0
-    normal: tuple[float, float, float] = (0.0, 0.0, 1.0)
-    name: str = ""
-
-    def __post_init__(self):
-        if self.kind not in (POINT, SURFACE):
-            raise ValueError(f"contact '{self.name or self.frame}': kind must be 'point' or "
-                             f"'surface', got {self.kind!r}")
-        if self.mu is not None and not self.mu >= 0:
-            raise ValueError(f"contact '{self.name or self.frame}': friction coefficient "
-                             f"{self.mu} is negative (μ ≥ 0)")
-        if not (self.kp >= 0 and self.kd >= 0):
-            raise ValueError(f"contact '{self.name or self.frame}': Baumgarte gains must be "
-                             "non-negative")
-
-    @property
-    def size(self) -> int:
-        """Rows of the contact in ``J_c``: 3 (point) or 6 (surface)."""
-        return 3 if self.kind == POINT else 6
 
 
 @dataclass(frozen=True)
