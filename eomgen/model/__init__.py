@@ -43,7 +43,14 @@ from .checks import (
 from .contact import POINT, SURFACE, Contact
 from .notices import Notice, NoticeKind, emit_notices
 from .parts import Inertial, Joint, JointType, Link, Parameter
-from .robot import RobotModel, all_scalars, joint_motion, lock_joints
+from .robot import (
+    RobotModel,
+    all_scalars,
+    flexible_indices,
+    joint_actuators,
+    joint_motion,
+    lock_joints,
+)
 from .scalars import IDENTITY3, ZERO3, Mat3, Scalar, Vec3, mat3, parameter_symbol, scalar, vec3
 from .snapping import SNAP_TOLERANCE, Snap, snap, snap_summary, snapping
 from .transforms import Transform, rotation_about_axis, rotation_from_rpy
@@ -55,8 +62,8 @@ __all__ = [
     "DEFAULT_FRICTION_WIDTH", "IDENTITY3", "MAX_JOINTS", "POINT", "SNAP_TOLERANCE", "SURFACE",
     "ZERO3", "Actuator", "Contact", "Inertial", "Joint", "JointType", "Link", "Mat3", "Notice",
     "NoticeKind", "Parameter", "RobotModel", "Scalar", "Snap", "Transform", "Vec3",
-    "all_scalars", "build_model", "check_actuator", "check_axis", "check_inertial", "check_size",
-    "check_tree", "emit_notices", "joint_motion", "lock_joints", "mat3", "parameter_symbol",
-    "rotation_about_axis", "rotation_from_rpy", "scalar", "snap", "snap_summary", "snapping",
-    "vec3",
+    "all_scalars", "build_model", "check_actuator", "check_axis", "check_inertial",
+    "check_size", "check_tree", "emit_notices", "flexible_indices", "joint_actuators",
+    "joint_motion", "lock_joints", "mat3", "parameter_symbol", "rotation_about_axis",
+    "rotation_from_rpy", "scalar", "snap", "snap_summary", "snapping", "vec3",
 ]

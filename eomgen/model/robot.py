@@ -1,5 +1,6 @@
 """The robot model (:class:`RobotModel`): links, joints, gravity, parameters, contacts; and the
-operations on a whole model (joint motion, locking joints)."""
+queries and operations on a whole model (all its scalars, the joints' actuators, joint motion,
+locking joints)."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ import sympy as sp
 
 from .. import reprs
 from ..errors import KinematicTreeError, ParameterError
+from .actuator import Actuator
 from .contact import Contact
 from .notices import Notice
 from .parts import Inertial, Joint, JointType, Link, Parameter
@@ -173,6 +175,17 @@ def all_scalars(model: RobotModel) -> Iterable[sp.Expr]:
             yield from row
         if joint.actuator is not None:
             yield from joint.actuator.scalars()
+
+
+def joint_actuators(model: RobotModel) -> tuple[Actuator, ...]:
+    """The actuator of every movable joint, in ``model.joint_names`` order (a joint without
+    one gets ``Actuator()``: no armature, no friction, rigid)."""
+    return tuple(j.actuator or Actuator() for j in model.movable_joints)
+
+
+def flexible_indices(model: RobotModel) -> tuple[int, ...]:
+    """Indices (into ``q``) of the flexible joints (those with a stiffness), in joint order."""
+    return tuple(k for k, a in enumerate(joint_actuators(model)) if a.flexible)
 
 
 def joint_motion(joint: Joint, value) -> Transform:
