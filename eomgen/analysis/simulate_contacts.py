@@ -35,6 +35,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import Callable, Sequence
 
 import numpy as np
@@ -307,8 +308,6 @@ def plot_drift(study: ContactStudy, path) -> None:
 
 def write_contact_outputs(study: ContactStudy, outdir, stem: str) -> list:
     """``<stem>.md``, ``<stem>.csv`` and ``<stem>.png`` (drift against time) in ``outdir``."""
-    from pathlib import Path
-
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     png = outdir / f"{stem}.png"
