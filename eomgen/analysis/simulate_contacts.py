@@ -6,11 +6,12 @@
 
 at zero torque, ``(q̈, F_c)`` from the KKT system of
 :class:`eomgen.numeric.contacts.ContactDynamics` (M and h = C q̇ + g from the derived program,
-:func:`~eomgen.numeric.contacts.derived_mass_and_bias`), every contact held still where it is at ``q0`` (its **anchor**: position ``p*`` and, for a
-surface contact, orientation ``R*``, from the frame kinematics at ``q0``). The constraint is
-imposed on accelerations only, so the integrator's truncation error lets the contacts drift
-(the classical index reduction problem); Baumgarte's ``γ = kd J_c q̇ + kp e`` feeds the error
-back (``ë + kd ė + kp e = 0``, see :mod:`eomgen.numeric.contacts` for ``e``).
+:func:`~eomgen.numeric.contacts.derived_mass_and_bias`), every contact held still where it is
+at ``q0`` (its **anchor**: position ``p*`` and, for a surface contact, orientation ``R*``, from
+the frame kinematics at ``q0``). The constraint is imposed on accelerations only, so the
+integrator's truncation error lets the contacts drift (the classical index reduction problem);
+Baumgarte's ``γ = kd J_c q̇ + kp e`` feeds the error back (``ë + kd ė + kp e = 0``, see
+:mod:`eomgen.numeric.contacts` for ``e``).
 
 Each integrator runs twice, **without** Baumgarte (``γ = 0``) and **with** it (the scene's gains
 where a contact gives some, else :data:`DEFAULT_GAINS`), and reports, sampled on the output grid:

@@ -141,7 +141,8 @@ class RobotModel:
         return replace(self, links=links, joints=joints, gravity=sv(self.gravity),
                        parameters=params)
 
-    def with_numeric_parameters(self, values: Mapping[sp.Symbol, float] | None = None) -> "RobotModel":
+    def with_numeric_parameters(self, values: Mapping[sp.Symbol, float] | None = None
+                                ) -> "RobotModel":
         """A copy with every parameter replaced by a number (``values`` over the defaults).
 
         Raises
@@ -189,7 +190,8 @@ def flexible_indices(model: RobotModel) -> tuple[int, ...]:
 
 
 def joint_motion(joint: Joint, value) -> Transform:
-    """The transform a joint applies at position ``value`` (rad or m): child frame in joint frame."""
+    """The transform a joint applies at position ``value`` (rad or m): child frame in joint
+    frame."""
     value = scalar(value) if not isinstance(value, sp.Basic) else value
     if joint.type.is_revolute:
         return Transform(rotation_about_axis(joint.axis, value), ZERO3)
