@@ -44,6 +44,14 @@ straight-line program of ``τ_L`` is differentiated in forward mode along the tr
 (:func:`time_derivative_program`: each intermediate ``x = f(…)`` gets ``ẋ = Σ ∂f/∂s ṡ``), which
 keeps the program's size linear in the model (the 7-DOF Panda included).
 
+Where each piece lives: the drive data in the model (:class:`eomgen.model.Actuator`,
+:func:`eomgen.model.joint_actuators`, :func:`eomgen.model.flexible_indices`); the friction law
+(:func:`eomgen.symbolic.drives.friction_torque_expr`) and the program transform
+(:func:`eomgen.symbolic.transforms.time_derivative_program`) in the symbolic engine; this
+module the symbolic equations over a :class:`~eomgen.dynamics.Dynamics`
+(:class:`RigidActuatorDynamics`, :class:`SpongDynamics`); the NumPy evaluators in
+:mod:`eomgen.numeric.actuated` (re-exported here, the path the docs name).
+
 The generated modules export these on request (:mod:`eomgen.symbolic.drives`,
 ``eomgen generate --outputs M_a,tau_f,...``; the flat inverse dynamics, :mod:`eomgen.symbolic.flat`,
 ``--outputs motor_angles,motor_velocities,flat_motor_torque``); see docs/actuators.md.
@@ -60,9 +68,25 @@ import sympy as sp
 
 from .dynamics import Dynamics
 from .errors import ParameterError
-from .model import Actuator, RobotModel, joint_motion, scalar
-from .symbolic.evaluate import compile_program
+from .model import Actuator, RobotModel, flexible_indices, joint_actuators, joint_motion
+from .symbolic.drives import friction_torque_expr
 from .symbolic.program import Program
+from .symbolic.transforms import time_derivative_program
+
+# Deprecated path of the numeric evaluators: they moved to eomgen.numeric.actuated (docs and
+# tests name them here, as eomgen.actuators.flexible_forward_dynamics and so on).
+from .numeric.actuated import (
+    ActuatedModel,
+    actuated_model,
+    flexible_energy,
+    flexible_forward_dynamics,
+    flexible_inverse_dynamics,
+    flexible_rest_state,
+    friction_torque,
+    rigid_forward_dynamics,
+    rigid_inverse_dynamics,
+    rigid_M,
+)
 
 __all__ = [
     "joint_actuators", "flexible_indices", "friction_torque_expr", "RigidActuatorDynamics",
@@ -71,33 +95,6 @@ __all__ = [
     "rigid_inverse_dynamics", "rigid_forward_dynamics", "flexible_forward_dynamics",
     "flexible_energy", "flexible_inverse_dynamics", "flexible_rest_state",
 ]
-
-
-# ----------------------------------------------------------------------------------------------
-# Actuator data of a model
-# ----------------------------------------------------------------------------------------------
-
-def joint_actuators(model: RobotModel) -> tuple[Actuator, ...]:
-    """The actuator of every movable joint, in ``model.joint_names`` order (a joint without
-    one gets ``Actuator()``: no armature, no friction, rigid)."""
-    return tuple(j.actuator or Actuator() for j in model.movable_joints)
-
-
-def flexible_indices(model: RobotModel) -> tuple[int, ...]:
-    """Indices (into ``q``) of the flexible joints (those with a stiffness), in joint order."""
-    return tuple(k for k, a in enumerate(joint_actuators(model)) if a.flexible)
-
-
-def friction_torque_expr(actuators: Sequence[Actuator], qd: Sequence[sp.Expr],
-                         smooth: bool = False) -> sp.Matrix:
-    """Symbolic friction torques ``τ_f,i = d_i q̇_i + f_i sign(q̇_i)`` (``smooth``: ``tanh(q̇_i /
-    w_i)`` in place of the sign), (len(qd), 1); positive along the joint axis when the joint
-    turns positively, i.e. the torque the drive spends on friction."""
-    out = []
-    for a, v in zip(actuators, qd):
-        coulomb = sp.tanh(v / a.friction_width) if smooth else sp.sign(v)
-        out.append(a.damping * v + (a.friction * coulomb if a.friction != 0 else 0))
-    return sp.Matrix(out)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -419,294 +416,3 @@ def spong_dynamics(dynamics: Dynamics, coupling: bool = False) -> SpongDynamics:
         dynamics, actuators, flexible, _symbols("thm", flexible), _symbols("thmd", flexible),
         _symbols("thmdd", flexible), _symbols("tau", n), _symbols("qddd", n),
         _symbols("qdddd", n), coupling, S)
-
-
-# ----------------------------------------------------------------------------------------------
-# Forward-mode time derivatives of a straight-line program
-# ----------------------------------------------------------------------------------------------
-
-def time_derivative_program(program: Program, rates: Mapping[sp.Symbol, sp.Expr],
-                            names: Sequence[str], prefix: str = "d_") -> Program:
-    """The program extended with the time derivatives of the outputs ``names``.
-
-    Each intermediate ``x = f(s₁, …)`` gets ``d_x = Σ ∂f/∂s_k · ṡ_k`` (forward mode along
-    time), ``rates`` giving the derivative of each input (``q → qd``, ``qd → qdd``, …; inputs
-    not listed, such as parameters, are constant) and of intermediates whose derivative an
-    earlier pass defined. The new outputs are named ``prefix + name``. Applying it twice gives
-    second derivatives; the program stays linear in size.
-    """
-    d: dict[sp.Symbol, sp.Expr] = dict(rates)
-
-    def derivative(expr: sp.Expr) -> sp.Expr:
-        return _time_derivative(expr, d, {})
-
-    taken = {s.name for s, _ in program.assignments}
-    assignments = list(program.assignments)
-    for symbol, expr in program.assignments:
-        if symbol in d:  # its derivative is known (from an earlier pass)
-            continue
-        if prefix + symbol.name in taken:
-            raise ValueError(f"prefix {prefix!r} clashes with intermediate {symbol.name}")
-        rate = derivative(expr)
-        if rate == 0:
-            continue
-        if rate.is_Atom:
-            d[symbol] = rate
-            continue
-        new = sp.Symbol(prefix + symbol.name, real=True)
-        assignments.append((new, rate))
-        d[symbol] = new
-    outputs = list(program.outputs)
-    for name in names:
-        outputs.append((prefix + name, program.output(name).applyfunc(derivative)))
-    return Program(tuple(assignments), tuple(outputs))
-
-
-def _time_derivative(expr: sp.Expr, d: Mapping[sp.Symbol, sp.Expr], memo: dict) -> sp.Expr:
-    """``d/dt expr`` by one pass over the expression tree (product and chain rules), symbols
-    changing at the rates ``d``: linear in the size of ``expr``, where ``sp.diff`` by each
-    symbol in turn would be quadratic."""
-    if expr in memo:
-        return memo[expr]
-    if expr.is_Symbol:
-        out = d.get(expr, sp.Integer(0))
-    elif expr.is_Number or not (expr.free_symbols & d.keys()):
-        out = sp.Integer(0)
-    elif expr.is_Add:
-        out = sp.Add(*[_time_derivative(a, d, memo) for a in expr.args])
-    elif expr.is_Mul:
-        args = expr.args
-        terms = []
-        for k, a in enumerate(args):
-            da = _time_derivative(a, d, memo)
-            if da != 0:
-                terms.append(sp.Mul(*args[:k], da, *args[k + 1:]))
-        out = sp.Add(*terms)
-    elif expr.is_Pow and expr.exp.is_Number:
-        base, e = expr.args
-        out = e * base ** (e - 1) * _time_derivative(base, d, memo)
-    elif isinstance(expr, sp.sin):
-        out = sp.cos(expr.args[0]) * _time_derivative(expr.args[0], d, memo)
-    elif isinstance(expr, sp.cos):
-        out = -sp.sin(expr.args[0]) * _time_derivative(expr.args[0], d, memo)
-    else:  # anything else: by the symbols it depends on
-        out = sp.Add(*[sp.diff(expr, s) * d[s] for s in expr.free_symbols if s in d])
-    memo[expr] = out
-    return out
-
-
-# ----------------------------------------------------------------------------------------------
-# Numeric
-# ----------------------------------------------------------------------------------------------
-
-@dataclass(frozen=True, eq=False)
-class ActuatedModel:
-    """A model with actuators, every parameter a number: what the numeric functions read.
-
-    Arrays are (n,) float64 in ``joint_names`` order; ``flexible`` and ``rigid`` are index
-    arrays. ``stiffness`` is NaN for rigid joints.
-    """
-
-    joint_names: tuple[str, ...]
-    flexible: np.ndarray
-    rigid: np.ndarray
-    armature: np.ndarray
-    damping: np.ndarray
-    friction: np.ndarray
-    friction_width: np.ndarray
-    stiffness: np.ndarray
-    _program: Callable[..., dict]
-    _taylor_source: Program
-    _inputs: tuple[sp.Symbol, ...]
-    _parameter_values: tuple[float, ...]
-
-    @property
-    def n(self) -> int:
-        return len(self.joint_names)
-
-    @property
-    def m(self) -> int:
-        return len(self.flexible)
-
-    def rigid_terms(self, q, qd) -> tuple[np.ndarray, np.ndarray, float]:
-        """``M(q)`` (n×n), ``C(q, q̇) q̇ + g(q)`` (n,) and ``P(q)`` [J] of the links alone."""
-        out = self._program(*np.concatenate([q, qd]), *self._parameter_values)
-        return out["M"], (out["C"] @ np.asarray(qd) + out["g"][:, 0]), float(out["P"][0, 0])
-
-    @cached_property
-    def _taylor(self) -> Callable[..., dict]:
-        return compile_program(self._taylor_source, self._inputs)
-
-    def link_torque_derivatives(self, q, qd, qdd, qddd, qdddd):
-        """``τ_L = M q̈ + C q̇ + g`` and its first and second time derivatives along the
-        trajectory (n,) each, from the forward-mode differentiated program."""
-        out = self._taylor(*np.concatenate([q, qd, qdd, qddd, qdddd]), *self._parameter_values)
-        return out["tauL"][:, 0], out["d_tauL"][:, 0], out["dd_d_tauL"][:, 0]
-
-
-def _number(x, values: Mapping[sp.Symbol, float], what: str, source: str) -> float:
-    x = scalar(x).xreplace(values) if isinstance(x, sp.Basic) else x
-    try:
-        return float(x)
-    except TypeError:
-        raise ParameterError(source, what, f"no numeric value for {x}") from None
-
-
-def actuated_model(dynamics: Dynamics, values: Mapping[str | sp.Symbol, float] | None = None
-                   ) -> ActuatedModel:
-    """Compile ``dynamics`` (``M``, ``C``, ``g``, ``P``) with its model's actuators for
-    numeric use; parameters take ``values`` (by name or symbol) over their defaults.
-
-    Raises
-    ------
-    ParameterError
-        A parameter without a value.
-    """
-    model = dynamics.model
-    given = {(parameter_key.name if isinstance(parameter_key, sp.Symbol) else parameter_key): v
-             for parameter_key, v in (values or {}).items()}
-    params = [p.symbol for p in model.parameters]
-    numbers = {}
-    for p in model.parameters:
-        value = given.get(p.name, p.value)
-        if value is None:
-            raise ParameterError(model.source, f"parameter '{p.name}'", "no numeric value")
-        numbers[p.symbol] = float(value)
-    actuators = joint_actuators(model)
-
-    def column(name):
-        return np.array([np.nan if getattr(a, name) is None else
-                         _number(getattr(a, name), numbers, f"joint '{j}' actuator {name}",
-                                 model.source)
-                         for a, j in zip(actuators, model.joint_names)], dtype=float)
-
-    program = dynamics.program
-    missing = {"M", "C", "g", "P"} - set(dynamics.outputs)
-    if missing:
-        raise ValueError(f"dynamics lacks {sorted(missing)}: derive with outputs M, C, g")
-    q, qd, qdd = dynamics.q, dynamics.qd, dynamics.qdd
-    n = len(q)
-    qddd, qdddd = _symbols("qddd", range(n)), _symbols("qdddd", range(n))
-    tau_L = (program.output("M") * sp.Matrix(qdd) + program.output("C") * sp.Matrix(qd)
-             + program.output("g"))
-    base = Program(program.assignments, (("tauL", tau_L),)).pruned(["tauL"])
-    rates = dict(zip(q, qd)) | dict(zip(qd, qdd)) | dict(zip(qdd, qddd)) \
-        | dict(zip(qddd, qdddd))
-    once = time_derivative_program(base, rates, ["tauL"], "d_")
-    defined = {s.name: s for s, _ in once.assignments}
-    known = {s: defined["d_" + s.name] for s, _ in base.assignments if "d_" + s.name in defined}
-    twice = time_derivative_program(once, rates | known, ["d_tauL"], "dd_")
-    flexible = np.array(flexible_indices(model), dtype=int)
-    return ActuatedModel(
-        model.joint_names, flexible,
-        np.array([k for k in range(n) if k not in set(flexible.tolist())], dtype=int),
-        column("armature"), column("damping"), column("friction"), column("friction_width"),
-        column("stiffness"),
-        compile_program(program.pruned(["M", "C", "g", "P"]), tuple(q) + tuple(qd)
-                        + tuple(params)),
-        twice.pruned(["tauL", "d_tauL", "dd_d_tauL"]),
-        tuple(q) + tuple(qd) + tuple(qdd) + qddd + qdddd + tuple(params),
-        tuple(numbers[s] for s in params))
-
-
-def rigid_M(am: ActuatedModel, q) -> np.ndarray:
-    """``M(q) + diag(a)`` (n×n), every joint's armature added (the rigid model)."""
-    M, _, _ = am.rigid_terms(np.asarray(q, float), np.zeros(am.n))
-    return M + np.diag(am.armature)
-
-
-def friction_torque(am: ActuatedModel, qd, smooth: bool = False, joints=None) -> np.ndarray:
-    """``d q̇ + f sign(q̇)`` (``smooth``: ``f tanh(q̇/w)``) for the joints ``joints`` (indices,
-    default all; ``qd`` of matching length)."""
-    k = np.arange(am.n) if joints is None else np.asarray(joints, int)
-    qd = np.asarray(qd, float)
-    coulomb = np.tanh(qd / am.friction_width[k]) if smooth else np.sign(qd)
-    return am.damping[k] * qd + am.friction[k] * coulomb
-
-
-def rigid_inverse_dynamics(am: ActuatedModel, q, qd, qdd, smooth: bool = False) -> np.ndarray:
-    """``(M + diag(a)) q̈ + C q̇ + g + τ_f(q̇)`` (n,), every joint rigid."""
-    M, h, _ = am.rigid_terms(np.asarray(q, float), np.asarray(qd, float))
-    return (M + np.diag(am.armature)) @ qdd + h + friction_torque(am, qd, smooth)
-
-
-def rigid_forward_dynamics(am: ActuatedModel, q, qd, tau, smooth: bool = True) -> np.ndarray:
-    """``q̈`` (n,) of the rigid model with actuators under joint torques ``tau``."""
-    M, h, _ = am.rigid_terms(np.asarray(q, float), np.asarray(qd, float))
-    rhs = np.asarray(tau, float) - h - friction_torque(am, qd, smooth)
-    return np.linalg.solve(M + np.diag(am.armature), rhs)
-
-
-def _split(am: ActuatedModel, x):
-    x = np.asarray(x, float)
-    n, m = am.n, am.m
-    if x.shape != (2 * n + 2 * m,):
-        raise ValueError(f"the state must have shape ({2 * n + 2 * m},): q, qd ({n} each), "
-                         f"theta, thetad ({m} each); got {x.shape}")
-    return x[:n], x[n:2 * n], x[2 * n:2 * n + m], x[2 * n + m:]
-
-
-def flexible_forward_dynamics(am: ActuatedModel, x, tau, smooth: bool = True) -> np.ndarray:
-    """``ẋ`` of the reduced Spong model, ``x = (q, q̇, θ, θ̇)`` (2n + 2m,), inputs ``tau`` (n,):
-    joint torques of rigid joints, motor torques of flexible ones."""
-    q, qd, th, thd = _split(am, x)
-    tau = np.asarray(tau, float)
-    F, R = am.flexible, am.rigid
-    M, h, _ = am.rigid_terms(q, qd)
-    a_rigid = np.zeros(am.n)
-    a_rigid[R] = am.armature[R]
-    spring = am.stiffness[F] * (th - q[F])
-    u = np.zeros(am.n)
-    u[R] = tau[R] - friction_torque(am, qd[R], smooth, R)
-    u[F] = spring
-    qdd = np.linalg.solve(M + np.diag(a_rigid), u - h)
-    thdd = (tau[F] - spring - friction_torque(am, thd, smooth, F)) / am.armature[F]
-    return np.concatenate([qd, qdd, thd, thdd])
-
-
-def flexible_energy(am: ActuatedModel, x) -> float:
-    """Total energy [J] of the reduced Spong model: link and motor kinetic energy, gravity
-    and spring potential. Conserved without friction and input."""
-    q, qd, th, thd = _split(am, x)
-    F, R = am.flexible, am.rigid
-    M, _, P = am.rigid_terms(q, qd)
-    a_rigid = np.zeros(am.n)
-    a_rigid[R] = am.armature[R]
-    e = th - q[F]
-    return float(0.5 * qd @ (M + np.diag(a_rigid)) @ qd + 0.5 * am.armature[F] @ thd ** 2
-                 + P + 0.5 * am.stiffness[F] @ e ** 2)
-
-
-def flexible_inverse_dynamics(am: ActuatedModel, q, qd, qdd, qddd, qdddd,
-                              smooth: bool = False) -> dict[str, np.ndarray]:
-    """The motor states and inputs that make the links of the reduced Spong model follow a
-    trajectory, from ``q`` and its derivatives up to order 4 (flatness; no numeric
-    differentiation: see the module docstring).
-
-    Returns
-    -------
-    dict
-        ``theta``, ``thetad``, ``thetadd`` (m,) and ``tau`` (n,): motor torques for flexible
-        joints, joint torques for rigid ones.
-    """
-    q, qd, qdd = (np.asarray(v, float) for v in (q, qd, qdd))
-    F, R = am.flexible, am.rigid
-    t0, t1, t2 = am.link_torque_derivatives(q, qd, qdd, np.asarray(qddd, float),
-                                            np.asarray(qdddd, float))
-    K = am.stiffness[F]
-    theta = q[F] + t0[F] / K
-    thetad = qd[F] + t1[F] / K
-    thetadd = qdd[F] + t2[F] / K
-    tau = np.empty(am.n)
-    tau[F] = am.armature[F] * thetadd + t0[F] + friction_torque(am, thetad, smooth, F)
-    tau[R] = t0[R] + am.armature[R] * qdd[R] + friction_torque(am, qd[R], smooth, R)
-    return {"theta": theta, "thetad": thetad, "thetadd": thetadd, "tau": tau}
-
-
-def flexible_rest_state(am: ActuatedModel, q) -> np.ndarray:
-    """The state ``x`` at rest at link angles ``q``: springs wound up to hold gravity,
-    ``θ = q_F + K⁻¹ g_F(q)`` (the inputs that hold it: ``tau = g(q)``)."""
-    q = np.asarray(q, float)
-    F = am.flexible
-    _, g, _ = am.rigid_terms(q, np.zeros(am.n))
-    return np.concatenate([q, np.zeros(am.n), q[F] + g[F] / am.stiffness[F], np.zeros(am.m)])

@@ -28,6 +28,7 @@ import sympy as sp
 
 from .dynamics import Dynamics
 from .errors import ParameterError
+from .model import all_scalars
 from .numeric import numeric_model, rnea
 from .symbolic.evaluate import compile_program
 
@@ -73,9 +74,7 @@ def _rel(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
 def _is_exact(model) -> bool:
     """Exact symbolic checks need exact numbers: a float rotation is orthogonal only to rounding,
     and the identities fail by that rounding."""
-    from .model import _all_scalars
-
-    return not any(v.atoms(sp.Float) for v in _all_scalars(model))
+    return not any(v.atoms(sp.Float) for v in all_scalars(model))
 
 
 def _exact(dynamics: Dynamics, name: str) -> sp.Matrix:

@@ -12,7 +12,8 @@ module                 what
                        error
 ``conditioning``       the Cholesky solve with a condition estimate, and
                        :class:`~eomgen.analysis.conditioning.IllConditionedWarning`
-``pinocchio_bridge``   a ``pinocchio.Model`` built from a :class:`~eomgen.model.RobotModel`
+``pinocchio_bridge``   deprecated path of :mod:`eomgen.numeric.pinocchio` (a ``pinocchio.Model``
+                       built from a :class:`~eomgen.model.RobotModel`)
 ``report``             Markdown/CSV tables and the speed-against-error plots
 ``commands``           the ``eomgen bench`` and ``eomgen simulate`` commands
 =====================  =====================================================================

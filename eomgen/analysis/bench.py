@@ -29,12 +29,13 @@ import statistics
 import tempfile
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Callable, Protocol
 
 import numpy as np
 
+from ..compiler import c_compiler
 from ..model import RobotModel
 from ..progress import plural
 from .precision import Reference, relative_error
@@ -263,8 +264,6 @@ class BenchPlan:
 
 
 def _with_pareto(m: Measurement, pareto: bool) -> Measurement:
-    from dataclasses import replace
-
     return replace(m, pareto=pareto)
 
 
@@ -283,8 +282,6 @@ def prepare_bench(model: RobotModel, samples: int = 50, seed: int = 0, batch_siz
         workdir.cleanup()
         raise
     skipped = []
-    from ..compiler import c_compiler
-
     if c_compiler() is None:
         skipped.append("C (CasADi): no C compiler found")
     if not any(r.name == "Pinocchio" for r in routes):

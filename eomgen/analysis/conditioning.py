@@ -2,7 +2,7 @@
 
 The code is :mod:`eomgen.runtime.cholesky`, which the generated NumPy modules include
 verbatim for their ``forward_dynamics`` (they import nothing from eomgen): one copy of these
-rules.
+rules. This module re-exports its public names for eomgen's analyses.
 
 * ``M = L Lᵀ`` by Cholesky; when that fails, M is not (numerically) positive definite and a
   :class:`numpy.linalg.LinAlgError` names the state: a joint that moves no mass, or inertias
@@ -26,13 +26,9 @@ rules.
 
 from __future__ import annotations
 
-from ..runtime.cholesky import IllConditionedWarning
-from ..runtime.cholesky import _CONDITION_LIMIT as CONDITION_LIMIT
-from ..runtime.cholesky import _EXACT_FROM as EXACT_FROM
-from ..runtime.cholesky import _cholesky_solve as cholesky_solve
-from ..runtime.cholesky import _condition_estimate as condition_estimate
-from ..runtime.cholesky import _condition_number as condition_number
-from ..runtime.cholesky import _ill_conditioned_message as ill_conditioned_message
+from ..runtime.cholesky import (CONDITION_LIMIT, EXACT_FROM, IllConditionedWarning,
+                               cholesky_solve, condition_estimate, condition_number,
+                               ill_conditioned_message)
 
 __all__ = ["CONDITION_LIMIT", "EXACT_FROM", "IllConditionedWarning", "cholesky_solve",
            "condition_estimate", "condition_number", "ill_conditioned_message"]

@@ -38,7 +38,7 @@ True
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Callable, Iterable, Sequence
 
 import mpmath
@@ -47,7 +47,7 @@ import sympy as sp
 from sympy.printing.pycode import MpmathPrinter
 
 from ..dynamics import Dynamics, derive
-from ..model import Inertial, RobotModel, Transform
+from ..model import Inertial, RobotModel, Transform, all_scalars
 from ..numeric import NumericModel, Numbers, M_rnea, numeric_model, rnea
 from ..symbolic.printing import program_function
 from ..symbolic.program import Program
@@ -283,8 +283,8 @@ class Reference:
             raise ValueError("the reference needs at least 30 digits")
         self.dps = dps
         self.model = high_precision_model(model)
-        exact = not any(_has_float(x) for x in _scalars(model.with_numeric_parameters()
-                                                          if model.parameters else model))
+        exact = not any(_has_float(x) for x in all_scalars(model.with_numeric_parameters()
+                                                             if model.parameters else model))
         if (dynamics is not None and exact and not model.parameters
                 and {"M", "tau"} <= set(dynamics.outputs)):
             self.dynamics = dynamics
@@ -344,12 +344,6 @@ class Reference:
                     scale = max(max_abs(b), mpmath.mpf(10) ** -300)
                     worst = max(worst, max_abs(a - b) / scale)
         return float(worst)
-
-
-def _scalars(model: RobotModel):
-    from ..model import _all_scalars
-
-    return _all_scalars(model)
 
 
 __all__ = ["DPS", "MODEL_DPS", "Reference", "high_precision_model", "compile_program_mp",

@@ -65,7 +65,7 @@ def pyplot():
     ImportError
         With the install hint, when Matplotlib is missing.
     """
-    try:
+    try:  # optional dependency (the analysis extra): imported when a plot is made
         import matplotlib
     except ImportError as exc:  # pragma: no cover - the analysis extra installs it
         raise ImportError("plots need Matplotlib: pip install 'eomgen[analysis]'") from exc

@@ -26,7 +26,7 @@ C extension, batch         float64  the same on the whole batch (the loop runs i
 RNEA (eomgen.numeric)      float64  :func:`eomgen.numeric.rnea` and ``M_rnea``
 Pinocchio                  float64  plain ``pin.rnea(model, data, q, qd, qdd)`` and
                                     ``pin.crba(model, data, q)`` on the model built by
-                                    :mod:`~eomgen.analysis.pinocchio_bridge` (the joint
+                                    :mod:`~eomgen.numeric.pinocchio` (the joint
                                     reordering only where its order differs from eomgen's)
 =========================  =======  ====================================================
 
@@ -53,6 +53,7 @@ from ..dynamics import Dynamics, derive
 from ..model import RobotModel
 from ..progress import plural
 from ..numeric import M_rnea, numeric_model, rnea
+from ..numeric.pinocchio import plain_calls, to_pinocchio
 from ..outputs import INVERSE, MASS
 from ..codegen.backends.numpy_backend import NumPyModulePrinter
 from ..symbolic.evaluate import FloatPrinter
@@ -236,7 +237,7 @@ def build_routes(model: RobotModel, workdir: Path, dynamics: Dynamics | None = N
                              "casadi.Function (SX virtual machine)")
     library = paths.get(casadi_stem + ".so")
     if library is not None:
-        import casadi as ca
+        import casadi as ca  # optional dependency: only where a CasADi library was built
 
         routes += _casadi_routes("C (CasADi)", ca.external(tau_name, str(library)),
                                  ca.external(M_name, str(library)), n,
@@ -268,8 +269,6 @@ def build_routes(model: RobotModel, workdir: Path, dynamics: Dynamics | None = N
                         _per_state(lambda q: M_rnea(nm, q), (n, n)),
                         "eomgen.numeric.rnea; M by n + 1 RNEA calls"))
     try:
-        from .pinocchio_bridge import to_pinocchio
-
         pm = to_pinocchio(model)
     except ImportError:
         progress("Pinocchio is not installed: no Pinocchio route")
@@ -279,24 +278,12 @@ def build_routes(model: RobotModel, workdir: Path, dynamics: Dynamics | None = N
 
 
 def pinocchio_route(pm, n: int) -> Route:
-    """Pinocchio through its plain public calls, ``pin.rnea(model, data, q, qd, qdd)`` and
-    ``pin.crba(model, data, q)`` (which from Python returns the whole symmetric M), on arrays
-    already in Pinocchio's joint order. When that order is not eomgen's (a tree whose
-    description lists joints out of depth-first order), the reordering a user would need is
-    part of the route and its note says so."""
-    import pinocchio as pin
-
-    model, data = pm.model, pm.data
-    if np.array_equal(pm.perm, np.arange(n)):
-        return Route("Pinocchio", "float64", False,
-                     _per_state(lambda q, qd, qdd: pin.rnea(model, data, q, qd, qdd), (n,)),
-                     _per_state(lambda q: pin.crba(model, data, q), (n, n)),
-                     f"pinocchio {pin.__version__}: plain pin.rnea and pin.crba calls")
-    return Route("Pinocchio", "float64", False, _per_state(pm.rnea, (n,)),
-                 _per_state(pm.crba, (n, n)),
-                 f"pinocchio {pin.__version__}: pin.rnea and pin.crba with the joints "
-                 "reordered to eomgen's order (a conversion a user of this model needs)")
-    return [r for r in routes if r.name not in skip]
+    """Pinocchio as a user would call it (:func:`eomgen.numeric.pinocchio.plain_calls`): the
+    plain public calls on arrays in Pinocchio's joint order, or, when that order is not
+    eomgen's, with the reordering a user would need as part of the route (its note says so)."""
+    rnea_pin, crba_pin, note = plain_calls(pm, n)
+    return Route("Pinocchio", "float64", False, _per_state(rnea_pin, (n,)),
+                 _per_state(crba_pin, (n, n)), note)
 
 
 class CFunction:

@@ -48,6 +48,7 @@ import math
 import time
 import warnings
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Callable, Protocol, Sequence
 
 import numpy as np
@@ -318,7 +319,7 @@ class Adaptive:
         return f"rtol = {self.rtol:g}"
 
     def run(self, system: System, q0, qd0, times: np.ndarray):
-        from scipy.integrate import solve_ivp
+        from scipy.integrate import solve_ivp  # optional dependency (the analysis extra)
 
         n = system.n
 
@@ -560,8 +561,6 @@ def plot(studies: Sequence[Study], path) -> None:
 
 def write_outputs(studies: Sequence[Study], outdir, stem: str = "simulate") -> list:
     """``<stem>.md``, ``<stem>.csv`` and ``<stem>.png`` in ``outdir``; returns their paths."""
-    from pathlib import Path
-
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     png = outdir / f"{stem}.png"

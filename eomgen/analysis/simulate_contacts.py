@@ -4,13 +4,14 @@
 
     M(q) q̈ + C(q, q̇) q̇ + g(q) = τ + J_c(q)ᵀ F_c,      J_c q̈ + J̇_c q̇ = −γ
 
-at zero torque, ``(q̈, F_c)`` from the KKT system of :class:`eomgen.contacts.ContactDynamics`
-(M and h = C q̇ + g from the derived program, :func:`~eomgen.contacts.derived_mass_and_bias`),
-every contact held still where it is at ``q0`` (its **anchor**: position ``p*`` and, for a
-surface contact, orientation ``R*``, from the frame kinematics at ``q0``). The constraint is
-imposed on accelerations only, so the integrator's truncation error lets the contacts drift
-(the classical index reduction problem); Baumgarte's ``γ = kd J_c q̇ + kp e`` feeds the error
-back (``ë + kd ė + kp e = 0``, see :mod:`eomgen.contacts` for ``e``).
+at zero torque, ``(q̈, F_c)`` from the KKT system of
+:class:`eomgen.numeric.contacts.ContactDynamics` (M and h = C q̇ + g from the derived program,
+:func:`~eomgen.numeric.contacts.derived_mass_and_bias`), every contact held still where it is
+at ``q0`` (its **anchor**: position ``p*`` and, for a surface contact, orientation ``R*``, from
+the frame kinematics at ``q0``). The constraint is imposed on accelerations only, so the
+integrator's truncation error lets the contacts drift (the classical index reduction problem);
+Baumgarte's ``γ = kd J_c q̇ + kp e`` feeds the error back (``ë + kd ė + kp e = 0``, see
+:mod:`eomgen.numeric.contacts` for ``e``).
 
 Each integrator runs twice, **without** Baumgarte (``γ = 0``) and **with** it (the scene's gains
 where a contact gives some, else :data:`DEFAULT_GAINS`), and reports, sampled on the output grid:
@@ -35,12 +36,13 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, replace
+from pathlib import Path
 from typing import Callable, Sequence
 
 import numpy as np
 
-from ..contacts import POINT, Contact, ContactDynamics, derived_mass_and_bias, rotation_log
-from ..model import RobotModel
+from ..model import POINT, Contact, RobotModel
+from ..numeric.contacts import ContactDynamics, derived_mass_and_bias, rotation_log
 from ..numeric import kinetic_energy, numeric_model, potential_energy
 from ..progress import plural
 from .report import csv_text, fmt, markdown_table, pyplot
@@ -307,8 +309,6 @@ def plot_drift(study: ContactStudy, path) -> None:
 
 def write_contact_outputs(study: ContactStudy, outdir, stem: str) -> list:
     """``<stem>.md``, ``<stem>.csv`` and ``<stem>.png`` (drift against time) in ``outdir``."""
-    from pathlib import Path
-
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     png = outdir / f"{stem}.png"

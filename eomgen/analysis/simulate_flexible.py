@@ -37,7 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..actuators import flexible_indices, joint_actuators
+from ..model import flexible_indices, joint_actuators
 from ..model import RobotModel
 from .report import pyplot
 from .simulate import Adaptive, System

@@ -76,7 +76,9 @@ def load(path, strict: bool = False, defer_notices: bool = False,
         :class:`~eomgen.errors.UnknownFormatError` and :class:`~eomgen.errors.TooLargeError`
         (files above :data:`MAX_FILE_BYTES`), the others from the format's parser.
     """
-    from . import dh, urdf, yaml_format  # noqa: F401  (registration side effect)
+    # Importing a format registers it; here, so that each parser and its dependencies load on
+    # first use (start-up time), not with eomgen.parsers.
+    from . import dh, urdf, yaml_format  # noqa: F401
 
     path = Path(path)
     if not path.is_file():

@@ -1,9 +1,11 @@
 """Solving ``M(q) q̈ = b`` with a Cholesky factorisation, a condition number and a warning.
 
-The one NumPy copy of these rules: :mod:`eomgen.analysis.conditioning` (and so ``simulate``,
-``verify``, ``lambdify``) imports it under public names, and the NumPy backend includes the text after the
-``# --- included`` marker in every generated module that exports ``forward_dynamics`` (see
-:func:`included_source`):
+The one NumPy copy of these rules. The NumPy backend includes the text between the
+``# --- included`` and ``# --- end of the included text`` markers in every generated module that
+exports ``forward_dynamics`` (see :func:`included_source`), where its names are private to the
+generated module; after the end marker this module gives them their public names
+(:data:`CONDITION_LIMIT`, :func:`cholesky_solve`, ...), which eomgen's own solvers use
+(:mod:`eomgen.analysis.conditioning`, and so ``simulate``, ``verify``, ``lambdify``):
 
 * ``M = L Lᵀ`` by Cholesky; when that fails, M is not (numerically) positive definite and a
   :class:`numpy.linalg.LinAlgError` names the state: a joint that moves no mass, or inertias
@@ -26,12 +28,13 @@ from pathlib import Path
 import numpy as np
 
 _MARKER = "# --- included in the generated NumPy modules from here on ---\n"
+_END_MARKER = "# --- end of the included text: public names for eomgen's own use ---\n"
 
 
 def included_source() -> str:
-    """The text the NumPy backend includes in a generated module (after the marker line)."""
+    """The text the NumPy backend includes in a generated module (between the markers)."""
     text = Path(__file__).read_text(encoding="utf-8")
-    return text[text.index(_MARKER) + len(_MARKER):].strip("\n")
+    return text[text.index(_MARKER) + len(_MARKER):text.index(_END_MARKER)].strip("\n")
 
 
 # --- included in the generated NumPy modules from here on ---
@@ -125,3 +128,18 @@ def _not_positive_definite(M):
         except np.linalg.LinAlgError:
             return k
     return 0
+
+
+# --- end of the included text: public names for eomgen's own use ---
+#: forward_dynamics warns when the condition number of M exceeds this (cond(M) * eps > 1e-6).
+CONDITION_LIMIT = _CONDITION_LIMIT
+#: Above this estimate the exact condition number is computed (eigenvalues of M).
+EXACT_FROM = _EXACT_FROM
+condition_estimate = _condition_estimate
+condition_number = _condition_number
+ill_conditioned_message = _ill_conditioned_message
+cholesky_solve = _cholesky_solve
+
+__all__ = ["CONDITION_LIMIT", "EXACT_FROM", "IllConditionedWarning", "cholesky_solve",
+           "condition_estimate", "condition_number", "ill_conditioned_message",
+           "included_source"]

@@ -16,18 +16,33 @@ generated functions. The equations and conventions are those of :mod:`eomgen.act
   joints, ``S_R`` selecting the rigid joints and ``τ`` one vector: joint torque of a rigid joint,
   motor torque of a flexible one.
 
-Units: N m (N for prismatic joints), kg m², rad, rad/s.
+Units: N m (N for prismatic joints), kg m², rad, rad/s. The friction law itself is
+:func:`friction_torque_expr`, shared with :mod:`eomgen.actuators` and :mod:`eomgen.symbolic.flat`.
 """
 
 from __future__ import annotations
 
 import sympy as sp
 
-from ..actuators import flexible_indices, friction_torque_expr, joint_actuators
+from typing import Sequence
+
 from ..errors import GenerationError
+from ..model import Actuator, flexible_indices, joint_actuators
 
 #: The symbols :func:`build_drives` makes that need flexible joints.
 FLEXIBLE = frozenset({"tau_K", "thetadd_m"})
+
+
+def friction_torque_expr(actuators: Sequence[Actuator], qd: Sequence[sp.Expr],
+                         smooth: bool = False) -> sp.Matrix:
+    """Symbolic friction torques ``τ_f,i = d_i q̇_i + f_i sign(q̇_i)`` (``smooth``: ``tanh(q̇_i /
+    w_i)`` in place of the sign), (len(qd), 1); positive along the joint axis when the joint
+    turns positively, i.e. the torque the drive spends on friction."""
+    out = []
+    for a, v in zip(actuators, qd):
+        coulomb = sp.tanh(v / a.friction_width) if smooth else sp.sign(v)
+        out.append(a.damping * v + (a.friction * coulomb if a.friction != 0 else 0))
+    return sp.Matrix(out)
 
 
 def require_flexible(model, symbols) -> None:

@@ -33,9 +33,10 @@ from typing import Mapping, Sequence
 
 import sympy as sp
 
-from ..actuators import _time_derivative, flexible_indices, friction_torque_expr, joint_actuators
-from .drives import require_flexible
+from ..model import flexible_indices, joint_actuators
+from .drives import friction_torque_expr, require_flexible
 from .program import ProgramBuilder
+from .transforms import time_derivative
 
 #: The symbols :func:`build_flat` makes (all need flexible joints).
 FLAT = frozenset({"theta_flat", "thetad_flat", "tau_flat", "tau_flat_smooth"})
@@ -93,7 +94,7 @@ def define_time_derivatives(builder: ProgramBuilder, exprs: Sequence[sp.Expr],
         unknown = [s for s in expr.free_symbols if s in intermediates and s not in d]
         if unknown:  # would be taken as constant: a wrong derivative, never silently
             raise RuntimeError(f"no time derivative for the intermediates {unknown}")
-        return _time_derivative(expr, d, {}).xreplace(named)
+        return time_derivative(expr, d).xreplace(named)
 
     def remember(defined: sp.Expr, derivative: sp.Expr) -> None:
         """Record ``derivative`` as the rate of what ``define`` returned: a symbol, or a number

@@ -1,4 +1,5 @@
-"""Numeric rigid-body dynamics in NumPy: the independent reference for the symbolic engine.
+"""Numeric rigid-body dynamics in NumPy (Newton–Euler): the independent reference for the symbolic
+engine.
 
 The design follows Pinocchio's Model/Data split. :func:`numeric_model` turns a
 :class:`~eomgen.model.RobotModel` into a :class:`NumericModel` once: every parameter replaced
@@ -48,7 +49,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from .model import JointType, RobotModel, parameter_symbol
+from ..model import JointType, RobotModel, parameter_symbol
 
 #: Joint type codes stored in :attr:`NumericModel.joint_type`.
 FIXED, REVOLUTE, PRISMATIC = 0, 1, 2

@@ -1,0 +1,69 @@
+"""The robot model: plain, frozen data shared by every stage of eomgen.
+
+Conventions (URDF's, whatever the input format):
+
+* Every link has a frame. A joint connects a parent link to a child link; its ``origin`` is the
+  pose of the joint frame in the parent link frame, and the child link frame *is* the joint
+  frame moved by the joint variable: ``T_parent_child(q) = origin · motion(axis, q)``.
+* ``axis`` is a unit vector in the joint (= child link) frame. A revolute joint rotates by ``q``
+  radians about it (right hand rule); a prismatic joint translates by ``q`` metres along it.
+* A link's inertial data: mass [kg], centre of mass [m] in the link frame, and the 3×3
+  rotational inertia [kg m²] about the centre of mass, expressed in the link frame axes (a
+  URDF ``<inertial><origin rpy>`` is already applied by the parser).
+* ``gravity`` is the gravitational acceleration [m/s²] in the root link frame, e.g.
+  ``(0, 0, -9.81)`` for URDF input.
+* A movable joint may carry an :class:`Actuator` (armature, friction, stiffness): the rigid
+  bodies' ``M``, ``C``, ``g`` do not use it; :mod:`eomgen.actuators` does (docs/actuators.md).
+
+Every geometric and inertial quantity is a SymPy expression: a number (exact integers are kept
+exact so that structural zeros stay zeros) or an expression in the model's parameter symbols.
+``RobotModel.parameters`` lists those symbols with their default numeric values.
+
+The package holds one concept per module, bottom up: :mod:`~eomgen.model.scalars` (numbers,
+3-vectors, 3×3 matrices), :mod:`~eomgen.model.snapping`, :mod:`~eomgen.model.transforms`
+(rotations, rigid transforms), :mod:`~eomgen.model.actuator`, :mod:`~eomgen.model.contact`,
+:mod:`~eomgen.model.parts` (joint types, links, joints, parameters),
+:mod:`~eomgen.model.notices`, :mod:`~eomgen.model.robot` (:class:`RobotModel`) and
+:mod:`~eomgen.model.checks` (validation, :func:`build_model`). Import every name from
+``eomgen.model``.
+"""
+
+from __future__ import annotations
+
+from .actuator import DEFAULT_FRICTION_WIDTH, Actuator
+from .checks import (
+    MAX_JOINTS,
+    build_model,
+    check_actuator,
+    check_axis,
+    check_inertial,
+    check_size,
+    check_tree,
+)
+from .contact import POINT, SURFACE, Contact
+from .notices import Notice, NoticeKind, emit_notices
+from .parts import Inertial, Joint, JointType, Link, Parameter
+from .robot import (
+    RobotModel,
+    all_scalars,
+    flexible_indices,
+    joint_actuators,
+    joint_motion,
+    lock_joints,
+)
+from .scalars import IDENTITY3, ZERO3, Mat3, Scalar, Vec3, mat3, parameter_symbol, scalar, vec3
+from .snapping import SNAP_TOLERANCE, Snap, snap, snap_summary, snapping
+from .transforms import Transform, rotation_about_axis, rotation_from_rpy
+
+#: Deprecated: the old private name of :func:`all_scalars` (eomgen.symbolic.textbook's import).
+_all_scalars = all_scalars
+
+__all__ = [
+    "DEFAULT_FRICTION_WIDTH", "IDENTITY3", "MAX_JOINTS", "POINT", "SNAP_TOLERANCE", "SURFACE",
+    "ZERO3", "Actuator", "Contact", "Inertial", "Joint", "JointType", "Link", "Mat3", "Notice",
+    "NoticeKind", "Parameter", "RobotModel", "Scalar", "Snap", "Transform", "Vec3",
+    "all_scalars", "build_model", "check_actuator", "check_axis", "check_inertial",
+    "check_size", "check_tree", "emit_notices", "flexible_indices", "joint_actuators",
+    "joint_motion", "lock_joints", "mat3", "parameter_symbol", "rotation_about_axis",
+    "rotation_from_rpy", "scalar", "snap", "snap_summary", "snapping", "vec3",
+]

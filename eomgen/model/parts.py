@@ -1,0 +1,83 @@
+"""The parts of a robot: joint types, links with their inertial data, joints, parameters."""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass, field
+
+import sympy as sp
+
+from .actuator import Actuator
+from .scalars import ZERO3, Mat3, Scalar, Vec3, mat3, scalar, vec3
+from .transforms import Transform
+
+class JointType(enum.Enum):
+    """Joint types eomgen models. Floating and planar joints are refused by the parsers; a URDF
+    ``<mimic>`` joint is read as an independent joint (see :mod:`eomgen.parsers.urdf`)."""
+
+    REVOLUTE = "revolute"
+    CONTINUOUS = "continuous"
+    PRISMATIC = "prismatic"
+    FIXED = "fixed"
+
+    @property
+    def is_movable(self) -> bool:
+        return self is not JointType.FIXED
+
+    @property
+    def is_revolute(self) -> bool:
+        return self in (JointType.REVOLUTE, JointType.CONTINUOUS)
+
+
+@dataclass(frozen=True)
+class Inertial:
+    """Mass [kg], centre of mass [m] in the link frame, inertia [kg m²] about the centre of mass
+    in the link frame axes."""
+
+    mass: Scalar
+    com: Vec3 = ZERO3
+    inertia: Mat3 = field(default_factory=lambda: mat3([[0, 0, 0], [0, 0, 0], [0, 0, 0]]))
+
+    def __post_init__(self):  # accept plain numbers from Python callers
+        object.__setattr__(self, "mass", scalar(self.mass))
+        object.__setattr__(self, "com", vec3(self.com))
+        object.__setattr__(self, "inertia", mat3(self.inertia))
+
+
+@dataclass(frozen=True)
+class Link:
+    """A rigid body. ``inertial`` is None for a massless link (valid: frames, sensors)."""
+
+    name: str
+    inertial: Inertial | None = None
+
+
+@dataclass(frozen=True)
+class Joint:
+    """A joint from ``parent`` link to ``child`` link; see the module docstring for frames."""
+
+    name: str
+    type: JointType
+    parent: str
+    child: str
+    origin: Transform = Transform()
+    axis: Vec3 = vec3([0, 0, 1])
+    #: The drive of a movable joint (armature, friction, elasticity); None for none.
+    actuator: "Actuator | None" = None
+
+    def __post_init__(self):  # accept plain numbers from Python callers
+        object.__setattr__(self, "axis", vec3(self.axis))
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A symbol the model keeps symbolic, with the numeric value used where numbers are needed
+    (verification, defaults of generated keyword arguments). ``value`` is None when unknown."""
+
+    symbol: sp.Symbol
+    value: float | None = None
+    description: str = ""
+
+    @property
+    def name(self) -> str:
+        return self.symbol.name

@@ -1,0 +1,221 @@
+"""The robot model (:class:`RobotModel`): links, joints, gravity, parameters, contacts; and the
+queries and operations on a whole model (all its scalars, the joints' actuators, joint motion,
+locking joints)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+from typing import Iterable, Mapping
+
+import sympy as sp
+
+from .. import reprs
+from ..errors import KinematicTreeError, ParameterError
+from .actuator import Actuator
+from .contact import Contact
+from .notices import Notice
+from .parts import Inertial, Joint, JointType, Link, Parameter
+from .scalars import IDENTITY3, ZERO3, Vec3, scalar, vec3
+from .transforms import Transform, rotation_about_axis
+
+@dataclass(frozen=True)
+class RobotModel:
+    """A robot: links, joints (in description order), gravity and parameters.
+
+    The kinematic structure is a tree rooted at ``root``. ``joints`` keeps the order of the
+    description; ``movable_joints`` (and hence the joint vector ``q``) follows it.
+    ``info`` carries format-specific extras for display (e.g. the DH table) and never changes the
+    dynamics. ``notices`` are the parser's findings that warn (or, under ``strict``, refuse):
+    see :class:`Notice`; they take no part in comparing models.
+    """
+
+    name: str
+    links: tuple[Link, ...]
+    joints: tuple[Joint, ...]
+    root: str
+    gravity: Vec3 = vec3([0, 0, -9.81])
+    parameters: tuple[Parameter, ...] = ()
+    source: str = "<memory>"
+    info: tuple[tuple[str, object], ...] = ()
+    notices: tuple[Notice, ...] = field(default=(), compare=False, repr=False)
+    #: The scene's contacts (:class:`~eomgen.model.Contact`, rows of ``J_c`` in this order)
+    #: and the frames it names (``frames:``), carried so that the output builders see them
+    #: (:mod:`eomgen.symbolic.frames`); empty for a model without a scene.
+    contacts: tuple[Contact, ...] = ()
+    frames: tuple[str, ...] = ()
+    #: Pose of the root link's frame in the frame of the description's root link, when a scene
+    #: moved the fixed frame (:func:`eomgen.reduction.apply_scene`); None when they coincide.
+    #: Frame kinematics are given in the description's frame.
+    root_pose: Transform | None = None
+
+    @cached_property
+    def link_by_name(self) -> dict[str, Link]:
+        return {link.name: link for link in self.links}
+
+    @cached_property
+    def parent_joint(self) -> dict[str, Joint]:
+        """The joint whose child is the given link (absent for the root)."""
+        return {joint.child: joint for joint in self.joints}
+
+    @cached_property
+    def movable_joints(self) -> tuple[Joint, ...]:
+        return tuple(j for j in self.joints if j.type.is_movable)
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        return tuple(j.name for j in self.movable_joints)
+
+    @property
+    def dof(self) -> int:
+        return len(self.movable_joints)
+
+    @cached_property
+    def topological_joints(self) -> tuple[Joint, ...]:
+        """Joints in depth-first preorder from the root: every joint comes after the joint of
+        its parent link, each subtree's joints are contiguous, and siblings keep description
+        order."""
+        children: dict[str, list[Joint]] = {}
+        for joint in self.joints:
+            children.setdefault(joint.parent, []).append(joint)
+        order: list[Joint] = []
+        stack = list(reversed(children.get(self.root, [])))
+        while stack:
+            joint = stack.pop()
+            order.append(joint)
+            stack.extend(reversed(children.get(joint.child, [])))
+        return tuple(order)
+
+    def _repr_html_(self) -> str | None:  # rich display in notebooks: registered by eomgen.display
+        return reprs.render("model", self, "text/html")
+
+    @property
+    def parameter_values(self) -> dict[sp.Symbol, float]:
+        """Default numeric value of every parameter that has one."""
+        return {p.symbol: p.value for p in self.parameters if p.value is not None}
+
+    @property
+    def free_symbols(self) -> set[sp.Symbol]:
+        """Every symbol appearing anywhere in the model's numbers."""
+        found: set[sp.Symbol] = set()
+        for value in all_scalars(self):
+            found |= value.free_symbols
+        return found
+
+    def substitute(self, values: Mapping[sp.Symbol, object]) -> "RobotModel":
+        """A copy with the given symbols replaced by numbers or expressions; parameters that
+        became numbers are dropped from ``parameters``."""
+        subs = {k: scalar(v) if not isinstance(v, sp.Basic) else v for k, v in values.items()}
+
+        def s(x):
+            return scalar(x.xreplace(subs)) if isinstance(x, sp.Basic) else x
+
+        def sv(v):
+            return tuple(s(x) for x in v)
+
+        links = tuple(
+            replace(
+                link,
+                inertial=None
+                if link.inertial is None
+                else Inertial(
+                    s(link.inertial.mass),
+                    sv(link.inertial.com),
+                    tuple(sv(r) for r in link.inertial.inertia),
+                ),
+            )
+            for link in self.links
+        )
+        joints = tuple(
+            replace(
+                j,
+                origin=Transform(
+                    tuple(sv(r) for r in j.origin.rotation), sv(j.origin.translation)
+                ),
+                axis=sv(j.axis),
+                actuator=None if j.actuator is None else j.actuator.substitute(subs),
+            )
+            for j in self.joints
+        )
+        params = tuple(p for p in self.parameters if p.symbol not in subs)
+        return replace(self, links=links, joints=joints, gravity=sv(self.gravity),
+                       parameters=params)
+
+    def with_numeric_parameters(self, values: Mapping[sp.Symbol, float] | None = None
+                                ) -> "RobotModel":
+        """A copy with every parameter replaced by a number (``values`` over the defaults).
+
+        Raises
+        ------
+        ParameterError
+            When a parameter has neither a default nor a given value.
+        """
+        merged = dict(self.parameter_values)
+        merged.update(values or {})
+        missing = sorted(s.name for s in self.free_symbols if s not in merged)
+        if missing:
+            raise ParameterError(self.source, "parameters",
+                                   "no numeric value for " + ", ".join(missing))
+        return self.substitute(merged)
+
+
+def all_scalars(model: RobotModel) -> Iterable[sp.Expr]:
+    """Every number of the model (gravity, inertial data, joint geometry, actuators), in a fixed
+    order: the expressions whose symbols are the model's."""
+    yield from model.gravity
+    for link in model.links:
+        if link.inertial is not None:
+            yield link.inertial.mass
+            yield from link.inertial.com
+            for row in link.inertial.inertia:
+                yield from row
+    for joint in model.joints:
+        yield from joint.axis
+        yield from joint.origin.translation
+        for row in joint.origin.rotation:
+            yield from row
+        if joint.actuator is not None:
+            yield from joint.actuator.scalars()
+
+
+def joint_actuators(model: RobotModel) -> tuple[Actuator, ...]:
+    """The actuator of every movable joint, in ``model.joint_names`` order (a joint without
+    one gets ``Actuator()``: no armature, no friction, rigid)."""
+    return tuple(j.actuator or Actuator() for j in model.movable_joints)
+
+
+def flexible_indices(model: RobotModel) -> tuple[int, ...]:
+    """Indices (into ``q``) of the flexible joints (those with a stiffness), in joint order."""
+    return tuple(k for k, a in enumerate(joint_actuators(model)) if a.flexible)
+
+
+def joint_motion(joint: Joint, value) -> Transform:
+    """The transform a joint applies at position ``value`` (rad or m): child frame in joint
+    frame."""
+    value = scalar(value) if not isinstance(value, sp.Basic) else value
+    if joint.type.is_revolute:
+        return Transform(rotation_about_axis(joint.axis, value), ZERO3)
+    if joint.type is JointType.PRISMATIC:
+        return Transform(IDENTITY3, tuple(a * value for a in joint.axis))  # type: ignore[arg-type]
+    return Transform()
+
+
+def lock_joints(model: RobotModel, positions: Mapping[str, object]) -> RobotModel:
+    """A copy of ``model`` with the named movable joints made fixed at the given positions.
+
+    Raises
+    ------
+    KinematicTreeError
+        When a name is not a movable joint of the model.
+    """
+    movable = {j.name for j in model.movable_joints}
+    for name in positions:
+        if name not in movable:
+            raise KinematicTreeError(model.source, f"joint '{name}'",
+                                   "cannot lock: not a movable joint of this model")
+    joints = tuple(
+        replace(j, type=JointType.FIXED, origin=j.origin @ joint_motion(j, positions[j.name]))
+        if j.name in positions else j
+        for j in model.joints
+    )
+    return replace(model, joints=joints)

@@ -1,0 +1,201 @@
+"""Adapters to Pinocchio (optional: ``pip install pin``; importing this module does not import it).
+
+* :func:`to_pinocchio` builds a ``pinocchio.Model`` from a :class:`~eomgen.model.RobotModel`,
+  joint by joint (:class:`PinocchioModel`, in eomgen's joint order), and :func:`plain_calls`
+  gives its dynamics as a user would call them (the benchmark's Pinocchio route).
+* :class:`PinocchioFreeFlyer` reads a URDF with Pinocchio's own free flyer and evaluates it in
+  eomgen's Euler coordinates (:mod:`eomgen.numeric.floating_base`).
+
+Building from the model rather than from URDF text means every input eomgen reads (URDF, DH
+tables, eomgen YAML, scenes, locked joints) gets the same Pinocchio model, and a continuous
+joint stays one coordinate (Pinocchio's URDF reader gives it two: cos and sin).
+
+* Every movable joint becomes ``JointModelRevoluteUnaligned`` / ``JointModelPrismaticUnaligned``
+  about its axis, placed at the composite of the fixed transforms from its last movable
+  ancestor (or the root) to its origin.
+* Every link's inertia is appended to the Pinocchio joint it moves with, at the composite
+  placement; links fixed to the root do not move and are left out.
+* Joints are numbered in depth-first preorder (Pinocchio's CRBA assumes every subtree is a
+  contiguous range); :class:`PinocchioModel` maps coordinates to eomgen's ``JOINT_NAMES`` order.
+* Gravity is the model's, in the root frame; parameters take their values.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model import RobotModel
+from .floating_base import dynamics_from_free_flyer, to_free_flyer
+
+__all__ = ["PinocchioModel", "to_pinocchio", "plain_calls", "PinocchioFreeFlyer"]
+
+
+def _floats(v) -> np.ndarray:
+    return np.array([float(x) for x in v], dtype=float)
+
+
+def _matrix(m) -> np.ndarray:
+    return np.array([[float(x) for x in row] for row in m], dtype=float)
+
+
+@dataclass(frozen=True)
+class PinocchioModel:
+    """A Pinocchio model and data of a robot, in eomgen's joint order.
+
+    Attributes
+    ----------
+    model, data:
+        ``pinocchio.Model`` and ``pinocchio.Data``.
+    perm:
+        (n,) ints: Pinocchio's coordinate k is eomgen's ``perm[k]`` (``q_pin = q[perm]``).
+    """
+
+    model: object
+    data: object
+    perm: np.ndarray
+
+    def rnea(self, q, qd, qdd) -> np.ndarray:
+        """τ (n,) in eomgen's order, by ``pinocchio.rnea``."""
+        import pinocchio as pin  # optional dependency: imported when used
+
+        p = self.perm
+        tau = np.empty(len(p))
+        tau[p] = pin.rnea(self.model, self.data, np.asarray(q, float)[p],
+                          np.asarray(qd, float)[p], np.asarray(qdd, float)[p])
+        return tau
+
+    def crba(self, q) -> np.ndarray:
+        """M (n, n) in eomgen's order, by ``pinocchio.crba`` (upper triangle mirrored)."""
+        import pinocchio as pin  # optional dependency: imported when used
+
+        p = self.perm
+        upper = np.triu(pin.crba(self.model, self.data, np.asarray(q, float)[p]))
+        M_pin = upper + np.triu(upper, 1).T
+        inverse = np.argsort(p)
+        return M_pin[np.ix_(inverse, inverse)]
+
+
+def to_pinocchio(model: RobotModel) -> PinocchioModel:
+    """Build the Pinocchio model of ``model`` (see the module docstring).
+
+    Raises
+    ------
+    ImportError
+        When Pinocchio is not installed.
+    """
+    import pinocchio as pin  # optional dependency: imported when used
+
+    if model.free_symbols:
+        model = model.with_numeric_parameters()
+    pmodel = pin.Model()
+    pmodel.name = model.name
+    anchor = {model.root: (0, pin.SE3.Identity())}  # link -> (joint id, placement in it)
+    for joint in model.topological_joints:  # depth-first preorder
+        parent_id, placement = anchor[joint.parent]
+        T = placement * pin.SE3(_matrix(joint.origin.rotation), _floats(joint.origin.translation))
+        if joint.type.is_movable:
+            axis = _floats(joint.axis)
+            kind = (pin.JointModelRevoluteUnaligned(axis) if joint.type.is_revolute
+                    else pin.JointModelPrismaticUnaligned(axis))
+            jid = pmodel.addJoint(parent_id, kind, T, joint.name)
+            anchor[joint.child] = (jid, pin.SE3.Identity())
+        else:
+            anchor[joint.child] = (parent_id, T)
+    for link in model.links:
+        jid, T = anchor[link.name]
+        if link.inertial is None or jid == 0:
+            continue
+        i = link.inertial
+        inertia = pin.Inertia(float(i.mass), _floats(i.com), _matrix(i.inertia))
+        pmodel.appendBodyToJoint(jid, inertia, T)
+    pmodel.gravity = pin.Motion(_floats(model.gravity), np.zeros(3))
+    ours = {name: k for k, name in enumerate(model.joint_names)}
+    perm = np.empty(pmodel.nv, dtype=int)
+    for jid in range(1, pmodel.njoints):
+        perm[pmodel.joints[jid].idx_q] = ours[pmodel.names[jid]]
+    return PinocchioModel(pmodel, pmodel.createData(), perm)
+
+
+def plain_calls(pm: PinocchioModel, n: int):
+    """``(rnea, crba, note)``: Pinocchio's dynamics as a user would call it on ``pm``, for timing.
+
+    Where Pinocchio's joint order is eomgen's, the plain public calls ``pin.rnea(model, data,
+    q, qd, qdd)`` and ``pin.crba(model, data, q)`` (which from Python returns the whole
+    symmetric M), on arrays already in Pinocchio's order; otherwise :meth:`PinocchioModel.rnea`
+    and :meth:`~PinocchioModel.crba`, the reordering a user of this model would need, and the
+    note says so."""
+    import pinocchio as pin  # optional dependency: imported when used
+
+    model, data = pm.model, pm.data
+    if np.array_equal(pm.perm, np.arange(n)):
+        return (lambda q, qd, qdd: pin.rnea(model, data, q, qd, qdd),
+                lambda q: pin.crba(model, data, q),
+                f"pinocchio {pin.__version__}: plain pin.rnea and pin.crba calls")
+    return (pm.rnea, pm.crba,
+            f"pinocchio {pin.__version__}: pin.rnea and pin.crba with the joints "
+            "reordered to eomgen's order (a conversion a user of this model needs)")
+
+
+class PinocchioFreeFlyer:
+    """Pinocchio's free-flyer model of a URDF (its own reader, ``JointModelFreeFlyer``),
+    evaluated in eomgen's Euler coordinates: for interoperation and as a reference.
+
+    Parameters
+    ----------
+    urdf:
+        The URDF file.
+    joint_names:
+        The floating eomgen model's ``joint_names`` (virtual joints first): the order of
+        eomgen's q.
+    locked:
+        Joints Pinocchio locks at 0 (``buildReducedModel``), as a scene locks them.
+
+    Pinocchio is optional; it is imported when an instance is made.
+
+    Attributes
+    ----------
+    model, data:
+        ``pinocchio.Model`` and ``pinocchio.Data``.
+    idx:
+        (n,) ints: Pinocchio's velocity coordinate k is eomgen's ``idx[k]``.
+    """
+
+    def __init__(self, urdf, joint_names, locked=()):
+        import pinocchio as pin  # optional dependency: imported when an instance is made
+
+        self.pin = pin
+        model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
+        if locked:
+            ids = [model.getJointId(name) for name in locked]
+            model = pin.buildReducedModel(model, ids, pin.neutral(model))
+        self.model, self.data = model, model.createData()
+        names = list(model.names)[2:]  # after 'universe' and the free flyer
+        if sorted(names) != sorted(joint_names[6:]):
+            raise ValueError("Pinocchio's joints are not the model's: "
+                             f"{sorted(set(names) ^ set(joint_names[6:]))}")
+        self.idx = np.array(list(range(6)) + [joint_names.index(n) for n in names])
+
+    def state(self, q, qd):
+        """Pinocchio's ``(q, v)`` (its joint order) of eomgen's Euler state."""
+        q = np.asarray(q, dtype=float)
+        q_ff, v = to_free_flyer(q, qd)
+        q_pin = np.concatenate([q_ff[:7], q[self.idx[6:]]])
+        return q_pin, v[self.idx]
+
+    def dynamics(self, q, qd):
+        """Pinocchio's M, C q̇, g mapped to Euler coordinates (:func:`dynamics_from_free_flyer`),
+        eomgen's order."""
+        pin = self.pin
+        q_pin, v = self.state(q, qd)
+        n = len(q)
+        M = pin.crba(self.model, self.data, q_pin)
+        M = np.triu(M) + np.triu(M, 1).T
+        g = pin.computeGeneralizedGravity(self.model, self.data, q_pin)
+        h = pin.rnea(self.model, self.data, q_pin, v, np.zeros(n)) - g
+        M_o = np.empty((n, n))
+        M_o[np.ix_(self.idx, self.idx)] = M
+        h_o, g_o = np.empty(n), np.empty(n)
+        h_o[self.idx], g_o[self.idx] = h, g
+        return dynamics_from_free_flyer(q, qd, M_o, h_o, g_o)
