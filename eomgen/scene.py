@@ -60,7 +60,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Iterable
 
-from .contacts import POINT, SURFACE, Contact
+from .model import POINT, SURFACE, Contact
 from .errors import DescriptionError, SceneError
 from .model import Inertial, Parameter, Vec3, check_inertial, mat3, vec3
 from .outputs import select
@@ -135,7 +135,7 @@ class Scene:
         The functions wanted (:func:`eomgen.outputs.select` names); None
         for all.
     contacts:
-        Frames held still (:class:`eomgen.contacts.Contact`), in file order.
+        Frames held still (:class:`eomgen.model.Contact`), in file order.
     frames:
         Links whose kinematics the ``frame_*`` outputs give (``FRAME_NAMES``), in file order;
         empty for the default (the contact frames, else the leaf links).

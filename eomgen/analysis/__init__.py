@@ -15,7 +15,7 @@ module                 what
 ``pinocchio_bridge``   deprecated path of :mod:`eomgen.numeric.pinocchio` (a ``pinocchio.Model``
                        built from a :class:`~eomgen.model.RobotModel`)
 ``report``             Markdown/CSV tables and the speed-against-error plots
-``commands``           the ``eomgen bench`` and ``eomgen simulate`` commands
+(commands)             ``eomgen bench`` and ``eomgen simulate`` are in :mod:`eomgen.cli.bench_simulate`
 =====================  =====================================================================
 
 Nothing here is imported by ``import eomgen``; NumPy is the only hard dependency of

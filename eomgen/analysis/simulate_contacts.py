@@ -64,7 +64,7 @@ class ContactSystem:
     model:
         The robot (parameters take their values).
     contacts:
-        :class:`~eomgen.contacts.Contact` s, e.g. a scene report's ``contacts``.
+        :class:`~eomgen.model.Contact` s, e.g. a scene report's ``contacts``.
     q0:
         (n,) the configuration whose contact poses become the anchors.
     baumgarte:

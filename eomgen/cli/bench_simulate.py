@@ -172,7 +172,7 @@ def simulate(description, outdir, duration, dts, rtols, names, q0, qd0, gains, s
     progress = Progress(quiet)
     model, report = load_reduced(description, scene_path, strict)
     contacts = report.contacts if report is not None else ()
-    from ..actuators import flexible_indices  # SymPy: only when the command runs
+    from ..model import flexible_indices  # SymPy: only when the command runs
 
     flexible = bool(flexible_indices(model)) and not contacts
     integrators = integrators_named(chosen, step_list, rtol_list, stiff=flexible)

@@ -3,7 +3,7 @@
 The functions live in :mod:`eomgen.identification.estimation` (data, weighted least squares,
 physically consistent fit, excitation trajectories) and :mod:`eomgen.identification.report`;
 they are importable from here too. Loaded on first use: importing the command line
-(:mod:`eomgen.identification.commands`) must not import NumPy, so that a cached
+(:mod:`eomgen.cli.excite_identify`) must not import NumPy, so that a cached
 ``eomgen generate`` stays light.
 """
 

@@ -91,7 +91,7 @@ class ReductionReport:
     planar: PlanarMotion | None
     notes: tuple[str, ...]
     outputs: tuple[str, ...]
-    #: The scene's contacts (:class:`eomgen.contacts.Contact`); each frame is a link of the
+    #: The scene's contacts (:class:`eomgen.model.Contact`); each frame is a link of the
     #: reduced model (a massless frame fixed to its body when the merge absorbed it).
     contacts: tuple = ()
 

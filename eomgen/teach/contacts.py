@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..contacts import POINT
+from ..model import POINT
 from ..dynamics import Dynamics
 from ..present import notation as nt
 from ..present import readability as rd
