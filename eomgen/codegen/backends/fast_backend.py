@@ -242,22 +242,34 @@ def load_fast(folder: Path, stem: str) -> Loaded:
                   namespace[function](*inputs, **parameters))
 
 
-@register("fast", "C extension module for Python (one state or a batch looped in C), "
-          "compiled when a C compiler is found", config=FastConfig, order=40,
-          printer=FastCPrinter, load=load_fast)
-def generate_fast(job: Job, config: FastConfig = FastConfig()) -> list[GeneratedFile]:
+def emit_fast(job: Job, config: FastConfig = FastConfig()) -> list[GeneratedFile]:
+    """The fast module's C source ``<stem>_fast.c`` (nothing compiled)."""
     module = job.stem + config.suffix
-    source = _render_source(job, config)
-    files = [GeneratedFile(module + ".c", source)]
+    return [GeneratedFile(module + ".c", _render_source(job, config))]
+
+
+def build_fast(job: Job, emitted: list[GeneratedFile], config: FastConfig = FastConfig()
+               ) -> list[GeneratedFile]:
+    """The compiled extension module built from the emitted C source, or nothing (with a
+    RuntimeWarning saying why) when no C compiler or no Python headers are found."""
+    module = job.stem + config.suffix
+    (source,) = [f.content for f in emitted if f.name == module + ".c"]
     built = compile_module(source, module, config)
     if isinstance(built, bytes):
         suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
-        files.append(GeneratedFile(module + suffix, built, golden=False))
-    else:
-        warnings.warn(f"fast backend: {built}; wrote {module}.c only, not the compiled module",
-                      RuntimeWarning, stacklevel=2)
-    return files
+        return [GeneratedFile(module + suffix, built, golden=False)]
+    warnings.warn(f"fast backend: {built}; wrote {module}.c only, not the compiled module",
+                  RuntimeWarning, stacklevel=3)
+    return []
 
 
-__all__ = ["FastCPrinter", "FastConfig", "generate_fast", "compile_module", "c_string_literal",
-           "python_headers"]
+@register("fast", "C extension module for Python (one state or a batch looped in C), "
+          "compiled when a C compiler is found", config=FastConfig, order=40,
+          printer=FastCPrinter, load=load_fast, emit=emit_fast, build=build_fast)
+def generate_fast(job: Job, config: FastConfig = FastConfig()) -> list[GeneratedFile]:
+    emitted = emit_fast(job, config)
+    return emitted + build_fast(job, emitted, config)
+
+
+__all__ = ["FastCPrinter", "FastConfig", "generate_fast", "emit_fast", "build_fast",
+           "compile_module", "c_string_literal", "python_headers"]
