@@ -21,9 +21,8 @@ from typing import Any, Callable, Mapping
 
 from .. import __version__
 from ..output import GeneratedFile  # noqa: F401  (backends import it from here)
-from ..dynamics import Dynamics
+from ..outputs import function_names
 from .functions import (
-    DEFAULT_FUNCTIONS,
     FunctionSpec,
     ParameterArgument,
     function_specs,
@@ -38,13 +37,13 @@ from .functions import (
 class Job:
     """Everything a backend needs, computed once for all backends."""
 
-    dynamics: Dynamics
+    dynamics: "Dynamics"  # eomgen.dynamics.Dynamics, not imported: see .functions
     specs: tuple[FunctionSpec, ...]
     parameters: tuple[ParameterArgument, ...]
     stem: str                 # file-name stem, e.g. "planar_2link"
     source_name: str          # description file name (no directory: output is location-free)
     source_sha256: str        # hash of the description file's bytes
-    functions: tuple[str, ...] = DEFAULT_FUNCTIONS  # exported functions, in module order
+    functions: tuple[str, ...] = function_names(default_only=True)  # exported, in module order
     notes: tuple[str, ...] = ()  # further header lines (e.g. the scene the model comes from)
     constants: tuple[tuple[str, tuple[str, ...]], ...] = ()  # NAME tuples the module exports
 
@@ -64,7 +63,7 @@ class Job:
         ]
 
 
-def make_job(dynamics: Dynamics, functions=None, notes=(), count_operations: bool = True) -> Job:
+def make_job(dynamics: "Dynamics", functions=None, notes=(), count_operations: bool = True) -> Job:
     """Build the specs shared by every backend from dynamics derived with the outputs that
     ``functions`` need (default: all functions, hence M, C, g and tau; see
     :func:`~eomgen.codegen.functions.select_functions`). ``notes`` are extra header lines;

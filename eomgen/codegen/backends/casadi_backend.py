@@ -19,11 +19,10 @@ from pathlib import Path
 import sympy as sp
 from sympy.printing.pycode import PythonCodePrinter
 
-from ...outputs import exported
+from ...outputs import exported, function_names
 from ...compiler import c_compiler
 from .. import GeneratedFile, Job, Loaded, register
 from ...symbolic.printing import FloatLiteralMixin, exec_source
-from ..functions import DEFAULT_FUNCTIONS
 from ..render import render
 from .common import python_module_context
 
@@ -102,7 +101,7 @@ def load_module_source(source: str, name: str) -> dict:
     return exec_source(source, f"<{name}>", {"__name__": name})
 
 
-FUNCTION_NAMES = DEFAULT_FUNCTIONS  # what a module exports unless a job asks for others
+FUNCTION_NAMES = function_names(default_only=True)  # exported unless a job asks for others
 
 
 class NoCompilerWarning(UserWarning):
