@@ -21,6 +21,7 @@ import sysconfig
 import tempfile
 import warnings
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 
 import sympy as sp
@@ -32,8 +33,28 @@ from .. import GeneratedFile, Job, Loaded, register
 from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, composition_names,
                        constrained_names, exported)
 from ...symbolic.printing import FloatLiteralMixin
-from ..render import render
+from ..render import TEMPLATES_DIR, render
 from .common import import_file
+
+#: The fixed C runtime every generated module includes parts of: real C files (compiled and
+#: warning-checked on their own by tests/test_fast_runtime_c.py), by the name the template
+#: gives their text (``runtime.cholesky`` ...).
+RUNTIME_DIR = TEMPLATES_DIR / "fast" / "runtime"
+RUNTIME_FILES = ("cholesky", "call", "split_columns")
+#: The line of a runtime file below which its text goes into the generated module (above it:
+#: the file's own comment and the #includes that let it compile alone).
+RUNTIME_MARKER = "/* eomgen: the generated module holds the text below this line. */\n"
+
+
+@lru_cache(maxsize=None)
+def runtime_source(name: str) -> str:
+    """The text of runtime file ``templates/fast/runtime/<name>.c`` that a generated module
+    includes: what follows its marker line, without the final newline."""
+    text = (RUNTIME_DIR / f"{name}.c").read_text(encoding="utf-8")
+    head, marker, body = text.partition(RUNTIME_MARKER)
+    if not marker:
+        raise ValueError(f"{RUNTIME_DIR / name}.c lacks the line {RUNTIME_MARKER.strip()}")
+    return body.rstrip("\n")
 
 
 #: parenthesize(x, _BARE) leaves only atoms (symbols, numbers) without parentheses
@@ -192,6 +213,7 @@ def _render_source(job: Job, config: FastConfig) -> str:
         cfd=cfd,
         nc=nc,
         constrained_doc=constrained_doc,
+        runtime={name: runtime_source(name) for name in RUNTIME_FILES},
     )
 
 
