@@ -117,3 +117,31 @@ int main(void)
     assert [float(v) for v in values[1:9]] == [2.0, 1.0, 3.0, -1.0, 2.0, 4.0, 4.0, 2.0]
     for got, expected in zip(values[9:12], (1.0, 2.0, 3.0)):
         assert abs(float(got) - expected) < 1e-14, values
+
+
+def test_generated_modules_hold_the_runtime_text_and_build_false_compiles_nothing():
+    """A module with forward dynamics holds the Cholesky and call runtimes, one with contacts
+    the KKT runtime too, each as in its file; render_files(..., build=False) emits the C source
+    without compiling it (no binary among the files, the same source as a building render)."""
+    import eomgen
+    from eomgen.codegen.functions import select_functions
+    from eomgen.codegen.generate import render_files
+    from eomgen.reduction import apply_scene
+    from eomgen.scene import load_scene
+
+    arm = eomgen.load(eomgen.example_path("planar_2link"))
+    wall = apply_scene(arm, load_scene(Path(__file__).resolve().parents[1]
+                                       / "examples/contacts/planar_2link_wall.yaml")).model
+    for model, functions, expected in (
+            (arm, None, ("cholesky", "call")),
+            (wall, ["constrained_forward_dynamics"], ("cholesky", "kkt", "call"))):
+        chosen = None if functions is None else select_functions(functions)
+        files = render_files(model, ["fast"], functions=chosen, build=False)
+        assert [f.name for f in files] == [f"{model.name}_fast.c"]
+        assert all(isinstance(f.content, str) and f.golden for f in files)
+        source = files[0].content
+        for name in RUNTIME_FILES:
+            assert (runtime_source(name) in source) == (name in expected), (model.name, name)
+        if functions is None:  # the building render writes the same text (and maybe a binary)
+            built = render_files(model, ["fast"], build=True)
+            assert built[0].name == files[0].name and built[0].content == source
