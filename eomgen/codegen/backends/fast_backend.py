@@ -34,7 +34,7 @@ from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, composition_n
                        constrained_names, exported)
 from ...symbolic.printing import FloatLiteralMixin
 from ..render import TEMPLATES_DIR, render
-from .common import import_file
+from .common import import_file, positional, warning_exports
 
 #: The fixed C runtime every generated module includes parts of: real C files (compiled and
 #: warning-checked on their own by tests/test_fast_runtime_c.py), by the name the template
@@ -204,8 +204,7 @@ def _render_source(job: Job, config: FastConfig) -> str:
         constants=[(name, [c_string_literal(v) for v in values])
                    for name, values in job.constants],
         exports=[name for name, _ in job.constants] + list(exported(job.functions, "fast"))
-        + (["IllConditionedWarning"]
-                                       if FORWARD.function in job.functions else []),
+        + warning_exports(job),
         forward_doc=forward_doc,
         forward_dynamics=FORWARD.function in job.functions,
         fd=composition_names(FORWARD),
@@ -259,9 +258,7 @@ def load_fast(folder: Path, stem: str) -> Loaded:
     path = folder / (stem + FastConfig.suffix + suffix)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: the fast module was not compiled (no C compiler?)")
-    namespace = import_file(path, stem + FastConfig.suffix)
-    return Loaded(namespace, lambda function, *inputs, **parameters:
-                  namespace[function](*inputs, **parameters))
+    return positional(import_file(path, stem + FastConfig.suffix))
 
 
 def emit_fast(job: Job, config: FastConfig = FastConfig()) -> list[GeneratedFile]:
