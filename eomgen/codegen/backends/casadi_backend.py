@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import os
 import re
-import subprocess
 import tempfile
 import warnings
 from dataclasses import dataclass
@@ -20,7 +19,7 @@ import sympy as sp
 from sympy.printing.pycode import PythonCodePrinter
 
 from ...outputs import exported, function_names
-from ...compiler import c_compiler
+from ...compiler import c_compiler, shared_library
 from .. import GeneratedFile, Job, Loaded, register
 from ...symbolic.printing import FloatLiteralMixin, exec_source
 from ..render import render
@@ -153,16 +152,9 @@ def build_c(job: Job, emitted: list[GeneratedFile], config: CasADiConfig = CasAD
         warnings.warn(f"no C compiler found ($CC, cc, gcc, clang): wrote {stem}.c/.h "
                       "without the .so", NoCompilerWarning, stacklevel=3)
         return []
-    with tempfile.TemporaryDirectory() as tmp:
-        c_path = Path(tmp, stem + ".c")
-        c_path.write_text(source)
-        library = Path(tmp, stem + ".so")
-        result = subprocess.run(
-            [compiler, "-O3", "-fPIC", "-shared", "-o", str(library), str(c_path), "-lm"],
-            capture_output=True, text=True)
-        if result.returncode != 0:
-            raise RuntimeError(f"compiling {stem}.c failed: {result.stderr.strip()[:500]}")
-        return [GeneratedFile(stem + ".so", library.read_bytes(), golden=False)]
+    return [GeneratedFile(stem + ".so", shared_library(compiler, source, stem,
+                                                       ("-O3", "-fPIC", "-shared"),
+                                                       message_limit=500), golden=False)]
 
 
 @register("c", "C source through CasADi's code generator, and a shared library when a C compiler is found",

@@ -16,9 +16,7 @@ small integer powers written as products. Template: ``templates/fast/module.c.ji
 
 from __future__ import annotations
 
-import subprocess
 import sysconfig
-import tempfile
 import warnings
 from dataclasses import dataclass
 from functools import lru_cache
@@ -28,7 +26,7 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.precedence import PRECEDENCE
 
-from ...compiler import c_compiler
+from ...compiler import c_compiler, shared_library
 from .. import GeneratedFile, Job, Loaded, register
 from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, composition_names,
                        constrained_names, exported)
@@ -238,16 +236,8 @@ def compile_module(source: str, module: str, config: FastConfig = FastConfig()
     if headers is None:
         return "Python's C headers (Python.h) are not installed"
     suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
-    with tempfile.TemporaryDirectory() as tmp:
-        c_path = Path(tmp, module + ".c")
-        c_path.write_text(source, encoding="utf-8")
-        library = Path(tmp, module + suffix)
-        command = [compiler, *config.flags, *(f"-I{h}" for h in headers), "-o", str(library),
-                   str(c_path), "-lm"]
-        result = subprocess.run(command, capture_output=True, text=True)
-        if result.returncode != 0:
-            raise RuntimeError(f"compiling {module}.c failed: {result.stderr.strip()[:800]}")
-        return library.read_bytes()
+    return shared_library(compiler, source, module, [*config.flags, *(f"-I{h}" for h in headers)],
+                          suffix)
 
 
 def load_fast(folder: Path, stem: str) -> Loaded:
