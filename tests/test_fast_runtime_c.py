@@ -34,7 +34,7 @@ static const int parameter_has_default[NP + 1] = {1, 0};
 """
 
 #: What each runtime file needs defined before it.
-PRELUDES = {"call": MODULE_CONSTANTS}
+PRELUDES = {"call": MODULE_CONSTANTS, "contact_call": MODULE_CONSTANTS}
 
 #: A static function or variable defined at the start of a line of the runtime's text.
 STATIC = re.compile(r"^static\s+[^;(]*?\**\b(\w+)\s*(?:\(|=|\[)", re.M)
@@ -50,9 +50,16 @@ def _toolchain() -> tuple[str, tuple[str, ...]]:
     return compiler, headers
 
 
+#: A runtime file that another includes to compile alone (kkt.c the Cholesky runtime).
+INCLUDE = re.compile(r'^#include "(\w+)\.c"', re.M)
+
+
 def _unit(name: str) -> str:
-    """The translation unit of runtime file ``name``: prelude, the file, its statics used."""
-    statics = STATIC.findall(runtime_source(name))
+    """The translation unit of runtime file ``name``: prelude, the file, the statics of the
+    file and of the runtime files it includes used."""
+    text = (RUNTIME_DIR / f"{name}.c").read_text(encoding="utf-8")
+    included = INCLUDE.findall(text.partition(RUNTIME_MARKER)[0])
+    statics = [s for part in (name, *included) for s in STATIC.findall(runtime_source(part))]
     assert statics, name
     used = ", ".join(f"(const void *)&{symbol}" for symbol in statics)
     return (PRELUDES.get(name, "") + f'#include "{RUNTIME_DIR / (name + ".c")}"\n'
@@ -134,7 +141,7 @@ def test_generated_modules_hold_the_runtime_text_and_build_false_compiles_nothin
                                        / "examples/contacts/planar_2link_wall.yaml")).model
     for model, functions, expected in (
             (arm, None, ("cholesky", "call")),
-            (wall, ["constrained_forward_dynamics"], ("cholesky", "kkt", "call"))):
+            (wall, ["constrained_forward_dynamics"], ("cholesky", "kkt", "call", "contact_call"))):
         chosen = None if functions is None else select_functions(functions)
         files = render_files(model, ["fast"], functions=chosen, build=False)
         assert [f.name for f in files] == [f"{model.name}_fast.c"]

@@ -38,7 +38,7 @@ from .common import import_file, positional, warning_exports
 #: warning-checked on their own by tests/test_fast_runtime_c.py), by the name the template
 #: gives their text (``runtime.cholesky`` ...).
 RUNTIME_DIR = TEMPLATES_DIR / "fast" / "runtime"
-RUNTIME_FILES = ("cholesky", "kkt", "call", "split_columns")
+RUNTIME_FILES = ("cholesky", "kkt", "call", "split_columns", "contact_call")
 #: The line of a runtime file below which its text goes into the generated module (above it:
 #: the file's own comment and the #includes that let it compile alone).
 RUNTIME_MARKER = "/* eomgen: the generated module holds the text below this line. */\n"
