@@ -1,11 +1,16 @@
 """The C compiler eomgen uses, looked up in one place: by the C backend (CasADi's C code and
 its shared library), the fast backend (the CPython extension) and the derivation cache (whose
-keys name the compiler, since it changes the files)."""
+keys name the compiler, since it changes the files); and the one way the backends' build steps
+run it (:func:`shared_library`)."""
 
 from __future__ import annotations
 
 import os
 import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+from typing import Sequence
 
 #: Tried in this order after ``$CC``.
 CANDIDATES = ("cc", "gcc", "clang")
@@ -28,4 +33,28 @@ def c_compiler_path() -> str | None:
     return shutil.which(compiler) if compiler else None
 
 
-__all__ = ["c_compiler", "c_compiler_path", "CANDIDATES"]
+def shared_library(compiler: str, source: str, name: str, flags: Sequence[str],
+                   suffix: str = ".so", message_limit: int = 800) -> bytes:
+    """The bytes of the shared library ``<name><suffix>`` that ``compiler`` builds from the C
+    ``source`` (written as ``<name>.c`` in a temporary folder): ``compiler *flags -o library
+    <name>.c -lm``. ``flags`` say what to build (``-shared``, ``-fPIC``, include folders).
+
+    Raises
+    ------
+    RuntimeError
+        When the compiler fails: ``compiling <name>.c failed:`` and the first
+        ``message_limit`` characters of what it printed.
+    """
+    with tempfile.TemporaryDirectory() as tmp:
+        c_path = Path(tmp, name + ".c")
+        c_path.write_text(source, encoding="utf-8")
+        library = Path(tmp, name + suffix)
+        result = subprocess.run([compiler, *flags, "-o", str(library), str(c_path), "-lm"],
+                                capture_output=True, text=True)
+        if result.returncode != 0:
+            raise RuntimeError(f"compiling {name}.c failed: "
+                               f"{result.stderr.strip()[:message_limit]}")
+        return library.read_bytes()
+
+
+__all__ = ["c_compiler", "c_compiler_path", "shared_library", "CANDIDATES"]

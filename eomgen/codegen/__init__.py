@@ -4,6 +4,12 @@ A backend is three small things (a printer, a config, a template folder under ``
 registered with :func:`register` in its own module under ``backends/`` (found by name, see
 :mod:`.backends`); :func:`eomgen.codegen.generate.generate` runs the chosen backends on one
 :class:`Job` and writes their files atomically. Adding a backend touches no other module.
+
+Two stages per backend: *emit* renders text files (pure: templates and printers, no compiler)
+and *build* turns emitted sources into binaries (the C backend's shared library, the fast
+backend's extension module); only backends with something to compile register a build step.
+``render_files(..., build=False)`` (and ``render_job``, ``generate``) emits without building,
+for callers that read the text and throw binaries away.
 """
 
 from __future__ import annotations
@@ -15,9 +21,8 @@ from typing import Any, Callable, Mapping
 
 from .. import __version__
 from ..output import GeneratedFile  # noqa: F401  (backends import it from here)
-from ..dynamics import Dynamics
+from ..outputs import function_names
 from .functions import (
-    DEFAULT_FUNCTIONS,
     FunctionSpec,
     ParameterArgument,
     function_specs,
@@ -32,13 +37,13 @@ from .functions import (
 class Job:
     """Everything a backend needs, computed once for all backends."""
 
-    dynamics: Dynamics
+    dynamics: "Dynamics"  # eomgen.dynamics.Dynamics, not imported: see .functions
     specs: tuple[FunctionSpec, ...]
     parameters: tuple[ParameterArgument, ...]
     stem: str                 # file-name stem, e.g. "planar_2link"
     source_name: str          # description file name (no directory: output is location-free)
     source_sha256: str        # hash of the description file's bytes
-    functions: tuple[str, ...] = DEFAULT_FUNCTIONS  # exported functions, in module order
+    functions: tuple[str, ...] = function_names(default_only=True)  # exported, in module order
     notes: tuple[str, ...] = ()  # further header lines (e.g. the scene the model comes from)
     constants: tuple[tuple[str, tuple[str, ...]], ...] = ()  # NAME tuples the module exports
 
@@ -58,7 +63,7 @@ class Job:
         ]
 
 
-def make_job(dynamics: Dynamics, functions=None, notes=(), count_operations: bool = True) -> Job:
+def make_job(dynamics: "Dynamics", functions=None, notes=(), count_operations: bool = True) -> Job:
     """Build the specs shared by every backend from dynamics derived with the outputs that
     ``functions`` need (default: all functions, hence M, C, g and tau; see
     :func:`~eomgen.codegen.functions.select_functions`). ``notes`` are extra header lines;
@@ -89,6 +94,12 @@ class Backend:
     Python, e.g. LaTeX); ``requires`` are the Python packages that needs (optional extras).
     Tests and benchmarks loop over the backends that have ``load`` and whose ``requires`` are
     installed (:func:`loadable_backends`), so a new backend is tested without being listed.
+
+    A backend that compiles has two stages: ``emit(job, config) -> files`` renders the text
+    files (no compiler involved) and ``build(job, emitted, config) -> files`` compiles the
+    binaries from them; its ``generate`` is the two in a row. Both are None for a backend
+    whose ``generate`` only renders text. :meth:`files` runs a backend with or without its
+    build.
     """
 
     name: str
@@ -101,6 +112,16 @@ class Backend:
     printer: type | None = None
     load: Callable[[Path, str], "Loaded"] | None = None
     requires: tuple[str, ...] = ()
+    emit: Callable[..., list[GeneratedFile]] | None = None
+    build: Callable[..., list[GeneratedFile]] | None = None
+
+    def files(self, job: Job, build: bool = True) -> list[GeneratedFile]:
+        """The backend's files for ``job`` (default config): with ``build``, what
+        :attr:`generate` gives; without, only the text files :attr:`emit` renders (nothing
+        compiled). A backend without a build step gives the same files either way."""
+        if build or self.emit is None:
+            return self.generate(job)
+        return self.emit(job)
 
 
 @dataclass(frozen=True)
@@ -122,15 +143,19 @@ BACKENDS: dict[str, Backend] = {}
 
 def register(name: str, description: str, needs: tuple[str, ...] = (), config: type | None = None,
              order: int = 1000, reserved: tuple[str, ...] = (), printer: type | None = None,
-             load: Callable[[Path, str], Loaded] | None = None, requires: tuple[str, ...] = ()):
+             load: Callable[[Path, str], Loaded] | None = None, requires: tuple[str, ...] = (),
+             emit: Callable[..., list[GeneratedFile]] | None = None,
+             build: Callable[..., list[GeneratedFile]] | None = None):
     """Decorator registering ``generate(job, config=...) -> list[GeneratedFile]`` as backend
     ``name``, with its config dataclass ``config``, the identifiers its modules bind
-    (``reserved``), its printer class and how to load what it wrote (``load``, ``requires``:
-    see :class:`Backend`). Backends are listed by ``order``, then name."""
+    (``reserved``), its printer class, how to load what it wrote (``load``, ``requires``) and,
+    for a backend that compiles, its two stages ``emit`` and ``build`` (see
+    :class:`Backend`). Backends are listed by ``order``, then name."""
 
     def decorate(function: Callable[..., list[GeneratedFile]]):
         BACKENDS[name] = Backend(name, description, function, tuple(needs), config, order,
-                                 tuple(reserved), printer, load, tuple(requires))
+                                 tuple(reserved), printer, load, tuple(requires),
+                                 emit=emit, build=build)
         ordered = sorted(BACKENDS.items(), key=lambda item: (item[1].order, item[0]))
         BACKENDS.clear()
         BACKENDS.update(ordered)

@@ -20,9 +20,11 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..dynamics import Dynamics
-from ..outputs import BY_SYMBOL, INPUTS, OUTPUTS, function_names, resolve, select, splits
+from ..outputs import BY_SYMBOL, INPUTS, OUTPUTS, resolve, select, splits
 from ..symbolic.program import Program
+
+# ``dynamics`` arguments are eomgen.dynamics.Dynamics, named in strings only: eomgen.dynamics
+# imports eomgen.lambdify, which prints through this module (no import back up).
 
 
 @dataclass(frozen=True)
@@ -109,7 +111,7 @@ def module_name(robot_name: str) -> str:
     return stem if stem[0].isalpha() else "robot_" + stem
 
 
-def parameter_arguments(dynamics: Dynamics) -> tuple[ParameterArgument, ...]:
+def parameter_arguments(dynamics: "Dynamics") -> tuple[ParameterArgument, ...]:
     """Keyword arguments for the parameters the model keeps symbolic, sorted by name."""
     taken: set[str] = set()
     reserved = reserved_identifiers()
@@ -121,19 +123,10 @@ def parameter_arguments(dynamics: Dynamics) -> tuple[ParameterArgument, ...]:
     return tuple(out)
 
 
-#: Every function a generated module can export, in module order, with the derived outputs
-#: (see :data:`eomgen.dynamics.ALL_OUTPUTS`) it needs. Read from :data:`eomgen.outputs.OUTPUTS`.
+#: Deprecated, read :data:`eomgen.outputs.OUTPUTS` (``{f: o.needs for f, o in OUTPUTS.items()}``):
+#: kept importable for eomgen.lambdify and the tests until they read the registry.
 FUNCTION_OUTPUTS: dict[str, tuple[str, ...]] = {f: o.needs for f, o in OUTPUTS.items()}
-FUNCTION_NAMES: tuple[str, ...] = tuple(FUNCTION_OUTPUTS)
-#: The functions a module exports when the caller names none (the equations of motion; further
-#: outputs such as the regressor are exported when asked for).
-DEFAULT_FUNCTIONS: tuple[str, ...] = function_names(default_only=True)
-
-#: Functions a function is composed from, and so generated with it.
-FUNCTION_REQUIRES: dict[str, tuple[str, ...]] = {
-    f: o.composed_from for f, o in OUTPUTS.items() if o.composed}
-
-#: Short names accepted for functions: the symbol of what they return.
+#: Deprecated, read :data:`eomgen.outputs.BY_SYMBOL`: short names (symbols) → functions.
 FUNCTION_ALIASES: dict[str, str] = {s: o.function for s, o in BY_SYMBOL.items()}
 
 
@@ -149,8 +142,8 @@ def select_functions(names=None) -> tuple[str, ...]:
 
 
 def derived_outputs(functions=None) -> tuple[str, ...]:
-    """The outputs :func:`eomgen.derive` must build for ``functions`` (default:
-    :data:`DEFAULT_FUNCTIONS`), in registry order.
+    """The outputs :func:`eomgen.derive` must build for ``functions`` (default: those exported
+    by default, :func:`eomgen.outputs.function_names`), in registry order.
 
     >>> derived_outputs(["g"])
     ('g',)
@@ -159,7 +152,7 @@ def derived_outputs(functions=None) -> tuple[str, ...]:
     return tuple(o for o in BY_SYMBOL if o in needed)
 
 
-def function_specs(dynamics: Dynamics, functions=None,
+def function_specs(dynamics: "Dynamics", functions=None,
                    count_operations: bool = True) -> tuple[FunctionSpec, ...]:
     """The specs of the printed functions among ``functions`` (default: all; see
     :func:`select_functions`), from dynamics derived with the outputs they need.
@@ -193,7 +186,7 @@ def function_specs(dynamics: Dynamics, functions=None,
     return tuple(specs)
 
 
-def module_constants(dynamics: Dynamics, functions) -> tuple[tuple[str, tuple[str, ...]], ...]:
+def module_constants(dynamics: "Dynamics", functions) -> tuple[tuple[str, tuple[str, ...]], ...]:
     """The name tuples a module exporting ``functions`` exports besides ``JOINT_NAMES`` (e.g.
     ``PARAMETER_NAMES``, the columns of the regressor): ``((NAME, (str, ...)), ...)`` from the
     outputs' :attr:`~eomgen.outputs.Output.constants`, in module order."""

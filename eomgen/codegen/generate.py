@@ -61,13 +61,15 @@ def keep_symbolic(model: RobotModel, names: Iterable[str] | None) -> RobotModel:
 
 
 def render_files(model: RobotModel, backends: Sequence[str], progress: Progress = lambda _: None,
-                 functions: Iterable[str] | None = None, notes: Sequence[str] = ()
-                 ) -> list[GeneratedFile]:
+                 functions: Iterable[str] | None = None, notes: Sequence[str] = (),
+                 build: bool = True) -> list[GeneratedFile]:
     """Derive ``model`` once and run each backend; nothing is written.
 
     ``functions`` (default: all, see :func:`~eomgen.codegen.functions.select_functions`) are the
     functions the modules export; only the outputs they need are derived. ``notes`` are extra
-    header lines of every file.
+    header lines of every file. ``build=False`` renders the text files only: nothing is
+    compiled, so the C backend's ``.so`` and the fast backend's extension module are left out
+    (the other files are the same, byte for byte).
     """
     start = time.perf_counter()
     outputs = derived_outputs(functions)
@@ -79,7 +81,7 @@ def render_files(model: RobotModel, backends: Sequence[str], progress: Progress 
     job = make_job(dynamics, functions, notes)
     progress(f"derived in {time.perf_counter() - start:.2f} s; "
              + ", ".join(f"{s.name} {s.operation_count} ops" for s in job.specs))
-    return render_job(job, backends, progress)
+    return render_job(job, backends, progress, build)
 
 
 def usable_backends(names: Sequence[str], functions: Iterable[str] | None = None
@@ -93,9 +95,10 @@ def usable_backends(names: Sequence[str], functions: Iterable[str] | None = None
     return usable, [n for n in names if n not in usable]
 
 
-def render_job(job, backends: Sequence[str], progress: Progress = lambda _: None
-               ) -> list[GeneratedFile]:
+def render_job(job, backends: Sequence[str], progress: Progress = lambda _: None,
+               build: bool = True) -> list[GeneratedFile]:
     """Run each backend on ``job`` (see :func:`eomgen.codegen.make_job`); nothing is written.
+    ``build=False`` emits the text files without compiling (:meth:`eomgen.codegen.Backend.files`).
 
     Raises
     ------
@@ -114,7 +117,7 @@ def render_job(job, backends: Sequence[str], progress: Progress = lambda _: None
     for name in backends:
         start = time.perf_counter()
         progress(f"{name}: generating")  # the C backend compiles: a stage of its own in a log
-        produced = registry[name].generate(job)
+        produced = registry[name].files(job, build)
         progress(f"{name}: {', '.join(f.name for f in produced)} "
                  f"({time.perf_counter() - start:.2f} s)")
         files.extend(produced)
@@ -128,7 +131,7 @@ def render_job(job, backends: Sequence[str], progress: Progress = lambda _: None
 def generate(model: RobotModel, outdir: Path, backends: str | Sequence[str] = "all",
              symbolic: Iterable[str] | None = None, progress: Progress = lambda _: None,
              functions: Iterable[str] | None = None, cache: bool | CacheRequest = True,
-             cache_dir: Path | None = None) -> list[Path]:
+             cache_dir: Path | None = None, build: bool = True) -> list[Path]:
     """Generate the chosen backends' files for ``model`` into ``outdir``; returns their paths.
 
     Parameters
@@ -154,6 +157,9 @@ def generate(model: RobotModel, outdir: Path, backends: str | Sequence[str] = "a
         ones there (:mod:`eomgen.cache`); ``False`` derives afresh and stores nothing.
     cache_dir:
         The cache folder (default: :func:`eomgen.cache.default_cache_dir`).
+    build:
+        Compile what the backends compile (the C backend's shared library, the fast
+        backend's extension module); ``False`` writes their text files only.
     """
     chosen = select_backends(backends)
     if functions is not None:
@@ -166,6 +172,9 @@ def generate(model: RobotModel, outdir: Path, backends: str | Sequence[str] = "a
             for name in skipped:
                 progress(f"{name}: skipped (needs {', '.join(available_backends()[name].needs)})")
     model = keep_symbolic(model, symbolic)
+    # build=False is passed only when given, so that the cache keys of building calls (the
+    # options are part of the key) are those of earlier versions
+    options = {} if build else {"build": False}
     files = render_cached(render_files, model, chosen, progress, cache=cache,
-                          cache_dir=cache_dir, functions=functions)
+                          cache_dir=cache_dir, functions=functions, **options)
     return write_atomically(files, Path(outdir))

@@ -56,9 +56,10 @@ class SceneGeneration:
 def render_scene_files(model: RobotModel, scene: Scene | None, backends: Sequence[str],
                        symbolic: Iterable[str] | None = None,
                        progress: Progress = lambda _: None, explain: bool = False,
-                       timeout: float = MEASURE_TIMEOUT) -> SceneGeneration:
+                       timeout: float = MEASURE_TIMEOUT, build: bool = True) -> SceneGeneration:
     """Apply ``scene`` to ``model``, derive and render; nothing is written. The files include
-    the report when ``scene`` is given (None applies the empty scene: merging only).
+    the report when ``scene`` is given (None applies the empty scene: merging only);
+    ``build=False`` compiles nothing (see :func:`~.generate.render_files`).
 
     With ``explain``, the whole description and the reduced model are both derived again, each
     in a fresh process (:func:`~eomgen.reduction.measure_derivation`, at most ``timeout``
@@ -81,7 +82,7 @@ def render_scene_files(model: RobotModel, scene: Scene | None, backends: Sequenc
     job = make_job(dynamics, functions, notes)
     progress(f"derived in {after.seconds:.2f} s; "
              + ", ".join(f"{s.name} {s.operation_count} ops" for s in job.specs))
-    files = render_job(job, backends, progress)
+    files = render_job(job, backends, progress, build)
     before = None
     if explain:
         whole = _with_scene_parameters(model, reduced)
@@ -118,7 +119,8 @@ def generate_scene(model: RobotModel, scene: Scene | None, outdir: Path,
                    backends: str | Sequence[str] = "all", symbolic: Iterable[str] | None = None,
                    progress: Progress = lambda _: None, explain: bool = False,
                    timeout: float = MEASURE_TIMEOUT, cache: bool | CacheRequest = False,
-                   cache_dir: Path | None = None) -> tuple[list[Path], SceneGeneration]:
+                   cache_dir: Path | None = None, build: bool = True
+                   ) -> tuple[list[Path], SceneGeneration]:
     """Generate the chosen backends' files for ``model`` reduced by ``scene``, and the scene
     report, into ``outdir`` (all files or none); returns their paths and what was produced.
 
@@ -128,6 +130,7 @@ def generate_scene(model: RobotModel, scene: Scene | None, outdir: Path,
     :class:`~eomgen.cache.CacheRequest` (``eomgen generate --scene`` keys the description and
     scene files before reading them, :func:`eomgen.cache.command_request`) stores the files
     under its key in the derivation cache (folder ``cache_dir``); anything else stores nothing.
+    ``build=False`` writes the text files only (nothing compiled).
     """
     chosen = select_backends(backends)
     outputs = scene.outputs if scene is not None else None
@@ -137,7 +140,8 @@ def generate_scene(model: RobotModel, scene: Scene | None, outdir: Path,
         chosen, skipped = usable_backends(chosen, outputs)
         for name in skipped:
             progress(f"{name}: skipped (needs {', '.join(available_backends()[name].needs)})")
-    produced = render_scene_files(model, scene, chosen, symbolic, progress, explain, timeout)
-    if isinstance(cache, CacheRequest):
+    produced = render_scene_files(model, scene, chosen, symbolic, progress, explain, timeout,
+                                  build)
+    if isinstance(cache, CacheRequest) and build:  # the key says nothing of build=False
         Cache(cache_dir).put(cache.key, produced.files, tuple(cache.notices))
     return write_atomically(produced.files, Path(outdir)), produced

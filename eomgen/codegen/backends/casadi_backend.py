@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import os
 import re
-import subprocess
 import tempfile
 import warnings
 from dataclasses import dataclass
@@ -19,11 +18,10 @@ from pathlib import Path
 import sympy as sp
 from sympy.printing.pycode import PythonCodePrinter
 
-from ...outputs import exported
-from ...compiler import c_compiler
+from ...outputs import exported, function_names
+from ...compiler import c_compiler, shared_library
 from .. import GeneratedFile, Job, Loaded, register
 from ...symbolic.printing import FloatLiteralMixin, exec_source
-from ..functions import DEFAULT_FUNCTIONS
 from ..render import render
 from .common import python_module_context
 
@@ -102,7 +100,7 @@ def load_module_source(source: str, name: str) -> dict:
     return exec_source(source, f"<{name}>", {"__name__": name})
 
 
-FUNCTION_NAMES = DEFAULT_FUNCTIONS  # what a module exports unless a job asks for others
+FUNCTION_NAMES = function_names(default_only=True)  # exported unless a job asks for others
 
 
 class NoCompilerWarning(UserWarning):
@@ -117,9 +115,9 @@ _C_PARAMETER_NOTE = [
 ]
 
 
-@register("c", "C source through CasADi's code generator, and a shared library when a C compiler is found",
-          config=CasADiConfig, order=30)
-def generate_c(job: Job, config: CasADiConfig = CasADiConfig()) -> list[GeneratedFile]:
+def emit_c(job: Job, config: CasADiConfig = CasADiConfig()) -> list[GeneratedFile]:
+    """The C source and header CasADi's code generator writes for the CasADi module's
+    functions, each opening with the eomgen header (nothing compiled)."""
     import casadi as ca
 
     namespace = load_module_source(_render_module(job, config), job.stem + "_casadi")
@@ -135,24 +133,32 @@ def generate_c(job: Job, config: CasADiConfig = CasADiConfig()) -> list[Generate
         generator.generate(tmp + os.sep)
         c_source = Path(tmp, prefix + ".c").read_text()
         h_source = Path(tmp, prefix + ".h").read_text()
-        lines = job.header_lines("CasADi CodeGenerator via casadi/module.py.jinja")
-        if job.parameters:
-            lines += _C_PARAMETER_NOTE
-        header = "".join(f"/* {line.replace('*/', '* /')} */\n" for line in lines)
-        files = [GeneratedFile(stem + ".c", header + c_source),
-                 GeneratedFile(stem + ".h", header + h_source)]
-        compiler = c_compiler()
-        if compiler is not None:
-            c_path = Path(tmp, stem + ".c")
-            c_path.write_text(header + c_source)
-            library = Path(tmp, stem + ".so")
-            result = subprocess.run(
-                [compiler, "-O3", "-fPIC", "-shared", "-o", str(library), str(c_path), "-lm"],
-                capture_output=True, text=True)
-            if result.returncode != 0:
-                raise RuntimeError(f"compiling {stem}.c failed: {result.stderr.strip()[:500]}")
-            files.append(GeneratedFile(stem + ".so", library.read_bytes(), golden=False))
-        else:
-            warnings.warn(f"no C compiler found ($CC, cc, gcc, clang): wrote {stem}.c/.h "
-                          "without the .so", NoCompilerWarning, stacklevel=2)
-    return files
+    lines = job.header_lines("CasADi CodeGenerator via casadi/module.py.jinja")
+    if job.parameters:
+        lines += _C_PARAMETER_NOTE
+    header = "".join(f"/* {line.replace('*/', '* /')} */\n" for line in lines)
+    return [GeneratedFile(stem + ".c", header + c_source),
+            GeneratedFile(stem + ".h", header + h_source)]
+
+
+def build_c(job: Job, emitted: list[GeneratedFile], config: CasADiConfig = CasADiConfig()
+            ) -> list[GeneratedFile]:
+    """The shared library compiled from the emitted C source (``casadi.external`` loads it),
+    or nothing, with a :class:`NoCompilerWarning`, when no C compiler is found."""
+    stem = job.stem + "_casadi"
+    (source,) = [f.content for f in emitted if f.name == stem + ".c"]
+    compiler = c_compiler()
+    if compiler is None:
+        warnings.warn(f"no C compiler found ($CC, cc, gcc, clang): wrote {stem}.c/.h "
+                      "without the .so", NoCompilerWarning, stacklevel=3)
+        return []
+    return [GeneratedFile(stem + ".so", shared_library(compiler, source, stem,
+                                                       ("-O3", "-fPIC", "-shared"),
+                                                       message_limit=500), golden=False)]
+
+
+@register("c", "C source through CasADi's code generator, and a shared library when a C compiler is found",
+          config=CasADiConfig, order=30, emit=emit_c, build=build_c)
+def generate_c(job: Job, config: CasADiConfig = CasADiConfig()) -> list[GeneratedFile]:
+    emitted = emit_c(job, config)
+    return emitted + build_c(job, emitted, config)

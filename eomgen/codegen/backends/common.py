@@ -137,6 +137,12 @@ def dunder_all_lines(names, width: int = 79) -> list[str]:
     return lines
 
 
+def warning_exports(job: Job) -> list[str]:
+    """``["IllConditionedWarning"]`` when the module composes forward dynamics (whose Cholesky
+    solve warns of an ill-conditioned M, in the NumPy, PyTorch and fast modules), else ``[]``."""
+    return ["IllConditionedWarning"] if FORWARD.function in job.functions else []
+
+
 def python_module_context(job: Job, printer, template: str, extra_exports=(),
                           backend: str | None = None) -> dict:
     """What the Python-source templates (NumPy, CasADi) receive: the printed functions and the
@@ -183,6 +189,13 @@ def import_file(path: Path, name: str) -> dict:
     return vars(module)
 
 
+def positional(namespace: dict) -> Loaded:
+    """``namespace`` as a :class:`~eomgen.codegen.Loaded` whose functions take the input
+    vectors positionally and the parameters by keyword (NumPy, JAX, PyTorch, fast)."""
+    return Loaded(namespace, lambda function, *inputs, **parameters:
+                  namespace[function](*inputs, **parameters))
+
+
 def python_loader(suffix: str, before: Callable[[], None] | None = None):
     """A backend's ``load`` for a generated Python module ``<stem><suffix>`` whose functions
     take the input vectors positionally (NumPy, JAX, PyTorch). ``before`` runs first (JAX:
@@ -191,9 +204,7 @@ def python_loader(suffix: str, before: Callable[[], None] | None = None):
     def load(folder: Path, stem: str) -> Loaded:
         if before is not None:
             before()
-        namespace = import_file(folder / (stem + suffix),
-                                f"{stem}{suffix[:-3]}_{abs(hash(str(folder)))}")
-        return Loaded(namespace, lambda function, *inputs, **parameters:
-                      namespace[function](*inputs, **parameters))
+        return positional(import_file(folder / (stem + suffix),
+                                      f"{stem}{suffix[:-3]}_{abs(hash(str(folder)))}"))
 
     return load

@@ -16,24 +16,43 @@ small integer powers written as products. Template: ``templates/fast/module.c.ji
 
 from __future__ import annotations
 
-import subprocess
 import sysconfig
-import tempfile
 import warnings
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.precedence import PRECEDENCE
 
-from ...compiler import c_compiler
+from ...compiler import c_compiler, shared_library
 from .. import GeneratedFile, Job, Loaded, register
 from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, composition_names,
                        constrained_names, exported)
 from ...symbolic.printing import FloatLiteralMixin
-from ..render import render
-from .common import import_file
+from ..render import TEMPLATES_DIR, render
+from .common import import_file, positional, warning_exports
+
+#: The fixed C runtime every generated module includes parts of: real C files (compiled and
+#: warning-checked on their own by tests/test_fast_runtime_c.py), by the name the template
+#: gives their text (``runtime.cholesky`` ...).
+RUNTIME_DIR = TEMPLATES_DIR / "fast" / "runtime"
+RUNTIME_FILES = ("cholesky", "kkt", "call", "split_columns", "contact_call")
+#: The line of a runtime file below which its text goes into the generated module (above it:
+#: the file's own comment and the #includes that let it compile alone).
+RUNTIME_MARKER = "/* eomgen: the generated module holds the text below this line. */\n"
+
+
+@lru_cache(maxsize=None)
+def runtime_source(name: str) -> str:
+    """The text of runtime file ``templates/fast/runtime/<name>.c`` that a generated module
+    includes: what follows its marker line, without the final newline."""
+    text = (RUNTIME_DIR / f"{name}.c").read_text(encoding="utf-8")
+    head, marker, body = text.partition(RUNTIME_MARKER)
+    if not marker:
+        raise ValueError(f"{RUNTIME_DIR / name}.c lacks the line {RUNTIME_MARKER.strip()}")
+    return body.rstrip("\n")
 
 
 #: parenthesize(x, _BARE) leaves only atoms (symbols, numbers) without parentheses
@@ -183,8 +202,7 @@ def _render_source(job: Job, config: FastConfig) -> str:
         constants=[(name, [c_string_literal(v) for v in values])
                    for name, values in job.constants],
         exports=[name for name, _ in job.constants] + list(exported(job.functions, "fast"))
-        + (["IllConditionedWarning"]
-                                       if FORWARD.function in job.functions else []),
+        + warning_exports(job),
         forward_doc=forward_doc,
         forward_dynamics=FORWARD.function in job.functions,
         fd=composition_names(FORWARD),
@@ -192,6 +210,7 @@ def _render_source(job: Job, config: FastConfig) -> str:
         cfd=cfd,
         nc=nc,
         constrained_doc=constrained_doc,
+        runtime={name: runtime_source(name) for name in RUNTIME_FILES},
     )
 
 
@@ -217,16 +236,8 @@ def compile_module(source: str, module: str, config: FastConfig = FastConfig()
     if headers is None:
         return "Python's C headers (Python.h) are not installed"
     suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
-    with tempfile.TemporaryDirectory() as tmp:
-        c_path = Path(tmp, module + ".c")
-        c_path.write_text(source, encoding="utf-8")
-        library = Path(tmp, module + suffix)
-        command = [compiler, *config.flags, *(f"-I{h}" for h in headers), "-o", str(library),
-                   str(c_path), "-lm"]
-        result = subprocess.run(command, capture_output=True, text=True)
-        if result.returncode != 0:
-            raise RuntimeError(f"compiling {module}.c failed: {result.stderr.strip()[:800]}")
-        return library.read_bytes()
+    return shared_library(compiler, source, module, [*config.flags, *(f"-I{h}" for h in headers)],
+                          suffix)
 
 
 def load_fast(folder: Path, stem: str) -> Loaded:
@@ -237,27 +248,37 @@ def load_fast(folder: Path, stem: str) -> Loaded:
     path = folder / (stem + FastConfig.suffix + suffix)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: the fast module was not compiled (no C compiler?)")
-    namespace = import_file(path, stem + FastConfig.suffix)
-    return Loaded(namespace, lambda function, *inputs, **parameters:
-                  namespace[function](*inputs, **parameters))
+    return positional(import_file(path, stem + FastConfig.suffix))
+
+
+def emit_fast(job: Job, config: FastConfig = FastConfig()) -> list[GeneratedFile]:
+    """The fast module's C source ``<stem>_fast.c`` (nothing compiled)."""
+    module = job.stem + config.suffix
+    return [GeneratedFile(module + ".c", _render_source(job, config))]
+
+
+def build_fast(job: Job, emitted: list[GeneratedFile], config: FastConfig = FastConfig()
+               ) -> list[GeneratedFile]:
+    """The compiled extension module built from the emitted C source, or nothing (with a
+    RuntimeWarning saying why) when no C compiler or no Python headers are found."""
+    module = job.stem + config.suffix
+    (source,) = [f.content for f in emitted if f.name == module + ".c"]
+    built = compile_module(source, module, config)
+    if isinstance(built, bytes):
+        suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
+        return [GeneratedFile(module + suffix, built, golden=False)]
+    warnings.warn(f"fast backend: {built}; wrote {module}.c only, not the compiled module",
+                  RuntimeWarning, stacklevel=3)
+    return []
 
 
 @register("fast", "C extension module for Python (one state or a batch looped in C), "
           "compiled when a C compiler is found", config=FastConfig, order=40,
-          printer=FastCPrinter, load=load_fast)
+          printer=FastCPrinter, load=load_fast, emit=emit_fast, build=build_fast)
 def generate_fast(job: Job, config: FastConfig = FastConfig()) -> list[GeneratedFile]:
-    module = job.stem + config.suffix
-    source = _render_source(job, config)
-    files = [GeneratedFile(module + ".c", source)]
-    built = compile_module(source, module, config)
-    if isinstance(built, bytes):
-        suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
-        files.append(GeneratedFile(module + suffix, built, golden=False))
-    else:
-        warnings.warn(f"fast backend: {built}; wrote {module}.c only, not the compiled module",
-                      RuntimeWarning, stacklevel=2)
-    return files
+    emitted = emit_fast(job, config)
+    return emitted + build_fast(job, emitted, config)
 
 
-__all__ = ["FastCPrinter", "FastConfig", "generate_fast", "compile_module", "c_string_literal",
-           "python_headers"]
+__all__ = ["FastCPrinter", "FastConfig", "generate_fast", "emit_fast", "build_fast",
+           "compile_module", "c_string_literal", "python_headers"]

@@ -11,11 +11,10 @@ from dataclasses import dataclass
 from sympy.printing.numpy import NumPyPrinter
 
 from .. import GeneratedFile, Job, register
-from ...outputs import FORWARD
 from ...symbolic.printing import FloatLiteralMixin
 from ..render import render
 from ...runtime.cholesky import included_source
-from .common import python_loader, python_module_context
+from .common import python_loader, python_module_context, warning_exports
 
 
 class NumPyModulePrinter(FloatLiteralMixin, NumPyPrinter):
@@ -58,6 +57,6 @@ def numpy_source(job: Job, printer, config: NumPyConfig = NumPyConfig()) -> str:
     """The NumPy module's text for ``job`` printed with ``printer`` (also what
     :func:`eomgen.lambdify` executes): the template, with the Cholesky runtime
     (:mod:`eomgen.runtime.cholesky`) included where forward dynamics needs it."""
-    extra = ["IllConditionedWarning"] if FORWARD.function in job.functions else []
     return render(config.template, cholesky_runtime=included_source(),
-                  **python_module_context(job, printer, config.template, extra, backend="numpy"))
+                  **python_module_context(job, printer, config.template, warning_exports(job),
+                                          backend="numpy"))

@@ -13,9 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .. import GeneratedFile, Job, register
-from ...outputs import FORWARD
 from ..render import render
-from .common import python_loader, python_module_context
+from .common import python_loader, python_module_context, warning_exports
 from .numpy_backend import ArrayModulePrinter
 
 
@@ -39,6 +38,6 @@ class TorchConfig:
           load=python_loader(TorchConfig.suffix), requires=("torch",))
 def generate_torch(job: Job, config: TorchConfig = TorchConfig()) -> list[GeneratedFile]:
     printer = TorchModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
-    extra = ["IllConditionedWarning"] if FORWARD.function in job.functions else []
-    text = render(config.template, **python_module_context(job, printer, config.template, extra, backend="torch"))
+    text = render(config.template, **python_module_context(job, printer, config.template,
+                                                           warning_exports(job), backend="torch"))
     return [GeneratedFile(job.stem + config.suffix, text)]

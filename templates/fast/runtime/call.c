@@ -1,0 +1,221 @@
+/* Runtime of eomgen's fast backend: the Python interface every generated `_fast.c` shares,
+ * i.e. the table entry of a function (function_t), parsing of a call's arrays, parameters and
+ * keywords (parse), and the loop of a kernel over one state or a batch (evaluate).
+ *
+ * The generated module defines, before this text: NQ (joints), NP (parameters kept symbolic),
+ * MAX_IN (most vector inputs of a function), parameter_names[NP + 1] (NULL-terminated),
+ * parameter_defaults[NP + 1] and parameter_has_default[NP + 1]; and includes Python.h, NumPy's
+ * arrayobject.h, <math.h> and <string.h>, as this file does.
+ *
+ * Real C source, not a template: eomgen copies the text below the marker line into the module
+ * (eomgen.codegen.backends.fast_backend.runtime_source), and tests/test_fast_runtime_c.py
+ * compiles it on its own with -Wall -Wextra -Werror. */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
+#include <numpy/arrayobject.h>
+#include <math.h>
+#include <string.h>
+
+/* eomgen: the generated module holds the text below this line. */
+typedef void (*kernel_t)(const double *const *, const double *, double *);
+
+typedef struct {
+    const char *name;
+    int n_in;
+    const char *inputs[MAX_IN];
+    int rows, cols;  /* cols 0: a vector of rows entries */
+    kernel_t kernel;
+    int sizes[MAX_IN];  /* length of each input (0: NQ) */
+} function_t;
+
+static PyObject *ill_conditioned_warning = NULL;  /* IllConditionedWarning */
+static PyObject *lin_alg_error = NULL;            /* numpy.linalg.LinAlgError */
+
+/* The parsed call: input arrays (float64, C-contiguous), parameters, number of states. */
+typedef struct {
+    PyArrayObject *arrays[MAX_IN];
+    double p[NP + 1];
+    npy_intp states;
+    int single;
+    int return_condition;
+    double damping;
+} call_t;
+
+/* The keywords a composed function takes besides its inputs and parameters (parse()). */
+#define TAKES_RETURN_CONDITION 1
+#define TAKES_DAMPING 2
+
+static void release(call_t *call)
+{
+    int i;
+    for (i = 0; i < MAX_IN; ++i)
+        Py_CLEAR(call->arrays[i]);
+}
+
+static PyArrayObject *as_states(PyObject *object, const char *name, int size)
+{
+    PyArrayObject *array;
+    if (PyArray_CheckExact(object) && PyArray_TYPE((PyArrayObject *)object) == NPY_DOUBLE &&
+            PyArray_ISCARRAY_RO((PyArrayObject *)object)) {
+        Py_INCREF(object);
+        array = (PyArrayObject *)object;
+    } else {
+        array = (PyArrayObject *)PyArray_FROMANY(object, NPY_DOUBLE, 0, 0, NPY_ARRAY_IN_ARRAY);
+        if (array == NULL)
+            return NULL;
+    }
+    if (!((PyArray_NDIM(array) == 1 && PyArray_DIM(array, 0) == size) ||
+          (PyArray_NDIM(array) == 2 && PyArray_DIM(array, 1) == size))) {
+        PyObject *shape = PyObject_GetAttrString((PyObject *)array, "shape");
+        PyErr_Format(PyExc_ValueError, "%s must have shape (%d,) or (N, %d), got %R", name, size,
+                     size, shape);
+        Py_XDECREF(shape);
+        Py_DECREF(array);
+        return NULL;
+    }
+    return array;
+}
+
+static int parse(const function_t *f, PyObject *const *args, Py_ssize_t nargs,
+                 PyObject *kwnames, call_t *call, int takes)
+{
+    PyObject *given[MAX_IN] = {NULL};
+    int set[NP + 1] = {0};
+    Py_ssize_t i, nkw = kwnames ? PyTuple_GET_SIZE(kwnames) : 0;
+    int j;
+    memset(call, 0, sizeof(*call));
+    if (nargs > f->n_in) {
+        PyErr_Format(PyExc_TypeError, "%s() takes %d positional arguments but %zd were given",
+                     f->name, f->n_in, nargs);
+        return -1;
+    }
+    for (i = 0; i < nargs; ++i)
+        given[i] = args[i];
+    for (i = 0; i < nkw; ++i) {
+        PyObject *key = PyTuple_GET_ITEM(kwnames, i), *value = args[nargs + i];
+        int found = 0;
+        for (j = 0; j < f->n_in && !found; ++j)
+            if (PyUnicode_CompareWithASCIIString(key, f->inputs[j]) == 0) {
+                if (given[j] != NULL) {
+                    PyErr_Format(PyExc_TypeError, "%s() got multiple values for argument '%s'",
+                                 f->name, f->inputs[j]);
+                    return -1;
+                }
+                given[j] = value;
+                found = 1;
+            }
+        for (j = 0; j < NP && !found; ++j)
+            if (PyUnicode_CompareWithASCIIString(key, parameter_names[j]) == 0) {
+                call->p[j] = PyFloat_AsDouble(value);
+                if (call->p[j] == -1.0 && PyErr_Occurred())
+                    return -1;
+                set[j] = 1;
+                found = 1;
+            }
+        if (!found && (takes & TAKES_RETURN_CONDITION) &&
+                PyUnicode_CompareWithASCIIString(key, "return_condition") == 0) {
+            int truth = PyObject_IsTrue(value);
+            if (truth < 0)
+                return -1;
+            call->return_condition = truth;
+            found = 1;
+        }
+        if (!found && (takes & TAKES_DAMPING) &&
+                PyUnicode_CompareWithASCIIString(key, "damping") == 0) {
+            call->damping = PyFloat_AsDouble(value);
+            if (call->damping == -1.0 && PyErr_Occurred())
+                return -1;
+            if (!(call->damping >= 0.0 && isfinite(call->damping))) {
+                PyErr_Format(PyExc_ValueError, "%s(): damping must be a finite number >= 0, "
+                             "got %R", f->name, value);
+                return -1;
+            }
+            found = 1;
+        }
+        if (!found) {
+            PyErr_Format(PyExc_TypeError, "%s() got an unexpected keyword argument %R",
+                         f->name, key);
+            return -1;
+        }
+    }
+    for (j = 0; j < NP; ++j)
+        if (!set[j]) {
+            if (!parameter_has_default[j]) {
+                PyErr_Format(PyExc_TypeError,
+                             "%s() missing keyword argument '%s' (the description gives it no "
+                             "value)", f->name, parameter_names[j]);
+                return -1;
+            }
+            call->p[j] = parameter_defaults[j];
+        }
+    call->single = 1;
+    call->states = 1;  /* a function without vector inputs is evaluated once */
+    for (j = 0; j < f->n_in; ++j) {
+        if (given[j] == NULL) {
+            PyErr_Format(PyExc_TypeError, "%s() missing required argument '%s'", f->name,
+                         f->inputs[j]);
+            release(call);
+            return -1;
+        }
+        call->arrays[j] = as_states(given[j], f->inputs[j], f->sizes[j] ? f->sizes[j] : NQ);
+        if (call->arrays[j] == NULL) {
+            release(call);
+            return -1;
+        }
+        {
+            int one = PyArray_NDIM(call->arrays[j]) == 1;
+            npy_intp states = one ? 1 : PyArray_DIM(call->arrays[j], 0);
+            if (j > 0 && states != call->states) {
+                PyErr_Format(PyExc_ValueError, "the inputs must hold the same number of "
+                             "states, got %zd (%s) and %zd (%s)", (Py_ssize_t)call->states,
+                             f->inputs[0], (Py_ssize_t)states, f->inputs[j]);
+                release(call);
+                return -1;
+            }
+            call->states = states;
+            call->single = call->single && one;
+        }
+    }
+    return 0;
+}
+
+static PyObject *evaluate(const function_t *f, PyObject *const *args, Py_ssize_t nargs,
+                          PyObject *kwnames)
+{
+    call_t call;
+    npy_intp dims[3];
+    int nd = 0, j;
+    npy_intp k, size = (npy_intp)f->rows * (f->cols ? f->cols : 1);
+    const double *in[MAX_IN] = {NULL}, *at[MAX_IN] = {NULL};
+    double *out;
+    PyArrayObject *result;
+    if (parse(f, args, nargs, kwnames, &call, 0) < 0)
+        return NULL;
+    if (!call.single)
+        dims[nd++] = call.states;
+    dims[nd++] = f->rows;
+    if (f->cols)
+        dims[nd++] = f->cols;
+    result = (PyArrayObject *)PyArray_SimpleNew(nd, dims, NPY_DOUBLE);
+    if (result == NULL) {
+        release(&call);
+        return NULL;
+    }
+    out = (double *)PyArray_DATA(result);
+    for (j = 0; j < f->n_in; ++j)
+        in[j] = (const double *)PyArray_DATA(call.arrays[j]);
+    if (call.states == 1) {
+        f->kernel(in, call.p, out);
+    } else {
+        Py_BEGIN_ALLOW_THREADS
+        for (k = 0; k < call.states; ++k) {
+            for (j = 0; j < f->n_in; ++j)
+                at[j] = in[j] + k * (f->sizes[j] ? f->sizes[j] : NQ);
+            f->kernel(at, call.p, out + k * size);
+        }
+        Py_END_ALLOW_THREADS
+    }
+    release(&call);
+    return (PyObject *)result;
+}
