@@ -62,7 +62,6 @@ import secrets
 import stat
 import sys
 import warnings
-from contextlib import contextmanager
 import sysconfig
 from dataclasses import dataclass
 from functools import lru_cache
@@ -70,6 +69,7 @@ from pathlib import Path
 from typing import Callable, Mapping, Sequence
 
 from .compiler import c_compiler_path
+from .errors import recorded_warnings
 from .output import GeneratedFile
 
 #: Version of the entry layout; entries of another format are stale.
@@ -574,24 +574,6 @@ class CachedNotice(UserWarning):
     compiler was found), shown again when a library call is answered from that entry."""
 
 
-@contextmanager
-def _shown_warnings():
-    """Within the block, warnings are shown as usual and the lines shown collected in the list
-    yielded."""
-    shown: list[str] = []
-    show = warnings.showwarning
-
-    def record(message, *args, **kwargs):
-        shown.append(" ".join(str(message).split()))
-        show(message, *args, **kwargs)
-
-    warnings.showwarning = record
-    try:
-        yield shown
-    finally:
-        warnings.showwarning = show
-
-
 def render_cached(render: Callable[..., list], model, backends: Sequence[str],
                   progress: Callable[[str], None], *, cache: bool | CacheRequest = True,
                   cache_dir: Path | None = None, **options) -> list[GeneratedFile]:
@@ -617,7 +599,7 @@ def render_cached(render: Callable[..., list], model, backends: Sequence[str],
             for notice in entry.notices:
                 warnings.warn(notice, CachedNotice, stacklevel=3)
         return list(entry.files)
-    with _shown_warnings() as shown:
+    with recorded_warnings(tidy=lambda text: " ".join(text.split())) as shown:
         files = render(model, backends, progress, **options)
     store.put(request.key, files, (*request.notices, *shown))
     return files

@@ -46,13 +46,34 @@ axis of ``0 0 0``).
 
 from __future__ import annotations
 
+import contextlib
 import warnings
+from typing import Callable, Iterator
 
 
 def one_line(text: str) -> str:
     """``text`` with line breaks and other non-printable characters escaped (``\\n``,
     ``\\u2028``), so that a message built from file content (names, paths) stays on one line."""
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+
+
+@contextlib.contextmanager
+def recorded_warnings(tidy: Callable[[str], str] = one_line) -> Iterator[list[str]]:
+    """Within the block, warnings are shown as usual and their messages, passed through
+    ``tidy``, collected in the list yielded (the CLI and the derivation cache store them, so
+    that a cached run shows them again)."""
+    notices: list[str] = []
+    shown = warnings.showwarning
+
+    def record(message, *args, **kwargs):
+        notices.append(tidy(str(message)))
+        shown(message, *args, **kwargs)
+
+    warnings.showwarning = record
+    try:
+        yield notices
+    finally:
+        warnings.showwarning = shown
 
 
 class EomgenError(Exception):

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 import shutil
 import signal
 import tempfile
@@ -24,6 +25,17 @@ from pathlib import Path
 from typing import Sequence
 
 from .errors import GenerationError, one_line
+
+
+def module_name(robot_name: str) -> str:
+    """The file-name stem of a robot's generated files: a lower-case identifier.
+
+    >>> module_name("UR5 robot"), module_name("7dof")
+    ('ur5_robot', 'robot_7dof')
+    """
+    stem = re.sub(r"[^a-z0-9_]", "_", robot_name.lower().encode("ascii", "replace").decode("ascii"))
+    stem = stem.strip("_") or "robot"
+    return stem if stem[0].isalpha() else "robot_" + stem
 
 
 class OutputError(GenerationError):

@@ -17,7 +17,7 @@ import warnings
 
 import click
 
-from ..errors import EomgenError, one_line
+from ..errors import EomgenError, one_line, recorded_warnings  # noqa: F401  (the CLI's)
 from ..progress import end_line
 
 
@@ -71,21 +71,3 @@ def handle_errors(command):
             sys.exit(128 + (signal.SIGTERM if isinstance(exc, Terminated) else signal.SIGINT))
 
     return click.option("--debug", is_flag=True, help="Show a traceback on errors.")(wrapper)
-
-
-@contextlib.contextmanager
-def recorded_warnings():
-    """Within the block, warnings are shown as usual and their messages collected in the list
-    yielded (a cached run prints them again)."""
-    notices: list[str] = []
-    shown = warnings.showwarning
-
-    def record(message, *args, **kwargs):
-        notices.append(one_line(str(message)))
-        shown(message, *args, **kwargs)
-
-    warnings.showwarning = record
-    try:
-        yield notices
-    finally:
-        warnings.showwarning = shown

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..output import module_name
 from ..robots import example_path
 
 
@@ -43,6 +44,4 @@ def load_reduced(description: Path | None, scene_path: Path | None, strict: bool
 def output_stem(model) -> str:
     """The file-name stem of ``model``'s outputs (``bench_<stem>.md``, ``identify_<stem>.csv``):
     the generated modules' name."""
-    from ..codegen.functions import module_name  # SymPy: only when a command writes outputs
-
     return module_name(model.name)

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
+from ..output import module_name  # noqa: F401  (re-exported: its earlier home)
 from ..outputs import BY_SYMBOL, INPUTS, OUTPUTS, resolve, select, splits
 from ..symbolic.program import Program
 
@@ -102,13 +103,6 @@ def safe_identifier(name: str, taken: set[str], reserved: frozenset[str] | None 
         candidate += "_"
     taken.add(candidate)
     return candidate
-
-
-def module_name(robot_name: str) -> str:
-    """The file-name stem for a robot: a lower-case identifier."""
-    stem = re.sub(r"[^a-z0-9_]", "_", robot_name.lower().encode("ascii", "replace").decode("ascii"))
-    stem = stem.strip("_") or "robot"
-    return stem if stem[0].isalpha() else "robot_" + stem
 
 
 def parameter_arguments(dynamics: "Dynamics") -> tuple[ParameterArgument, ...]:

@@ -33,7 +33,7 @@ import sympy as sp
 
 from .. import __version__
 from ..actuators import spong_dynamics
-from ..codegen.functions import module_name
+from ..output import module_name
 from ..dynamics import Dynamics, derive
 from ..errors import ParameterError
 from ..model import IDENTITY3, RobotModel

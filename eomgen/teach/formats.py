@@ -27,7 +27,7 @@ import tempfile
 from pathlib import Path
 from typing import Callable
 
-from ..codegen.render import render
+from ..templating import render
 from ..errors import GenerationError
 from ..output import GeneratedFile
 from ..present.printer import latex_comment, latex_escape

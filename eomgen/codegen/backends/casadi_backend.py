@@ -22,7 +22,7 @@ from ...outputs import exported, function_names
 from ...compiler import c_compiler, shared_library
 from .. import GeneratedFile, Job, Loaded, register
 from ...symbolic.printing import FloatLiteralMixin, exec_source
-from ..render import render
+from ...templating import render
 from .common import python_module_context
 
 _FUNCTIONS = ("sin", "cos", "tan", "sqrt", "exp", "log", "asin", "acos", "atan", "atan2",

@@ -31,7 +31,7 @@ from .. import GeneratedFile, Job, Loaded, register
 from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, composition_names,
                        constrained_names, exported)
 from ...symbolic.printing import FloatLiteralMixin
-from ..render import TEMPLATES_DIR, render
+from ...templating import TEMPLATES_DIR, render
 from .common import import_file, positional, warning_exports
 
 #: The fixed C runtime every generated module includes parts of: real C files (compiled and

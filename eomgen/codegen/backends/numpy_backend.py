@@ -12,7 +12,7 @@ from sympy.printing.numpy import NumPyPrinter
 
 from .. import GeneratedFile, Job, register
 from ...symbolic.printing import FloatLiteralMixin
-from ..render import render
+from ...templating import render
 from ...runtime.cholesky import included_source
 from .common import python_loader, python_module_context, warning_exports
 
