@@ -439,6 +439,26 @@ class Study:
                 f"{REFERENCE_TOLERANCE:g} ({self.reference_seconds:.2g} s).")
 
 
+def initial_state(q0, qd0, n: int, joint_names) -> tuple[np.ndarray, np.ndarray]:
+    """The start of a simulation of ``n`` coordinates (the joints ``joint_names``, then the
+    motors of flexible joints, if any): ``q0`` [rad or m] and ``qd0`` [rad/s or m/s] as float
+    arrays, 1 rad (or m) and 0 for a value left out (None).
+
+    >>> initial_state(None, None, 2, ("joint1", "joint2"))
+    (array([1., 1.]), array([0., 0.]))
+
+    Raises
+    ------
+    ValueError
+        When either has another number of values than ``n`` (the message names the joints).
+    """
+    q0 = np.full(n, 1.0) if q0 is None else np.asarray(q0, float)
+    qd0 = np.zeros(n) if qd0 is None else np.asarray(qd0, float)
+    if q0.shape != (n,) or qd0.shape != (n,):
+        raise ValueError(f"q0 and qd0 must have {n} values (joints {', '.join(joint_names)})")
+    return q0, qd0
+
+
 def run_study(model: RobotModel, integrators: Sequence, duration: float, q0=None, qd0=None,
               progress: Callable[[str], None] = lambda _: None, system: System | None = None
               ) -> Study:
@@ -449,12 +469,7 @@ def run_study(model: RobotModel, integrators: Sequence, duration: float, q0=None
     ``q0`` defaults to 1 rad (or m) per joint, ``qd0`` to zero.
     """
     system = system or System(model)
-    n = system.n
-    q0 = np.full(n, 1.0) if q0 is None else np.asarray(q0, float)
-    qd0 = np.zeros(n) if qd0 is None else np.asarray(qd0, float)
-    if q0.shape != (n,) or qd0.shape != (n,):
-        raise ValueError(f"q0 and qd0 must have {n} values (joints "
-                         f"{', '.join(system.model.joint_names)})")
+    q0, qd0 = initial_state(q0, qd0, system.n, system.model.joint_names)
     progress("reference (DOP853, rtol = atol = 1e-12)")
     reference, info = simulate(system, Adaptive("DOP853", REFERENCE_TOLERANCE), q0, qd0, duration)
     reference_seconds = info["seconds"]
@@ -485,7 +500,7 @@ def run_study(model: RobotModel, integrators: Sequence, duration: float, q0=None
             warnings.warn(ill_conditioned_message(info["max_condition"],
                                                   f" during {integrator.name}"),
                           IllConditionedWarning, stacklevel=2)
-    joints = getattr(system, "links", n)  # a flexible system has n joints and m motors
+    joints = getattr(system, "links", system.n)  # a flexible system has n joints and m motors
     return Study(system.model.name, joints, float(duration), tuple(q0.tolist()),
                  tuple(qd0.tolist()),
                  scale, reference_seconds, tuple(runs))

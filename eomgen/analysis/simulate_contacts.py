@@ -47,7 +47,7 @@ from ..numeric import kinetic_energy, numeric_model, potential_energy
 from ..progress import plural
 from .report import csv_text, fmt, markdown_table, pyplot
 from .routes import numeric_only
-from .simulate import OUTPUT_POINTS, Diverged, ImplicitMidpoint, Trajectory, simulate
+from .simulate import OUTPUT_POINTS, Diverged, ImplicitMidpoint, initial_state, simulate
 
 #: ``(kp [1/s²], kd [1/s])`` for contacts whose scene gives no Baumgarte gains: the error
 #: equation ``ë + kd ė + kp e = 0`` critically damped at ω = 10 rad/s.
@@ -235,11 +235,7 @@ def run_contact_study(model: RobotModel, contacts: Sequence[Contact], integrator
     reported with status ``diverged``, not raised."""
     model = numeric_only(model)
     n = model.dof
-    q0 = np.full(n, 1.0) if q0 is None else np.asarray(q0, float)
-    qd0 = np.zeros(n) if qd0 is None else np.asarray(qd0, float)
-    if q0.shape != (n,) or qd0.shape != (n,):
-        raise ValueError(f"q0 and qd0 must have {n} values (joints "
-                         f"{', '.join(model.joint_names)})")
+    q0, qd0 = initial_state(q0, qd0, n, model.joint_names)
     progress(f"deriving M, h and the contact frames of {model.name}")
     mass_and_bias = derived_mass_and_bias(model)
     systems = {on: ContactSystem(model, contacts, q0, on, gains, mass_and_bias=mass_and_bias)
