@@ -18,9 +18,9 @@ import sympy as sp
 
 from ..model import RobotModel
 from .crba import M_program
-from .newton_euler import _name, inverse_dynamics_program
 from .derivation import new_derivation
-from .program import Program
+from .newton_euler import inverse_dynamics_program
+from .program import Program, name_expr
 
 
 def dynamics_program(model: RobotModel) -> tuple[tuple, tuple, Program]:
@@ -40,7 +40,7 @@ def dynamics_program(model: RobotModel) -> tuple[tuple, tuple, Program]:
     M = M_program(tree, q, b)
     g = inverse_dynamics_program(tree, q, zero, zero, model.gravity, b)
     bias = inverse_dynamics_program(tree, q, qd, zero, model.gravity, b)
-    Cqd = sp.Matrix([[_name(b, bias[k, 0] - g[k, 0], f"Cqd{k + 1}", ("Cqd", k + 1))]
+    Cqd = sp.Matrix([[name_expr(b, bias[k, 0] - g[k, 0], f"Cqd{k + 1}", ("Cqd", k + 1))]
                      for k in range(n)])
     outputs = (("M", M), ("Cqd", Cqd), ("g", g))
     return q, qd, d.program(outputs)

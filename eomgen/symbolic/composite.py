@@ -47,78 +47,10 @@ from typing import Iterable
 import sympy as sp
 
 from ..bodies import BodyTree
-from ..model import Mat3, Vec3
+from ..model import Vec3
 from .program import Program, ProgramBuilder, rough_operation_count
-
-
-def _cross(a: Vec3, b: Vec3) -> tuple:
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _dot(a, b) -> sp.Expr:
-    return sp.Add(*[x * y for x, y in zip(a, b)])
-
-
-def _matvec(A, v) -> tuple:
-    return tuple(sp.Add(*[A[r][k] * v[k] for k in range(3)]) for r in range(3))
-
-
-def _matmul(A, B) -> tuple:
-    return tuple(tuple(sp.Add(*[A[r][k] * B[k][c] for k in range(3)]) for c in range(3))
-                 for r in range(3))
-
-
-def _rotation(axis: Vec3, c, s) -> tuple:
-    """Rotation about unit ``axis`` by the angle whose cosine and sine are ``c`` and ``s``."""
-    x, y, z = axis
-    t = 1 - c
-    return (
-        (t * x * x + c, t * x * y - s * z, t * x * z + s * y),
-        (t * x * y + s * z, t * y * y + c, t * y * z - s * x),
-        (t * x * z - s * y, t * y * z + s * x, t * z * z + c),
-    )
-
-
-@dataclass
-class SpatialInertia:
-    """Inertial parameters about the reference point o (world orientation): mass, first moment h,
-    inertia Ī (3×3)."""
-
-    mass: sp.Expr
-    h: tuple
-    I: tuple
-
-    def __add__(self, other: "SpatialInertia") -> "SpatialInertia":
-        return SpatialInertia(
-            self.mass + other.mass,
-            tuple(a + b for a, b in zip(self.h, other.h)),
-            tuple(tuple(a + b for a, b in zip(r, s)) for r, s in zip(self.I, other.I)),
-        )
-
-    def apply(self, S: tuple) -> tuple:
-        """Momentum ``I S`` of the motion ``S = [ω; v]``: ``[Ī ω + h × v; m v − h × ω]``."""
-        w, v = S[:3], S[3:]
-        Iw = _matvec(self.I, w)
-        hv = _cross(self.h, v)
-        hw = _cross(self.h, w)
-        n = tuple(Iw[r] + hv[r] for r in range(3))
-        f = tuple(self.mass * v[r] - hw[r] for r in range(3))
-        return n + f
-
-
-def motion_cross(a: tuple, b: tuple) -> tuple:
-    """Spatial motion cross product ``a × b`` = [ω_a × ω_b; ω_a × v_b + v_a × ω_b]."""
-    wa, va, wb, vb = a[:3], a[3:], b[:3], b[3:]
-    w = _cross(wa, wb)
-    v1, v2 = _cross(wa, vb), _cross(va, wb)
-    return w + tuple(v1[r] + v2[r] for r in range(3))
-
-
-def force_cross(a: tuple, f: tuple) -> tuple:
-    """Spatial force cross product ``a ×* f`` = [ω × n + v × f; ω × f]."""
-    w, v, n, lin = a[:3], a[3:], f[:3], f[3:]
-    n1, n2 = _cross(w, n), _cross(v, lin)
-    return tuple(n1[r] + n2[r] for r in range(3)) + _cross(w, lin)
+from .spatial import (SpatialInertia, cross, dot, force_cross, matmul, matvec, motion_cross,
+                      rotation)
 
 
 @dataclass
@@ -148,20 +80,20 @@ def forward_kinematics(tree: BodyTree, q, b: ProgramBuilder) -> Kinematics:
         else:
             Rp, pp = kin.R[body.parent], kin.p[body.parent]
             R0 = tuple(b.define_all(row, f"A{n}_{r}", ("A", n, r)) for r, row in
-                       enumerate(_matmul(Rp, body.placement.rotation)))
+                       enumerate(matmul(Rp, body.placement.rotation)))
             p0 = b.define_all(tuple(pp[r] + e for r, e in
-                                    enumerate(_matvec(Rp, body.placement.translation))), f"o{n}_",
+                                    enumerate(matvec(Rp, body.placement.translation))), f"o{n}_",
                                 ("o", n))
-        z = b.define_all(_matvec(R0, joint.axis), f"z{n}_", ("z", n))
+        z = b.define_all(matvec(R0, joint.axis), f"z{n}_", ("z", n))
         qi = q[body.q_index]
         if joint.type.is_revolute:
             s = b.define(sp.sin(qi), f"s{n}", ("s", n))
             c = b.define(sp.cos(qi), f"c{n}", ("c", n))
             kin.sin_cos.append((s, c))
             R = tuple(b.define_all(row, f"R{n}_{r}", ("R", n, r)) for r, row in
-                      enumerate(_matmul(R0, _rotation(joint.axis, c, s))))
+                      enumerate(matmul(R0, rotation(joint.axis, c, s))))
             p = p0
-            S = z + b.define_all(_cross(p, z), f"v{n}_", ("v", n))
+            S = z + b.define_all(cross(p, z), f"v{n}_", ("v", n))
         else:
             kin.sin_cos.append(None)
             R = R0
@@ -181,12 +113,12 @@ def body_inertia_in_world(tree: BodyTree, kin: Kinematics, b: ProgramBuilder) ->
         n = body.q_index + 1
         par = body.inertial
         R, p, m = kin.R[i], kin.p[i], par.mass
-        Rh = b.define_all(_matvec(R, par.first_moment), f"Rh{n}_",
+        Rh = b.define_all(matvec(R, par.first_moment), f"Rh{n}_",
                           ("Rh", n))
-        RI = _matmul(R, par.inertia)
+        RI = matmul(R, par.inertia)
         RIRt = [[sp.Add(*[RI[r][k] * R[c][k] for k in range(3)]) for c in range(3)] for r in range(3)]
         pp = sp.Add(*[x * x for x in p])
-        pRh = _dot(p, Rh)
+        pRh = dot(p, Rh)
         I = [[None] * 3 for _ in range(3)]
         for r in range(3):
             for c in range(r, 3):
@@ -344,7 +276,7 @@ def composite_M_program(tree: BodyTree, q, b: ProgramBuilder) -> sp.Matrix:
     M = sp.zeros(n, n)
     for j in range(n):
         for i in [j] + tree.ancestors(j):
-            value = b.define(_dot(kin.S[i], F[j]), f"M{idx[i] + 1}_{idx[j] + 1}",
+            value = b.define(dot(kin.S[i], F[j]), f"M{idx[i] + 1}_{idx[j] + 1}",
                              ("M", idx[i] + 1, idx[j] + 1))
             M[idx[i], idx[j]] = M[idx[j], idx[i]] = value
     return M
@@ -356,7 +288,7 @@ def composite_gravity_program(tree: BodyTree, q, gravity: Vec3, b: ProgramBuilde
     _, _, _, F = _world_composites(tree, q, b)
     g = sp.zeros(len(tree.bodies), 1)
     for i, body in enumerate(tree.bodies):
-        g[body.q_index, 0] = b.define(-_dot(gravity, F[i][3:]), f"g{body.q_index + 1}",
+        g[body.q_index, 0] = b.define(-dot(gravity, F[i][3:]), f"g{body.q_index + 1}",
                                       ("g", body.q_index + 1))
     return g
 
@@ -374,10 +306,10 @@ def potential_energy(tree: BodyTree, kin: Kinematics, gravity: Vec3) -> sp.Expr:
     moment = [sp.Integer(0)] * 3
     for i, body in enumerate(tree.bodies):
         par = body.inertial
-        Rh = _matvec(kin.R[i], par.first_moment)
+        Rh = matvec(kin.R[i], par.first_moment)
         for r in range(3):
             moment[r] += par.mass * (kin.origin[r] + kin.p[i][r]) + Rh[r]
-    return -_dot(gravity, moment)
+    return -dot(gravity, moment)
 
 
 def coriolis_program(tree: BodyTree, q, qd, b: ProgramBuilder) -> sp.Matrix:
@@ -421,10 +353,10 @@ def coriolis_program(tree: BodyTree, q, qd, b: ProgramBuilder) -> sp.Matrix:
     for i, par in enumerate(world):
         w, v = V[i][:3], V[i][3:]
         momentum.append(list(par.apply(V[i])))
-        wh = _cross(w, par.h)
+        wh = cross(w, par.h)
         h_rate.append([par.mass * v[r] + wh[r] for r in range(3)])
-        A = [_cross(w, tuple(par.I[r][c] for r in range(3))) for c in range(3)]  # columns of [ω]× Ī
-        hv = 2 * _dot(par.h, v)
+        A = [cross(w, tuple(par.I[r][c] for r in range(3))) for c in range(3)]  # columns of [ω]× Ī
+        hv = 2 * dot(par.h, v)
         I_rate.append([[A[c][r] + A[r][c] - v[r] * par.h[c] - par.h[r] * v[c]
                         + (hv if r == c else 0) for c in range(3)] for r in range(3)])
     for i in reversed(range(n)):
@@ -452,7 +384,7 @@ def coriolis_program(tree: BodyTree, q, qd, b: ProgramBuilder) -> sp.Matrix:
         ISd = comp[j].apply(Sd[j])
         F1 = b.define_all(tuple(ISd[r] + half * (IdS[r] + X[r]) for r in range(6)), f"Fa{tag}_",
                           ("Fa", tag))
-        C[tag - 1, tag - 1] = b.define(_dot(S[j], F1), f"C{tag}_{tag}", ("C", tag, tag))
+        C[tag - 1, tag - 1] = b.define(dot(S[j], F1), f"C{tag}_{tag}", ("C", tag, tag))
         ancestors = tree.ancestors(j)
         if not ancestors:
             continue
@@ -460,8 +392,8 @@ def coriolis_program(tree: BodyTree, q, qd, b: ProgramBuilder) -> sp.Matrix:
                           ("Fb", tag))
         for i in ancestors:
             a, c = tree.bodies[i].q_index, tree.bodies[j].q_index
-            C[a, c] = b.define(_dot(S[i], F1), f"C{idx[i]}_{tag}", ("C", idx[i], tag))
-            C[c, a] = b.define(_dot(Sd[i], F) + _dot(S[i], F3), f"C{tag}_{idx[i]}",
+            C[a, c] = b.define(dot(S[i], F1), f"C{idx[i]}_{tag}", ("C", idx[i], tag))
+            C[c, a] = b.define(dot(Sd[i], F) + dot(S[i], F3), f"C{tag}_{idx[i]}",
                                ("C", tag, idx[i]))
     return C
 
@@ -509,7 +441,7 @@ def _coriolis(tree, S, F, comp, qd, idx, b: ProgramBuilder) -> sp.Matrix:
         if key in dM_cache:
             return dM_cache[key]
         if anc[i][k] and i != k and anc[k][j]:
-            value = _dot(S[i], SxF(k, j))
+            value = dot(S[i], SxF(k, j))
         elif anc[j][k] and j != k:
             a, b_, c, d = SxS(k, i), IS(k, j), IS(k, i), SxS(k, j)
             value = sp.Add(*[-x * y for x, y in zip(a, b_) if x != 0 and y != 0],
