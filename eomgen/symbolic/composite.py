@@ -1,14 +1,13 @@
-"""M, C and g as straight-line programs: composite bodies, the CRBA, Newton–Euler at rest and
-Echeandia and Wensing's Coriolis recursion, whichever is cheaper for the robot.
+"""M, C and g in world axes: composite bodies, the Christoffel symbols of the closed-form ∂M/∂q
+and Echeandia and Wensing's Coriolis recursion, as straight-line programs.
 
-:func:`derive_program` (what :func:`eomgen.derive` calls) builds each asked output by the
-cheaper of two exact programs (:func:`cheapest_routes`): M by the body-frame CRBA
-(:mod:`eomgen.symbolic.crba`) or by the world-frame composite bodies below; C by the O(n²)
-recursion of :func:`coriolis_program` or by the Christoffel symbols below; g by the
-Newton–Euler program at rest (:mod:`eomgen.symbolic.newton_euler`) or from the composite
-bodies below. Every route gives the same matrices; C is always the Christoffel C.
+These are the world-frame routes among which :mod:`eomgen.symbolic.routes` chooses (beside the
+body-frame CRBA of :mod:`eomgen.symbolic.crba` and the Newton–Euler g of
+:mod:`eomgen.symbolic.newton_euler`); every route gives the same matrices, C is always the
+Christoffel C. :func:`forward_kinematics` (world rotations, origins and motion axes) is also
+what :mod:`eomgen.symbolic.frames` builds on.
 
-The world-frame routes are the Lagrangian method, M = Σ_l J_lᵀ I_l J_l and c_ijk = ½(∂M_ij/∂q_k + ∂M_ik/∂q_j −
+The world-frame programs are the Lagrangian method, M = Σ_l J_lᵀ I_l J_l and c_ijk = ½(∂M_ij/∂q_k + ∂M_ik/∂q_j −
 ∂M_jk/∂q_i), with the sums over links regrouped by subtree so that no expression grows with the
 number of links:
 
@@ -42,13 +41,12 @@ Units: SI (rad, m, kg, s). Sign convention: M q̈ + C q̇ + g = τ.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Iterable
 
 import sympy as sp
 
 from ..bodies import BodyTree
 from ..model import Vec3
-from .program import Program, ProgramBuilder, rough_operation_count
+from .program import ProgramBuilder
 from .spatial import (SpatialInertia, cross, dot, force_cross, matmul, matvec, motion_cross,
                       rotation)
 
@@ -155,101 +153,6 @@ def is_ancestor_or_self(tree: BodyTree, a: int, j: int) -> bool:
             return True
         j = tree.bodies[j].parent
     return False
-
-
-def _routes() -> dict:
-    """The programs of each output: ``{output: ((name, build), …)}`` with
-    ``build(tree, q, qd, gravity, b)`` returning the output's matrix."""
-    from .crba import M_program
-    from .newton_euler import inverse_dynamics_program
-
-    def rnea_gravity(tree, q, qd, gravity, b):
-        zero = (sp.Integer(0),) * len(tree.bodies)
-        return inverse_dynamics_program(tree, q, zero, zero, gravity, b, hint="g")
-
-    return {
-        "M": (("CRBA", lambda tree, q, qd, gravity, b: M_program(tree, q, b)),
-              ("composite", lambda tree, q, qd, gravity, b: composite_M_program(tree, q, b))),
-        "C": (("recursion", lambda tree, q, qd, gravity, b: coriolis_program(tree, q, qd, b)),
-              ("Christoffel", _christoffel_route)),
-        "g": (("Newton-Euler", rnea_gravity),
-              ("composite", lambda tree, q, qd, gravity, b:
-               composite_gravity_program(tree, q, gravity, b))),
-    }
-
-
-#: Above this many joints the Christoffel-symbol C is not tried: its O(n³) program was larger
-#: than the recursion's O(n²) one on every robot measured with 6 joints (random arms with
-#: general axes: 4,222–5,007 against 3,701–4,140 operations; the 6-link spatial chain of
-#: benchmarks/complexity.py 4,059 against 3,354; 5 joints: 3,163–3,512 against 3,120–3,351),
-#: and building it dominates ``derive``'s time for long chains.
-CHRISTOFFEL_MAX_JOINTS = 5
-
-
-def _christoffel_route(tree, q, qd, gravity, b):
-    if len(tree.bodies) > CHRISTOFFEL_MAX_JOINTS:
-        return None
-    return christoffel_coriolis_program(tree, q, qd, b)
-
-
-def cheapest_routes(tree: BodyTree, q, qd, gravity: Vec3, outputs: Iterable[str],
-                    reserved=()) -> tuple[dict[str, str], Program]:
-    """Build every route (see :func:`derive_program`) of each of ``outputs`` into one scratch
-    builder, where they share their common work (the world-frame composites, sines and
-    cosines), and keep for each output the route whose own program has the fewest operations
-    (:func:`~eomgen.symbolic.program.rough_operation_count`; the first route on a tie).
-
-    Returns ``({output: route name}, the program of the chosen outputs, pruned)``.
-    """
-    scratch = ProgramBuilder(reserved)
-    routes = _routes()
-    chosen, best_matrices = {}, []
-    for output in outputs:
-        best = None
-        for name, build in routes[output]:
-            matrix = build(tree, q, qd, gravity, scratch)
-            if matrix is None:  # route not tried for this robot
-                continue
-            used = Program(tuple(scratch.assignments), ((output, matrix),)).pruned([output])
-            count = rough_operation_count([e for _, e in used.assignments] + list(matrix))
-            if best is None or count < best[0]:
-                best = (count, name, matrix)
-        chosen[output] = best[1]
-        best_matrices.append((output, best[2]))
-    program = Program(tuple(scratch.assignments), tuple(best_matrices))
-    return chosen, program.pruned([o for o, _ in best_matrices])
-
-
-def derive_program(tree: BodyTree, q, qd, gravity: Vec3, outputs: set[str], b: ProgramBuilder) -> dict:
-    """Build M, C and/or g (as asked in ``outputs``) into the program builder ``b``.
-
-    Each output has two exact programs, and the one with fewer operations for this robot is
-    built (:func:`cheapest_routes`):
-
-    * ``M``: the body-frame CRBA (:func:`eomgen.symbolic.crba.M_program`), cheapest
-      for joint axes along the link frames' axes (the Panda: 641 operations against 1,784), or
-      ``M_ij = S_iᵀ I^c_j S_j`` in world axes (:func:`composite_M_program`), cheaper
-      for general axes, whose body-frame rotations cost more than one world rotation per body;
-    * ``C``: Echeandia and Wensing's recursion (:func:`coriolis_program`, O(n²)) or the
-      Christoffel symbols of ∂M/∂q (:func:`christoffel_coriolis_program`, O(n³) but fewer
-      intermediates for two to four joints; tried up to :data:`CHRISTOFFEL_MAX_JOINTS`
-      joints): the same matrix;
-    * ``g``: the Newton–Euler program at rest, ``g = τ(q, 0, 0)``
-      (:func:`eomgen.symbolic.newton_euler.inverse_dynamics_program`), or ``g_i = −g_vecᵀ f_i``
-      from the composite bodies (:func:`composite_gravity_program`);
-
-    and ``P`` (with g) from the world-frame kinematics (:func:`potential_energy`).
-
-    Returns a dict with SymPy matrices in terms of intermediates: ``"M"`` (n×n), ``"C"`` (n×n),
-    ``"g"`` (n×1), plus ``"P"`` (1×1 potential energy, when g is asked).
-    """
-    _, program = cheapest_routes(tree, q, qd, gravity,
-                                 [o for o in ("M", "g", "C") if o in outputs], b.reserved)
-    result = b.absorb(program)
-    if "g" in outputs:
-        kin = forward_kinematics(tree, q, b)
-        result["P"] = sp.Matrix([[b.define(potential_energy(tree, kin, gravity), "P", ("P",))]])
-    return result
 
 
 def _world_composites(tree: BodyTree, q, b: ProgramBuilder) -> tuple:
@@ -473,12 +376,3 @@ def _coriolis(tree, S, F, comp, qd, idx, b: ProgramBuilder) -> sp.Matrix:
             C[idx[i], idx[j]] = b.define(sp.Add(*terms), f"C{idx[i] + 1}_{idx[j] + 1}",
                                           ("C", idx[i] + 1, idx[j] + 1))
     return C
-
-
-def build_lagrangian(derivation, wanted) -> dict:
-    """The builder of M, C and g in :mod:`eomgen.outputs`: :func:`derive_program` on the
-    derivation's body tree for the ``wanted`` ones, with the potential energy ``P`` [J] when g is
-    among them."""
-    result = derive_program(derivation.tree, derivation.q, derivation.qd,
-                            derivation.model.gravity, set(wanted), derivation.builder)
-    return {name: result[name] for name in ("M", "C", "g", "P") if name in result}
