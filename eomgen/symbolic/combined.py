@@ -17,6 +17,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..model import RobotModel
+from ..outputs import BY_SYMBOL
 from .crba import M_program
 from .derivation import new_derivation
 from .newton_euler import inverse_dynamics_program
@@ -61,8 +62,6 @@ def build_combined(derivation, wanted) -> dict:
     (n × (n + 1)), returned as (M, h): the results side by side from the outputs already in
     the program (``derivation.output``), so that they are the separate functions' own results
     and share every intermediate; the generated module splits them into tuples."""
-    from ..outputs import BY_SYMBOL
-
     result = {}
     for symbol in wanted:
         parts = BY_SYMBOL[symbol].returns
