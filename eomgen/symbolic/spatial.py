@@ -34,30 +34,50 @@ from ..model import Vec3
 from .program import ProgramBuilder, name_expr, name_exprs, name_matrix, name_symmetric
 
 
+_ZERO = sp.S.Zero
+
+
+def _symbolic(x) -> bool:
+    return isinstance(x, sp.Expr) and not x.is_Number
+
+
+def mul(x, y):
+    """``x y``; when one factor is an exact 0 or 1 (a Python or SymPy integer) and the other a
+    SymPy expression that is not a number, the result SymPy's product would give (0, or the
+    other factor) without building the product: structural zeros and ones (identity
+    rotations, axes along a coordinate axis) are most of the factors of the recursions."""
+    if (type(x) is int or isinstance(x, sp.Integer)) and (x == 0 or x == 1) and _symbolic(y):
+        return _ZERO if x == 0 else y
+    if (type(y) is int or isinstance(y, sp.Integer)) and (y == 0 or y == 1) and _symbolic(x):
+        return _ZERO if y == 0 else x
+    return x * y
+
+
 def cross(a, b) -> tuple:
     """The cross product ``a × b`` of two 3-vectors (in the same axes)."""
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+    return (mul(a[1], b[2]) - mul(a[2], b[1]), mul(a[2], b[0]) - mul(a[0], b[2]),
+            mul(a[0], b[1]) - mul(a[1], b[0]))
 
 
 def dot(a, b) -> sp.Expr:
     """The scalar product ``aᵀ b`` of two vectors of the same length (in the same axes)."""
-    return sp.Add(*[x * y for x, y in zip(a, b)])
+    return sp.Add(*[mul(x, y) for x, y in zip(a, b)])
 
 
 def matvec(A, v) -> tuple:
     """``A v`` for a 3×3 ``A`` (rows) and a 3-vector ``v``."""
-    return tuple(sp.Add(*[A[r][k] * v[k] for k in range(3)]) for r in range(3))
+    return tuple(sp.Add(*[mul(A[r][k], v[k]) for k in range(3)]) for r in range(3))
 
 
 def transpose_apply(A, v) -> tuple:
     """``Aᵀ v`` for a 3×3 ``A`` (rows) and a 3-vector ``v``, without forming ``Aᵀ``: for a
     rotation from frame b to frame a, ``v`` in a's axes to b's."""
-    return tuple(sp.Add(*[A[k][r] * v[k] for k in range(3)]) for r in range(3))
+    return tuple(sp.Add(*[mul(A[k][r], v[k]) for k in range(3)]) for r in range(3))
 
 
 def matmul(A, B) -> tuple:
     """``A B`` for two 3×3 matrices (rows); for rotations, ``R_ab R_bc = R_ac``."""
-    return tuple(tuple(sp.Add(*[A[r][k] * B[k][c] for k in range(3)]) for c in range(3))
+    return tuple(tuple(sp.Add(*[mul(A[r][k], B[k][c]) for k in range(3)]) for c in range(3))
                  for r in range(3))
 
 
@@ -288,5 +308,6 @@ class JointFrames:
 
 
 __all__ = ["JointFrames", "SpatialInertia", "add", "aligned_axis", "cross", "dot",
-           "force_cross", "matmul", "matvec", "motion_cross", "rotate_aligned", "rotate_back",
-           "rotation", "scale", "skew", "skew_times", "transpose", "transpose_apply"]
+           "force_cross", "matmul", "matvec", "motion_cross", "mul", "rotate_aligned",
+           "rotate_back", "rotation", "scale", "skew", "skew_times", "transpose",
+           "transpose_apply"]
