@@ -48,7 +48,7 @@ from ..bodies import BodyTree
 from ..model import Vec3
 from .program import ProgramBuilder
 from .spatial import (SpatialInertia, cross, dot, force_cross, matmul, matvec, motion_cross,
-                      rotation)
+                      mul, rotation)
 
 
 @dataclass
@@ -114,7 +114,8 @@ def body_inertia_in_world(tree: BodyTree, kin: Kinematics, b: ProgramBuilder) ->
         Rh = b.define_all(matvec(R, par.first_moment), f"Rh{n}_",
                           ("Rh", n))
         RI = matmul(R, par.inertia)
-        RIRt = [[sp.Add(*[RI[r][k] * R[c][k] for k in range(3)]) for c in range(3)] for r in range(3)]
+        RIRt = [[sp.Add(*[mul(RI[r][k], R[c][k]) for k in range(3)]) for c in range(3)]
+                for r in range(3)]
         pp = sp.Add(*[x * x for x in p])
         pRh = dot(p, Rh)
         I = [[None] * 3 for _ in range(3)]

@@ -51,7 +51,7 @@ from mpmath.libmp import prec_to_dps
 from ..bodies import BodyTree, InertialParameters
 from ..model import Transform, Vec3
 from .program import ProgramBuilder, name_expr, name_exprs
-from .spatial import JointFrames, aligned_axis, cross, dot, matvec, rotation
+from .spatial import JointFrames, aligned_axis, cross, dot, matvec, mul, rotation
 
 
 def _invariant_part(axis: Vec3, revolute: bool, par: InertialParameters) -> InertialParameters:
@@ -259,8 +259,8 @@ def _euler_moment(I, dw, U, ww, b: ProgramBuilder, tag) -> tuple:
         squares = 0
         if I[j][k] != 0:
             squares = I[j][k] * name_expr(b, ww[j][j] - ww[k][k], f"wd{tag}_{i}", ("wd", tag, i))
-        out.append(I[i][i] * dw[i] - I[i][j] * U[k][i] + I[i][k] * U[j][i] + squares
-                   + (I[k][k] - I[j][j]) * ww[j][k])
+        out.append(mul(I[i][i], dw[i]) - mul(I[i][j], U[k][i]) + mul(I[i][k], U[j][i]) + squares
+                   + mul(I[k][k] - I[j][j], ww[j][k]))
     return tuple(out)
 
 
