@@ -14,6 +14,9 @@ import types
 from dataclasses import dataclass
 from typing import Callable
 
+from .outputs import BY_SYMBOL, FORWARD
+from .symbolic.printing import exec_source
+
 
 @dataclass(frozen=True)
 class NumericDynamics:
@@ -74,8 +77,6 @@ def lambdify(dynamics: "eomgen.dynamics.Dynamics") -> NumericDynamics:  # noqa: 
     from .codegen import make_job
     from .codegen.backends.numpy_backend import NumPyConfig, NumPyModulePrinter, numpy_source
     from .codegen.functions import FUNCTION_OUTPUTS
-    from .outputs import BY_SYMBOL, FORWARD
-    from .symbolic.printing import exec_source
 
     derived = set(dynamics.outputs)
     functions = [f for f, needs in FUNCTION_OUTPUTS.items() if set(needs) <= derived]

@@ -34,10 +34,11 @@ from typing import Iterable
 import numpy as np
 import sympy as sp
 
-from ..errors import KinematicTreeError
+from ..errors import GenerationError, KinematicTreeError
 from ..model import IDENTITY3, RobotModel, Transform, ZERO3
 from .composite import forward_kinematics
 from .derivation import new_derivation
+from .evaluate import compile_program
 from .program import Program, ProgramBuilder
 from .spatial import cross, matmul, matvec, motion_cross, transpose
 
@@ -98,8 +99,6 @@ class FrameKinematics:
 
     @cached_property
     def _compiled(self):
-        from .evaluate import compile_program
-
         params = tuple(p.symbol for p in self.model.parameters)
         values = self.model.parameter_values
         missing = [p.name for p in self.model.parameters if p.symbol not in values]
@@ -298,8 +297,6 @@ def contact_row_count(model: RobotModel) -> int:
 
 
 def _require_contacts(model: RobotModel) -> None:
-    from ..errors import GenerationError
-
     if not model.contacts:
         raise GenerationError(
             f"{model.source}: contact outputs (contact_jacobian, contact_bias, "
@@ -357,7 +354,6 @@ def _friction_contacts(model: RobotModel) -> list:
     """``(contact, first row, unit normal in the axes of its force rows)`` of every contact,
     refusing contacts without a friction coefficient."""
     from ..contacts import POINT
-    from ..errors import GenerationError
 
     _require_contacts(model)
     missing = [c.name for c in model.contacts if c.mu is None]
