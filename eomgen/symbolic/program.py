@@ -85,6 +85,10 @@ class ProgramBuilder:
         self._reserved = set(reserved)
         self._names: set[str] = set()
         self._by_value: dict[sp.Expr, sp.Symbol] = {}
+        # The free-symbol sets of the named expressions: an expression whose set is not among
+        # them cannot be the negation of one (negating changes no symbol), so define skips
+        # building ``-expr`` (SymPy distributes the sign over every term: a sixth of derive).
+        self._symbol_sets: set[frozenset] = set()
         self.assignments: list[tuple[sp.Symbol, sp.Expr]] = []
         #: Work shared between programs built into this builder (e.g. the world-frame
         #: composites of :mod:`eomgen.symbolic.composite`), by a key of the caller's choice.
@@ -118,11 +122,14 @@ class ProgramBuilder:
         known = self._by_value.get(expr)
         if known is not None:
             return known
-        neg = self._by_value.get(-expr)
-        if neg is not None:
-            return -neg
+        symbols = frozenset(expr.free_symbols)
+        if symbols in self._symbol_sets:
+            neg = self._by_value.get(-expr)
+            if neg is not None:
+                return -neg
         symbol = self._fresh(hint)
         self._by_value[expr] = symbol
+        self._symbol_sets.add(symbols)
         self.assignments.append(Assignment(symbol, expr, as_tag(tag)))
         return symbol
 
@@ -148,6 +155,7 @@ class ProgramBuilder:
             if new != symbol:
                 changed[symbol] = new
             self._by_value[expr] = new
+            self._symbol_sets.add(frozenset(expr.free_symbols))
             self.assignments.append(Assignment(new, expr, getattr(assignment, "tag", None)))
         return {name: matrix.applyfunc(moved) for name, matrix in program.outputs}
 
