@@ -25,7 +25,8 @@ from .outputs import derived_symbols
 # because the docs and earlier code import them from eomgen.dynamics.
 from .symbolic.derivation import Derivation, joint_symbols, new_derivation, vector_symbols  # noqa: F401
 from .symbolic.program import Program
-from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS
+from .symbolic.named import AUTO_EXPAND_WORK, ExpansionTooLargeError, ProgramMatrix
+from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS, textbook_derivation
 
 #: What generated modules export by default: the mass matrix, Coriolis matrix, gravity vector
 #: and the inverse dynamics τ(q, q̇, q̈) (by a symbolic Newton–Euler pass; cheaper to evaluate).
@@ -111,9 +112,8 @@ class Dynamics:
         """The body-by-body textbook derivation of the model
         (:class:`eomgen.symbolic.textbook.TextbookDerivation`): M, C, g reduced with
         ``sin² + cos² = 1``, in angle sums ``cos(q2 + q3)`` along parallel joint axes, exact
-        numbers. Computed in a polynomial ring (seconds for 3 joints), on first use."""
-        from .symbolic.textbook import textbook_derivation
-
+        numbers. Computed in a polynomial ring (seconds for 3 joints), on first use. A façade
+        for the README's API: the work is :func:`eomgen.symbolic.textbook.textbook_derivation`."""
         return textbook_derivation(self.model, max_dof=MAX_SIMPLIFY_JOINTS)
 
     @cached_property
@@ -121,7 +121,10 @@ class Dynamics:
         """The regressor written out for teaching (:func:`eomgen.regressor.regressor_form`):
         the named columns of Y(q, q̇, q̈) in compact trigonometric notation and the base
         parameters as formulas of the standard ones, on first use. Meant for teaching-sized
-        models (the LaTeX document and the notebook use it below the textbook bound)."""
+        models (the LaTeX document and the notebook use it below the textbook bound). A façade
+        for the README's API: the work is :func:`eomgen.regressor.regressor_form`."""
+        # Imported on first use (start-up time): eomgen.regressor loads NumPy (about 0.25 s),
+        # which deriving never needs.
         from .regressor import regressor_form
 
         return regressor_form(self.model)
@@ -131,8 +134,6 @@ class Dynamics:
         program's named intermediates, with their definitions: a
         :class:`~eomgen.symbolic.named.ProgramMatrix`, whatever the model's size (nothing is
         expanded; ``.expand()`` writes it out)."""
-        from .symbolic.named import ProgramMatrix
-
         if name not in self.outputs:
             raise KeyError(f"{name} was not derived (outputs: {', '.join(self.outputs)})")
         return ProgramMatrix(name, self.program.output(name), self.program.assignments)
@@ -143,8 +144,6 @@ class Dynamics:
         <eomgen.symbolic.named.ProgramMatrix.expand>`) when that takes at most
         :data:`~eomgen.symbolic.named.AUTO_EXPAND_WORK` term operations (about a
         second at most), else the named form."""
-        from .symbolic.named import AUTO_EXPAND_WORK, ExpansionTooLargeError
-
         if name not in self.outputs:
             raise KeyError(f"{name} was not derived (outputs: {', '.join(self.outputs)})")
         if self.simplified:
@@ -218,7 +217,10 @@ class Dynamics:
         """NumPy functions ``M(q, **p)``, ``C(q, qd, **p)``, ``g(q, **p)``,
         ``tau(q, qd, qdd, **p)`` compiled from the program (not from expanded matrices): the
         generated NumPy module's functions, with the parameters kept symbolic as keyword
-        arguments. See :class:`eomgen.lambdify.NumericDynamics`."""
+        arguments. See :class:`eomgen.lambdify.NumericDynamics`. A façade for the README's
+        API: the work is :func:`eomgen.lambdify.lambdify`."""
+        # Imported on first use: lambdify prints through code generation (Jinja, the NumPy
+        # backend), which derive never needs (start-up time).
         from .lambdify import lambdify
 
         return lambdify(self)

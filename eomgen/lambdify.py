@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import types
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Callable
+from typing import Callable
 
-if TYPE_CHECKING:
-    from .dynamics import Dynamics
+from .outputs import BY_SYMBOL, FORWARD
+from .symbolic.printing import exec_source
 
 
 @dataclass(frozen=True)
@@ -59,7 +59,7 @@ class NumericDynamics:
     source: str
 
 
-def lambdify(dynamics: Dynamics) -> NumericDynamics:
+def lambdify(dynamics: "eomgen.dynamics.Dynamics") -> NumericDynamics:  # noqa: F821
     """Compile the NumPy module of ``dynamics`` in memory (see :class:`NumericDynamics`).
 
     Examples
@@ -72,11 +72,11 @@ def lambdify(dynamics: Dynamics) -> NumericDynamics:
     >>> np.round(f.g(np.zeros(2), m2=2.0), 4)
     array([34.335,  9.81 ])
     """
+    # Imported on first use (start-up time): code generation loads Jinja and the backends,
+    # which `import eomgen` and derive never need.
     from .codegen import make_job
     from .codegen.backends.numpy_backend import NumPyConfig, NumPyModulePrinter, numpy_source
     from .codegen.functions import FUNCTION_OUTPUTS
-    from .outputs import BY_SYMBOL, FORWARD
-    from .symbolic.printing import exec_source
 
     derived = set(dynamics.outputs)
     functions = [f for f, needs in FUNCTION_OUTPUTS.items() if set(needs) <= derived]

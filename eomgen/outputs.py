@@ -190,7 +190,7 @@ BY_SYMBOL: dict[str, Output] = {}
 
 _REVOLUTE_EFFORT = "N m (revolute), N (prismatic)"
 #: M, C and g (and the potential energy P) come from one Lagrangian program.
-_LAGRANGIAN = "eomgen.symbolic.composite:build_lagrangian"
+_LAGRANGIAN = "eomgen.symbolic.routes:build_lagrangian"
 
 MASS = register_output(Output(
     "mass_matrix", "M", "Mass matrix M(q), symmetric positive definite.", ("q",), False,

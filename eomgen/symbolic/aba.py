@@ -37,93 +37,13 @@ import sympy as sp
 
 from ..bodies import BodyTree
 from ..model import RobotModel, Vec3
-from .composite import _cross, _dot, _matvec
-from .newton_euler import _Frames, _name, _name_all, grouped_inertials
-from .program import Tag, _tag
 from .derivation import new_derivation
-from .program import Program, ProgramBuilder
+from .crba import M_program
+from .newton_euler import grouped_inertials, inverse_dynamics_program
+from .program import Program, ProgramBuilder, name_expr, name_exprs, name_matrix, name_symmetric
+from .spatial import JointFrames, add, cross, dot, matvec, scale, skew, transpose
 
 _ZERO = sp.Integer(0)
-
-
-def _add(a, b) -> tuple:
-    return tuple(x + y for x, y in zip(a, b))
-
-
-def _scale(a, s) -> tuple:
-    return tuple(x * s for x in a)
-
-
-def _transpose(A) -> tuple:
-    return tuple(tuple(A[c][r] for c in range(3)) for r in range(3))
-
-
-def _skew_times(p, A) -> tuple:
-    """[p]× A, column by column."""
-    cols = [_cross(p, tuple(A[r][c] for r in range(3))) for c in range(3)]
-    return tuple(tuple(cols[c][r] for c in range(3)) for r in range(3))
-
-
-def _motion_to_body(frames: _Frames, i, ang, lin) -> tuple:
-    """Parent-coordinate motion vector (about the parent origin) → body i coordinates."""
-    moved = _add(lin, _cross(ang, frames.offset(i)))  # velocity of the point at body i's origin
-    return frames.to_body(i, ang), frames.to_body(i, moved)
-
-
-def _force_to_parent(frames: _Frames, i, n, f) -> tuple:
-    f_p = frames.to_parent(i, f)
-    return _add(frames.to_parent(i, n), _cross(frames.offset(i), f_p)), f_p
-
-
-def _inertia_to_parent(frames: _Frames, i, A, B, C, b: ProgramBuilder, tag) -> tuple:
-    """``X_iᵀ I X_i``: body-coordinate spatial inertia → parent coordinates and origin.
-
-    With R the rotation and p the offset of body i in its parent, and P = [p]×: the blocks are
-    rotated (R A Rᵀ, R B Rᵀ, R C Rᵀ), then referred to the parent origin:
-    A_p = A − B P − (B P)ᵀ − P C P, B_p = B + P C, C_p = C.
-    """
-    def rotated(X, hint, block, symmetric):
-        RX = [_name_all(b, frames.to_parent(i, tuple(X[r][c] for r in range(3))), f"{hint}r{c}_",
-                        ("RX", tag, block, c)) for c in range(3)]  # RX[c] = column c of R X
-        # row r of R X Rᵀ is R times row r of R X
-        out = [frames.to_parent(i, tuple(RX[c][r] for c in range(3))) for r in range(3)]
-        return (_symmetric if symmetric else _full)(b, out, hint, ("XIX", tag, block))
-
-    A = rotated(A, f"Ar{tag}_", 0, True)
-    B = rotated(B, f"Br{tag}_", 1, False)
-    C = rotated(C, f"Cr{tag}_", 2, True)
-    p = frames.offset(i)
-    if all(x == 0 for x in p):
-        return A, B, C
-    BP = _full(b, _transpose(_skew_times(p, _transpose(B))), f"BP{tag}_",
-               ("shift", tag, 0))  # −B [p]×
-    PC = _full(b, _skew_times(p, C), f"PC{tag}_", ("shift", tag, 1))  # [p]× C
-    PCP = _transpose(_skew_times(p, _transpose(PC)))  # −[p]× C [p]×
-    A_p = tuple(tuple(A[r][c] + BP[r][c] + BP[c][r] + PCP[r][c] for c in range(3))
-                for r in range(3))
-    B_p = tuple(tuple(B[r][c] + PC[r][c] for c in range(3)) for r in range(3))
-    return A_p, B_p, C
-
-
-def _entry_tag(tag, r, c):
-    tag = _tag(tag)
-    return None if tag is None else Tag(tag.family, tag.index + (r, c))
-
-
-def _symmetric(b: ProgramBuilder, A, hint: str, tag=None) -> tuple:
-    """Name the upper triangle of a symmetric 3×3 and mirror it (entry (r, c) tagged with
-    ``tag``'s index followed by r, c)."""
-    named = [[None] * 3 for _ in range(3)]
-    for r in range(3):
-        for c in range(r, 3):
-            named[r][c] = named[c][r] = _name(b, A[r][c], f"{hint}{r}{c}", _entry_tag(tag, r, c))
-    return tuple(tuple(row) for row in named)
-
-
-def _full(b: ProgramBuilder, A, hint: str, tag=None) -> tuple:
-    """Name every entry of a 3×3 (entry (r, c) tagged with ``tag``'s index followed by r, c)."""
-    return tuple(tuple(_name(b, A[r][c], f"{hint}{r}{c}", _entry_tag(tag, r, c))
-                       for c in range(3)) for r in range(3))
 
 
 def forward_dynamics_program(tree: BodyTree, q, qd, tau, gravity: Vec3, b: ProgramBuilder,
@@ -153,7 +73,7 @@ def forward_dynamics_program(tree: BodyTree, q, qd, tau, gravity: Vec3, b: Progr
     """
     n = len(tree.bodies)
     zero = (_ZERO,) * 3
-    frames = _Frames.named(tree, q, b)
+    frames = JointFrames.named(tree, q, b)
     inertials = grouped_inertials(tree) if grouped else [body.inertial for body in tree.bodies]
 
     def subspace(i):
@@ -170,23 +90,22 @@ def forward_dynamics_program(tree: BodyTree, q, qd, tau, gravity: Vec3, b: Progr
         if body.parent < 0:
             ang, lin = zero, zero
         else:
-            ang, lin = _motion_to_body(frames, i, *vel[body.parent])
-        ang = _name_all(b, _add(ang, _scale(S_ang, rate)), f"v{tag}w", ("Vb", tag, 0))
-        lin = _name_all(b, _add(lin, _scale(S_lin, rate)), f"v{tag}v", ("Vb", tag, 1))
+            ang, lin = frames.motion_to_body(i, *vel[body.parent])
+        ang = name_exprs(b, add(ang, scale(S_ang, rate)), f"v{tag}w", ("Vb", tag, 0))
+        lin = name_exprs(b, add(lin, scale(S_lin, rate)), f"v{tag}v", ("Vb", tag, 1))
         vel.append((ang, lin))
-        vJ_ang, vJ_lin = _scale(S_ang, rate), _scale(S_lin, rate)
-        c_ang = _cross(ang, vJ_ang)
-        c_lin = _add(_cross(ang, vJ_lin), _cross(lin, vJ_ang))
-        cvec.append((_name_all(b, c_ang, f"c{tag}w", ("cb", tag, 0)),
-                     _name_all(b, c_lin, f"c{tag}v", ("cb", tag, 1))))
+        vJ_ang, vJ_lin = scale(S_ang, rate), scale(S_lin, rate)
+        c_ang = cross(ang, vJ_ang)
+        c_lin = add(cross(ang, vJ_lin), cross(lin, vJ_ang))
+        cvec.append((name_exprs(b, c_ang, f"c{tag}w", ("cb", tag, 0)),
+                     name_exprs(b, c_lin, f"c{tag}v", ("cb", tag, 1))))
         par = inertials[i]
         m, h, I_O = par.mass, par.first_moment, par.inertia
-        Bh = ((0, -h[2], h[1]), (h[2], 0, -h[0]), (-h[1], h[0], 0))
-        IA.append([I_O, Bh, tuple(tuple(m if r == c else _ZERO for c in range(3)) for r in range(3))])
+        IA.append([I_O, skew(h), tuple(tuple(m if r == c else _ZERO for c in range(3)) for r in range(3))])
         # p = v ×* (I v): momentum (I_O ω + h × v_O, m v_O − h × ω)
-        mom_n = _name_all(b, _add(_matvec(I_O, ang), _cross(h, lin)), f"h{tag}n", ("hb", tag, 0))
-        mom_f = _name_all(b, _add(_scale(lin, m), _cross(ang, h)), f"h{tag}f", ("hb", tag, 1))
-        pA.append([_add(_cross(ang, mom_n), _cross(lin, mom_f)), _cross(ang, mom_f)])
+        mom_n = name_exprs(b, add(matvec(I_O, ang), cross(h, lin)), f"h{tag}n", ("hb", tag, 0))
+        mom_f = name_exprs(b, add(scale(lin, m), cross(ang, h)), f"h{tag}f", ("hb", tag, 1))
+        pA.append([add(cross(ang, mom_n), cross(lin, mom_f)), cross(ang, mom_f)])
 
     # pass 2: articulated inertias and bias forces, leaves to root
     Uvec: list = [None] * n
@@ -195,28 +114,28 @@ def forward_dynamics_program(tree: BodyTree, q, qd, tau, gravity: Vec3, b: Progr
     for i in reversed(range(n)):
         body = tree.bodies[i]
         tag = body.q_index + 1
-        A, B, C = (_symmetric(b, IA[i][0], f"IA{tag}_A", ("IAb", tag, 0)),
-                   _full(b, IA[i][1], f"IA{tag}_B", ("IAb", tag, 1)),
-                   _symmetric(b, IA[i][2], f"IA{tag}_C", ("IAb", tag, 2)))
-        p_n = _name_all(b, pA[i][0], f"pA{tag}n", ("pA", tag, 0))
-        p_f = _name_all(b, pA[i][1], f"pA{tag}f", ("pA", tag, 1))
+        A, B, C = (name_symmetric(b, IA[i][0], f"IA{tag}_A", ("IAb", tag, 0)),
+                   name_matrix(b, IA[i][1], f"IA{tag}_B", ("IAb", tag, 1)),
+                   name_symmetric(b, IA[i][2], f"IA{tag}_C", ("IAb", tag, 2)))
+        p_n = name_exprs(b, pA[i][0], f"pA{tag}n", ("pA", tag, 0))
+        p_f = name_exprs(b, pA[i][1], f"pA{tag}f", ("pA", tag, 1))
         S_ang, S_lin = subspace(i)
         # U = I^A S (6-vector: moment part, force part)
-        U_n = _name_all(b, _add(_matvec(A, S_ang), _matvec(B, S_lin)), f"U{tag}n",
+        U_n = name_exprs(b, add(matvec(A, S_ang), matvec(B, S_lin)), f"U{tag}n",
                         ("UA", tag, 0))
-        U_f = _name_all(b, _add(_matvec(_transpose(B), S_ang), _matvec(C, S_lin)), f"U{tag}f",
+        U_f = name_exprs(b, add(matvec(transpose(B), S_ang), matvec(C, S_lin)), f"U{tag}f",
                         ("UA", tag, 1))
-        D = _name(b, _dot(S_ang, U_n) + _dot(S_lin, U_f), f"D{tag}", ("D", tag))
-        Dinv[i] = _name(b, 1 / D, f"Dinv{tag}", ("Dinv", tag))
-        uval[i] = _name(b, tau[body.q_index] - _dot(S_ang, p_n) - _dot(S_lin, p_f), f"u{tag}",
+        D = name_expr(b, dot(S_ang, U_n) + dot(S_lin, U_f), f"D{tag}", ("D", tag))
+        Dinv[i] = name_expr(b, 1 / D, f"Dinv{tag}", ("Dinv", tag))
+        uval[i] = name_expr(b, tau[body.q_index] - dot(S_ang, p_n) - dot(S_lin, p_f), f"u{tag}",
                         ("u", tag))
         Uvec[i] = (U_n, U_f)
         p = body.parent
         if p < 0:
             continue
         # I^a = I^A − U Uᵀ / D; along a coordinate-axis S its row and column vanish exactly
-        Ud_n = _name_all(b, _scale(U_n, Dinv[i]), f"Ud{tag}n", ("Ud", tag, 0))
-        Ud_f = _name_all(b, _scale(U_f, Dinv[i]), f"Ud{tag}f", ("Ud", tag, 1))
+        Ud_n = name_exprs(b, scale(U_n, Dinv[i]), f"Ud{tag}n", ("Ud", tag, 0))
+        Ud_f = name_exprs(b, scale(U_f, Dinv[i]), f"Ud{tag}f", ("Ud", tag, 1))
         six_S = S_ang + S_lin
         axis = [j for j in range(6) if six_S[j] != 0]
         exact_zero = set(axis) if len(axis) == 1 and abs(six_S[axis[0]]) == 1 else set()
@@ -228,24 +147,24 @@ def forward_dynamics_program(tree: BodyTree, q, qd, tau, gravity: Vec3, b: Progr
             for c in range(r, 6):
                 if r in exact_zero or c in exact_zero:
                     continue
-                Ia[r][c] = Ia[c][r] = _name(b, full6[r][c] - Ud6[r] * U6[c], f"Ia{tag}_{r}{c}",
+                Ia[r][c] = Ia[c][r] = name_expr(b, full6[r][c] - Ud6[r] * U6[c], f"Ia{tag}_{r}{c}",
                                             ("Ia", tag, r, c))
         # p^a = p^A + I^a c + U u / D
         c6 = cvec[i][0] + cvec[i][1]
         Iac = [sp.Add(*[Ia[r][k] * c6[k] for k in range(6)]) for r in range(6)]
         pa = [p_n[r] + Iac[r] + Ud_n[r] * uval[i] for r in range(3)]
         pa_f = [p_f[r] + Iac[r + 3] + Ud_f[r] * uval[i] for r in range(3)]
-        pa_n = _name_all(b, pa, f"pa{tag}n", ("pa", tag, 0))
-        pa_f = _name_all(b, pa_f, f"pa{tag}f", ("pa", tag, 1))
+        pa_n = name_exprs(b, pa, f"pa{tag}n", ("pa", tag, 0))
+        pa_f = name_exprs(b, pa_f, f"pa{tag}f", ("pa", tag, 1))
         a_blk = tuple(tuple(Ia[r][c] for c in range(3)) for r in range(3))
         b_blk = tuple(tuple(Ia[r][c + 3] for c in range(3)) for r in range(3))
         c_blk = tuple(tuple(Ia[r + 3][c + 3] for c in range(3)) for r in range(3))
-        A_p, B_p, C_p = _inertia_to_parent(frames, i, a_blk, b_blk, c_blk, b, tag)
+        A_p, B_p, C_p = frames.inertia_to_parent(i, a_blk, b_blk, c_blk, b, tag)
         IA[p] = [tuple(tuple(x + y for x, y in zip(r1, r2)) for r1, r2 in zip(IA[p][0], A_p)),
                  tuple(tuple(x + y for x, y in zip(r1, r2)) for r1, r2 in zip(IA[p][1], B_p)),
                  tuple(tuple(x + y for x, y in zip(r1, r2)) for r1, r2 in zip(IA[p][2], C_p))]
-        n_p, f_p = _force_to_parent(frames, i, pa_n, pa_f)
-        pA[p] = [_add(pA[p][0], n_p), _add(pA[p][1], f_p)]
+        n_p, f_p = frames.force_to_parent(i, pa_n, pa_f)
+        pA[p] = [add(pA[p][0], n_p), add(pA[p][1], f_p)]
 
     # pass 3: accelerations, root to leaves
     qdd = sp.zeros(n, 1)
@@ -254,16 +173,16 @@ def forward_dynamics_program(tree: BodyTree, q, qd, tau, gravity: Vec3, b: Progr
     for i, body in enumerate(tree.bodies):
         tag = body.q_index + 1
         a_ang, a_lin = base if body.parent < 0 else acc[body.parent]
-        a_ang, a_lin = _motion_to_body(frames, i, a_ang, a_lin)
-        a_ang = _name_all(b, _add(a_ang, cvec[i][0]), f"ap{tag}w", ("aprime", tag, 0))
-        a_lin = _name_all(b, _add(a_lin, cvec[i][1]), f"ap{tag}v", ("aprime", tag, 1))
+        a_ang, a_lin = frames.motion_to_body(i, a_ang, a_lin)
+        a_ang = name_exprs(b, add(a_ang, cvec[i][0]), f"ap{tag}w", ("aprime", tag, 0))
+        a_lin = name_exprs(b, add(a_lin, cvec[i][1]), f"ap{tag}v", ("aprime", tag, 1))
         U_n, U_f = Uvec[i]
-        x = _name(b, Dinv[i] * (uval[i] - _dot(U_n, a_ang) - _dot(U_f, a_lin)), f"qdd{tag}",
+        x = name_expr(b, Dinv[i] * (uval[i] - dot(U_n, a_ang) - dot(U_f, a_lin)), f"qdd{tag}",
                   ("qdd", tag))
         qdd[body.q_index, 0] = x
         S_ang, S_lin = subspace(i)
-        acc[i] = (_name_all(b, _add(a_ang, _scale(S_ang, x)), f"a{tag}w", ("ab", tag, 0)),
-                  _name_all(b, _add(a_lin, _scale(S_lin, x)), f"a{tag}v", ("ab", tag, 1)))
+        acc[i] = (name_exprs(b, add(a_ang, scale(S_ang, x)), f"a{tag}w", ("ab", tag, 0)),
+                  name_exprs(b, add(a_lin, scale(S_lin, x)), f"a{tag}v", ("ab", tag, 1)))
     return qdd
 
 
@@ -318,9 +237,6 @@ def cholesky_program(model: RobotModel) -> ForwardDynamics:
     A generated module's ``forward_dynamics`` does the same arithmetic with its own
     M (the root-frame composite program) and a numeric Cholesky factorisation.
     """
-    from .crba import M_program
-    from .newton_euler import inverse_dynamics_program
-
     d = new_derivation(model, ("q", "qd", "tau"))
     tree, q, qd, tau, b = d.tree, d.q, d.qd, d.tau, d.builder
     n = model.dof
@@ -332,18 +248,18 @@ def cholesky_program(model: RobotModel) -> ForwardDynamics:
         for i in range(j, n):
             value = M[i, j] - sp.Add(*[L[i][k] * L[j][k] for k in range(j)])
             if i == j:
-                L[j][j] = _name(b, sp.sqrt(value), f"L{j + 1}_{j + 1}", ("L", j + 1, j + 1))
-                inv_diag[j] = _name(b, 1 / L[j][j], f"Linv{j + 1}", ("Linv", j + 1))
+                L[j][j] = name_expr(b, sp.sqrt(value), f"L{j + 1}_{j + 1}", ("L", j + 1, j + 1))
+                inv_diag[j] = name_expr(b, 1 / L[j][j], f"Linv{j + 1}", ("Linv", j + 1))
             else:
-                L[i][j] = _name(b, value * inv_diag[j], f"L{i + 1}_{j + 1}", ("L", i + 1, j + 1))
+                L[i][j] = name_expr(b, value * inv_diag[j], f"L{i + 1}_{j + 1}", ("L", i + 1, j + 1))
     y = [_ZERO] * n
     for i in range(n):
         rhs = tau[i] - bias[i, 0] - sp.Add(*[L[i][k] * y[k] for k in range(i)])
-        y[i] = _name(b, rhs * inv_diag[i], f"y{i + 1}", ("ychol", i + 1))
+        y[i] = name_expr(b, rhs * inv_diag[i], f"y{i + 1}", ("ychol", i + 1))
     x = [_ZERO] * n
     for i in reversed(range(n)):
         rhs = y[i] - sp.Add(*[L[k][i] * x[k] for k in range(i + 1, n)])
-        x[i] = _name(b, rhs * inv_diag[i], f"qdd{i + 1}", ("qdd", i + 1))
+        x[i] = name_expr(b, rhs * inv_diag[i], f"qdd{i + 1}", ("qdd", i + 1))
     return ForwardDynamics(q, qd, tau, d.program([("qdd", sp.Matrix(x))]))
 
 

@@ -17,10 +17,11 @@ from __future__ import annotations
 import sympy as sp
 
 from ..model import RobotModel
+from ..outputs import BY_SYMBOL
 from .crba import M_program
-from .newton_euler import _name, inverse_dynamics_program
 from .derivation import new_derivation
-from .program import Program
+from .newton_euler import inverse_dynamics_program
+from .program import Program, name_expr
 
 
 def dynamics_program(model: RobotModel) -> tuple[tuple, tuple, Program]:
@@ -40,7 +41,7 @@ def dynamics_program(model: RobotModel) -> tuple[tuple, tuple, Program]:
     M = M_program(tree, q, b)
     g = inverse_dynamics_program(tree, q, zero, zero, model.gravity, b)
     bias = inverse_dynamics_program(tree, q, qd, zero, model.gravity, b)
-    Cqd = sp.Matrix([[_name(b, bias[k, 0] - g[k, 0], f"Cqd{k + 1}", ("Cqd", k + 1))]
+    Cqd = sp.Matrix([[name_expr(b, bias[k, 0] - g[k, 0], f"Cqd{k + 1}", ("Cqd", k + 1))]
                      for k in range(n)])
     outputs = (("M", M), ("Cqd", Cqd), ("g", g))
     return q, qd, d.program(outputs)
@@ -61,8 +62,6 @@ def build_combined(derivation, wanted) -> dict:
     (n × (n + 1)), returned as (M, h): the results side by side from the outputs already in
     the program (``derivation.output``), so that they are the separate functions' own results
     and share every intermediate; the generated module splits them into tuples."""
-    from ..outputs import BY_SYMBOL
-
     result = {}
     for symbol in wanted:
         parts = BY_SYMBOL[symbol].returns

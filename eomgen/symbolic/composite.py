@@ -1,14 +1,13 @@
-"""M, C and g as straight-line programs: composite bodies, the CRBA, Newton–Euler at rest and
-Echeandia and Wensing's Coriolis recursion, whichever is cheaper for the robot.
+"""M, C and g in world axes: composite bodies, the Christoffel symbols of the closed-form ∂M/∂q
+and Echeandia and Wensing's Coriolis recursion, as straight-line programs.
 
-:func:`derive_program` (what :func:`eomgen.derive` calls) builds each asked output by the
-cheaper of two exact programs (:func:`cheapest_routes`): M by the body-frame CRBA
-(:mod:`eomgen.symbolic.crba`) or by the world-frame composite bodies below; C by the O(n²)
-recursion of :func:`coriolis_program` or by the Christoffel symbols below; g by the
-Newton–Euler program at rest (:mod:`eomgen.symbolic.newton_euler`) or from the composite
-bodies below. Every route gives the same matrices; C is always the Christoffel C.
+These are the world-frame routes among which :mod:`eomgen.symbolic.routes` chooses (beside the
+body-frame CRBA of :mod:`eomgen.symbolic.crba` and the Newton–Euler g of
+:mod:`eomgen.symbolic.newton_euler`); every route gives the same matrices, C is always the
+Christoffel C. :func:`forward_kinematics` (world rotations, origins and motion axes) is also
+what :mod:`eomgen.symbolic.frames` builds on.
 
-The world-frame routes are the Lagrangian method, M = Σ_l J_lᵀ I_l J_l and c_ijk = ½(∂M_ij/∂q_k + ∂M_ik/∂q_j −
+The world-frame programs are the Lagrangian method, M = Σ_l J_lᵀ I_l J_l and c_ijk = ½(∂M_ij/∂q_k + ∂M_ik/∂q_j −
 ∂M_jk/∂q_i), with the sums over links regrouped by subtree so that no expression grows with the
 number of links:
 
@@ -42,83 +41,14 @@ Units: SI (rad, m, kg, s). Sign convention: M q̈ + C q̇ + g = τ.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Iterable
 
 import sympy as sp
 
 from ..bodies import BodyTree
-from ..model import Mat3, Vec3
-from .program import Program, ProgramBuilder, rough_operation_count
-
-
-def _cross(a: Vec3, b: Vec3) -> tuple:
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _dot(a, b) -> sp.Expr:
-    return sp.Add(*[x * y for x, y in zip(a, b)])
-
-
-def _matvec(A, v) -> tuple:
-    return tuple(sp.Add(*[A[r][k] * v[k] for k in range(3)]) for r in range(3))
-
-
-def _matmul(A, B) -> tuple:
-    return tuple(tuple(sp.Add(*[A[r][k] * B[k][c] for k in range(3)]) for c in range(3))
-                 for r in range(3))
-
-
-def _rotation(axis: Vec3, c, s) -> tuple:
-    """Rotation about unit ``axis`` by the angle whose cosine and sine are ``c`` and ``s``."""
-    x, y, z = axis
-    t = 1 - c
-    return (
-        (t * x * x + c, t * x * y - s * z, t * x * z + s * y),
-        (t * x * y + s * z, t * y * y + c, t * y * z - s * x),
-        (t * x * z - s * y, t * y * z + s * x, t * z * z + c),
-    )
-
-
-@dataclass
-class SpatialInertia:
-    """Inertial parameters about the reference point o (world orientation): mass, first moment h,
-    inertia Ī (3×3)."""
-
-    mass: sp.Expr
-    h: tuple
-    I: tuple
-
-    def __add__(self, other: "SpatialInertia") -> "SpatialInertia":
-        return SpatialInertia(
-            self.mass + other.mass,
-            tuple(a + b for a, b in zip(self.h, other.h)),
-            tuple(tuple(a + b for a, b in zip(r, s)) for r, s in zip(self.I, other.I)),
-        )
-
-    def apply(self, S: tuple) -> tuple:
-        """Momentum ``I S`` of the motion ``S = [ω; v]``: ``[Ī ω + h × v; m v − h × ω]``."""
-        w, v = S[:3], S[3:]
-        Iw = _matvec(self.I, w)
-        hv = _cross(self.h, v)
-        hw = _cross(self.h, w)
-        n = tuple(Iw[r] + hv[r] for r in range(3))
-        f = tuple(self.mass * v[r] - hw[r] for r in range(3))
-        return n + f
-
-
-def motion_cross(a: tuple, b: tuple) -> tuple:
-    """Spatial motion cross product ``a × b`` = [ω_a × ω_b; ω_a × v_b + v_a × ω_b]."""
-    wa, va, wb, vb = a[:3], a[3:], b[:3], b[3:]
-    w = _cross(wa, wb)
-    v1, v2 = _cross(wa, vb), _cross(va, wb)
-    return w + tuple(v1[r] + v2[r] for r in range(3))
-
-
-def force_cross(a: tuple, f: tuple) -> tuple:
-    """Spatial force cross product ``a ×* f`` = [ω × n + v × f; ω × f]."""
-    w, v, n, lin = a[:3], a[3:], f[:3], f[3:]
-    n1, n2 = _cross(w, n), _cross(v, lin)
-    return tuple(n1[r] + n2[r] for r in range(3)) + _cross(w, lin)
+from ..model import Vec3
+from .program import ProgramBuilder
+from .spatial import (SpatialInertia, cross, dot, force_cross, matmul, matvec, motion_cross,
+                      mul, rotation)
 
 
 @dataclass
@@ -148,20 +78,20 @@ def forward_kinematics(tree: BodyTree, q, b: ProgramBuilder) -> Kinematics:
         else:
             Rp, pp = kin.R[body.parent], kin.p[body.parent]
             R0 = tuple(b.define_all(row, f"A{n}_{r}", ("A", n, r)) for r, row in
-                       enumerate(_matmul(Rp, body.placement.rotation)))
+                       enumerate(matmul(Rp, body.placement.rotation)))
             p0 = b.define_all(tuple(pp[r] + e for r, e in
-                                    enumerate(_matvec(Rp, body.placement.translation))), f"o{n}_",
+                                    enumerate(matvec(Rp, body.placement.translation))), f"o{n}_",
                                 ("o", n))
-        z = b.define_all(_matvec(R0, joint.axis), f"z{n}_", ("z", n))
+        z = b.define_all(matvec(R0, joint.axis), f"z{n}_", ("z", n))
         qi = q[body.q_index]
         if joint.type.is_revolute:
             s = b.define(sp.sin(qi), f"s{n}", ("s", n))
             c = b.define(sp.cos(qi), f"c{n}", ("c", n))
             kin.sin_cos.append((s, c))
             R = tuple(b.define_all(row, f"R{n}_{r}", ("R", n, r)) for r, row in
-                      enumerate(_matmul(R0, _rotation(joint.axis, c, s))))
+                      enumerate(matmul(R0, rotation(joint.axis, c, s))))
             p = p0
-            S = z + b.define_all(_cross(p, z), f"v{n}_", ("v", n))
+            S = z + b.define_all(cross(p, z), f"v{n}_", ("v", n))
         else:
             kin.sin_cos.append(None)
             R = R0
@@ -181,12 +111,13 @@ def body_inertia_in_world(tree: BodyTree, kin: Kinematics, b: ProgramBuilder) ->
         n = body.q_index + 1
         par = body.inertial
         R, p, m = kin.R[i], kin.p[i], par.mass
-        Rh = b.define_all(_matvec(R, par.first_moment), f"Rh{n}_",
+        Rh = b.define_all(matvec(R, par.first_moment), f"Rh{n}_",
                           ("Rh", n))
-        RI = _matmul(R, par.inertia)
-        RIRt = [[sp.Add(*[RI[r][k] * R[c][k] for k in range(3)]) for c in range(3)] for r in range(3)]
+        RI = matmul(R, par.inertia)
+        RIRt = [[sp.Add(*[mul(RI[r][k], R[c][k]) for k in range(3)]) for c in range(3)]
+                for r in range(3)]
         pp = sp.Add(*[x * x for x in p])
-        pRh = _dot(p, Rh)
+        pRh = dot(p, Rh)
         I = [[None] * 3 for _ in range(3)]
         for r in range(3):
             for c in range(r, 3):
@@ -225,101 +156,6 @@ def is_ancestor_or_self(tree: BodyTree, a: int, j: int) -> bool:
     return False
 
 
-def _routes() -> dict:
-    """The programs of each output: ``{output: ((name, build), …)}`` with
-    ``build(tree, q, qd, gravity, b)`` returning the output's matrix."""
-    from .crba import M_program
-    from .newton_euler import inverse_dynamics_program
-
-    def rnea_gravity(tree, q, qd, gravity, b):
-        zero = (sp.Integer(0),) * len(tree.bodies)
-        return inverse_dynamics_program(tree, q, zero, zero, gravity, b, hint="g")
-
-    return {
-        "M": (("CRBA", lambda tree, q, qd, gravity, b: M_program(tree, q, b)),
-              ("composite", lambda tree, q, qd, gravity, b: composite_M_program(tree, q, b))),
-        "C": (("recursion", lambda tree, q, qd, gravity, b: coriolis_program(tree, q, qd, b)),
-              ("Christoffel", _christoffel_route)),
-        "g": (("Newton-Euler", rnea_gravity),
-              ("composite", lambda tree, q, qd, gravity, b:
-               composite_gravity_program(tree, q, gravity, b))),
-    }
-
-
-#: Above this many joints the Christoffel-symbol C is not tried: its O(n³) program was larger
-#: than the recursion's O(n²) one on every robot measured with 6 joints (random arms with
-#: general axes: 4,222–5,007 against 3,701–4,140 operations; the 6-link spatial chain of
-#: benchmarks/complexity.py 4,059 against 3,354; 5 joints: 3,163–3,512 against 3,120–3,351),
-#: and building it dominates ``derive``'s time for long chains.
-CHRISTOFFEL_MAX_JOINTS = 5
-
-
-def _christoffel_route(tree, q, qd, gravity, b):
-    if len(tree.bodies) > CHRISTOFFEL_MAX_JOINTS:
-        return None
-    return christoffel_coriolis_program(tree, q, qd, b)
-
-
-def cheapest_routes(tree: BodyTree, q, qd, gravity: Vec3, outputs: Iterable[str],
-                    reserved=()) -> tuple[dict[str, str], Program]:
-    """Build every route (see :func:`derive_program`) of each of ``outputs`` into one scratch
-    builder, where they share their common work (the world-frame composites, sines and
-    cosines), and keep for each output the route whose own program has the fewest operations
-    (:func:`~eomgen.symbolic.program.rough_operation_count`; the first route on a tie).
-
-    Returns ``({output: route name}, the program of the chosen outputs, pruned)``.
-    """
-    scratch = ProgramBuilder(reserved)
-    routes = _routes()
-    chosen, best_matrices = {}, []
-    for output in outputs:
-        best = None
-        for name, build in routes[output]:
-            matrix = build(tree, q, qd, gravity, scratch)
-            if matrix is None:  # route not tried for this robot
-                continue
-            used = Program(tuple(scratch.assignments), ((output, matrix),)).pruned([output])
-            count = rough_operation_count([e for _, e in used.assignments] + list(matrix))
-            if best is None or count < best[0]:
-                best = (count, name, matrix)
-        chosen[output] = best[1]
-        best_matrices.append((output, best[2]))
-    program = Program(tuple(scratch.assignments), tuple(best_matrices))
-    return chosen, program.pruned([o for o, _ in best_matrices])
-
-
-def derive_program(tree: BodyTree, q, qd, gravity: Vec3, outputs: set[str], b: ProgramBuilder) -> dict:
-    """Build M, C and/or g (as asked in ``outputs``) into the program builder ``b``.
-
-    Each output has two exact programs, and the one with fewer operations for this robot is
-    built (:func:`cheapest_routes`):
-
-    * ``M``: the body-frame CRBA (:func:`eomgen.symbolic.crba.M_program`), cheapest
-      for joint axes along the link frames' axes (the Panda: 641 operations against 1,784), or
-      ``M_ij = S_iᵀ I^c_j S_j`` in world axes (:func:`composite_M_program`), cheaper
-      for general axes, whose body-frame rotations cost more than one world rotation per body;
-    * ``C``: Echeandia and Wensing's recursion (:func:`coriolis_program`, O(n²)) or the
-      Christoffel symbols of ∂M/∂q (:func:`christoffel_coriolis_program`, O(n³) but fewer
-      intermediates for two to four joints; tried up to :data:`CHRISTOFFEL_MAX_JOINTS`
-      joints): the same matrix;
-    * ``g``: the Newton–Euler program at rest, ``g = τ(q, 0, 0)``
-      (:func:`eomgen.symbolic.newton_euler.inverse_dynamics_program`), or ``g_i = −g_vecᵀ f_i``
-      from the composite bodies (:func:`composite_gravity_program`);
-
-    and ``P`` (with g) from the world-frame kinematics (:func:`potential_energy`).
-
-    Returns a dict with SymPy matrices in terms of intermediates: ``"M"`` (n×n), ``"C"`` (n×n),
-    ``"g"`` (n×1), plus ``"P"`` (1×1 potential energy, when g is asked).
-    """
-    _, program = cheapest_routes(tree, q, qd, gravity,
-                                 [o for o in ("M", "g", "C") if o in outputs], b.reserved)
-    result = b.absorb(program)
-    if "g" in outputs:
-        kin = forward_kinematics(tree, q, b)
-        result["P"] = sp.Matrix([[b.define(potential_energy(tree, kin, gravity), "P", ("P",))]])
-    return result
-
-
 def _world_composites(tree: BodyTree, q, b: ProgramBuilder) -> tuple:
     """World-frame kinematics, body and composite inertias and ``F_j = I^c_j S_j`` of every
     body (built once per builder, tree and q)."""
@@ -344,7 +180,7 @@ def composite_M_program(tree: BodyTree, q, b: ProgramBuilder) -> sp.Matrix:
     M = sp.zeros(n, n)
     for j in range(n):
         for i in [j] + tree.ancestors(j):
-            value = b.define(_dot(kin.S[i], F[j]), f"M{idx[i] + 1}_{idx[j] + 1}",
+            value = b.define(dot(kin.S[i], F[j]), f"M{idx[i] + 1}_{idx[j] + 1}",
                              ("M", idx[i] + 1, idx[j] + 1))
             M[idx[i], idx[j]] = M[idx[j], idx[i]] = value
     return M
@@ -356,7 +192,7 @@ def composite_gravity_program(tree: BodyTree, q, gravity: Vec3, b: ProgramBuilde
     _, _, _, F = _world_composites(tree, q, b)
     g = sp.zeros(len(tree.bodies), 1)
     for i, body in enumerate(tree.bodies):
-        g[body.q_index, 0] = b.define(-_dot(gravity, F[i][3:]), f"g{body.q_index + 1}",
+        g[body.q_index, 0] = b.define(-dot(gravity, F[i][3:]), f"g{body.q_index + 1}",
                                       ("g", body.q_index + 1))
     return g
 
@@ -374,10 +210,10 @@ def potential_energy(tree: BodyTree, kin: Kinematics, gravity: Vec3) -> sp.Expr:
     moment = [sp.Integer(0)] * 3
     for i, body in enumerate(tree.bodies):
         par = body.inertial
-        Rh = _matvec(kin.R[i], par.first_moment)
+        Rh = matvec(kin.R[i], par.first_moment)
         for r in range(3):
             moment[r] += par.mass * (kin.origin[r] + kin.p[i][r]) + Rh[r]
-    return -_dot(gravity, moment)
+    return -dot(gravity, moment)
 
 
 def coriolis_program(tree: BodyTree, q, qd, b: ProgramBuilder) -> sp.Matrix:
@@ -421,10 +257,10 @@ def coriolis_program(tree: BodyTree, q, qd, b: ProgramBuilder) -> sp.Matrix:
     for i, par in enumerate(world):
         w, v = V[i][:3], V[i][3:]
         momentum.append(list(par.apply(V[i])))
-        wh = _cross(w, par.h)
+        wh = cross(w, par.h)
         h_rate.append([par.mass * v[r] + wh[r] for r in range(3)])
-        A = [_cross(w, tuple(par.I[r][c] for r in range(3))) for c in range(3)]  # columns of [ω]× Ī
-        hv = 2 * _dot(par.h, v)
+        A = [cross(w, tuple(par.I[r][c] for r in range(3))) for c in range(3)]  # columns of [ω]× Ī
+        hv = 2 * dot(par.h, v)
         I_rate.append([[A[c][r] + A[r][c] - v[r] * par.h[c] - par.h[r] * v[c]
                         + (hv if r == c else 0) for c in range(3)] for r in range(3)])
     for i in reversed(range(n)):
@@ -452,7 +288,7 @@ def coriolis_program(tree: BodyTree, q, qd, b: ProgramBuilder) -> sp.Matrix:
         ISd = comp[j].apply(Sd[j])
         F1 = b.define_all(tuple(ISd[r] + half * (IdS[r] + X[r]) for r in range(6)), f"Fa{tag}_",
                           ("Fa", tag))
-        C[tag - 1, tag - 1] = b.define(_dot(S[j], F1), f"C{tag}_{tag}", ("C", tag, tag))
+        C[tag - 1, tag - 1] = b.define(dot(S[j], F1), f"C{tag}_{tag}", ("C", tag, tag))
         ancestors = tree.ancestors(j)
         if not ancestors:
             continue
@@ -460,8 +296,8 @@ def coriolis_program(tree: BodyTree, q, qd, b: ProgramBuilder) -> sp.Matrix:
                           ("Fb", tag))
         for i in ancestors:
             a, c = tree.bodies[i].q_index, tree.bodies[j].q_index
-            C[a, c] = b.define(_dot(S[i], F1), f"C{idx[i]}_{tag}", ("C", idx[i], tag))
-            C[c, a] = b.define(_dot(Sd[i], F) + _dot(S[i], F3), f"C{tag}_{idx[i]}",
+            C[a, c] = b.define(dot(S[i], F1), f"C{idx[i]}_{tag}", ("C", idx[i], tag))
+            C[c, a] = b.define(dot(Sd[i], F) + dot(S[i], F3), f"C{tag}_{idx[i]}",
                                ("C", tag, idx[i]))
     return C
 
@@ -509,7 +345,7 @@ def _coriolis(tree, S, F, comp, qd, idx, b: ProgramBuilder) -> sp.Matrix:
         if key in dM_cache:
             return dM_cache[key]
         if anc[i][k] and i != k and anc[k][j]:
-            value = _dot(S[i], SxF(k, j))
+            value = dot(S[i], SxF(k, j))
         elif anc[j][k] and j != k:
             a, b_, c, d = SxS(k, i), IS(k, j), IS(k, i), SxS(k, j)
             value = sp.Add(*[-x * y for x, y in zip(a, b_) if x != 0 and y != 0],
@@ -541,12 +377,3 @@ def _coriolis(tree, S, F, comp, qd, idx, b: ProgramBuilder) -> sp.Matrix:
             C[idx[i], idx[j]] = b.define(sp.Add(*terms), f"C{idx[i] + 1}_{idx[j] + 1}",
                                           ("C", idx[i] + 1, idx[j] + 1))
     return C
-
-
-def build_lagrangian(derivation, wanted) -> dict:
-    """The builder of M, C and g in :mod:`eomgen.outputs`: :func:`derive_program` on the
-    derivation's body tree for the ``wanted`` ones, with the potential energy ``P`` [J] when g is
-    among them."""
-    result = derive_program(derivation.tree, derivation.q, derivation.qd,
-                            derivation.model.gravity, set(wanted), derivation.builder)
-    return {name: result[name] for name in ("M", "C", "g", "P") if name in result}

@@ -19,11 +19,10 @@ import sympy as sp
 
 from ..bodies import BodyTree
 from ..model import RobotModel
-from .aba import _force_to_parent, _Frames, _full, _inertia_to_parent, _symmetric
-from .composite import _dot, _matvec
-from .newton_euler import _name, _name_all, grouped_inertials
 from .derivation import new_derivation
-from .program import Program, ProgramBuilder
+from .newton_euler import grouped_inertials
+from .program import Program, ProgramBuilder, name_expr, name_exprs, name_matrix, name_symmetric
+from .spatial import JointFrames, dot, matvec, skew, transpose
 
 _ZERO = sp.Integer(0)
 
@@ -33,13 +32,12 @@ def M_program(tree: BodyTree, q, b: ProgramBuilder, grouped: bool = True) -> sp.
     [kg m², kg m, kg] in ``JOINT_NAMES`` order."""
     n = len(tree.bodies)
     zero = (_ZERO,) * 3
-    frames = _Frames.named(tree, q, b)
+    frames = JointFrames.named(tree, q, b)
     inertials = grouped_inertials(tree) if grouped else [body.inertial for body in tree.bodies]
     IC = []
     for par in inertials:
         h, m = par.first_moment, par.mass
-        Bh = ((_ZERO, -h[2], h[1]), (h[2], _ZERO, -h[0]), (-h[1], h[0], _ZERO))
-        IC.append([par.inertia, Bh, tuple(tuple(m if r == c else _ZERO for c in range(3))
+        IC.append([par.inertia, skew(h), tuple(tuple(m if r == c else _ZERO for c in range(3))
                                           for r in range(3))])
 
     def subspace(i):
@@ -51,30 +49,30 @@ def M_program(tree: BodyTree, q, b: ProgramBuilder, grouped: bool = True) -> sp.
     for i in reversed(range(n)):
         body = tree.bodies[i]
         tag = body.q_index + 1
-        A = _symmetric(b, IC[i][0], f"Ic{tag}_A", ("Icb", tag, 0))
-        B = _full(b, IC[i][1], f"Ic{tag}_B", ("Icb", tag, 1))
-        C = _symmetric(b, IC[i][2], f"Ic{tag}_C", ("Icb", tag, 2))
+        A = name_symmetric(b, IC[i][0], f"Ic{tag}_A", ("Icb", tag, 0))
+        B = name_matrix(b, IC[i][1], f"Ic{tag}_B", ("Icb", tag, 1))
+        C = name_symmetric(b, IC[i][2], f"Ic{tag}_C", ("Icb", tag, 2))
         S_ang, S_lin = subspace(i)
-        Bt = tuple(tuple(B[c][r] for c in range(3)) for r in range(3))
-        F_n = _name_all(b, tuple(x + y for x, y in zip(_matvec(A, S_ang), _matvec(B, S_lin))),
+        Bt = transpose(B)
+        F_n = name_exprs(b, tuple(x + y for x, y in zip(matvec(A, S_ang), matvec(B, S_lin))),
                         f"F{tag}_{tag}n", ("Fbody", tag, tag, 0))
-        F_f = _name_all(b, tuple(x + y for x, y in zip(_matvec(Bt, S_ang), _matvec(C, S_lin))),
+        F_f = name_exprs(b, tuple(x + y for x, y in zip(matvec(Bt, S_ang), matvec(C, S_lin))),
                         f"F{tag}_{tag}f", ("Fbody", tag, tag, 1))
-        M[body.q_index, body.q_index] = _name(b, _dot(S_ang, F_n) + _dot(S_lin, F_f),
+        M[body.q_index, body.q_index] = name_expr(b, dot(S_ang, F_n) + dot(S_lin, F_f),
                                               f"M{tag}_{tag}", ("M", tag, tag))
         j = i
         while tree.bodies[j].parent >= 0:
-            F_n, F_f = _force_to_parent(frames, j, F_n, F_f)
+            F_n, F_f = frames.force_to_parent(j, F_n, F_f)
             j = tree.bodies[j].parent
             other = tree.bodies[j].q_index
-            F_n = _name_all(b, F_n, f"F{other + 1}_{tag}n", ("Fbody", other + 1, tag, 0))
-            F_f = _name_all(b, F_f, f"F{other + 1}_{tag}f", ("Fbody", other + 1, tag, 1))
+            F_n = name_exprs(b, F_n, f"F{other + 1}_{tag}n", ("Fbody", other + 1, tag, 0))
+            F_f = name_exprs(b, F_f, f"F{other + 1}_{tag}f", ("Fbody", other + 1, tag, 1))
             S_ang, S_lin = subspace(j)
-            value = _name(b, _dot(S_ang, F_n) + _dot(S_lin, F_f), f"M{other + 1}_{tag}",
+            value = name_expr(b, dot(S_ang, F_n) + dot(S_lin, F_f), f"M{other + 1}_{tag}",
                           ("M", other + 1, tag))
             M[other, body.q_index] = M[body.q_index, other] = value
         if body.parent >= 0:
-            A_p, B_p, C_p = _inertia_to_parent(frames, i, A, B, C, b, tag)
+            A_p, B_p, C_p = frames.inertia_to_parent(i, A, B, C, b, tag)
             p = body.parent
             IC[p] = [tuple(tuple(x + y for x, y in zip(r1, r2)) for r1, r2 in zip(IC[p][0], A_p)),
                      tuple(tuple(x + y for x, y in zip(r1, r2)) for r1, r2 in zip(IC[p][1], B_p)),

@@ -34,24 +34,13 @@ from typing import Iterable
 import numpy as np
 import sympy as sp
 
-from ..errors import KinematicTreeError
+from ..errors import GenerationError, KinematicTreeError
 from ..model import IDENTITY3, RobotModel, Transform, ZERO3
-from .composite import forward_kinematics, motion_cross
+from .composite import forward_kinematics
 from .derivation import new_derivation
+from .evaluate import compile_program
 from .program import Program, ProgramBuilder
-
-def _cross(a, b) -> tuple:
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _matvec(A, v) -> tuple:
-    return tuple(sp.Add(*[A[r][k] * v[k] for k in range(3)]) for r in range(3))
-
-
-def _matmul(A, B) -> tuple:
-    return tuple(tuple(sp.Add(*[A[r][k] * B[k][c] for k in range(3)]) for c in range(3))
-                 for r in range(3))
-
+from .spatial import cross, matmul, matvec, motion_cross, transpose
 
 #: The outputs of each frame, ``<kind>_<k>`` with k the frame's index in ``frames``.
 FRAME_OUTPUTS = ("p", "R", "J", "Jb", "dJqd", "dJbqd")
@@ -110,8 +99,6 @@ class FrameKinematics:
 
     @cached_property
     def _compiled(self):
-        from .evaluate import compile_program
-
         params = tuple(p.symbol for p in self.model.parameters)
         values = self.model.parameter_values
         missing = [p.name for p in self.model.parameters if p.symbol not in values]
@@ -186,50 +173,50 @@ def frame_kinematics(model: RobotModel, tree, q, qd, b: ProgramBuilder,
         else:
             i = body_of[link]
             R = tuple(b.define_all(row, f"Rf{k}_{r}") for r, row in
-                      enumerate(_matmul(kin.R[i], pose.rotation)))
+                      enumerate(matmul(kin.R[i], pose.rotation)))
             p = b.define_all(tuple(kin.p[i][r] + e for r, e in
-                                   enumerate(_matvec(kin.R[i], pose.translation))), f"pf{k}_")
+                                   enumerate(matvec(kin.R[i], pose.translation))), f"pf{k}_")
             for j in [i] + tree.ancestors(i):
                 S = kin.S[j]
                 lin = b.define_all(tuple(S[3 + r] + e for r, e in
-                                         enumerate(_cross(S[:3], p))), f"Jf{k}_{j + 1}_")
+                                         enumerate(cross(S[:3], p))), f"Jf{k}_{j + 1}_")
                 col = tree.bodies[j].q_index
                 for r in range(3):
                     J[r, col] = lin[r]
                     J[3 + r, col] = S[r]
             V, A = motion(i)
             w = V[:3]
-            v_lin = b.define_all(tuple(V[3 + r] + e for r, e in enumerate(_cross(w, p))),
+            v_lin = b.define_all(tuple(V[3 + r] + e for r, e in enumerate(cross(w, p))),
                                  f"vf{k}_")
-            Axp = _cross(A[:3], p)
-            wxv = _cross(w, v_lin)
+            Axp = cross(A[:3], p)
+            wxv = cross(w, v_lin)
             acc = b.define_all(tuple(A[3 + r] + Axp[r] + wxv[r] for r in range(3)), f"af{k}_")
             dJqd = tuple(acc) + tuple(A[:3])
-        Rt = tuple(tuple(R[c][r] for c in range(3)) for r in range(3))
+        Rt = transpose(R)
         Jb = sp.zeros(6, n)
         for col in range(n):
             for half in (0, 3):
-                rotated = _matvec(Rt, tuple(J[half + r, col] for r in range(3)))
+                rotated = matvec(Rt, tuple(J[half + r, col] for r in range(3)))
                 for r in range(3):
                     Jb[half + r, col] = b.define(rotated[r], f"Jb{k}_{half + r}_{col + 1}")
-        w_b = b.define_all(_matvec(Rt, w), f"wb{k}_")
-        v_b = b.define_all(_matvec(Rt, v_lin), f"vb{k}_")
-        a_b = _matvec(Rt, dJqd[:3])
-        wxv_b = _cross(w_b, v_b)
+        w_b = b.define_all(matvec(Rt, w), f"wb{k}_")
+        v_b = b.define_all(matvec(Rt, v_lin), f"vb{k}_")
+        a_b = matvec(Rt, dJqd[:3])
+        wxv_b = cross(w_b, v_b)
         dJbqd = (tuple(b.define(a_b[r] - wxv_b[r], f"ab{k}_{r}") for r in range(3))
-                 + b.define_all(_matvec(Rt, dJqd[3:]), f"wdb{k}_"))
+                 + b.define_all(matvec(Rt, dJqd[3:]), f"wdb{k}_"))
         if model.root_pose is not None:  # to the description's root frame (Jb, dJbqd stay)
             R0, t0 = model.root_pose.rotation, model.root_pose.translation
-            p = b.define_all(tuple(t0[r] + e for r, e in enumerate(_matvec(R0, p))), f"pw{k}_")
-            R = tuple(b.define_all(row, f"Rw{k}_{r}") for r, row in enumerate(_matmul(R0, R)))
+            p = b.define_all(tuple(t0[r] + e for r, e in enumerate(matvec(R0, p))), f"pw{k}_")
+            R = tuple(b.define_all(row, f"Rw{k}_{r}") for r, row in enumerate(matmul(R0, R)))
             Jw = sp.zeros(6, n)
             for col in range(n):
                 for half in (0, 3):
-                    rotated = _matvec(R0, tuple(J[half + r, col] for r in range(3)))
+                    rotated = matvec(R0, tuple(J[half + r, col] for r in range(3)))
                     for r in range(3):
                         Jw[half + r, col] = b.define(rotated[r], f"Jw{k}_{half + r}_{col + 1}")
             J = Jw
-            dJqd = b.define_all(_matvec(R0, dJqd[:3]) + _matvec(R0, dJqd[3:]), f"dJw{k}_")
+            dJqd = b.define_all(matvec(R0, dJqd[:3]) + matvec(R0, dJqd[3:]), f"dJw{k}_")
         result.append({
             "p": sp.Matrix(3, 1, list(p)),
             "R": sp.Matrix(3, 3, [x for row in R for x in row]),
@@ -310,8 +297,6 @@ def contact_row_count(model: RobotModel) -> int:
 
 
 def _require_contacts(model: RobotModel) -> None:
-    from ..errors import GenerationError
-
     if not model.contacts:
         raise GenerationError(
             f"{model.source}: contact outputs (contact_jacobian, contact_bias, "
@@ -369,7 +354,6 @@ def _friction_contacts(model: RobotModel) -> list:
     """``(contact, first row, unit normal in the axes of its force rows)`` of every contact,
     refusing contacts without a friction coefficient."""
     from ..contacts import POINT
-    from ..errors import GenerationError
 
     _require_contacts(model)
     missing = [c.name for c in model.contacts if c.mu is None]

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..bodies import BodyTree, InertialParameters
-from .newton_euler import _aligned
+from .spatial import aligned_axis
 
 #: Slot of each Pinocchio-ordered parameter: ("m",), ("h", a), ("I", a, b).
 SLOTS = (("m",), ("h", 0), ("h", 1), ("h", 2), ("I", 0, 0), ("I", 0, 1), ("I", 1, 1),
@@ -93,7 +93,7 @@ def group_parameters(tree: BodyTree, pi: tuple[sp.Symbol, ...]) -> Grouping:
         par = grouped[i]
         col = 10 * body.q_index
         if body.joint.type.is_revolute:
-            aligned = _aligned(body.joint.axis)
+            aligned = aligned_axis(body.joint.axis)
             if aligned is None:
                 raise ValueError(f"joint '{body.joint.name}': the closed-form grouping needs a "
                                  "revolute axis along ±x, ±y or ±z of the joint frame")

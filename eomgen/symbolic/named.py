@@ -20,11 +20,13 @@ from __future__ import annotations
 
 import functools
 import operator
-from fractions import Fraction
 from typing import Iterable, Mapping, Sequence
 
 import sympy as sp
 from sympy.core.basic import _args_sortkey
+# Exact rational coefficients: gmpy2's mpq when it is installed, else SymPy's pure-Python
+# rational, both several times faster than fractions.Fraction for the same exact values.
+from sympy.external.gmpy import MPQ
 
 #: :meth:`ProgramMatrix.expand` stops when an intermediate result passes this many terms, unless
 #: called with ``max_terms=None``.
@@ -59,7 +61,7 @@ class _Polynomials:
     """Sparse polynomials in the generators of one expansion, as ``{monomial: coefficient}``
     dicts: a monomial is one integer holding every exponent in a field of :attr:`BITS` bits
     (so multiplying monomials is adding integers), a coefficient a Python float (a model with
-    decimal numbers) or an exact int / Fraction. After every product, ``sin² q_i`` is replaced
+    decimal numbers) or an exact int / rational (``MPQ``). After every product, ``sin² q_i`` is replaced
     by ``1 − cos² q_i``, which keeps the degree in ``sin q_i`` at most one.
 
     ``work`` counts the term operations done; :meth:`spend` stops the expansion past
@@ -91,7 +93,7 @@ class _Polynomials:
         if x.is_Integer:
             value = int(x)
         elif self.exact:
-            value = Fraction(int(x.p), int(x.q))
+            value = MPQ(int(x.p), int(x.q))
         else:
             value = float(x)
         return {0: value} if value else {}
@@ -102,20 +104,18 @@ class _Polynomials:
     def add_to(self, out: dict, b: dict, what: str) -> None:
         """``out += b``, in place."""
         self.spend(len(b), 0, what)
-        get = out.get
         for m, c in b.items():
-            out[m] = get(m, 0) + c
+            out[m] = out[m] + c if m in out else c
 
     def multiply(self, a: dict, b: dict, what: str) -> dict:
         if len(a) < len(b):
             a, b = b, a
         self.spend(len(a) * len(b), 0, what)
         out: dict = {}
-        get = out.get
         for mb, cb in b.items():
             for ma, ca in a.items():
                 m = ma + mb
-                out[m] = get(m, 0) + ca * cb
+                out[m] = out[m] + ca * cb if m in out else ca * cb
         out = self.reduce(out)
         self.spend(0, len(out), what)
         return out
@@ -133,15 +133,14 @@ class _Polynomials:
             while seen & mask:
                 self.work += len(f)
                 out: dict = {}
-                get = out.get
                 for m, c in f.items():
                     if m & mask:  # s^e with e ≥ 2: s^(e−2) (1 − c²)
                         rest = m - square
-                        out[rest] = get(rest, 0) + c
+                        out[rest] = out[rest] + c if rest in out else c
                         rest += 2 << cos
-                        out[rest] = get(rest, 0) - c
+                        out[rest] = out[rest] - c if rest in out else -c
                     else:
-                        out[m] = get(m, 0) + c
+                        out[m] = out[m] + c if m in out else c
                 f = {m: c for m, c in out.items() if c}
                 seen = functools.reduce(operator.or_, f, 0)
         return f
@@ -163,7 +162,7 @@ class _Polynomials:
                     factors.append(powers[k, e])
                 m >>= self.BITS
                 k += 1
-            number = (sp.Rational(c.numerator, c.denominator) if isinstance(c, Fraction)
+            number = (sp.Rational(c.numerator, c.denominator) if isinstance(c, MPQ)
                       else sp.Integer(c) if isinstance(c, int) else sp.Float(c))
             factors.sort(key=_args_sortkey)
             if not factors:

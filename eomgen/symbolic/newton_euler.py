@@ -50,69 +50,8 @@ from mpmath.libmp import prec_to_dps
 
 from ..bodies import BodyTree, InertialParameters
 from ..model import Transform, Vec3
-from .composite import _cross, _dot, _matvec, _rotation
-from .program import ProgramBuilder, Tag, _tag
-
-
-def _rotate_back(axis: Vec3, c, s, v) -> tuple:
-    """Rot(axis, q)ᵀ v by Rodrigues' formula: v c − (axis × v) s + axis (axis·v)(1 − c)."""
-    k_cross_v = _cross(axis, v)
-    k_dot_v = _dot(axis, v)
-    return tuple(v[r] * c - k_cross_v[r] * s + axis[r] * k_dot_v * (1 - c) for r in range(3))
-
-
-def _transpose_apply(R, v) -> tuple:
-    """Rᵀ v for a 3×3 rotation given as rows."""
-    return tuple(sp.Add(*[R[k][r] * v[k] for k in range(3)]) for r in range(3))
-
-
-def _aligned(axis) -> tuple[int, int] | None:
-    """``(k, sign)`` when ``axis`` is ``sign`` times the k-th unit vector, else None."""
-    values = tuple(axis)
-    for k in range(3):
-        for sign in (1, -1):
-            if values == tuple(sign if j == k else 0 for j in range(3)):
-                return k, sign
-    return None
-
-
-def _rotate_aligned(k: int, c, s, v, transpose: bool) -> tuple:
-    """Rot(e_k, q) v, or its transpose, touching only the two components that change."""
-    i, j = (k + 1) % 3, (k + 2) % 3
-    if transpose:
-        s = -s
-    w = [None, None, None]
-    w[i] = c * v[i] - s * v[j]
-    w[j] = s * v[i] + c * v[j]
-    w[k] = v[k]
-    return tuple(w)
-
-
-def _leads_negative(expr: sp.Expr) -> bool:
-    """Whether ``expr`` prints with a leading minus sign (one more operation than its negation
-    when that negation can be absorbed where it is used: a constant factor, a subtraction)."""
-    if expr.is_Add:  # printers put a term without a minus sign first when there is one
-        return all(term.could_extract_minus_sign() for term in expr.args)
-    return expr.is_Mul and expr.could_extract_minus_sign()
-
-
-def _name(b: ProgramBuilder, expr, hint: str, tag=None, scaled: bool = False) -> sp.Expr:
-    """``b.define(expr, hint, tag)``, but an expression that leads with a minus sign is named
-    negated and used as ``−name``: the sign then folds into the products and sums that use it
-    (its tag then says what the negated entry is: documents print the name's definition)."""
-    expr = sp.sympify(expr)
-    if _leads_negative(expr):
-        negated = sp.Add(*[-t for t in expr.args]) if expr.is_Add else -expr
-        return -b.define(negated, hint, tag, scaled)
-    return b.define(expr, hint, tag, scaled)
-
-
-def _name_all(b: ProgramBuilder, exprs, hint: str, tag=None, scaled: bool = False) -> tuple:
-    """:func:`_name` of each entry, hinted ``hint0, hint1, …``; entry k is tagged with ``tag``
-    (``(family, index...)``) followed by k."""
-    tag = _tag(tag)
-    return tuple(_name(b, e, f"{hint}{k}", None if tag is None else
-                       Tag(tag.family, tag.index + (k,)), scaled) for k, e in enumerate(exprs))
+from .program import ProgramBuilder, name_expr, name_exprs
+from .spatial import JointFrames, aligned_axis, cross, dot, matvec, mul, rotation
 
 
 def _invariant_part(axis: Vec3, revolute: bool, par: InertialParameters) -> InertialParameters:
@@ -126,8 +65,8 @@ def _invariant_part(axis: Vec3, revolute: bool, par: InertialParameters) -> Iner
     if not revolute:
         return InertialParameters(zero, (zero,) * 3, par.inertia)
     k = tuple(axis)
-    along = _dot(k, par.first_moment)
-    aligned = _aligned(k)
+    along = dot(k, par.first_moment)
+    aligned = aligned_axis(k)
     beta = par.inertia[(aligned[0] + 2) % 3][(aligned[0] + 2) % 3] if aligned else zero
     inertia = tuple(tuple(beta * ((1 if r == c else 0) - k[r] * k[c]) for c in range(3))
                     for r in range(3))
@@ -183,7 +122,7 @@ def leaf_phases(tree: BodyTree, inertials: list) -> tuple[list, dict]:
     parents = {body.parent for body in tree.bodies}
     phases = {}
     for i, body in enumerate(tree.bodies):
-        aligned = _aligned(body.joint.axis)
+        aligned = aligned_axis(body.joint.axis)
         if i in parents or not body.joint.type.is_revolute or aligned is None:
             continue
         a, sign = aligned
@@ -196,7 +135,7 @@ def leaf_phases(tree: BodyTree, inertials: list) -> tuple[list, dict]:
         digits = prec_to_dps(min(v._prec for v in (h[x], h[y]) if v.is_Float) if
                              h[x].is_Float or h[y].is_Float else 53)
         phi = (sign * sp.atan2(h[y], h[x])).evalf(digits)
-        turn = _rotation(body.joint.axis, h[x] / length, sign * h[y] / length)
+        turn = rotation(body.joint.axis, h[x] / length, sign * h[y] / length)
         turned = inertials[i].transformed(Transform(tuple(zip(*turn)), (0, 0, 0)))
         first = [sp.Integer(0)] * 3
         first[x] = length  # and h[y] is now exactly 0
@@ -262,7 +201,7 @@ def _folded(par: InertialParameters) -> InertialParameters:
 def _omega_products(w, b: ProgramBuilder, tag) -> tuple:
     """The products ``ww[r][c] = ω_r ω_c`` named (only those used survive), as a symmetric 3×3
     nested tuple."""
-    ww = [[_name(b, w[r] * w[c], f"ww{tag}_{r}{c}", ("ww", tag, r, c)) for c in range(3)]
+    ww = [[name_expr(b, w[r] * w[c], f"ww{tag}_{r}{c}", ("ww", tag, r, c)) for c in range(3)]
           for r in range(3)]
     for r in range(3):
         for c in range(r):
@@ -298,7 +237,7 @@ def _khalil_U(ww, dw, b: ProgramBuilder, tag) -> tuple:
                 e = -b.define(sum((ww[x][x] for x in range(3) if x != r), sp.Integer(0)),
                               f"U{tag}_{r}{c}", ("U", tag, r, c))
             else:
-                e = _name(b, ww[r][c] + skew[r][c], f"U{tag}_{r}{c}", ("U", tag, r, c))
+                e = name_expr(b, ww[r][c] + skew[r][c], f"U{tag}_{r}{c}", ("U", tag, r, c))
             row.append(e)
         U.append(tuple(row))
     return tuple(U)
@@ -319,64 +258,10 @@ def _euler_moment(I, dw, U, ww, b: ProgramBuilder, tag) -> tuple:
         j, k = (i + 1) % 3, (i + 2) % 3
         squares = 0
         if I[j][k] != 0:
-            squares = I[j][k] * _name(b, ww[j][j] - ww[k][k], f"wd{tag}_{i}", ("wd", tag, i))
-        out.append(I[i][i] * dw[i] - I[i][j] * U[k][i] + I[i][k] * U[j][i] + squares
-                   + (I[k][k] - I[j][j]) * ww[j][k])
+            squares = I[j][k] * name_expr(b, ww[j][j] - ww[k][k], f"wd{tag}_{i}", ("wd", tag, i))
+        out.append(mul(I[i][i], dw[i]) - mul(I[i][j], U[k][i]) + mul(I[i][k], U[j][i]) + squares
+                   + mul(I[k][k] - I[j][j], ww[j][k]))
     return tuple(out)
-
-
-class _Frames:
-    """Rotations between a body frame and its parent's, by the joint's sine and cosine."""
-
-    def __init__(self, tree: BodyTree, q, sincos):
-        self.tree, self.q, self.sincos = tree, q, sincos
-
-    @classmethod
-    def named(cls, tree: BodyTree, q, b: ProgramBuilder) -> "_Frames":
-        """The frames of ``tree`` with each revolute joint's ``s_k``, ``c_k`` named in ``b``."""
-        sincos = []
-        for body in tree.bodies:
-            k = body.q_index
-            if body.joint.type.is_revolute:
-                sincos.append((_name(b, sp.sin(q[k]), f"s{k + 1}", ("s", k + 1)),
-                               _name(b, sp.cos(q[k]), f"c{k + 1}", ("c", k + 1))))
-            else:
-                sincos.append(None)
-        return cls(tree, q, sincos)
-
-    def to_body(self, i, v) -> tuple:
-        """Parent-frame 3-vector → body i frame: Rot(k, q)ᵀ R_placeᵀ v."""
-        body = self.tree.bodies[i]
-        w = _transpose_apply(body.placement.rotation, v)
-        if body.joint.type.is_revolute:
-            s, c = self.sincos[i]
-            aligned = _aligned(body.joint.axis)
-            if aligned is not None:
-                return _rotate_aligned(aligned[0], c, aligned[1] * s, w, transpose=True)
-            return _rotate_back(body.joint.axis, c, s, w)
-        return w
-
-    def to_parent(self, i, v) -> tuple:
-        """Body i frame 3-vector → parent frame: R_place Rot(k, q) v."""
-        body = self.tree.bodies[i]
-        w = v
-        if body.joint.type.is_revolute:
-            s, c = self.sincos[i]
-            aligned = _aligned(body.joint.axis)
-            if aligned is not None:
-                w = _rotate_aligned(aligned[0], c, aligned[1] * s, v, transpose=False)
-            else:
-                w = _rotate_back(body.joint.axis, c, -s, v)
-        return _matvec(body.placement.rotation, w)
-
-    def offset(self, i) -> tuple:
-        """Body i's origin in the parent frame [m] (moved by q for a prismatic joint)."""
-        body = self.tree.bodies[i]
-        r = body.placement.translation
-        if body.joint.type.is_revolute:
-            return r
-        k = _matvec(body.placement.rotation, body.joint.axis)
-        return tuple(r[j] + k[j] * self.q[body.q_index] for j in range(3))
 
 
 def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: ProgramBuilder,
@@ -391,7 +276,7 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
     zero33 = (zero, zero, zero)
     inertials, phases = leaf_phases(tree, grouped_inertials(tree))
 
-    frames = _Frames(tree, q, sincos)  # sincos is filled body by body below
+    frames = JointFrames(tree, q, sincos)  # sincos is filled body by body below
     to_body, to_parent, offset = frames.to_body, frames.to_parent, frames.offset
 
     # linear accelerations are carried divided by a length L (acceleration_length) [1/s²]
@@ -405,8 +290,8 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
             angle = q[k]
             if i in phases:  # the leaf's turned frame (leaf_phases)
                 angle = b.define(q[k] + phases[i], f"qp{tag}", ("qp", tag))
-            sincos.append((_name(b, sp.sin(angle), f"s{tag}", ("s", tag)),
-                           _name(b, sp.cos(angle), f"c{tag}", ("c", tag))))
+            sincos.append((name_expr(b, sp.sin(angle), f"s{tag}", ("s", tag)),
+                           name_expr(b, sp.cos(angle), f"c{tag}", ("c", tag))))
         else:
             sincos.append(None)
         if body.parent < 0:
@@ -415,27 +300,27 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
             p = body.parent
             w_p, dw_p, a_p, U_p = omega[p], domega[p], acc[p], khalil[p][0]
         # origin acceleration of this body in the parent frame: a_p + U_p r
-        Ur = _matvec(U_p, tuple(_scaled(x, length) for x in offset(i)))
-        a_o = _name_all(b, tuple(a_p[j] + Ur[j] for j in range(3)), f"ap{tag}_", ("ap", tag),
+        Ur = matvec(U_p, tuple(_scaled(x, length) for x in offset(i)))
+        a_o = name_exprs(b, tuple(a_p[j] + Ur[j] for j in range(3)), f"ap{tag}_", ("ap", tag),
                         scaled=True)
         if body.joint.type.is_revolute:
-            a = _name_all(b, to_body(i, a_o), f"a{tag}_", ("a", tag))
-            w_in = _name_all(b, to_body(i, w_p), f"wp{tag}_", ("wp", tag))
-            w = _name_all(b, tuple(w_in[j] + z[j] * qd[k] for j in range(3)), f"w{tag}_",
+            a = name_exprs(b, to_body(i, a_o), f"a{tag}_", ("a", tag))
+            w_in = name_exprs(b, to_body(i, w_p), f"wp{tag}_", ("wp", tag))
+            w = name_exprs(b, tuple(w_in[j] + z[j] * qd[k] for j in range(3)), f"w{tag}_",
                           ("w", tag))
             ww = _omega_products(w, b, tag)
             # q̇ (ω_in × k): a product that is also some ω_r ω_c (ω's component along k is q̇
             # alone when the parent's ω has none there) uses that product's name
             dw_rel = tuple(_renamed_terms(e, w, ww) for e in
-                           _cross(w_in, tuple(z[j] * qd[k] for j in range(3))))
-            dw = _name_all(b, tuple(e + dw_rel[j] + z[j] * qdd[k] for j, e in
+                           cross(w_in, tuple(z[j] * qd[k] for j in range(3))))
+            dw = name_exprs(b, tuple(e + dw_rel[j] + z[j] * qdd[k] for j, e in
                                     enumerate(to_body(i, dw_p))), f"dw{tag}_", ("dw", tag))
         else:
-            w = _name_all(b, to_body(i, w_p), f"w{tag}_", ("w", tag))
+            w = name_exprs(b, to_body(i, w_p), f"w{tag}_", ("w", tag))
             ww = _omega_products(w, b, tag)
-            dw = _name_all(b, to_body(i, dw_p), f"dw{tag}_", ("dw", tag))
-            cor = _cross(w, tuple(2 * z[j] * qd[k] for j in range(3)))
-            a = _name_all(b, tuple(e + cor[j] + z[j] * qdd[k] for j, e in
+            dw = name_exprs(b, to_body(i, dw_p), f"dw{tag}_", ("dw", tag))
+            cor = cross(w, tuple(2 * z[j] * qd[k] for j in range(3)))
+            a = name_exprs(b, tuple(e + cor[j] + z[j] * qdd[k] for j, e in
                                    enumerate(to_body(i, a_o))), f"a{tag}_", ("a", tag))
         omega.append(w)
         domega.append(dw)
@@ -450,10 +335,10 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
         m, h, I = par.mass, par.first_moment, par.inertia
         w, dw, a = omega[i], domega[i], acc[i]
         U, ww = khalil[i]
-        Uh = _matvec(U, h)
+        Uh = matvec(U, h)
         f = tuple(m * length * a[j] + Uh[j] for j in range(3))
         nn = tuple(x + y for x, y in zip(_euler_moment(I, dw, U, ww, b, tag),
-                                         _cross(tuple(x * length for x in h), a)))
+                                         cross(tuple(x * length for x in h), a)))
         force[i] = list(f)
         moment[i] = list(nn)
 
@@ -461,16 +346,16 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
     for i in reversed(range(n)):
         body = tree.bodies[i]
         tag = body.q_index + 1
-        f = _name_all(b, force[i], f"f{tag}_", ("f", tag), scaled=True)
-        nn = _name_all(b, moment[i], f"n{tag}_", ("n", tag), scaled=True)
+        f = name_exprs(b, force[i], f"f{tag}_", ("f", tag), scaled=True)
+        nn = name_exprs(b, moment[i], f"n{tag}_", ("n", tag), scaled=True)
         axis = body.joint.axis
-        tau[body.q_index, 0] = _name(b, _dot(axis, nn if body.joint.type.is_revolute else f),
+        tau[body.q_index, 0] = name_expr(b, dot(axis, nn if body.joint.type.is_revolute else f),
                                         f"{hint}{tag}", ("effort", tag))
         p = body.parent
         if p >= 0:
-            f_p = _name_all(b, to_parent(i, f), f"fp{tag}_", ("fp", tag))
+            f_p = name_exprs(b, to_parent(i, f), f"fp{tag}_", ("fp", tag))
             n_p = to_parent(i, nn)
-            rf = _cross(offset(i), f_p)
+            rf = cross(offset(i), f_p)
             for j in range(3):
                 force[p][j] = force[p][j] + f_p[j]
                 moment[p][j] = moment[p][j] + n_p[j] + rf[j]

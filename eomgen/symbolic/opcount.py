@@ -16,6 +16,8 @@ from __future__ import annotations
 import ast
 from typing import Iterable
 
+from .printing import NumPyModulePrinter
+
 #: NumPy functions counted as one arithmetic operation each.
 MATH_FUNCTIONS = frozenset({"sin", "cos", "tan", "sqrt", "exp", "log", "arctan2", "abs",
                             "sinh", "cosh", "tanh", "arcsin", "arccos", "arctan", "sign"})
@@ -49,8 +51,6 @@ def program_operation_count(program, names: Iterable[str] | None = None) -> int:
     NumPy backend prints it: its assignments needed for the named outputs (all by default) and
     their non-zero output entries. Equals :func:`module_operation_counts` of a generated NumPy
     module for the function computing those outputs."""
-    from ..codegen.backends.numpy_backend import NumPyModulePrinter
-
     printer = NumPyModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
     program = program if names is None else program.pruned(names)
     total = 0

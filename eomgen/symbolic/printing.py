@@ -9,6 +9,9 @@ Two things every printer of eomgen shares:
   true division is correctly rounded), so no generated code spends a division on a constant.
   Backends whose literals look different (C needs ``1.0`` rather than ``1``; the float32
   batches wrap each literal in their dtype) override only :meth:`FloatLiteralMixin._literal`.
+* :class:`NumPyModulePrinter`: the NumPy backend's printer (SymPy's ``NumPyPrinter`` with
+  ``np.`` for the module and these literals), which :mod:`eomgen.symbolic.opcount` also counts
+  operations with.
 * :func:`print_program` and :func:`program_function`: a :class:`~eomgen.symbolic.program.Program`
   printed once into a Python function ``_program(*inputs)`` (assignments in evaluation order,
   then the outputs), compiled and run with :func:`exec_source` in a namespace holding only the
@@ -31,6 +34,7 @@ from __future__ import annotations
 from typing import Callable, Mapping, Sequence
 
 import sympy as sp
+from sympy.printing.numpy import NumPyPrinter
 
 from .program import Program
 
@@ -67,6 +71,16 @@ class FloatLiteralMixin:
         if isinstance(item, sp.Rational) and not item.is_Integer and item.is_positive:
             return self._print(item)
         return super().parenthesize(item, level, strict)
+
+
+class NumPyModulePrinter(FloatLiteralMixin, NumPyPrinter):
+    """NumPy code with ``np.`` as the module prefix and exact float literals
+    (:class:`FloatLiteralMixin`): the printer of the NumPy backend
+    (:mod:`eomgen.codegen.backends.numpy_backend`)."""
+
+    def _module_format(self, fqn, register=True):
+        text = super()._module_format(fqn, register)
+        return "np." + text[len("numpy."):] if text.startswith("numpy.") else text
 
 
 def print_program(program: Program, inputs: Sequence[sp.Symbol], printer,

@@ -39,8 +39,9 @@ class Tag(NamedTuple):
     index: tuple[int, ...] = ()
 
 
-def _tag(tag) -> Tag | None:
-    """A :class:`Tag` from a Tag, ``(family, index...)`` or ``(family, (index...))``."""
+def as_tag(tag) -> Tag | None:
+    """A :class:`Tag` from a Tag, ``(family, index...)`` or ``(family, (index...))``; None
+    stays None."""
     if tag is None or isinstance(tag, Tag):
         return tag
     family, *index = tag
@@ -84,6 +85,10 @@ class ProgramBuilder:
         self._reserved = set(reserved)
         self._names: set[str] = set()
         self._by_value: dict[sp.Expr, sp.Symbol] = {}
+        # The free-symbol sets of the named expressions: an expression whose set is not among
+        # them cannot be the negation of one (negating changes no symbol), so define skips
+        # building ``-expr`` (SymPy distributes the sign over every term: a sixth of derive).
+        self._symbol_sets: set[frozenset] = set()
         self.assignments: list[tuple[sp.Symbol, sp.Expr]] = []
         #: Work shared between programs built into this builder (e.g. the world-frame
         #: composites of :mod:`eomgen.symbolic.composite`), by a key of the caller's choice.
@@ -117,12 +122,15 @@ class ProgramBuilder:
         known = self._by_value.get(expr)
         if known is not None:
             return known
-        neg = self._by_value.get(-expr)
-        if neg is not None:
-            return -neg
+        symbols = frozenset(expr.free_symbols)
+        if symbols in self._symbol_sets:
+            neg = self._by_value.get(-expr)
+            if neg is not None:
+                return -neg
         symbol = self._fresh(hint)
         self._by_value[expr] = symbol
-        self.assignments.append(Assignment(symbol, expr, _tag(tag)))
+        self._symbol_sets.add(symbols)
+        self.assignments.append(Assignment(symbol, expr, as_tag(tag)))
         return symbol
 
     def absorb(self, program: "Program") -> dict[str, sp.Matrix]:
@@ -147,16 +155,77 @@ class ProgramBuilder:
             if new != symbol:
                 changed[symbol] = new
             self._by_value[expr] = new
+            self._symbol_sets.add(frozenset(expr.free_symbols))
             self.assignments.append(Assignment(new, expr, getattr(assignment, "tag", None)))
         return {name: matrix.applyfunc(moved) for name, matrix in program.outputs}
 
     def define_all(self, exprs: Sequence, hint: str, tag=None) -> tuple:
         """Define each entry of a vector, hinting names ``hint0, hint1, …``; entry ``k`` is
         tagged with ``tag``'s index followed by ``k``."""
-        tag = _tag(tag)
+        tag = as_tag(tag)
         return tuple(self.define(e, f"{hint}{k}",
                                  None if tag is None else Tag(tag.family, tag.index + (k,)))
                      for k, e in enumerate(exprs))
+
+
+def entry_tag(tag, *entry) -> Tag | None:
+    """The tag of one entry of a named vector or matrix: ``tag``'s index followed by the entry's
+    indices (``entry_tag(("Ia", 3), 0, 2)`` is ``Tag("Ia", (3, 0, 2))``); None for no tag."""
+    tag = as_tag(tag)
+    return None if tag is None else Tag(tag.family, tag.index + tuple(entry))
+
+
+def _leads_negative(expr: sp.Expr) -> bool:
+    """Whether ``expr`` prints with a leading minus sign (one more operation than its negation
+    when that negation can be absorbed where it is used: a constant factor, a subtraction)."""
+    if expr.is_Add:  # printers put a term without a minus sign first when there is one
+        return all(term.could_extract_minus_sign() for term in expr.args)
+    return expr.is_Mul and expr.could_extract_minus_sign()
+
+
+def name_expr(b: ProgramBuilder, expr, hint: str, tag=None, scaled: bool = False) -> sp.Expr:
+    """``b.define(expr, hint, tag, scaled)``, but an expression that leads with a minus sign is
+    named negated and used as ``−name``: the sign then folds into the products and sums that
+    use it (its tag then says what the negated entry is: documents print the name's
+    definition). What the recursive algorithms (Newton–Euler, CRBA, ABA) name their
+    intermediates with.
+
+    >>> b = ProgramBuilder()
+    >>> x, y = sp.symbols("x y")
+    >>> name_expr(b, -x*y - y, "t"), b.assignments
+    (-t, [(t, x*y + y)])
+    """
+    expr = sp.sympify(expr)
+    if _leads_negative(expr):
+        negated = sp.Add(*[-t for t in expr.args]) if expr.is_Add else -expr
+        return -b.define(negated, hint, tag, scaled)
+    return b.define(expr, hint, tag, scaled)
+
+
+def name_exprs(b: ProgramBuilder, exprs, hint: str, tag=None, scaled: bool = False) -> tuple:
+    """:func:`name_expr` of each entry, hinted ``hint0, hint1, …``; entry k is tagged with
+    ``tag`` (``(family, index...)``) followed by k."""
+    tag = as_tag(tag)
+    return tuple(name_expr(b, e, f"{hint}{k}", None if tag is None else
+                           Tag(tag.family, tag.index + (k,)), scaled) for k, e in enumerate(exprs))
+
+
+def name_symmetric(b: ProgramBuilder, A, hint: str, tag=None) -> tuple:
+    """Name the upper triangle of a symmetric 3×3 (:func:`name_expr`, hinted ``<hint><r><c>``)
+    and mirror it; entry (r, c) is tagged with ``tag``'s index followed by r, c."""
+    named = [[None] * 3 for _ in range(3)]
+    for r in range(3):
+        for c in range(r, 3):
+            named[r][c] = named[c][r] = name_expr(b, A[r][c], f"{hint}{r}{c}",
+                                                  entry_tag(tag, r, c))
+    return tuple(tuple(row) for row in named)
+
+
+def name_matrix(b: ProgramBuilder, A, hint: str, tag=None) -> tuple:
+    """Name every entry of a 3×3 (:func:`name_expr`, hinted ``<hint><r><c>``); entry (r, c)
+    is tagged with ``tag``'s index followed by r, c."""
+    return tuple(tuple(name_expr(b, A[r][c], f"{hint}{r}{c}", entry_tag(tag, r, c))
+                       for c in range(3)) for r in range(3))
 
 
 def rough_operation_count(exprs: Iterable[sp.Expr]) -> int:

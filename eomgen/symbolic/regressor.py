@@ -39,9 +39,8 @@ from __future__ import annotations
 import sympy as sp
 
 from ..bodies import BodyTree
-from .composite import _cross, _dot
-from .newton_euler import _Frames
 from .program import ProgramBuilder
+from .spatial import JointFrames, cross, dot
 
 #: Column names of one body's block, Pinocchio's order; the joint number (1-based, JOINT_NAMES
 #: order) is appended: ``M1, MX1, …`` (Khalil's names: mass, first moments, inertia about the
@@ -89,7 +88,7 @@ def regressor_program(tree: BodyTree, q, qd, qdd, gravity, b: ProgramBuilder,
     zero3 = (sp.Integer(0),) * 3
     sincos: list = []
 
-    to_body = _Frames(tree, q, sincos).to_body  # sincos is filled body by body below
+    to_body = JointFrames(tree, q, sincos).to_body  # sincos is filled body by body below
 
     def offset(i):
         """Body i's origin in its parent's frame (moves with a prismatic joint)."""
@@ -118,17 +117,17 @@ def regressor_program(tree: BodyTree, q, qd, qdd, gravity, b: ProgramBuilder,
             w_p, dw_p, a_p, v_p, g_p, h_p = (omega[j], domega[j], acc[j], vel[j], grav[j],
                                              height[j])
         r = offset(i)
-        wr = _cross(w_p, r)
+        wr = cross(w_p, r)
         v_o = tuple(v_p[a] + wr[a] for a in range(3))
         a_o = tuple(a_p[a] + x + y for a, (x, y) in
-                    enumerate(zip(_cross(dw_p, r), _cross(w_p, wr))))
+                    enumerate(zip(cross(dw_p, r), cross(w_p, wr))))
         w_in = b.define_all(to_body(i, w_p), f"wp{tag}_")
         dw_in = to_body(i, dw_p)
         a_in = to_body(i, b.define_all(a_o, f"ap{tag}_"))
         v_in = to_body(i, b.define_all(v_o, f"vp{tag}_"))
         if revolute:
             w = b.define_all(tuple(w_in[a] + z[a] * qd[k] for a in range(3)), f"w{tag}_")
-            rel = _cross(w_in, tuple(z[a] * qd[k] for a in range(3)))
+            rel = cross(w_in, tuple(z[a] * qd[k] for a in range(3)))
             dw = b.define_all(tuple(dw_in[a] + rel[a] + z[a] * qdd[k] for a in range(3)),
                               f"dw{tag}_")
             a_ = b.define_all(a_in, f"a{tag}_")
@@ -136,7 +135,7 @@ def regressor_program(tree: BodyTree, q, qd, qdd, gravity, b: ProgramBuilder,
         else:
             w = w_in
             dw = b.define_all(dw_in, f"dw{tag}_")
-            cor = _cross(w, tuple(2 * z[a] * qd[k] for a in range(3)))
+            cor = cross(w, tuple(2 * z[a] * qd[k] for a in range(3)))
             a_ = b.define_all(tuple(a_in[a] + cor[a] + z[a] * qdd[k] for a in range(3)),
                               f"a{tag}_")
             v = b.define_all(tuple(v_in[a] + z[a] * qd[k] for a in range(3)), f"v{tag}_")
@@ -145,7 +144,7 @@ def regressor_program(tree: BodyTree, q, qd, qdd, gravity, b: ProgramBuilder,
         acc.append(a_)
         vel.append(v)
         # gravity in body coordinates and g_vec · (origin position), for the potential energy
-        height.append(b.define(h_p + _dot(g_p, r), f"gp{tag}"))
+        height.append(b.define(h_p + dot(g_p, r), f"gp{tag}"))
         grav.append(b.define_all(to_body(i, g_p), f"gb{tag}_"))
 
     Y = sp.zeros(n, p)
@@ -158,8 +157,8 @@ def regressor_program(tree: BodyTree, q, qd, qdd, gravity, b: ProgramBuilder,
         w, dw, a_, v = omega[j], domega[j], acc[j], vel[j]
         # energies
         half = sp.Rational(1, 2)
-        YK[0, col] = b.define(half * _dot(v, v), f"K{tag}_0")
-        for e, value in enumerate(_cross(v, w)):
+        YK[0, col] = b.define(half * dot(v, v), f"K{tag}_0")
+        for e, value in enumerate(cross(v, w)):
             YK[0, col + 1 + e] = b.define(value, f"K{tag}_{1 + e}")
         for e, (r_, c_) in enumerate(_INERTIA_ENTRIES):
             YK[0, col + 4 + e] = b.define(half * _sym_times(r_, c_, w, w), f"K{tag}_{4 + e}")
@@ -173,7 +172,7 @@ def regressor_program(tree: BodyTree, q, qd, qdd, gravity, b: ProgramBuilder,
         if body.parent >= 0:
             r = offset(j)
             for anc, (w_s, v_s) in axes_at[body.parent].items():
-                v_moved = tuple(v_s[e] + x for e, x in enumerate(_cross(w_s, r)))
+                v_moved = tuple(v_s[e] + x for e, x in enumerate(cross(w_s, r)))
                 t = f"{tree.bodies[anc].q_index + 1}_{tag}"
                 axes[anc] = (b.define_all(to_body(j, w_s), f"sw{t}_"),
                              b.define_all(to_body(j, v_moved), f"sv{t}_"))
@@ -181,12 +180,12 @@ def regressor_program(tree: BodyTree, q, qd, qdd, gravity, b: ProgramBuilder,
         for anc, (w_s, v_s) in axes.items():
             row = tree.bodies[anc].q_index
             t = f"{row + 1}_{tag}"
-            entries = [_dot(v_s, a_)]
-            h_col = _cross(a_, w_s)
-            dv = _cross(dw, v_s)
-            wwv = _cross(w, _cross(w, v_s))
+            entries = [dot(v_s, a_)]
+            h_col = cross(a_, w_s)
+            dv = cross(dw, v_s)
+            wwv = cross(w, cross(w, v_s))
             entries += [h_col[e] - dv[e] + wwv[e] for e in range(3)]
-            u = b.define_all(_cross(w_s, w), f"u{t}_") if any(x != 0 for x in w_s) else zero3
+            u = b.define_all(cross(w_s, w), f"u{t}_") if any(x != 0 for x in w_s) else zero3
             entries += [_sym_times(r_, c_, w_s, dw) + _sym_times(r_, c_, u, w)
                         for r_, c_ in _INERTIA_ENTRIES]
             for e, value in enumerate(entries):

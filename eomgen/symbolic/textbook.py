@@ -34,7 +34,7 @@ from fractions import Fraction
 import sympy as sp
 
 from ..bodies import body_tree
-from ..model import IDENTITY3, RobotModel, Transform, ZERO3, joint_motion
+from ..model import IDENTITY3, RobotModel, Transform, ZERO3, _all_scalars, joint_motion
 from .derivation import joint_symbols
 
 #: Largest number of joints for which the textbook derivation is computed by default.
@@ -364,10 +364,11 @@ def textbook_derivation(model: RobotModel, max_dof: int = TEXTBOOK_MAX_DOF) -> T
             for r in range(3):
                 J_w[r][tree.bodies[a].q_index] = axes[a][r]
         inertia = [[A(I_c[r, k]) for k in range(3)] for r in range(3)]
-        I_w = [[A.reduce(x) for x in row] for row in _matmul(_matmul(R, inertia), _transpose(R))]
+        I_w = [[A.reduce(x) for x in row] for row in A.product(A.product(R, inertia),
+                                                                 A.transpose(R))]
         share = [[A.reduce(x) for x in row] for row in
-                 _add(_scale(mass, _matmul(_transpose(J_v), J_v)),
-                      _matmul(_transpose(J_w), _matmul(I_w, J_w)))]
+                 A.plus(A.times(mass, A.product(A.transpose(J_v), J_v)),
+                        A.product(A.transpose(J_w), A.product(I_w, J_w)))]
         P = -mass * sum((gravity[r] * p_c[r] for r in range(3)), zero)
         shares.append(share)
         potentials.append(P)
@@ -379,7 +380,7 @@ def textbook_derivation(model: RobotModel, max_dof: int = TEXTBOOK_MAX_DOF) -> T
 
     M = [[A.ring.zero] * n for _ in range(n)]
     for share in shares:
-        M = _add(M, share)
+        M = A.plus(M, share)
     P = sum(potentials, A.ring.zero)
     half = A.ring.domain.convert(sp.Rational(1, 2))
     dM = [[[A.reduce(A.derivative(M[i][j], k)) for j in range(n)] for i in range(n)]
@@ -433,6 +434,27 @@ class _TrigAlgebra:
         self._pair_index = [(position[sp.sin(x)], position[sp.cos(x)]) for x in q]
         self._angles = None  # see absolute_angles
         self.written: frozenset[float] = frozenset()  # see textbook_derivation
+
+    # Matrices of ring elements (lists of rows, any shape), with the ring's own arithmetic: a
+    # product skips zero factors and sums from the ring's zero.
+
+    @staticmethod
+    def transpose(A):
+        return [list(column) for column in zip(*A)]
+
+    @staticmethod
+    def product(A, B):
+        zero = A[0][0].ring.zero
+        return [[sum((A[i][k] * B[k][j] for k in range(len(B)) if A[i][k] and B[k][j]), zero)
+                 for j in range(len(B[0]))] for i in range(len(A))]
+
+    @staticmethod
+    def plus(A, B):
+        return [[a + b for a, b in zip(ra, rb)] for ra, rb in zip(A, B)]
+
+    @staticmethod
+    def times(x, A):
+        return [[x * a for a in row] for row in A]
 
     def reduce(self, f):
         """``f`` modulo ``sin² q_k + cos² q_k = 1``: a canonical form of degree at most one in
@@ -567,8 +589,6 @@ def description_floats(model: RobotModel) -> frozenset[float]:
     """The floats of ``model``'s description (gravity, inertials, joint axes and origins,
     actuators, parameter values): documents print these with all their digits, and round only
     floats computed from them (:func:`round_floats`)."""
-    from ..model import _all_scalars
-
     found = {float(p.value) for p in model.parameters if p.value is not None}
     for value in _all_scalars(model):
         if isinstance(value, sp.Basic):
@@ -617,24 +637,6 @@ def _swap_squares(f, k: int, j: int):
         base[k] = e % 2
         out += ring({tuple(base): coefficient}) * one_minus ** (e // 2)
     return out
-
-
-def _transpose(A):
-    return [list(column) for column in zip(*A)]
-
-
-def _matmul(A, B):
-    zero = A[0][0].ring.zero
-    return [[sum((A[i][k] * B[k][j] for k in range(len(B)) if A[i][k] and B[k][j]), zero)
-             for j in range(len(B[0]))] for i in range(len(A))]
-
-
-def _add(A, B):
-    return [[a + b for a, b in zip(ra, rb)] for ra, rb in zip(A, B)]
-
-
-def _scale(x, A):
-    return [[x * a for a in row] for row in A]
 
 
 def quadratic_form(A: sp.Matrix, x) -> sp.Expr:
