@@ -1,7 +1,7 @@
 """The two exact programs of each of M, C and g that ``derive`` chooses from (issue 18).
 
 ``derive_program`` builds, for each output, whichever of two programs has fewer operations for
-the robot at hand (:func:`eomgen.symbolic.composite.cheapest_routes`), so every route must give
+the robot at hand (:func:`eomgen.symbolic.routes.cheapest_routes`), so every route must give
 the same matrices on every robot, not only on those where it wins. Each route is forced here and
 checked against independent computations:
 
@@ -23,7 +23,8 @@ import eomgen
 from eomgen.bodies import body_tree
 from eomgen.dynamics import derive, joint_symbols
 from eomgen.numeric import coriolis_times_qd, gravity_torques, M_rnea, numeric_model
-from eomgen.symbolic.composite import _routes, coriolis_program
+from eomgen.symbolic.composite import coriolis_program
+from eomgen.symbolic.routes import routes as _routes
 from eomgen.symbolic.evaluate import compile_program
 from eomgen.symbolic.opcount import program_operation_count
 from eomgen.symbolic.program import Program, ProgramBuilder

@@ -34,7 +34,6 @@ directions are zero; the others change by about ε relative).
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable, Sequence

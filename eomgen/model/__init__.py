@@ -55,9 +55,6 @@ from .scalars import IDENTITY3, ZERO3, Mat3, Scalar, Vec3, mat3, parameter_symbo
 from .snapping import SNAP_TOLERANCE, Snap, snap, snap_summary, snapping
 from .transforms import Transform, rotation_about_axis, rotation_from_rpy
 
-#: Deprecated: the old private name of :func:`all_scalars` (eomgen.symbolic.textbook's import).
-_all_scalars = all_scalars
-
 __all__ = [
     "DEFAULT_FRICTION_WIDTH", "IDENTITY3", "MAX_JOINTS", "POINT", "SNAP_TOLERANCE", "SURFACE",
     "ZERO3", "Actuator", "Contact", "Inertial", "Joint", "JointType", "Link", "Mat3", "Notice",

@@ -35,7 +35,7 @@ import numpy as np
 import sympy as sp
 
 from ..errors import GenerationError, KinematicTreeError
-from ..model import IDENTITY3, RobotModel, Transform, ZERO3
+from ..model import IDENTITY3, POINT, RobotModel, Transform, ZERO3
 from .composite import forward_kinematics
 from .derivation import new_derivation
 from .evaluate import compile_program
@@ -280,7 +280,6 @@ def frame_constants(dynamics) -> dict[str, tuple[str, ...]]:
 def contact_rows(model: RobotModel) -> tuple[str, ...]:
     """Names of the rows of ``J_c`` and of ``F_c``: ``<contact>.f_x`` … (a point contact: force
     in world axes; a surface contact: force then moment ``n_x`` … in its frame's axes)."""
-    from ..contacts import POINT
 
     rows = []
     for c in model.contacts:
@@ -317,7 +316,6 @@ def build_contacts(derivation, wanted) -> dict:
     GenerationError
         When the model carries no contacts (a scene's ``contacts:``).
     """
-    from ..contacts import POINT
 
     model = derivation.model
     _require_contacts(model)
@@ -353,7 +351,6 @@ def build_contact_inverse_dynamics(derivation, wanted) -> dict:
 def _friction_contacts(model: RobotModel) -> list:
     """``(contact, first row, unit normal in the axes of its force rows)`` of every contact,
     refusing contacts without a friction coefficient."""
-    from ..contacts import POINT
 
     _require_contacts(model)
     missing = [c.name for c in model.contacts if c.mu is None]

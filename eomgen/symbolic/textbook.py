@@ -34,7 +34,7 @@ from fractions import Fraction
 import sympy as sp
 
 from ..bodies import body_tree
-from ..model import IDENTITY3, RobotModel, Transform, ZERO3, _all_scalars, joint_motion
+from ..model import IDENTITY3, RobotModel, Transform, ZERO3, all_scalars, joint_motion
 from .derivation import joint_symbols
 
 #: Largest number of joints for which the textbook derivation is computed by default.
@@ -590,7 +590,7 @@ def description_floats(model: RobotModel) -> frozenset[float]:
     actuators, parameter values): documents print these with all their digits, and round only
     floats computed from them (:func:`round_floats`)."""
     found = {float(p.value) for p in model.parameters if p.value is not None}
-    for value in _all_scalars(model):
+    for value in all_scalars(model):
         if isinstance(value, sp.Basic):
             found.update(float(f) for f in value.atoms(sp.Float))
         elif isinstance(value, float):

@@ -11,19 +11,10 @@ from dataclasses import dataclass
 from sympy.printing.numpy import NumPyPrinter
 
 from .. import GeneratedFile, Job, register
-from ...symbolic.printing import FloatLiteralMixin
+from ...symbolic.printing import NumPyModulePrinter
 from ...templating import render
 from ...runtime.cholesky import included_source
 from .common import python_loader, python_module_context, warning_exports
-
-
-class NumPyModulePrinter(FloatLiteralMixin, NumPyPrinter):
-    """NumPy code with ``np.`` as the module prefix and exact float literals
-    (:class:`~eomgen.symbolic.printing.FloatLiteralMixin`)."""
-
-    def _module_format(self, fqn, register=True):
-        text = super()._module_format(fqn, register)
-        return "np." + text[len("numpy."):] if text.startswith("numpy.") else text
 
 
 @dataclass(frozen=True)
