@@ -26,9 +26,8 @@ from eomgen.parsers.urdf import parse_urdf_string
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 
-from conftest import erd_robots_dir
+from support import ROOT, erd_robots_dir
 
-ROOT = Path(__file__).resolve().parents[1]
 FLEXIBLE_2LINK = ROOT / "examples" / "robots" / "flexible_2link.yaml"
 
 ARM = """<robot name="r"><link name="base"/>

@@ -12,35 +12,21 @@ joints printed by every backend, against independent computations:
 from __future__ import annotations
 
 import re
-from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import eomgen
 from eomgen import actuators as A
-from eomgen.model import Actuator
 from eomgen.numeric import M_rnea, numeric_model, rnea
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
-from conftest import erd_robots_dir
-from generated import BACKENDS, generated  # noqa: F401  (BACKENDS: test_flat_outputs)
+from support import erd_robots_dir
+from support.generated import generated
+from support.robots import FLEXIBLE_2LINK, drive_arm as arm
 
 RIGID = ("M_a", "tau_f", "tau_f_smooth", "tau_a")
 FLEXIBLE = ("M_l", "tau_K", "thetadd_m", "h", "M")
-
-
-def arm():
-    """The flexible 2-link arm with joint 1 made rigid and given armature and friction; joint 2
-    flexible (K2, B2 from the description) with motor friction."""
-    model = eomgen.load(Path(__file__).resolve().parent.parent
-                        / "examples/robots/flexible_2link.yaml")
-    drives = {"joint1": Actuator(armature=0.3, damping=0.4, friction=0.2, friction_width=0.5)}
-    joints = tuple(replace(j, actuator=drives.get(j.name, replace(
-        j.actuator, damping=0.05, friction=0.1, friction_width=0.5)) if j.actuator else j.actuator)
-        for j in model.joints)
-    return replace(model, joints=joints)
 
 
 def load(model, names, folder):
@@ -105,7 +91,7 @@ def test_flexible_outputs_of_a_rigid_robot_are_a_one_line_error(tmp_path):
     assert result.exit_code == 2, result.output
     assert re.search(r"planar_2link\.yaml: tau_K need flexible joints", result.output)
     assert len(result.output.strip().splitlines()) == 1 and not out.exists()
-    flexible = str(Path(__file__).resolve().parent.parent / "examples/robots/flexible_2link.yaml")
+    flexible = str(FLEXIBLE_2LINK)
     result = CliRunner().invoke(main, ["generate", flexible,
                                        "--backend", "numpy", "--outputs", "tau_K,thetadd_m,M_l",
                                        "-o", str(out), "--no-cache", "--quiet"])

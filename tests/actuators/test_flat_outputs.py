@@ -8,14 +8,14 @@ forward-mode program, compiled separately) at random states, and fed to
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import eomgen
 from eomgen import actuators as A
-from test_drive_outputs import BACKENDS, arm, load
+from support.generated import BACKENDS, generated as generate_all
+from support.robots import FLEXIBLE_2LINK, drive_arm as arm
 
 FLAT = ("motor_angles", "motor_velocities", "flat_motor_torque", "flat_motor_torque_smooth")
 
@@ -23,7 +23,7 @@ FLAT = ("motor_angles", "motor_velocities", "flat_motor_torque", "flat_motor_tor
 @pytest.fixture(scope="module")
 def generated(tmp_path_factory):
     model = arm()  # joint 1 rigid (armature, friction), joint 2 flexible (motor friction)
-    return model, load(model, FLAT, tmp_path_factory.mktemp("flat")), A.actuated_model(
+    return model, generate_all(model, FLAT, tmp_path_factory.mktemp("flat"))[0], A.actuated_model(
         eomgen.derive(model))
 
 
@@ -85,7 +85,7 @@ def test_flat_outputs_of_a_rigid_robot_are_a_one_line_error(tmp_path):
     assert re.search(r"planar_2link\.yaml: tau_flat, theta_flat need flexible joints",
                      result.output)
     assert len(result.output.strip().splitlines()) == 1 and not out.exists()
-    flexible = str(Path(__file__).resolve().parent.parent / "examples/robots/flexible_2link.yaml")
+    flexible = str(FLEXIBLE_2LINK)
     result = CliRunner().invoke(main, ["generate", flexible, "--backend", "numpy", "--outputs",
                                        "tau_flat", "-o", str(out), "--no-cache", "--quiet"])
     assert result.exit_code == 0, result.output

@@ -19,7 +19,7 @@ from eomgen.analysis.precision import (Reference, high_precision_model, max_abs,
                                        mp_rnea, relative_error)
 from eomgen.cli import main
 from eomgen.numeric import kinetic_energy, numeric_model, potential_energy, rnea
-from reference import random_robot
+from support.reference import random_robot
 
 pytest.importorskip("matplotlib")
 pytest.importorskip("scipy")

@@ -1,5 +1,5 @@
-"""The JAX backend against the NumPy module (tests/array_backends.py) and on its own promises:
-batch shapes, dtypes, parameter defaults, jax.jit / jax.vmap / jax.grad, forward dynamics,
+"""The JAX backend against the NumPy module (tests/support/array_backends.py) and on its own
+promises: batch shapes, dtypes, parameter defaults, jax.jit / jax.vmap / jax.grad, forward dynamics,
 XLA computing each sine and cosine once, dask over JAX functions. Skips with a reason when jax
 is missing (the ``jax`` extra); removing the JAX backend removes this file with it."""
 
@@ -9,8 +9,10 @@ import numpy as np
 import pytest
 
 from eomgen.codegen.generate import generate
-from array_backends import (ARGUMENTS, FUNCTIONS, ROBOTS, assert_relative, central_difference,
-                            hostile_modules, load_module, robot_modules, states)
+from support.array_backends import (
+    ARGUMENTS, FUNCTIONS, ROBOTS, assert_relative, central_difference, hostile_modules,
+    load_module, robot_modules, states,
+)
 
 jax = pytest.importorskip("jax", reason="the JAX backend needs jax: pip install 'eomgen[jax]'")
 jax.config.update("jax_enable_x64", True)
@@ -177,7 +179,7 @@ def test_forward_dynamics_of_a_singular_M_is_nan(robot):
 def test_hostile_names_stay_text_and_the_module_runs():
     """Robot and joint names that try to break out of strings stay text; the module imports
     only jax.numpy and agrees with the NumPy module."""
-    from test_codegen import HOSTILE
+    from support.robots import HOSTILE
 
     modules = hostile_modules("jax")
     q, qd, qdd = states(len(HOSTILE), seed=8)

@@ -1,4 +1,4 @@
-"""The PyTorch backend against the NumPy module (tests/array_backends.py) and on its own
+"""The PyTorch backend against the NumPy module (tests/support/array_backends.py) and on its own
 promises: tensors of shape (n,) or (N, n), the inputs' dtype and device, parameter defaults,
 autograd through every output, forward dynamics with NumPy's conditioning report. Skips with a
 reason when torch is missing (the ``torch`` extra)."""
@@ -9,8 +9,10 @@ import numpy as np
 import pytest
 
 from eomgen.codegen.generate import generate
-from array_backends import (ARGUMENTS, FUNCTIONS, ROBOTS, assert_relative, central_difference,
-                            hostile_modules, load_module, robot_modules, states)
+from support.array_backends import (
+    ARGUMENTS, FUNCTIONS, ROBOTS, assert_relative, central_difference, hostile_modules,
+    load_module, robot_modules, states,
+)
 
 torch = pytest.importorskip("torch",
                             reason="the PyTorch backend needs torch: pip install 'eomgen[torch]'")
@@ -152,7 +154,7 @@ def test_forward_dynamics_singular_and_ill_conditioned(robot):
 def test_hostile_names_stay_text_and_the_module_runs():
     """Robot and joint names that try to break out of strings stay text; the module imports
     only torch and agrees with the NumPy module."""
-    from test_codegen import HOSTILE
+    from support.robots import HOSTILE
 
     modules = hostile_modules("torch")
     q, qd, qdd = states(len(HOSTILE), seed=8)

@@ -9,8 +9,6 @@ fallback without a compiler.
 from __future__ import annotations
 
 import ast
-import importlib.util
-import sys
 import warnings
 from pathlib import Path
 
@@ -24,6 +22,7 @@ from eomgen.codegen.backends.fast_backend import c_string_literal, python_header
 from eomgen.codegen.backends.casadi_backend import c_compiler
 from eomgen.codegen.generate import render_files
 from eomgen.dynamics import derive
+from support import load_module
 
 FUNCTIONS = {"mass_matrix": ("q",), "coriolis_matrix": ("q", "qd"), "gravity_vector": ("q",),
              "inverse_dynamics": ("q", "qd", "qdd"), "forward_dynamics": ("q", "qd", "tau")}
@@ -42,9 +41,7 @@ def _load(folder: Path, files, stem: str):
     for name, path in ((stem + "_numpy", folder / f"{stem}_numpy.py"),
                        (stem + "_fast", next(folder.glob(f"{stem}_fast.*.so"), None)
                         or next(folder.glob(f"{stem}_fast*.pyd")))):
-        spec = importlib.util.spec_from_file_location(name, path)
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
+        module = load_module(path, name)
         modules.append(module)
     return modules
 

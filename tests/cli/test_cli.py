@@ -7,35 +7,19 @@ need a real process (the ``python -m`` entry point, ``--debug`` tracebacks) use 
 from __future__ import annotations
 
 import subprocess
-import sys
-from pathlib import Path
 
 import pytest
-from click.testing import CliRunner
 
 import eomgen
-from eomgen.cli import main
+import support
 from eomgen.robots import example_path
 
-from conftest import erd_robots_dir
+from support import ERROR, WARNING, erd_robots_dir, run_cli as run, write
 
-ERROR = "eomgen: error: "
-WARNING = "eomgen: warning: "
-
-
-def run(*args: str):
-    """``eomgen ARGS`` in process; returns click's Result (exit_code, stdout, stderr)."""
-    return CliRunner().invoke(main, [str(a) for a in args], prog_name="eomgen")
 
 
 def run_process(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "eomgen.cli", *map(str, args)],
-                          capture_output=True, text=True, timeout=120)
-
-
-def write(path: Path, text: str) -> Path:
-    path.write_text(text, encoding="utf-8")
-    return path
+    return support.run_process(*args, timeout=120)
 
 
 # ----------------------------------------------------------------------------------------------

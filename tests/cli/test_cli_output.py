@@ -33,17 +33,9 @@ import pytest
 from eomgen.output import GeneratedFile, OutputError, check_output_folder, write_atomically
 from eomgen.progress import Progress, plural
 
-from conftest import erd_robots_dir
+from support import ERROR, ROOT, SCENES, erd_robots_dir, run_process
 
-ROOT = Path(__file__).resolve().parent.parent
-SCENES = ROOT / "examples" / "scenes"
-ERROR = "eomgen: error: "
 STAGE = re.compile(r"^eomgen: .* \[\+\d+\.\d s\]$")
-
-
-def run_process(*args, env=None, cwd=None, timeout=300) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "eomgen.cli", *map(str, args)],
-                          capture_output=True, text=True, timeout=timeout, env=env, cwd=cwd)
 
 
 def snapshot(folder: Path) -> dict[str, bytes | None]:

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from reference import random_robot, to_urdf
+from support.reference import random_robot, to_urdf
 
 ROBOT = "random_chain_12"
 PREVIOUS = {f"{ROBOT}_numpy.py": b"# the previous generation (numpy)\n",

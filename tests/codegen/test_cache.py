@@ -22,12 +22,11 @@ import warnings
 from pathlib import Path
 
 import pytest
-from click.testing import CliRunner
 
 import eomgen
+from support import CORPUS, run_cli as run
 from eomgen import cache
 from eomgen.cache import Cache, CacheRequest, cache_key, command_request, generation_key
-from eomgen.cli import main
 from eomgen.codegen import BACKENDS, Backend, GeneratedFile, available_backends
 from eomgen.codegen.backends.casadi_backend import c_compiler
 from eomgen.codegen.backends.fast_backend import python_headers
@@ -35,7 +34,6 @@ from eomgen.codegen.generate import generate
 from eomgen.model import lock_joints
 
 ARM = eomgen.example_path("planar_2link")
-CORPUS = Path(__file__).resolve().parent / "corpus"
 NOTICE = "eomgen: notice: "
 
 
@@ -50,10 +48,6 @@ def folder(tmp_path, monkeypatch) -> Path:
 @pytest.fixture(scope="module")
 def arm():
     return eomgen.load(ARM)
-
-
-def run(*args):
-    return CliRunner().invoke(main, [str(a) for a in args], prog_name="eomgen")
 
 
 def entries(folder: Path) -> list[Path]:

@@ -21,7 +21,6 @@ from __future__ import annotations
 import ast
 import builtins
 import ctypes
-import importlib.util
 import io
 import keyword
 import os
@@ -30,7 +29,6 @@ import shutil
 import subprocess
 import sys
 import tokenize
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -47,11 +45,11 @@ from eomgen.codegen.generate import generate, keep_symbolic, render_files, write
 from eomgen.model import (Inertial, Joint, JointType, Link, Parameter, RobotModel, Transform,
                           build_model, vec3)
 from eomgen.numeric import NumericModel, numeric_model, rnea
-from conftest import erd_robots_dir
-from reference import random_robot
+from support.robots import DOCSTRING_BREAKER, HOSTILE, hostile_star, ur5
+from support import TESTS, assert_close, erd_robots_dir, load_module, load_quietly, random_states
+from support.reference import random_robot
 
 RTOL = 1e-10
-TESTS = Path(__file__).resolve().parent
 
 #: What every generated Python module exports.
 PUBLIC = ("JOINT_NAMES", "NQ", "PARAMETERS", "mass_matrix", "coriolis_matrix", "gravity_vector",
@@ -70,38 +68,11 @@ SIGNATURES = {
 }
 MATRIX_OUTPUTS = {"mass_matrix", "coriolis_matrix"}
 
-#: Names that try to break out of the string literals, docstrings and comments they end up in.
-HOSTILE = ('a"); import os #', "\\input{/etc/passwd}", "x\n__import__('os').system('echo pwned')",
-           "'''", '"""', "ø∂")
-#: A robot name that is valid Python once a docstring quoting it ends early.
-DOCSTRING_BREAKER = '"""+__import__("os").system("echo pwned")+"""'
 
 
 # ----------------------------------------------------------------------------------------------
 # Helpers
 # ----------------------------------------------------------------------------------------------
-
-def assert_close(a, b, what=""):
-    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
-    assert a.shape == b.shape, f"{what}: shape {a.shape} != {b.shape}"
-    err = float(np.max(np.abs(a - b))) if a.size else 0.0
-    scale = max(1.0, float(np.max(np.abs(b))) if b.size else 1.0)
-    assert err <= RTOL * scale, f"{what}: max|a-b| = {err:.3g} (scale {scale:.3g})\na={a}\nb={b}"
-
-
-def load_module(path: Path, name: str) -> ModuleType:
-    """Import a generated file as a module (not registered in sys.modules)."""
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-def random_states(rng: np.random.Generator, n: int, count: int = 4):
-    """(q, qd, qdd) triples at random."""
-    return [(rng.uniform(-np.pi, np.pi, n), rng.normal(size=n), rng.normal(size=n))
-            for _ in range(count)]
-
 
 def ca_call(f, parameters: dict, *vectors) -> np.ndarray:
     """Evaluate a casadi.Function of the generated interface at one state; parameters by name."""
@@ -130,19 +101,6 @@ def rnea_reference(nm: NumericModel, function: str, q, qd, third) -> np.ndarray:
     if function == "forward_dynamics":
         return np.linalg.solve(M, third - rnea(nm, q, qd, zero))
     raise ValueError(function)  # coriolis_matrix is only known through C qd
-
-
-def load_quietly(path: Path) -> RobotModel:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # PUMA 560's published inertias warn by design
-        return eomgen.load(path)
-
-
-def ur5() -> RobotModel:
-    robots = erd_robots_dir()
-    if robots is None:
-        pytest.skip("example-robot-data is not installed")
-    return load_quietly(robots / "ur_description" / "urdf" / "ur5_robot.urdf")
 
 
 #: Example name → the model. The random robots cover a chain and a tree, prismatic and fixed
@@ -768,25 +726,6 @@ def test_no_c_compiler_warns_library_callers(build, tmp_path, monkeypatch):
 # Hostile names
 # ----------------------------------------------------------------------------------------------
 
-def hostile_star(robot_name: str) -> RobotModel:
-    """One body per hostile name, each on its own joint (same name) from the base."""
-    links = [Link("base")]
-    joints = []
-    for k, name in enumerate(HOSTILE):
-        m = 1.0 + k
-        links.append(Link(name, Inertial(m, [0.1 * k, 0.05, -0.1],
-                                         [[0.02, 0, 0], [0, 0.03, 0], [0, 0, 0.04]])))
-        kind = JointType.PRISMATIC if k % 3 == 1 else JointType.REVOLUTE
-        axis = vec3([(0, 0, 1), (0, 1, 0), (1, 0, 0)][k % 3])
-        joints.append(Joint(name, kind, "base", name, Transform.from_xyz_rpy([0.1, 0.2 * k, 0]),
-                            axis))
-    links.append(Link("tool ⟨\"'⟩"))
-    joints.append(Joint("fixed */ /*", JointType.FIXED, HOSTILE[0], "tool ⟨\"'⟩",
-                        Transform.from_xyz_rpy([0, 0, 0.2])))
-    return build_model("hostile \"\"\" source */", robot_name, links, joints,
-                       gravity=(0.3, -0.2, -9.81))
-
-
 NUMPY_CALLS = {"_batch", "_states", "mass_matrix", "inverse_dynamics", "ValueError", "len", "range",
                "reversed", "zip", "all", "int", "_at", "_not_positive_definite",
                "FloatingPointError",
@@ -911,7 +850,7 @@ def test_hostile_robot_names_stay_text(robot_name):
 
 def test_hostile_names_through_urdf(tmp_path):
     """A URDF file is the realistic carrier of such names."""
-    from reference import to_urdf
+    from support.reference import to_urdf
 
     path = tmp_path / "hostile.urdf"
     path.write_text(to_urdf(hostile_star(DOCSTRING_BREAKER)), encoding="utf-8")
@@ -1045,7 +984,7 @@ sys.path.insert(0, sys.argv[1])
 import numpy as np
 import eomgen
 from eomgen.codegen.generate import render_files, write_atomically
-from reference import random_robot
+from support.reference import random_robot
 warnings.simplefilter("ignore")
 which, outdir = sys.argv[2], sys.argv[3]
 if which == "planar":

@@ -3,7 +3,7 @@ generates now, byte for byte.
 
 After an intended change of the generated code, rewrite it with::
 
-    python3 -m pytest tests/test_golden.py --update-golden
+    python3 -m pytest tests/codegen/test_golden.py --update-golden
 """
 
 from __future__ import annotations
@@ -18,9 +18,8 @@ import pytest
 
 import eomgen
 from eomgen.codegen.generate import render_files, select_backends
-from conftest import erd_robots_dir
+from support import ROOT, erd_robots_dir
 
-ROOT = Path(__file__).resolve().parent.parent
 GOLDEN = ROOT / "generated"
 
 
@@ -56,13 +55,14 @@ def test_generated_is_up_to_date(name, request):
         for file_name, content in files.items():
             (folder / file_name).write_text(content, encoding="utf-8", newline="\n")
         return
-    assert folder.is_dir(), f"{folder} missing: run pytest tests/test_golden.py --update-golden"
+    assert folder.is_dir(), (f"{folder} missing: run pytest tests/codegen/test_golden.py "
+                             "--update-golden")
     committed = sorted(p.name for p in folder.iterdir())
     assert committed == sorted(files), "generated/ holds other files than the generator makes"
     for file_name, content in files.items():
         on_disk = (folder / file_name).read_text(encoding="utf-8")
         assert on_disk == content, (f"generated/{name}/{file_name} is stale: "
-                                    "run pytest tests/test_golden.py --update-golden")
+                                    "run pytest tests/codegen/test_golden.py --update-golden")
 
 
 def test_generation_is_deterministic_across_processes():

@@ -9,7 +9,6 @@ backend order of ``--backend all``), so a registry that drifted from the code fa
 from __future__ import annotations
 
 import dataclasses
-import importlib.util
 import inspect
 import shutil
 from pathlib import Path
@@ -27,6 +26,7 @@ from eomgen.codegen.functions import (FUNCTION_ALIASES, RESERVED_IDENTIFIERS, de
 from eomgen.codegen.render import TEMPLATES_DIR
 from eomgen.dynamics import ALL_OUTPUTS, derive
 from eomgen.outputs import BY_SYMBOL, FORWARD, OUTPUTS, Output, register_output
+from support import load_module
 
 #: The function table of the generated modules as the README documented it before the registry.
 DOCUMENTED = {"mass_matrix": ("M", ("q",)), "coriolis_matrix": ("C", ("q", "qd")),
@@ -77,9 +77,7 @@ def test_generated_module_exports_the_registry_with_its_shapes(planar, tmp_path)
     (file,) = available_backends()["numpy"].generate(job)
     path = tmp_path / file.name
     path.write_text(file.content, encoding="utf-8")
-    spec = importlib.util.spec_from_file_location("registry_planar_numpy", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = load_module(path, "registry_planar_numpy")
     n = planar.model.dof
     rng = np.random.default_rng(3)
     values = {"q": rng.normal(size=n), "qd": rng.normal(size=n), "qdd": rng.normal(size=n),
@@ -234,7 +232,6 @@ def toys():
 
 
 def test_a_registered_output_reaches_every_backend(toys, tmp_path):
-    import sympy as sp  # noqa: F811  (the builder's module-level name, for clarity here)
     from eomgen.codegen.generate import render_files
 
     model = eomgen.load(eomgen.example_path("planar_2link"))

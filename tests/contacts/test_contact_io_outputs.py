@@ -22,7 +22,7 @@ from eomgen.errors import GenerationError
 from eomgen.numeric import numeric_model, rnea
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
-from generated import BACKENDS, generated
+from support.generated import BACKENDS, generated
 
 # the bundled planar arm (l1 = l2 = 1 in its YAML) with its tip on a wall normal to -x,
 # friction 0.5, and a second point contact on link1's frame (rows 4-6, normal +y)

@@ -13,14 +13,13 @@ from __future__ import annotations
 
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import eomgen
 from eomgen.codegen import loadable_backends
-from conftest import erd_robots_dir
+from support import ROOT, erd_robots_dir, floating_states
 from eomgen import floating
 from eomgen.codegen.functions import select_functions
 from eomgen.codegen.generate import render_files
@@ -31,7 +30,6 @@ from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from eomgen.symbolic.frames import output_frames
 
-ROOT = Path(__file__).resolve().parents[1]
 WALL = ROOT / "examples/contacts/planar_2link_wall.yaml"
 STANDING = ROOT / "examples/contacts/solo12_standing.yaml"
 FRAME_FUNCTIONS = ["frame_positions", "frame_rotations", "frame_jacobians",
@@ -162,11 +160,7 @@ def solo(tmp_path_factory):
 
 
 def _states(count, seed):
-    rng = np.random.default_rng(seed)
-    for _ in range(count):
-        q = rng.uniform(-1, 1, 18)
-        q[4] = rng.uniform(-1.2, 1.2)  # pitch away from ±π/2 (the Euler singularity)
-        yield q, rng.uniform(-1, 1, 18), rng.uniform(-2, 2, 18)
+    return floating_states(18, count, seed, accelerations=True)
 
 
 @pytest.mark.slow

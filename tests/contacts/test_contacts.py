@@ -9,27 +9,21 @@ on a point.
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import eomgen
-from conftest import erd_robots_dir
+from support import CONTACTS, DOCS, erd_robots_dir, floating_states, load_quietly, relative
 from eomgen import floating, numeric
 from eomgen.contacts import Contact, ContactDynamics, derived_mass_and_bias
 from eomgen.errors import SceneError
 from eomgen.model import Inertial, Joint, JointType, Link, Transform, build_model
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
-from test_floating import SOLO, FreeFlyerReference, _quiet_load, random_states
+from support.robots import SOLO, FreeFlyerReference
 
 FEET = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
-DOCS = Path(__file__).resolve().parents[1] / "docs"
-
-
-def relative(a, b) -> float:
-    return float(np.abs(np.asarray(a) - b).max() / np.abs(b).max())
 
 
 @pytest.fixture(scope="module")
@@ -37,7 +31,7 @@ def solo():
     if erd_robots_dir() is None:
         pytest.skip("example-robot-data is not installed")
     path = erd_robots_dir() / SOLO
-    return path, floating.add_floating_base(_quiet_load(path))
+    return path, floating.add_floating_base(load_quietly(path))
 
 
 @pytest.mark.parametrize("kind, feet", [("point", FEET), ("surface", FEET[:1])])
@@ -56,7 +50,7 @@ def test_constrained_dynamics_matches_pinocchio(solo, kind, feet):
     datas = pin.StdVec_RigidConstraintData([c.createData() for c in models])
     pin.initConstraintDynamics(pm, pd, models, datas)
     rng = np.random.default_rng(20)
-    for q, qd in random_states(18, 2, seed=21):
+    for q, qd in floating_states(18, 2, seed=21):
         tau = rng.uniform(-2, 2, 18)
         qdd, F = cd.constrained_forward_dynamics(q, qd, tau)
         q_pin, v = ref.state(q, qd)
@@ -77,7 +71,7 @@ def test_contact_jacobian_is_a_finite_difference_of_frame_positions(solo):
     _, model = solo
     cd = ContactDynamics(model, tuple(Contact(f) for f in FEET))
     nm = numeric.numeric_model(model)
-    q, qd = next(random_states(18, 1, seed=22))
+    q, qd = next(floating_states(18, 1, seed=22))
     h = 1e-6
     plus, minus = numeric.link_poses(nm, q + h * qd), numeric.link_poses(nm, q - h * qd)
     fd = np.concatenate([(plus[f][1] - minus[f][1]) / (2 * h) for f in FEET])
@@ -207,7 +201,7 @@ def test_energy_is_conserved_with_contacts_and_no_torque():
 def test_redundant_contacts_need_the_damped_variant(solo):
     _, model = solo
     cd = ContactDynamics(model, (Contact("FL_FOOT"), Contact("FL_FOOT", name="again")))
-    q, qd = next(random_states(18, 1, seed=23))
+    q, qd = next(floating_states(18, 1, seed=23))
     tau = np.zeros(18)
     with pytest.raises(np.linalg.LinAlgError):
         cd.constrained_forward_dynamics(q, qd, tau)
@@ -221,7 +215,7 @@ def test_redundant_contacts_need_the_damped_variant(solo):
 def test_baumgarte_velocity_gain_damps_a_drifting_contact(solo):
     """With J q̇ ≠ 0, kd makes the constraint accelerate against it: J q̈ + J̇ q̇ = −kd J q̇."""
     _, model = solo
-    q, qd = next(random_states(18, 1, seed=24))
+    q, qd = next(floating_states(18, 1, seed=24))
     cd = ContactDynamics(model, (Contact("FL_FOOT", kd=10.0),))
     qdd, _ = cd.constrained_forward_dynamics(q, qd, np.zeros(18))
     J = cd.contact_jacobian(q)
@@ -230,7 +224,7 @@ def test_baumgarte_velocity_gain_damps_a_drifting_contact(solo):
 
 def test_baumgarte_position_gain_pulls_a_point_contact_to_its_anchor(solo):
     _, model = solo
-    q, qd = next(random_states(18, 1, seed=26))
+    q, qd = next(floating_states(18, 1, seed=26))
     anchor = np.array([0.1, -0.2, 0.0])
     cd = ContactDynamics(model, (Contact("FL_FOOT", kp=25.0, kd=10.0),),
                          anchors={"FL_FOOT": anchor})
@@ -250,7 +244,7 @@ def test_contacts_made_in_python_are_checked():
 
 def test_scene_contacts_through_apply_scene(solo):
     path, model = solo
-    robot = _quiet_load(path)
+    robot = load_quietly(path)
     scene = load_scene("solo.yaml", text="version: 1\nfloating_base: true\ncontacts:\n"
                        + "".join(f"  - {{frame: {f}, mu: 0.7}}\n" for f in FEET))
     reduced, report = apply_scene(robot, scene)
@@ -258,7 +252,7 @@ def test_scene_contacts_through_apply_scene(solo):
     assert [c.frame for c in report.contacts] == list(FEET)
     assert any(note.startswith("contacts") and "μ = 0.7" in note for note in report.notes)
     assert all(f in reduced.link_by_name for f in FEET)  # kept though merged into the shanks
-    q, qd = next(random_states(18, 1, seed=25))
+    q, qd = next(floating_states(18, 1, seed=25))
     tau = np.ones(18)
     a = ContactDynamics(reduced, report.contacts).constrained_forward_dynamics(q, qd, tau)
     b = ContactDynamics(model, report.contacts).constrained_forward_dynamics(q, qd, tau)
@@ -267,7 +261,7 @@ def test_scene_contacts_through_apply_scene(solo):
 
 def test_documented_contact_errors_are_what_eomgen_prints(solo):
     path, _ = solo
-    robot = _quiet_load(path)
+    robot = load_quietly(path)
     text = (DOCS / "scenes.md").read_text(encoding="utf-8")
     documented = [line[len("eomgen: error: "):] for line in text.splitlines()
                   if line.startswith("eomgen: error: solo_scene.yaml")]
@@ -308,9 +302,9 @@ def test_cli_refuses_a_bad_contact_with_one_line_and_exit_code_2(solo, tmp_path)
 
 def test_example_contact_scene(solo):
     path, model = solo
-    scene = load_scene(Path(__file__).resolve().parents[1] / "examples" / "contacts"
+    scene = load_scene(CONTACTS
                        / "solo12_standing.yaml")
-    reduced, report = apply_scene(_quiet_load(path), scene)
+    reduced, report = apply_scene(load_quietly(path), scene)
     assert scene.robot == "solo" and reduced.joint_names == model.joint_names
     assert [(c.frame, c.kind, c.mu) for c in report.contacts] == [(f, "point", 0.7)
                                                                  for f in FEET]
@@ -320,5 +314,5 @@ def test_documented_contact_scene_loads(solo):
     path, model = solo
     text = (DOCS / "scenes.md").read_text(encoding="utf-8")
     block = [b for b in text.split("```yaml\n")[1:] if "robot: solo" in b][0].split("```")[0]
-    reduced, report = apply_scene(_quiet_load(path), load_scene("doc.yaml", text=block))
+    reduced, report = apply_scene(load_quietly(path), load_scene("doc.yaml", text=block))
     assert reduced.joint_names == model.joint_names and len(report.contacts) == 4

@@ -9,22 +9,19 @@ with its four feet held (through eomgen.floating's map to Pinocchio's free flyer
 
 from __future__ import annotations
 
-import importlib.util
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import eomgen
-from conftest import erd_robots_dir
+from support import ROOT, erd_robots_dir, load_module
 from eomgen import floating
 from eomgen.codegen.functions import select_functions
 from eomgen.codegen.generate import render_files
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 
-ROOT = Path(__file__).resolve().parents[1]
 WALL = ROOT / "examples/contacts/planar_2link_wall.yaml"
 STANDING = ROOT / "examples/contacts/solo12_standing.yaml"
 CFD = "constrained_forward_dynamics"
@@ -47,9 +44,7 @@ def _modules(model, tmp_path):
     loaded = []
     for name, path in ((f"{model.name}_fast", libraries[0]),
                        (f"{model.name}_numpy_{tmp_path.name}", tmp_path / f"{model.name}_numpy.py")):
-        spec = importlib.util.spec_from_file_location(name, path)
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
+        module = load_module(path, name)
         loaded.append(module)
     return loaded
 
@@ -118,7 +113,7 @@ def test_wall_statics_and_pinocchio(wall, tmp_path):
     assert np.abs(qdd).max() < 1e-9 and np.allclose(F, [-f, 0, 0], atol=1e-8)
 
     pin = pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
-    from reference import to_urdf
+    from support.reference import to_urdf
 
     path = tmp_path / "planar_2link.urdf"
     path.write_text(to_urdf(eomgen.load(eomgen.example_path("planar_2link"))), encoding="utf-8")

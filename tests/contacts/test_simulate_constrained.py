@@ -9,13 +9,13 @@ eomgen.numeric's M and h.
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 import pytest
 from click.testing import CliRunner
 
 import eomgen
+from support import ROOT
 from eomgen import actuators as A
 from eomgen import numeric
 from eomgen.cli import _load_reduced, main
@@ -32,7 +32,6 @@ from eomgen.analysis.simulate_contacts import ContactSystem, run_contact_study  
 from eomgen.analysis.simulate_flexible import (FlexibleSystem, flexible_start,  # noqa: E402
                                                plot_step, step_response)
 
-ROOT = Path(__file__).resolve().parents[1]
 WALL = ROOT / "examples/contacts/planar_2link_wall.yaml"
 TOP = ROOT / "examples/robots/spinning_top.yaml"
 TOP_SCENE = ROOT / "examples/contacts/top_on_a_point.yaml"

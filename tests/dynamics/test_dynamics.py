@@ -24,30 +24,24 @@ import pytest
 import sympy as sp
 
 import eomgen
+import support
 from eomgen.dynamics import Dynamics, derive
 from eomgen.errors import UnsupportedFeatureWarning
 from eomgen.model import RobotModel, lock_joints, parameter_symbol
 from eomgen.numeric import kinetic_energy, numeric_model, potential_energy
 from eomgen.robots import example_path
 from eomgen.symbolic.evaluate import compile_program
-from conftest import erd_robots_dir
-from reference import random_robot, to_pinocchio
+from support import assert_close, erd_robots_dir
+from support.reference import random_robot, to_pinocchio
 
 RTOL = 1e-10
 _COMPILED: dict = {}
 STATES = 3  # random states per robot for the numeric comparisons
 
 
-def assert_close(a, b, rtol=RTOL, what=""):
-    a, b = np.asarray(a), np.asarray(b)
-    assert a.shape == b.shape, (what, a.shape, b.shape)
-    err = float(np.max(np.abs(a - b))) if a.size else 0.0
-    scale = max(1.0, float(np.max(np.abs(b))) if b.size else 1.0)
-    assert err <= rtol * scale, f"{what}: max|a-b| = {err:.3g} (scale {scale:.3g})\na={a}\nb={b}"
-
-
 def random_states(rng, n, count=STATES):
-    return [(rng.uniform(-np.pi, np.pi, n), rng.normal(size=n)) for _ in range(count)]
+    """(q, qd) pairs."""
+    return support.random_states(rng, n, count, parts=2)
 
 
 def evaluated(dyn: Dynamics) -> "Evaluated":
@@ -573,7 +567,7 @@ def test_joint_order_is_description_order_not_tree_order(tmp_path):
 def test_derivation_steps_group_intermediates_by_their_tags_not_their_names():
     from eomgen.dynamics import STEP_FAMILIES
 
-    from reference import random_robot
+    from support.reference import random_robot
 
     # general axes: derive takes the world-frame composite programs, whose steps are tagged
     model = random_robot(np.random.default_rng(3), 3, prismatic=False, fixed_links=False)

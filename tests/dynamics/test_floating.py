@@ -7,41 +7,21 @@ parser and of its numeric Newton–Euler), its dynamics mapped to Euler coordina
 
 from __future__ import annotations
 
-import warnings
 
 import numpy as np
 import pytest
 
 import eomgen
-from conftest import erd_robots_dir
+from support import erd_robots_dir, floating_states, load_quietly, relative
 from eomgen import floating, numeric
-from eomgen.floating import PinocchioFreeFlyer as FreeFlyerReference
 from eomgen.errors import InvalidInertiaError, KinematicTreeError, SceneError
 from eomgen.model import Inertial, Joint, JointType, Link, build_model, vec3
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
+from support.robots import SOLO, FreeFlyerReference
 
-SOLO = "solo_description/robots/solo12.urdf"
 TALOS = "talos_data/robots/talos_reduced.urdf"
 LEGS = ("leg_left_6_link", "leg_right_6_link")
-
-
-def _quiet_load(path):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return eomgen.load(path)
-
-
-def relative(a, b) -> float:
-    return float(np.abs(np.asarray(a) - b).max() / np.abs(b).max())
-
-
-def random_states(n, count, seed=0):
-    rng = np.random.default_rng(seed)
-    for _ in range(count):
-        q = rng.uniform(-1, 1, n)
-        q[4] = rng.uniform(-1.2, 1.2)  # pitch away from ±π/2
-        yield q, rng.uniform(-1, 1, n)
 
 
 @pytest.fixture(scope="module")
@@ -51,7 +31,7 @@ def solo():
     if robots is None:
         pytest.skip("example-robot-data is not installed")
     path = robots / SOLO
-    model = floating.add_floating_base(_quiet_load(path))
+    model = floating.add_floating_base(load_quietly(path))
     return model, FreeFlyerReference(path, model.joint_names)
 
 
@@ -65,7 +45,7 @@ def test_floating_model_layout(solo):
 def test_solo12_matches_pinocchio_free_flyer(solo):
     model, ref = solo
     nm = numeric.numeric_model(model)
-    for q, qd in random_states(18, 4):
+    for q, qd in floating_states(18, 4):
         M, Cqd, g = ref.dynamics(q, qd)
         assert relative(numeric.M_rnea(nm, q), M) <= 1e-10
         assert relative(numeric.coriolis_times_qd(nm, q, qd), Cqd) <= 1e-10
@@ -81,7 +61,7 @@ def test_solo12_symbolic_derivation_matches_pinocchio(solo):
     report = eomgen.verify(dyn, samples=3)  # SPD, Ṁ − 2C skew, against Newton–Euler
     assert all(check.passed for check in report.checks), report
     f = compile_program(dyn.program, dyn.q + dyn.qd)
-    for q, qd in random_states(18, 3, seed=1):
+    for q, qd in floating_states(18, 3, seed=1):
         out = f(*q, *qd)
         M, Cqd, g = ref.dynamics(q, qd)
         assert relative(out["M"], M) <= 1e-10
@@ -94,7 +74,7 @@ def test_talos_legs_scene_matches_pinocchio():
     if erd_robots_dir() is None:
         pytest.skip("example-robot-data is not installed")
     path = erd_robots_dir() / TALOS
-    robot = _quiet_load(path)
+    robot = load_quietly(path)
     scene = load_scene("talos_legs.yaml", text="version: 1\nfloating_base: true\ntips: ["
                        + ", ".join(LEGS) + "]\n")
     legs, report = apply_scene(robot, scene)
@@ -103,7 +83,7 @@ def test_talos_legs_scene_matches_pinocchio():
     others = [j.name for j in robot.movable_joints if j.name not in legs.joint_names]
     ref = FreeFlyerReference(path, legs.joint_names, locked=others)
     nm = numeric.numeric_model(legs)
-    for q, qd in random_states(18, 3, seed=2):
+    for q, qd in floating_states(18, 3, seed=2):
         M, Cqd, g = ref.dynamics(q, qd)
         assert relative(numeric.M_rnea(nm, q), M) <= 1e-10
         assert relative(numeric.coriolis_times_qd(nm, q, qd), Cqd) <= 1e-10
@@ -113,7 +93,7 @@ def test_talos_legs_scene_matches_pinocchio():
 def test_state_maps_round_trip_and_match_pinocchio_kinematics(solo):
     model, ref = solo
     pin = ref.pin
-    for q, qd in random_states(18, 3, seed=3):
+    for q, qd in floating_states(18, 3, seed=3):
         q_ff, v = floating.to_free_flyer(q, qd)
         assert np.isclose(np.linalg.norm(q_ff[3:7]), 1.0)
         q2, qd2 = floating.from_free_flyer(q_ff, v)
@@ -221,7 +201,7 @@ def test_small_floating_robot_symbolic_matches_numeric():
     dyn = eomgen.derive(model)
     f = compile_program(dyn.program, dyn.q + dyn.qd)
     nm = numeric.numeric_model(model)
-    for q, qd in random_states(7, 3, seed=6):
+    for q, qd in floating_states(7, 3, seed=6):
         out = f(*q, *qd)
         assert relative(out["M"], numeric.M_rnea(nm, q)) <= 1e-12
         assert relative(out["C"] @ qd, numeric.coriolis_times_qd(nm, q, qd)) <= 1e-12

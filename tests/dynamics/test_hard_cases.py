@@ -52,7 +52,6 @@ float32
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import warnings
 
@@ -67,6 +66,7 @@ from eomgen.codegen import available_backends, make_job
 from eomgen.dynamics import derive
 from eomgen.model import Inertial, Joint, JointType, Link, Transform, build_model
 from eomgen.numeric import M_rnea, numeric_model, rnea
+from support import load_module, random_states
 
 EPS = float(np.finfo(np.float64).eps)
 EPS32 = float(np.finfo(np.float32).eps)
@@ -149,21 +149,12 @@ class Case:
         (generated,) = available_backends()["numpy"].generate(job)
         path = folder / generated.name
         path.write_text(generated.content, encoding="utf-8")
-        spec = importlib.util.spec_from_file_location(f"hard_{name}", path)
-        self.module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(self.module)
+        self.module = load_module(path, f"hard_{name}")
         self.reference = Reference(self.model, dynamics=self.dynamics)
         self.nm = numeric_model(self.model)
 
     def states(self, count: int, seed: int = 0):
-        return random_states(self.n, count, seed)
-
-
-def random_states(n: int, count: int, seed: int):
-    """(q, qd, qdd) triples: q uniform in [−π, π], qd and qdd standard normal."""
-    rng = np.random.default_rng(seed)
-    return [(rng.uniform(-np.pi, np.pi, n), rng.normal(size=n), rng.normal(size=n))
-            for _ in range(count)]
+        return random_states(seed, self.n, count)
 
 
 @pytest.fixture(scope="module")
@@ -315,7 +306,7 @@ def test_ill_conditioned_mass_matrices_warn_clearly(cases, name):
 
 def test_condition_estimate_is_a_lower_bound_on_random_robots():
     """(max L_ii / min L_ii)² ≤ cond₂(M) always, and close to it for robots."""
-    from reference import random_robot
+    from support.reference import random_robot
 
     rng = np.random.default_rng(11)
     ratios = []
@@ -342,9 +333,7 @@ def test_singular_mass_matrix_raises_a_clear_error(tmp_path):
     (generated,) = available_backends()["numpy"].generate(job)
     path = tmp_path / generated.name
     path.write_text(generated.content, encoding="utf-8")
-    spec = importlib.util.spec_from_file_location("hard_singular", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = load_module(path, "hard_singular")
     q = np.array([0.3, 0.2])
     with pytest.raises(np.linalg.LinAlgError, match="not positive definite"):
         module.forward_dynamics(q, np.zeros(2), np.ones(2))
@@ -438,7 +427,7 @@ def test_far_from_the_root_origin_the_program_keeps_its_digits(d_over_l):
     dyn = derive(model, outputs=("M", "C", "g", "tau"), simplify=False)
     reference = Reference(model, dynamics=dyn)
     evaluate = compile_batch(dyn.program, dyn.q + dyn.qd + dyn.qdd, ["M", "C", "g", "tau"])
-    for q, qd, qdd in random_states(2, 5, seed=12):
+    for q, qd, qdd in random_states(12, 2, 5):
         M, C, g, tau = (x[0] for x in evaluate(*q[:, None], *qd[:, None], *qdd[:, None]))
         zero = np.zeros_like(q)
         g_ref = reference.tau(q, zero, zero)
@@ -459,7 +448,7 @@ def test_a_long_link_before_a_short_one_keeps_the_digits_of_its_small_entries():
     dyn = derive(model, outputs=("M",), simplify=False)
     reference = Reference(model, dynamics=dyn)
     M_program = compile_batch(dyn.program, dyn.q, ["M"])
-    for q, _, _ in random_states(2, 5, seed=3):
+    for q, _, _ in random_states(3, 2, 5):
         M_ref = reference.M(q)
         M = M_program(*q[:, None])[0][0]
         assert relative_error(M, M_ref) <= EVAL_BOUND

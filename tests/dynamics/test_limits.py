@@ -16,7 +16,7 @@ from eomgen.expressions import MAX_MAGNITUDE, parse_scalar
 from eomgen.model import MAX_JOINTS, Joint, JointType, Link, build_model
 from eomgen.parsers import _yaml
 
-from reference import random_robot
+from support.reference import random_robot
 
 
 def test_simplify_is_refused_above_its_limit_with_the_way_out():

@@ -18,7 +18,8 @@ from eomgen import numeric
 from eomgen.robots import example_path
 from eomgen.symbolic import named
 from eomgen.symbolic.named import ExpansionTooLargeError, ProgramMatrix
-from reference import random_robot
+from support.reference import random_robot
+from support import uniform_states
 
 
 @functools.cache
@@ -29,8 +30,7 @@ def spatial5():
 
 
 def states(n, count=3, seed=1):
-    rng = np.random.default_rng(seed)
-    return [tuple(rng.uniform(-2, 2, n) for _ in range(3)) for _ in range(count)]
+    return uniform_states(seed, n, count)
 
 
 def values(dyn, q, qd=None, qdd=None):

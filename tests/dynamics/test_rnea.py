@@ -35,12 +35,13 @@ from eomgen.numeric import (
     potential_energy,
     rnea,
 )
-from reference import (
+from support.reference import (
     pin_q_order,
     random_robot,
     to_pinocchio,
     to_urdf,
 )
+from support import uniform_states
 
 pin = pytest.importorskip("pinocchio")
 
@@ -57,7 +58,7 @@ def assert_close(a, b, rtol=RTOL):
 
 
 def random_state(rng, n, scale=2.0):
-    return tuple(rng.uniform(-scale, scale, size=n) for _ in range(3))
+    return uniform_states(rng, n, 1, scale=scale)[0]
 
 
 class PinocchioReference:

@@ -23,6 +23,7 @@ import sympy as sp
 
 import eomgen
 from eomgen.robots import example_path
+from support import load_module
 
 Q = sp.symbols("q1:4", real=True)
 QD = sp.symbols("qd1:4", real=True)
@@ -319,7 +320,6 @@ def test_numbers_print_as_short_decimals():
 
 def test_lambdify_equals_the_generated_numpy_module(tmp_path):
     """``dyn.lambdify()`` computes what the generated NumPy module computes."""
-    import importlib.util
 
     from eomgen.codegen import make_job
     from eomgen.codegen.backends.numpy_backend import generate_numpy
@@ -329,9 +329,7 @@ def test_lambdify_equals_the_generated_numpy_module(tmp_path):
     [file] = generate_numpy(make_job(dyn))
     path = tmp_path / file.name
     path.write_text(file.content)
-    spec = importlib.util.spec_from_file_location("generated_arm", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = load_module(path, "generated_arm")
     f = dyn.lambdify()
     assert f.tau is not None and f.forward is not None
     rng = np.random.default_rng(5)
@@ -351,7 +349,7 @@ def test_large_models_are_bounded_before_anything_is_expanded():
     the straight-line program alone."""
     from dataclasses import replace
 
-    from reference import random_robot
+    from support.reference import random_robot
 
     from eomgen.notebook import build_notebook
     from eomgen.symbolic.textbook import TEXTBOOK_MAX_OPERATIONS

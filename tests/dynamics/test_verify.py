@@ -38,7 +38,7 @@ from eomgen.model import (
 from eomgen.robots import example_path
 from eomgen.symbolic.program import Program
 from eomgen.verify import verify
-from reference import random_inertial, random_robot
+from support.reference import random_inertial, random_robot
 
 SYMMETRIC = "M symmetric"
 PD = "M positive definite"

@@ -6,8 +6,6 @@ with PSD pseudo-inertias, and bad CSV files refused in one line with nothing wri
 from __future__ import annotations
 
 import csv
-import subprocess
-import sys
 import warnings
 from functools import lru_cache
 from pathlib import Path
@@ -25,7 +23,7 @@ from eomgen.identification import (IdentificationError, Measurements, MotionBoun
 from eomgen.parsers.urdf import JointLimit, joint_limits
 from eomgen.regressor import base_parameters, derive_regressor
 
-from conftest import erd_robots_dir
+from support import ROOT, erd_robots_dir, run_process
 
 pytest.importorskip("scipy", reason="identification needs scipy (pip install 'eomgen[identify]')")
 
@@ -50,11 +48,6 @@ def simulated(name: str, samples: int, noise: float = 0.0, seed: int = 0):
     data = simulate_measurements(model, ex.trajectory, t, noise=noise, seed=seed)
     W = observation_matrix(reg, base.base, data.q, data.qd, data.qdd)
     return data, W, base.beta(reg.numeric_parameters())
-
-
-def run_process(*args) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "eomgen.cli", *map(str, args)],
-                          capture_output=True, text=True, timeout=300)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -460,7 +453,7 @@ def test_excite_and_identify_a_scene_of_the_panda(tmp_path):
     if robots is None:
         pytest.skip("example-robot-data is not installed")
     urdf = robots / "panda_description/urdf/panda.urdf"
-    scene = Path(__file__).parent.parent / "examples/scenes/panda_two_joints.yaml"
+    scene = ROOT / "examples/scenes/panda_two_joints.yaml"
     data = tmp_path / "panda.csv"
     done = run_process("excite", urdf, "--scene", scene, "-o", data, "--samples", 100,
                        "--noise", 0.01, "--quiet")

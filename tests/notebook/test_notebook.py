@@ -8,17 +8,12 @@ import dataclasses
 import nbformat
 import pytest
 import sympy as sp
-from click.testing import CliRunner
 
 import eomgen
-from eomgen.cli import main
+from support import run_cli as run
 from eomgen.display import dynamics_latex, expression_latex, grouped_matrices
 from eomgen.symbolic.textbook import textbook_derivation
 from eomgen.notebook import build_notebook
-
-
-def run(*args):
-    return CliRunner().invoke(main, [str(a) for a in args], prog_name="eomgen")
 
 
 @pytest.fixture(scope="module")

@@ -25,25 +25,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from click.testing import CliRunner
 
 import eomgen
+from support import CORPUS, ERROR, WARNING, load_module, run_cli as run
 from eomgen.codegen import available_backends
 from eomgen import errors
-from eomgen.cli import main
 from eomgen.codegen.functions import parameter_arguments
 from eomgen.dynamics import derive
 
-CORPUS = Path(__file__).resolve().parent / "corpus"
 EXPECTED = yaml.safe_load((CORPUS / "expected.yaml").read_text(encoding="utf-8"))
 BAD: dict[str, dict] = EXPECTED["bad"]
 VALID: dict[str, dict] = EXPECTED["valid"]
-ERROR = "eomgen: error: "
-WARNING = "eomgen: warning: "
-
-
-def run(*args) -> "click.testing.Result":  # noqa: F821
-    return CliRunner().invoke(main, [str(a) for a in args], prog_name="eomgen")
 
 
 def error_lines(stderr: str) -> list[str]:
@@ -147,13 +139,6 @@ def test_generate_in_a_real_process(tmp_path):
 # Hostile but valid files
 # ----------------------------------------------------------------------------------------------
 
-def load_module(path: Path, name: str):
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 @pytest.mark.parametrize("name", sorted(VALID))
 def test_hostile_but_valid_files_generate_with_every_backend(name, tmp_path, capfd):
     path = CORPUS / name
@@ -177,9 +162,7 @@ def test_hostile_but_valid_files_generate_with_every_backend(name, tmp_path, cap
         assert file_name.isascii() and "/" not in file_name
         if "_fast." in file_name and not file_name.endswith(".c"):  # the compiled fast module
             stem = file_name.split(".")[0]
-            spec = importlib.util.spec_from_file_location(stem, file)
-            fast = importlib.util.module_from_spec(spec)
-            spec.loader.exec_module(fast)
+            fast = load_module(file, stem)
             assert fast.JOINT_NAMES == model.joint_names and fast.NQ == n
             assert set(fast.PARAMETERS) == {p.identifier for p in parameter_arguments(
                 derive(model, outputs=("g",), simplify=False))}

@@ -14,13 +14,14 @@ import time
 import warnings
 import xml.etree.ElementTree as ET
 from pathlib import Path
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 import pytest
 import sympy as sp
 
 import eomgen
+from support.robots import INERTIA, joint, legged, link, robot
+from support import ROOT
 from eomgen.errors import (
     DescriptionError,
     PhysicalConsistencyWarning,
@@ -252,24 +253,6 @@ def test_robot_name_and_massless_links(erd_robots_dir):
 # ----------------------------------------------------------------------------------------------
 # Hand-written URDFs
 # ----------------------------------------------------------------------------------------------
-
-def robot(*parts: str, name: str = "r") -> str:
-    return f"<robot name={quoteattr(name)}>" + "".join(parts) + "</robot>"
-
-
-INERTIA = '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/>'
-
-
-def link(name: str, inertial: str | None = f'<inertial><mass value="1"/>{INERTIA}</inertial>'
-         ) -> str:
-    return f"<link name={quoteattr(name)}>{inertial or ''}</link>"
-
-
-def joint(name: str, parent: str, child: str, kind: str = "revolute",
-          body: str = '<axis xyz="0 0 1"/>') -> str:
-    return (f"<joint name={quoteattr(name)} type={quoteattr(kind)}>"
-            f"<parent link={quoteattr(parent)}/><child link={quoteattr(child)}/>{body}</joint>")
-
 
 #: Joint limits: ignored by eomgen, required by urdfdom (Pinocchio) for revolute and prismatic.
 LIMIT = '<limit lower="-3" upper="3" effort="1" velocity="1"/>'
@@ -634,30 +617,6 @@ def test_triangle_inequality_raises_under_strict(tmp_path):
 # Floating bases: a root that looks like a legged robot's trunk warns (refused under strict)
 # ----------------------------------------------------------------------------------------------
 
-def legged(direction=(0, 0, -1), legs: int = 4, length: float = 0.3, hip: float = 0.2,
-           world: bool = False, massless_root: bool = False) -> str:
-    """A trunk with ``legs`` two-joint branches, each reaching ``length`` along ``direction``
-    from a hip ``hip`` metres out of the trunk's centre (at q = 0). ``world``: bolted to a
-    ``world`` root link; ``massless_root``: a massless root fixed to the massive trunk, as
-    ANYmal and Go1 are written."""
-    parts = [link("trunk")]
-    if world:
-        parts += [link("world", None), joint("bolt", "world", "trunk", "fixed", "")]
-    if massless_root:
-        parts += [link("base", None), joint("base_to_trunk", "base", "trunk", "fixed", "")]
-    half = " ".join(f"{length / 2 * d:g}" for d in direction)
-    for k in range(legs):
-        angle = 2 * math.pi * k / legs
-        at = f"{hip * math.cos(angle):.6g} {hip * math.sin(angle):.6g} 0"
-        parts += [link(f"thigh{k}"), link(f"shin{k}"), link(f"foot{k}", None),
-                  joint(f"hip{k}", "trunk", f"thigh{k}",
-                        body=f'<origin xyz="{at}"/><axis xyz="0 1 0"/>'),
-                  joint(f"knee{k}", f"thigh{k}", f"shin{k}",
-                        body=f'<origin xyz="{half}"/><axis xyz="0 1 0"/>'),
-                  joint(f"sole{k}", f"shin{k}", f"foot{k}", "fixed", f'<origin xyz="{half}"/>')]
-    return robot(*parts, name="legged")
-
-
 def floating_notices(model: RobotModel) -> list[Notice]:
     return [n for n in model.notices if n.kind is NoticeKind.FLOATING_BASE]
 
@@ -786,7 +745,7 @@ def test_floating_base_rule_over_every_example_robot_data_file(erd_robots_dir):
 
 
 def test_documented_floating_base_warning_is_what_eomgen_prints(erd_robots_dir):
-    text = (Path(__file__).resolve().parents[1] / "docs" / "formats.md").read_text("utf-8")
+    text = (ROOT / "docs" / "formats.md").read_text("utf-8")
     documented = [line for line in text.splitlines() if line.startswith("solo12.urdf: root")]
     path = erd_robots_dir / "solo_description/robots/solo12.urdf"
     model = parse_urdf_string(path.read_bytes(), source="solo12.urdf", defer_notices=True)

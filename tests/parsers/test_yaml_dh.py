@@ -18,6 +18,7 @@ import pytest
 import sympy as sp
 
 import eomgen
+from support import ROOT
 from eomgen.errors import (
     DescriptionError,
     EomgenError,
@@ -28,7 +29,7 @@ from eomgen.model import JointType, RobotModel, parameter_symbol
 from eomgen.parsers import _yaml, dh, yaml_format
 from eomgen.robots import DEFAULT, EXAMPLES, example_path
 
-DOCS = Path(__file__).resolve().parents[1] / "docs" / "formats.md"
+DOCS = ROOT / "docs" / "formats.md"
 
 # ----------------------------------------------------------------------------------------------
 # Helpers: homogeneous transforms and forward kinematics, in NumPy

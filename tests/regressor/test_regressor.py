@@ -14,13 +14,13 @@ import pytest
 import sympy as sp
 
 import eomgen
-from conftest import erd_robots_dir
+from support import erd_robots_dir, random_states
 from eomgen.errors import UnsupportedError, UnsupportedFeatureWarning
 from eomgen.numeric import kinetic_energy, numeric_model, potential_energy, rnea
 from eomgen.regressor import (base_parameters, derive_regressor, identify, regressor_form,
                               symbolic_base_parameters)
 from eomgen.symbolic.textbook import fourier_form
-from reference import pin_q_order, planar_2link_by_hand, random_robot, to_pinocchio
+from support.reference import pin_q_order, planar_2link_by_hand, random_robot, to_pinocchio
 
 URDF = {
     "ur5": "ur_description/urdf/ur5_robot.urdf",
@@ -56,9 +56,7 @@ def regressor(name: str, actuators: tuple = ()):
 
 
 def states(n: int, count: int = 3, seed: int = 7):
-    rng = np.random.default_rng(seed)
-    for _ in range(count):
-        yield rng.uniform(-np.pi, np.pi, n), rng.standard_normal(n), rng.standard_normal(n)
+    return random_states(seed, n, count)
 
 
 @pytest.mark.parametrize("name", ["planar_2link", "puma560_dh", "ur5", "random_chain",

@@ -8,18 +8,17 @@ from __future__ import annotations
 
 import importlib.util
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import eomgen
-from conftest import erd_robots_dir
+from support import ROOT, erd_robots_dir, random_states
 from eomgen.codegen.generate import render_files
 from eomgen.errors import UnsupportedFeatureWarning
 from eomgen.numeric import kinetic_energy, numeric_model, potential_energy, rnea
-from generated import BACKENDS, generated as generate_all
-from reference import pin_q_order
+from support.generated import BACKENDS, generated as generate_all
+from support.reference import pin_q_order
 
 FUNCTIONS = ("regressor", "inertial_parameters", "base_regressor", "base_parameters",
              "kinetic_energy_regressor", "potential_energy_regressor", "inverse_dynamics")
@@ -41,9 +40,7 @@ def generated(model, backends, folder, functions=FUNCTIONS) -> tuple[dict, dict]
 
 
 def states(n: int, count: int = 3, seed: int = 11):
-    rng = np.random.default_rng(seed)
-    for _ in range(count):
-        yield rng.uniform(-np.pi, np.pi, n), rng.standard_normal(n), rng.standard_normal(n)
+    return random_states(seed, n, count)
 
 
 def rank(W: np.ndarray) -> int:
@@ -172,7 +169,7 @@ def test_panda_base_regressor_is_small_and_has_the_published_count():
     from eomgen.codegen import make_job
 
     panda, _ = load_urdf("panda_description/urdf/panda.urdf")
-    scene = Path(__file__).resolve().parents[1] / "examples/scenes/panda_fingers_locked.yaml"
+    scene = ROOT / "examples/scenes/panda_fingers_locked.yaml"
     model = eomgen.apply_scene(panda, eomgen.load_scene(scene))[0]
     dyn = eomgen.derive(model, outputs=["Y", "Y_base", "beta"], simplify=False)
     job = make_job(dyn, ["regressor", "base_regressor", "base_parameters"])
@@ -211,7 +208,7 @@ def test_cli_generates_the_regressor_outputs_and_refuses_a_flexible_joint(tmp_pa
         np.testing.assert_allclose(module.base_regressor(q, qd, qdd) @ module.base_parameters(),
                                    tau, rtol=1e-12)
 
-    flexible = Path(__file__).resolve().parents[1] / "examples/robots/flexible_2link.yaml"
+    flexible = ROOT / "examples/robots/flexible_2link.yaml"
     bad = tmp_path / "bad"
     result = CliRunner().invoke(main, ["generate", str(flexible), "--backend", "numpy",
                                        "--outputs", "Y", "-o", str(bad), "--no-cache", "--quiet"])
@@ -240,7 +237,7 @@ def test_tilted_axes_take_the_numeric_route(tmp_path):
     closed-form grouping does not apply, the numeric route gives the base; Y π is
     eomgen.numeric's Newton–Euler and Y_base β = Y π."""
     from eomgen.regressor import generated_base
-    from reference import random_robot
+    from support.reference import random_robot
 
     model = random_robot(np.random.default_rng(1), 4, tree=True)
     assert generated_base(model).route == "numeric"

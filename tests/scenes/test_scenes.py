@@ -18,7 +18,6 @@ import dataclasses
 import functools
 import importlib.util
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -32,10 +31,9 @@ from eomgen.model import Inertial, Joint, JointType, Link, RobotModel, Transform
 from eomgen.reduction import Reduction, apply_scene, planar_motion
 from eomgen.scene import PLANNED_KEYS, SCENE_KEYS, Scene, load_scene
 from eomgen.symbolic.evaluate import compile_program
-from conftest import erd_robots_dir
-from reference import random_robot, to_pinocchio
+from support import ROOT, assert_close, erd_robots_dir, run_process
+from support.reference import random_robot, to_pinocchio
 
-ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "examples" / "scenes"
 RTOL = 1e-10
 ALL = ("M", "C", "g", "tau")
@@ -50,12 +48,6 @@ EXAMPLES = {
 }
 
 
-def assert_close(a, b, what=""):
-    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
-    assert a.shape == b.shape, (what, a.shape, b.shape)
-    err = float(np.max(np.abs(a - b))) if a.size else 0.0
-    scale = max(1.0, float(np.max(np.abs(b))) if b.size else 1.0)
-    assert err <= RTOL * scale, f"{what}: max|a-b| = {err:.3g} (scale {scale:.3g})"
 
 
 @functools.cache
@@ -674,14 +666,6 @@ def test_fixed_base_must_be_true_or_false():
 
 # Through the command line, in real processes ----------------------------------------------------
 
-def run_process(*args) -> "subprocess.CompletedProcess":
-    import subprocess
-    import sys
-
-    return subprocess.run([sys.executable, "-m", "eomgen.cli", *map(str, args)],
-                          capture_output=True, text=True, timeout=300)
-
-
 def warning_lines(stderr: str) -> list[str]:
     return [line for line in stderr.splitlines() if line.startswith("eomgen: warning: ")]
 
@@ -714,7 +698,7 @@ def test_cli_warns_and_refuses_only_about_what_the_scene_keeps(tmp_path):
 
 
 def test_cli_floating_base_warns_is_refused_and_silenced_by_fixed_base(tmp_path):
-    from test_parsers_urdf import legged
+    from support.robots import legged
 
     description = tmp_path / "biped.urdf"
     description.write_text(legged(legs=2), encoding="utf-8")

@@ -1,5 +1,5 @@
-"""Shared by the tests of the array backends (tests/test_backend_jax.py, test_backend_torch.py):
-each backend's module generated next to the NumPy module, which is the reference (itself checked
+"""Shared by the tests of the array backends (tests/backends/test_backend_jax.py,
+test_backend_torch.py): each backend's module generated next to the NumPy module, which is the reference (itself checked
 against Newton–Euler and Pinocchio in test_codegen).
 
 Robots: the bundled planar arm (all parameters symbolic) and PUMA 560, the UR5 and the Panda
@@ -8,7 +8,6 @@ Robots: the bundled planar arm (all parameters symbolic) and PUMA 560, the UR5 a
 
 from __future__ import annotations
 
-import importlib.util
 import warnings
 from pathlib import Path
 from types import SimpleNamespace
@@ -20,21 +19,13 @@ import eomgen
 from eomgen.codegen.generate import generate
 from eomgen.codegen.scene_generate import generate_scene
 from eomgen.scene import load_scene
-from conftest import erd_robots_dir
+from support import ROOT, erd_robots_dir, load_module  # noqa: F401  (load_module: re-export)
 
-ROOT = Path(__file__).resolve().parent.parent
 FUNCTIONS = ("mass_matrix", "coriolis_matrix", "gravity_vector", "inverse_dynamics",
              "forward_dynamics")
 ARGUMENTS = {"mass_matrix": 1, "coriolis_matrix": 2, "gravity_vector": 1,
              "inverse_dynamics": 3, "forward_dynamics": 3}
 ROBOTS = ("planar_2link", "puma560", "ur5", "panda")
-
-
-def load_module(path: Path, name: str):
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def generate_robot(name: str, outdir: Path, backends: str) -> list[Path]:
@@ -107,7 +98,7 @@ def hostile_modules(kind: str) -> dict:
     import ast
 
     from eomgen.codegen.generate import render_files
-    from test_codegen import DOCSTRING_BREAKER, HOSTILE, hostile_star
+    from support.robots import DOCSTRING_BREAKER, HOSTILE, hostile_star
 
     files = {f.name: f.content for f in render_files(hostile_star(DOCSTRING_BREAKER),
                                                      ["numpy", kind])}

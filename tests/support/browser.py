@@ -1,16 +1,16 @@
 """Headless Chromium for the tests: open an HTML page, screenshot it, and measure whether its
 math was really typeset (MathML laid out in two dimensions) rather than shown as raw TeX.
 
-Import from a test module as ``from browser import ...`` (pytest puts ``tests/`` on
-``sys.path``; ``tests/`` is deliberately not a package). Selenium and Pillow are imported only
-when a browser is started, so this module imports (and its doctests run) without them.
+Import from a test module as ``from support.browser import ...`` (see :mod:`support`).
+Selenium and Pillow are imported only when a browser is started, so this module imports (and
+its doctests run) without them.
 
 The browser and its driver are the system's (Debian packages ``chromium`` and
 ``chromium-driver``, installed by ``.ci/run``), named by absolute path so that Selenium Manager
 never looks for, let alone downloads, anything. Host names resolve to nothing inside the
 browser: a page that asks for a network resource gets an error, and the report lists the URL.
 
->>> from browser import count_ink_bands
+>>> from support.browser import count_ink_bands
 >>> count_ink_bands([0, 3, 5, 0, 0, 0, 4, 0])  # dark pixels per image row, top to bottom
 2
 """

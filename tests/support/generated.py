@@ -1,5 +1,5 @@
 """Generate a model's modules with every code backend, import them and call their functions
-alike: the harness of the tests of the registered outputs (``tests/test_*_outputs.py``).
+alike: the harness of the tests of the registered outputs (``tests/*/test_*_outputs.py``).
 
 ``call(function, *vectors, **parameters)`` runs a generated function and returns NumPy arrays;
 CasADi functions are called by name (a parameter left out takes its default, as in the other

@@ -1,8 +1,7 @@
 """Independent references for the tests: Pinocchio models built from a RobotModel, a URDF
 writer (so Pinocchio's own URDF reader can check our frame conventions), and random robots.
 
-Import from a test module as ``from reference import ...`` (pytest puts ``tests/`` on
-``sys.path``; ``tests/`` is deliberately not a package).
+Import from a test module as ``from support.reference import ...`` (see :mod:`support`).
 """
 
 from __future__ import annotations

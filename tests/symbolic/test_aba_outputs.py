@@ -18,8 +18,8 @@ import pytest
 import eomgen
 from eomgen.codegen.functions import select_functions
 from eomgen.numeric import M_rnea, numeric_model, rnea
-from generated import generated
-from reference import pin_q_order, random_robot, to_pinocchio
+from support.generated import generated
+from support.reference import pin_q_order, random_robot, to_pinocchio
 
 FUNCTIONS = select_functions(["qdd_aba", "h", "forward_dynamics"])
 

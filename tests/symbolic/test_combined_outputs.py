@@ -14,7 +14,7 @@ import pytest
 import eomgen
 from eomgen.numeric import M_rnea, numeric_model, rnea
 from eomgen.outputs import DYNAMICS, MASS_AND_BIAS, splits
-from generated import generated
+from support.generated import generated
 
 
 @pytest.fixture(scope="module", params=["planar_2link", "puma560_arm3"])

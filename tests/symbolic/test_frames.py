@@ -14,19 +14,20 @@ import eomgen
 from eomgen import floating, numeric
 from eomgen.errors import KinematicTreeError
 from eomgen.symbolic.frames import derive_frames, frame_site
-from test_floating import SOLO, FreeFlyerReference, _quiet_load, random_states
+from support import floating_states, load_quietly
+from support.robots import SOLO, FreeFlyerReference
 
 FEET = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
 
 
 @pytest.fixture(scope="module")
 def solo():
-    from conftest import erd_robots_dir
+    from support import erd_robots_dir
 
     if erd_robots_dir() is None:
         pytest.skip("example-robot-data is not installed")
     path = erd_robots_dir() / SOLO
-    model = floating.add_floating_base(_quiet_load(path))
+    model = floating.add_floating_base(load_quietly(path))
     return path, model, derive_frames(model, FEET + ("base_link", "FL_UPPER_LEG"))
 
 
@@ -38,7 +39,7 @@ def test_jacobians_are_finite_differences_of_the_poses(solo):
     _, model, fk = solo
     nm = numeric.numeric_model(model)
     h = 1e-6
-    for q, qd in random_states(18, 2, seed=10):
+    for q, qd in floating_states(18, 2, seed=10):
         out = fk.evaluate(q, qd)
         plus = numeric.link_poses(nm, q + h * qd)
         minus = numeric.link_poses(nm, q - h * qd)
@@ -64,7 +65,7 @@ def test_frames_match_pinocchio(solo):
     path, model, fk = solo
     ref = FreeFlyerReference(path, model.joint_names)
     pm, pd, idx = ref.model, ref.data, ref.idx
-    for q, qd in random_states(18, 3, seed=11):
+    for q, qd in floating_states(18, 3, seed=11):
         out = fk.evaluate(q, qd)
         q_pin, v = ref.state(q, qd)
         T = floating.velocity_map(q)

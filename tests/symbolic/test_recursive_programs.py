@@ -28,8 +28,9 @@ from eomgen.symbolic.crba import crba_program
 from eomgen.symbolic.evaluate import compile_program
 from eomgen.symbolic.newton_euler import grouped_inertials
 from eomgen.symbolic.opcount import count_node, module_operation_counts, program_operation_count
-from conftest import erd_robots_dir
-from reference import pin_q_order, random_robot, to_pinocchio
+from support import ROOT, assert_close
+from support.reference import pin_q_order, random_robot, to_pinocchio
+from support.robots import panda, puma
 
 RTOL = 1e-10
 
@@ -37,10 +38,6 @@ RTOL = 1e-10
 RANDOM = [(1, 4, False), (3, 6, False), (4, 7, True), (9, 7, False), (10, 3, True)]
 
 
-def assert_close(a, b, what=""):
-    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
-    err = np.max(np.abs(a - b)) if a.size else 0.0
-    assert err <= RTOL * max(1.0, np.max(np.abs(b))), f"{what}: |a-b| = {err:.3g}\n{a}\n{b}"
 
 
 def random_model(case):
@@ -48,19 +45,6 @@ def random_model(case):
     return random_robot(np.random.default_rng(seed), n, tree=tree)
 
 
-def puma():
-    return eomgen.load(eomgen.example_path("puma560_dh"))
-
-
-def panda():
-    robots = erd_robots_dir()
-    if robots is None:
-        pytest.skip("example-robot-data is not installed")
-    from eomgen.model import lock_joints
-
-    with pytest.warns(Warning):  # the <mimic> finger joint is read as independent
-        model = eomgen.load(robots / "panda_description" / "urdf" / "panda.urdf")
-    return lock_joints(model, {n: 0 for n in model.joint_names if "finger" in n})
 
 
 # ----------------------------------------------------------------------------------------------
@@ -282,7 +266,7 @@ def _aligned_tree(seed: int):
     """Revolute joints about ±x, ±y, ±z with offsets of a repeated length 0.3 m and two last
     bodies (a tree), random inertias and gravity: what leaf_phases and acceleration_length
     act on (random_robot's axes and offsets are mostly general)."""
-    from reference import random_inertial
+    from support.reference import random_inertial
 
     rng = np.random.default_rng(seed)
     links = [Link("base", None)] + [Link(f"l{k}", random_inertial(rng)) for k in range(5)]
@@ -347,9 +331,8 @@ def test_aba_beats_the_cholesky_route_for_a_long_chain():
     solving by Cholesky. A planar chain keeps the test fast; the spatial chains are in
     benchmarks/complexity.py."""
     import sys
-    from pathlib import Path
 
-    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+    sys.path.insert(0, str(ROOT / "benchmarks"))
     from derive_speed import planar_model
 
     model = planar_model(30)

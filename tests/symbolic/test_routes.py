@@ -27,8 +27,8 @@ from eomgen.symbolic.composite import _routes, coriolis_program
 from eomgen.symbolic.evaluate import compile_program
 from eomgen.symbolic.opcount import program_operation_count
 from eomgen.symbolic.program import Program, ProgramBuilder
-from reference import random_robot
-from test_recursive_programs import panda
+from support.reference import random_robot
+from support.robots import panda
 
 #: (seed, joints, tree): chains and trees with prismatic joints, random axes and fixed links.
 RANDOM = [(1, 4, False), (4, 5, True), (10, 3, True)]

@@ -19,7 +19,7 @@ import re
 import pytest
 from latex2mathml.converter import convert
 
-from browser import (
+from support.browser import (
     assert_math_rendered, chromium_available, count_ink_bands, headless_chromium,
     math_rendering_report,
 )

@@ -39,16 +39,17 @@ from eomgen.codegen.backends.latex_printer import (
 )
 from eomgen.dynamics import Dynamics, joint_symbols
 from eomgen.model import (
-    Inertial, Joint, JointType, Link, Parameter, Transform, build_model, lock_joints,
-    parameter_symbol,
+    Inertial, Joint, JointType, Link, Parameter, Transform, build_model, parameter_symbol,
 )
 from eomgen.robots import example_path
 from eomgen.symbolic.evaluate import compile_program
 from eomgen.symbolic.textbook import (
     TEXTBOOK_MAX_DOF, christoffel_symbols, description_floats, fourier_form, textbook_derivation,
 )
-from conftest import erd_robots_dir
-from reference import planar_2link_by_hand, random_robot
+from support import erd_robots_dir
+from support import TESTS
+from support.reference import planar_2link_by_hand, random_robot
+from support.robots import puma_arm
 
 ALL = ("M", "C", "g", "tau")
 pytestmark = pytest.mark.filterwarnings("ignore::eomgen.errors.PhysicalConsistencyWarning")
@@ -511,9 +512,7 @@ def test_hostile_names_only_appear_escaped():
 
 def _puma_arm() -> Dynamics:
     """The PUMA 560 with its wrist locked: a 3-joint arm with float parameters (textbook)."""
-    model = lock_joints(eomgen.load(example_path("puma560_dh")),
-                        {"joint4": 0, "joint5": 0, "joint6": 0})
-    return eomgen.derive(model, outputs=ALL, simplify=False)
+    return eomgen.derive(puma_arm(), outputs=ALL, simplify=False)
 
 
 def test_documents_are_deterministic_across_hash_seeds():
@@ -523,7 +522,7 @@ def test_documents_are_deterministic_across_hash_seeds():
         "import hashlib, sys, warnings\n"
         "warnings.simplefilter('ignore')\n"
         "sys.path.insert(0, %r)\n"
-        "from test_latex import _puma_arm\n"
+        "from support.robots import puma_arm\n"
         "import eomgen\n"
         "from eomgen.codegen import make_job\n"
         "from eomgen.codegen.backends.latex_backend import render_document\n"
@@ -531,8 +530,9 @@ def test_documents_are_deterministic_across_hash_seeds():
         "    dyn = eomgen.derive(eomgen.load(eomgen.example_path(name)), "
         "outputs=('M', 'C', 'g', 'tau'))\n"
         "    print(hashlib.sha256(render_document(make_job(dyn)).encode()).hexdigest())\n"
-        "print(hashlib.sha256(render_document(make_job(_puma_arm())).encode()).hexdigest())\n"
-    ) % str(Path(__file__).parent)
+        "arm = eomgen.derive(puma_arm(), outputs=%r, simplify=False)\n"
+        "print(hashlib.sha256(render_document(make_job(arm)).encode()).hexdigest())\n"
+    ) % (str(TESTS), ALL)
     expected = []
     for name in ("planar_2link", "puma560_dh"):
         again = render_document(make_job(eomgen.derive(eomgen.load(example_path(name)), outputs=ALL)))
@@ -637,7 +637,7 @@ def test_program_legend_reads_tags_not_names():
     """The intermediates of the world-frame Lagrangian programs carry a Tag set where they are
     defined; the document's legend groups by the tags, so renaming every intermediate to a
     neutral name (x0, x1, …, tags kept) leaves the legend as it was."""
-    from reference import random_robot
+    from support.reference import random_robot
 
     from eomgen.codegen.backends.latex_backend import (LatexConfig, PROGRAM_NAMES, printing,
                                                        program_sections)

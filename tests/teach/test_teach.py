@@ -22,8 +22,8 @@ import sympy as sp
 from click.testing import CliRunner
 
 import eomgen
+from support import CORPUS, ROOT
 from eomgen.cli import main
-from eomgen.codegen.backends import latex_backend as lb
 from eomgen.errors import GenerationError
 from eomgen.symbolic.textbook import textbook_derivation
 from eomgen.teach import FORMATS, build_handout, handout_files, parse_formats
@@ -32,7 +32,6 @@ from eomgen.teach.content import HALF, _quadratic_terms, named_coriolis
 from eomgen.teach.document import Equations, Figure, Paragraph, Table, code, prose
 from eomgen.teach.formats import HtmlFormat, MarkdownFormat, TexFormat
 
-CORPUS = Path(__file__).parent / "corpus"
 PDFLATEX = shutil.which("pdflatex")
 PDFTOTEXT = shutil.which("pdftotext")
 needs_pdflatex = pytest.mark.skipif(PDFLATEX is None or PDFTOTEXT is None,
@@ -350,7 +349,7 @@ def test_formats_in_a_fresh_process_match(tmp_path):
 
 @pytest.mark.browser
 def test_html_math_is_rendered_in_headless_chromium(arm_handout, tmp_path):
-    from browser import (assert_math_rendered, chromium_available, headless_chromium,
+    from support.browser import (assert_math_rendered, chromium_available, headless_chromium,
                          math_rendering_report)
 
     reason = chromium_available()
@@ -432,12 +431,12 @@ def test_scene_turns_a_real_arm_into_a_teaching_example(tmp_path):
     handout in the textbook sequence, saying which joints the scene locked, whose M, C, g pass
     every check against Newton–Euler on the reduced model. (That reduction equals Pinocchio's
     buildReducedModel is tests/test_scenes.py's business.)"""
-    from conftest import erd_robots_dir
+    from support import erd_robots_dir
 
     robots = erd_robots_dir()
     if robots is None:
         pytest.skip("example-robot-data is not installed")
-    scene = Path(__file__).parent.parent / "examples" / "scenes" / "panda_two_joints.yaml"
+    scene = ROOT / "examples" / "scenes" / "panda_two_joints.yaml"
     out = tmp_path / "out"
     result = CliRunner().invoke(main, [
         "teach", str(robots / "panda_description" / "urdf" / "panda.urdf"),
@@ -559,7 +558,7 @@ def test_no_drive_section_without_actuators(arm_handout):
 
 # -- contacts: the 2-link arm on a wall -----------------------------------------------------
 
-WALL_SCENE = (Path(__file__).resolve().parents[1] / "examples" / "contacts"
+WALL_SCENE = (ROOT / "examples" / "contacts"
               / "planar_2link_wall.yaml")
 
 
