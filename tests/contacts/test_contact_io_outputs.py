@@ -10,9 +10,6 @@ numeric cone check; finite differences in time of the generated body Jacobians.
 
 from __future__ import annotations
 
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 
@@ -23,6 +20,7 @@ from eomgen.numeric import numeric_model, rnea
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support.generated import BACKENDS, generated
+from support import run_in_process
 
 # the bundled planar arm (l1 = l2 = 1 in its YAML) with its tip on a wall normal to -x,
 # friction 0.5, and a second point contact on link1's frame (rows 4-6, normal +y)
@@ -169,19 +167,16 @@ def test_cli_generates_the_contact_inverse_dynamics(tmp_path):
     scene = tmp_path / "wall.yaml"
     scene.write_text(SCENE)
     out = tmp_path / "out"
-    run = subprocess.run([sys.executable, "-m", "eomgen.cli", "generate",
-                          "--scene", str(scene), "--no-cache", "--outputs",
-                          "contact_inverse_dynamics,friction_cone_margin", "--backend", "numpy",
-                          "-o", str(out), "--quiet"], capture_output=True, text=True)
+    run = run_in_process("generate", "--scene", scene, "--no-cache", "--outputs",
+                         "contact_inverse_dynamics,friction_cone_margin", "--backend", "numpy",
+                         "-o", out, "--quiet")
     assert run.returncode == 0, run.stderr
     text = next(out.glob("*.py")).read_text()
     assert "def contact_inverse_dynamics(q, qd, qdd, F_c" in text
     assert "F_c : array, shape (6,) or (N, 6)" in text
     bad = tmp_path / "bad.yaml"
     bad.write_text("version: 1\nrobot: planar_2link\ncontacts:\n  - {frame: tip}\n")
-    run = subprocess.run([sys.executable, "-m", "eomgen.cli", "generate", "--no-cache",
-                          "--scene", str(bad), "--outputs", "friction_cone_margin",
-                          "-o", str(tmp_path / "none"), "--quiet"], capture_output=True,
-                         text=True)
+    run = run_in_process("generate", "--no-cache", "--scene", bad, "--outputs",
+                         "friction_cone_margin", "-o", tmp_path / "none", "--quiet")
     assert run.returncode == 2 and not (tmp_path / "none").exists()
     assert len(run.stderr.strip().splitlines()) == 1 and "friction coefficient" in run.stderr

@@ -11,15 +11,12 @@ eomgen.contacts' numeric KKT (Newton–Euler M and h).
 
 from __future__ import annotations
 
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 
 import eomgen
 from eomgen.codegen import loadable_backends
-from support import ROOT, erd_robots_dir, floating_states
+from support import ROOT, erd_robots_dir, floating_states, run_in_process
 from eomgen import floating
 from eomgen.codegen.functions import select_functions
 from eomgen.codegen.generate import render_files
@@ -272,8 +269,7 @@ def test_bad_scene_frames_are_one_line_errors(text, message):
 
 
 def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "eomgen.cli", "generate", *args, "--no-cache",
-                           "--quiet"], capture_output=True, text=True)
+    return run_in_process("generate", *args, "--no-cache", "--quiet")
 
 
 def test_cli_generates_contact_outputs_and_refuses_them_without_contacts(tmp_path):

@@ -14,7 +14,9 @@ import numpy as np
 import pytest
 
 import eomgen
-from support import CONTACTS, DOCS, erd_robots_dir, floating_states, load_quietly, relative
+from support import (
+    CONTACTS, DOCS, erd_robots_dir, floating_states, load_quietly, relative, run_in_process,
+)
 from eomgen import floating, numeric
 from eomgen.contacts import Contact, ContactDynamics, derived_mass_and_bias
 from eomgen.errors import SceneError
@@ -285,15 +287,10 @@ def test_documented_contact_errors_are_what_eomgen_prints(solo):
 
 
 def test_cli_refuses_a_bad_contact_with_one_line_and_exit_code_2(solo, tmp_path):
-    import subprocess
-    import sys
-
     path, _ = solo
     scene = tmp_path / "solo_scene.yaml"
     scene.write_text("version: 1\nfloating_base: true\ncontacts: [{frame: FL_FOOT, mu: -0.5}]\n")
-    result = subprocess.run([sys.executable, "-m", "eomgen.cli", "generate", str(path),
-                             "--scene", str(scene), "-o", str(tmp_path / "out")],
-                            capture_output=True, text=True, timeout=300)
+    result = run_in_process("generate", path, "--scene", scene, "-o", tmp_path / "out")
     assert result.returncode == 2
     assert result.stderr.strip() == (f"eomgen: error: {scene}: contacts[0] 'FL_FOOT' mu: "
                                      "friction coefficient -0.5 is negative (μ ≥ 0)")

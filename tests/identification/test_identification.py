@@ -23,7 +23,7 @@ from eomgen.identification import (IdentificationError, Measurements, MotionBoun
 from eomgen.parsers.urdf import JointLimit, joint_limits
 from eomgen.regressor import base_parameters, derive_regressor
 
-from support import ROOT, erd_robots_dir, run_process
+from support import ROOT, erd_robots_dir, run_in_process
 
 pytest.importorskip("scipy", reason="identification needs scipy (pip install 'eomgen[identify]')")
 
@@ -148,7 +148,7 @@ def test_excite_keeps_the_urdf_limits_and_the_options(tmp_path):
     urdf = tmp_path / "arm.urdf"
     urdf.write_text(ARM_URDF.format(lower=0.3))
     data = tmp_path / "arm.csv"
-    done = run_process("excite", urdf, "-o", data, "--samples", 400, "--amplitude", 0.8,
+    done = run_in_process("excite", urdf, "-o", data, "--samples", 400, "--amplitude", 0.8,
                        "--max-velocity", 0.3, "--max-acceleration", 0.2, "--quiet")
     assert done.returncode == 0, done.stderr
     read = read_measurements(data, ("joint1", "joint2"))
@@ -159,7 +159,7 @@ def test_excite_keeps_the_urdf_limits_and_the_options(tmp_path):
     # no room: joint1's limits [1.5, 2] lie outside ±--amplitude 1; nothing written
     urdf.write_text(ARM_URDF.format(lower=1.5).replace('upper="1.2"', 'upper="2"'))
     out = tmp_path / "none.csv"
-    done = run_process("excite", urdf, "-o", out, "--quiet")
+    done = run_in_process("excite", urdf, "-o", out, "--quiet")
     assert done.returncode == 2 and done.stderr.count("\n") == 1, done.stderr
     assert done.stderr.startswith(f"eomgen: error: {urdf}: joint 'joint1': its limits [1.5, 2]")
     assert not out.exists()
@@ -273,7 +273,7 @@ def test_identify_cutoff_on_full_data_is_reported(tmp_path):
     path = tmp_path / "planar.csv"
     path.write_text(measurements_csv(data))
     out = tmp_path / "id"
-    done = run_process("identify", PLANAR, path, "-o", out, "--quiet", "--cutoff", 4)
+    done = run_in_process("identify", PLANAR, path, "-o", out, "--quiet", "--cutoff", 4)
     assert done.returncode == 0, done.stderr
     assert "q, q̇, q̈, τ zero-phase low-pass filtered at 4 Hz" in done.stdout
     # 40 Hz sampling: 3 periods of 4 Hz (30 samples) trimmed each end, every 5th kept
@@ -361,12 +361,12 @@ def test_physical_fit_of_a_physical_robot_keeps_the_estimate():
 def test_excite_then_identify_puma(tmp_path):
     pytest.importorskip("cvxpy", reason="--physical needs cvxpy (pip install 'eomgen[identify]')")
     data = tmp_path / "puma.csv"
-    result = run_process("excite", PUMA, "-o", data, "--samples", 150, "--noise", 0.01,
+    result = run_in_process("excite", PUMA, "-o", data, "--samples", 150, "--noise", 0.01,
                          "--quiet")
     assert result.returncode == 0, result.stderr
     assert result.stdout.splitlines()[-1] == str(data)
     out = tmp_path / "id"
-    result = run_process("identify", PUMA, data, "-o", out, "--quiet", "--physical")
+    result = run_in_process("identify", PUMA, data, "-o", out, "--quiet", "--physical")
     assert result.returncode == 0, result.stderr
     assert "min eig of its body's pseudo-inertia J" in result.stdout
     names = sorted(p.name for p in out.iterdir())
@@ -375,7 +375,7 @@ def test_excite_then_identify_puma(tmp_path):
     assert len(rows) == 1 + 36 and rows[0].startswith("name,expression,estimate,std")
     png = (out / "identify_puma560.png").read_bytes()
     again = tmp_path / "id2"
-    assert run_process("identify", PUMA, data, "-o", again, "--quiet",
+    assert run_in_process("identify", PUMA, data, "-o", again, "--quiet",
                        "--physical").returncode == 0
     assert (again / "identify_puma560.png").read_bytes() == png  # deterministic
     assert "| 36 | ZZ6 | `ZZ6` |" in result.stdout
@@ -419,7 +419,7 @@ def test_bad_csv_is_one_line_exit_2_and_nothing_written(tmp_path, case):
     edit, message = BAD[case]
     path = edited(tmp_path, edit)
     out = tmp_path / "out"
-    result = run_process("identify", PLANAR, path, "-o", out, "--quiet")
+    result = run_in_process("identify", PLANAR, path, "-o", out, "--quiet")
     assert result.returncode == 2
     assert result.stderr.count("\n") == 1 and result.stderr.startswith("eomgen: error: ")
     assert str(path) in result.stderr and message in result.stderr, result.stderr
@@ -441,7 +441,7 @@ def test_unexciting_data_name_the_rank(tmp_path):
 
 
 def test_excite_refuses_a_folder_as_output_before_any_work(tmp_path):
-    result = run_process("excite", PLANAR, "-o", tmp_path)
+    result = run_in_process("excite", PLANAR, "-o", tmp_path)
     assert result.returncode == 2 and "it is a folder, not a file" in result.stderr
     assert result.stderr.count("\n") == 1
 
@@ -455,14 +455,14 @@ def test_excite_and_identify_a_scene_of_the_panda(tmp_path):
     urdf = robots / "panda_description/urdf/panda.urdf"
     scene = ROOT / "examples/scenes/panda_two_joints.yaml"
     data = tmp_path / "panda.csv"
-    done = run_process("excite", urdf, "--scene", scene, "-o", data, "--samples", 100,
+    done = run_in_process("excite", urdf, "--scene", scene, "-o", data, "--samples", 100,
                        "--noise", 0.01, "--quiet")
     assert done.returncode == 0, done.stderr
     assert data.read_text().splitlines()[0] == (
         "t,q_panda_joint2,q_panda_joint4,qd_panda_joint2,qd_panda_joint4,qdd_panda_joint2,"
         "qdd_panda_joint4,tau_panda_joint2,tau_panda_joint4")
     out = tmp_path / "id"
-    done = run_process("identify", urdf, data, "--scene", scene, "-o", out, "--quiet")
+    done = run_in_process("identify", urdf, data, "--scene", scene, "-o", out, "--quiet")
     assert done.returncode == 0, done.stderr
     rows = list(csv.DictReader((out / "identify_panda.csv").open()))
     assert [r["name"] for r in rows] == ["MX1R", "MY1R", "ZZ1R", "MX2", "MY2", "ZZ2"]

@@ -7,8 +7,6 @@ tools that keep the floats (Pinocchio reads the UR5 to 1e-15 of eomgen only with
 from __future__ import annotations
 
 import math
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -17,6 +15,7 @@ import eomgen
 from eomgen.analysis.routes import compile_batch
 from eomgen.dynamics import derive
 from eomgen.model import SNAP_TOLERANCE, snap_summary
+from support import run_in_process
 
 ANGLE = 1.57079632679  # π/2 to 11 decimals: cos is 4.9e-12, snapped to 0
 
@@ -95,13 +94,11 @@ def test_ur5_without_snapping_agrees_with_pinocchio_to_1e_14(erd_robots_dir):
 
 
 def test_cli_no_snap_changes_the_output_and_the_cache_key(bent, tmp_path):
-    command = [sys.executable, "-m", "eomgen.cli", "generate", str(bent), "--backend", "numpy",
-               "--cache-dir", str(tmp_path / "cache")]
+    command = ["generate", bent, "--backend", "numpy", "--cache-dir", tmp_path / "cache"]
     outputs, progress = {}, []
     for flag in ([], ["--no-snap"], []):
         out = tmp_path / ("kept" if flag else "snapped")
-        result = subprocess.run(command + flag + ["-o", str(out)], capture_output=True,
-                                text=True)
+        result = run_in_process(*command, *flag, "-o", out)
         assert result.returncode == 0, result.stderr
         text = (out / "bent_numpy.py").read_text()
         assert outputs.setdefault(bool(flag), text) == text  # the cached run: the same file
