@@ -46,7 +46,10 @@ from eomgen.model import (Inertial, Joint, JointType, Link, Parameter, RobotMode
                           build_model, vec3)
 from eomgen.numeric import NumericModel, numeric_model, rnea
 from support.robots import DOCSTRING_BREAKER, HOSTILE, hostile_star, ur5
-from support import TESTS, assert_close, erd_robots_dir, load_module, load_quietly, random_states
+from support import (
+    TESTS, assert_close, erd_robots_dir, load_module, load_quietly, random_states,
+    render_text_files,
+)
 from support.reference import random_robot
 
 RTOL = 1e-10
@@ -983,7 +986,8 @@ import sys, warnings
 sys.path.insert(0, sys.argv[1])
 import numpy as np
 import eomgen
-from eomgen.codegen.generate import render_files, write_atomically
+from eomgen.codegen.generate import write_atomically
+from support import render_text_files
 from support.reference import random_robot
 warnings.simplefilter("ignore")
 which, outdir = sys.argv[2], sys.argv[3]
@@ -991,7 +995,7 @@ if which == "planar":
     model, backends = eomgen.load(eomgen.example_path("planar_2link")), ["numpy", "casadi", "c"]
 else:
     model, backends = random_robot(np.random.default_rng(3), 3, tree=True), ["numpy", "casadi"]
-write_atomically([f for f in render_files(model, backends) if f.golden], outdir)
+write_atomically([f for f in render_text_files(model, backends) if f.golden], outdir)
 """
 
 
@@ -1019,8 +1023,8 @@ def test_generation_is_deterministic(build, tmp_path):
         tree = lambda: random_robot(np.random.default_rng(3), 3, tree=True)  # noqa: E731
         first = {"planar": _text_files(Path(build("planar_2link").numpy.__file__).parent),
                  "tree": _contents(render_files(tree(), ["numpy", "casadi"]))}
-        again = {"planar": _contents(render_files(EXAMPLES["planar_2link"](),
-                                                  ["numpy", "casadi", "c"])),
+        again = {"planar": _contents(render_text_files(EXAMPLES["planar_2link"](),
+                                                       ["numpy", "casadi", "c"])),
                  "tree": _contents(render_files(tree(), ["numpy", "casadi"]))}
     finally:
         results = {which: job.communicate(timeout=120) for which, job in jobs.items()}
