@@ -58,6 +58,7 @@ def test_jax_jit_and_vmap_agree_with_numpy(robot, name):
         assert_relative(jax.jit(jax.vmap(f))(*args), expected, what=f"jit vmap {function}")
 
 
+@pytest.mark.slow
 def test_xla_computes_each_sine_and_cosine_once(robot):
     """Compiled for the CPU under jax.jit(jax.vmap(f)), each named sine and cosine is one
     instruction: XLA's fusion counts sin and cos as cheap and copied them into every output loop

@@ -619,6 +619,7 @@ def test_left_out_parameters_take_the_description_values(build, tmp_path, symbol
     assert_interfaces_use_description_values(ex, np.random.default_rng(14))
 
 
+@pytest.mark.slow
 def test_scene_payload_is_in_the_defaults(tmp_path):
     """examples/scenes/ur5_payload.yaml keeps the payload mass m_load symbolic (2 kg): called
     without it, every interface carries the payload, which moves g(q) from the bare arm's."""
@@ -1008,6 +1009,7 @@ def _contents(files: list[GeneratedFile]) -> dict[str, bytes]:
             if f.golden}
 
 
+@pytest.mark.slow
 def test_generation_is_deterministic(build, tmp_path):
     """Twice in this process, and in processes with other hash seeds: identical bytes (the
     bundled arm with every backend, a random tree with the Python backends)."""
@@ -1145,6 +1147,7 @@ def _expected_default_files() -> set[str]:
     return {"planar_2link" + s for b in available_backends() for s in suffixes.get(b, [])}
 
 
+@pytest.mark.slow
 def test_cli_default_generates_the_bundled_arm(cli):
     run = cli["default"]
     assert run.returncode == 0, run.stderr
@@ -1161,6 +1164,7 @@ def test_cli_default_generates_the_bundled_arm(cli):
     assert module.JOINT_NAMES == ("joint1", "joint2")
 
 
+@pytest.mark.slow
 def test_cli_numpy_backend_writes_only_the_numpy_module(cli, build):
     run = cli["numpy"]
     assert run.returncode == 0, run.stderr
@@ -1170,6 +1174,7 @@ def test_cli_numpy_backend_writes_only_the_numpy_module(cli, build):
         build("planar_2link").paths["planar_2link_numpy.py"].read_bytes()
 
 
+@pytest.mark.slow
 def test_cli_symbolic_keeps_the_named_parameters(cli):
     run = cli["symbolic"]
     assert run.returncode == 0 and run.stderr == ""
@@ -1179,6 +1184,7 @@ def test_cli_symbolic_keeps_the_named_parameters(cli):
 
 @pytest.mark.parametrize("name, mentions", [("unknown_backend", "fortran"),
                                             ("unknown_symbolic", "nosuch")])
+@pytest.mark.slow
 def test_cli_bad_request_is_one_error_line_and_writes_nothing(cli, name, mentions):
     run = cli[name]
     assert run.returncode == 2

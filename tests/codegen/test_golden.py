@@ -41,6 +41,7 @@ def _render(path: Path) -> dict[str, str | bytes]:
 
 
 @pytest.mark.parametrize("name", list(_examples()))
+@pytest.mark.slow
 def test_generated_is_up_to_date(name, request):
     source = _examples()[name]
     if source is None:
@@ -65,6 +66,7 @@ def test_generated_is_up_to_date(name, request):
                                     "run pytest tests/codegen/test_golden.py --update-golden")
 
 
+@pytest.mark.slow
 def test_generation_is_deterministic_across_processes():
     """Same input, byte-identical files, even with another hash seed."""
     script = (

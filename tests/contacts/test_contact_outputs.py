@@ -62,6 +62,7 @@ def _call(module, backend, function, *args):
 
 # --- the planar arm on a wall: closed form, every backend -------------------------------------
 
+@pytest.mark.slow
 def test_planar_wall_outputs_in_every_backend(tmp_path):
     arm = eomgen.load(eomgen.example_path("planar_2link"))
     wall = apply_scene(arm, load_scene(WALL)).model

@@ -154,6 +154,7 @@ def test_redundant_contacts_need_damping(tmp_path):
 
 # --- solo12 with a floating base and four feet held -------------------------------------------
 
+@pytest.mark.slow
 def test_solo_fast_equals_numpy_and_pinocchio(tmp_path):
     pin = pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
     if erd_robots_dir() is None:

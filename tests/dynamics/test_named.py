@@ -45,6 +45,7 @@ def close(a, b, rtol=1e-12):
     np.testing.assert_allclose(a.reshape(b.shape), b, rtol=0, atol=rtol * max(1.0, np.abs(b).max()))
 
 
+@pytest.mark.slow
 def test_large_model_gives_the_named_form_after_bounded_work(monkeypatch):
     """The 5-joint arm's M is not written out: derive's result tries the expansion within
     AUTO_EXPAND_WORK term operations, stops, and gives the named form."""
@@ -64,6 +65,7 @@ def test_large_model_gives_the_named_form_after_bounded_work(monkeypatch):
     assert {s for s, _ in M.subexpressions} <= {s for s, _ in dyn.program.assignments}
 
 
+@pytest.mark.slow
 def test_named_form_evaluates_to_the_numeric_model():
     """Indexing, substitution, evalf, products with SymPy matrices and lambdify all give the
     numbers of the numeric Newton-Euler; substituting every input gives an ordinary Matrix."""

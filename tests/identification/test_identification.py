@@ -186,6 +186,7 @@ def test_one_percent_noise_stays_within_three_reported_sigma():
     np.testing.assert_allclose(est.sigma, added, rtol=0.2)
 
 
+@pytest.mark.slow
 def test_reported_standard_deviations_are_calibrated():
     """Over 40 noise draws the errors (β̂ − β) / std have unit spread, and 3 std covers
     what it should (99.7 % per parameter; all 36 at once for about 0.9973^36 = 91 % of draws,

@@ -53,6 +53,7 @@ def test_notebook_is_deterministic_without_outputs(arm):
 
 
 @pytest.mark.parametrize("example", ["planar_2link", "puma560_dh", "elbow_rrr"])
+@pytest.mark.slow
 def test_cli_notebook_runs_without_errors(tmp_path, example):
     """The notebooks of the bundled examples execute without a cell error (the 6-joint PUMA
     takes the large-model path: no textbook cells, summaries instead)."""

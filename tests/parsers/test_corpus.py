@@ -116,6 +116,7 @@ REAL_PROCESS_CASES = ["urdf_xml_billion_laughs.urdf", "urdf_inertia_triangle_ine
              "urdf_too_many_joints.urdf"]
 
 
+@pytest.mark.slow
 def test_generate_in_a_real_process(tmp_path):
     started = {}
     for name in REAL_PROCESS_CASES:
@@ -140,6 +141,7 @@ def test_generate_in_a_real_process(tmp_path):
 # ----------------------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("name", sorted(VALID))
+@pytest.mark.slow
 def test_hostile_but_valid_files_generate_with_every_backend(name, tmp_path, capfd):
     path = CORPUS / name
     with warnings.catch_warnings(record=True) as caught:

@@ -178,6 +178,7 @@ def load_text(text: str | bytes, suffix: str) -> RobotModel:
 
 @settings(max_examples=12, **COMMON)
 @given(spec=robots(), form=st.sampled_from(["model", ".urdf", ".yaml"]))
+@pytest.mark.slow
 def test_random_valid_robots_pass_verification(spec, form):
     model = to_model(spec) if form == "model" else load_text(WRITERS[form](spec), form)
     assert model.dof == sum(j.kind != "fixed" for j in spec.joints)
@@ -292,6 +293,7 @@ def check_clean(text: str | bytes, suffix: str) -> None:
 
 @settings(max_examples=EXPLORE or 150, **COMMON)
 @given(data=st.data(), seed=st.sampled_from(SEEDS))
+@pytest.mark.slow
 def test_corrupted_bundled_and_fixed_descriptions_fail_cleanly(data, seed):
     suffix, text = seed
     check_clean(data.draw(corruptions(text), label="corrupted"), suffix)

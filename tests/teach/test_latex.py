@@ -515,6 +515,7 @@ def _puma_arm() -> Dynamics:
     return eomgen.derive(puma_arm(), outputs=ALL, simplify=False)
 
 
+@pytest.mark.slow
 def test_documents_are_deterministic_across_hash_seeds():
     """Same input, byte-identical output: twice in this process, and in a fresh interpreter
     with another hash seed (no set or dict order leaks into the text)."""
@@ -592,6 +593,7 @@ def test_documents_compile_with_pdflatex(tmp_path, name, title):
 
 
 @needs_pdflatex
+@pytest.mark.slow
 def test_general_arm_textbook_document_compiles(tmp_path):
     model = replace(random_robot(np.random.default_rng(0), 2), name="general_arm")
     job = make_job(eomgen.derive(model, outputs=ALL, simplify=False))
@@ -633,6 +635,7 @@ def test_rounded_digits_remain_an_option():
     assert "1.03119 R_{2,00}" in rounded and "1.03118515 R_{2,00}" in full
 
 
+@pytest.mark.slow
 def test_program_legend_reads_tags_not_names():
     """The intermediates of the world-frame Lagrangian programs carry a Tag set where they are
     defined; the document's legend groups by the tags, so renaming every intermediate to a

@@ -227,6 +227,7 @@ for name in ("planar_2link", "puma560_dh"):
 """
 
 
+@pytest.mark.slow
 def test_render_is_deterministic_in_process_and_across_interpreters(planar, puma):
     first = digests([planar, puma])
     assert digests([planar, puma]) == first
