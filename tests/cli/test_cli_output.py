@@ -33,7 +33,7 @@ import pytest
 from eomgen.output import GeneratedFile, OutputError, check_output_folder, write_atomically
 from eomgen.progress import Progress, plural
 
-from support import ERROR, ROOT, SCENES, erd_robots_dir, run_process
+from support import ERROR, ROOT, SCENES, erd_robots_dir, run_in_process, run_process
 
 STAGE = re.compile(r"^eomgen: .* \[\+\d+\.\d s\]$")
 
@@ -195,26 +195,27 @@ def test_generate_reports_each_stage_with_its_time_in_a_log(tmp_path):
     assert times == sorted(times)
 
 
-def test_quiet_silences_every_command(tmp_path):
+def test_quiet_silences_every_command(tmp_path, monkeypatch):
     """``--quiet`` on every command (bench: in the scene test below); without it, stage
-    lines."""
+    lines. In process: what is printed is the commands' doing, not the interpreter's."""
+    monkeypatch.chdir(tmp_path)
     runs = [("verify", "--samples", "2"), ("generate", "--backend", "numpy", "--no-cache"),
             ("notebook", "-o", tmp_path / "n.ipynb"), ("teach", "--format", "md", "--no-check")]
     if has_analysis():
         runs.append(("simulate", "--duration", "0.05", "--integrators", "rk4", "--dt", "1e-2"))
     for args in runs:
         out = ["-o", tmp_path / args[0]] if args[0] in ("generate", "teach", "simulate") else []
-        done = run_process(*args, *out, "--quiet", cwd=tmp_path)
+        done = run_in_process(*args, *out, "--quiet")
         assert done.returncode == 0, (args, done.stderr)
         assert done.stderr == "", args
     for args in runs[2:4]:  # the others' stage lines are tested on their own
-        loud = run_process(*args, cwd=tmp_path, *(["-o", tmp_path / "t"] if args[0] == "teach"
-                                                 else []))
+        loud = run_in_process(*args, *(["-o", tmp_path / "t"] if args[0] == "teach" else []))
         assert loud.returncode == 0 and loud.stderr.splitlines(), args
         assert all(STAGE.match(line) for line in loud.stderr.splitlines()), loud.stderr
 
 
 @pytest.mark.skipif(not has_analysis(), reason="simulate needs the analysis extra")
+@pytest.mark.slow
 def test_simulate_names_each_integrator_in_a_log(tmp_path):
     done = run_process("simulate", "--duration", "0.05", "--integrators", "euler,rk4",
                        "--dt", "1e-2", "--rtol", "1e-4", "-o", tmp_path)
