@@ -156,7 +156,7 @@ def test_an_output_that_cannot_be_written_is_one_line_before_the_work(command, t
              "simulate": ["--duration", "0.1", "--integrators", "rk4"]}.get(command, [])
     for output, problem in _bad_outputs(tmp_path, command):
         before = snapshot(tmp_path)
-        done = run_process(command, *extra, "-o", output, cwd=tmp_path)
+        done = run_in_process(command, *extra, "-o", output)
         assert done.returncode == 2, (command, output, done.stderr)
         lines = done.stderr.splitlines()
         assert len(lines) == 1, done.stderr
@@ -322,12 +322,12 @@ def test_verify_and_notebook_take_a_scene(tmp_path):
     """The Panda reduced to its shoulder and elbow: verify checks the reduced model against
     Newton-Euler; the notebook's first cell loads the same reduced model."""
     urdf, scene = panda(), SCENES / "panda_two_joints.yaml"
-    done = run_process("verify", urdf, "--scene", scene, "--samples", "3", "--quiet")
+    done = run_in_process("verify", urdf, "--scene", scene, "--samples", "3", "--quiet")
     assert done.returncode == 0, done.stderr
     assert done.stdout.startswith("derived panda (2 joints: panda_joint2, panda_joint4) in ")
     assert done.stdout.splitlines()[-1] == "all checks passed"
     notebook = tmp_path / "panda.ipynb"
-    done = run_process("notebook", urdf, "--scene", scene, "-o", notebook, "--quiet")
+    done = run_in_process("notebook", urdf, "--scene", scene, "-o", notebook, "--quiet")
     assert done.returncode == 0, done.stderr
     import nbformat
 
@@ -353,13 +353,13 @@ def test_verify_and_notebook_take_a_scene(tmp_path):
 @pytest.mark.skipif(not has_analysis(), reason="bench and simulate need the analysis extra")
 def test_bench_and_simulate_take_a_scene(tmp_path):
     urdf, scene = panda(), SCENES / "panda_two_joints.yaml"
-    done = run_process("simulate", urdf, "--scene", scene, "--duration", "0.05",
-                       "--integrators", "rk4", "--dt", "1e-2", "--q0", "0.3,-1", "-o", tmp_path,
-                       "--quiet")
+    done = run_in_process("simulate", urdf, "--scene", scene, "--duration", "0.05",
+                          "--integrators", "rk4", "--dt", "1e-2", "--q0", "0.3,-1", "-o", tmp_path,
+                          "--quiet")
     assert done.returncode == 0, done.stderr
     assert done.stdout.startswith("panda (2 joints)")
-    done = run_process("bench", urdf, "--scene", scene, "--samples", "2", "--repeats", "1",
-                       "--batch-size", "2", "-o", tmp_path, "--quiet")
+    done = run_in_process("bench", urdf, "--scene", scene, "--samples", "2", "--repeats", "1",
+                          "--batch-size", "2", "-o", tmp_path, "--quiet")
     assert done.returncode == 0, done.stderr
     assert "eomgen: warning" not in done.stderr or all(
         line.startswith("eomgen: warning: ") for line in done.stderr.splitlines())  # quiet
