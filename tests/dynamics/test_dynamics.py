@@ -209,8 +209,8 @@ def test_planar_2link_energies_match_numeric_model():
     P = sp.lambdify([dyn.q], dyn.P.xreplace(values))
     rng = np.random.default_rng(1)
     for q, qd in random_states(rng, 2):
-        assert_close(K(q, qd), kinetic_energy(nm, q, qd), 1e-12)
-        assert_close(P(q), potential_energy(nm, q), 1e-12)
+        assert_close(K(q, qd), kinetic_energy(nm, q, qd), rtol=1e-12)
+        assert_close(P(q), potential_energy(nm, q), rtol=1e-12)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -366,10 +366,10 @@ def test_C_is_built_from_christoffel_symbols(which):
     rng = np.random.default_rng(3)
     for q, qd in random_states(rng, dyn.model.dof, 2):
         C = evaluate(q, qd)["C"]
-        assert_close(C, christoffel_C(evaluate, q, qd), 1e-10, what=f"{which} C")
+        assert_close(C, christoffel_C(evaluate, q, qd), rtol=1e-10, what=f"{which} C")
         # and what the Christoffel form implies: Ṁ = C + Cᵀ
         Mdot = evaluate(q + 1j * 1e-30 * qd, qd)["M"].imag / 1e-30
-        assert_close(C + C.T, Mdot, 1e-10, what=f"{which} Mdot")
+        assert_close(C + C.T, Mdot, rtol=1e-10, what=f"{which} Mdot")
 
 
 def test_christoffel_reference_agrees_with_central_differences():
@@ -383,7 +383,7 @@ def test_christoffel_reference_agrees_with_central_differences():
                    for e in np.eye(n)])
     C = np.einsum("kij,k->ij", dM, qd) + np.einsum("jik,k->ij", dM, qd) - \
         np.einsum("ijk,k->ij", dM, qd)
-    assert_close(christoffel_C(evaluate, q, qd), C / 2, 1e-7)
+    assert_close(christoffel_C(evaluate, q, qd), C / 2, rtol=1e-7)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -407,7 +407,7 @@ def test_gravity_only_computes_no_coriolis_or_mass_matrix():
     full = evaluated(random_dynamics(RANDOM[3]))
     only_g = Evaluated(dyn)
     for q, _ in random_states(np.random.default_rng(5), model.dof):
-        assert_close(only_g(q)["g"], full(q)["g"], 1e-14)
+        assert_close(only_g(q)["g"], full(q)["g"], rtol=1e-14)
     with pytest.raises(KeyError, match="C was not derived"):
         dyn.C
 
@@ -419,7 +419,7 @@ def test_C_alone_matches_the_full_derivation():
     full = evaluated(random_dynamics(RANDOM[3]))
     only_c = Evaluated(dyn)
     for q, qd in random_states(np.random.default_rng(6), model.dof):
-        assert_close(only_c(q, qd)["C"], full(q, qd)["C"], 1e-14)
+        assert_close(only_c(q, qd)["C"], full(q, qd)["C"], rtol=1e-14)
 
 
 def test_C_alone_outputs_only_C():
@@ -480,13 +480,13 @@ def test_parameters_stay_symbolic_and_substitute_to_the_numeric_model(tmp_path, 
         substituted = sp.lambdify([dyn.q, dyn.qd], getattr(dyn, name).xreplace(values))
         direct = sp.lambdify([numeric.q, numeric.qd], getattr(numeric, name))
         for q, qd in random_states(rng, 2):
-            assert_close(substituted(q, qd), direct(q, qd), 1e-12, what=name)
+            assert_close(substituted(q, qd), direct(q, qd), rtol=1e-12, what=name)
     # and through the programs, the parameters given as inputs
     ev, ev_num = Evaluated(dyn), Evaluated(numeric)
     for q, qd in random_states(rng, 2):
         a, b = ev(q, qd), ev_num(q, qd)
         for name in ("M", "C", "g"):
-            assert_close(a[name], b[name], 1e-12, what=name)
+            assert_close(a[name], b[name], rtol=1e-12, what=name)
 
 
 def test_parameter_values_can_be_changed_after_deriving():
@@ -502,7 +502,7 @@ def test_parameter_values_can_be_changed_after_deriving():
         substituted = sp.lambdify([dyn.q, dyn.qd], getattr(dyn, name).xreplace(values))
         derived = sp.lambdify([direct.q, direct.qd], getattr(direct, name))
         for q, qd in random_states(rng, 2):
-            assert_close(substituted(q, qd), derived(q, qd), 1e-12, what=name)
+            assert_close(substituted(q, qd), derived(q, qd), rtol=1e-12, what=name)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -108,7 +108,7 @@ def erd_robots_or_skip() -> Path:
 # ----------------------------------------------------------------------------------------------
 
 
-def assert_close(a, b, rtol=RTOL, what="", same_shape=True):
+def assert_close(a, b, what="", rtol=RTOL, same_shape=True):
     """``max|a - b| <= rtol * max(1, max|b|)``, and (``same_shape``) equal shapes."""
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     if same_shape:
