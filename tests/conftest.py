@@ -2,7 +2,6 @@
 
 ``erd_robots_dir`` is a fixture here (request it as an argument; it skips the test when
 example-robot-data is not installed) and a plain function in :mod:`support` (returns None).
-Big robots are derived once per test run by the session fixtures below.
 """
 
 from __future__ import annotations

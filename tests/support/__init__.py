@@ -14,7 +14,7 @@ hold the bigger shared pieces:
 * :mod:`support.array_backends`: the JAX and PyTorch modules next to the NumPy one;
 * :mod:`support.browser`: headless Chromium judging typeset math.
 
-Fixtures (session-scoped derivations of the big robots, the cache folders) live in
+Fixtures (``erd_robots_dir``, the cache folders, ``--update-golden``) live in
 ``tests/conftest.py``.
 """
 
@@ -218,7 +218,8 @@ def run_in_process(*args) -> subprocess.CompletedProcess:
                                        result.stdout, stderr)
 
 
-def run_process(*args, env=None, cwd=None, timeout=300, check=False) -> subprocess.CompletedProcess:
+def run_process(*args, env=None, cwd=None, timeout=300, check=False
+                ) -> subprocess.CompletedProcess:
     """``python -m eomgen.cli ARGS`` in a real process: for what only a process shows (exit
     codes of the interpreter, signals, terminals, hash seeds, the cache shared between
     processes, start-up imports)."""

@@ -8,8 +8,8 @@
   literals, docstrings and comments they end up in;
 * the flexible 2-link arm with drives (:func:`drive_arm`).
 
-Each function builds a fresh model; the session fixtures of ``conftest.py`` derive the big ones
-once per test run.
+Each function builds a fresh model (models are frozen data, but tests that cache a derivation
+do so in their own module).
 """
 
 from __future__ import annotations
