@@ -1,0 +1,222 @@
+"""The command line: ``eomgen verify``, help, version, and what bad input looks like.
+
+Most runs go through click's CliRunner (in process, stdout and stderr kept apart); the few that
+need a real process (the ``python -m`` entry point, ``--debug`` tracebacks) use subprocess.
+"""
+
+from __future__ import annotations
+
+import subprocess
+
+import pytest
+
+import eomgen
+import support
+from eomgen.robots import example_path
+
+from support import ERROR, WARNING, erd_robots_dir, run_cli as run, write
+
+
+
+def run_process(*args: str) -> subprocess.CompletedProcess:
+    return support.run_process(*args, timeout=120)
+
+
+# ----------------------------------------------------------------------------------------------
+# Success
+# ----------------------------------------------------------------------------------------------
+
+
+def test_verify_without_arguments_checks_the_bundled_arm():
+    result = run("verify")
+    assert result.exit_code == 0, result.output
+    lines = result.stdout.splitlines()
+    assert lines[0].startswith("derived planar_2link (2 joints: joint1, joint2)")
+    assert lines[-1] == "all checks passed"
+    assert "(exact)" in result.stdout
+    assert "FAIL" not in result.stdout
+    assert [line.split(" [+")[0] for line in result.stderr.splitlines()] == [
+        "eomgen: deriving M, C, g and tau of planar_2link (2 joints)",
+        "eomgen: checking at 20 random states"]  # progress on stderr; results on stdout
+    quiet = run("verify", "--quiet")
+    assert quiet.stdout.splitlines()[1:] == lines[1:] and quiet.stderr == ""
+
+
+def test_verify_a_urdf_from_example_robot_data():
+    robots = erd_robots_dir()
+    if robots is None:
+        pytest.skip("example-robot-data is not installed")
+    result = run("verify", robots / "ur_description/urdf/ur5_robot.urdf", "--samples", "5",
+                 "--quiet")
+    assert result.exit_code == 0, result.output
+    assert result.stdout.startswith("derived ur5 (6 joints: shoulder_pan_joint, ")
+    assert result.stdout.splitlines()[-1] == "all checks passed"
+    assert result.stderr == ""
+
+
+def test_entry_point_as_a_module():
+    """``python -m eomgen.cli`` (what the ``eomgen`` script runs), in a real process."""
+    done = run_process("verify", "--samples", "3", "--seed", "7")
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines()[-1] == "all checks passed"
+    assert "3 samples" in done.stdout
+
+
+def test_failed_check_exits_1(tmp_path):
+    """A description that loads but whose mass matrix is singular (a massless link on a
+    prismatic joint): the report says which check failed, exit code 1, no error line."""
+    path = write(tmp_path / "slider.yaml", """\
+name: slider
+links:
+  - {name: base}
+  - {name: arm, mass: 2, com: [1, 0, 0], inertia: {ixx: 1, iyy: 1, izz: 1}}
+  - {name: tip}
+joints:
+  - {name: turn, type: revolute, parent: base, child: arm, axis: [0, 0, 1]}
+  - {name: slide, type: prismatic, parent: arm, child: tip, axis: [1, 0, 0]}
+""")
+    result = run("verify", path, "--samples", "3")
+    assert result.exit_code == 1, result.output
+    assert "  FAIL M positive definite" in result.stdout
+    assert result.stdout.splitlines()[-1] == "SOME CHECKS FAILED"
+    assert ERROR not in result.stderr
+
+
+# ----------------------------------------------------------------------------------------------
+# Bad input: exit code 2 and one line on stderr naming the file
+# ----------------------------------------------------------------------------------------------
+
+LINK = ('<link name="arm"><inertial><mass value="{mass}"/>'
+        '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>')
+JOINT = ('<joint name="j" type="revolute"><parent link="base"/><child link="arm"/>'
+         '<axis xyz="0 0 1"/></joint>')
+
+BAD = {
+    # id: (file name or None for a missing file, content, words the message must contain)
+    "malformed URDF": ("bad.urdf", '<robot name="r">\n<link name="a">\n</robot>\n',
+                       ["line 3", "malformed XML"]),
+    "negative mass": ("negative.urdf",
+                      f'<robot name="r"><link name="base"/>{LINK.format(mass=-2)}{JOINT}</robot>',
+                      ["link 'arm'", "mass -2.0 is negative"]),
+    "unknown suffix": ("robot.txt", "name: r\n", ["unknown file type '.txt'"]),
+    "missing file": (None, "", ["no such file"]),
+    "YAML unknown key": ("robot.yaml", "name: r\nlinks:\n  - {name: base, colour: red}\n"
+                                       "joints: []\n", ["links[0] 'base'", "colour"]),
+    "YAML neither format": ("robot.yaml", "name: r\n", ["cannot tell which format"]),
+    "floating joint": ("float.urdf",
+                       f'<robot name="r"><link name="base"/>{LINK.format(mass=1)}'
+                       f'{JOINT.replace("revolute", "floating")}</robot>',
+                       ["joint 'j'", "floating joints are not supported"]),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD))
+def test_bad_input_is_one_error_line_naming_the_file(tmp_path, case):
+    name, content, words = BAD[case]
+    path = tmp_path / (name or "missing.urdf")
+    if name is not None:
+        write(path, content)
+    result = run("verify", path)
+    assert result.exit_code == 2, result.output
+    assert result.stdout == ""
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith(f"{ERROR}{path}: "), lines[0]
+    for word in words:
+        assert word in lines[0], lines[0]
+    assert "Traceback" not in result.stderr
+
+
+def test_a_file_name_with_a_line_break_stays_on_one_line(tmp_path):
+    path = write(tmp_path / "two\nlines.urdf", "<robot")
+    result = run("verify", path)
+    assert result.exit_code == 2
+    assert len(result.stderr.splitlines()) == 1, result.stderr
+    assert result.stderr.startswith(ERROR) and "two\\nlines.urdf" in result.stderr
+
+
+def test_debug_shows_a_traceback(tmp_path):
+    path = write(tmp_path / "negative.urdf",
+                 f'<robot name="r"><link name="base"/>{LINK.format(mass=-2)}{JOINT}</robot>')
+    plain = run_process("verify", path)
+    assert plain.returncode == 2 and plain.stderr.count("\n") == 1
+    debug = run_process("verify", path, "--debug")
+    assert debug.returncode != 0
+    assert "Traceback (most recent call last)" in debug.stderr
+    assert "eomgen.errors.InvalidInertiaError" in debug.stderr and "is negative" in debug.stderr
+    assert ERROR not in debug.stderr
+
+
+# ----------------------------------------------------------------------------------------------
+# Warnings and --strict
+# ----------------------------------------------------------------------------------------------
+
+
+def test_puma560_warns_about_link1_and_passes():
+    path = example_path("puma560_dh")
+    result = run("verify", path, "--samples", "3", "--quiet")  # warnings even when quiet
+    assert result.exit_code == 0, result.output
+    warnings = result.stderr.splitlines()
+    assert warnings and all(line.startswith(f"{WARNING}{path}: link '") for line in warnings)
+    assert any(line.startswith(f"{WARNING}{path}: link 'link1'") for line in warnings)
+    assert all("triangle inequality" in line for line in warnings)
+    assert result.stdout.splitlines()[-1] == "all checks passed"
+
+
+def test_puma560_is_refused_under_strict():
+    path = example_path("puma560_dh")
+    result = run("verify", path, "--strict")
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith(f"{ERROR}{path}: link 'link1'")
+    assert "triangle inequality" in lines[0] and "--strict" in lines[0]
+    assert result.stdout == ""
+
+
+def test_mimic_joint_is_refused_under_strict():
+    robots = erd_robots_dir()
+    if robots is None:
+        pytest.skip("example-robot-data is not installed")
+    path = robots / "panda_description/urdf/panda.urdf"
+    result = run("verify", path, "--strict")
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith(f"{ERROR}{path}: joint 'panda_finger_joint2' <mimic>: ")
+
+
+# ----------------------------------------------------------------------------------------------
+# Help and version
+# ----------------------------------------------------------------------------------------------
+
+
+def test_help_shows_examples():
+    result = run("--help")
+    assert result.exit_code == 0
+    assert "Examples:" in result.stdout
+    assert "  eomgen verify" in result.stdout
+    assert "verify" in result.stdout.split("Commands:")[1]
+    assert run("-h").stdout == result.stdout
+
+
+def test_verify_help_shows_examples_and_options():
+    result = run("verify", "--help")
+    assert result.exit_code == 0
+    assert "Examples:" in result.stdout
+    assert "  eomgen verify\n" in result.stdout
+    assert "eomgen verify ur5.urdf --samples 100 --seed 3" in result.stdout
+    for option in ("--samples", "--seed", "--tolerance", "--strict", "--debug"):
+        assert option in result.stdout
+
+
+def test_version():
+    result = run("--version")
+    assert result.exit_code == 0
+    assert result.stdout == f"eomgen, version {eomgen.__version__}\n"
+
+
+def test_unknown_option_is_a_usage_error():
+    result = run("verify", "--no-such-option")
+    assert result.exit_code == 2
+    assert "No such option" in result.stderr

@@ -1,0 +1,90 @@
+"""Interrupting ``eomgen generate`` (SIGINT, SIGTERM) mid-derivation.
+
+A 12-link spatial chain takes seconds to derive. ``eomgen generate`` runs on it in a real
+process, over a folder holding a previous complete output; once the process reports that it is
+deriving, it is sent SIGINT (Ctrl-C) or SIGTERM. It must say ``eomgen: interrupted`` (one line,
+no traceback) and exit with 130 or 143, leave the previous output byte for byte, and leave no
+staging folder or temporary file behind (in the output's parent folder nor in the cache).
+"""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from support.reference import random_robot, to_urdf
+
+ROBOT = "random_chain_12"
+PREVIOUS = {f"{ROBOT}_numpy.py": b"# the previous generation (numpy)\n",
+            f"{ROBOT}_casadi.py": b"# the previous generation (casadi)\n",
+            f"{ROBOT}.tex": b"% the previous generation\n",
+            "notes.txt": b"not eomgen's\n"}
+
+
+@pytest.fixture(scope="module")
+def chain(tmp_path_factory) -> Path:
+    model = random_robot(np.random.default_rng(5), 12)
+    assert model.name == ROBOT and model.dof == 12
+    path = tmp_path_factory.mktemp("chain") / "chain12.urdf"
+    path.write_text(to_urdf(model), encoding="utf-8")
+    return path
+
+
+def _snapshot(folder: Path) -> dict[str, bytes]:
+    return {p.name: p.read_bytes() for p in folder.iterdir()}
+
+
+def _default_sigint():
+    """Children of a shell without job control inherit SIGINT ignored; Python then never
+    raises KeyboardInterrupt. The test wants eomgen's own handling, so restore the default."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+@pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)],
+                         ids=["SIGINT", "SIGTERM"])
+def test_interrupt_mid_derivation_keeps_the_previous_output(chain, tmp_path, signum, code):
+    work = tmp_path / "work"
+    outdir = work / "out"
+    outdir.mkdir(parents=True)
+    for name, content in PREVIOUS.items():
+        (outdir / name).write_bytes(content)
+    cache = tmp_path / "cache"
+    process = subprocess.Popen(
+        [sys.executable, "-m", "eomgen.cli", "generate", str(chain), "-o", str(outdir),
+         "--backend", "numpy,casadi,latex", "--cache-dir", str(cache)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=_default_sigint)
+    try:
+        seen = []
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            line = process.stderr.readline()
+            if not line:
+                break
+            seen.append(line)
+            if "deriving" in line:
+                break
+        assert seen and "deriving" in seen[-1], "".join(seen)
+        time.sleep(0.5)  # well inside the derivation, which takes seconds
+        assert process.poll() is None, "the derivation ended before the signal"
+        process.send_signal(signum)
+        stdout, rest = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.communicate()
+    stderr = "".join(seen) + rest
+    assert process.returncode == code, stderr
+    assert stdout == ""
+    assert "Traceback" not in stderr
+    other = [line for line in stderr.splitlines() if not line.startswith("eomgen: deriving")]
+    assert other == ["eomgen: interrupted"], stderr
+    assert _snapshot(outdir) == PREVIOUS
+    assert [p.name for p in work.iterdir()] == ["out"]  # no staging folder
+    leftovers = [p for p in cache.rglob("*") if p.name.startswith(".")] if cache.exists() else []
+    assert leftovers == []
