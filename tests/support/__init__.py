@@ -20,9 +20,7 @@ Fixtures (``erd_robots_dir``, the cache folders, ``--update-golden``) live in
 
 from __future__ import annotations
 
-import contextlib
 import functools
-import inspect
 import importlib.metadata
 import importlib.util
 import os
@@ -233,30 +231,10 @@ def run_process(*args, env=None, cwd=None, timeout=300, check=False
 # ----------------------------------------------------------------------------------------------
 
 
-@contextlib.contextmanager
-def without_compiling():
-    """Within the block the backends that compile (the C backend's shared library, the fast
-    backend's extension module) find no C compiler: they emit their text files, byte for byte
-    the same, and skip the build, without warning about it. For renders whose binaries a test
-    throws away; the tests that load compiled code compile as before."""
-    from eomgen.codegen.backends import casadi_backend, fast_backend
-    from eomgen.codegen.backends.casadi_backend import NoCompilerWarning
-
-    with pytest.MonkeyPatch.context() as patch, warnings.catch_warnings():
-        patch.setattr(casadi_backend, "c_compiler", lambda: None)
-        patch.setattr(fast_backend, "c_compiler", lambda: None)
-        warnings.filterwarnings("ignore", category=NoCompilerWarning)
-        warnings.filterwarnings("ignore", message="fast backend: no C compiler found",
-                                category=RuntimeWarning)
-        yield
-
-
 def render_text_files(model, backends, **options):
-    """``eomgen.codegen.generate.render_files(model, backends, **options)`` without compiling:
-    the text files (``build=False`` where the codegen has it, else :func:`without_compiling`)."""
+    """``eomgen.codegen.generate.render_files(model, backends, **options)`` without compiling
+    (``build=False``): the text files, byte for byte those a build writes, for renders whose
+    binaries a test would throw away; the tests that load compiled code compile as before."""
     from eomgen.codegen.generate import render_files
 
-    if "build" in inspect.signature(render_files).parameters:
-        return render_files(model, backends, build=False, **options)
-    with without_compiling():
-        return render_files(model, backends, **options)
+    return render_files(model, backends, build=False, **options)

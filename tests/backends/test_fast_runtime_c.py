@@ -18,6 +18,7 @@ import pytest
 from eomgen.codegen.backends.fast_backend import (RUNTIME_DIR, RUNTIME_FILES, RUNTIME_MARKER,
                                                   python_headers, runtime_source)
 from eomgen.compiler import c_compiler
+from support import ROOT
 
 WARNINGS = ("-Wall", "-Wextra", "-Werror")
 
@@ -137,8 +138,7 @@ def test_generated_modules_hold_the_runtime_text_and_build_false_compiles_nothin
     from eomgen.scene import load_scene
 
     arm = eomgen.load(eomgen.example_path("planar_2link"))
-    wall = apply_scene(arm, load_scene(Path(__file__).resolve().parents[1]
-                                       / "examples/contacts/planar_2link_wall.yaml")).model
+    wall = apply_scene(arm, load_scene(ROOT / "examples/contacts/planar_2link_wall.yaml")).model
     for model, functions, expected in (
             (arm, None, ("cholesky", "call")),
             (wall, ["constrained_forward_dynamics"], ("cholesky", "kkt", "call", "contact_call"))):
