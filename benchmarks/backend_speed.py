@@ -64,7 +64,7 @@ JAX_ROUTES = (("jax jit+vmap", None, ""),
 def panda_modules(outdir: Path):
     sys.path.insert(0, str(ROOT / "tests"))
     try:
-        from conftest import erd_robots_dir
+        from support import erd_robots_dir
     finally:
         sys.path.pop(0)
     robots = erd_robots_dir()

@@ -41,7 +41,7 @@ TARGET = 20.0
 def ur5_path() -> Path | None:
     sys.path.insert(0, str(ROOT / "tests"))
     try:
-        from conftest import erd_robots_dir
+        from support import erd_robots_dir
     finally:
         sys.path.pop(0)
     robots = erd_robots_dir()

@@ -219,7 +219,7 @@ class Report:
 def erd_robots_dir() -> Path:
     """example-robot-data's ``robots/`` folder ($EXAMPLE_ROBOT_DATA_ROBOTS, else site-packages).
 
-    A short version of ``tests/conftest.py``'s lookup (that module needs pytest, which the
+    A short version of ``tests/support/__init__.py``'s lookup (that module needs pytest, which the
     ``bench`` extra does not install).
     """
     suffix = Path("cmeel.prefix", "share", "example-robot-data", "robots")

@@ -131,7 +131,7 @@ def puma_model(locked: dict[str, float]):
 
 
 def erd_robots_dir() -> Path | None:
-    """The example-robot-data ``robots/`` folder (same lookup as tests/conftest.py)."""
+    """The example-robot-data ``robots/`` folder (same lookup as tests/support/__init__.py)."""
     suffix = Path("cmeel.prefix", "share", "example-robot-data", "robots")
     override = os.environ.get("EXAMPLE_ROBOT_DATA_ROBOTS")
     candidates = [Path(override)] if override else []

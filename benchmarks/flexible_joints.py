@@ -52,7 +52,7 @@ METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
 def robots_dir() -> Path:
     if os.environ.get("EXAMPLE_ROBOT_DATA_ROBOTS"):
         return Path(os.environ["EXAMPLE_ROBOT_DATA_ROBOTS"])
-    from conftest import erd_robots_dir
+    from support import erd_robots_dir
 
     found = erd_robots_dir()
     if found is None:

@@ -47,7 +47,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
 import eomgen  # noqa: E402
-from conftest import erd_robots_dir  # noqa: E402
+from support import erd_robots_dir  # noqa: E402
 from eomgen import floating, numeric  # noqa: E402
 from eomgen.contacts import Contact, ContactDynamics  # noqa: E402
 from eomgen.reduction import apply_scene  # noqa: E402

@@ -10,7 +10,7 @@ numbers from fewer samples and shorter runs, so do not commit what it writes.
 
 Writes ``docs/img/bench_<robot>.png``, ``docs/img/simulate.png`` and
 ``benchmarks/results/{bench_<robot>,simulate,hard_cases,forms}.{md,csv}``. Robots: the bundled planar
-2-link arm and PUMA 560 and, when example-robot-data is installed (as in tests/conftest.py),
+2-link arm and PUMA 560 and, when example-robot-data is installed (as in tests/support/__init__.py),
 the UR5, the Panda (fingers locked at 0) and the double pendulum.
 """
 
@@ -29,7 +29,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 import eomgen  # noqa: E402
 from eomgen.model import lock_joints  # noqa: E402
-from conftest import erd_robots_dir  # noqa: E402
+from support import erd_robots_dir  # noqa: E402
 
 IMAGES = ROOT / "docs" / "img"
 RESULTS = ROOT / "benchmarks" / "results"
@@ -96,7 +96,7 @@ def simulate(duration: float, panda_duration: float) -> None:
 
 
 def hard_cases() -> None:
-    """The hard cases of tests/test_hard_cases.py: cond(M) and the largest errors."""
+    """The hard cases of tests/dynamics/test_hard_cases.py: cond(M) and the largest errors."""
     import test_hard_cases as hc
     from eomgen.analysis.precision import relative_error
     from eomgen.analysis.report import csv_text, fmt, markdown_table

@@ -53,12 +53,12 @@ from dataclasses import replace
 
 
 def random_arm(n, seed=0):
-    from reference import random_robot
+    from support.reference import random_robot
     return replace(random_robot(np.random.default_rng(seed), n), name=f"random_{{n}}dof")
 
 
 def panda():
-    from conftest import erd_robots_dir
+    from support import erd_robots_dir
     from eomgen.reduction import apply_scene
     from eomgen.scene import load_scene
     robots = erd_robots_dir()

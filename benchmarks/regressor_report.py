@@ -49,7 +49,7 @@ PANDA_BASE_OPS = 2700
 
 
 def models() -> dict:
-    from conftest import erd_robots_dir
+    from support import erd_robots_dir
 
     out = {}
     with warnings.catch_warnings():

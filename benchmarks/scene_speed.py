@@ -71,7 +71,7 @@ CASES = {
 
 def robots_dir() -> Path:
     sys.path.insert(0, str(ROOT / "tests"))
-    from conftest import erd_robots_dir  # the one place that knows where the package puts them
+    from support import erd_robots_dir  # the one place that knows where the package puts them
 
     found = erd_robots_dir()
     if found is None:

@@ -11,7 +11,7 @@ Two independent evaluations at :data:`DPS` (40) significant digits with mpmath:
   :data:`MPMATH` numbers: 3-vectors and 3×3 matrices as NumPy object arrays).
 
 :class:`Reference` holds both and checks that they agree (:meth:`Reference.cross_check`; to
-about 1e-35 in practice, see ``tests/test_hard_cases.py``).
+about 1e-35 in practice, see ``tests/dynamics/test_hard_cases.py``).
 
 The model the reference uses
 ----------------------------

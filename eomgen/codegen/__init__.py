@@ -175,7 +175,7 @@ def available_backends() -> dict[str, Backend]:
 def loadable_backends() -> dict[str, Backend]:
     """The backends whose generated code can be imported and called here: those with a
     ``load`` whose ``requires`` are installed, by ``order`` then name."""
-    from importlib.util import find_spec
+    from importlib.util import find_spec  # start-up time: only this listing asks
 
     return {name: b for name, b in available_backends().items()
             if b.load is not None and all(find_spec(r) is not None for r in b.requires)}

@@ -82,6 +82,8 @@ RESERVED_IDENTIFIERS = frozenset(
 def reserved_identifiers() -> frozenset[str]:
     """:data:`RESERVED_IDENTIFIERS` and the names every registered backend reserves: the same
     parameter names in every backend's module."""
+    # The package's registry: complete only once eomgen.codegen has imported every backend,
+    # which happens after this module (imported by eomgen.codegen) is loaded.
     from . import available_backends
 
     return RESERVED_IDENTIFIERS.union(OUTPUTS, BY_SYMBOL,

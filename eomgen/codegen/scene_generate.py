@@ -135,6 +135,7 @@ def generate_scene(model: RobotModel, scene: Scene | None, outdir: Path,
     chosen = select_backends(backends)
     outputs = scene.outputs if scene is not None else None
     if backends == "all" or list(backends) == ["all"]:
+        # The package's registry, complete once eomgen.codegen has imported every backend.
         from . import available_backends
 
         chosen, skipped = usable_backends(chosen, outputs)

@@ -70,6 +70,7 @@ def load_casadi(folder: Path, stem: str) -> Loaded:
     """The CasADi module written into ``folder``; a function is called by name (a parameter
     left out takes the description's value) and gives its output as a NumPy array (a vector
     output flattened, as the other backends give it)."""
+    # start-up time: only loading a generated CasADi module needs NumPy and the registry
     import numpy as np
 
     from ...outputs import OUTPUTS
@@ -118,7 +119,7 @@ _C_PARAMETER_NOTE = [
 def emit_c(job: Job, config: CasADiConfig = CasADiConfig()) -> list[GeneratedFile]:
     """The C source and header CasADi's code generator writes for the CasADi module's
     functions, each opening with the eomgen header (nothing compiled)."""
-    import casadi as ca
+    import casadi as ca  # start-up time: CasADi takes a while to import; only loading needs it
 
     namespace = load_module_source(_render_module(job, config), job.stem + "_casadi")
     stem = job.stem + "_casadi"

@@ -35,7 +35,7 @@ from ...templating import TEMPLATES_DIR, render
 from .common import import_file, positional, warning_exports
 
 #: The fixed C runtime every generated module includes parts of: real C files (compiled and
-#: warning-checked on their own by tests/test_fast_runtime_c.py), by the name the template
+#: warning-checked on their own by tests/backends/test_fast_runtime_c.py), by the name the template
 #: gives their text (``runtime.cholesky`` ...).
 RUNTIME_DIR = TEMPLATES_DIR / "fast" / "runtime"
 RUNTIME_FILES = ("cholesky", "kkt", "call", "split_columns", "contact_call")
@@ -217,7 +217,7 @@ def _render_source(job: Job, config: FastConfig) -> str:
 def python_headers() -> tuple[str, ...] | None:
     """Include folders for Python's and NumPy's C headers, or None when ``Python.h`` is
     missing (a Python built without its development files)."""
-    import numpy
+    import numpy  # start-up time: only building the extension needs NumPy's headers
 
     include = sysconfig.get_paths().get("include")
     if not include or not Path(include, "Python.h").is_file():

@@ -52,7 +52,7 @@ class JaxConfig:
 def _float64() -> None:
     """JAX in float64, as the tests compare the module with NumPy to 1e-12 (a process-wide
     setting of JAX's)."""
-    import jax
+    import jax  # optional dependency (eomgen[jax]): only loading a generated module needs it
 
     jax.config.update("jax_enable_x64", True)
 
