@@ -54,7 +54,7 @@ def dask_map(function: Callable, *states, chunks: int = 100_000, **parameters):
     ImportError
         When dask is not installed.
     """
-    try:
+    try:  # optional dependency (eomgen[dask])
         import dask.array as da
     except ImportError as exc:  # pragma: no cover - depends on the environment
         raise ImportError("eomgen.batch.dask_map needs dask: pip install 'eomgen[dask]'") from exc

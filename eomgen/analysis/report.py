@@ -70,7 +70,7 @@ def pyplot():
     except ImportError as exc:  # pragma: no cover - the analysis extra installs it
         raise ImportError("plots need Matplotlib: pip install 'eomgen[analysis]'") from exc
     matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # after choosing the Agg backend above
 
     return plt
 
