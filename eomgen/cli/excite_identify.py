@@ -23,14 +23,30 @@ from .options import (description_argument, output_file_option, output_folder_op
                       quiet_option, scene_option, strict_option)
 
 
-def _regressor(model, friction: bool, progress: Progress):
-    # SymPy: only when a command runs
-    from ..regressor import base_parameters, derive_regressor
+#: What the actuator terms add to the efforts, for the excite summary.
+_TERM_WORDS = {"armature": "armature", "viscous": "viscous friction",
+               "coulomb": "Coulomb friction"}
 
+
+def _regressor(model, friction: bool | None, progress: Progress):
+    # SymPy: only when a command runs
+    from ..regressor import base_parameters, derive_regressor, identification_terms
+
+    terms = identification_terms(model, friction)
     progress(f"deriving the regressor of {model.name} ({plural(model.dof, 'joint')})")
-    reg = derive_regressor(model, ("viscous", "coulomb") if friction else ())
+    reg = derive_regressor(model, terms)
     progress("finding the base parameters")
     return reg, base_parameters(reg)
+
+
+def _friction_option(what: str):
+    return click.option(
+        "--friction/--no-friction", default=None,
+        help="Viscous and Coulomb friction columns (FV<k>, FC<k>). Default: those the "
+             "description declares (URDF <dynamics damping friction>, YAML or scene "
+             "actuators), as the generated regressor has them; --friction adds both for "
+             f"every joint; --no-friction leaves them out{what}. A declared armature (IA<k>) "
+             "is always kept.")
 
 
 @click.command()
@@ -55,8 +71,7 @@ def _regressor(model, friction: bool, progress: Progress):
 @click.option("--positions-only", is_flag=True,
               help="Write only t, q_<joint> and tau_<joint> (identify then differentiates "
                    "q through a zero-phase filter).")
-@click.option("--friction", is_flag=True,
-              help="Optimise for the regressor with viscous and Coulomb friction columns.")
+@_friction_option(" and simulates without friction")
 @scene_option()
 @quiet_option()
 @strict_option
@@ -72,7 +87,8 @@ def excite(description, output, duration, samples, harmonics, amplitude, max_vel
     --amplitude, q_j within the joint's <limit> lower/upper (URDF), |qd_j| ≤
     --max-velocity and the URDF velocity limit, |qdd_j| ≤ --max-acceleration; a joint with
     no room to move is an error. Efforts from eomgen's numeric
-    Newton-Euler with the description's parameters, plus --noise. Columns: t, q_<joint>,
+    Newton-Euler with the description's parameters, plus the armature, viscous and Coulomb
+    friction its joints declare (see --friction), plus --noise. Columns: t, q_<joint>,
     qd_<joint>, qdd_<joint>, tau_<joint> (JOINT_NAMES order).
 
     \b
@@ -85,6 +101,7 @@ def excite(description, output, duration, samples, harmonics, amplitude, max_vel
     # NumPy, SciPy (optional, checked above): only when the command runs
     from ..identification.estimation import (excitation_trajectory, measurements_csv,
                                              motion_bounds, simulate_measurements)
+    from ..regressor import declared_actuator_terms
 
     if not duration > 0 or duration == float("inf"):
         raise IdentificationError(f"--duration must be a positive number of seconds, got "
@@ -110,13 +127,18 @@ def excite(description, output, duration, samples, harmonics, amplitude, max_vel
                                seed=seed, bounds=bounds)
     progress(f"simulating {plural(samples, 'sample')}")
     t = [k * duration / samples for k in range(samples)]
-    data = simulate_measurements(model, ex.trajectory, t, noise=noise, seed=seed)
+    data = simulate_measurements(model, ex.trajectory, t, noise=noise, seed=seed,
+                                 actuators=reg.actuators)
     [path] = write_atomically([GeneratedFile(output.name,
                                              measurements_csv(data, not positions_only))],
                               output.parent)
     progress.clear()
+    drives = [_TERM_WORDS[term] for term in reg.actuators
+              if term in declared_actuator_terms(model)]
+    drives = ", ".join(drives[:-1]) + " and " * (len(drives) > 1) + "".join(drives[-1:])
     click.echo(f"excitation of {model.name}: cond(Y_base) {ex.initial_condition:.4g} at the "
-               f"random start, {ex.condition:.4g} optimised ({ex.evaluations} evaluations)")
+               f"random start, {ex.condition:.4g} optimised ({ex.evaluations} evaluations)"
+               + (f"; efforts with the description's {drives}" if drives else ""))
     click.echo(str(path))
 
 
@@ -127,8 +149,7 @@ def excite(description, output, duration, samples, harmonics, amplitude, max_vel
 @click.option("--physical", is_flag=True,
               help="Also fit physically consistent parameters (every pseudo-inertia "
                    "positive semi-definite; needs cvxpy: pip install 'eomgen[identify]').")
-@click.option("--friction", is_flag=True,
-              help="Add viscous and Coulomb friction columns (FV<k>, FC<k>).")
+@_friction_option(" (the description column then has no friction either)")
 @click.option("--cutoff", default=None, type=float,
               help="Cut-off [Hz] of the zero-phase low-pass filter. DATA without qd_, "
                    "qdd_ columns: q is filtered and differentiated [default: sampling "
@@ -147,7 +168,9 @@ def identify(description, data, outdir, physical, friction, cutoff, scene_path, 
     Butterworth filter and central differences), joints as in the description (after
     --scene). With qd_, qdd_ columns and --cutoff, all four signals go through that filter
     (t needed). Weighted least squares (Gautier) with standard deviations and the condition
-    number; --physical adds a fit with positive semi-definite pseudo-inertias. Writes
+    number; --physical adds a fit with positive semi-definite pseudo-inertias. The
+    friction (and armature) the description declares is fitted too (see --friction), and
+    the report's description column shows the declared values. Writes
     identify_<robot>.md (table), .csv (estimates) and .png (predicted against measured
     efforts) into OUTPUT.
 
@@ -160,6 +183,7 @@ def identify(description, data, outdir, physical, friction, cutoff, scene_path, 
     from ..identification.estimation import (observation_matrix, physical_fit,
                                              read_measurements, weighted_least_squares)
     from ..identification.report import IdentificationReport
+    from ..regressor import description_values
 
     if physical and importlib.util.find_spec("cvxpy") is None:
         raise IdentificationError("--physical needs cvxpy: pip install 'eomgen[identify]'")
@@ -177,7 +201,7 @@ def identify(description, data, outdir, physical, friction, cutoff, scene_path, 
         progress("solving the physically consistent fit (SDP)")
         fit = physical_fit(reg, base, W, measured.tau, estimate.sigma, str(data))
     try:
-        reference = base.beta(reg.numeric_parameters())
+        reference = base.beta(description_values(reg))
     except ParameterError:
         reference = None
     names, expressions = zip(*[(name, str(expr)) for name, expr in base.expressions()])

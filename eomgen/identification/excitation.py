@@ -7,12 +7,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Mapping, Sequence
+from typing import Iterable, Mapping, Sequence
 
 import numpy as np
 
 from ..errors import IdentificationError, one_line
+from ..model import joint_actuators
 from ..numeric import numeric_model, rnea
+from ..regressor.derive import by_symbol
+from ..regressor.generated import DECLARED_TERMS
 from ..regressor.least_squares import normalised_condition
 from .measurements import Measurements
 
@@ -264,15 +267,55 @@ def excitation_trajectory(reg, base, period: float = 10.0, harmonics: int = 3,
 
 
 def simulate_measurements(model, trajectory: FourierTrajectory, t, noise: float = 0.0,
-                          seed: int = 0, values: Mapping | None = None) -> Measurements:
-    """Efforts along ``trajectory`` at times ``t`` from eomgen.numeric's recursive
-    Newton–Euler (:func:`eomgen.numeric.rnea`), plus Gaussian noise of standard deviation
-    ``noise`` times each joint's RMS effort (``noise=0.01``: 1 %), drawn from ``seed``."""
+                          seed: int = 0, values: Mapping | None = None,
+                          actuators: Iterable[str] = tuple(DECLARED_TERMS)) -> Measurements:
+    """Efforts along ``trajectory`` at times ``t``: eomgen.numeric's recursive Newton–Euler
+    (:func:`eomgen.numeric.rnea`) plus the drive terms the joints' actuators declare, plus
+    Gaussian noise of standard deviation ``noise`` times each joint's RMS effort
+    (``noise=0.01``: 1 %), drawn from ``seed``.
+
+    The drive terms are those of the regressor's actuator columns, for the terms in
+    ``actuators`` (default all of :data:`~eomgen.regressor.DECLARED_TERMS`)::
+
+        τ_k += I_a q̈_k  ("armature")  + f_v q̇_k  ("viscous", URDF damping)
+               + f_c sign q̇_k  ("coulomb", URDF friction)
+
+    Coulomb friction is the regressor's sign(q̇), not the tanh smoothing of forward simulation.
+
+    Raises
+    ------
+    IdentificationError
+        For a flexible joint (a stiffness): its motor has an equation of its own.
+    """
     nm = numeric_model(model, values)
     t = np.asarray(t, dtype=float)
     q, qd, qdd = trajectory.states(t)
     tau = np.array([rnea(nm, *s) for s in zip(q, qd, qdd)]).reshape(len(t), model.dof)
+    tau = tau + _drive_efforts(model, values, tuple(actuators), qd, qdd)
     if noise:
         rms = np.sqrt(np.mean(tau ** 2, axis=0))
         tau = tau + np.random.default_rng(seed).standard_normal(tau.shape) * (noise * rms)
     return Measurements(tuple(model.joint_names), t, q, qd, qdd, tau, False, "<simulated>")
+
+
+def _drive_efforts(model, values, terms, qd, qdd) -> np.ndarray:
+    """Σ over ``terms`` of the actuators' armature q̈, damping q̇, friction sign q̇, (N, n)."""
+    unknown = [term for term in terms if term not in DECLARED_TERMS]
+    if unknown:
+        raise ValueError(f"actuator terms must be ones of {tuple(DECLARED_TERMS)}, got {unknown}")
+    out = np.zeros_like(qd)
+    if not any(j.actuator is not None for j in model.movable_joints):
+        return out
+    numbers = model.with_numeric_parameters(by_symbol(values))
+    actuators = joint_actuators(numbers)
+    for joint, actuator in zip(numbers.movable_joints, actuators):
+        if actuator.flexible:
+            raise IdentificationError(one_line(
+                f"{model.source}: joint '{joint.name}' is flexible (its actuator has a "
+                "stiffness): its motor has an equation of its own, which the rigid-body "
+                "regressor does not describe"))
+    signals = {"armature": qdd, "viscous": qd, "coulomb": np.sign(qd)}
+    for term in terms:
+        coefficients = np.array([float(getattr(a, DECLARED_TERMS[term])) for a in actuators])
+        out = out + coefficients * signals[term]
+    return out

@@ -35,8 +35,9 @@ from __future__ import annotations
 from ..symbolic.regressor import ACTUATOR_NAMES, ACTUATOR_TERMS, INERTIAL_NAMES  # noqa: F401
 from .derive import Regressor, by_symbol, derive_regressor
 from .form import PARAMETER_MEANINGS, RegressorForm, regressor_form
-from .generated import (DECLARED_TERMS, GeneratedBase, base_parameter_names, build_outputs,
-                        declared_actuator_terms, description_parameters, generated_base,
+from .generated import (DECLARED_TERMS, FRICTION_TERMS, GeneratedBase, base_parameter_names,
+                        build_outputs, declared_actuator_terms, description_parameters,
+                        description_values, generated_base, identification_terms,
                         parameter_names)
 from .least_squares import Identification, identify, normalised_condition, observation_matrix
 from .notation import by_coefficient, parameter_latex
@@ -52,6 +53,7 @@ __all__ = [
     "parameter_latex", "by_coefficient",
     "PARAMETER_MEANINGS", "RegressorForm", "regressor_form",
     "Identification", "identify", "observation_matrix", "normalised_condition",
-    "DECLARED_TERMS", "GeneratedBase", "declared_actuator_terms", "description_parameters",
+    "DECLARED_TERMS", "FRICTION_TERMS", "GeneratedBase", "declared_actuator_terms",
+    "description_parameters", "description_values", "identification_terms",
     "generated_base", "build_outputs", "parameter_names", "base_parameter_names",
 ]

@@ -7,10 +7,12 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
+from typing import Mapping
 
+import numpy as np
 import sympy as sp
 
-from ..errors import UnsupportedError
+from ..errors import ParameterError, UnsupportedError
 from ..model import RobotModel
 from ..symbolic.program import Program
 from ..symbolic.regressor import ACTUATOR_NAMES, INERTIAL_NAMES, regressor_program
@@ -46,6 +48,34 @@ def declared_actuator_terms(model: RobotModel) -> tuple[str, ...]:
                  if any(getattr(a, field) != 0 for _, a in actuators))
 
 
+#: The friction terms among :data:`DECLARED_TERMS`: what ``--friction`` / ``--no-friction`` of
+#: ``eomgen excite`` and ``eomgen identify`` add or leave out (:func:`identification_terms`).
+FRICTION_TERMS = ("viscous", "coulomb")
+
+
+def identification_terms(model: RobotModel, friction: bool | None = None) -> tuple[str, ...]:
+    """The actuator terms of the regressor that ``eomgen excite`` and ``eomgen identify`` use
+    for ``model`` (:data:`DECLARED_TERMS` order).
+
+    ``friction=None`` (the default): those the description declares
+    (:func:`declared_actuator_terms`), as the generated regressor has them. ``True``: viscous
+    and Coulomb friction columns for every joint even where none is declared (the declared
+    values are then 0). ``False``: no friction columns (a declared armature is kept: it is part
+    of the inertia the joint sees).
+
+    Raises
+    ------
+    UnsupportedError
+        For a flexible joint, as :func:`declared_actuator_terms`.
+    """
+    declared = declared_actuator_terms(model)
+    if friction is None:
+        return declared
+    wanted = (set(declared) | set(FRICTION_TERMS)) if friction \
+        else (set(declared) - set(FRICTION_TERMS))
+    return tuple(term for term in DECLARED_TERMS if term in wanted)
+
+
 def description_parameters(reg: Regressor) -> sp.Matrix:
     """π of the description (p × 1): :meth:`Regressor.inertial_parameters` with the actuator
     columns taken from the joints' actuators (armature, damping, friction; 0 for a joint
@@ -57,6 +87,25 @@ def description_parameters(reg: Regressor) -> sp.Matrix:
             values[f"{ACTUATOR_NAMES[term]}{k + 1}"] = (
                 0 if actuator is None else getattr(actuator, DECLARED_TERMS[term]))
     return reg.inertial_parameters(actuator=values)
+
+
+def description_values(reg: Regressor, values: Mapping | None = None) -> np.ndarray:
+    """:func:`description_parameters` as floats (p,), the model's parameters at their default
+    values (``values``, symbol or name → value, overriding): the π whose β the identification
+    report compares its estimate with, declared friction and armature included.
+
+    Raises
+    ------
+    ParameterError
+        When a parameter has no value.
+    """
+    merged = reg.parameter_values(values)
+    pi = description_parameters(reg).xreplace({k: sp.sympify(v) for k, v in merged.items()})
+    free = sorted({s.name for x in pi for s in x.free_symbols})
+    if free:
+        raise ParameterError(reg.model.source, "parameters", "no numeric value for "
+                             + ", ".join(free))
+    return np.array([float(x) for x in pi], dtype=float)
 
 
 @dataclass(frozen=True)

@@ -449,7 +449,8 @@ def test_excite_refuses_a_folder_as_output_before_any_work(tmp_path):
 
 def test_excite_and_identify_a_scene_of_the_panda(tmp_path):
     """--scene: the Panda reduced to its shoulder and elbow; columns named after the joints
-    the scene keeps, the description's β recovered within 3 std from 1 % noise."""
+    the scene keeps (and the viscous friction its URDF declares, simulated and fitted), the
+    description's β recovered within 3 std from 1 % noise."""
     robots = erd_robots_dir()
     if robots is None:
         pytest.skip("example-robot-data is not installed")
@@ -466,6 +467,7 @@ def test_excite_and_identify_a_scene_of_the_panda(tmp_path):
     done = run_in_process("identify", urdf, data, "--scene", scene, "-o", out, "--quiet")
     assert done.returncode == 0, done.stderr
     rows = list(csv.DictReader((out / "identify_panda.csv").open()))
-    assert [r["name"] for r in rows] == ["MX1R", "MY1R", "ZZ1R", "MX2", "MY2", "ZZ2"]
+    assert [r["name"] for r in rows] == ["MX1R", "MY1R", "ZZ1R", "MX2", "MY2", "ZZ2", "FV1",
+                                         "FV2"]
     for r in rows:
         assert abs(float(r["estimate"]) - float(r["description"])) < 3 * float(r["std"]), r
