@@ -28,11 +28,19 @@ _TERM_WORDS = {"armature": "armature", "viscous": "viscous friction",
                "coulomb": "Coulomb friction"}
 
 
-def _regressor(model, friction: bool | None, progress: Progress):
+def _terms(model, friction: bool | None) -> tuple[str, ...]:
+    """The actuator columns (:func:`eomgen.regressor.identification_terms`), found before any
+    work so that a flexible joint is refused at once."""
     # SymPy: only when a command runs
-    from ..regressor import base_parameters, derive_regressor, identification_terms
+    from ..regressor import identification_terms
 
-    terms = identification_terms(model, friction)
+    return identification_terms(model, friction)
+
+
+def _regressor(model, terms: tuple[str, ...], progress: Progress):
+    # SymPy: only when a command runs
+    from ..regressor import base_parameters, derive_regressor
+
     progress(f"deriving the regressor of {model.name} ({plural(model.dof, 'joint')})")
     reg = derive_regressor(model, terms)
     progress("finding the base parameters")
@@ -101,7 +109,7 @@ def excite(description, output, duration, samples, harmonics, amplitude, max_vel
     # NumPy, SciPy (optional, checked above): only when the command runs
     from ..identification.estimation import (excitation_trajectory, measurements_csv,
                                              motion_bounds, simulate_measurements)
-    from ..regressor import declared_actuator_terms
+    from ..regressor import declared_actuator_terms  # SymPy: only when the command runs
 
     if not duration > 0 or duration == float("inf"):
         raise IdentificationError(f"--duration must be a positive number of seconds, got "
@@ -113,6 +121,7 @@ def excite(description, output, duration, samples, harmonics, amplitude, max_vel
     check_output_file(output)
     progress = Progress(quiet)
     model, _ = load_reduced(description, scene_path, strict)
+    terms = _terms(model, friction)
     limits = {}
     if description.suffix.lower() == ".urdf":
         from ..parsers.urdf import joint_limits  # the parsers (SymPy): only when a command runs
@@ -120,7 +129,7 @@ def excite(description, output, duration, samples, harmonics, amplitude, max_vel
         limits = joint_limits(description)
     bounds = motion_bounds(model.joint_names, amplitude, limits, max_velocity,
                            max_acceleration, str(description))
-    reg, base = _regressor(model, friction, progress)
+    reg, base = _regressor(model, terms, progress)
     progress(f"optimising a {harmonics}-harmonic Fourier trajectory "
              f"({model.dof * (2 * harmonics + 1)} coefficients)")
     ex = excitation_trajectory(reg, base, period=duration, harmonics=harmonics,
@@ -183,16 +192,17 @@ def identify(description, data, outdir, physical, friction, cutoff, scene_path, 
     from ..identification.estimation import (observation_matrix, physical_fit,
                                              read_measurements, weighted_least_squares)
     from ..identification.report import IdentificationReport
-    from ..regressor import description_values
+    from ..regressor import description_values  # SymPy: only when the command runs
 
     if physical and importlib.util.find_spec("cvxpy") is None:
         raise IdentificationError("--physical needs cvxpy: pip install 'eomgen[identify]'")
     check_output_folder(outdir)
     progress = Progress(quiet)
     model, _ = load_reduced(description, scene_path, strict)
+    terms = _terms(model, friction)
     progress(f"reading {data}")
     measured = read_measurements(data, model.joint_names, cutoff)
-    reg, base = _regressor(model, friction, progress)
+    reg, base = _regressor(model, terms, progress)
     progress(f"stacking the base regressor over {plural(measured.N, 'sample')}")
     W = observation_matrix(reg, base.base, measured.q, measured.qd, measured.qdd)
     estimate = weighted_least_squares(W, measured.tau, str(data))
