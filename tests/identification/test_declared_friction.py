@@ -141,3 +141,18 @@ def test_friction_adds_columns_a_description_does_not_declare(arm):
     for r in rows[len(INERTIAL):]:
         assert float(r["description"]) == 0.0 and abs(float(r["estimate"])) < 1e-8, r
     assert np.isfinite([float(r["std"]) for r in rows]).all()
+
+
+def test_a_flexible_joint_is_one_line_exit_2_and_nothing_written(arm):
+    """A stiffness (Spong's flexible joint) has no rigid-body regressor: excite and identify
+    refuse it, as ``generate --outputs regressor`` does, rather than treat the joint as rigid."""
+    scene = write(arm / "flexible.yaml", "version: 1\nactuators:\n"
+                                         "  elbow: {armature: 0.02, stiffness: 100}\n")
+    data = write(arm / "data.csv", "t,q_shoulder,q_elbow,tau_shoulder,tau_elbow\n")
+    for args in (("excite", arm / "arm.urdf", "-o", arm / "out.csv"),
+                 ("identify", arm / "arm.urdf", data, "-o", arm / "out")):
+        done = run_in_process(*args, "--scene", scene, "--quiet")
+        assert done.returncode == 2 and done.stderr.count("\n") == 1, done.stderr
+        assert "joint 'elbow' actuator: a flexible joint has no rigid-body regressor" \
+            in done.stderr
+    assert sorted(p.name for p in arm.iterdir()) == ["arm.urdf", "data.csv", "flexible.yaml"]
