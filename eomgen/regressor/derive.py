@@ -87,8 +87,10 @@ class Regressor:
         """π of the description, p × 1: each body's (m, h, I about its origin), symbolic in the
         model's parameters unless ``values`` (symbol or name → number) are given.
 
-        Actuator entries are not in descriptions: 0 unless ``actuator`` maps their names
-        (``"FV2"``) to values.
+        Actuator entries (``IA``, ``FV``, ``FC``, ``FO``) are 0 here unless ``actuator`` maps
+        their names (``"FV2"``) to values; the values a description declares (its
+        ``<dynamics>`` or actuators) come from
+        :func:`eomgen.regressor.generated.description_values`.
         """
         pi = []
         bodies = sorted(self.tree.bodies, key=lambda body: body.q_index)
