@@ -390,6 +390,27 @@ def test_cli_writes_every_file(tmp_path):
     assert "checking the derivation against Newton-Euler" in result.stderr
 
 
+@pytest.mark.parametrize("robot", ["scara_rrp", "cylindrical_rpp"])
+def test_sums_leave_out_zero_terms(robot, tmp_path):
+    """Issue 29: the SCARA's handout printed ``τ3 = M3,3 q̈3 + 0 + g3`` and ``… + 0`` where a
+    joint has no velocity terms or no gravity; zero terms are left out, and a sum of zeros is 0."""
+    out = tmp_path / "out"
+    result = CliRunner().invoke(main, ["teach", str(eomgen.example_path(robot)), "--format",
+                                       "md,tex", "--no-check", "--quiet", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    for suffix in ("md", "tex"):
+        text = (out / f"{robot}_handout.{suffix}").read_text()
+        zero_terms = re.findall(r"[+-] 0(?= [+-]| *\\\\|\s*$)", text, flags=re.M)
+        assert not zero_terms, f"{robot}_handout.{suffix} prints a zero term"
+        if robot == "scara_rrp":
+            assert r"\tau_{3} &= M_{3,3} \ddot{q}_{3} + g_{3}" in text
+            assert r"\tau_{3} &= m_{3} \ddot{q}_{3} - g m_{3}" in text
+        else:
+            assert r"\tau_{2} &= M_{2,2} \ddot{q}_{2} + g_{2} \\" in text
+            assert r"\tau_{3} &= m_{3} \ddot{q}_{3} - h \dot{q}_{1}^{2}" + "\n" in text
+            assert r"g_{1} &= 0 \\" in text  # an all-zero sum is printed as 0
+
+
 @pytest.mark.parametrize("args,message", [
     (["--format", "docx"], "unknown handout format docx"),
     ([str(CORPUS / "urdf_cycle.urdf"), "--format", "md"], "urdf_cycle.urdf"),
