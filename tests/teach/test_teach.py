@@ -411,6 +411,30 @@ def test_sums_leave_out_zero_terms(robot, tmp_path):
             assert r"g_{1} &= 0 \\" in text  # an all-zero sum is printed as 0
 
 
+def test_units_in_descriptions_print_as_superscripts(tmp_path):
+    """Issue 29: a parameter described in "[kg m^2]" printed as "kg mˆ2" in the PDF; the
+    exponent of a unit is a superscript in every format (the rest of the text stays escaped)."""
+    out = tmp_path / "out"
+    formats = "md,html,tex" + (",pdf" if PDFLATEX else "")
+    result = CliRunner().invoke(main, ["teach", str(eomgen.example_path("elbow_rrr")),
+                                       "--format", formats, "--no-check", "--quiet",
+                                       "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    tex = (out / "elbow_rrr_handout.tex").read_text()
+    assert "textasciicircum" not in tex
+    assert r"inertia of link 1 about the waist axis {[}kg m$^{2}$" in tex
+    assert r"gravitational acceleration {[}m/s$^{2}${]}" in tex
+    md = (out / "elbow_rrr_handout.md").read_text()
+    assert r"| inertia of link 1 about the waist axis \[kg m$^{2}$\] |" in md
+    html_page = (out / "elbow_rrr_handout.html").read_text()
+    assert "m^2" not in html_page and "<mn>2</mn></mrow></msup>" in html_page
+    if PDFLATEX and PDFTOTEXT:
+        text = subprocess.run([PDFTOTEXT, str(out / "elbow_rrr_handout.pdf"), "-"],
+                              capture_output=True, text=True, check=True).stdout
+        assert "ˆ" not in text and "^" not in text
+        assert "waist axis [kg m2 ]" in text  # m with a raised 2
+
+
 @pytest.mark.parametrize("args,message", [
     (["--format", "docx"], "unknown handout format docx"),
     ([str(CORPUS / "urdf_cycle.urdf"), "--format", "md"], "urdf_cycle.urdf"),
