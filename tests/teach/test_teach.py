@@ -29,7 +29,8 @@ from eomgen.symbolic.textbook import textbook_derivation
 from eomgen.teach import FORMATS, build_handout, handout_files, parse_formats
 from eomgen.teach import readability as rd
 from eomgen.teach.content import HALF, _quadratic_terms, named_coriolis
-from eomgen.teach.document import Equations, Figure, Paragraph, Table, code, prose
+from eomgen.teach.document import (Equations, Figure, Handout, Paragraph, Section, Table,
+                                   code, prose)
 from eomgen.teach.formats import HtmlFormat, MarkdownFormat, TexFormat
 
 PDFLATEX = shutil.which("pdflatex")
@@ -274,6 +275,60 @@ def test_pdf_compiles_and_holds_the_two_link_equations(arm_handout, tmp_path):
     ]
     missing = [e for e in expected if unicodedata.normalize("NFKC", e) not in text]
     assert not missing, f"not in the PDF's text: {missing}"
+
+
+def _pdf_pages(pdf: bytes, tmp_path: Path) -> list[str]:
+    """The text of each page of ``pdf`` (a table's row on one line), without white space."""
+    path = tmp_path / "pages.pdf"
+    path.write_bytes(pdf)
+    text = subprocess.run([PDFTOTEXT, "-layout", str(path), "-"], capture_output=True, check=True,
+                          text=True).stdout
+    return [re.sub(r"\s+", "", unicodedata.normalize("NFKC", page)) for page in text.split("\f")]
+
+
+def _page_of(pages: list[str], text: str) -> int:
+    found = [k for k, page in enumerate(pages) if re.sub(r"\s+", "", text) in page]
+    assert found, f"{text!r} is not in the PDF"
+    return found[0]
+
+
+@needs_pdflatex
+def test_tables_start_on_the_page_of_their_introduction(arm_handout, tmp_path):
+    """Issue 29: the two-link handout's parameter table had its introduction at the foot of
+    page 1 and its heading and rows on page 2. A table's introduction, heading and first row
+    share a page; every table of the handout is checked."""
+    [pdf] = FORMATS["pdf"](arm_handout)
+    pages = _pdf_pages(pdf.content, tmp_path)
+    tables = [
+        ("Joints, in the order of the joint vector", "variablejointtypeparent", "joint1revolutebase"),
+        ("Links: mass (kg), centre of mass", "linkmasscentreofmassinertia", "basemassless"),
+        ("Parameters: symbols kept in the equations", "symbolvaluemeaning",
+         "inertia of link 1 about z"),
+        ("eomgen checked what it derived", "propertycheckedlargesterror", "M symmetric"),
+    ]
+    for introduction, heading, first_row in tables:
+        page = _page_of(pages, introduction)
+        assert _page_of(pages, heading) == page, f"the heading of {introduction!r} moved on"
+        assert _page_of(pages, first_row) == page, f"the rows of {introduction!r} moved on"
+
+
+@needs_pdflatex
+def test_long_tables_repeat_their_heading_and_never_leave_it_alone(tmp_path):
+    """A table too long for one page keeps its heading with its first rows, and repeats it on
+    the next page, wherever the page before it ends."""
+    rows = tuple((prose(f"row{k}"), prose(f"value{k}")) for k in range(70))
+    for lines in range(50, 60):  # the table starts near the foot of page 1, a line apart
+        handout = Handout("long", "Long table", (Section("Text", (
+            Paragraph(prose(" ".join(["Words that fill the page before the table."] * 2 * lines))),
+            Paragraph(prose("The long table:")),
+            Table((prose("name"), prose("content")), rows))),))
+        [pdf] = FORMATS["pdf"](handout)
+        pages = _pdf_pages(pdf.content, tmp_path)
+        first = _page_of(pages, "The long table:")
+        assert _page_of(pages, "namecontent") == first
+        assert _page_of(pages, "row0value0") == first
+        last = _page_of(pages, "row69value69")
+        assert last > first and "namecontent" in pages[last]
 
 
 @needs_pdflatex
