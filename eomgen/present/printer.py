@@ -208,6 +208,18 @@ def display_width(tex: str) -> int:
     return width
 
 
+
+def _is_zero_term(term) -> bool:
+    """Whether a term of a printed sum is zero as written: the number 0 (or 0.0), or a product
+    built unevaluated with such a factor. Structural only: no simplification, no assumptions."""
+    if isinstance(term, sp.UnevaluatedExpr):
+        return _is_zero_term(term.args[0])
+    if getattr(term, "is_Number", False):
+        return term == 0
+    if getattr(term, "is_Mul", False):
+        return any(_is_zero_term(factor) for factor in term.args)
+    return term == 0
+
 class DerivationLatexPrinter(LatexPrinter):
     """SymPy's :class:`~sympy.printing.latex.LatexPrinter` in the notation of the derivation
     documents (see the module docstring).
@@ -297,8 +309,11 @@ class DerivationLatexPrinter(LatexPrinter):
         return pack(self._tokens(sp.sympify(expr), width), width)
 
     def print_sum_lines(self, terms: Iterable, width: int) -> list[str]:
-        """The sum of ``terms``, in the given order (not SymPy's), as display lines."""
-        return pack(self._sum_tokens(list(terms), width), width)
+        """The sum of ``terms``, in the given order (not SymPy's), as display lines. Zero terms
+        are left out (``M_{3,3} \\ddot{q}_{3} + g_{3}``, never ``… + 0 + g_{3}``); a sum of
+        none, or of zeros only, prints as ``0``."""
+        kept = [term for term in terms if not _is_zero_term(term)]
+        return pack(self._sum_tokens(kept, width), width) if kept else ["0"]
 
     def _sum_tokens(self, terms: list, width: int) -> list[str]:
         tokens: list[str] = []

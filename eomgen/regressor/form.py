@@ -121,8 +121,8 @@ def regressor_form(model_or_regressor) -> RegressorForm:
     columns = tuple(k for k in range(reg.p) if any(Y[i, k] != 0 for i in range(reg.n)))
     zero = tuple(k for k in range(reg.p) if k not in columns)
     try:
-        sym = symbolic_base_parameters(reg)
-        base, names, exact = sym.base, sym.names, not sym.residual
+        sym = symbolic_base_parameters(reg, Y=Y)  # Y: what residual groupings solve exactly
+        base, names, exact = sym.base, sym.names, not sym.numeric
         beta = sym.expressions
     except UnsupportedError:  # an axis the grouping rules do not cover
         num = base_parameters(reg)

@@ -46,8 +46,8 @@ from ..symbolic.textbook import TextbookDerivation
 from ..verify import VerificationReport, verify
 from .contacts import (contact_equations, contact_forces,  # noqa: F401  (re-exported)
                        contact_section, contact_symbol_names)
-from .document import (Equation, Equations, Figure, Handout, Paragraph, Section, Table, code, math,
-                       plain, prose)
+from .document import (Equation, Equations, Figure, Handout, Paragraph, Section, Table, code,
+                       described, math, plain, prose)
 from .drives import (drive_equations, drive_symbol_names, drives_section,  # noqa: F401
                      has_drives, spring_values)
 from .sketch import render_sketch, sketch_geometry
@@ -83,7 +83,7 @@ def _robot_section(model: RobotModel, w: Writer, sketch_caption: tuple,
     blocks: list = []
     info = dict(model.info)
     if info.get("description"):
-        blocks.append(Paragraph((plain(str(info["description"])),)))
+        blocks.append(Paragraph(described(str(info["description"]))))
     if scene is not None:
         blocks.append(_scene_paragraph(scene))
     movable = {j.name: k for k, j in enumerate(model.movable_joints, start=1)}
@@ -146,7 +146,7 @@ def _robot_section(model: RobotModel, w: Writer, sketch_caption: tuple,
         par_rows = tuple(
             ((math(w.tex(par.symbol)),),
              (math(w.tex(sp.Float(par.value, 15))),) if par.value is not None else prose("none"),
-             (plain(par.description),))
+             described(par.description))
             for par in sorted(model.parameters, key=lambda par: par.name))
         blocks.append(Paragraph(prose(
             "Parameters: symbols kept in the equations, with the values the description "

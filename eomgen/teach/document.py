@@ -42,6 +42,30 @@ def plain(text: str) -> Span:
     return Span("text", str(text))
 
 
+#: A unit's exponent in user text: ``m^2``, ``s^-2``, ``m^{2}`` (after a letter or a bracket).
+_EXPONENT = re.compile(r"(?<=[A-Za-z)\]])\^(?:\{(-?[0-9]+)\}|(-?[0-9]+))")
+
+
+def described(text: str) -> Inline:
+    """User text (a parameter's meaning) as plain spans, except that a unit's exponent
+    (``kg m^2``, ``m/s^-2``, ``m^{2}``) is a superscript, so that the PDF prints m² and not
+    ``mˆ2``. Only the matched digits become math; the rest stays escaped text.
+
+    >>> [(s.kind, s.value) for s in described("inertia [kg m^2], g in m/s^{-2}")]
+    [('text', 'inertia [kg m'), ('math', '^{2}'), ('text', '], g in m/s'), ('math', '^{-2}')]
+    """
+    spans: list[Span] = []
+    at = 0
+    for match in _EXPONENT.finditer(text):
+        if match.start() > at:
+            spans.append(plain(text[at:match.start()]))
+        spans.append(math("^{" + (match.group(1) or match.group(2)) + "}"))
+        at = match.end()
+    if at < len(text) or not spans:
+        spans.append(plain(text[at:]))
+    return tuple(spans)
+
+
 def code(text: str) -> Span:
     """A name from the description, in a monospace font."""
     return Span("code", str(text))

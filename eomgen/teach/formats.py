@@ -79,10 +79,12 @@ class _Format:
     def cell(self, content: Inline) -> str:
         return self.inline(content)
 
+    def section(self, handout: Handout, section) -> dict:
+        return {"title": self.text(section.title),
+                "blocks": [self.block(handout, b) for b in section.blocks]}
+
     def render(self, handout: Handout) -> str:
-        sections = [{"title": self.text(s.title),
-                     "blocks": [self.block(handout, b) for b in s.blocks]}
-                    for s in handout.sections]
+        sections = [self.section(handout, s) for s in handout.sections]
         return render(self.template, title=self.text(handout.title), sections=sections,
                       header=list(handout.header), comment=self.comment)
 
@@ -105,6 +107,18 @@ def _aligned_rows(block: Equations) -> str:
 _TEX_TYPOGRAPHY = {"\u2013": "--", "\u2014": "---", "\u2019": "'", "\u00a0": "~"}
 
 
+#: A table of at most this many rows is kept on one page with its introduction; a longer one
+#: (longtable, its heading repeated on every page) keeps its heading and KEEP_FIRST_ROWS rows.
+KEEP_ROWS = 20
+KEEP_FIRST_ROWS = 5
+
+
+def _paragraph_lines(tex: str) -> int:
+    """Lines a paragraph of the handout takes, generously (about 90 characters of source a
+    line, plus the space between paragraphs)."""
+    return len(tex) // 90 + 2
+
+
 class TexFormat(_Format):
     name = "tex"
     template = "teach/handout.tex.jinja"
@@ -120,6 +134,32 @@ class TexFormat(_Format):
 
     def equations(self, block):
         return "\\begin{align*}\n" + _aligned_rows(block) + "\n\\end{align*}"
+
+    def section(self, handout, section):
+        """The section, with the lines to keep on one page (``keep``, for ``\\keeplines``)
+        set before each table: the paragraph that introduces it, its heading and its first
+        rows (all of them, up to :data:`KEEP_ROWS`) go to the next page together rather than
+        leave the heading, or the introduction, at the foot of a page. Before the first block
+        the section heading is kept with them too."""
+        out = super().section(handout, section)
+        blocks = out["blocks"]
+        out["keep"] = 0
+        for data in blocks:
+            data["keep"] = 0
+        for t, (block, data) in enumerate(zip(section.blocks, blocks)):
+            if not isinstance(block, Table):
+                continue
+            rows = len(block.rows)
+            lines = 3 + (rows if rows <= KEEP_ROWS else KEEP_FIRST_ROWS)
+            at = t
+            if t and isinstance(section.blocks[t - 1], Paragraph):
+                at = t - 1
+                lines += _paragraph_lines(blocks[at]["text"])
+            if at == 0:
+                out["keep"] = lines + 4
+            else:
+                blocks[at]["keep"] = lines
+        return out
 
     def figure_file(self, handout, figure):
         return f"{handout.stem}_{figure.name}.pdf"

@@ -52,6 +52,29 @@ def test_notebook_is_deterministic_without_outputs(arm):
         assert needle in text
 
 
+def test_scara_base_parameters_keep_the_description_symbols():
+    """Issue 29: the SCARA's notebook printed ``ZZ2R = 0.499999999999999 MX3 + ZZ2 + ZZ3``.
+    The MX3 column is a dependency the grouping rules leave (a prismatic joint parallel to the
+    revolute one before it); its coefficient is solved exactly, 2 a2, and the β the notebook
+    prints (regressor_form through expression_latex) carries no float."""
+    from eomgen.regressor import regressor_form
+    from eomgen.symbolic.textbook import fourier_form
+
+    model = eomgen.load(eomgen.example_path("scara_rrp"))
+    dyn = eomgen.derive(model)
+    form = regressor_form(model)
+    P = {s.name: s for s in form.regressor.parameter_symbols}
+    a2 = next(p.symbol for p in model.parameters if p.name == "a2")
+    beta = dict(zip(form.base_names, form.beta))
+    assert beta["ZZ2R"] == P["ZZ2"] + P["ZZ3"] + 2 * a2 * P["MX3"]
+    assert beta["MX2R"] == P["MX2"] + P["MX3"] and beta["MY2R"] == P["MY2"] - P["MY3"]
+    assert form.exact and not any(b.atoms(sp.Float) for b in form.beta)
+    identity = form.Y_base * sp.Matrix(form.beta) - form.Y * form.pi
+    assert all(fourier_form(e, form.regressor.q) == 0 for e in identity)
+    tex = expression_latex(dyn, beta["ZZ2R"], form.latex_names)
+    assert tex == r"2 \mathrm{MX}_{3} a_{2} + \mathrm{ZZ}_{2} + \mathrm{ZZ}_{3}"
+
+
 @pytest.mark.parametrize("example", ["planar_2link", "puma560_dh", "elbow_rrr"])
 @pytest.mark.slow
 def test_cli_notebook_runs_without_errors(tmp_path, example):

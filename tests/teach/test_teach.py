@@ -29,7 +29,8 @@ from eomgen.symbolic.textbook import textbook_derivation
 from eomgen.teach import FORMATS, build_handout, handout_files, parse_formats
 from eomgen.teach import readability as rd
 from eomgen.teach.content import HALF, _quadratic_terms, named_coriolis
-from eomgen.teach.document import Equations, Figure, Paragraph, Table, code, prose
+from eomgen.teach.document import (Equations, Figure, Handout, Paragraph, Section, Table,
+                                   code, prose)
 from eomgen.teach.formats import HtmlFormat, MarkdownFormat, TexFormat
 
 PDFLATEX = shutil.which("pdflatex")
@@ -276,6 +277,60 @@ def test_pdf_compiles_and_holds_the_two_link_equations(arm_handout, tmp_path):
     assert not missing, f"not in the PDF's text: {missing}"
 
 
+def _pdf_pages(pdf: bytes, tmp_path: Path) -> list[str]:
+    """The text of each page of ``pdf`` (a table's row on one line), without white space."""
+    path = tmp_path / "pages.pdf"
+    path.write_bytes(pdf)
+    text = subprocess.run([PDFTOTEXT, "-layout", str(path), "-"], capture_output=True, check=True,
+                          text=True).stdout
+    return [re.sub(r"\s+", "", unicodedata.normalize("NFKC", page)) for page in text.split("\f")]
+
+
+def _page_of(pages: list[str], text: str) -> int:
+    found = [k for k, page in enumerate(pages) if re.sub(r"\s+", "", text) in page]
+    assert found, f"{text!r} is not in the PDF"
+    return found[0]
+
+
+@needs_pdflatex
+def test_tables_start_on_the_page_of_their_introduction(arm_handout, tmp_path):
+    """Issue 29: the two-link handout's parameter table had its introduction at the foot of
+    page 1 and its heading and rows on page 2. A table's introduction, heading and first row
+    share a page; every table of the handout is checked."""
+    [pdf] = FORMATS["pdf"](arm_handout)
+    pages = _pdf_pages(pdf.content, tmp_path)
+    tables = [
+        ("Joints, in the order of the joint vector", "variablejointtypeparent", "joint1revolutebase"),
+        ("Links: mass (kg), centre of mass", "linkmasscentreofmassinertia", "basemassless"),
+        ("Parameters: symbols kept in the equations", "symbolvaluemeaning",
+         "inertia of link 1 about z"),
+        ("eomgen checked what it derived", "propertycheckedlargesterror", "M symmetric"),
+    ]
+    for introduction, heading, first_row in tables:
+        page = _page_of(pages, introduction)
+        assert _page_of(pages, heading) == page, f"the heading of {introduction!r} moved on"
+        assert _page_of(pages, first_row) == page, f"the rows of {introduction!r} moved on"
+
+
+@needs_pdflatex
+def test_long_tables_repeat_their_heading_and_never_leave_it_alone(tmp_path):
+    """A table too long for one page keeps its heading with its first rows, and repeats it on
+    the next page, wherever the page before it ends."""
+    rows = tuple((prose(f"row{k}"), prose(f"value{k}")) for k in range(70))
+    for lines in range(50, 60):  # the table starts near the foot of page 1, a line apart
+        handout = Handout("long", "Long table", (Section("Text", (
+            Paragraph(prose(" ".join(["Words that fill the page before the table."] * 2 * lines))),
+            Paragraph(prose("The long table:")),
+            Table((prose("name"), prose("content")), rows))),))
+        [pdf] = FORMATS["pdf"](handout)
+        pages = _pdf_pages(pdf.content, tmp_path)
+        first = _page_of(pages, "The long table:")
+        assert _page_of(pages, "namecontent") == first
+        assert _page_of(pages, "row0value0") == first
+        last = _page_of(pages, "row69value69")
+        assert last > first and "namecontent" in pages[last]
+
+
 @needs_pdflatex
 def test_pdf_is_deterministic(arm_handout):
     assert FORMATS["pdf"](arm_handout)[0].content == FORMATS["pdf"](arm_handout)[0].content
@@ -388,6 +443,51 @@ def test_cli_writes_every_file(tmp_path):
                      "planar_2link_handout.tex", "planar_2link_sketch.pdf",
                      "planar_2link_sketch.svg"]
     assert "checking the derivation against Newton-Euler" in result.stderr
+
+
+@pytest.mark.parametrize("robot", ["scara_rrp", "cylindrical_rpp"])
+def test_sums_leave_out_zero_terms(robot, tmp_path):
+    """Issue 29: the SCARA's handout printed ``τ3 = M3,3 q̈3 + 0 + g3`` and ``… + 0`` where a
+    joint has no velocity terms or no gravity; zero terms are left out, and a sum of zeros is 0."""
+    out = tmp_path / "out"
+    result = CliRunner().invoke(main, ["teach", str(eomgen.example_path(robot)), "--format",
+                                       "md,tex", "--no-check", "--quiet", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    for suffix in ("md", "tex"):
+        text = (out / f"{robot}_handout.{suffix}").read_text()
+        zero_terms = re.findall(r"[+-] 0(?= [+-]| *\\\\|\s*$)", text, flags=re.M)
+        assert not zero_terms, f"{robot}_handout.{suffix} prints a zero term"
+        if robot == "scara_rrp":
+            assert r"\tau_{3} &= M_{3,3} \ddot{q}_{3} + g_{3}" in text
+            assert r"\tau_{3} &= m_{3} \ddot{q}_{3} - g m_{3}" in text
+        else:
+            assert r"\tau_{2} &= M_{2,2} \ddot{q}_{2} + g_{2} \\" in text
+            assert r"\tau_{3} &= m_{3} \ddot{q}_{3} - h \dot{q}_{1}^{2}" + "\n" in text
+            assert r"g_{1} &= 0 \\" in text  # an all-zero sum is printed as 0
+
+
+def test_units_in_descriptions_print_as_superscripts(tmp_path):
+    """Issue 29: a parameter described in "[kg m^2]" printed as "kg mˆ2" in the PDF; the
+    exponent of a unit is a superscript in every format (the rest of the text stays escaped)."""
+    out = tmp_path / "out"
+    formats = "md,html,tex" + (",pdf" if PDFLATEX else "")
+    result = CliRunner().invoke(main, ["teach", str(eomgen.example_path("elbow_rrr")),
+                                       "--format", formats, "--no-check", "--quiet",
+                                       "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    tex = (out / "elbow_rrr_handout.tex").read_text()
+    assert "textasciicircum" not in tex
+    assert r"inertia of link 1 about the waist axis {[}kg m$^{2}$" in tex
+    assert r"gravitational acceleration {[}m/s$^{2}${]}" in tex
+    md = (out / "elbow_rrr_handout.md").read_text()
+    assert r"| inertia of link 1 about the waist axis \[kg m$^{2}$\] |" in md
+    html_page = (out / "elbow_rrr_handout.html").read_text()
+    assert "m^2" not in html_page and "<mn>2</mn></mrow></msup>" in html_page
+    if PDFLATEX and PDFTOTEXT:
+        text = subprocess.run([PDFTOTEXT, str(out / "elbow_rrr_handout.pdf"), "-"],
+                              capture_output=True, text=True, check=True).stdout
+        assert "ˆ" not in text and "^" not in text
+        assert "waist axis [kg m2 ]" in text  # m with a raised 2
 
 
 @pytest.mark.parametrize("args,message", [
