@@ -68,8 +68,8 @@ def render_scene_files(model: RobotModel, scene: Scene | None, backends: Sequenc
     """
     start = time.perf_counter()
     reduced, report = apply_scene(model, scene)
-    progress(f"scene {Path(report.scene).name}: {report.after.dof} of "
-             f"{plural(report.before.dof, 'joint')} move, {report.after.links} of {report.before.links} links kept "
+    progress(f"scene {Path(report.scene).name}: {report.moving_summary()}, "
+             f"{report.after.links} of {report.before.links} links kept "
              f"({time.perf_counter() - start:.2f} s)")
     reduced = keep_symbolic(reduced, symbolic)
     functions = report.outputs
@@ -111,8 +111,8 @@ def _header_notes(report: ReductionReport, scene: Scene | None) -> tuple[str, ..
         return ()
     path = Path(scene.source)
     digest = hashlib.sha256(path.read_bytes()).hexdigest() if path.is_file() else "0" * 64
-    return (f"Reduced by scene {path.name!r} (sha256 {digest[:16]}): {report.after.dof} of "
-            f"{report.before.dof} joints move; see the scene report.",)
+    return (f"Reduced by scene {path.name!r} (sha256 {digest[:16]}): "
+            f"{report.moving_summary()}; see the scene report.",)
 
 
 def generate_scene(model: RobotModel, scene: Scene | None, outdir: Path,
