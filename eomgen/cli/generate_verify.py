@@ -81,6 +81,20 @@ class BackendOption(click.Option):
             self.help = template
 
 
+class BackendListingCommand(click.Command):
+    """A command whose help ends its description with the registered backends, one line each
+    (:func:`eomgen.codegen.available_backends`, looked up when help is shown), so that a new
+    backend is listed without editing the help."""
+
+    def format_help_text(self, ctx, formatter):
+        super().format_help_text(ctx, formatter)
+        from ..codegen import available_backends  # SymPy: only when the help is shown
+
+        with formatter.section("Backends (--backend; all by default)"):
+            formatter.write_dl([(name, backend.description)
+                                for name, backend in available_backends().items()])
+
+
 def functions_option(text: str | None) -> tuple[str, ...] | None:
     """The functions ``--outputs`` names (None when not given), or a one-line error."""
     if text is None:
@@ -110,7 +124,7 @@ def answer_from_cache(request, outdir: Path, quiet: bool, cache_dir: Path | None
     return True
 
 
-@click.command()
+@click.command(cls=BackendListingCommand)
 @description_argument()
 @click.option("--backend", "backends", default="all", show_default=True, cls=BackendOption,
               help="Comma-separated backends among {backends}; or all.")
@@ -142,10 +156,9 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
              cache_dir, no_snap, outputs, strict):
     """Generate code and a derivation for DESCRIPTION (default: the bundled planar 2-link arm).
 
-    Writes <robot>_numpy.py (NumPy, single states and batches), <robot>_casadi.py (CasADi
-    functions), <robot>_casadi.c/.h (C through CasADi, plus a .so when a C compiler is found) and
-    <robot>.tex (the derivation) into OUTPUT, all files or none. A request made before (same
-    file bytes, options and eomgen) is answered from the derivation cache.
+    Writes the files of each backend (listed below) into OUTPUT, named <robot>_<backend>
+    (<robot>_numpy.py, <robot>_casadi.c, <robot>.tex, ...), all files or none. A request made
+    before (same file bytes, options and eomgen) is answered from the derivation cache.
 
     \b
     Examples:

@@ -210,6 +210,29 @@ def test_verify_help_shows_examples_and_options():
         assert option in result.stdout
 
 
+def test_generate_help_lists_every_registered_backend():
+    """Issue 29: the help listed four of the seven backends, by hand; it lists the registry,
+    so a backend registered later is listed too."""
+    import dataclasses
+
+    from eomgen.codegen import BACKENDS, available_backends
+
+    def listed() -> list[str]:
+        result = run("generate", "--help")
+        assert result.exit_code == 0
+        section = result.stdout.split("Backends (--backend", 1)[1].split("Options:", 1)[0]
+        return [line.split()[0] for line in section.splitlines()[1:]
+                if line.startswith("  ") and not line.startswith("   ")]
+
+    backends = available_backends()
+    assert listed() == list(backends) and len(backends) >= 7
+    BACKENDS["extra"] = dataclasses.replace(backends["numpy"], name="extra")
+    try:
+        assert "extra" in listed()
+    finally:
+        del BACKENDS["extra"]
+
+
 def test_version():
     result = run("--version")
     assert result.exit_code == 0
