@@ -35,9 +35,10 @@ from .options import (description_argument, output_folder_option, quiet_option, 
 def verify(description, samples, seed, tolerance, scene_path, quiet, strict):
     """Derive DESCRIPTION's dynamics and check them against Newton–Euler.
 
-    DESCRIPTION is a URDF, DH-table YAML or eomgen YAML file (default: the bundled planar
-    2-link arm). Checks: M symmetric positive definite, Ṁ − 2C skew-symmetric, g, the columns of
-    M and the whole equation against the numeric recursive Newton–Euler algorithm.
+    DESCRIPTION is a URDF, DH-table YAML or eomgen YAML file, or a bundled example's name
+    (default: the bundled planar 2-link arm). Checks: M symmetric positive definite, Ṁ − 2C
+    skew-symmetric, g, the columns of M and the whole equation against the numeric recursive
+    Newton–Euler algorithm.
 
     \b
     Examples:
