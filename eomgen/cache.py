@@ -89,7 +89,7 @@ COMMAND_IGNORED = frozenset({"description", "outdir", "quiet", "debug", "no_cach
 #: file's bytes and name). A parameter in none of these, given with a value other than None or
 #: False (``--explain``), turns the command-level cache off for that run: it may print more
 #: than the files, which a cached run would not repeat.
-COMMAND_KEYED = frozenset({"backends", "symbolic", "strict", "no_snap", "outputs"})
+COMMAND_KEYED = frozenset({"backends", "symbolic", "strict", "no_snap", "outputs", "name"})
 
 Notify = Callable[[str], None]
 
@@ -257,6 +257,8 @@ def command_request(description: Path, params: Mapping[str, object]) -> CacheReq
         options["scene_file"] = scene_path.name
     for name, value in sorted(params.items()):
         if name in COMMAND_IGNORED or name == "scene_path":
+            continue
+        if name == "name" and value is None:  # keyed only when given: earlier keys stay valid
             continue
         if name not in COMMAND_KEYED:
             if value is None or value is False:

@@ -21,6 +21,7 @@ import shutil
 import signal
 import tempfile
 from dataclasses import dataclass
+from keyword import iskeyword
 from pathlib import Path
 from typing import Sequence
 
@@ -51,6 +52,16 @@ class GeneratedFile:
     name: str
     content: str | bytes
     golden: bool = True
+
+
+def checked_stem(stem: str | None) -> str | None:
+    """``stem`` when it can name generated modules (an ASCII Python identifier, not a keyword;
+    ``eomgen generate --name``), else a :class:`~eomgen.errors.GenerationError`; None stays None
+    (the robot's name, :func:`module_name`)."""
+    if stem is None or (stem.isascii() and stem.isidentifier() and not iskeyword(stem)):
+        return stem
+    raise GenerationError(f"--name: {stem!r} cannot name a Python module (letters, digits and "
+                          f"underscores, not starting with a digit, not a keyword)")
 
 
 def _existing_ancestor(path: Path) -> Path:

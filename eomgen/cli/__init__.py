@@ -56,6 +56,11 @@ def main(ctx):
       eomgen generate ur5.urdf --backend numpy,casadi -o build/ur5
       eomgen verify                          # check the bundled arm against Newton-Euler
       eomgen verify robot.urdf --samples 50
+      eomgen teach scara_rrp                 # a bundled example by name
+
+    DESCRIPTION, in every command, is a URDF, DH-table YAML or eomgen YAML file, or the name of
+    a bundled example (cylindrical_rpp, elbow_rrr, planar_2link, puma560_arm3, puma560_dh,
+    scara_rrp, stanford_rrp); a file of that name wins.
     """
     if ctx.invoked_subcommand is None:  # plain ``eomgen``: the help, and success
         click.echo(ctx.get_help())

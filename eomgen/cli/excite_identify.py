@@ -109,6 +109,7 @@ def excite(description, output, duration, samples, harmonics, amplitude, max_vel
     # NumPy, SciPy (optional, checked above): only when the command runs
     from ..identification.estimation import (excitation_trajectory, measurements_csv,
                                              motion_bounds, simulate_measurements)
+    from ..identification.excitation import EXCITATION_ITERATIONS
     from ..regressor import declared_actuator_terms  # SymPy: only when the command runs
 
     if not duration > 0 or duration == float("inf"):
@@ -132,8 +133,10 @@ def excite(description, output, duration, samples, harmonics, amplitude, max_vel
     reg, base = _regressor(model, terms, progress)
     progress(f"optimising a {harmonics}-harmonic Fourier trajectory "
              f"({model.dof * (2 * harmonics + 1)} coefficients)")
-    ex = excitation_trajectory(reg, base, period=duration, harmonics=harmonics,
-                               seed=seed, bounds=bounds)
+    with progress.steps(EXCITATION_ITERATIONS, "optimising") as steps:
+        ex = excitation_trajectory(reg, base, period=duration, harmonics=harmonics,
+                                   seed=seed, bounds=bounds, maxiter=EXCITATION_ITERATIONS,
+                                   progress=lambda line: steps.update(1, line))
     progress(f"simulating {plural(samples, 'sample')}")
     t = [k * duration / samples for k in range(samples)]
     data = simulate_measurements(model, ex.trajectory, t, noise=noise, seed=seed,

@@ -10,12 +10,13 @@ from __future__ import annotations
 import dataclasses
 import sys
 import time
+from importlib.machinery import EXTENSION_SUFFIXES
 from pathlib import Path
 
 import click
 
 from ..errors import GenerationError, VerificationError
-from ..output import check_output_folder, write_atomically
+from ..output import check_output_folder, checked_stem, write_atomically
 from ..progress import Progress, plural
 from .handling import handle_errors, recorded_warnings
 from .loading import default_description, load, load_reduced
@@ -35,9 +36,10 @@ from .options import (description_argument, output_folder_option, quiet_option, 
 def verify(description, samples, seed, tolerance, scene_path, quiet, strict):
     """Derive DESCRIPTION's dynamics and check them against Newton–Euler.
 
-    DESCRIPTION is a URDF, DH-table YAML or eomgen YAML file (default: the bundled planar
-    2-link arm). Checks: M symmetric positive definite, Ṁ − 2C skew-symmetric, g, the columns of
-    M and the whole equation against the numeric recursive Newton–Euler algorithm.
+    DESCRIPTION is a URDF, DH-table YAML or eomgen YAML file, or a bundled example's name
+    (default: the bundled planar 2-link arm). Checks: M symmetric positive definite, Ṁ − 2C
+    skew-symmetric, g, the columns of M and the whole equation against the numeric recursive
+    Newton–Euler algorithm.
 
     \b
     Examples:
@@ -81,6 +83,20 @@ class BackendOption(click.Option):
             self.help = template
 
 
+class BackendListingCommand(click.Command):
+    """A command whose help ends its description with the registered backends, one line each
+    (:func:`eomgen.codegen.available_backends`, looked up when help is shown), so that a new
+    backend is listed without editing the help."""
+
+    def format_help_text(self, ctx, formatter):
+        super().format_help_text(ctx, formatter)
+        from ..codegen import available_backends  # SymPy: only when the help is shown
+
+        with formatter.section("Backends (--backend; all by default)"):
+            formatter.write_dl([(name, backend.description)
+                                for name, backend in available_backends().items()])
+
+
 def functions_option(text: str | None) -> tuple[str, ...] | None:
     """The functions ``--outputs`` names (None when not given), or a one-line error."""
     if text is None:
@@ -93,24 +109,44 @@ def functions_option(text: str | None) -> tuple[str, ...] | None:
         raise GenerationError(f"--outputs: {exc}") from None
 
 
-def answer_from_cache(request, outdir: Path, quiet: bool, cache_dir: Path | None) -> bool:
-    """Write the files of a cached ``eomgen generate`` run and list them, as the run did;
-    False when the cache holds no (valid) entry. Imports neither SymPy nor the parsers."""
+def import_hint(paths: list[Path], outdir: Path, stem_given: bool) -> str | None:
+    """The line saying how to import the Python modules among ``paths`` (None when there are
+    none: LaTeX or C only): the ``.py`` files and extension modules, not a ``.py`` file that a
+    shared library of the same name (the C backend's ``<stem>_casadi.so``) would shadow."""
+    names = {p.name for p in paths}
+    modules = {n[:-3] for n in names if n.endswith(".py") and n[:-3] + ".so" not in names}
+    modules |= {n[:-len(EXTENSION_SUFFIXES[0])] for n in names
+                if n.endswith(EXTENSION_SUFFIXES[0])}
+    modules = sorted(modules, key=lambda m: (not m.endswith("_numpy"), m))
+    if not modules:
+        return None
+    also = f" (also {', '.join(modules[1:])})" if len(modules) > 1 else ""
+    rename = "" if stem_given else "; --name STEM names them STEM_*"
+    return (f"eomgen: to import, put the folder on the path, sys.path.insert(0, "
+            f"{str(outdir)!r}), then import {modules[0]}{also}{rename}")
+
+
+def answer_from_cache(request, outdir: Path, quiet: bool, cache_dir: Path | None
+                      ) -> list[Path] | None:
+    """Write the files of a cached ``eomgen generate`` run and list them, as the run did, and
+    return their paths; None when the cache holds no (valid) entry. Imports neither SymPy nor
+    the parsers."""
     from ..cache import Cache  # start-up time (certifi, ~0.15 s): only when asked
 
     entry = Cache(cache_dir).get(request.key)
     if entry is None:
-        return False
+        return None
     for notice in entry.notices:
         click.echo(f"eomgen: warning: {notice}", err=True)
     if not quiet:
         click.echo(f"eomgen: using cached result (key {request.key[:16]}…)", err=True)
-    for path in write_atomically(entry.files, outdir):
+    paths = write_atomically(entry.files, outdir)
+    for path in paths:
         click.echo(str(path))
-    return True
+    return paths
 
 
-@click.command()
+@click.command(cls=BackendListingCommand)
 @description_argument()
 @click.option("--backend", "backends", default="all", show_default=True, cls=BackendOption,
               help="Comma-separated backends among {backends}; or all.")
@@ -129,6 +165,9 @@ def answer_from_cache(request, outdir: Path, quiet: bool, cache_dir: Path | None
 @click.option("--cache-dir", default=None, type=click.Path(file_okay=False, path_type=Path),
               help="Derivation cache folder (default: $EOMGEN_CACHE_DIR, else "
                    "$XDG_CACHE_HOME/eomgen, else ~/.cache/eomgen).")
+@click.option("--name", "name", default=None, metavar="STEM",
+              help="Name the files and modules STEM_numpy.py, STEM_casadi.py, ... (a Python "
+                   "identifier; default: from the robot's name in the description).")
 @click.option("--no-snap", is_flag=True,
               help="Keep rotation and axis entries exactly as the description's floats give "
                    "them (default: entries within 1e-11 of 0 or ±1 are made exact).")
@@ -139,13 +178,12 @@ def answer_from_cache(request, outdir: Path, quiet: bool, cache_dir: Path | None
 @strict_option
 @handle_errors
 def generate(description, backends, outdir, symbolic, quiet, scene_path, explain, no_cache,
-             cache_dir, no_snap, outputs, strict):
+             cache_dir, name, no_snap, outputs, strict):
     """Generate code and a derivation for DESCRIPTION (default: the bundled planar 2-link arm).
 
-    Writes <robot>_numpy.py (NumPy, single states and batches), <robot>_casadi.py (CasADi
-    functions), <robot>_casadi.c/.h (C through CasADi, plus a .so when a C compiler is found) and
-    <robot>.tex (the derivation) into OUTPUT, all files or none. A request made before (same
-    file bytes, options and eomgen) is answered from the derivation cache.
+    Writes the files of each backend (listed below) into OUTPUT, named <robot>_<backend>
+    (<robot>_numpy.py, <robot>_casadi.c, <robot>.tex, ...), all files or none. A request made
+    before (same file bytes, options and eomgen) is answered from the derivation cache.
 
     \b
     Examples:
@@ -154,6 +192,7 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
       eomgen generate eomgen/robots/planar_2link.yaml --symbolic m2,g
       eomgen generate talos_reduced.urdf --scene examples/scenes/talos_left_arm.yaml --explain
     """
+    checked_stem(name)
     check_output_folder(outdir)
     functions = functions_option(outputs)
     progress = Progress(quiet)
@@ -163,7 +202,10 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
 
         request = command_request(description or default_description(),
                                   click.get_current_context().params)
-        if request is not None and answer_from_cache(request, outdir, quiet, cache_dir):
+        paths = None if request is None else answer_from_cache(request, outdir, quiet,
+                                                                 cache_dir)
+        if paths is not None:
+            say_how_to_import(paths, outdir, name, quiet)
             return
     # SymPy and the code generators: only when the cache did not answer
     from ..codegen.generate import generate as run_generate
@@ -186,13 +228,21 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
         from ..codegen.scene_generate import generate_scene  # SymPy, as above
 
         paths, produced = generate_scene(model, scene, outdir, backends, names, progress,
-                                         explain, cache=cache, cache_dir=cache_dir)
+                                         explain, cache=cache, cache_dir=cache_dir, stem=name)
         progress.clear()
         if explain:
             click.echo(produced.markdown)
     else:
         paths = run_generate(model, outdir, backends, names, progress, functions, cache=cache,
-                             cache_dir=cache_dir)
+                             cache_dir=cache_dir, stem=name)
         progress.clear()
     for path in paths:
         click.echo(str(path))
+    say_how_to_import(paths, outdir, name, quiet)
+
+
+def say_how_to_import(paths: list[Path], outdir: Path, name: str | None, quiet: bool) -> None:
+    """One line on stderr (not under ``--quiet``): how to import the modules written."""
+    hint = import_hint(paths, outdir, name is not None)
+    if hint and not quiet:
+        click.echo(hint, err=True)

@@ -1,7 +1,7 @@
 """The arguments and options several ``eomgen`` commands take, declared once.
 
 Each is a click decorator (or a function making one, where commands differ in a default or a
-help text): the DESCRIPTION argument, ``--scene``, ``--quiet``, ``--strict`` and ``-o/--output``
+help text): the DESCRIPTION argument (a file, or a bundled example's name), ``--scene``, ``--quiet``, ``--strict`` and ``-o/--output``
 (a folder or a file). Whether an output can be written is checked by the command itself
 (:mod:`eomgen.output`: one error line, not click's usage text). ``--debug`` comes with the error
 handling (:func:`eomgen.cli.handling.handle_errors`).
@@ -13,6 +13,8 @@ from pathlib import Path
 
 import click
 
+from ..robots import EXAMPLES
+
 #: ``--scene`` of most commands.
 SCENE_HELP = ("Scene file (YAML, docs/scenes.md): reduce the robot to what the scene moves "
               "first (e.g. examples/scenes/panda_two_joints.yaml).")
@@ -23,10 +25,20 @@ QUIET_HELP = ("No progress on stderr (stage lines in a log, an updating line or 
 
 
 def description_argument(required: bool = False):
-    """DESCRIPTION: a URDF, DH-table YAML or eomgen YAML file; optional (the bundled planar
-    2-link arm, :func:`eomgen.cli.loading.default_description`) unless ``required``."""
-    return click.argument("description", required=required,
+    """DESCRIPTION: a URDF, DH-table YAML or eomgen YAML file, or the name of a bundled example
+    (:data:`eomgen.robots.EXAMPLES`, e.g. ``scara_rrp``; a file of that name wins); optional
+    (the bundled planar 2-link arm, :func:`eomgen.cli.loading.default_description`) unless
+    ``required``."""
+    return click.argument("description", required=required, callback=_file_or_example,
                           type=click.Path(dir_okay=False, path_type=Path))
+
+
+def _file_or_example(ctx, param, value: Path | None) -> Path | None:
+    """``value`` itself when it exists (or is not an example's name), else the bundled
+    example's file of that name, as :func:`eomgen.example_path` gives it in Python."""
+    if value is None or value.exists():
+        return value
+    return EXAMPLES.get(str(value), value)
 
 
 strict_option = click.option(

@@ -63,17 +63,20 @@ class Job:
         ]
 
 
-def make_job(dynamics: "Dynamics", functions=None, notes=(), count_operations: bool = True) -> Job:
+def make_job(dynamics: "Dynamics", functions=None, notes=(), count_operations: bool = True,
+             stem: str | None = None) -> Job:
     """Build the specs shared by every backend from dynamics derived with the outputs that
     ``functions`` need (default: all functions, hence M, C, g and tau; see
     :func:`~eomgen.codegen.functions.select_functions`). ``notes`` are extra header lines;
-    ``count_operations=False`` leaves the operation counts of the header at 0 (faster)."""
+    ``count_operations=False`` leaves the operation counts of the header at 0 (faster);
+    ``stem`` names the files and modules (default: the robot's name,
+    :func:`eomgen.output.module_name`)."""
     source = Path(dynamics.model.source)
     digest = hashlib.sha256(source.read_bytes()).hexdigest() if source.is_file() else "0" * 64
     chosen = select_functions(functions)
     return Job(dynamics, function_specs(dynamics, chosen, count_operations),
                parameter_arguments(dynamics),
-               module_name(dynamics.model.name), source.name, digest, chosen, tuple(notes),
+               stem or module_name(dynamics.model.name), source.name, digest, chosen, tuple(notes),
                module_constants(dynamics, chosen))
 
 

@@ -15,7 +15,7 @@ from ..dynamics import derive
 from ..cache import CacheRequest, render_cached
 from ..errors import GenerationError
 from ..model import RobotModel, snap_summary
-from ..output import write_atomically  # noqa: F401  (re-exported)
+from ..output import checked_stem, write_atomically  # noqa: F401  (re-exported)
 from ..progress import plural
 from . import GeneratedFile, available_backends, make_job
 from .functions import derived_outputs, select_functions
@@ -62,14 +62,15 @@ def keep_symbolic(model: RobotModel, names: Iterable[str] | None) -> RobotModel:
 
 def render_files(model: RobotModel, backends: Sequence[str], progress: Progress = lambda _: None,
                  functions: Iterable[str] | None = None, notes: Sequence[str] = (),
-                 build: bool = True) -> list[GeneratedFile]:
+                 build: bool = True, stem: str | None = None) -> list[GeneratedFile]:
     """Derive ``model`` once and run each backend; nothing is written.
 
     ``functions`` (default: all, see :func:`~eomgen.codegen.functions.select_functions`) are the
     functions the modules export; only the outputs they need are derived. ``notes`` are extra
     header lines of every file. ``build=False`` renders the text files only: nothing is
     compiled, so the C backend's ``.so`` and the fast backend's extension module are left out
-    (the other files are the same, byte for byte).
+    (the other files are the same, byte for byte). ``stem`` names the files and modules
+    (default: the robot's name; see :func:`eomgen.codegen.make_job`).
     """
     start = time.perf_counter()
     outputs = derived_outputs(functions)
@@ -78,7 +79,7 @@ def render_files(model: RobotModel, backends: Sequence[str], progress: Progress 
         progress(snap_summary(snapped))
     progress(f"deriving {', '.join(outputs)} of {model.name} ({plural(model.dof, 'joint')})")
     dynamics = derive(model, outputs=outputs, simplify=False)
-    job = make_job(dynamics, functions, notes)
+    job = make_job(dynamics, functions, notes, stem=stem)
     progress(f"derived in {time.perf_counter() - start:.2f} s; "
              + ", ".join(f"{s.name} {s.operation_count} ops" for s in job.specs))
     return render_job(job, backends, progress, build)
@@ -131,7 +132,8 @@ def render_job(job, backends: Sequence[str], progress: Progress = lambda _: None
 def generate(model: RobotModel, outdir: Path, backends: str | Sequence[str] = "all",
              symbolic: Iterable[str] | None = None, progress: Progress = lambda _: None,
              functions: Iterable[str] | None = None, cache: bool | CacheRequest = True,
-             cache_dir: Path | None = None, build: bool = True) -> list[Path]:
+             cache_dir: Path | None = None, build: bool = True, stem: str | None = None
+             ) -> list[Path]:
     """Generate the chosen backends' files for ``model`` into ``outdir``; returns their paths.
 
     Parameters
@@ -160,7 +162,11 @@ def generate(model: RobotModel, outdir: Path, backends: str | Sequence[str] = "a
     build:
         Compile what the backends compile (the C backend's shared library, the fast
         backend's extension module); ``False`` writes their text files only.
+    stem:
+        The files' and modules' name (``<stem>_numpy.py``; a Python identifier); default: the
+        robot's name (:func:`eomgen.output.module_name`).
     """
+    stem = checked_stem(stem)
     chosen = select_backends(backends)
     if functions is not None:
         try:
@@ -175,6 +181,8 @@ def generate(model: RobotModel, outdir: Path, backends: str | Sequence[str] = "a
     # build=False is passed only when given, so that the cache keys of building calls (the
     # options are part of the key) are those of earlier versions
     options = {} if build else {"build": False}
+    if stem is not None:  # likewise: part of the key only when given
+        options["stem"] = stem
     files = render_cached(render_files, model, chosen, progress, cache=cache,
                           cache_dir=cache_dir, functions=functions, **options)
     return write_atomically(files, Path(outdir))

@@ -17,6 +17,7 @@ from typing import Iterable, Sequence
 from ..cache import Cache, CacheRequest
 from ..dynamics import derive
 from ..model import RobotModel
+from ..output import checked_stem
 from ..progress import plural
 from ..reduction import (
     MEASURE_TIMEOUT,
@@ -56,10 +57,12 @@ class SceneGeneration:
 def render_scene_files(model: RobotModel, scene: Scene | None, backends: Sequence[str],
                        symbolic: Iterable[str] | None = None,
                        progress: Progress = lambda _: None, explain: bool = False,
-                       timeout: float = MEASURE_TIMEOUT, build: bool = True) -> SceneGeneration:
+                       timeout: float = MEASURE_TIMEOUT, build: bool = True,
+                       stem: str | None = None) -> SceneGeneration:
     """Apply ``scene`` to ``model``, derive and render; nothing is written. The files include
     the report when ``scene`` is given (None applies the empty scene: merging only);
-    ``build=False`` compiles nothing (see :func:`~.generate.render_files`).
+    ``build=False`` compiles nothing (see :func:`~.generate.render_files`); ``stem`` names the
+    files (default: the robot's name).
 
     With ``explain``, the whole description and the reduced model are both derived again, each
     in a fresh process (:func:`~eomgen.reduction.measure_derivation`, at most ``timeout``
@@ -68,8 +71,8 @@ def render_scene_files(model: RobotModel, scene: Scene | None, backends: Sequenc
     """
     start = time.perf_counter()
     reduced, report = apply_scene(model, scene)
-    progress(f"scene {Path(report.scene).name}: {report.after.dof} of "
-             f"{plural(report.before.dof, 'joint')} move, {report.after.links} of {report.before.links} links kept "
+    progress(f"scene {Path(report.scene).name}: {report.moving_summary()}, "
+             f"{report.after.links} of {report.before.links} links kept "
              f"({time.perf_counter() - start:.2f} s)")
     reduced = keep_symbolic(reduced, symbolic)
     functions = report.outputs
@@ -79,7 +82,7 @@ def render_scene_files(model: RobotModel, scene: Scene | None, backends: Sequenc
     dynamics = derive(reduced, outputs=outputs, simplify=False)
     after = derivation_cost(dynamics)
     notes = _header_notes(report, scene)
-    job = make_job(dynamics, functions, notes)
+    job = make_job(dynamics, functions, notes, stem=stem)
     progress(f"derived in {after.seconds:.2f} s; "
              + ", ".join(f"{s.name} {s.operation_count} ops" for s in job.specs))
     files = render_job(job, backends, progress, build)
@@ -111,15 +114,15 @@ def _header_notes(report: ReductionReport, scene: Scene | None) -> tuple[str, ..
         return ()
     path = Path(scene.source)
     digest = hashlib.sha256(path.read_bytes()).hexdigest() if path.is_file() else "0" * 64
-    return (f"Reduced by scene {path.name!r} (sha256 {digest[:16]}): {report.after.dof} of "
-            f"{report.before.dof} joints move; see the scene report.",)
+    return (f"Reduced by scene {path.name!r} (sha256 {digest[:16]}): "
+            f"{report.moving_summary()}; see the scene report.",)
 
 
 def generate_scene(model: RobotModel, scene: Scene | None, outdir: Path,
                    backends: str | Sequence[str] = "all", symbolic: Iterable[str] | None = None,
                    progress: Progress = lambda _: None, explain: bool = False,
                    timeout: float = MEASURE_TIMEOUT, cache: bool | CacheRequest = False,
-                   cache_dir: Path | None = None, build: bool = True
+                   cache_dir: Path | None = None, build: bool = True, stem: str | None = None
                    ) -> tuple[list[Path], SceneGeneration]:
     """Generate the chosen backends' files for ``model`` reduced by ``scene``, and the scene
     report, into ``outdir`` (all files or none); returns their paths and what was produced.
@@ -130,8 +133,10 @@ def generate_scene(model: RobotModel, scene: Scene | None, outdir: Path,
     :class:`~eomgen.cache.CacheRequest` (``eomgen generate --scene`` keys the description and
     scene files before reading them, :func:`eomgen.cache.command_request`) stores the files
     under its key in the derivation cache (folder ``cache_dir``); anything else stores nothing.
-    ``build=False`` writes the text files only (nothing compiled).
+    ``build=False`` writes the text files only (nothing compiled). ``stem`` names the files
+    (default: the robot's name), as in :func:`~.generate.generate`.
     """
+    stem = checked_stem(stem)
     chosen = select_backends(backends)
     outputs = scene.outputs if scene is not None else None
     if backends == "all" or list(backends) == ["all"]:
@@ -142,7 +147,7 @@ def generate_scene(model: RobotModel, scene: Scene | None, outdir: Path,
         for name in skipped:
             progress(f"{name}: skipped (needs {', '.join(available_backends()[name].needs)})")
     produced = render_scene_files(model, scene, chosen, symbolic, progress, explain, timeout,
-                                  build)
+                                  build, stem)
     if isinstance(cache, CacheRequest) and build:  # the key says nothing of build=False
         Cache(cache_dir).put(cache.key, produced.files, tuple(cache.notices))
     return write_atomically(produced.files, Path(outdir)), produced

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Iterable, Mapping, Sequence
+from typing import Callable, Iterable, Mapping, Sequence
 
 import numpy as np
 
@@ -162,10 +162,15 @@ class Excitation:
     evaluations: int
 
 
+#: The optimiser's iterations at most (:func:`excitation_trajectory`'s ``maxiter``).
+EXCITATION_ITERATIONS = 30
+
+
 def excitation_trajectory(reg, base, period: float = 10.0, harmonics: int = 3,
                           amplitude: float = 1.0, samples: int | None = None, seed: int = 0,
-                          maxiter: int = 30, values: Mapping | None = None,
-                          bounds: MotionBounds | None = None) -> Excitation:
+                          maxiter: int = EXCITATION_ITERATIONS, values: Mapping | None = None,
+                          bounds: MotionBounds | None = None,
+                          progress: Callable[[str], None] = lambda _: None) -> Excitation:
     """Fourier coefficients minimising cond(W_base) (Swevers et al. 1997) within bounds on
     q, q̇ and q̈.
 
@@ -200,6 +205,10 @@ def excitation_trajectory(reg, base, period: float = 10.0, harmonics: int = 3,
         Bound on |q_j(t)| [rad or m] when ``bounds`` is None.
     bounds:
         Position ranges and velocity and acceleration bounds (:func:`motion_bounds`).
+    progress:
+        Called after each iteration of the optimiser with ``"cond c, e
+        evaluations"`` (c the best condition number so far); the optimisation takes seconds to
+        a minute.
     """
     from scipy.optimize import minimize  # an optional dependency (eomgen[identify])
 
@@ -228,14 +237,19 @@ def excitation_trajectory(reg, base, period: float = 10.0, harmonics: int = 3,
         return FourierTrajectory(x[:n], x[n:n + n * L].reshape(n, L),
                                  x[n + n * L:].reshape(n, L), omega)
 
-    count = [0]
+    count, lowest = [0], [300.0]
 
     def condition(trajectory):
         count[0] += 1
         q, qd, qdd = trajectory.states(t)
         W = np.vstack([f(*row)["Y_base"] for row in zip(q, qd, qdd)])
         c = normalised_condition(W)
-        return math.log10(c) if math.isfinite(c) and c < 1e300 else 300.0
+        value = math.log10(c) if math.isfinite(c) and c < 1e300 else 300.0
+        lowest[0] = min(lowest[0], value)
+        return value
+
+    def iterated(_x):
+        progress(f"cond {10 ** lowest[0]:.4g}, {count[0]} evaluations")
 
     def objective(x):
         return condition(unpack(x))
@@ -256,7 +270,7 @@ def excitation_trajectory(reg, base, period: float = 10.0, harmonics: int = 3,
     x0 = rng.uniform(low, high)
     initial = 10 ** objective(x0)
     result = minimize(objective, x0, method="L-BFGS-B", bounds=list(zip(low, high)),
-                      options={"maxiter": int(maxiter)})
+                      options={"maxiter": int(maxiter)}, callback=iterated)
     best = unpack(result.x if result.fun <= math.log10(initial) else x0)
     value = condition(best)
     wider = stretched(best)

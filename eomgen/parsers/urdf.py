@@ -502,11 +502,14 @@ def _read_joint_type(element: ET.Element, source: str, where: str) -> JointType:
     if text is None:
         raise SchemaError(source, where, "no 'type' attribute")
     if text == "floating":
+        parent = _link_reference(element, "parent", source, where)
         child = _link_reference(element, "child", source, where)
         raise UnsupportedError(
             source, where,
-            f"floating joints are not supported: eomgen models fixed-base robots only; make "
-            f"it a fixed joint to model link '{child}' bolted to the world")
+            f"floating joints are not supported: to let link '{child}' fly, remove this joint "
+            f"and link '{parent}' (so that '{child}' is the root) and give a scene "
+            f"'floating_base: true' (docs/scenes.md); to bolt it to the world, make it a "
+            f"fixed joint")
     if text == "planar":
         raise UnsupportedError(
             source, where,

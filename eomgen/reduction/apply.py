@@ -117,7 +117,8 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
         moving=reduced.joint_names, world=world, locked=tuple(locks), merged=merged,
         dropped=dropped,
         dropped_payloads=dropped_payloads, planar=planar, notes=tuple(notes),
-        outputs=select(scene.outputs), contacts=scene.contacts)
+        outputs=select(scene.outputs), contacts=scene.contacts,
+        virtual_joints=EULER_JOINTS if scene.floating_base else ())
     return Reduction(reduced, report)
 
 

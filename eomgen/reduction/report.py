@@ -94,10 +94,28 @@ class ReductionReport:
     #: The scene's contacts (:class:`eomgen.model.Contact`); each frame is a link of the
     #: reduced model (a massless frame fixed to its body when the merge absorbed it).
     contacts: tuple = ()
+    #: The six virtual joints a scene's ``floating_base`` put above the root (moving, but not
+    #: the description's); empty without a floating base.
+    virtual_joints: tuple[str, ...] = ()
 
     @property
     def locked_by_default(self) -> tuple[str, ...]:
         return tuple(j.name for j in self.locked if not j.listed)
+
+    @property
+    def moving_described(self) -> int:
+        """How many of the description's own joints move (virtual joints not counted)."""
+        return self.after.dof - len(self.virtual_joints)
+
+    def moving_summary(self) -> str:
+        """``"2 of 9 joints move"``; with a floating base ``"12 of 12 joints move, and the
+        floating base's 6 virtual joints (18 in all)"``."""
+        noun = "joint" if self.before.dof == 1 else "joints"
+        text = f"{self.moving_described} of {self.before.dof} {noun} move"
+        if self.virtual_joints:
+            text += (f", and the floating base's {len(self.virtual_joints)} virtual joints "
+                     f"({self.after.dof} in all)")
+        return text
 
     def markdown(self, before: DerivationCost | None = None,
                  after: DerivationCost | None = None) -> str:

@@ -69,7 +69,9 @@ def _scene_paragraph(report) -> Paragraph:
     parts: list = ["This handout models ", code(report.robot), " as the scene ",
                    code(Path(report.scene).name), " reduces it"]
     parts += [": ", plain(report.description)] if report.description else []
-    parts.append(f". Moving: {len(report.moving)} of {report.before.dof} joints")
+    parts.append(f". Moving: {report.moving_described} of {report.before.dof} joints")
+    if report.virtual_joints:
+        parts.append(f", and the floating base's {len(report.virtual_joints)} virtual joints")
     if report.locked:
         parts.append("; locked (rad or m): ")
         for k, lock in enumerate(report.locked):

@@ -210,6 +210,66 @@ def test_verify_help_shows_examples_and_options():
         assert option in result.stdout
 
 
+def test_generate_help_lists_every_registered_backend():
+    """Issue 29: the help listed four of the seven backends, by hand; it lists the registry,
+    so a backend registered later is listed too."""
+    import dataclasses
+
+    from eomgen.codegen import BACKENDS, available_backends
+
+    def listed() -> list[str]:
+        result = run("generate", "--help")
+        assert result.exit_code == 0
+        section = result.stdout.split("Backends (--backend", 1)[1].split("Options:", 1)[0]
+        return [line.split()[0] for line in section.splitlines()[1:]
+                if line.startswith("  ") and not line.startswith("   ")]
+
+    backends = available_backends()
+    assert listed() == list(backends) and len(backends) >= 7
+    BACKENDS["extra"] = dataclasses.replace(backends["numpy"], name="extra")
+    try:
+        assert "extra" in listed()
+    finally:
+        del BACKENDS["extra"]
+
+
+def test_a_bundled_example_name_is_a_description_in_every_command(tmp_path, monkeypatch):
+    """Issue 29: `eomgen teach scara_rrp` said "no such file" although Python's
+    eomgen.example_path("scara_rrp") works; every command's DESCRIPTION takes the name, and a
+    real file of that name wins."""
+    from eomgen.cli import main
+    from eomgen.robots import EXAMPLES
+
+    for name, command in main.commands.items():
+        argument = next((p for p in command.params if p.name == "description"), None)
+        assert argument is not None, name
+        assert argument.process_value(click_context(command), "scara_rrp") == \
+            EXAMPLES["scara_rrp"], name
+    assert ", ".join(sorted(EXAMPLES)) in " ".join(run("--help").stdout.split())
+
+    monkeypatch.chdir(tmp_path)
+    taught = run("teach", "scara_rrp", "--format", "md", "-o", "handout", "--no-check", "--quiet")
+    assert taught.exit_code == 0, taught.output
+    assert (tmp_path / "handout" / "scara_rrp_handout.md").is_file()
+    generated = run("generate", "elbow_rrr", "--backend", "numpy", "-o", "out", "--no-cache",
+                    "--quiet")
+    assert generated.exit_code == 0, generated.output
+    assert (tmp_path / "out" / "elbow_rrr_numpy.py").is_file()
+
+    (tmp_path / "scara_rrp").write_text("not a robot", encoding="utf-8")  # a file wins
+    refused = run("verify", "scara_rrp")
+    assert refused.exit_code == 2
+    assert refused.stderr.startswith(f"{ERROR}scara_rrp: unknown file type ''")
+    missing = run("verify", "scara")
+    assert missing.exit_code == 2 and missing.stderr == f"{ERROR}scara: no such file\n"
+
+
+def click_context(command):
+    import click
+
+    return click.Context(command)
+
+
 def test_version():
     result = run("--version")
     assert result.exit_code == 0

@@ -183,8 +183,9 @@ def test_check_output_folder_tells_a_writable_place_from_others(tmp_path):
 def test_generate_reports_each_stage_with_its_time_in_a_log(tmp_path):
     done = run_process("generate", "--no-cache", "--backend", "numpy,c", "-o", tmp_path / "o")
     assert done.returncode == 0, done.stderr
-    lines = done.stderr.splitlines()
+    *lines, hint = done.stderr.splitlines()
     assert lines and all(STAGE.match(line) for line in lines), lines
+    assert hint.startswith("eomgen: to import, ")  # after the stages, no time: not a stage
     stages = [line.split(" [+")[0].removeprefix("eomgen: ") for line in lines]
     assert stages[0].startswith("deriving M, C, g, tau of planar_2link (2 joints)")
     assert stages[1].startswith("derived in ")
@@ -260,8 +261,9 @@ def test_a_terminal_gets_one_updating_line(tmp_path):
     text = seen.decode()
     assert "\r\x1b[Keomgen: deriving M, C, g, tau of planar_2link" in text
     assert "\r\x1b[Keomgen: numpy: planar_2link_numpy.py" in text
-    assert "[+" not in text and "\n" not in text.replace("\r\n", "")
-    assert text.endswith("\r\x1b[K")  # cleared before the results
+    progress, hint = text.rsplit("\r\x1b[K", 1)  # cleared before the results
+    assert "[+" not in progress and "\n" not in progress.replace("\r\n", "")
+    assert hint.startswith("eomgen: to import, ") and hint.endswith("\r\n")  # one line left
     assert stdout.decode().splitlines() == [str(tmp_path / "o" / "planar_2link_numpy.py")]
 
 
@@ -469,3 +471,52 @@ def test_the_readme_finds_the_example_robots():
     assert robots.resolve() == erd_robots_dir().resolve()
     named = re.findall(r"`\$ROBOTS/([^`]+\.urdf)`", readme)
     assert len(named) >= 3 and all((robots / path).is_file() for path in named), named
+
+
+def test_name_chooses_the_modules_stem_says_how_to_import_and_keys_the_cache(tmp_path):
+    """Issue 29: modules were named after the robot (uf_robot_* for xarm7.urdf) with no option
+    and no hint. --name STEM names them, one stderr line says how to import them (none under
+    --quiet), a bad STEM is one error line and nothing written, and the derivation cache keeps
+    names apart (the command's cache and the library's)."""
+    cache = tmp_path / "cache"
+    common = ("--backend", "numpy,latex", "--cache-dir", cache)
+    named = run_in_process("generate", "--name", "arm2", "-o", tmp_path / "a", *common)
+    assert named.returncode == 0, named.stderr
+    assert sorted(p.name for p in (tmp_path / "a").iterdir()) == ["arm2.tex", "arm2_numpy.py"]
+    hints = [line for line in named.stderr.splitlines() if "import" in line]
+    assert hints == [f"eomgen: to import, put the folder on the path, sys.path.insert(0, "
+                     f"{str(tmp_path / 'a')!r}), then import arm2_numpy"]
+    sys.path.insert(0, str(tmp_path / "a"))
+    try:
+        module = importlib.import_module("arm2_numpy")
+        assert module.NQ == 2
+    finally:
+        sys.path.remove(str(tmp_path / "a"))
+        sys.modules.pop("arm2_numpy", None)
+
+    plain = run_in_process("generate", "-o", tmp_path / "b", *common)  # not the cached arm2
+    assert plain.returncode == 0 and "using cached result" not in plain.stderr
+    assert (tmp_path / "b" / "planar_2link_numpy.py").is_file()
+    assert "--name STEM names them STEM_*" in plain.stderr.splitlines()[-1]
+    again = run_in_process("generate", "--name", "arm2", "-o", tmp_path / "c", *common,
+                           "--quiet")
+    assert again.returncode == 0 and again.stderr == ""  # the cache answers, silently
+    assert (tmp_path / "c" / "arm2_numpy.py").read_bytes() == \
+        (tmp_path / "a" / "arm2_numpy.py").read_bytes()
+
+    for bad in ("2arm", "arm-2", "class", "bras_à"):
+        refused = run_in_process("generate", "--name", bad, "-o", tmp_path / "d", *common)
+        assert refused.returncode == 2 and not (tmp_path / "d").exists()
+        assert refused.stderr == (f"{ERROR}--name: {bad!r} cannot name a Python module "
+                                  "(letters, digits and underscores, not starting with a "
+                                  "digit, not a keyword)\n")
+
+    import eomgen
+    from eomgen.codegen.generate import generate
+
+    model = eomgen.load(eomgen.example_path("planar_2link"))
+    library = tmp_path / "lib"
+    first = generate(model, library / "x", "numpy", stem="arm3", cache_dir=cache)
+    second = generate(model, library / "y", "numpy", cache_dir=cache)
+    assert [p.name for p in first] == ["arm3_numpy.py"]
+    assert [p.name for p in second] == ["planar_2link_numpy.py"]

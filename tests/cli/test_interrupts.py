@@ -9,10 +9,12 @@ staging folder or temporary file behind (in the output's parent folder nor in th
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -40,10 +42,25 @@ def _snapshot(folder: Path) -> dict[str, bytes]:
     return {p.name: p.read_bytes() for p in folder.iterdir()}
 
 
-def _default_sigint():
+#: Calls of the before-fork hooks in this process: Python code run between fork and exec,
+#: as a ``preexec_fn`` does (JAX, loaded by other tests in the same process, warns then that
+#: os.fork() may deadlock; plain subprocess starts call no hook).
+FORK_HOOKS: list[int] = []
+os.register_at_fork(before=lambda: FORK_HOOKS.append(1))
+
+
+@contextmanager
+def _children_with_default_sigint():
     """Children of a shell without job control inherit SIGINT ignored; Python then never
-    raises KeyboardInterrupt. The test wants eomgen's own handling, so restore the default."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    raises KeyboardInterrupt. The test wants eomgen's own handling, so while the child starts,
+    SIGINT is handled here: exec resets a handled signal to its default (an ignored one stays
+    ignored). No ``preexec_fn``: it would run Python in the forked child of a multithreaded
+    process."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 @pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)],
@@ -55,10 +72,13 @@ def test_interrupt_mid_derivation_keeps_the_previous_output(chain, tmp_path, sig
     for name, content in PREVIOUS.items():
         (outdir / name).write_bytes(content)
     cache = tmp_path / "cache"
-    process = subprocess.Popen(
-        [sys.executable, "-m", "eomgen.cli", "generate", str(chain), "-o", str(outdir),
-         "--backend", "numpy,casadi,latex", "--cache-dir", str(cache)],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=_default_sigint)
+    hooks = len(FORK_HOOKS)
+    with _children_with_default_sigint():
+        process = subprocess.Popen(
+            [sys.executable, "-m", "eomgen.cli", "generate", str(chain), "-o", str(outdir),
+             "--backend", "numpy,casadi,latex", "--cache-dir", str(cache)],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert len(FORK_HOOKS) == hooks  # issue 29: no Python ran between fork and exec
     try:
         seen = []
         deadline = time.monotonic() + 60

@@ -447,6 +447,33 @@ def test_excite_refuses_a_folder_as_output_before_any_work(tmp_path):
     assert result.stderr.count("\n") == 1
 
 
+def test_excite_reports_the_optimisation_as_it_goes(tmp_path):
+    """Issue 29: excite optimised 13-40 s without a word; each iteration of the optimiser is a
+    stage line (with the time, in a log) giving the best condition number so far, and --quiet
+    silences them."""
+    import re
+
+    from eomgen.identification.excitation import EXCITATION_ITERATIONS
+
+    done = run_in_process("excite", "scara_rrp", "-o", tmp_path / "a.csv", "--samples", 50)
+    assert done.returncode == 0, done.stderr
+    line = re.compile(r"^eomgen: optimising: (\d+)/(\d+), cond ([0-9.e+]+), (\d+) evaluations "
+                      r"\[\+\d+\.\d s\]$")
+    steps = [line.match(text) for text in done.stderr.splitlines()]
+    steps = [(int(m[1]), int(m[2]), float(m[3]), int(m[4])) for m in steps if m]
+    assert len(steps) >= 2 and [s[0] for s in steps] == list(range(1, len(steps) + 1))
+    assert all(s[1] == EXCITATION_ITERATIONS for s in steps)
+    conds, evaluations = [s[2] for s in steps], [s[3] for s in steps]
+    assert conds == sorted(conds, reverse=True) and evaluations == sorted(set(evaluations))
+    said = re.search(r"cond\(Y_base\) ([0-9.e+]+) at the random start, ([0-9.e+]+) optimised",
+                     done.stdout)
+    assert float(said[2]) <= conds[-1] * (1 + 1e-3) < float(said[1])
+    quiet = run_in_process("excite", "scara_rrp", "-o", tmp_path / "b.csv", "--samples", 50,
+                           "--quiet")
+    assert quiet.returncode == 0 and quiet.stderr == ""
+    assert (tmp_path / "a.csv").read_bytes() == (tmp_path / "b.csv").read_bytes()
+
+
 def test_excite_and_identify_a_scene_of_the_panda(tmp_path):
     """--scene: the Panda reduced to its shoulder and elbow; columns named after the joints
     the scene keeps (and the viscous friction its URDF declares, simulated and fitted), the

@@ -681,14 +681,37 @@ def test_deferred_notices_warn_nothing_and_emit_as_loading_would(tmp_path):
     assert model == eomgen.load(path, defer_notices=True)  # notices take no part in equality
 
 
-def test_floating_joint_error_says_what_to_do():
+def test_floating_joint_error_says_what_to_do(tmp_path):
+    """Issue 29: the error points to the scene's floating_base, and doing what it says works
+    (through the command, as a user would)."""
+    from support import ERROR, run_in_process
+
     document = robot(link("world", None), link("trunk"),
                      joint("root_joint", "world", "trunk", "floating", ""))
     with pytest.raises(UnsupportedError) as caught:
         parse_urdf_string(document, source="f.urdf")
     assert str(caught.value) == (
-        "f.urdf: joint 'root_joint': floating joints are not supported: eomgen models "
-        "fixed-base robots only; make it a fixed joint to model link 'trunk' bolted to the world")
+        "f.urdf: joint 'root_joint': floating joints are not supported: to let link 'trunk' "
+        "fly, remove this joint and link 'world' (so that 'trunk' is the root) and give a "
+        "scene 'floating_base: true' (docs/scenes.md); to bolt it to the world, make it a "
+        "fixed joint")
+    urdf = tmp_path / "f.urdf"
+    urdf.write_text(document, encoding="utf-8")
+    out = tmp_path / "out"
+    failed = run_in_process("generate", urdf, "--backend", "numpy", "-o", out, "--no-cache")
+    lines = failed.stderr.strip().splitlines()
+    assert failed.returncode == 2 and len(lines) == 1 and not out.exists()
+    assert lines[0].startswith(f"{ERROR}{urdf}: joint 'root_joint': ")
+    assert "'floating_base: true'" in lines[0]
+
+    urdf.write_text(robot(link("trunk")), encoding="utf-8")  # as the message says
+    scene = tmp_path / "fly.yaml"
+    scene.write_text("version: 1\nfloating_base: true\n", encoding="utf-8")
+    flying = run_in_process("generate", urdf, "--scene", scene, "--backend", "numpy", "-o", out,
+                            "--no-cache", "--quiet")
+    assert flying.returncode == 0, flying.stderr
+    assert "NQ = 6" in next(out.glob("*_numpy.py")).read_text(encoding="utf-8")
+
     fixed = parse_urdf_string(document.replace('type="floating"', 'type="fixed"'),
                               defer_notices=True)
     assert fixed.root == "world" and not fixed.notices  # as the message says: no warning left

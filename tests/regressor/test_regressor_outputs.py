@@ -252,3 +252,35 @@ def test_tilted_axes_take_the_numeric_route(tmp_path):
         base_stack.append(call("base_regressor", q, qd, qdd))
         np.testing.assert_allclose(base_stack[-1] @ beta, tau, rtol=1e-8, atol=1e-8)
     assert rank(np.vstack(base_stack)) == len(beta) == len(modules["numpy"]["BASE_PARAMETER_NAMES"])
+
+
+def test_a_model_too_large_to_write_out_has_its_regressor_generated_as_the_docs_say(tmp_path):
+    """Issue 29: docs/regressor.md said the Y of models beyond the textbook bound "is printed by
+    no backend yet"; `eomgen generate --outputs regressor` prints it for the 6-joint PUMA, and
+    the LaTeX document's sentence points to eomgen.regressor."""
+    from support import DOCS, run_in_process
+
+    from eomgen.symbolic.textbook import TEXTBOOK_MAX_DOF
+
+    puma = eomgen.example_path("puma560_dh")
+    out = tmp_path / "out"
+    result = run_in_process("generate", puma, "--backend", "numpy", "--outputs",
+                            "regressor,pi", "-o", out, "--no-cache", "--quiet")
+    assert result.returncode == 0, result.stderr
+    module = load_module_file(out / "puma560_numpy.py")
+    assert len(module.PARAMETER_NAMES) > 6 * 10 - 1 and 6 > TEXTBOOK_MAX_DOF
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # PUMA link 1 is not a physical body (see its file)
+        nm = numeric_model(eomgen.load(puma))
+    for q, qd, qdd in states(6, 2):
+        np.testing.assert_allclose(module.regressor(q, qd, qdd) @ module.inertial_parameters(),
+                                   rnea(nm, q, qd, qdd), rtol=1e-10, atol=1e-12)
+    text = (DOCS / "regressor.md").read_text(encoding="utf-8")
+    assert "no backend" not in text and "every code backend prints it" in text
+
+
+def load_module_file(path):
+    spec = importlib.util.spec_from_file_location(path.stem + "_docs", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module

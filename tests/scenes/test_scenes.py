@@ -721,6 +721,29 @@ def test_cli_floating_base_warns_is_refused_and_silenced_by_fixed_base(tmp_path)
     assert silenced.stderr == ""
 
 
+def test_floating_base_counts_the_described_joints_and_the_virtual_ones_apart(tmp_path):
+    """Issue 29: a floating A1's scene log said "18 of 12 joints move"; the log, the generated
+    module's header and the handout count the description's joints and the six virtual ones."""
+    from support import run_in_process
+    from support.robots import legged
+
+    description = tmp_path / "biped.urdf"
+    description.write_text(legged(legs=2), encoding="utf-8")
+    scene = tmp_path / "fly.yaml"
+    scene.write_text("version: 1\nfloating_base: true\noutputs: [g]\n", encoding="utf-8")
+    result = run_in_process("generate", description, "--scene", scene, "--backend", "numpy",
+                            "-o", tmp_path / "out", "--no-cache")
+    assert result.returncode == 0, result.stderr
+    said = "4 of 4 joints move, and the floating base's 6 virtual joints (10 in all)"
+    assert f"scene fly.yaml: {said}, " in result.stderr
+    assert f"{said}; see the scene report." in next((tmp_path / "out").glob("*_numpy.py")
+                                                    ).read_text(encoding="utf-8")
+    report = apply_scene(eomgen.load(description), load_scene(scene)).report
+    assert report.moving_described == 4 and len(report.moving) == 10
+    plain = apply_scene(eomgen.load(description), Scene(tips=("shin0",))).report
+    assert plain.moving_summary() == "2 of 4 joints move"
+
+
 @pytest.mark.slow
 def test_cli_panda_with_its_mimic_finger_locked_passes_strict(tmp_path):
     """The issue's case: panda_fingers_locked.yaml locks the mimic finger, so neither the
