@@ -103,6 +103,19 @@ def mul(x, y):
     return x * y
 
 
+def total(terms) -> sp.Expr:
+    """``sp.Add(*terms)``. A sum of monomials (see :func:`mul`) that no two share their symbols
+    (so that none combine), zeros aside, is made directly as the sum SymPy makes: the terms
+    sorted as SymPy sorts them."""
+    kept = [t for t in terms if not (t is _ZERO or (type(t) is int and t == 0))]
+    if len(kept) > 1 and all(type(t) in (sp.Symbol, sp.Mul) for t in kept):
+        monomials = [_monomial(t) for t in kept]
+        if all(m is not None for m in monomials) and \
+                len({m[1] for m in monomials}) == len(monomials):
+            return sp.Add._from_args(tuple(sorted(kept, key=_SORT_KEY)), True)
+    return sp.Add(*terms)
+
+
 def cross(a, b) -> tuple:
     """The cross product ``a × b`` of two 3-vectors (in the same axes)."""
     return (mul(a[1], b[2]) - mul(a[2], b[1]), mul(a[2], b[0]) - mul(a[0], b[2]),
@@ -111,23 +124,23 @@ def cross(a, b) -> tuple:
 
 def dot(a, b) -> sp.Expr:
     """The scalar product ``aᵀ b`` of two vectors of the same length (in the same axes)."""
-    return sp.Add(*[mul(x, y) for x, y in zip(a, b)])
+    return total([mul(x, y) for x, y in zip(a, b)])
 
 
 def matvec(A, v) -> tuple:
     """``A v`` for a 3×3 ``A`` (rows) and a 3-vector ``v``."""
-    return tuple(sp.Add(*[mul(A[r][k], v[k]) for k in range(3)]) for r in range(3))
+    return tuple(total([mul(A[r][k], v[k]) for k in range(3)]) for r in range(3))
 
 
 def transpose_apply(A, v) -> tuple:
     """``Aᵀ v`` for a 3×3 ``A`` (rows) and a 3-vector ``v``, without forming ``Aᵀ``: for a
     rotation from frame b to frame a, ``v`` in a's axes to b's."""
-    return tuple(sp.Add(*[mul(A[k][r], v[k]) for k in range(3)]) for r in range(3))
+    return tuple(total([mul(A[k][r], v[k]) for k in range(3)]) for r in range(3))
 
 
 def matmul(A, B) -> tuple:
     """``A B`` for two 3×3 matrices (rows); for rotations, ``R_ab R_bc = R_ac``."""
-    return tuple(tuple(sp.Add(*[mul(A[r][k], B[k][c]) for k in range(3)]) for c in range(3))
+    return tuple(tuple(total([mul(A[r][k], B[k][c]) for k in range(3)]) for c in range(3))
                  for r in range(3))
 
 
@@ -359,5 +372,5 @@ class JointFrames:
 
 __all__ = ["JointFrames", "SpatialInertia", "add", "aligned_axis", "cross", "dot",
            "force_cross", "matmul", "matvec", "motion_cross", "mul", "rotate_aligned",
-           "rotate_back", "rotation", "scale", "skew", "skew_times", "transpose",
+           "rotate_back", "rotation", "scale", "skew", "skew_times", "total", "transpose",
            "transpose_apply"]
