@@ -121,8 +121,8 @@ def body_inertia_in_world(tree: BodyTree, kin: Kinematics, b: ProgramBuilder) ->
         I = [[None] * 3 for _ in range(3)]
         for r in range(3):
             for c in range(r, 3):
-                value = (RIRt[r][c] + m * ((pp if r == c else 0) - p[r] * p[c])
-                         + (2 * pRh if r == c else 0) - p[r] * Rh[c] - Rh[r] * p[c])
+                value = (RIRt[r][c] + m * ((pp if r == c else 0) - mul(p[r], p[c]))
+                         + (2 * pRh if r == c else 0) - mul(p[r], Rh[c]) - mul(Rh[r], p[c]))
                 I[r][c] = I[c][r] = b.define(value, f"Iw{n}_{r}{c}", ("Iw", n, r, c))
         h = b.define_all(tuple(m * p[r] + Rh[r] for r in range(3)), f"hw{n}_", ("hw", n))
         out.append(SpatialInertia(m, h, tuple(tuple(row) for row in I)))

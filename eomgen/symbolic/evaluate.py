@@ -10,7 +10,6 @@ from __future__ import annotations
 
 from typing import Callable, Sequence
 
-import numpy as np
 import sympy as sp
 from sympy.printing.pycode import PythonCodePrinter
 
@@ -33,6 +32,8 @@ def compile_program(program: Program, inputs: Sequence[sp.Symbol]) -> Callable[.
     ``inputs`` are the symbols the caller provides values for, in order (joint symbols and any
     parameters kept symbolic).
     """
+    import numpy as np  # here: derive imports this module (through frames), not NumPy
+
     printer = FloatPrinter()
     names = [name for name, _ in program.outputs]
     functions = {f: getattr(np, f) for f in ("sin", "cos", "tan", "sqrt", "pi")}

@@ -29,9 +29,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Iterable
+from typing import TYPE_CHECKING, Iterable
 
-import numpy as np
 import sympy as sp
 
 from ..errors import GenerationError, KinematicTreeError
@@ -41,6 +40,9 @@ from .derivation import new_derivation
 from .evaluate import compile_program
 from .program import Program, ProgramBuilder
 from .spatial import cross, matmul, matvec, motion_cross, transpose
+
+if TYPE_CHECKING:  # the annotations only: NumPy is imported where it is used
+    import numpy as np
 
 #: The outputs of each frame, ``<kind>_<k>`` with k the frame's index in ``frames``.
 FRAME_OUTPUTS = ("p", "R", "J", "Jb", "dJqd", "dJbqd")
@@ -112,6 +114,8 @@ class FrameKinematics:
         """Numbers at one state: ``{frame: {"p": (3,), "R": (3, 3), "J": (6, n), "Jb": (6, n),
         "dJqd": (6,), "dJbqd": (6,)}}``; parameters take their default values; ``qd``
         defaults to zero."""
+        import numpy as np  # here: derive imports this module (F_c's size), not NumPy
+
         n = len(self.q)
         q = np.asarray(q, dtype=float).reshape(n)
         qd = np.zeros(n) if qd is None else np.asarray(qd, dtype=float).reshape(n)
@@ -358,6 +362,8 @@ def _friction_contacts(model: RobotModel) -> list:
         raise GenerationError(
             f"{model.source}: contact '{missing[0]}' has no friction coefficient: the friction "
             "cone outputs need 'mu' on every contact of the scene")
+    import numpy as np  # here: derive imports this module (F_c's size), not NumPy
+
     out, row = [], 0
     for c in model.contacts:
         normal = np.asarray(c.normal if c.kind == POINT else (0.0, 0.0, 1.0), dtype=float)
@@ -369,6 +375,8 @@ def _friction_contacts(model: RobotModel) -> list:
 def _tangents(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Two unit tangents ``t1, t2`` with ``(t1, t2, normal)`` right-handed: ``t1`` is the
     coordinate axis least aligned with the normal, made orthogonal to it."""
+    import numpy as np  # here: derive imports this module (F_c's size), not NumPy
+
     axis = np.eye(3)[int(np.argmin(np.abs(normal)))]
     t1 = axis - (axis @ normal) * normal
     t1 /= np.linalg.norm(t1)
@@ -398,6 +406,8 @@ def build_friction_cones(derivation, wanted) -> dict:
     ``n`` to a right-handed frame, ``t1`` from the coordinate axis least aligned with ``n``
     (for ``n = +z``: ``t1 = x``, ``t2 = y``).
     """
+    import numpy as np  # here: derive imports this module (F_c's size), not NumPy
+
     F = derivation.inputs["F_c"]
     cone, pyramid = [], []
     for c, row, normal in _friction_contacts(derivation.model):

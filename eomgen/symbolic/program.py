@@ -52,11 +52,17 @@ def as_tag(tag) -> Tag | None:
 
 class Assignment(tuple):
     """One ``(symbol, expression)`` step of a program, with the :class:`Tag` its builder gave
-    it (``tag``, or None). Unpacks, compares and hashes as the pair."""
+    it (``tag``, or None). Unpacks, compares and hashes as the pair.
 
-    def __new__(cls, symbol: sp.Symbol, expr: sp.Expr, tag: Tag | None = None):
+    ``free`` is the expression's free symbols when its builder had them at hand (else None):
+    :meth:`Program.pruned` reads them instead of walking the expression again (each
+    ``derive`` prunes its program several times)."""
+
+    def __new__(cls, symbol: sp.Symbol, expr: sp.Expr, tag: Tag | None = None,
+                free: frozenset | None = None):
         self = super().__new__(cls, (symbol, expr))
         self.tag = tag
+        self.free = free
         return self
 
     def __reduce__(self):
@@ -130,7 +136,7 @@ class ProgramBuilder:
         symbol = self._fresh(hint)
         self._by_value[expr] = symbol
         self._symbol_sets.add(symbols)
-        self.assignments.append(Assignment(symbol, expr, as_tag(tag)))
+        self.assignments.append(Assignment(symbol, expr, as_tag(tag), symbols))
         return symbol
 
     def absorb(self, program: "Program") -> dict[str, sp.Matrix]:
@@ -155,8 +161,10 @@ class ProgramBuilder:
             if new != symbol:
                 changed[symbol] = new
             self._by_value[expr] = new
-            self._symbol_sets.add(frozenset(expr.free_symbols))
-            self.assignments.append(Assignment(new, expr, getattr(assignment, "tag", None)))
+            symbols = frozenset(expr.free_symbols)
+            self._symbol_sets.add(symbols)
+            self.assignments.append(Assignment(new, expr, getattr(assignment, "tag", None),
+                                               symbols))
         return {name: matrix.applyfunc(moved) for name, matrix in program.outputs}
 
     def define_all(self, exprs: Sequence, hint: str, tag=None) -> tuple:
@@ -278,7 +286,8 @@ class Program:
             symbol, expr = assignment
             if symbol in needed:
                 kept.append(assignment)  # as it is, with its tag
-                needed |= expr.free_symbols
+                free = getattr(assignment, "free", None)
+                needed |= expr.free_symbols if free is None else free
         return Program(tuple(reversed(kept)), outs)
 
     def tags(self) -> dict[sp.Symbol, Tag]:

@@ -26,6 +26,7 @@ index order): the programs printed from them, and so every generated file, depen
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cmp_to_key
 
 import sympy as sp
 
@@ -41,16 +42,78 @@ def _symbolic(x) -> bool:
     return isinstance(x, sp.Expr) and not x.is_Number
 
 
+def _monomial(x):
+    """``(coefficient, symbols)`` of a non-zero SymPy number (no symbols), a symbol (coefficient
+    None), or a product of one optional number and distinct symbols; None for anything else."""
+    t = type(x)
+    if t is sp.Symbol:
+        return (None, (x,)) if x.is_commutative else None
+    if t is sp.Mul:
+        if not x.is_commutative:
+            return None
+        args = x.args
+        if args[0].is_Number:
+            coefficient, args = args[0], args[1:]
+            if not (coefficient.is_Float or coefficient.is_Rational):
+                return None
+        else:
+            coefficient = None
+        return (coefficient, args) if all(type(a) is sp.Symbol for a in args) else None
+    if (x.is_Float or x.is_Rational) and x:  # a SymPy number: nan, oo and zoo are neither
+        return x, ()
+    return None
+
+
+_SORT_KEY = cmp_to_key(sp.Basic.compare)
+
+
 def mul(x, y):
     """``x y``; when one factor is an exact 0 or 1 (a Python or SymPy integer) and the other a
     SymPy expression that is not a number, the result SymPy's product would give (0, or the
     other factor) without building the product: structural zeros and ones (identity
-    rotations, axes along a coordinate axis) are most of the factors of the recursions."""
+    rotations, axes along a coordinate axis) are most of the factors of the recursions.
+
+    The commonest other products of the recursions, of two *monomials* (a non-zero number, a
+    symbol, or a number times distinct symbols) with no symbol in common, are made directly as
+    the product SymPy makes: the product of the numbers first (none when it is 1), then the
+    symbols sorted as SymPy sorts factors. SymPy's general flattening would build the same
+    product, and a new float for each float coefficient whose assumptions it then works out
+    (a third of such a product's cost)."""
     if (type(x) is int or isinstance(x, sp.Integer)) and (x == 0 or x == 1) and _symbolic(y):
         return _ZERO if x == 0 else y
     if (type(y) is int or isinstance(y, sp.Integer)) and (y == 0 or y == 1) and _symbolic(x):
         return _ZERO if y == 0 else x
+    if isinstance(x, sp.Basic) and isinstance(y, sp.Basic):
+        a, b = _monomial(x), _monomial(y)
+        if a is not None and b is not None and (a[1] or b[1]):
+            symbols = a[1] + b[1]
+            if len(set(symbols)) == len(symbols):
+                if a[0] is None:
+                    coefficient = b[0]
+                elif b[0] is None:
+                    coefficient = a[0]
+                else:
+                    coefficient = a[0] * b[0]
+                if coefficient is None or coefficient is sp.S.One:
+                    if len(symbols) > 1:
+                        return sp.Mul._from_args(tuple(sorted(symbols, key=_SORT_KEY)), True)
+                elif (coefficient.is_Float or coefficient.is_Rational) and coefficient:
+                    return sp.Mul._from_args(
+                        (coefficient,) + tuple(sorted(symbols, key=_SORT_KEY)), True)
     return x * y
+
+
+def total(terms) -> sp.Expr:
+    """``sp.Add(*terms)``. A sum of monomials (see :func:`mul`) that no two share their symbols
+    (so that none combine), zeros aside, is made directly as the sum SymPy makes: the terms
+    sorted as SymPy sorts them."""
+    kept = [t for t in terms if not (t is _ZERO or (type(t) is int and t == 0))]
+    if len(kept) > 1 and all(type(t) in (sp.Symbol, sp.Mul) for t in kept):
+        monomials = [_monomial(t) for t in kept]
+        if all(m is not None for m in monomials) and \
+                len({m[1] for m in monomials}) == len(monomials):
+            return sp.Add._from_args(tuple(sorted(kept, key=_SORT_KEY)), True)
+    return sp.Add(*terms)
 
 
 def cross(a, b) -> tuple:
@@ -61,23 +124,23 @@ def cross(a, b) -> tuple:
 
 def dot(a, b) -> sp.Expr:
     """The scalar product ``aᵀ b`` of two vectors of the same length (in the same axes)."""
-    return sp.Add(*[mul(x, y) for x, y in zip(a, b)])
+    return total([mul(x, y) for x, y in zip(a, b)])
 
 
 def matvec(A, v) -> tuple:
     """``A v`` for a 3×3 ``A`` (rows) and a 3-vector ``v``."""
-    return tuple(sp.Add(*[mul(A[r][k], v[k]) for k in range(3)]) for r in range(3))
+    return tuple(total([mul(A[r][k], v[k]) for k in range(3)]) for r in range(3))
 
 
 def transpose_apply(A, v) -> tuple:
     """``Aᵀ v`` for a 3×3 ``A`` (rows) and a 3-vector ``v``, without forming ``Aᵀ``: for a
     rotation from frame b to frame a, ``v`` in a's axes to b's."""
-    return tuple(sp.Add(*[mul(A[k][r], v[k]) for k in range(3)]) for r in range(3))
+    return tuple(total([mul(A[k][r], v[k]) for k in range(3)]) for r in range(3))
 
 
 def matmul(A, B) -> tuple:
     """``A B`` for two 3×3 matrices (rows); for rotations, ``R_ab R_bc = R_ac``."""
-    return tuple(tuple(sp.Add(*[mul(A[r][k], B[k][c]) for k in range(3)]) for c in range(3))
+    return tuple(tuple(total([mul(A[r][k], B[k][c]) for k in range(3)]) for c in range(3))
                  for r in range(3))
 
 
@@ -149,8 +212,8 @@ def rotate_aligned(k: int, c, s, v, transpose: bool) -> tuple:
     if transpose:
         s = -s
     w = [None, None, None]
-    w[i] = c * v[i] - s * v[j]
-    w[j] = s * v[i] + c * v[j]
+    w[i] = mul(c, v[i]) - mul(s, v[j])
+    w[j] = mul(s, v[i]) + mul(c, v[j])
     w[k] = v[k]
     return tuple(w)
 
@@ -179,7 +242,7 @@ class SpatialInertia:
         hv = cross(self.h, v)
         hw = cross(self.h, w)
         n = tuple(Iw[r] + hv[r] for r in range(3))
-        f = tuple(self.mass * v[r] - hw[r] for r in range(3))
+        f = tuple(mul(self.mass, v[r]) - hw[r] for r in range(3))
         return n + f
 
 
@@ -309,5 +372,5 @@ class JointFrames:
 
 __all__ = ["JointFrames", "SpatialInertia", "add", "aligned_axis", "cross", "dot",
            "force_cross", "matmul", "matvec", "motion_cross", "mul", "rotate_aligned",
-           "rotate_back", "rotation", "scale", "skew", "skew_times", "transpose",
+           "rotate_back", "rotation", "scale", "skew", "skew_times", "total", "transpose",
            "transpose_apply"]
