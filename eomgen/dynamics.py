@@ -172,8 +172,12 @@ class Dynamics:
         of named intermediates with their definitions (``.subexpressions``), which indexes,
         adds and multiplies like a matrix, substitutes (``.subs``; all inputs given: an
         ordinary matrix of numbers), evaluates (``.evalf``), lambdifies, displays, and
-        ``.expand()`` writes out on request. For numbers, :meth:`lambdify` is the fast route.
-        The same holds for :attr:`C`, :attr:`g`, :attr:`P`, :attr:`K` and :attr:`tau`."""
+        ``.expand()`` writes out on request. SymPy's own functions (``sympify``, ``Matrix``,
+        ``lambdify``, ``simplify``, ``latex``) take it as an ordinary matrix whose entries are
+        written out where that is cheap, else functions of their inputs (``M_1_1(q1, …)``) that
+        evaluate the program (:mod:`eomgen.symbolic.entries`). For numbers, :meth:`lambdify`
+        is the fast route. The same holds for :attr:`C`, :attr:`g`, :attr:`P`, :attr:`K` and
+        :attr:`tau`."""
         return self._expanded("M")
 
     @cached_property

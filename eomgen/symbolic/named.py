@@ -9,7 +9,10 @@ intermediates ``x_k`` plus their definitions (:attr:`ProgramMatrix.subexpression
 which is what the code printers use. It indexes and multiplies like a matrix, substitutes,
 evaluates numerically, lambdifies with its named subexpressions as the common subexpressions,
 displays in a notebook, and :meth:`ProgramMatrix.expand` writes it out as an ordinary SymPy
-matrix on request, stopping with a clear message when it grows past a limit.
+matrix on request, stopping with a clear message when it grows past a limit. SymPy's own
+functions (``sympify``, ``Matrix``, ``lambdify``, ``simplify``, ``latex``) take it through
+:meth:`ProgramMatrix._sympy_`: the matrix written out where that is cheap, else its entries as
+functions of their inputs that evaluate the program (:mod:`eomgen.symbolic.entries`).
 
 Expansion (:func:`expand_program`) multiplies sparse polynomials in ``sin q_i``, ``cos q_i``,
 the velocities and the parameters, reducing with ``sin² q_i + cos² q_i = 1`` after every
@@ -28,6 +31,8 @@ from sympy.core.basic import _args_sortkey
 # rational, both several times faster than fractions.Fraction for the same exact values.
 from sympy.external.gmpy import MPQ
 
+from .entries import program_entry
+
 #: :meth:`ProgramMatrix.expand` stops when an intermediate result passes this many terms, unless
 #: called with ``max_terms=None``.
 EXPAND_MAX_TERMS = 200_000
@@ -40,9 +45,12 @@ NOISE_RTOL = 1e-12
 #: that takes at most this many term operations (about a second), else left named.
 AUTO_EXPAND_WORK = 1_000_000
 
-#: The work of building one term of a result as a SymPy expression, in term operations (a
-#: SymPy object costs about as much as 300 polynomial term operations).
-TERM_COST = 300
+#: The work of building one term of a result as a SymPy expression, in term operations.
+#: Measured (one core, SymPy 1.14): a polynomial term operation takes 0.4–1.3 µs, building a
+#: term 95–280 µs (more for terms with more factors), so 150. At 300 the 4,212-term M of the
+#: PUMA 560 with symbolic inertias (0.05·10⁶ polynomial operations, written out in 0.49 s) and
+#: the 5,549-term M of the Panda (0.63 s) were estimated at 1.3 and 1.7 s and left named.
+TERM_COST = 150
 
 #: Subexpressions shown by :meth:`ProgramMatrix._repr_latex_` before "… and k more".
 LATEX_MAX_SUBEXPRESSIONS = 40
@@ -355,11 +363,22 @@ class ProgramMatrix:
     #: Above a SymPy Matrix's (10.01), so that ``Matrix * program_matrix`` calls our ``__rmul__``.
     _op_priority = 20.0
 
-    def __init__(self, name: str, value, definitions: Sequence[tuple[sp.Symbol, sp.Expr]]):
+    #: Not a sequence to SymPy (``sympy.utilities.iterables.iterable``): SymPy's functions take
+    #: it whole, through :meth:`_sympy_` and the printing methods, not entry by entry.
+    _iterable = False
+    #: NumPy defers ``array * program_matrix`` to :meth:`__rmul__` (the object defines
+    #: ``__array__`` for ``sympy.Matrix(program_matrix)``).
+    __array_ufunc__ = None
+
+    def __init__(self, name: str, value, definitions: Sequence[tuple[sp.Symbol, sp.Expr]],
+                 label: str | None = None):
         self.name = name
         self.value = sp.ImmutableMatrix(value) if isinstance(value, sp.MatrixBase) else sp.sympify(value)
         self.definitions = tuple(definitions)
+        self.label = label or name
         self._pruned = None
+        self._sympy_form = None
+        self._failed_work = None  # the work limit an expansion of it passed
 
     # --- what it is --------------------------------------------------------------------------
     @property
@@ -401,20 +420,30 @@ class ProgramMatrix:
         return (self._wrap(e) for e in self.value)
 
     def __getitem__(self, key):
-        return self._wrap(self.value[key])
+        label = None
+        if isinstance(key, int) and self.is_Matrix:
+            key = divmod(key % len(self.value), self.cols)
+        if isinstance(key, tuple) and all(isinstance(k, int) for k in key) and self.is_Matrix:
+            i, j = key[0] % self.rows, key[1] % self.cols
+            label = self._entry_label(i, j)
+        return self._wrap(self.value[key], label=label)
+
+    def _entry_label(self, i: int, j: int) -> str:
+        """``M_2_3`` for ``M[1, 2]``, ``g_2`` for ``g[1]`` (1-based, as in the textbooks)."""
+        return f"{self.name}_{i + 1}" if self.cols == 1 else f"{self.name}_{i + 1}_{j + 1}"
 
     @property
     def T(self) -> "ProgramMatrix":
         return self._wrap(self.value.T)
 
-    def _wrap(self, value, definitions=None):
+    def _wrap(self, value, definitions=None, label=None):
         """``value`` as a ProgramMatrix over these definitions, or plain SymPy when it needs
         none (a structural zero, an entry in the inputs only)."""
         definitions = self.definitions if definitions is None else definitions
         defined = {s for s, _ in definitions}
         if not any(e.free_symbols & defined for e in _entries(value)):
             return value
-        return ProgramMatrix(self.name, value, definitions)
+        return ProgramMatrix(self.name, value, definitions, label)
 
     # --- arithmetic ----------------------------------------------------------------------------
     def _other(self, other):
@@ -550,6 +579,8 @@ class ProgramMatrix:
             entries = expand_program(self.subexpressions, _entries(self.value), max_terms,
                                      max_work)
         except ExpansionTooLargeError as error:
+            if max_work is not None:
+                self._failed_work = max(self._failed_work or 0, max_work)
             raise ExpansionTooLargeError(
                 f"{self.name}: {error}. The named form (.subexpressions, .subs, .evalf, "
                 ".lambdify, dyn.lambdify()) needs no expansion; .expand(max_terms=None) "
@@ -559,6 +590,64 @@ class ProgramMatrix:
         return sp.Matrix(self.rows, self.cols, entries)
 
     as_explicit = expand
+
+    # --- to SymPy ------------------------------------------------------------------------------
+    def _sympy_(self):
+        """What SymPy's functions see (``sympify``, ``simplify``, ``lambdify``, ``Matrix``, the
+        printers): an ordinary SymPy matrix (or expression) of the same value. Written out
+        (:meth:`expand`) when that takes at most :data:`AUTO_EXPAND_WORK` term operations;
+        else each entry written out within its share of that work, or, when that is not
+        enough, the entry as a function of its inputs that evaluates the definitions it
+        needs (:func:`eomgen.symbolic.entries.program_entry`: ``M_1_1(q1, …)``). Computed
+        once."""
+        if self._sympy_form is None:
+            self._sympy_form = self._as_sympy()
+        return self._sympy_form
+
+    def _as_sympy(self):
+        if (self._failed_work or 0) < AUTO_EXPAND_WORK:
+            try:
+                written = self.expand(max_work=AUTO_EXPAND_WORK)
+                return sp.ImmutableMatrix(written) if self.is_Matrix else written
+            except (ExpansionTooLargeError, NotImplementedError):
+                pass
+        if not self.is_Matrix:
+            return program_entry(self.label, self.value, self.subexpressions)
+        share = AUTO_EXPAND_WORK // len(self.value)
+        entries = []
+        for k, entry in enumerate(self.value):
+            i, j = divmod(k, self.cols)
+            needed = _prune(self.subexpressions, [entry])
+            try:
+                [written] = expand_program(needed, [entry], None, share)
+            except (ExpansionTooLargeError, NotImplementedError):
+                written = program_entry(self._entry_label(i, j), entry, needed)
+            entries.append(written)
+        return sp.ImmutableMatrix(self.rows, self.cols, entries)
+
+    @property
+    def args(self) -> tuple:
+        """``(self._sympy_(),)``: where ``sympy.lambdify`` looks for the implementations of
+        the entries' functions."""
+        return (self._sympy_(),)
+
+    def __array__(self, dtype=None, copy=None):
+        # NumPy is imported here, when an array is asked for: deriving never needs it.
+        import numpy as np
+
+        value = self._sympy_()
+        if self.is_Matrix:
+            return np.array(value.tolist(), dtype=object if dtype is None else dtype)
+        return np.array(value, dtype=object if dtype is None else dtype)
+
+    def _latex(self, printer):
+        return printer._print(self._sympy_())
+
+    def _sympystr(self, printer):
+        return printer._print(self._sympy_())
+
+    def _pretty(self, printer):
+        return printer._print(self._sympy_())
 
     def __repr__(self) -> str:
         shape = "×".join(map(str, self.shape)) if self.is_Matrix else "scalar"
