@@ -52,46 +52,56 @@ def symbolic_inertials(model):
                        parameters=parameters)
 
 
-def models():
+#: The random arms (seed, joints) with every inertial parameter symbolic: too large to write
+#: out, so their M, C and g all stay named and reach SymPy through the protocol.
+RANDOM_ARMS = {"random 5-joint, symbolic": (2, 5), "random 7-joint, symbolic": (3, 7)}
+
+
+def model_named(which):
+    if which == "panda":
+        if erd_robots_dir() is None:
+            pytest.skip("example-robot-data is not installed (the test extra)")
+        return panda()
+    if which in RANDOM_ARMS:
+        seed, n = RANDOM_ARMS[which]
+        arm = random_robot(np.random.default_rng(seed), n, prismatic=False, fixed_links=False)
+        return symbolic_inertials(arm)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the PUMA's published inertias are not physical
-        for name in BUNDLED:
-            yield name, eomgen.load(example_path(name))
-    if erd_robots_dir() is not None:
-        yield "panda", panda()
-    for seed, n in ((2, 5), (3, 7)):
-        arm = random_robot(np.random.default_rng(seed), n, prismatic=False, fixed_links=False)
-        yield f"random {n}-joint, symbolic", symbolic_inertials(arm)
+        return eomgen.load(example_path(which))
 
 
+# One case per robot, so that a parallel run spreads them (together about a minute).
 @pytest.mark.slow
-def test_sympy_functions_take_M_C_g_of_every_size():
+@pytest.mark.parametrize("which", [*BUNDLED, "panda", *RANDOM_ARMS])
+def test_sympy_functions_take_M_C_g_of_every_size(which):
     named = 0
-    for which, model in models():
-        dyn = eomgen.derive(model)
-        numeric = dyn.lambdify()
-        values = {p.symbol: p.value for p in model.parameters}
-        parameters = list(values)
-        rng = np.random.default_rng(0)
-        q, qd = rng.uniform(-1, 1, model.dof), rng.uniform(-1, 1, model.dof)
-        for name in ("M", "C", "g"):
-            X = getattr(dyn, name)
-            named += type(X).__name__ == "ProgramMatrix"
-            what = f"{which}: {name}"
-            S = sp.sympify(X)
-            assert isinstance(S, sp.MatrixBase) and S.shape == X.shape, what
-            assert sp.Matrix(X) == S, what
-            last = X[X.rows - 1, X.cols - 1]
-            for tex in (sp.latex(X), sp.latex(last)):
-                assert "ProgramMatrix" not in tex and "mathtt" not in tex, what
-            assert isinstance(sp.sympify(last), sp.Expr), what
-            # simplify on the entry of fewest operations (SymPy's simplify of a written-out
-            # entry of hundreds of terms takes minutes, whoever calls it)
-            smallest = min(S, key=sp.count_ops)
-            assert isinstance(sp.simplify(smallest), sp.Expr), what
-            inputs = [dyn.q, dyn.qd] if name == "C" else [dyn.q]
-            f = sp.lambdify(inputs + [parameters], X)
-            got = np.asarray(f(*[q, qd][:len(inputs)], [values[p] for p in parameters]), float)
-            expected = (numeric.C(q, qd) if name == "C" else getattr(numeric, name)(q))
-            assert_close(got.reshape(np.shape(expected)), expected, what)
-    assert named >= 4  # the large ones stayed named: the test reached the SymPy protocol
+    model = model_named(which)
+    dyn = eomgen.derive(model)
+    numeric = dyn.lambdify()
+    values = {p.symbol: p.value for p in model.parameters}
+    parameters = list(values)
+    rng = np.random.default_rng(0)
+    q, qd = rng.uniform(-1, 1, model.dof), rng.uniform(-1, 1, model.dof)
+    for name in ("M", "C", "g"):
+        X = getattr(dyn, name)
+        named += type(X).__name__ == "ProgramMatrix"
+        what = f"{which}: {name}"
+        S = sp.sympify(X)
+        assert isinstance(S, sp.MatrixBase) and S.shape == X.shape, what
+        assert sp.Matrix(X) == S, what
+        last = X[X.rows - 1, X.cols - 1]
+        for tex in (sp.latex(X), sp.latex(last)):
+            assert "ProgramMatrix" not in tex and "mathtt" not in tex, what
+        assert isinstance(sp.sympify(last), sp.Expr), what
+        # simplify on the entry of fewest operations (SymPy's simplify of a written-out
+        # entry of hundreds of terms takes minutes, whoever calls it)
+        smallest = min(S, key=sp.count_ops)
+        assert isinstance(sp.simplify(smallest), sp.Expr), what
+        inputs = [dyn.q, dyn.qd] if name == "C" else [dyn.q]
+        f = sp.lambdify(inputs + [parameters], X)
+        got = np.asarray(f(*[q, qd][:len(inputs)], [values[p] for p in parameters]), float)
+        expected = (numeric.C(q, qd) if name == "C" else getattr(numeric, name)(q))
+        assert_close(got.reshape(np.shape(expected)), expected, what)
+    if which in RANDOM_ARMS:  # they stayed named: the test reached the SymPy protocol
+        assert named == 3
