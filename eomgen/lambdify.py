@@ -14,7 +14,7 @@ import types
 from dataclasses import dataclass
 from typing import Callable
 
-from .outputs import BY_SYMBOL, FORWARD
+from .outputs import BY_SYMBOL, FORWARD, OUTPUTS
 from .symbolic.printing import exec_source
 
 
@@ -76,10 +76,9 @@ def lambdify(dynamics: "eomgen.dynamics.Dynamics") -> NumericDynamics:  # noqa: 
     # which `import eomgen` and derive never need.
     from .codegen import make_job
     from .codegen.backends.numpy_backend import NumPyConfig, NumPyModulePrinter, numpy_source
-    from .codegen.functions import FUNCTION_OUTPUTS
 
     derived = set(dynamics.outputs)
-    functions = [f for f, needs in FUNCTION_OUTPUTS.items() if set(needs) <= derived]
+    functions = [f for f, o in OUTPUTS.items() if set(o.needs) <= derived]
     job = make_job(dynamics, functions, count_operations=False)
     # The NumPy backend's printer and template; terms in SymPy's internal order (sorting them
     # for a readable file is most of the printing time).

@@ -119,12 +119,6 @@ def parameter_arguments(dynamics: "Dynamics") -> tuple[ParameterArgument, ...]:
     return tuple(out)
 
 
-#: Deprecated, read :data:`eomgen.outputs.OUTPUTS` (``{f: o.needs for f, o in OUTPUTS.items()}``):
-#: kept importable for eomgen.lambdify and the tests until they read the registry.
-FUNCTION_OUTPUTS: dict[str, tuple[str, ...]] = {f: o.needs for f, o in OUTPUTS.items()}
-#: Deprecated, read :data:`eomgen.outputs.BY_SYMBOL`: short names (symbols) → functions.
-FUNCTION_ALIASES: dict[str, str] = {s: o.function for s, o in BY_SYMBOL.items()}
-
 
 def select_functions(names=None) -> tuple[str, ...]:
     """The functions to generate for the requested ``names``, in module order: see

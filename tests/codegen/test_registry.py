@@ -21,7 +21,7 @@ import eomgen
 from eomgen import cache, compiler, outputs
 from eomgen.codegen import BACKENDS, available_backends, loadable_backends, make_job
 from eomgen.codegen.backends import BACKEND_MODULES, casadi_backend, fast_backend
-from eomgen.codegen.functions import (FUNCTION_ALIASES, RESERVED_IDENTIFIERS, derived_outputs,
+from eomgen.codegen.functions import (RESERVED_IDENTIFIERS, derived_outputs,
                                       reserved_identifiers, safe_identifier, select_functions)
 from eomgen.codegen.render import TEMPLATES_DIR
 from eomgen.dynamics import ALL_OUTPUTS, derive
@@ -45,7 +45,7 @@ def test_registry_holds_the_documented_functions_in_module_order():
     assert {f: (o.symbol, o.inputs) for f, o in default.items()} == DOCUMENTED
     assert list(default) == list(DOCUMENTED) == list(select_functions())
     assert ALL_OUTPUTS == ("M", "C", "g", "tau")
-    assert {s: f for s, f in FUNCTION_ALIASES.items() if OUTPUTS[f].default} == {
+    assert {s: o.function for s, o in BY_SYMBOL.items() if o.default} == {
         "M": "mass_matrix", "C": "coriolis_matrix", "g": "gravity_vector",
         "tau": "inverse_dynamics"}
     assert FORWARD.composed and FORWARD.composed_from == ("mass_matrix", "inverse_dynamics")
