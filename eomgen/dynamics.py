@@ -291,7 +291,7 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     start = time.perf_counter()
     derivation = new_derivation(model)
     inputs = derivation.inputs
-    q, qd, qdd = derivation.q, derivation.qd, derivation.qdd
+    q, qd, qdd = inputs["q"], inputs["qd"], inputs["qdd"]
     timings.append(("bodies", time.perf_counter() - start))
     start = time.perf_counter()
     derivation.build(outputs)
@@ -299,6 +299,8 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     timings.append(("program", time.perf_counter() - start))
     program = derivation.program(result.items())
     steps = _steps(program, result)
+    if model.free_flyer:  # the textbook forms differentiate by q: not in a free flyer's chart
+        simplify = False
     if simplify is None:  # teaching-sized: few joints and a small program (a cheap estimate)
         counted = [o for o in ("M", "C", "g") if o in outputs]
         simplify = model.dof <= TEXTBOOK_MAX_DOF and (

@@ -116,7 +116,7 @@ def add_floating_base(model: RobotModel) -> RobotModel:
         if name in names:
             raise KinematicTreeError(model.source, f"link or joint '{name}'",
                                      "the name is taken by the floating base's virtual joints")
-    _check_spatial_inertia(model)
+    check_spatial_inertia(model)
     chain = [WORLD, *links, model.root]
     joints = tuple(
         Joint(name, kind, chain[k], chain[k + 1], Transform(), vec3(axis))
@@ -129,7 +129,7 @@ def add_floating_base(model: RobotModel) -> RobotModel:
         notices=tuple(n for n in model.notices if n.kind is not NoticeKind.FLOATING_BASE))
 
 
-def _check_spatial_inertia(model: RobotModel) -> None:
+def check_spatial_inertia(model: RobotModel) -> None:
     """Refuse a robot whose total spatial inertia (about the root, at q = 0) is singular."""
     try:
         nm = numeric_model(model)

@@ -56,6 +56,7 @@ INPUTS: dict[str, str] = {
 #: The inputs whose length is not the number of joints: ``"module:function"`` of
 #: ``function(model) -> int``, their length for a model (``F_c``: the contact rows).
 INPUT_SIZES: dict[str, str] = {
+    "q": "eomgen.model.robot:configuration_size",
     "F_c": "eomgen.symbolic.frames:contact_row_count",
 }
 

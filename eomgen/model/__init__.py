@@ -44,7 +44,10 @@ from .contact import POINT, SURFACE, Contact
 from .notices import Notice, NoticeKind, emit_notices
 from .parts import Inertial, Joint, JointType, Link, Parameter
 from .robot import (
+    FREE_FLYER_CONFIGURATION,
+    FREE_FLYER_VELOCITY,
     RobotModel,
+    configuration_size,
     all_scalars,
     flexible_indices,
     joint_actuators,
@@ -56,11 +59,11 @@ from .snapping import SNAP_TOLERANCE, Snap, snap, snap_summary, snapping
 from .transforms import Transform, rotation_about_axis, rotation_from_rpy
 
 __all__ = [
-    "DEFAULT_FRICTION_WIDTH", "IDENTITY3", "MAX_JOINTS", "POINT", "SNAP_TOLERANCE", "SURFACE",
+    "DEFAULT_FRICTION_WIDTH", "FREE_FLYER_CONFIGURATION", "FREE_FLYER_VELOCITY", "IDENTITY3", "MAX_JOINTS", "POINT", "SNAP_TOLERANCE", "SURFACE",
     "ZERO3", "Actuator", "Contact", "Inertial", "Joint", "JointType", "Link", "Mat3", "Notice",
     "NoticeKind", "Parameter", "RobotModel", "Scalar", "Snap", "Transform", "Vec3",
     "all_scalars", "build_model", "check_actuator", "check_axis", "check_inertial",
-    "check_size", "check_tree", "emit_notices", "flexible_indices", "joint_actuators",
+    "check_size", "check_tree", "configuration_size", "emit_notices", "flexible_indices", "joint_actuators",
     "joint_motion", "lock_joints", "mat3", "parameter_symbol", "rotation_about_axis",
     "rotation_from_rpy", "scalar", "snap", "snap_summary", "snapping", "vec3",
 ]

@@ -19,6 +19,20 @@ from .parts import Inertial, Joint, JointType, Link, Parameter
 from .scalars import IDENTITY3, ZERO3, Vec3, scalar, vec3
 from .transforms import Transform, rotation_about_axis
 
+#: A free flyer's configuration entries (q[0:7]): the root link origin in the world [m], then
+#: the unit quaternion (x, y, z, w) of its orientation (Pinocchio's ``JointModelFreeFlyer``).
+FREE_FLYER_CONFIGURATION = ("base_x", "base_y", "base_z", "base_qx", "base_qy", "base_qz",
+                            "base_qw")
+#: A free flyer's velocity entries (v[0:6], its joints' names): the twist of the root link in
+#: its own frame, linear [m/s] then angular [rad/s].
+FREE_FLYER_VELOCITY = ("base_vx", "base_vy", "base_vz", "base_wx", "base_wy", "base_wz")
+
+
+def configuration_size(model: "RobotModel") -> int:
+    """The length of ``q`` for ``model`` (its NQ; :data:`eomgen.outputs.INPUT_SIZES`)."""
+    return model.nq
+
+
 @dataclass(frozen=True)
 class RobotModel:
     """A robot: links, joints (in description order), gravity and parameters.
@@ -48,6 +62,10 @@ class RobotModel:
     #: moved the fixed frame (:func:`eomgen.reduction.apply_scene`); None when they coincide.
     #: Frame kinematics are given in the description's frame.
     root_pose: Transform | None = None
+    #: True when the first six movable joints are a quaternion free flyer's velocity
+    #: coordinates (:mod:`eomgen.free_flyer`): the configuration ``q`` then has ``dof + 1``
+    #: entries (root position, unit quaternion), the velocity ``v`` has ``dof``.
+    free_flyer: bool = False
 
     @cached_property
     def link_by_name(self) -> dict[str, Link]:
@@ -68,7 +86,22 @@ class RobotModel:
 
     @property
     def dof(self) -> int:
+        """The number of velocity coordinates (NV): one per movable joint."""
         return len(self.movable_joints)
+
+    @property
+    def nq(self) -> int:
+        """The number of configuration coordinates (NQ): :attr:`dof`, plus one for the
+        quaternion of a free flyer (seven entries for its six velocities)."""
+        return self.dof + 1 if self.free_flyer else self.dof
+
+    @property
+    def configuration_names(self) -> tuple[str, ...]:
+        """The names of the NQ entries of ``q``: :attr:`joint_names`, except that a free
+        flyer's six velocity coordinates give way to its seven configuration entries."""
+        if not self.free_flyer:
+            return self.joint_names
+        return FREE_FLYER_CONFIGURATION + self.joint_names[6:]
 
     @cached_property
     def topological_joints(self) -> tuple[Joint, ...]:

@@ -40,6 +40,7 @@ from ..model import RobotModel, Vec3
 from .derivation import new_derivation
 from .crba import M_program
 from .newton_euler import grouped_inertials, inverse_dynamics_program
+from .free_flyer import true_accelerations as chart_to_true
 from .program import Program, ProgramBuilder, name_expr, name_exprs, name_matrix, name_symmetric
 from .spatial import JointFrames, add, cross, dot, matvec, scale, skew, transpose
 
@@ -223,8 +224,9 @@ def aba_program(model: RobotModel) -> ForwardDynamics:
     (2, 1)
     """
     d = new_derivation(model, ("q", "qd", "tau"))
-    qdd = forward_dynamics_program(d.tree, d.q, d.qd, d.tau, model.gravity, d.builder)
-    return ForwardDynamics(d.q, d.qd, d.tau, d.program([("qdd", qdd)]))
+    qdd = true_accelerations(d, forward_dynamics_program(d.tree, d.q, d.qd, d.tau,
+                                                         model.gravity, d.builder))
+    return ForwardDynamics(d.inputs["q"], d.qd, d.tau, d.program([("qdd", qdd)]))
 
 
 def cholesky_program(model: RobotModel) -> ForwardDynamics:
@@ -241,7 +243,7 @@ def cholesky_program(model: RobotModel) -> ForwardDynamics:
     tree, q, qd, tau, b = d.tree, d.q, d.qd, d.tau, d.builder
     n = model.dof
     M = M_program(tree, q, b)
-    bias = inverse_dynamics_program(tree, q, qd, (_ZERO,) * n, model.gravity, b)
+    bias = inverse_dynamics_program(tree, q, qd, d.accelerations((_ZERO,) * n), model.gravity, b)
     L = [[_ZERO] * n for _ in range(n)]
     inv_diag = [_ZERO] * n
     for j in range(n):
@@ -260,13 +262,26 @@ def cholesky_program(model: RobotModel) -> ForwardDynamics:
     for i in reversed(range(n)):
         rhs = y[i] - sp.Add(*[L[k][i] * x[k] for k in range(i + 1, n)])
         x[i] = name_expr(b, rhs * inv_diag[i], f"qdd{i + 1}", ("qdd", i + 1))
-    return ForwardDynamics(q, qd, tau, d.program([("qdd", sp.Matrix(x))]))
+    qdd = true_accelerations(d, sp.Matrix(x))
+    return ForwardDynamics(d.inputs["q"], qd, tau, d.program([("qdd", qdd)]))
 
 
 def build_forward_dynamics_aba(derivation, wanted) -> dict:
     """The builder of ``qdd_aba`` in :mod:`eomgen.outputs` (``forward_dynamics_aba(q, qd,
     tau)``): :func:`forward_dynamics_program` on the derivation's body tree, q̈ [rad/s² or m/s²]
     in ``JOINT_NAMES`` order."""
-    return {"qdd_aba": forward_dynamics_program(derivation.tree, derivation.q, derivation.qd,
-                                                derivation.tau, derivation.model.gravity,
-                                                derivation.builder)}
+    qdd = forward_dynamics_program(derivation.tree, derivation.q, derivation.qd, derivation.tau,
+                                   derivation.model.gravity, derivation.builder)
+    return {"qdd_aba": true_accelerations(derivation, qdd)}
+
+
+def true_accelerations(derivation, qdd: sp.Matrix) -> sp.Matrix:
+    """``qdd`` (n×1) from a forward-dynamics program, as the model's accelerations: for a free
+    flyer the chart's turned into the root twist's derivative
+    (:func:`eomgen.symbolic.free_flyer.true_accelerations`), named ``vd…``."""
+    if not derivation.model.free_flyer:
+        return qdd
+    b = derivation.builder
+    true = chart_to_true(derivation.qd, list(qdd))
+    return sp.Matrix([b.define(e, f"vd{k + 1}", ("qdd", k + 1)) if k < 6 else e
+                      for k, e in enumerate(true)])

@@ -40,7 +40,7 @@ def dynamics_program(model: RobotModel) -> tuple[tuple, tuple, Program]:
     zero = (sp.Integer(0),) * n
     M = M_program(tree, q, b)
     g = inverse_dynamics_program(tree, q, zero, zero, model.gravity, b)
-    bias = inverse_dynamics_program(tree, q, qd, zero, model.gravity, b)
+    bias = inverse_dynamics_program(tree, q, qd, d.accelerations(zero), model.gravity, b)
     Cqd = sp.Matrix([[name_expr(b, bias[k, 0] - g[k, 0], f"Cqd{k + 1}", ("Cqd", k + 1))]
                      for k in range(n)])
     outputs = (("M", M), ("Cqd", Cqd), ("g", g))
@@ -52,7 +52,8 @@ def build_nonlinear_effects(derivation, wanted) -> dict:
     h = C(q, q̇) q̇ + g(q) = τ(q, q̇, 0), one Newton–Euler pass with q̈ = 0 [N m or N] (what
     Pinocchio's ``nonLinearEffects`` returns), without forming C."""
     zero = (sp.Integer(0),) * len(derivation.q)
-    return {"h": inverse_dynamics_program(derivation.tree, derivation.q, derivation.qd, zero,
+    return {"h": inverse_dynamics_program(derivation.tree, derivation.q, derivation.qd,
+                                          derivation.accelerations(zero),
                                           derivation.model.gravity, derivation.builder)}
 
 

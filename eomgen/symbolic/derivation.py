@@ -8,7 +8,8 @@ regressor, frames, the combined programs) and the output builders of :mod:`eomge
 start from it, so that the symbols, the reserved names and the sizes of the inputs are decided
 once.
 
-Symbols: ``q1 … qn`` [rad or m], ``qd1 … qdn`` [rad/s or m/s], ``qdd1 … qddn`` [rad/s² or
+Symbols: ``q1 … qn`` [rad or m] (``n`` = NQ, the configuration size: seven entries more
+than the joints for a free flyer, :mod:`eomgen.free_flyer`), ``qd1 … qdn`` [rad/s or m/s], ``qdd1 … qddn`` [rad/s² or
 m/s²], ``tau1 … taun`` [N m or N]; an input of :data:`eomgen.outputs.INPUTS` is
 ``<name>1 … <name>k`` with ``k`` its own size (:func:`eomgen.outputs.input_size`: the number of
 joints unless the registry says otherwise, e.g. the contact rows of ``F_c``).
@@ -16,7 +17,7 @@ joints unless the registry says otherwise, e.g. the contact rows of ``F_c``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Iterable
 
 import sympy as sp
@@ -24,6 +25,7 @@ import sympy as sp
 from ..bodies import BodyTree, body_tree
 from ..model import RobotModel
 from ..outputs import BY_SYMBOL, INPUTS, input_size
+from .free_flyer import chart_accelerations, root_placement
 from .program import Program, ProgramBuilder
 
 
@@ -51,18 +53,33 @@ class Derivation:
     inputs: dict[str, tuple[sp.Symbol, ...]]
     builder: ProgramBuilder
     shared: dict = field(default_factory=dict)
+    #: The joint coordinates the algorithms index by ``RigidBody.q_index`` (NV entries), when
+    #: they are not ``inputs["q"]``: a free flyer's six virtual joints are held at zero, its
+    #: pose from ``q[0:7]`` placed above them (:mod:`eomgen.symbolic.free_flyer`).
+    coordinates: tuple | None = None
 
     @property
-    def q(self) -> tuple[sp.Symbol, ...]:
-        return self.inputs["q"]
+    def q(self) -> tuple:
+        """The joint coordinates the algorithms use, one per velocity (NV): the ``q`` input
+        itself unless the model has a free flyer (:attr:`coordinates`)."""
+        return self.inputs["q"] if self.coordinates is None else self.coordinates
 
     @property
     def qd(self) -> tuple[sp.Symbol, ...]:
         return self.inputs["qd"]
 
     @property
-    def qdd(self) -> tuple[sp.Symbol, ...]:
-        return self.inputs["qdd"]
+    def qdd(self) -> tuple:
+        """The accelerations the algorithms take: the ``qdd`` input, for a free flyer turned
+        into the chart's (:func:`eomgen.symbolic.free_flyer.chart_accelerations`)."""
+        return self.accelerations(self.inputs["qdd"])
+
+    def accelerations(self, qdd) -> tuple:
+        """The accelerations an algorithm must be given for the true accelerations ``qdd``
+        (with velocities ``qd``): ``qdd`` itself, or for a free flyer the chart's."""
+        if not self.model.free_flyer:
+            return tuple(qdd)
+        return chart_accelerations(self.qd, qdd)
 
     @property
     def tau(self) -> tuple[sp.Symbol, ...]:
@@ -127,9 +144,17 @@ def new_derivation(model: RobotModel, inputs: Iterable[str] | None = None) -> De
     symbols = {name: vector_symbols(name, input_size(name, model)) for name in names}
     reserved = {s.name for v in symbols.values() for s in v} | {p.name for p in model.parameters}
     for name in ("q", "qd", "qdd"):
-        symbols.setdefault(name, vector_symbols(name, model.dof))
+        symbols.setdefault(name, vector_symbols(name, input_size(name, model)))
     ordered = {name: symbols[name] for name in INPUTS if name in symbols}
-    return Derivation(model, body_tree(model), ordered, ProgramBuilder(reserved))
+    builder, tree = ProgramBuilder(reserved), body_tree(model)
+    if not model.free_flyer:
+        return Derivation(model, tree, ordered, builder)
+    q = ordered["q"]
+    root = tree.bodies[0]
+    placed = replace(root, placement=root_placement(q, builder) @ root.placement)
+    tree = replace(tree, bodies=(placed,) + tree.bodies[1:])
+    coordinates = (sp.Integer(0),) * 6 + tuple(q[7:])
+    return Derivation(model, tree, ordered, builder, coordinates=coordinates)
 
 
 __all__ = ["Derivation", "joint_symbols", "new_derivation", "vector_symbols"]

@@ -30,6 +30,7 @@ from .composite import (christoffel_coriolis_program, composite_gravity_program,
                         composite_M_program, coriolis_program, forward_kinematics,
                         potential_energy)
 from .crba import M_program
+from .free_flyer import corrected_coriolis
 from .newton_euler import inverse_dynamics_program
 from .program import Program, ProgramBuilder, rough_operation_count
 
@@ -69,7 +70,7 @@ def routes() -> dict:
 
 
 def cheapest_routes(tree: BodyTree, q, qd, gravity: Vec3, outputs: Iterable[str],
-                    reserved=()) -> tuple[dict[str, str], Program]:
+                    reserved=(), christoffel: bool = True) -> tuple[dict[str, str], Program]:
     """Build every route (see :func:`routes`) of each of ``outputs`` into one scratch
     builder, where they share their common work (the world-frame composites, sines and
     cosines), and keep for each output the route whose own program has the fewest operations
@@ -85,6 +86,8 @@ def cheapest_routes(tree: BodyTree, q, qd, gravity: Vec3, outputs: Iterable[str]
     for output in outputs:
         best = None
         for name, build in table[output]:
+            if name == "Christoffel" and not christoffel:
+                continue
             matrix = build(tree, q, qd, gravity, scratch)
             if matrix is None:  # route not tried for this robot
                 continue
@@ -98,7 +101,8 @@ def cheapest_routes(tree: BodyTree, q, qd, gravity: Vec3, outputs: Iterable[str]
     return chosen, program.pruned([o for o, _ in best_matrices])
 
 
-def derive_program(tree: BodyTree, q, qd, gravity: Vec3, outputs: set[str], b: ProgramBuilder) -> dict:
+def derive_program(tree: BodyTree, q, qd, gravity: Vec3, outputs: set[str], b: ProgramBuilder,
+                   christoffel: bool = True) -> dict:
     """Build M, C and/or g (as asked in ``outputs``) into the program builder ``b``, each by
     the cheaper of its two exact programs for this robot (module docstring,
     :func:`cheapest_routes`): the body-frame CRBA is cheapest for joint axes along the link
@@ -108,11 +112,15 @@ def derive_program(tree: BodyTree, q, qd, gravity: Vec3, outputs: set[str], b: P
     :data:`CHRISTOFFEL_MAX_JOINTS` joints. With g comes ``P``, the potential energy, from the
     world-frame kinematics (:func:`eomgen.symbolic.composite.potential_energy`).
 
+    ``christoffel=False`` leaves the Christoffel C out (a free flyer's chart coordinates are
+    held at zero: nothing to differentiate by).
+
     Returns a dict with SymPy matrices in terms of intermediates: ``"M"`` (n×n), ``"C"`` (n×n),
     ``"g"`` (n×1), plus ``"P"`` (1×1 potential energy [J], when g is asked).
     """
     _, program = cheapest_routes(tree, q, qd, gravity,
-                                 [o for o in ("M", "g", "C") if o in outputs], b.reserved)
+                                 [o for o in ("M", "g", "C") if o in outputs], b.reserved,
+                                 christoffel=christoffel)
     result = b.absorb(program)
     if "g" in outputs:
         kin = forward_kinematics(tree, q, b)
@@ -124,8 +132,17 @@ def build_lagrangian(derivation, wanted) -> dict:
     """The builder of M, C and g in :mod:`eomgen.outputs`: :func:`derive_program` on the
     derivation's body tree for the ``wanted`` ones, with the potential energy ``P`` [J] when g is
     among them."""
+    wanted = set(wanted)
+    free_flyer = derivation.model.free_flyer
+    if free_flyer and "C" in wanted:
+        wanted.add("M")  # the free flyer's C is the chart's corrected with M
     result = derive_program(derivation.tree, derivation.q, derivation.qd,
-                            derivation.model.gravity, set(wanted), derivation.builder)
+                            derivation.model.gravity, wanted, derivation.builder,
+                            christoffel=not free_flyer)
+    if free_flyer and "C" in result:
+        b = derivation.builder
+        C = corrected_coriolis(result["C"], result["M"], derivation.qd)
+        result["C"] = C.applyfunc(lambda e: e if e.is_Atom else b.define(e, "Cff", ("C",)))
     return {name: result[name] for name in ("M", "C", "g", "P") if name in result}
 
 
