@@ -1,7 +1,7 @@
 """Batches larger than one machine's memory: any generated function over a ``dask.array``.
 
 :func:`dask_map` turns a generated function (the inverse dynamics of a NumPy module, or a JAX
-function, jitted or not) and state arrays of shape ``(N, NQ)`` into a lazy ``dask.array`` of
+function, jitted or not) and state arrays of shape ``(N, NV)`` into a lazy ``dask.array`` of
 its results, evaluated chunk by chunk of states by whatever dask scheduler is active: threads,
 processes, or a ``distributed`` cluster. Needs the ``dask`` extra (``pip install
 eomgen[dask]``); nothing here imports dask until it is called.
@@ -28,11 +28,11 @@ def dask_map(function: Callable, *states, chunks: int = 100_000, **parameters):
     Parameters
     ----------
     function : callable
-        A generated function taking state arrays of shape ``(N, NQ)`` and returning an array of
-        shape ``(N,) + S`` (``S = (NQ,)`` for vectors, ``(NQ, NQ)`` for matrices), e.g. the
+        A generated function taking state arrays of shape ``(N, NV)`` and returning an array of
+        shape ``(N,) + S`` (``S = (NV,)`` for vectors, ``(NV, NV)`` for matrices), e.g. the
         NumPy module's inverse dynamics (see :data:`eomgen.outputs.OUTPUTS`), or a JAX one (its
         results are copied back to NumPy).
-    *states : array or dask.array, shape (N, NQ)
+    *states : array or dask.array, shape (N, NV)
         The function's state arguments (q, qd, ...), in JOINT_NAMES order. NumPy arrays are
         split into chunks of ``chunks`` states; dask arrays are rechunked to the first one's
         chunks of states, with all joints of a state in one chunk.
@@ -64,7 +64,7 @@ def dask_map(function: Callable, *states, chunks: int = 100_000, **parameters):
                                                              chunks=(chunks, -1))
               for x in states]
     if any(x.ndim != 2 for x in arrays) or len({x.shape for x in arrays}) != 1:
-        raise ValueError("dask_map: the states must be arrays of one shape (N, NQ), got "
+        raise ValueError("dask_map: the states must be arrays of one shape (N, NV), got "
                          + ", ".join(str(x.shape) for x in arrays))
     rows = arrays[0].chunks[0]
     arrays = [x.rechunk((rows, -1)) for x in arrays]

@@ -15,8 +15,8 @@ then have different sizes, NQ = NV + 1, laid out as Pinocchio lays out a model b
  7 …         the robot's joints                     6 …        the robot's joints
 ==========  =====================================  =========  ===============================
 
-The robot's joints come in depth-first order from the root (siblings in description order),
-Pinocchio's order; a fixed-base model keeps the description's order instead. ``R`` rotates
+The robot's joints come in depth-first order from the root, the joints below one link sorted by
+name: the order of Pinocchio's URDF reader (:func:`pinocchio_order`); a fixed-base model keeps the description's order instead. ``R`` rotates
 root-frame vectors into the world frame. The dynamics are ``M(q) v̇ + C(q, v) v + g(q) = τ``
 in these velocities, τ[0:6] being the wrench on the root (force then moment, root frame); C is
 the matrix Pinocchio's ``computeCoriolisMatrix`` gives (Ṁ − 2C skew-symmetric).
@@ -91,9 +91,26 @@ def add_free_flyer(model: RobotModel) -> RobotModel:
     return replace(
         model,
         links=(Link(WORLD), *(Link(name) for name in links), *model.links),
-        joints=virtual + model.topological_joints,
+        joints=virtual + pinocchio_order(model),
         root=WORLD, free_flyer=True,
         notices=tuple(n for n in model.notices if n.kind is not NoticeKind.FLOATING_BASE))
+
+
+def pinocchio_order(model: RobotModel) -> tuple[Joint, ...]:
+    """The joints of ``model`` in the order Pinocchio's URDF reader gives them: depth-first from
+    the root, the joints below one link in the byte order of their names (urdfdom keeps a
+    link's children sorted by joint name)."""
+    children: dict[str, list[Joint]] = {}
+    for joint in model.joints:
+        children.setdefault(joint.parent, []).append(joint)
+    order: list[Joint] = []
+    stack = sorted(children.get(model.root, []), key=lambda j: j.name.encode(), reverse=True)
+    while stack:
+        joint = stack.pop()
+        order.append(joint)
+        stack.extend(sorted(children.get(joint.child, []), key=lambda j: j.name.encode(),
+                            reverse=True))
+    return tuple(order)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -202,4 +219,4 @@ def neutral(nq: int) -> np.ndarray:
 
 
 __all__ = ["CONFIGURATION_NAMES", "VELOCITY_NAMES", "add_free_flyer", "difference",
-           "integrate", "matrix_quaternion", "neutral", "quaternion_matrix"]
+           "integrate", "matrix_quaternion", "neutral", "pinocchio_order", "quaternion_matrix"]

@@ -68,7 +68,7 @@ class FunctionSpec:
 #: :func:`reserved_identifiers`.
 RESERVED_IDENTIFIERS = frozenset(
     {"math", *INPUTS, "out", "single", "batch", "n",
-     "JOINT_NAMES", "NQ", "PARAMETERS", *OUTPUTS, *BY_SYMBOL,
+     "JOINT_NAMES", "CONFIGURATION_NAMES", "NQ", "NV", "PARAMETERS", *OUTPUTS, *BY_SYMBOL,
      "self", "cls", "L", "x", "y", "d",
      "rhs", "bias", "args", "names", "vectors", "functions", "parameters", "q_columns",
      "qd_columns", "qdd_columns", "k", "finite", "condition", "return_condition",

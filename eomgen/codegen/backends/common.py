@@ -31,7 +31,7 @@ class PrintedFunction:
     operation_count: int
     units: str
     releases: list[list[str]]  # names no longer needed after each assignment
-    sizes: dict[str, int] | None = None  # lengths of the inputs not NQ long (INPUT_SIZES)
+    sizes: dict[str, int | str] | None = None  # lengths of inputs not NV long (input_sizes)
     returns: tuple = ()  # (symbol, start, stop or None) of a several-result function
 
 
@@ -50,6 +50,20 @@ def last_uses(assignments, outputs) -> list[list[str]]:
         releases.append(sorted(x.name for x in free))
     releases.reverse()
     return releases
+
+
+def input_sizes(arguments, model) -> dict:
+    """The lengths of the inputs of :data:`~eomgen.outputs.INPUT_SIZES` among ``arguments``
+    that are not NV: a number (e.g. the contact rows of ``F_c``), or ``"NQ"`` for ``q`` when
+    the configuration is longer than the velocity (a free flyer)."""
+    sizes = {}
+    for a in arguments:
+        if a.name == "q":
+            if model.nq != model.dof:
+                sizes["q"] = "NQ"
+        elif a.name in INPUT_SIZES:
+            sizes[a.name] = len(a.symbols)
+    return sizes
 
 
 def print_function(spec: FunctionSpec, job: Job, doprint, element_name) -> PrintedFunction:
@@ -91,7 +105,7 @@ def print_function(spec: FunctionSpec, job: Job, doprint, element_name) -> Print
         operation_count=spec.operation_count,
         units=spec.units,
         releases=last_uses(spec.program.assignments, list(spec.output)),
-        sizes={a.name: len(a.symbols) for a in spec.arguments if a.name in INPUT_SIZES},
+        sizes=input_sizes(spec.arguments, job.model),
         returns=spec.returns,
     )
 
@@ -121,8 +135,8 @@ def docstring_literal(text: str) -> str:
 def dunder_all_lines(names, width: int = 79) -> list[str]:
     """The lines of ``__all__ = [...]`` listing ``names``, filled up to ``width`` characters.
 
-    >>> dunder_all_lines(["NQ", "M"])
-    ['__all__ = ["NQ", "M"]']
+    >>> dunder_all_lines(["NV", "M"])
+    ['__all__ = ["NV", "M"]']
     """
     prefix = "__all__ = ["
     items = [f'"{name}"' for name in names]
@@ -159,7 +173,9 @@ def python_module_context(job: Job, printer, template: str, extra_exports=(),
         header=job.header_lines(template),
         robot=docstring_literal(job.model.name),
         joint_names=[python_literal(n) for n in job.dynamics.joint_names],
-        nq=job.model.dof,
+        nq=job.model.nq,
+        nv=job.model.dof,
+        configuration_names=[python_literal(n) for n in job.model.configuration_names],
         parameters=[(p.identifier, repr(float(p.default)) if p.default is not None else None,
                      python_literal(p.doc)) for p in job.parameters],
         functions=[print_function(spec, job, doprint, None) for spec in job.specs],
@@ -167,9 +183,9 @@ def python_module_context(job: Job, printer, template: str, extra_exports=(),
         # q, qd, qdd and tau (forward dynamics takes tau), then any other input a function takes
         vector_inputs=[name for name in INPUTS if name in ("q", "qd", "qdd", "tau") or any(
             name == a.name for spec in job.specs for a in spec.arguments)],
-        input_sizes={name: len(job.dynamics.input_symbols[name]) for name in INPUT_SIZES
-                     if name in job.dynamics.input_symbols},
-        dunder_all=dunder_all_lines(["JOINT_NAMES", "NQ", "PARAMETERS",
+        input_sizes={name: "NQ" if name == "q" else len(job.dynamics.input_symbols[name])
+                     for name in INPUT_SIZES if name in job.dynamics.input_symbols},
+        dunder_all=dunder_all_lines(["JOINT_NAMES", "CONFIGURATION_NAMES", "NQ", "NV", "PARAMETERS",
                                      *(name for name, _ in job.constants), *functions,
                                      *extra_exports]),
         exports=list(functions),

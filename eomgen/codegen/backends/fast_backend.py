@@ -2,9 +2,9 @@
 Python's headers are found, the compiled module ``<robot>_fast<EXT_SUFFIX>`` (e.g.
 ``ur5_fast.cpython-311-x86_64-linux-gnu.so``) that ``import ur5_fast`` loads.
 
-The module exports the same names as the NumPy module (``JOINT_NAMES``, ``NQ``, ``PARAMETERS``,
+The module exports the same names as the NumPy module (``JOINT_NAMES``, ``NV``, ``PARAMETERS``,
 the functions of :data:`eomgen.outputs.OUTPUTS`, ``IllConditionedWarning``), each function
-taking one state ``(NQ,)`` or a batch ``(N, NQ)`` and looping over the batch in C. It is the route for one state at a time
+taking one state ``(NV,)`` or a batch ``(N, NV)`` and looping over the batch in C. It is the route for one state at a time
 from Python: a call costs the C arithmetic plus a few hundred nanoseconds of argument parsing
 and one NumPy array allocation (no CasADi call layer, no ctypes). The composed
 ``forward_dynamics`` and ``constrained_forward_dynamics`` are solved in C by one shared Cholesky
@@ -133,8 +133,9 @@ def _render_source(job: Job, config: FastConfig) -> str:
             name=spec.name, summary=spec.summary, inputs=[a.name for a in spec.arguments],
             slots=[f'"{a.name}"' for a in spec.arguments]
             + ["NULL"] * (max_inputs - len(spec.arguments)),
-            # lengths of the inputs (NQ for the joint vectors; F_c has the contact rows)
-            sizes=[str(len(a.symbols)) if a.name in INPUT_SIZES else "NQ" for a in spec.arguments]
+            # lengths of the inputs (NV for the joint vectors; F_c has the contact rows)
+            sizes=["NQ" if a.name == "q" else str(len(a.symbols)) if a.name in INPUT_SIZES
+                   else "NV" for a in spec.arguments]
             + ["0"] * (max_inputs - len(spec.arguments)),
             rows=rows, cols=0 if spec.is_vector else cols, size=rows * cols,
             assignments=[(local[s].name, doprint(e)) for s, e in spec.program.assignments],
@@ -146,15 +147,15 @@ def _render_source(job: Job, config: FastConfig) -> str:
                         for p in job.parameters)
     for f in functions:
         shape = f"({f['rows']}, {f['cols']})" if f["cols"] else f"({f['rows']},)"
-        if f["returns"]:  # a tuple of results, each (NQ, NQ) or (NQ,)
-            shape = "(" + ", ".join(f"{symbol} (NQ, NQ)" if stop is not None else
-                                    f"{symbol} (NQ,)" for symbol, _, stop in f["returns"]) + ")"
+        if f["returns"]:  # a tuple of results, each (NV, NV) or (NV,)
+            shape = "(" + ", ".join(f"{symbol} (NV, NV)" if stop is not None else
+                                    f"{symbol} (NV,)" for symbol, _, stop in f["returns"]) + ")"
         keywords = ", *" + signature if signature else ""
         f["doc"] = c_string_literal(
             f"{f['name']}({', '.join(f['inputs'])}{keywords})\n--\n\n"
-            f"{f['summary']}\n\nInputs of shape (NQ,) or (N, NQ) in JOINT_NAMES order"
+            f"{f['summary']}\n\nInputs of shape (NV,) or (N, NV) in JOINT_NAMES order"
             + "".join(f", {name} of shape ({size},) or (N, {size})" for name, size
-                      in zip(f["inputs"], f["sizes"]) if size != "NQ")
+                      in zip(f["inputs"], f["sizes"]) if size != "NV")
             + ("; returns the tuple " if f["returns"] else "; returns shape ")
             + f"{shape} or (N,) + that, in {f['units']}. {f['operation_count']} arithmetic "
             "operations per state.")
@@ -172,8 +173,8 @@ def _render_source(job: Job, config: FastConfig) -> str:
     nc = next((f["rows"] for f in functions if f["name"] == cfd["jacobian"]), 0)
     constrained_doc = c_string_literal(
         f"{cfd['name']}({', '.join(CONSTRAINED_FORWARD.inputs)}, *{signature}, damping=0.0)"
-        f"\n--\n\n{CONSTRAINED_FORWARD.summary}\n\nReturns (qdd, F_c) of shapes (NQ,), "
-        f"({nc},) for one state, (N, NQ), (N, {nc}) for a batch; F_c in CONTACT_ROWS order "
+        f"\n--\n\n{CONSTRAINED_FORWARD.summary}\n\nReturns (qdd, F_c) of shapes (NV,), "
+        f"({nc},) for one state, (N, NV), (N, {nc}) for a batch; F_c in CONTACT_ROWS order "
         "(forces on the robot). Solved by Cholesky factors: M = L L^T, A = J_c M^-1 J_c^T + "
         "damping 1 = L_A L_A^T, F_c = A^-1 (-J_c-dot qd - J_c M^-1 (tau - C qd - g)), qdd = "
         "M^-1 (tau - C qd - g + J_c^T F_c). Raises numpy.linalg.LinAlgError when M is not "
@@ -194,7 +195,8 @@ def _render_source(job: Job, config: FastConfig) -> str:
         robot=c_comment(job.model.name),
         module=module,
         module_literal=c_string_literal(module),
-        nq=n,
+        nq=job.model.nq,
+        nv=n,
         max_inputs=max_inputs,
         joint_names=[c_string_literal(name) for name in job.dynamics.joint_names],
         parameters=parameters,

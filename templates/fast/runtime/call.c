@@ -2,7 +2,7 @@
  * i.e. the table entry of a function (function_t), parsing of a call's arrays, parameters and
  * keywords (parse), and the loop of a kernel over one state or a batch (evaluate).
  *
- * The generated module defines, before this text: NQ (joints), NP (parameters kept symbolic),
+ * The generated module defines, before this text: NV (joints), NP (parameters kept symbolic),
  * MAX_IN (most vector inputs of a function), parameter_names[NP + 1] (NULL-terminated),
  * parameter_defaults[NP + 1] and parameter_has_default[NP + 1]; and includes Python.h, NumPy's
  * arrayobject.h, <math.h> and <string.h>, as this file does.
@@ -26,7 +26,7 @@ typedef struct {
     const char *inputs[MAX_IN];
     int rows, cols;  /* cols 0: a vector of rows entries */
     kernel_t kernel;
-    int sizes[MAX_IN];  /* length of each input (0: NQ) */
+    int sizes[MAX_IN];  /* length of each input (0: NV) */
 } function_t;
 
 static PyObject *ill_conditioned_warning = NULL;  /* IllConditionedWarning */
@@ -158,7 +158,7 @@ static int parse(const function_t *f, PyObject *const *args, Py_ssize_t nargs,
             release(call);
             return -1;
         }
-        call->arrays[j] = as_states(given[j], f->inputs[j], f->sizes[j] ? f->sizes[j] : NQ);
+        call->arrays[j] = as_states(given[j], f->inputs[j], f->sizes[j] ? f->sizes[j] : NV);
         if (call->arrays[j] == NULL) {
             release(call);
             return -1;
@@ -211,7 +211,7 @@ static PyObject *evaluate(const function_t *f, PyObject *const *args, Py_ssize_t
         Py_BEGIN_ALLOW_THREADS
         for (k = 0; k < call.states; ++k) {
             for (j = 0; j < f->n_in; ++j)
-                at[j] = in[j] + k * (f->sizes[j] ? f->sizes[j] : NQ);
+                at[j] = in[j] + k * (f->sizes[j] ? f->sizes[j] : NV);
             f->kernel(at, call.p, out + k * size);
         }
         Py_END_ALLOW_THREADS

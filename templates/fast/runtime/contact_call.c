@@ -5,17 +5,17 @@
  * Real C source, not a template: eomgen copies the text below the marker line into the module
  * (eomgen.codegen.backends.fast_backend.runtime_source), and tests/test_fast_runtime_c.py
  * compiles it on its own with -Wall -Wextra -Werror (after what the module defines before the
- * call runtime: NQ, NP, MAX_IN and the parameter tables). */
+ * call runtime: NV, NP, MAX_IN and the parameter tables). */
 #include "call.c"  /* compiled alone: the call parsing it uses */
 
 /* eomgen: the generated module holds the text below this line. */
 /* The kernel of one state of the constrained forward dynamics (see constrained_solve): qdd
- * (NQ) and the contact forces F (nc) at (q, qd, tau), parameters p; returns the status. */
+ * (NV) and the contact forces F (nc) at (q, qd, tau), parameters p; returns the status. */
 typedef int (*contact_kernel_t)(const double *, const double *, const double *, const double *,
                                 double, double *, double *);
 
 /* The function f (inputs q, qd, tau; keyword damping) called from Python: (qdd, F_c) of
- * shapes (NQ,), (nc,) for one state, (N, NQ), (N, nc) for a batch, solved state by state with
+ * shapes (NV,), (nc,) for one state, (N, NV), (N, nc) for a batch, solved state by state with
  * `one`; FloatingPointError or numpy.linalg.LinAlgError named after f at the first state that
  * fails. */
 static PyObject *contact_call(const function_t *f, contact_kernel_t one, int nc,
@@ -30,7 +30,7 @@ static PyObject *contact_call(const function_t *f, contact_kernel_t one, int nc,
     if (parse(f, args, nargs, kwnames, &call, TAKES_DAMPING) < 0)
         return NULL;
     dims[0] = call.states;
-    dims[1] = NQ;
+    dims[1] = NV;
     result = (PyArrayObject *)(call.single ? PyArray_SimpleNew(1, dims + 1, NPY_DOUBLE)
                                            : PyArray_SimpleNew(2, dims, NPY_DOUBLE));
     dims[1] = nc;
@@ -48,7 +48,7 @@ static PyObject *contact_call(const function_t *f, contact_kernel_t one, int nc,
     qdd = (double *)PyArray_DATA(result);
     F = (double *)PyArray_DATA(forces);
     for (k = 0; k < call.states; ++k) {
-        status = one(q + k * NQ, qd + k * NQ, tau + k * NQ, call.p, call.damping, qdd + k * NQ,
+        status = one(q + k * NQ, qd + k * NV, tau + k * NV, call.p, call.damping, qdd + k * NV,
                      F + k * nc);
         if (status) {
             failed = k;
@@ -75,7 +75,7 @@ static PyObject *contact_call(const function_t *f, contact_kernel_t one, int nc,
             PyErr_Format(lin_alg_error, "%s: the contact Jacobian (%dx%d) has dependent rows%s: "
                          "J_c M^-1 J_c^T is singular (cond >~ 1e10) and the contact forces are "
                          "not unique (redundant contacts, or a direction no joint moves a "
-                         "contact frame in); use damping > 0", f->name, nc, NQ, at);
+                         "contact frame in); use damping > 0", f->name, nc, NV, at);
         Py_DECREF(result);
         Py_DECREF(forces);
         return NULL;
