@@ -20,14 +20,20 @@ are SI.
 
 import casadi as ca
 
-__all__ = ["JOINT_NAMES", "NQ", "PARAMETERS", "mass_matrix", "coriolis_matrix",
-           "gravity_vector", "inverse_dynamics", "forward_dynamics"]
+__all__ = ["JOINT_NAMES", "CONFIGURATION_NAMES", "NQ", "NV", "PARAMETERS",
+           "mass_matrix", "coriolis_matrix", "gravity_vector",
+           "inverse_dynamics", "forward_dynamics"]
 
 JOINT_NAMES = (
     'joint1',
     'joint2',
 )
+CONFIGURATION_NAMES = (
+    'joint1',
+    'joint2',
+)
 NQ = 2
+NV = 2
 PARAMETERS = {
     "I1": 0.08333333333333333,  # 'inertia of link 1 about z through its centre of mass [kg m^2]'
     "I2": 0.08333333333333333,  # 'inertia of link 2 about z through its centre of mass [kg m^2]'
@@ -173,9 +179,9 @@ def _function(name, inputs, outputs, input_names, output_names):
 
 def _build():
     q = ca.SX.sym("q", NQ)
-    qd = ca.SX.sym("qd", NQ)
-    qdd = ca.SX.sym("qdd", NQ)
-    tau = ca.SX.sym("tau", NQ)
+    qd = ca.SX.sym("qd", NV)
+    qdd = ca.SX.sym("qdd", NV)
+    tau = ca.SX.sym("tau", NV)
     I1 = ca.SX.sym("I1")
     I2 = ca.SX.sym("I2")
     g_ = ca.SX.sym("g_")
@@ -206,7 +212,7 @@ def _build():
         "inverse_dynamics", args + parameters, [_inverse_dynamics_expression(*args, *parameters)],
         ["q", "qd", "qdd"] + names, ["tau"])
     M = _mass_matrix_expression(q, *parameters)
-    bias = _inverse_dynamics_expression(q, qd, ca.SX.zeros(NQ, 1), *parameters)
+    bias = _inverse_dynamics_expression(q, qd, ca.SX.zeros(NV, 1), *parameters)
     functions["forward_dynamics"] = _function(
         "forward_dynamics", [q, qd, tau] + parameters, [_cholesky_solve(M, tau - bias)],
         ["q", "qd", "tau"] + names, ["qdd"])

@@ -5,8 +5,8 @@
  * Equations of motion M(q) qdd + C(q, qd) qd + g(q) = tau of robot planar_2link as the CPython
  * extension module `planar_2link_fast` (NumPy arrays in and out; arithmetic in C).
  *
- * Joint order: JOINT_NAMES. Every function takes one state, arrays of shape (NQ,), or a batch,
- * arrays of shape (N, NQ) (looped over in C), and returns the matching shape. Parameters kept
+ * Joint order: JOINT_NAMES. Every function takes one state, arrays of shape (NV,), or a batch,
+ * arrays of shape (N, NV) (looped over in C), and returns the matching shape. Parameters kept
  * symbolic are keyword arguments (Python floats) whose defaults are the description's values
  * (PARAMETERS). Units are SI.
  *
@@ -22,11 +22,12 @@
 #include <float.h>
 #include <string.h>
 
-#define NQ 2
+#define NQ 2  /* entries of q (configuration) */
+#define NV 2  /* entries of qd, qdd, tau (velocity): JOINT_NAMES */
 #define NP 9
 #define MAX_IN 3  /* most vector inputs of a function */
 
-static const char *const joint_names[NQ + 1] = {
+static const char *const joint_names[NV + 1] = {
     "joint1",
     "joint2",
     NULL};
@@ -65,7 +66,7 @@ static const int parameter_has_default[NP + 1] = {
     0};
 
 /* ---------------------------------------------------------------------------------------- */
-/* The functions of one state: inputs x[j] (NQ,) each (F_c: the contact rows), parameters p
+/* The functions of one state: inputs x[j] (NV,) each (F_c: the contact rows), parameters p
  * (NP,), output row-major. */
 
 /* Mass matrix M(q), symmetric positive definite.
@@ -229,26 +230,26 @@ static void solve_upper(const double *L, int n, double *y)
 static int forward_dynamics_one(const double *q, const double *qd, const double *tau,
                                 const double *p, double *qdd, double *condition)
 {
-    static const double zero[NQ] = {0.0};
-    double M[NQ * NQ], bias[NQ];
+    static const double zero[NV] = {0.0};
+    double M[NV * NV], bias[NV];
     double dmax, dmin;
     int i, j;
     const double *mass_in[MAX_IN] = {q}, *bias_in[MAX_IN] = {q, qd, zero};
     mass_matrix_one(mass_in, p, M);
     inverse_dynamics_one(bias_in, p, bias);
-    for (i = 0; i < NQ; ++i) {
+    for (i = 0; i < NV; ++i) {
         qdd[i] = tau[i] - bias[i];
         if (!isfinite(qdd[i]))
             return 1;
-        for (j = 0; j < NQ; ++j)
-            if (!isfinite(M[i * NQ + j]))
+        for (j = 0; j < NV; ++j)
+            if (!isfinite(M[i * NV + j]))
                 return 1;
     }
-    if (cholesky(M, NQ, 0.0, &dmax, &dmin))
+    if (cholesky(M, NV, 0.0, &dmax, &dmin))
         return 2;
-    solve_lower(M, NQ, qdd);
-    solve_upper(M, NQ, qdd);
-    *condition = NQ ? (dmax / dmin) * (dmax / dmin) : 1.0;
+    solve_lower(M, NV, qdd);
+    solve_upper(M, NV, qdd);
+    *condition = NV ? (dmax / dmin) * (dmax / dmin) : 1.0;
     return 0;
 }
 
@@ -263,7 +264,7 @@ typedef struct {
     const char *inputs[MAX_IN];
     int rows, cols;  /* cols 0: a vector of rows entries */
     kernel_t kernel;
-    int sizes[MAX_IN];  /* length of each input (0: NQ) */
+    int sizes[MAX_IN];  /* length of each input (0: NV) */
 } function_t;
 
 static PyObject *ill_conditioned_warning = NULL;  /* IllConditionedWarning */
@@ -395,7 +396,7 @@ static int parse(const function_t *f, PyObject *const *args, Py_ssize_t nargs,
             release(call);
             return -1;
         }
-        call->arrays[j] = as_states(given[j], f->inputs[j], f->sizes[j] ? f->sizes[j] : NQ);
+        call->arrays[j] = as_states(given[j], f->inputs[j], f->sizes[j] ? f->sizes[j] : NV);
         if (call->arrays[j] == NULL) {
             release(call);
             return -1;
@@ -448,7 +449,7 @@ static PyObject *evaluate(const function_t *f, PyObject *const *args, Py_ssize_t
         Py_BEGIN_ALLOW_THREADS
         for (k = 0; k < call.states; ++k) {
             for (j = 0; j < f->n_in; ++j)
-                at[j] = in[j] + k * (f->sizes[j] ? f->sizes[j] : NQ);
+                at[j] = in[j] + k * (f->sizes[j] ? f->sizes[j] : NV);
             f->kernel(at, call.p, out + k * size);
         }
         Py_END_ALLOW_THREADS
@@ -470,7 +471,7 @@ static PyObject *mass_matrix(PyObject *self, PyObject *const *args, Py_ssize_t n
 
 static const function_t coriolis_matrix_function = {
     "coriolis_matrix", 2, {"q", "qd", NULL},
-    2, 2, coriolis_matrix_one, {NQ, NQ, 0}};
+    2, 2, coriolis_matrix_one, {NQ, NV, 0}};
 
 static PyObject *coriolis_matrix(PyObject *self, PyObject *const *args, Py_ssize_t nargs,
                               PyObject *kwnames)
@@ -492,7 +493,7 @@ static PyObject *gravity_vector(PyObject *self, PyObject *const *args, Py_ssize_
 
 static const function_t inverse_dynamics_function = {
     "inverse_dynamics", 3, {"q", "qd", "qdd"},
-    2, 0, inverse_dynamics_one, {NQ, NQ, NQ}};
+    2, 0, inverse_dynamics_one, {NQ, NV, NV}};
 
 static PyObject *inverse_dynamics(PyObject *self, PyObject *const *args, Py_ssize_t nargs,
                               PyObject *kwnames)
@@ -502,7 +503,7 @@ static PyObject *inverse_dynamics(PyObject *self, PyObject *const *args, Py_ssiz
 }
 
 static const function_t forward_dynamics_function = {
-    "forward_dynamics", 3, {"q", "qd", "tau"}, NQ, 0, NULL};
+    "forward_dynamics", 3, {"q", "qd", "tau"}, NV, 0, NULL, {NQ}};
 
 static PyObject *forward_dynamics(PyObject *self, PyObject *const *args, Py_ssize_t nargs,
                                   PyObject *kwnames)
@@ -517,7 +518,7 @@ static PyObject *forward_dynamics(PyObject *self, PyObject *const *args, Py_ssiz
     if (parse(&forward_dynamics_function, args, nargs, kwnames, &call, TAKES_RETURN_CONDITION) < 0)
         return NULL;
     dims[0] = call.states;
-    dims[1] = NQ;
+    dims[1] = NV;
     result = (PyArrayObject *)(call.single ? PyArray_SimpleNew(1, dims + 1, NPY_DOUBLE)
                                            : PyArray_SimpleNew(2, dims, NPY_DOUBLE));
     conditions = (PyArrayObject *)PyArray_SimpleNew(1, dims, NPY_DOUBLE);
@@ -533,8 +534,8 @@ static PyObject *forward_dynamics(PyObject *self, PyObject *const *args, Py_ssiz
     qdd = (double *)PyArray_DATA(result);
     condition = (double *)PyArray_DATA(conditions);
     for (k = 0; k < call.states; ++k) {
-        status = forward_dynamics_one(q + k * NQ, qd + k * NQ, tau + k * NQ, call.p,
-                                      qdd + k * NQ, condition + k);
+        status = forward_dynamics_one(q + k * NQ, qd + k * NV, tau + k * NV, call.p,
+                                      qdd + k * NV, condition + k);
         if (status) {
             failed = k;
             break;
@@ -585,13 +586,13 @@ static PyObject *forward_dynamics(PyObject *self, PyObject *const *args, Py_ssiz
 
 static PyMethodDef methods[] = {
     {"mass_matrix", (PyCFunction)(void (*)(void))mass_matrix, METH_FASTCALL | METH_KEYWORDS,
-     "mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0)\012--\012\012Mass matrix M(q), symmetric positive definite.\012\012Inputs of shape (NQ,) or (N, NQ) in JOINT_NAMES order; returns shape (2, 2) or (N,) + that, in kg m^2 (revolute rows/columns), kg (prismatic). 19 arithmetic operations per state."},
+     "mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0)\012--\012\012Mass matrix M(q), symmetric positive definite.\012\012Inputs of shape (NV,) or (N, NV) in JOINT_NAMES order, q of shape (NQ,) or (N, NQ); returns shape (2, 2) or (N,) + that, in kg m^2 (revolute rows/columns), kg (prismatic). 19 arithmetic operations per state."},
     {"coriolis_matrix", (PyCFunction)(void (*)(void))coriolis_matrix, METH_FASTCALL | METH_KEYWORDS,
-     "coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0)\012--\012\012Coriolis matrix C(q, qd) from the Christoffel symbols of the first kind, so that Mdot - 2 C is skew-symmetric.\012\012Inputs of shape (NQ,) or (N, NQ) in JOINT_NAMES order; returns shape (2, 2) or (N,) + that, in kg m^2/s (revolute). 43 arithmetic operations per state."},
+     "coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0)\012--\012\012Coriolis matrix C(q, qd) from the Christoffel symbols of the first kind, so that Mdot - 2 C is skew-symmetric.\012\012Inputs of shape (NV,) or (N, NV) in JOINT_NAMES order, q of shape (NQ,) or (N, NQ); returns shape (2, 2) or (N,) + that, in kg m^2/s (revolute). 43 arithmetic operations per state."},
     {"gravity_vector", (PyCFunction)(void (*)(void))gravity_vector, METH_FASTCALL | METH_KEYWORDS,
-     "gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0)\012--\012\012Gravity vector g(q) = dP/dq.\012\012Inputs of shape (NQ,) or (N, NQ) in JOINT_NAMES order; returns shape (2,) or (N,) + that, in N m (revolute), N (prismatic). 16 arithmetic operations per state."},
+     "gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0)\012--\012\012Gravity vector g(q) = dP/dq.\012\012Inputs of shape (NV,) or (N, NV) in JOINT_NAMES order, q of shape (NQ,) or (N, NQ); returns shape (2,) or (N,) + that, in N m (revolute), N (prismatic). 16 arithmetic operations per state."},
     {"inverse_dynamics", (PyCFunction)(void (*)(void))inverse_dynamics, METH_FASTCALL | METH_KEYWORDS,
-     "inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0)\012--\012\012Joint efforts tau = M(q) qdd + C(q, qd) qd + g(q) (recursive Newton-Euler, straight-line).\012\012Inputs of shape (NQ,) or (N, NQ) in JOINT_NAMES order; returns shape (2,) or (N,) + that, in N m (revolute), N (prismatic). 46 arithmetic operations per state."},
+     "inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0)\012--\012\012Joint efforts tau = M(q) qdd + C(q, qd) qd + g(q) (recursive Newton-Euler, straight-line).\012\012Inputs of shape (NV,) or (N, NV) in JOINT_NAMES order, q of shape (NQ,) or (N, NQ); returns shape (2,) or (N,) + that, in N m (revolute), N (prismatic). 46 arithmetic operations per state."},
     {"forward_dynamics", (PyCFunction)(void (*)(void))forward_dynamics,
      METH_FASTCALL | METH_KEYWORDS,
      "forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0, return_condition=False)\012--\012\012Joint accelerations qdd solving M(q) qdd = tau - (C(q, qd) qd + g(q)) by Cholesky.\012\012Warns IllConditionedWarning when (max L_ii / min L_ii)^2, a lower bound of cond(M), exceeds 1e-6 / eps; return_condition=True also returns that estimate. Raises numpy.linalg.LinAlgError when M is not positive definite and FloatingPointError when M, C qd + g or tau is not finite."},
@@ -610,13 +611,13 @@ PyMODINIT_FUNC PyInit_planar_2link_fast(void)
     module = PyModule_Create(&module_definition);
     if (module == NULL)
         return NULL;
-    names = PyTuple_New(NQ);
+    names = PyTuple_New(NV);
     parameters = PyDict_New();
-    exports = Py_BuildValue("[sssssssss]", "JOINT_NAMES", "NQ",
-                            "PARAMETERS", "mass_matrix", "coriolis_matrix", "gravity_vector", "inverse_dynamics", "forward_dynamics", "IllConditionedWarning");
+    exports = Py_BuildValue("[ssssssssss]", "JOINT_NAMES", "NQ",
+                            "NV", "PARAMETERS", "mass_matrix", "coriolis_matrix", "gravity_vector", "inverse_dynamics", "forward_dynamics", "IllConditionedWarning");
     if (names == NULL || parameters == NULL || exports == NULL)
         goto fail;
-    for (i = 0; i < NQ; ++i) {
+    for (i = 0; i < NV; ++i) {
         PyObject *name = PyUnicode_FromString(joint_names[i]);
         if (name == NULL)
             goto fail;
@@ -646,6 +647,7 @@ PyMODINIT_FUNC PyInit_planar_2link_fast(void)
         goto fail;
     if (PyModule_AddObjectRef(module, "JOINT_NAMES", names) < 0 ||
             PyModule_AddIntConstant(module, "NQ", NQ) < 0 ||
+            PyModule_AddIntConstant(module, "NV", NV) < 0 ||
             PyModule_AddObjectRef(module, "PARAMETERS", parameters) < 0 ||
             PyModule_AddObjectRef(module, "IllConditionedWarning", ill_conditioned_warning) < 0 ||
             PyModule_AddObjectRef(module, "__all__", exports) < 0)

@@ -4,7 +4,7 @@
 """Equations of motion M(q) qdd + C(q, qd) qd + g(q) = tau of robot 'planar_2link'.
 
 Joint order: JOINT_NAMES (the movable joints in the order the description lists them).
-Every function takes one state, arrays of shape (NQ,), or a batch, arrays of shape (N, NQ),
+Every function takes one state, arrays of shape (NV,), or a batch, arrays of shape (N, NV),
 and returns the matching shape: a single result only when every input is a single state, and a
 ValueError when the inputs hold different numbers of states. Units are SI (rad, m, kg, s, N, N m).
 Parameters kept symbolic are keyword arguments; their defaults are the description's values
@@ -15,15 +15,20 @@ import warnings as _warnings
 
 import numpy as np
 
-__all__ = ["JOINT_NAMES", "NQ", "PARAMETERS", "mass_matrix", "coriolis_matrix",
-           "gravity_vector", "inverse_dynamics", "forward_dynamics",
-           "IllConditionedWarning"]
+__all__ = ["JOINT_NAMES", "CONFIGURATION_NAMES", "NQ", "NV", "PARAMETERS",
+           "mass_matrix", "coriolis_matrix", "gravity_vector",
+           "inverse_dynamics", "forward_dynamics", "IllConditionedWarning"]
 
 JOINT_NAMES = (
     'joint1',
     'joint2',
 )
+CONFIGURATION_NAMES = (
+    'joint1',
+    'joint2',
+)
 NQ = 2
+NV = 2
 PARAMETERS = {
     "I1": 0.08333333333333333,  # 'inertia of link 1 about z through its centre of mass [kg m^2]'
     "I2": 0.08333333333333333,  # 'inertia of link 2 about z through its centre of mass [kg m^2]'
@@ -37,7 +42,7 @@ PARAMETERS = {
 }
 
 
-def _batch(x, name, size=NQ):
+def _batch(x, name, size=NV):
     """x as a float array of shape (N, size), and whether it was a single state."""
     x = np.asarray(x, dtype=float)
     if x.ndim == 1 and x.shape[0] == size:
@@ -48,7 +53,7 @@ def _batch(x, name, size=NQ):
 
 
 def _states(*named):
-    """The (array, name) or (array, name, size) inputs as float arrays of shape (N, NQ) or
+    """The (array, name) or (array, name, size) inputs as float arrays of shape (N, NV) or
     (N, size), then whether all of them were single states."""
     arrays, singles = [], []
     for x, name, *size in named:
@@ -66,7 +71,7 @@ def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l
 
     Parameters
     ----------
-    q : array, shape (NQ,) or (N, NQ)
+    q : array, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
 
     Returns
@@ -103,9 +108,9 @@ def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_
 
     Parameters
     ----------
-    q : array, shape (NQ,) or (N, NQ)
+    q : array, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
-    qd : array, shape (NQ,) or (N, NQ)
+    qd : array, shape (NV,) or (N, NV)
         Joint velocities [rad/s or m/s], in JOINT_NAMES order.
 
     Returns
@@ -163,7 +168,7 @@ def gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81
 
     Parameters
     ----------
-    q : array, shape (NQ,) or (N, NQ)
+    q : array, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
 
     Returns
@@ -203,11 +208,11 @@ def inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.083333333333333
 
     Parameters
     ----------
-    q : array, shape (NQ,) or (N, NQ)
+    q : array, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
-    qd : array, shape (NQ,) or (N, NQ)
+    qd : array, shape (NV,) or (N, NV)
         Joint velocities [rad/s or m/s], in JOINT_NAMES order.
-    qdd : array, shape (NQ,) or (N, NQ)
+    qdd : array, shape (NV,) or (N, NV)
         Joint accelerations [rad/s^2 or m/s^2], in JOINT_NAMES order.
 
     Returns
@@ -364,9 +369,11 @@ def forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.083333333333333
 
     Parameters
     ----------
-    q, qd : array, shape (NQ,) or (N, NQ)
-        Joint positions [rad or m] and velocities [rad/s or m/s], in JOINT_NAMES order.
-    tau : array, shape (NQ,) or (N, NQ)
+    q : array, shape (NQ,) or (N, NQ)
+        Joint positions [rad or m], in CONFIGURATION_NAMES order.
+    qd : array, shape (NV,) or (N, NV)
+        Joint velocities [rad/s or m/s], in JOINT_NAMES order.
+    tau : array, shape (NV,) or (N, NV)
         Joint efforts [N m or N].
     return_condition : bool
         Also return the condition number of M (see above).
@@ -392,9 +399,9 @@ def forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.083333333333333
     FloatingPointError
         When M, C qd + g or tau is not finite at some state (overflow, non-finite input).
     """
-    q_batch, qd_batch, tau_batch, single = _states((q, "q"), (qd, "qd"), (tau, "tau"))
+    q_batch, qd_batch, tau_batch, single = _states((q, "q", NQ), (qd, "qd"), (tau, "tau"))
     M = mass_matrix(q_batch, I1=I1, I2=I2, g_=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
-    bias = inverse_dynamics(q_batch, qd_batch, np.zeros_like(q_batch), I1=I1, I2=I2, g_=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
+    bias = inverse_dynamics(q_batch, qd_batch, np.zeros_like(qd_batch), I1=I1, I2=I2, g_=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
     rhs = tau_batch - bias
     qdd, condition = _cholesky_solve(M[0] if single else M, rhs[0] if single else rhs,
                                      who="forward_dynamics: ", stacklevel=2)

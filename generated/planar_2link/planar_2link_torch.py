@@ -4,7 +4,7 @@
 """Equations of motion M(q) qdd + C(q, qd) qd + g(q) = tau of robot 'planar_2link', in PyTorch.
 
 Joint order: JOINT_NAMES (the movable joints in the order the description lists them).
-Every function takes one state, tensors of shape (NQ,), or a batch, tensors of shape (N, NQ),
+Every function takes one state, tensors of shape (NV,), or a batch, tensors of shape (N, NV),
 and returns the matching shape: a single result only when every input is a single state, and a
 ValueError when the inputs hold different numbers of states. Results are on the inputs' device
 in their (promoted) floating dtype; integer inputs, lists and NumPy arrays become tensors of
@@ -19,15 +19,20 @@ import warnings as _warnings
 
 import torch
 
-__all__ = ["JOINT_NAMES", "NQ", "PARAMETERS", "mass_matrix", "coriolis_matrix",
-           "gravity_vector", "inverse_dynamics", "forward_dynamics",
-           "IllConditionedWarning"]
+__all__ = ["JOINT_NAMES", "CONFIGURATION_NAMES", "NQ", "NV", "PARAMETERS",
+           "mass_matrix", "coriolis_matrix", "gravity_vector",
+           "inverse_dynamics", "forward_dynamics", "IllConditionedWarning"]
 
 JOINT_NAMES = (
     'joint1',
     'joint2',
 )
+CONFIGURATION_NAMES = (
+    'joint1',
+    'joint2',
+)
 NQ = 2
+NV = 2
 PARAMETERS = {
     "I1": 0.08333333333333333,  # 'inertia of link 1 about z through its centre of mass [kg m^2]'
     "I2": 0.08333333333333333,  # 'inertia of link 2 about z through its centre of mass [kg m^2]'
@@ -42,11 +47,11 @@ PARAMETERS = {
 
 
 def _states(*named):
-    """The (tensor, name) or (tensor, name, size) inputs as floating tensors of shape (N, NQ) or
+    """The (tensor, name) or (tensor, name, size) inputs as floating tensors of shape (N, NV) or
     (N, size) and one dtype, then whether all of them were single states."""
     arrays, singles = [], []
     for x, name, *size in named:
-        size = size[0] if size else NQ
+        size = size[0] if size else NV
         x = torch.as_tensor(x)
         if not x.is_floating_point():
             x = x.to(torch.get_default_dtype())
@@ -73,7 +78,7 @@ def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l
 
     Parameters
     ----------
-    q : tensor, shape (NQ,) or (N, NQ)
+    q : tensor, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
 
     Returns
@@ -118,9 +123,9 @@ def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_
 
     Parameters
     ----------
-    q : tensor, shape (NQ,) or (N, NQ)
+    q : tensor, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
-    qd : tensor, shape (NQ,) or (N, NQ)
+    qd : tensor, shape (NV,) or (N, NV)
         Joint velocities [rad/s or m/s], in JOINT_NAMES order.
 
     Returns
@@ -186,7 +191,7 @@ def gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81
 
     Parameters
     ----------
-    q : tensor, shape (NQ,) or (N, NQ)
+    q : tensor, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
 
     Returns
@@ -234,11 +239,11 @@ def inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.083333333333333
 
     Parameters
     ----------
-    q : tensor, shape (NQ,) or (N, NQ)
+    q : tensor, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
-    qd : tensor, shape (NQ,) or (N, NQ)
+    qd : tensor, shape (NV,) or (N, NV)
         Joint velocities [rad/s or m/s], in JOINT_NAMES order.
-    qdd : tensor, shape (NQ,) or (N, NQ)
+    qdd : tensor, shape (NV,) or (N, NV)
         Joint accelerations [rad/s^2 or m/s^2], in JOINT_NAMES order.
 
     Returns
@@ -318,9 +323,11 @@ def forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.083333333333333
 
     Parameters
     ----------
-    q, qd : tensor, shape (NQ,) or (N, NQ)
-        Joint positions [rad or m] and velocities [rad/s or m/s], in JOINT_NAMES order.
-    tau : tensor, shape (NQ,) or (N, NQ)
+    q : tensor, shape (NQ,) or (N, NQ)
+        Joint positions [rad or m], in CONFIGURATION_NAMES order.
+    qd : tensor, shape (NV,) or (N, NV)
+        Joint velocities [rad/s or m/s], in JOINT_NAMES order.
+    tau : tensor, shape (NV,) or (N, NV)
         Joint efforts [N m or N].
     return_condition : bool
         Also return the condition number of M (see above).
@@ -344,9 +351,9 @@ def forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.083333333333333
     FloatingPointError
         When M, C qd + g or tau is not finite at some state (overflow, non-finite input).
     """
-    q, qd, tau, single = _states((q, "q"), (qd, "qd"), (tau, "tau"))
+    q, qd, tau, single = _states((q, "q", NQ), (qd, "qd"), (tau, "tau"))
     M = mass_matrix(q, I1=I1, I2=I2, g_=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
-    bias = inverse_dynamics(q, qd, torch.zeros_like(q), I1=I1, I2=I2, g_=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
+    bias = inverse_dynamics(q, qd, torch.zeros_like(qd), I1=I1, I2=I2, g_=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
     rhs = tau - bias
     finite = torch.isfinite(M).flatten(1).all(dim=1) & torch.isfinite(rhs).all(dim=1)
     if not bool(finite.all()):
@@ -362,7 +369,7 @@ def forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.083333333333333
     eps = torch.finfo(M.dtype).eps
     with torch.no_grad():
         d = torch.diagonal(L, dim1=1, dim2=2)
-        condition = (d.amax(dim=1) / d.amin(dim=1)) ** 2 if NQ else M.new_ones(M.shape[0])
+        condition = (d.amax(dim=1) / d.amin(dim=1)) ** 2 if NV else M.new_ones(M.shape[0])
         close = condition > 1e-4 * (1e-6 / eps)
         if bool(close.any()):  # near the limit: the exact 2-norm condition number
             eigenvalues = torch.linalg.eigvalsh(M[close])

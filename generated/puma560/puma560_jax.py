@@ -6,7 +6,7 @@
 Joint order: JOINT_NAMES (the movable joints in the order the description lists them).
 Every function is a pure function of its arrays: it works under jax.jit, jax.vmap and
 jax.grad, and on whatever device JAX places its inputs. Each takes one state, arrays of shape
-(NQ,), or a batch, arrays of shape (N, NQ), and returns the matching shape: a single result
+(NV,), or a batch, arrays of shape (N, NV), and returns the matching shape: a single result
 only when every input is a single state, and a ValueError when the inputs hold different
 numbers of states. Units are SI (rad, m, kg, s, N, N m).
 
@@ -17,8 +17,9 @@ jax.config.update("jax_enable_x64", True).
 import jax.numpy as jnp
 from jax.scipy.linalg import cho_solve as _cho_solve
 
-__all__ = ["JOINT_NAMES", "NQ", "PARAMETERS", "mass_matrix", "coriolis_matrix",
-           "gravity_vector", "inverse_dynamics", "forward_dynamics"]
+__all__ = ["JOINT_NAMES", "CONFIGURATION_NAMES", "NQ", "NV", "PARAMETERS",
+           "mass_matrix", "coriolis_matrix", "gravity_vector",
+           "inverse_dynamics", "forward_dynamics"]
 
 JOINT_NAMES = (
     'joint1',
@@ -28,17 +29,26 @@ JOINT_NAMES = (
     'joint5',
     'joint6',
 )
+CONFIGURATION_NAMES = (
+    'joint1',
+    'joint2',
+    'joint3',
+    'joint4',
+    'joint5',
+    'joint6',
+)
 NQ = 6
+NV = 6
 PARAMETERS = {
 }
 
 
 def _states(*named):
-    """The (array, name) or (array, name, size) inputs as floating JAX arrays of shape (N, NQ)
+    """The (array, name) or (array, name, size) inputs as floating JAX arrays of shape (N, NV)
     or (N, size), then whether all of them were single states. Shapes are static under jax.jit, so the checks run at tracing."""
     arrays, singles = [], []
     for x, name, *size in named:
-        size = size[0] if size else NQ
+        size = size[0] if size else NV
         x = jnp.asarray(x)
         if not jnp.issubdtype(x.dtype, jnp.floating):
             x = x.astype(jnp.result_type(float))
@@ -62,7 +72,7 @@ def _kept(x, like):
 
 def _stack(x, shape, entries):
     """The entries (arrays of shape (N,) or scalars, in row-major order) as one array of shape
-    (N,) + shape in the dtype of x, an (N, NQ) state; one jnp.stack, which XLA compiles to
+    (N,) + shape in the dtype of x, an (N, NV) state; one jnp.stack, which XLA compiles to
     faster CPU code than one scatter per entry."""
     if not entries:
         return jnp.zeros((x.shape[0],) + shape, x.dtype)
@@ -75,7 +85,7 @@ def mass_matrix(q):
 
     Parameters
     ----------
-    q : array, shape (NQ,) or (N, NQ)
+    q : array, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
 
     Returns
@@ -198,9 +208,9 @@ def coriolis_matrix(q, qd):
 
     Parameters
     ----------
-    q : array, shape (NQ,) or (N, NQ)
+    q : array, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
-    qd : array, shape (NQ,) or (N, NQ)
+    qd : array, shape (NV,) or (N, NV)
         Joint velocities [rad/s or m/s], in JOINT_NAMES order.
 
     Returns
@@ -560,7 +570,7 @@ def gravity_vector(q):
 
     Parameters
     ----------
-    q : array, shape (NQ,) or (N, NQ)
+    q : array, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
 
     Returns
@@ -614,11 +624,11 @@ def inverse_dynamics(q, qd, qdd):
 
     Parameters
     ----------
-    q : array, shape (NQ,) or (N, NQ)
+    q : array, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
-    qd : array, shape (NQ,) or (N, NQ)
+    qd : array, shape (NV,) or (N, NV)
         Joint velocities [rad/s or m/s], in JOINT_NAMES order.
-    qdd : array, shape (NQ,) or (N, NQ)
+    qdd : array, shape (NV,) or (N, NV)
         Joint accelerations [rad/s^2 or m/s^2], in JOINT_NAMES order.
 
     Returns
@@ -786,9 +796,11 @@ def forward_dynamics(q, qd, tau, *, return_condition=False):
 
     Parameters
     ----------
-    q, qd : array, shape (NQ,) or (N, NQ)
-        Joint positions [rad or m] and velocities [rad/s or m/s], in JOINT_NAMES order.
-    tau : array, shape (NQ,) or (N, NQ)
+    q : array, shape (NQ,) or (N, NQ)
+        Joint positions [rad or m], in CONFIGURATION_NAMES order.
+    qd : array, shape (NV,) or (N, NV)
+        Joint velocities [rad/s or m/s], in JOINT_NAMES order.
+    tau : array, shape (NV,) or (N, NV)
         Joint efforts [N m or N].
     return_condition : bool
         Also return the condition number estimate of M (a Python bool, static under jit).
@@ -802,13 +814,13 @@ def forward_dynamics(q, qd, tau, *, return_condition=False):
         diagonal, a lower bound of the 2-norm condition number of M (typically within a factor
         of ten). The NumPy module warns above 1e-6 / eps (about 4.5e9 in float64).
     """
-    q, qd, tau, single = _states((q, "q"), (qd, "qd"), (tau, "tau"))
+    q, qd, tau, single = _states((q, "q", NQ), (qd, "qd"), (tau, "tau"))
     M = mass_matrix(q)
-    bias = inverse_dynamics(q, qd, jnp.zeros_like(q))
+    bias = inverse_dynamics(q, qd, jnp.zeros_like(qd))
     L = jnp.linalg.cholesky(M)
     x = _cho_solve((L, True), (tau - bias)[:, :, jnp.newaxis])[:, :, 0]
     if return_condition:
         d = jnp.diagonal(L, axis1=1, axis2=2)
-        condition = (jnp.max(d, axis=1) / jnp.min(d, axis=1)) ** 2 if NQ else jnp.ones(d.shape[0])
+        condition = (jnp.max(d, axis=1) / jnp.min(d, axis=1)) ** 2 if NV else jnp.ones(d.shape[0])
         return (x[0], condition[0]) if single else (x, condition)
     return x[0] if single else x

@@ -4,7 +4,7 @@
 """Equations of motion M(q) qdd + C(q, qd) qd + g(q) = tau of robot 'puma560'.
 
 Joint order: JOINT_NAMES (the movable joints in the order the description lists them).
-Every function takes one state, arrays of shape (NQ,), or a batch, arrays of shape (N, NQ),
+Every function takes one state, arrays of shape (NV,), or a batch, arrays of shape (N, NV),
 and returns the matching shape: a single result only when every input is a single state, and a
 ValueError when the inputs hold different numbers of states. Units are SI (rad, m, kg, s, N, N m).
 """
@@ -13,9 +13,9 @@ import warnings as _warnings
 
 import numpy as np
 
-__all__ = ["JOINT_NAMES", "NQ", "PARAMETERS", "mass_matrix", "coriolis_matrix",
-           "gravity_vector", "inverse_dynamics", "forward_dynamics",
-           "IllConditionedWarning"]
+__all__ = ["JOINT_NAMES", "CONFIGURATION_NAMES", "NQ", "NV", "PARAMETERS",
+           "mass_matrix", "coriolis_matrix", "gravity_vector",
+           "inverse_dynamics", "forward_dynamics", "IllConditionedWarning"]
 
 JOINT_NAMES = (
     'joint1',
@@ -25,12 +25,21 @@ JOINT_NAMES = (
     'joint5',
     'joint6',
 )
+CONFIGURATION_NAMES = (
+    'joint1',
+    'joint2',
+    'joint3',
+    'joint4',
+    'joint5',
+    'joint6',
+)
 NQ = 6
+NV = 6
 PARAMETERS = {
 }
 
 
-def _batch(x, name, size=NQ):
+def _batch(x, name, size=NV):
     """x as a float array of shape (N, size), and whether it was a single state."""
     x = np.asarray(x, dtype=float)
     if x.ndim == 1 and x.shape[0] == size:
@@ -41,7 +50,7 @@ def _batch(x, name, size=NQ):
 
 
 def _states(*named):
-    """The (array, name) or (array, name, size) inputs as float arrays of shape (N, NQ) or
+    """The (array, name) or (array, name, size) inputs as float arrays of shape (N, NV) or
     (N, size), then whether all of them were single states."""
     arrays, singles = [], []
     for x, name, *size in named:
@@ -59,7 +68,7 @@ def mass_matrix(q):
 
     Parameters
     ----------
-    q : array, shape (NQ,) or (N, NQ)
+    q : array, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
 
     Returns
@@ -254,9 +263,9 @@ def coriolis_matrix(q, qd):
 
     Parameters
     ----------
-    q : array, shape (NQ,) or (N, NQ)
+    q : array, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
-    qd : array, shape (NQ,) or (N, NQ)
+    qd : array, shape (NV,) or (N, NV)
         Joint velocities [rad/s or m/s], in JOINT_NAMES order.
 
     Returns
@@ -742,7 +751,7 @@ def gravity_vector(q):
 
     Parameters
     ----------
-    q : array, shape (NQ,) or (N, NQ)
+    q : array, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
 
     Returns
@@ -807,11 +816,11 @@ def inverse_dynamics(q, qd, qdd):
 
     Parameters
     ----------
-    q : array, shape (NQ,) or (N, NQ)
+    q : array, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
-    qd : array, shape (NQ,) or (N, NQ)
+    qd : array, shape (NV,) or (N, NV)
         Joint velocities [rad/s or m/s], in JOINT_NAMES order.
-    qdd : array, shape (NQ,) or (N, NQ)
+    qdd : array, shape (NV,) or (N, NV)
         Joint accelerations [rad/s^2 or m/s^2], in JOINT_NAMES order.
 
     Returns
@@ -1123,9 +1132,11 @@ def forward_dynamics(q, qd, tau, *, return_condition=False):
 
     Parameters
     ----------
-    q, qd : array, shape (NQ,) or (N, NQ)
-        Joint positions [rad or m] and velocities [rad/s or m/s], in JOINT_NAMES order.
-    tau : array, shape (NQ,) or (N, NQ)
+    q : array, shape (NQ,) or (N, NQ)
+        Joint positions [rad or m], in CONFIGURATION_NAMES order.
+    qd : array, shape (NV,) or (N, NV)
+        Joint velocities [rad/s or m/s], in JOINT_NAMES order.
+    tau : array, shape (NV,) or (N, NV)
         Joint efforts [N m or N].
     return_condition : bool
         Also return the condition number of M (see above).
@@ -1151,9 +1162,9 @@ def forward_dynamics(q, qd, tau, *, return_condition=False):
     FloatingPointError
         When M, C qd + g or tau is not finite at some state (overflow, non-finite input).
     """
-    q_batch, qd_batch, tau_batch, single = _states((q, "q"), (qd, "qd"), (tau, "tau"))
+    q_batch, qd_batch, tau_batch, single = _states((q, "q", NQ), (qd, "qd"), (tau, "tau"))
     M = mass_matrix(q_batch)
-    bias = inverse_dynamics(q_batch, qd_batch, np.zeros_like(q_batch))
+    bias = inverse_dynamics(q_batch, qd_batch, np.zeros_like(qd_batch))
     rhs = tau_batch - bias
     qdd, condition = _cholesky_solve(M[0] if single else M, rhs[0] if single else rhs,
                                      who="forward_dynamics: ", stacklevel=2)

@@ -19,8 +19,9 @@ are SI.
 
 import casadi as ca
 
-__all__ = ["JOINT_NAMES", "NQ", "PARAMETERS", "mass_matrix", "coriolis_matrix",
-           "gravity_vector", "inverse_dynamics", "forward_dynamics"]
+__all__ = ["JOINT_NAMES", "CONFIGURATION_NAMES", "NQ", "NV", "PARAMETERS",
+           "mass_matrix", "coriolis_matrix", "gravity_vector",
+           "inverse_dynamics", "forward_dynamics"]
 
 JOINT_NAMES = (
     'shoulder_pan_joint',
@@ -30,7 +31,16 @@ JOINT_NAMES = (
     'wrist_2_joint',
     'wrist_3_joint',
 )
+CONFIGURATION_NAMES = (
+    'shoulder_pan_joint',
+    'shoulder_lift_joint',
+    'elbow_joint',
+    'wrist_1_joint',
+    'wrist_2_joint',
+    'wrist_3_joint',
+)
 NQ = 6
+NV = 6
 PARAMETERS = {
 }
 #: default_in of the parameter inputs: their PARAMETERS values, NaN for a parameter without one.
@@ -738,9 +748,9 @@ def _function(name, inputs, outputs, input_names, output_names):
 
 def _build():
     q = ca.SX.sym("q", NQ)
-    qd = ca.SX.sym("qd", NQ)
-    qdd = ca.SX.sym("qdd", NQ)
-    tau = ca.SX.sym("tau", NQ)
+    qd = ca.SX.sym("qd", NV)
+    qdd = ca.SX.sym("qdd", NV)
+    tau = ca.SX.sym("tau", NV)
     parameters = []
     names = []
     vectors = {"q": q, "qd": qd, "qdd": qdd, "tau": tau}
@@ -762,7 +772,7 @@ def _build():
         "inverse_dynamics", args + parameters, [_inverse_dynamics_expression(*args, *parameters)],
         ["q", "qd", "qdd"] + names, ["tau"])
     M = _mass_matrix_expression(q, *parameters)
-    bias = _inverse_dynamics_expression(q, qd, ca.SX.zeros(NQ, 1), *parameters)
+    bias = _inverse_dynamics_expression(q, qd, ca.SX.zeros(NV, 1), *parameters)
     functions["forward_dynamics"] = _function(
         "forward_dynamics", [q, qd, tau] + parameters, [_cholesky_solve(M, tau - bias)],
         ["q", "qd", "tau"] + names, ["qdd"])

@@ -4,7 +4,7 @@
 """Equations of motion M(q) qdd + C(q, qd) qd + g(q) = tau of robot 'ur5', in PyTorch.
 
 Joint order: JOINT_NAMES (the movable joints in the order the description lists them).
-Every function takes one state, tensors of shape (NQ,), or a batch, tensors of shape (N, NQ),
+Every function takes one state, tensors of shape (NV,), or a batch, tensors of shape (N, NV),
 and returns the matching shape: a single result only when every input is a single state, and a
 ValueError when the inputs hold different numbers of states. Results are on the inputs' device
 in their (promoted) floating dtype; integer inputs, lists and NumPy arrays become tensors of
@@ -17,9 +17,9 @@ import warnings as _warnings
 
 import torch
 
-__all__ = ["JOINT_NAMES", "NQ", "PARAMETERS", "mass_matrix", "coriolis_matrix",
-           "gravity_vector", "inverse_dynamics", "forward_dynamics",
-           "IllConditionedWarning"]
+__all__ = ["JOINT_NAMES", "CONFIGURATION_NAMES", "NQ", "NV", "PARAMETERS",
+           "mass_matrix", "coriolis_matrix", "gravity_vector",
+           "inverse_dynamics", "forward_dynamics", "IllConditionedWarning"]
 
 JOINT_NAMES = (
     'shoulder_pan_joint',
@@ -29,17 +29,26 @@ JOINT_NAMES = (
     'wrist_2_joint',
     'wrist_3_joint',
 )
+CONFIGURATION_NAMES = (
+    'shoulder_pan_joint',
+    'shoulder_lift_joint',
+    'elbow_joint',
+    'wrist_1_joint',
+    'wrist_2_joint',
+    'wrist_3_joint',
+)
 NQ = 6
+NV = 6
 PARAMETERS = {
 }
 
 
 def _states(*named):
-    """The (tensor, name) or (tensor, name, size) inputs as floating tensors of shape (N, NQ) or
+    """The (tensor, name) or (tensor, name, size) inputs as floating tensors of shape (N, NV) or
     (N, size) and one dtype, then whether all of them were single states."""
     arrays, singles = [], []
     for x, name, *size in named:
-        size = size[0] if size else NQ
+        size = size[0] if size else NV
         x = torch.as_tensor(x)
         if not x.is_floating_point():
             x = x.to(torch.get_default_dtype())
@@ -66,7 +75,7 @@ def mass_matrix(q):
 
     Parameters
     ----------
-    q : tensor, shape (NQ,) or (N, NQ)
+    q : tensor, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
 
     Returns
@@ -252,9 +261,9 @@ def coriolis_matrix(q, qd):
 
     Parameters
     ----------
-    q : tensor, shape (NQ,) or (N, NQ)
+    q : tensor, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
-    qd : tensor, shape (NQ,) or (N, NQ)
+    qd : tensor, shape (NV,) or (N, NV)
         Joint velocities [rad/s or m/s], in JOINT_NAMES order.
 
     Returns
@@ -733,7 +742,7 @@ def gravity_vector(q):
 
     Parameters
     ----------
-    q : tensor, shape (NQ,) or (N, NQ)
+    q : tensor, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
 
     Returns
@@ -780,11 +789,11 @@ def inverse_dynamics(q, qd, qdd):
 
     Parameters
     ----------
-    q : tensor, shape (NQ,) or (N, NQ)
+    q : tensor, shape (NV,) or (N, NV)
         Joint positions [rad or m], in JOINT_NAMES order.
-    qd : tensor, shape (NQ,) or (N, NQ)
+    qd : tensor, shape (NV,) or (N, NV)
         Joint velocities [rad/s or m/s], in JOINT_NAMES order.
-    qdd : tensor, shape (NQ,) or (N, NQ)
+    qdd : tensor, shape (NV,) or (N, NV)
         Joint accelerations [rad/s^2 or m/s^2], in JOINT_NAMES order.
 
     Returns
@@ -1010,9 +1019,11 @@ def forward_dynamics(q, qd, tau, *, return_condition=False):
 
     Parameters
     ----------
-    q, qd : tensor, shape (NQ,) or (N, NQ)
-        Joint positions [rad or m] and velocities [rad/s or m/s], in JOINT_NAMES order.
-    tau : tensor, shape (NQ,) or (N, NQ)
+    q : tensor, shape (NQ,) or (N, NQ)
+        Joint positions [rad or m], in CONFIGURATION_NAMES order.
+    qd : tensor, shape (NV,) or (N, NV)
+        Joint velocities [rad/s or m/s], in JOINT_NAMES order.
+    tau : tensor, shape (NV,) or (N, NV)
         Joint efforts [N m or N].
     return_condition : bool
         Also return the condition number of M (see above).
@@ -1036,9 +1047,9 @@ def forward_dynamics(q, qd, tau, *, return_condition=False):
     FloatingPointError
         When M, C qd + g or tau is not finite at some state (overflow, non-finite input).
     """
-    q, qd, tau, single = _states((q, "q"), (qd, "qd"), (tau, "tau"))
+    q, qd, tau, single = _states((q, "q", NQ), (qd, "qd"), (tau, "tau"))
     M = mass_matrix(q)
-    bias = inverse_dynamics(q, qd, torch.zeros_like(q))
+    bias = inverse_dynamics(q, qd, torch.zeros_like(qd))
     rhs = tau - bias
     finite = torch.isfinite(M).flatten(1).all(dim=1) & torch.isfinite(rhs).all(dim=1)
     if not bool(finite.all()):
@@ -1054,7 +1065,7 @@ def forward_dynamics(q, qd, tau, *, return_condition=False):
     eps = torch.finfo(M.dtype).eps
     with torch.no_grad():
         d = torch.diagonal(L, dim1=1, dim2=2)
-        condition = (d.amax(dim=1) / d.amin(dim=1)) ** 2 if NQ else M.new_ones(M.shape[0])
+        condition = (d.amax(dim=1) / d.amin(dim=1)) ** 2 if NV else M.new_ones(M.shape[0])
         close = condition > 1e-4 * (1e-6 / eps)
         if bool(close.any()):  # near the limit: the exact 2-norm condition number
             eigenvalues = torch.linalg.eigvalsh(M[close])
