@@ -12,8 +12,10 @@ Version 1 of the format (every key but ``version`` is optional)::
     robot: talos                  # the robot's name; another robot is an error
     description: Left arm, the rest of the robot held still.
     fixed_base: true              # the root link is bolted to the world, on purpose
-    floating_base: false          # or: the root link flies free (six virtual joints);
-                                  #   'base: floating' says the same
+    floating_base: false          # or: the root link flies free: true or 'euler' (six
+                                  #   virtual joints, ZYX Euler angles), 'quaternion'
+                                  #   (Pinocchio's free flyer, NQ = NV + 1);
+                                  #   'base: floating' says the same as true
     base: torso_2_link            # the link the moving part hangs from (default: the root)
     tips: [arm_left_7_link]       # its ends (default: everything below base)
     locked:                       # joint: position [rad or m]; other joints outside the
@@ -83,6 +85,9 @@ ACTUATOR_ALIASES = ("friction", "armature", "flexible_joints")
 
 PAYLOAD_KEYS = ("link", "name", "mass", "com", "inertia")
 
+#: The values of ``floating_base`` and what they mean: no floating base, or its chart.
+FLOATING_CHARTS = {False: False, True: "euler", "euler": "euler", "quaternion": "quaternion"}
+
 #: ``base: floating`` is short for ``floating_base: true`` (a link of this name cannot be a
 #: scene's base).
 FLOATING = "floating"
@@ -113,8 +118,11 @@ class Scene:
         root that looks like a floating base (:mod:`eomgen.parsers.urdf`), as the task holds
         the robot still (an arm of a humanoid on a fixed torso, a legged robot on a stand).
     floating_base:
-        The root link flies free: :func:`eomgen.floating.add_floating_base` puts six virtual
-        joints (x, y, z, yaw, pitch, roll) between a fixed ``world`` link and it.
+        The root link flies free: ``"euler"`` (what ``true`` means):
+        :func:`eomgen.floating.add_floating_base` puts six virtual joints (x, y, z, yaw,
+        pitch, roll) between a fixed ``world`` link and it; ``"quaternion"``:
+        :func:`eomgen.free_flyer.add_free_flyer`, Pinocchio's free flyer (a unit quaternion in
+        q, the root twist in v). False for a root that does not fly.
     base, tips:
         The moving part is every movable joint on a path from ``base`` (default: the root) to
         one of ``tips`` (default: every joint below ``base``).
@@ -155,7 +163,7 @@ class Scene:
     parameters: tuple[Parameter, ...] = ()
     symbolic: tuple[str, ...] | None = None
     outputs: tuple[str, ...] | None = None
-    floating_base: bool = False
+    floating_base: bool | str = False
     contacts: tuple[Contact, ...] = ()
     frames: tuple[str, ...] = ()
 
@@ -254,13 +262,15 @@ def _read(data: dict, source: str, strict: bool) -> Scene:
     if not isinstance(fixed_base, bool):
         raise r.error("fixed_base", f"expected true or false, got {fixed_base!r}")
     floating_base = data.get("floating_base", False)
-    if not isinstance(floating_base, bool):
-        raise r.error("floating_base", f"expected true or false, got {floating_base!r}")
+    if floating_base not in FLOATING_CHARTS:
+        raise r.error("floating_base", "expected true, false, 'euler' or 'quaternion', got "
+                      f"{floating_base!r}")
     if data.get("base") == FLOATING:  # the spelling: base: floating
         if "floating_base" in data and not floating_base:
             raise r.error("base", "'base: floating' contradicts 'floating_base: false'")
-        floating_base = True
+        floating_base = floating_base or True
         data = {k: v for k, v in data.items() if k != "base"}
+    floating_base = FLOATING_CHARTS[floating_base]
     if floating_base and fixed_base:
         raise r.error("floating_base", "the base cannot be both fixed (fixed_base: true) and "
                       "floating")

@@ -11,6 +11,7 @@ import sympy as sp
 from ..bodies import attach_fixed_links
 from ..errors import DescriptionError
 from ..floating import EULER_JOINTS, add_floating_base
+from ..free_flyer import VELOCITY_NAMES, add_free_flyer
 from ..model import (
     Actuator,
     Joint,
@@ -67,8 +68,14 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
     before = ModelSize.of(model)
     model = _with_actuators(model, scene)
     model, payloads, scene_gravity, notes = _parameters(model, scene)
-    if scene.floating_base:
-        model = _float(model, scene)
+    if scene.floating_base == "quaternion":
+        model = _float(model, scene, add_free_flyer)
+        notes.append(f"the root link '{model.joints[5].child}' floats: a free flyer (q: "
+                     "position and quaternion x, y, z, w; v: the root twist "
+                     f"{', '.join(VELOCITY_NAMES)}) from the fixed link '{model.root}' (see "
+                     "eomgen.free_flyer)")
+    elif scene.floating_base:
+        model = _float(model, scene, add_floating_base)
         notes.append(f"the root link '{model.joints[5].child}' floats: six virtual joints "
                      f"{', '.join(EULER_JOINTS)} (position, ZYX Euler angles) from the fixed "
                      f"link '{model.root}' (see eomgen.floating)")
@@ -118,15 +125,17 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
         dropped=dropped,
         dropped_payloads=dropped_payloads, planar=planar, notes=tuple(notes),
         outputs=select(scene.outputs), contacts=scene.contacts,
-        virtual_joints=EULER_JOINTS if scene.floating_base else ())
+        virtual_joints=(VELOCITY_NAMES if scene.floating_base == "quaternion" else
+                        EULER_JOINTS if scene.floating_base else ()))
     return Reduction(reduced, report)
 
 
-def _float(model: RobotModel, scene: Scene) -> RobotModel:
-    """``model`` with a floating base (:func:`eomgen.floating.add_floating_base`); its
-    errors name the scene's ``floating_base`` entry."""
+def _float(model: RobotModel, scene: Scene, add) -> RobotModel:
+    """``model`` with a floating base (``add``: :func:`eomgen.floating.add_floating_base` or
+    :func:`eomgen.free_flyer.add_free_flyer`); its errors name the scene's ``floating_base``
+    entry."""
     try:
-        return add_floating_base(model)
+        return add(model)
     except DescriptionError as exc:
         raise scene_error(type(exc))(scene.source, "floating_base",
                                      f"{exc.element}: {exc.problem}") from None
@@ -432,7 +441,7 @@ def _merge(model: RobotModel, payloads: Sequence[Payload]):
     info = tuple((k, v) for k, v in model.info if not str(k).startswith("dh"))
     reduced = RobotModel(name=model.name, links=tuple(links), joints=tuple(joints),
                          root=model.root, gravity=model.gravity, parameters=model.parameters,
-                         source=model.source, info=info)
+                         source=model.source, info=info, free_flyer=model.free_flyer)
     return reduced, tuple(merged), tuple(dropped), tuple(dropped_payloads)
 
 

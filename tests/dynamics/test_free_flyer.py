@@ -122,3 +122,46 @@ def test_integrate_and_difference_equal_pinocchio(case):
         assert relative(q1[7:], expected[7:]) < 1e-12
         assert relative(difference(q, q1), pin.difference(pm, q, expected)) < 1e-10
     assert np.array_equal(neutral(pm.nq), pin.neutral(pm))
+
+
+SOLO = "solo_description/robots/solo12.urdf"
+TALOS = "talos_data/robots/talos_reduced.urdf"
+
+
+def erd_path(relative_path):
+    from support import erd_robots_dir
+    robots = erd_robots_dir()
+    if robots is None:
+        pytest.skip("example-robot-data is not installed")
+    return robots / relative_path
+
+
+@pytest.mark.parametrize("robot, tips", [
+    (SOLO, None), (TALOS, ("leg_left_6_link", "leg_right_6_link"))], ids=["solo12", "talos_legs"])
+def test_scene_quaternion_base_equals_pinocchio(robot, tips, tmp_path):
+    """``floating_base: quaternion`` in a scene: the NumPy module of solo12 and of Talos's
+    legs (the rest locked at 0) takes Pinocchio's arrays unchanged."""
+    from eomgen.reduction import apply_scene
+    from eomgen.scene import load_scene
+    from support import load_quietly
+    path = erd_path(robot)
+    text = "version: 1\nfloating_base: quaternion\n" + (
+        f"tips: [{', '.join(tips)}]\n" if tips else "")
+    model, report = apply_scene(load_quietly(path), load_scene("legs.yaml", text=text))
+    assert model.free_flyer and any("free flyer" in note for note in report.notes)
+    pm = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    locked = [pm.getJointId(n) for n in pm.names[2:] if n not in model.joint_names]
+    if locked:
+        pm = pin.buildReducedModel(pm, locked, pin.neutral(pm))
+    assert list(model.joint_names[6:]) == list(pm.names[2:])
+    calls, _ = generated(model, ("M", "C", "g", "tau"), tmp_path, backends=("numpy",))
+    call, data = calls["numpy"], pm.createData()
+    for q, v, a in states(pm, count=2, seed=17):
+        M = pin.crba(pm, data, q)
+        assert relative(call("mass_matrix", q), np.triu(M) + np.triu(M, 1).T) < 1e-10
+        assert relative(call("coriolis_matrix", q, v),
+                        pin.computeCoriolisMatrix(pm, data, q, v)) < 1e-10
+        assert relative(call("gravity_vector", q).ravel(),
+                        pin.computeGeneralizedGravity(pm, data, q)) < 1e-10
+        assert relative(call("inverse_dynamics", q, v, a).ravel(),
+                        pin.rnea(pm, data, q, v, a)) < 1e-10
