@@ -28,12 +28,14 @@ def dask_map(function: Callable, *states, chunks: int = 100_000, **parameters):
     Parameters
     ----------
     function : callable
-        A generated function taking state arrays of shape ``(N, NV)`` and returning an array of
+        A generated function taking state arrays of shape ``(N, NQ)`` (q) or ``(N, NV)``
+        (the others) and returning an array of
         shape ``(N,) + S`` (``S = (NV,)`` for vectors, ``(NV, NV)`` for matrices), e.g. the
         NumPy module's inverse dynamics (see :data:`eomgen.outputs.OUTPUTS`), or a JAX one (its
         results are copied back to NumPy).
-    *states : array or dask.array, shape (N, NV)
-        The function's state arguments (q, qd, ...), in JOINT_NAMES order. NumPy arrays are
+    *states : array or dask.array, shape (N, NQ) for q, (N, NV) for the others
+        The function's state arguments (q, qd, ...), in CONFIGURATION_NAMES and JOINT_NAMES
+        order. NumPy arrays are
         split into chunks of ``chunks`` states; dask arrays are rechunked to the first one's
         chunks of states, with all joints of a state in one chunk.
     chunks : int
@@ -63,8 +65,9 @@ def dask_map(function: Callable, *states, chunks: int = 100_000, **parameters):
     arrays = [x if isinstance(x, da.Array) else da.from_array(np.asarray(x, dtype=float),
                                                              chunks=(chunks, -1))
               for x in states]
-    if any(x.ndim != 2 for x in arrays) or len({x.shape for x in arrays}) != 1:
-        raise ValueError("dask_map: the states must be arrays of one shape (N, NV), got "
+    if any(x.ndim != 2 for x in arrays) or len({x.shape[0] for x in arrays}) != 1:
+        raise ValueError("dask_map: the states must be 2-D arrays of the same number of "
+                         "states N ((N, NQ) for q, (N, NV) for the others), got "
                          + ", ".join(str(x.shape) for x in arrays))
     rows = arrays[0].chunks[0]
     arrays = [x.rechunk((rows, -1)) for x in arrays]

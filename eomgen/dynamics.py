@@ -18,7 +18,7 @@ from typing import Iterable
 import sympy as sp
 
 from . import reprs
-from .errors import TooLargeError
+from .errors import TooLargeError, UnsupportedError
 from .model import Parameter, RobotModel
 from .outputs import derived_symbols
 # Derivation, joint_symbols and vector_symbols live in eomgen.symbolic.derivation; re-exported here
@@ -33,6 +33,12 @@ from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS, textbo
 #: :func:`derive` builds these and every further output of :mod:`eomgen.outputs`.
 ALL_OUTPUTS = derived_symbols(default_only=True)  # ("M", "C", "g", "tau")
 DEFAULT_OUTPUTS = ("M", "C", "g")
+
+#: The outputs derived for a model with a quaternion free flyer (:mod:`eomgen.free_flyer`),
+#: each checked against Pinocchio's free flyer; the others take ∂/∂q or the frames' J̇ q̇,
+#: not yet corrected for its chart.
+FREE_FLYER_OUTPUTS = ("M", "C", "g", "P", "tau", "h", "qdd_aba", "MCg", "Mh")
+
 #: ``derive(model, simplify=True)`` refuses models with more movable joints: trigonometric
 #: simplification of the expanded expressions grows exponentially with the number of joints
 #: (hours beyond this size), while the unsimplified program stays linear.
@@ -282,6 +288,12 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     unknown = outputs - set(known)
     if unknown:
         raise ValueError(f"unknown outputs {sorted(unknown)}; choose from {known}")
+    if model.free_flyer and outputs - set(FREE_FLYER_OUTPUTS):
+        raise UnsupportedError(
+            model.source, "floating_base: quaternion",
+            f"{', '.join(sorted(outputs - set(FREE_FLYER_OUTPUTS)))} not derived for a "
+            f"quaternion free flyer yet (it has {', '.join(FREE_FLYER_OUTPUTS)}); use "
+            "floating_base: euler")
     if simplify and model.dof > MAX_SIMPLIFY_JOINTS:
         raise TooLargeError(
             model.source, "derive(simplify=True)",

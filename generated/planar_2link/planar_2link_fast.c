@@ -31,6 +31,10 @@ static const char *const joint_names[NV + 1] = {
     "joint1",
     "joint2",
     NULL};
+static const char *const configuration_names[NQ + 1] = {
+    "joint1",
+    "joint2",
+    NULL};
 static const char *const parameter_names[NP + 1] = {
     "I1",  /* inertia of link 1 about z through its centre of mass [kg m^2] */
     "I2",  /* inertia of link 2 about z through its centre of mass [kg m^2] */
@@ -605,18 +609,25 @@ static struct PyModuleDef module_definition = {
 
 PyMODINIT_FUNC PyInit_planar_2link_fast(void)
 {
-    PyObject *module, *names, *parameters, *exports, *linalg;
+    PyObject *module, *names, *configuration, *parameters, *exports, *linalg;
     int i;
     import_array();
     module = PyModule_Create(&module_definition);
     if (module == NULL)
         return NULL;
     names = PyTuple_New(NV);
+    configuration = PyTuple_New(NQ);
     parameters = PyDict_New();
-    exports = Py_BuildValue("[ssssssssss]", "JOINT_NAMES", "NQ",
-                            "NV", "PARAMETERS", "mass_matrix", "coriolis_matrix", "gravity_vector", "inverse_dynamics", "forward_dynamics", "IllConditionedWarning");
-    if (names == NULL || parameters == NULL || exports == NULL)
+    exports = Py_BuildValue("[sssssssssss]", "JOINT_NAMES",
+                            "CONFIGURATION_NAMES", "NQ", "NV", "PARAMETERS", "mass_matrix", "coriolis_matrix", "gravity_vector", "inverse_dynamics", "forward_dynamics", "IllConditionedWarning");
+    if (names == NULL || configuration == NULL || parameters == NULL || exports == NULL)
         goto fail;
+    for (i = 0; i < NQ; ++i) {
+        PyObject *name = PyUnicode_FromString(configuration_names[i]);
+        if (name == NULL)
+            goto fail;
+        PyTuple_SET_ITEM(configuration, i, name);
+    }
     for (i = 0; i < NV; ++i) {
         PyObject *name = PyUnicode_FromString(joint_names[i]);
         if (name == NULL)
@@ -646,6 +657,7 @@ PyMODINIT_FUNC PyInit_planar_2link_fast(void)
     if (ill_conditioned_warning == NULL)
         goto fail;
     if (PyModule_AddObjectRef(module, "JOINT_NAMES", names) < 0 ||
+            PyModule_AddObjectRef(module, "CONFIGURATION_NAMES", configuration) < 0 ||
             PyModule_AddIntConstant(module, "NQ", NQ) < 0 ||
             PyModule_AddIntConstant(module, "NV", NV) < 0 ||
             PyModule_AddObjectRef(module, "PARAMETERS", parameters) < 0 ||
@@ -653,11 +665,13 @@ PyMODINIT_FUNC PyInit_planar_2link_fast(void)
             PyModule_AddObjectRef(module, "__all__", exports) < 0)
         goto fail;
     Py_DECREF(names);
+    Py_DECREF(configuration);
     Py_DECREF(parameters);
     Py_DECREF(exports);
     return module;
 fail:
     Py_XDECREF(names);
+    Py_XDECREF(configuration);
     Py_XDECREF(parameters);
     Py_XDECREF(exports);
     Py_DECREF(module);

@@ -3,7 +3,7 @@ on its own, with the C compiler eomgen finds, free of warnings under -Wall -Wext
 the generated modules hold its text (below the marker line) unchanged.
 
 A file is compiled as one translation unit: for the call runtime, behind what a generated
-module defines before it (NQ, NP, MAX_IN, the parameter tables); after it, a table that takes
+module defines before it (NQ, NV, NP, MAX_IN, the parameter tables); after it, a table that takes
 the address of every static function and variable it defines, so that none is unused.
 """
 
@@ -27,6 +27,7 @@ WARNINGS = ("-Wall", "-Wextra", "-Werror")
 MODULE_CONSTANTS = """\
 #include <stddef.h>
 #define NQ 2
+#define NV 2
 #define NP 1
 #define MAX_IN 3
 static const char *const parameter_names[NP + 1] = {"m2", NULL};

@@ -55,7 +55,7 @@ from support.reference import random_robot
 RTOL = 1e-10
 
 #: What every generated Python module exports.
-PUBLIC = ("JOINT_NAMES", "NQ", "PARAMETERS", "mass_matrix", "coriolis_matrix", "gravity_vector",
+PUBLIC = ("JOINT_NAMES", "CONFIGURATION_NAMES", "NQ", "NV", "PARAMETERS", "mass_matrix", "coriolis_matrix", "gravity_vector",
           "inverse_dynamics", "forward_dynamics")
 #: The NumPy module also exports the category of forward_dynamics' ill-conditioning warning.
 PUBLIC_EXTRA = {"numpy": ("IllConditionedWarning",), "casadi": ()}

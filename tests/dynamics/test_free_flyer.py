@@ -165,3 +165,10 @@ def test_scene_quaternion_base_equals_pinocchio(robot, tips, tmp_path):
                         pin.computeGeneralizedGravity(pm, data, q)) < 1e-10
         assert relative(call("inverse_dynamics", q, v, a).ravel(),
                         pin.rnea(pm, data, q, v, a)) < 1e-10
+
+
+def test_outputs_not_derived_for_the_chart_are_refused():
+    from eomgen import derive
+    from eomgen.errors import UnsupportedError
+    with pytest.raises(UnsupportedError, match="Y not derived for a quaternion free flyer"):
+        derive(add_free_flyer(floating_tree(5, 2)), outputs=("M", "Y"))

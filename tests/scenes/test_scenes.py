@@ -403,7 +403,7 @@ def test_scene_outputs_choose_what_is_derived_and_generated(tmp_path):
     spec = importlib.util.spec_from_file_location("g_only", out / "planar_2link_numpy.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    assert module.__all__ == ["JOINT_NAMES", "NQ", "PARAMETERS", "gravity_vector"]
+    assert module.__all__ == ["JOINT_NAMES", "CONFIGURATION_NAMES", "NQ", "NV", "PARAMETERS", "gravity_vector"]
     assert not hasattr(module, "coriolis_matrix") and not hasattr(module, "forward_dynamics")
     assert "Reduced by scene 'g_only.yaml'" in (out / "planar_2link_numpy.py").read_text()
 

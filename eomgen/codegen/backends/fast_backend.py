@@ -199,6 +199,7 @@ def _render_source(job: Job, config: FastConfig) -> str:
         nv=n,
         max_inputs=max_inputs,
         joint_names=[c_string_literal(name) for name in job.dynamics.joint_names],
+        configuration_names=[c_string_literal(name) for name in job.model.configuration_names],
         parameters=parameters,
         functions=functions,
         constants=[(name, [c_string_literal(v) for v in values])

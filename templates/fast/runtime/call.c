@@ -2,7 +2,7 @@
  * i.e. the table entry of a function (function_t), parsing of a call's arrays, parameters and
  * keywords (parse), and the loop of a kernel over one state or a batch (evaluate).
  *
- * The generated module defines, before this text: NV (joints), NP (parameters kept symbolic),
+ * The generated module defines, before this text: NQ (entries of q), NV (joints), NP (parameters kept symbolic),
  * MAX_IN (most vector inputs of a function), parameter_names[NP + 1] (NULL-terminated),
  * parameter_defaults[NP + 1] and parameter_has_default[NP + 1]; and includes Python.h, NumPy's
  * arrayobject.h, <math.h> and <string.h>, as this file does.
