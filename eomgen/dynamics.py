@@ -35,9 +35,11 @@ ALL_OUTPUTS = derived_symbols(default_only=True)  # ("M", "C", "g", "tau")
 DEFAULT_OUTPUTS = ("M", "C", "g")
 
 #: The outputs derived for a model with a quaternion free flyer (:mod:`eomgen.free_flyer`),
-#: each checked against Pinocchio's free flyer; the others take ∂/∂q or the frames' J̇ q̇,
-#: not yet corrected for its chart.
-FREE_FLYER_OUTPUTS = ("M", "C", "g", "P", "tau", "h", "qdd_aba", "MCg", "Mh")
+#: each checked against Pinocchio's free flyer; the others (the regressor, the drives and
+#: flexible joints, flatness) differentiate by q, which its chart holds at zero.
+FREE_FLYER_OUTPUTS = ("M", "C", "g", "P", "tau", "h", "qdd_aba", "MCg", "Mh", "p_f", "R_f",
+                      "J_f", "Jb_f", "dJqd_f", "dJbqd_f", "J_c", "dJqd_c", "tau_c", "cone_c",
+                      "pyramid_c")
 
 #: ``derive(model, simplify=True)`` refuses models with more movable joints: trigonometric
 #: simplification of the expanded expressions grows exponentially with the number of joints

@@ -38,6 +38,7 @@ from ..model import IDENTITY3, POINT, RobotModel, Transform, ZERO3
 from .composite import forward_kinematics
 from .derivation import new_derivation
 from .evaluate import compile_program
+from .free_flyer import chart_offset
 from .program import Program, ProgramBuilder
 from .spatial import cross, matmul, matvec, motion_cross, transpose
 
@@ -196,6 +197,8 @@ def frame_kinematics(model: RobotModel, tree, q, qd, b: ProgramBuilder,
             wxv = cross(w, v_lin)
             acc = b.define_all(tuple(A[3 + r] + Axp[r] + wxv[r] for r in range(3)), f"af{k}_")
             dJqd = tuple(acc) + tuple(A[:3])
+            if any(o != 0 for o in kin.origin):  # kin.p is from the first joint's origin
+                p = b.define_all(tuple(o + e for o, e in zip(kin.origin, p)), f"pof{k}_")
         Rt = transpose(R)
         Jb = sp.zeros(6, n)
         for col in range(n):
@@ -221,6 +224,9 @@ def frame_kinematics(model: RobotModel, tree, q, qd, b: ProgramBuilder,
                         Jw[half + r, col] = b.define(rotated[r], f"Jw{k}_{half + r}_{col + 1}")
             J = Jw
             dJqd = b.define_all(matvec(R0, dJqd[:3]) + matvec(R0, dJqd[3:]), f"dJw{k}_")
+        if model.free_flyer:  # the chart's J̇ q̇ less J n(v) (eomgen.symbolic.free_flyer)
+            dJqd = corrected_bias(J, dJqd, qd, b, f"dJff{k}_")
+            dJbqd = corrected_bias(Jb, dJbqd, qd, b, f"dJbff{k}_")
         result.append({
             "p": sp.Matrix(3, 1, list(p)),
             "R": sp.Matrix(3, 3, [x for row in R for x in row]),
@@ -230,6 +236,14 @@ def frame_kinematics(model: RobotModel, tree, q, qd, b: ProgramBuilder,
             "dJbqd": sp.Matrix(6, 1, list(dJbqd)),
         })
     return result
+
+
+def corrected_bias(J: sp.Matrix, bias, qd, b: ProgramBuilder, hint: str) -> tuple:
+    """A free flyer's ``J̇ v`` from the chart's: ``bias − J[:, 0:6] n(v)``
+    (:func:`eomgen.symbolic.free_flyer.chart_offset`), named with ``hint``."""
+    n = chart_offset(qd)
+    return b.define_all(tuple(bias[r] - sp.Add(*[J[r, c] * n[c] for c in range(6)])
+                              for r in range(J.rows)), hint)
 
 
 def output_frames(model: RobotModel) -> tuple[str, ...]:

@@ -172,3 +172,67 @@ def test_outputs_not_derived_for_the_chart_are_refused():
     from eomgen.errors import UnsupportedError
     with pytest.raises(UnsupportedError, match="Y not derived for a quaternion free flyer"):
         derive(add_free_flyer(floating_tree(5, 2)), outputs=("M", "Y"))
+
+
+@pytest.fixture(scope="module")
+def contact_case(tmp_path_factory):
+    """The random tree on a point contact (a leaf link) and a surface contact (another link),
+    its frames' kinematics and contact outputs in a NumPy module, and Pinocchio's model."""
+    from eomgen.model import Contact
+    fixed = floating_tree(5, 3)
+    parents = {j.parent for j in fixed.joints}
+    leaves = [l.name for l in fixed.links if l.name not in parents]
+    contacts = (Contact(leaves[0], "point", name="foot"),
+                Contact(leaves[-1], "surface", name="hand"))
+    model = replace(add_free_flyer(fixed), contacts=contacts)
+    folder = tmp_path_factory.mktemp("free_flyer_contacts")
+    (folder / "tree.urdf").write_text(to_urdf(fixed), encoding="utf-8")
+    pm = pin.buildModelFromUrdf(str(folder / "tree.urdf"), pin.JointModelFreeFlyer())
+    pm.gravity = pin.Motion(np.array([float(x) for x in fixed.gravity]), np.zeros(3))
+    outputs = ("M", "h", "J_f", "Jb_f", "dJqd_f", "dJbqd_f", "p_f", "J_c", "dJqd_c",
+               "tau", "tau_c", "constrained_forward_dynamics")
+    calls, modules = generated(model, outputs, folder, backends=("numpy",))
+    return model, pm, calls["numpy"], modules["numpy"]
+
+
+def test_frames_equal_pinocchio(contact_case):
+    """Frame origins, world-aligned and body Jacobians (NV wide) and both J̇ v against
+    Pinocchio's frame Jacobians and accelerations at v̇ = 0."""
+    _, pm, call, module = contact_case
+    data = pm.createData()
+    for q, v, _ in states(pm, count=2, seed=23):
+        pin.forwardKinematics(pm, data, q, v, np.zeros(pm.nv))
+        pin.computeJointJacobians(pm, data, q)
+        pin.updateFramePlacements(pm, data)
+        p_f, J_f, Jb_f = call("frame_positions", q), call("frame_jacobians", q), \
+            call("frame_body_jacobians", q)
+        dJ, dJb = call("frame_jacobians_dot_qd", q, v), call("frame_body_jacobians_dot_qd", q, v)
+        assert J_f.shape[1] == pm.nv
+        for k, name in enumerate(module["FRAME_NAMES"]):
+            fid = pm.getFrameId(name)
+            world = pin.LOCAL_WORLD_ALIGNED
+            assert relative(p_f[k], data.oMf[fid].translation) < 1e-10
+            assert relative(J_f[6 * k:6 * k + 6],
+                            pin.getFrameJacobian(pm, data, fid, world)) < 1e-10
+            assert relative(Jb_f[6 * k:6 * k + 6],
+                            pin.getFrameJacobian(pm, data, fid, pin.LOCAL)) < 1e-10
+            assert relative(dJ[6 * k:6 * k + 6], pin.getFrameClassicalAcceleration(
+                pm, data, fid, world).vector) < 1e-10
+            assert relative(dJb[6 * k:6 * k + 6], pin.getFrameAcceleration(
+                pm, data, fid, pin.LOCAL).vector) < 1e-10
+
+
+def test_constrained_dynamics_hold_the_contacts(contact_case):
+    """constrained_forward_dynamics solves M v̇ + h = τ + J_cᵀ F_c, J_c v̇ + J̇_c v = 0 with
+    Pinocchio's M and h; contact_inverse_dynamics gives τ back."""
+    _, pm, call, module = contact_case
+    data = pm.createData()
+    for q, v, tau in states(pm, count=2, seed=29):
+        qdd, F = module["constrained_forward_dynamics"](q, v, tau)
+        M = pin.crba(pm, data, q)
+        M = np.triu(M) + np.triu(M, 1).T
+        J, bias = call("contact_jacobian", q), call("contact_bias", q, v)
+        assert J.shape == (9, pm.nv)
+        assert relative(M @ qdd + pin.nonLinearEffects(pm, data, q, v), tau + J.T @ F) < 1e-9
+        assert np.abs(J @ qdd + bias).max() < 1e-9 * max(1.0, np.abs(bias).max())
+        assert relative(call("contact_inverse_dynamics", q, v, qdd, F), tau) < 1e-9

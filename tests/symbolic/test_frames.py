@@ -116,3 +116,23 @@ def test_unknown_frame_is_refused():
     arm = eomgen.load(eomgen.example_path("planar_2link"))
     with pytest.raises(KinematicTreeError, match="frame 'hand'"):
         derive_frames(arm, ["hand"])
+
+
+def test_frame_positions_of_a_tree_whose_first_joint_is_offset():
+    """A fixed-base tree whose first moving joint sits away from the root origin: the frame
+    origins are world positions (Pinocchio's ``oMf``), not positions from that joint (the
+    world-frame kinematics' reference point; a bug until the free flyer's frames showed it)."""
+    pin = pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
+    from support.reference import pin_q_order, random_robot, to_pinocchio
+    model = random_robot(np.random.default_rng(5), 3, tree=True)
+    assert any(v != 0 for v in model.joints[0].origin.translation)
+    leaves = [l.name for l in model.links if l.name not in {j.parent for j in model.joints}]
+    frames = derive_frames(model, leaves)
+    pm = to_pinocchio(model)
+    perm = pin_q_order(model, pm)
+    q = np.random.default_rng(1).normal(size=model.dof)
+    data = pm.createData()
+    pin.forwardKinematics(pm, data, q[perm])
+    pin.updateFramePlacements(pm, data)
+    for name, values in frames.evaluate(q).items():
+        assert np.allclose(values["p"], data.oMf[pm.getFrameId(name)].translation, atol=1e-12)
