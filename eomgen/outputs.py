@@ -344,6 +344,30 @@ def splits(output: Output, n: int) -> tuple[tuple[str, int, int | None], ...]:
     return tuple(out)
 
 
+# --- issue 27: centroidal quantities (eomgen.symbolic.centroidal) ----------------------------
+_CENTROIDAL = "eomgen.symbolic.centroidal:build_centroidal"
+CENTER_OF_MASS = register_output(Output(
+    "center_of_mass", "c_G", "Centre of mass c of the robot in world coordinates: (3,).",
+    ("q",), True, "m", ("c_G",), build=_CENTROIDAL, default=False))
+CENTER_OF_MASS_JACOBIAN = register_output(Output(
+    "center_of_mass_jacobian", "J_G", "Jacobian of the centre of mass, cdot = J_G qd: (3, n).",
+    ("q",), False, "m/rad or 1", ("J_G",), build=_CENTROIDAL, default=False))
+CENTROIDAL_MAP = register_output(Output(
+    "centroidal_momentum_matrix", "A_G", "Centroidal momentum matrix A_G, h_G = A_G qd = "
+    "[linear; angular momentum about the centre of mass], world axes: (6, n).", ("q",), False,
+    "kg m/rad or kg (linear rows), kg m^2/rad or kg m (angular rows)", ("A_G",),
+    build=_CENTROIDAL, default=False))
+CENTROIDAL_BIAS = register_output(Output(
+    "centroidal_momentum_bias", "dAGv", "Centroidal momentum bias A_G-dot qd: the rate of h_G "
+    "at qdd = 0, [linear; angular]: (6,).", ("q", "qd"), True, "N, N m", ("dAGv",),
+    build=_CENTROIDAL, default=False))
+CENTROIDAL_INERTIA = register_output(Output(
+    "centroidal_composite_inertia", "I_G", "Centroidal composite inertia [[m 1, 0], [0, I_c]], "
+    "I_c the rotational inertia about the centre of mass in world axes: (6, 6).", ("q",),
+    False, "kg (upper block), kg m^2 (lower block)", ("I_G",), build=_CENTROIDAL,
+    default=False))
+
+
 # --- issue 16: frame kinematics and contacts (eomgen.symbolic.frames) -----------------------
 _FRAMES = "eomgen.symbolic.frames:build_frames"
 _FRAME_NAMES = "eomgen.symbolic.frames:frame_constants"

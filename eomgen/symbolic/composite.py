@@ -156,7 +156,7 @@ def is_ancestor_or_self(tree: BodyTree, a: int, j: int) -> bool:
     return False
 
 
-def _world_composites(tree: BodyTree, q, b: ProgramBuilder) -> tuple:
+def world_composites(tree: BodyTree, q, b: ProgramBuilder) -> tuple:
     """World-frame kinematics, body and composite inertias and ``F_j = I^c_j S_j`` of every
     body (built once per builder, tree and q)."""
     key = ("world composites", id(tree), tuple(q))
@@ -175,7 +175,7 @@ def composite_M_program(tree: BodyTree, q, b: ProgramBuilder) -> sp.Matrix:
     """M(q) as ``M_ij = S_iᵀ F_j`` in world axes (module docstring), n×n, ``JOINT_NAMES``
     order [kg m², kg m, kg]."""
     n = len(tree.bodies)
-    kin, _, _, F = _world_composites(tree, q, b)
+    kin, _, _, F = world_composites(tree, q, b)
     idx = [body.q_index for body in tree.bodies]
     M = sp.zeros(n, n)
     for j in range(n):
@@ -189,7 +189,7 @@ def composite_M_program(tree: BodyTree, q, b: ProgramBuilder) -> sp.Matrix:
 def composite_gravity_program(tree: BodyTree, q, gravity: Vec3, b: ProgramBuilder) -> sp.Matrix:
     """g(q) as ``g_i = −g_vecᵀ f_i``, ``f_i`` the linear part of ``F_i`` (module docstring),
     n×1 [N m or N]."""
-    _, _, _, F = _world_composites(tree, q, b)
+    _, _, _, F = world_composites(tree, q, b)
     g = sp.zeros(len(tree.bodies), 1)
     for i, body in enumerate(tree.bodies):
         g[body.q_index, 0] = b.define(-dot(gravity, F[i][3:]), f"g{body.q_index + 1}",
@@ -200,7 +200,7 @@ def composite_gravity_program(tree: BodyTree, q, gravity: Vec3, b: ProgramBuilde
 def christoffel_coriolis_program(tree: BodyTree, q, qd, b: ProgramBuilder) -> sp.Matrix:
     """C(q, q̇) from the Christoffel symbols of the first kind and the closed-form ∂M/∂q of the
     module docstring, n×n, ``JOINT_NAMES`` order."""
-    kin, _, comp, F = _world_composites(tree, q, b)
+    kin, _, comp, F = world_composites(tree, q, b)
     return _coriolis(tree, kin.S, F, comp, qd, [body.q_index for body in tree.bodies], b)
 
 
@@ -243,7 +243,7 @@ def coriolis_program(tree: BodyTree, q, qd, b: ProgramBuilder) -> sp.Matrix:
     """
     n = len(tree.bodies)
     idx = [body.q_index + 1 for body in tree.bodies]
-    kin, world, comp, F_all = _world_composites(tree, q, b)
+    kin, world, comp, F_all = world_composites(tree, q, b)
     S = kin.S
     zero6 = (sp.Integer(0),) * 6
     V, Sd = [], []

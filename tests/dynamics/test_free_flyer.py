@@ -190,7 +190,8 @@ def contact_case(tmp_path_factory):
     pm = pin.buildModelFromUrdf(str(folder / "tree.urdf"), pin.JointModelFreeFlyer())
     pm.gravity = pin.Motion(np.array([float(x) for x in fixed.gravity]), np.zeros(3))
     outputs = ("M", "h", "J_f", "Jb_f", "dJqd_f", "dJbqd_f", "p_f", "J_c", "dJqd_c",
-               "tau", "tau_c", "constrained_forward_dynamics")
+               "tau", "tau_c", "constrained_forward_dynamics", "c_G", "J_G", "A_G", "dAGv",
+               "I_G")
     calls, modules = generated(model, outputs, folder, backends=("numpy",))
     return model, pm, calls["numpy"], modules["numpy"]
 
@@ -236,3 +237,26 @@ def test_constrained_dynamics_hold_the_contacts(contact_case):
         assert relative(M @ qdd + pin.nonLinearEffects(pm, data, q, v), tau + J.T @ F) < 1e-9
         assert np.abs(J @ qdd + bias).max() < 1e-9 * max(1.0, np.abs(bias).max())
         assert relative(call("contact_inverse_dynamics", q, v, qdd, F), tau) < 1e-9
+
+
+def test_centroidal_quantities_equal_pinocchio(contact_case):
+    """Centre of mass, its Jacobian, A_G, Ȧ_G v and the centroidal composite inertia against
+    centerOfMass, jacobianCenterOfMass, computeCentroidalMap, computeCentroidalMapTimeVariation
+    and ccrba's Ig; and the centroidal equation ḣ_G = [m g; 0] in free fall (Pinocchio's aba)."""
+    _, pm, call, _ = contact_case
+    data = pm.createData()
+    mass = sum(inertia.mass for inertia in pm.inertias)
+    for q, v, _ in states(pm, count=2, seed=31):
+        assert relative(call("center_of_mass", q), pin.centerOfMass(pm, data, q)) < 1e-10
+        assert relative(call("center_of_mass_jacobian", q),
+                        pin.jacobianCenterOfMass(pm, data, q)) < 1e-10
+        A_G = call("centroidal_momentum_matrix", q)
+        assert relative(A_G, pin.computeCentroidalMap(pm, data, q)) < 1e-10
+        dA = pin.computeCentroidalMapTimeVariation(pm, data, q, v)
+        bias = call("centroidal_momentum_bias", q, v)
+        assert relative(bias, dA @ v) < 1e-10
+        pin.ccrba(pm, data, q, v)
+        assert relative(call("centroidal_composite_inertia", q), data.Ig.matrix()) < 1e-10
+        falling = pin.aba(pm, data, q, v, np.zeros(pm.nv))
+        rate = A_G @ falling + bias
+        assert relative(rate, np.concatenate([mass * pm.gravity.linear, np.zeros(3)])) < 1e-9
