@@ -44,6 +44,33 @@ def _motions(tree, kin, qd, b) -> tuple[list, list]:
     return V, A
 
 
+def free_flyer_momentum(derivation) -> tuple[list, sp.Matrix]:
+    """The centre of mass (world) and A_G of a free-flyer model from the first six rows of M:
+    with the root twist as the first velocities, ``M[0:6, :]`` is the robot's momentum map
+    about the root origin in root axes (force rows first), and ``M[0:3, 3:6] = −m [c_b]×``
+    gives the centre of mass ``c_b`` in root axes. Rotated by the root's R and shifted to the
+    centre of mass: ``A_G[:, j] = [R f_j; R (n_j − c_b × f_j)]``. Cheaper than the world-frame
+    composites when M's rows are in the program anyway (solo12: see
+    benchmarks/legged_speed.py)."""
+    b, M = derivation.builder, derivation.output("M")
+    placement = derivation.tree.bodies[0].placement
+    R, p = placement.rotation, placement.translation
+    inv_mass = b.define(1 / M[0, 0], "inv_mtot", ("mtot",))
+    c_b = b.define_all((M[1, 5] * inv_mass, M[2, 3] * inv_mass, M[0, 4] * inv_mass), "cb")
+    Rc = [sp.Add(*[R[r][k] * c_b[k] for k in range(3)]) for r in range(3)]
+    com = [p[r] + Rc[r] for r in range(3)]
+    A_G = sp.zeros(6, M.cols)
+    for j in range(M.cols):
+        f = [M[r, j] for r in range(3)]
+        c_f = cross(c_b, f)
+        moment = [M[3 + r, j] - c_f[r] for r in range(3)]
+        for r in range(3):
+            A_G[r, j] = b.define(sp.Add(*[R[r][k] * f[k] for k in range(3)]), f"AGf{r}_{j + 1}")
+            A_G[3 + r, j] = b.define(sp.Add(*[R[r][k] * moment[k] for k in range(3)]),
+                                     f"AGn{r}_{j + 1}")
+    return com, A_G
+
+
 def build_centroidal(derivation, wanted) -> dict:
     """The builder of ``c_G``, ``J_G``, ``A_G``, ``dAGv`` and ``I_G`` (module docstring)."""
     tree, b, n = derivation.tree, derivation.builder, derivation.model.dof
@@ -54,15 +81,19 @@ def build_centroidal(derivation, wanted) -> dict:
     inv_mass = b.define(1 / mass, "inv_mtot", ("mtot",))
     c = b.define_all(tuple(first[r] * inv_mass for r in range(3)), "cG", ("cG",))
     result = {}
+    if derivation.model.free_flyer and wanted & {"c_G", "A_G", "J_G"}:
+        com, A_G = free_flyer_momentum(derivation)
+    else:
+        com = [kin.origin[r] + c[r] for r in range(3)]
+        A_G = sp.zeros(6, n)
+        for j, body in enumerate(tree.bodies):
+            n_o, f = F[j][:3], F[j][3:]
+            c_f = cross(c, f)
+            for r in range(3):
+                A_G[r, body.q_index] = f[r]
+                A_G[3 + r, body.q_index] = b.define(n_o[r] - c_f[r], f"AG{r}_{body.q_index + 1}")
     if "c_G" in wanted:
-        result["c_G"] = sp.Matrix([b.define(kin.origin[r] + c[r], f"com{r}") for r in range(3)])
-    A_G = sp.zeros(6, n)
-    for j, body in enumerate(tree.bodies):
-        n_o, f = F[j][:3], F[j][3:]
-        c_f = cross(c, f)
-        for r in range(3):
-            A_G[r, body.q_index] = f[r]
-            A_G[3 + r, body.q_index] = b.define(n_o[r] - c_f[r], f"AG{r}_{body.q_index + 1}")
+        result["c_G"] = sp.Matrix([b.define(com[r], f"com{r}") for r in range(3)])
     if "A_G" in wanted:
         result["A_G"] = A_G
     if "J_G" in wanted:
