@@ -181,6 +181,19 @@ def _so3_log(R):
     return theta / (2 * np.sin(theta)) * vee
 
 
+def configuration_rate(q, v) -> np.ndarray:
+    """``q̇`` (NQ) at velocity ``v`` (NV): the root origin's rate ``R v[0:3]``, the quaternion's
+    ``½ (x, y, z, w) ⊗ (ω, 0)`` (ω = v[3:6], root frame), then ``v[6:]``."""
+    q, v = np.asarray(q, dtype=float), np.asarray(v, dtype=float)
+    u, w, omega = q[3:6], q[6], v[3:6]
+    out = np.empty(len(q))
+    out[:3] = quaternion_matrix(q[3:7]) @ v[:3]
+    out[3:6] = 0.5 * (w * omega + np.cross(u, omega))
+    out[6] = -0.5 * (u @ omega)
+    out[7:] = v[6:]
+    return out
+
+
 def integrate(q, v, dt: float = 1.0) -> np.ndarray:
     """The configuration reached from ``q`` (NQ) moving with the constant velocity ``v`` (NV)
     for ``dt`` seconds: the free flyer along the SE(3) exponential of its twist ``v[0:6] dt``
@@ -218,5 +231,6 @@ def neutral(nq: int) -> np.ndarray:
     return q
 
 
-__all__ = ["CONFIGURATION_NAMES", "VELOCITY_NAMES", "add_free_flyer", "difference",
+__all__ = ["CONFIGURATION_NAMES", "VELOCITY_NAMES", "add_free_flyer", "configuration_rate",
+           "difference",
            "integrate", "matrix_quaternion", "neutral", "pinocchio_order", "quaternion_matrix"]

@@ -60,6 +60,7 @@ from ..numeric import kinetic_energy, numeric_model, potential_energy
 from .conditioning import (CONDITION_LIMIT, EXACT_FROM, IllConditionedWarning,
                            ill_conditioned_message)
 from .report import csv_text, fmt, markdown_table, pyplot
+from ..free_flyer import configuration_rate
 from .routes import compile_scalar, numeric_only
 
 #: Points of the output grid (both ends included).
@@ -99,12 +100,17 @@ class System:
     def __init__(self, model: RobotModel):
         self.model = numeric_only(model)
         dyn = derive(self.model, outputs=("M", "C", "g", "tau"), simplify=False)
-        self.n = n = len(dyn.q)
+        self.n = n = len(dyn.qd)
+        self.nq = len(dyn.q)
         zero_qdd = {s: 0 for s in dyn.qdd}
         self._M = compile_scalar(dyn.program, dyn.q, ["M"])
         self._bias = compile_scalar(dyn.program, dyn.q + dyn.qd, ["tau"], fixed=zero_qdd)
         self._Cg = compile_scalar(dyn.program, dyn.q + dyn.qd, ["C", "g"])
-        self._nm = numeric_model(self.model)
+        self.free_flyer = self.model.free_flyer
+        if self.free_flyer:  # eomgen.numeric has no free flyer: energy from the program
+            self._P = compile_scalar(dyn.program, dyn.q, ["P"])
+        else:
+            self._nm = numeric_model(self.model)
         self._shape = (n, n)
         self.evaluations = 0
         self._worst: tuple[float, list] = (1.0, [])
@@ -180,8 +186,21 @@ class System:
         return qd, np.array(pdot)
 
     def energy(self, q: np.ndarray, qd: np.ndarray) -> tuple[float, float]:
-        """``(K, P)`` [J] from :mod:`eomgen.numeric` (not the derived program)."""
+        """``(K, P)`` [J] from :mod:`eomgen.numeric` (not the derived program); for a free
+        flyer, which it does not model, ``K = ½ vᵀ M v`` and P from the program."""
+        if self.free_flyer:
+            return 0.5 * float(qd @ self.M(q) @ qd), float(self._P(*q.tolist())[0][0])
         return kinetic_energy(self._nm, q, qd), potential_energy(self._nm, q)
+
+    def configuration_rate(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+        """``q̇`` of the configuration at velocity ``qd``: ``qd`` itself, or for a free flyer
+        (:mod:`eomgen.free_flyer`) the rates of the root position (``R v``) and of its
+        quaternion (``½ quaternion ⊗ (ω, 0)``) followed by the joints' rates; so every
+        integrator integrates the quaternion as a vector (its norm drifts with the error of the
+        method; the dynamics normalise it)."""
+        if not self.free_flyer:
+            return qd
+        return configuration_rate(q, qd)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -237,7 +256,7 @@ class ExplicitEuler(FixedStep):
 
     def step(self, system, state, h):
         q, qd = state
-        return q + h * qd, qd + h * system.forward_dynamics(q, qd)
+        return q + h * system.configuration_rate(q, qd), qd + h * system.forward_dynamics(q, qd)
 
 
 @dataclass(frozen=True)
@@ -247,7 +266,7 @@ class SemiImplicitEuler(FixedStep):
     def step(self, system, state, h):
         q, qd = state
         qd = qd + h * system.forward_dynamics(q, qd)
-        return q + h * qd, qd
+        return q + h * system.configuration_rate(q, qd), qd
 
 
 @dataclass(frozen=True)
@@ -256,11 +275,14 @@ class RK4(FixedStep):
 
     def step(self, system, state, h):
         q, qd = state
-        f = system.forward_dynamics
-        k1q, k1v = qd, f(q, qd)
-        k2q, k2v = qd + h / 2 * k1v, f(q + h / 2 * k1q, qd + h / 2 * k1v)
-        k3q, k3v = qd + h / 2 * k2v, f(q + h / 2 * k2q, qd + h / 2 * k2v)
-        k4q, k4v = qd + h * k3v, f(q + h * k3q, qd + h * k3v)
+        f, rate = system.forward_dynamics, system.configuration_rate
+        k1q, k1v = rate(q, qd), f(q, qd)
+        q2, v2 = q + h / 2 * k1q, qd + h / 2 * k1v
+        k2q, k2v = rate(q2, v2), f(q2, v2)
+        q3, v3 = q + h / 2 * k2q, qd + h / 2 * k2v
+        k3q, k3v = rate(q3, v3), f(q3, v3)
+        q4, v4 = q + h * k3q, qd + h * k3v
+        k4q, k4v = rate(q4, v4), f(q4, v4)
         return (q + h / 6 * (k1q + 2 * k2q + 2 * k3q + k4q),
                 qd + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v))
 
@@ -289,10 +311,11 @@ class ImplicitMidpoint(FixedStep):
     def step(self, system, state, h):
         q0, p0 = state
         qd, pdot = system.velocity_and_momentum_rate(q0, p0)
-        q1, p1 = q0 + h * qd, p0 + h * pdot
+        q1, p1 = q0 + h * system.configuration_rate(q0, qd), p0 + h * pdot
         for _ in range(self.max_iterations):
-            qd, pdot = system.velocity_and_momentum_rate((q0 + q1) / 2, (p0 + p1) / 2)
-            q_next, p_next = q0 + h * qd, p0 + h * pdot
+            middle = (q0 + q1) / 2
+            qd, pdot = system.velocity_and_momentum_rate(middle, (p0 + p1) / 2)
+            q_next, p_next = q0 + h * system.configuration_rate(middle, qd), p0 + h * pdot
             change = max(np.max(np.abs(q_next - q1)), np.max(np.abs(p_next - p1)))
             scale = 1 + max(np.max(np.abs(q_next)), np.max(np.abs(p_next)))
             q1, p1 = q_next, p_next
@@ -321,10 +344,11 @@ class Adaptive:
     def run(self, system: System, q0, qd0, times: np.ndarray):
         from scipy.integrate import solve_ivp  # optional dependency (the analysis extra)
 
-        n = system.n
+        n = system.nq
 
         def rhs(t, z):
-            return np.concatenate([z[n:], system.forward_dynamics(z[:n], z[n:])])
+            return np.concatenate([system.configuration_rate(z[:n], z[n:]),
+                                   system.forward_dynamics(z[:n], z[n:])])
 
         z0 = np.concatenate([np.asarray(q0, float), np.asarray(qd0, float)])
         solution = solve_ivp(rhs, (times[0], times[-1]), z0, method=self.method, t_eval=times,
@@ -466,10 +490,21 @@ def run_study(model: RobotModel, integrators: Sequence, duration: float, q0=None
     against the reference (see the module docstring). A run that diverges is reported with
     status ``diverged`` and infinite errors, not raised.
 
-    ``q0`` defaults to 1 rad (or m) per joint, ``qd0`` to zero.
+    ``q0`` defaults to 1 rad (or m) per joint, ``qd0`` to zero; a free flyer's ``q0`` has its
+    NQ entries (root position and quaternion x, y, z, w first; default: at the origin,
+    identity quaternion).
     """
     system = system or System(model)
-    q0, qd0 = initial_state(q0, qd0, system.n, system.model.joint_names)
+    if getattr(system, "free_flyer", False):  # q0: NQ values, the root at rest by default
+        names = system.model.configuration_names
+        if q0 is None:
+            q0 = np.concatenate([[0.0] * 6 + [1.0], np.ones(system.nq - 7)])
+        if len(q0) != system.nq:
+            raise ValueError(f"q0 must have {system.nq} values ({', '.join(names)})")
+        q0, qd0 = np.asarray(q0, float), initial_state(None, qd0, system.n,
+                                                       system.model.joint_names)[1]
+    else:
+        q0, qd0 = initial_state(q0, qd0, system.n, system.model.joint_names)
     progress("reference (DOP853, rtol = atol = 1e-12)")
     reference, info = simulate(system, Adaptive("DOP853", REFERENCE_TOLERANCE), q0, qd0, duration)
     reference_seconds = info["seconds"]

@@ -178,10 +178,14 @@ def simulate(description, outdir, duration, dts, rtols, names, q0, qd0, gains, s
     integrators = integrators_named(chosen, step_list, rtol_list, stiff=flexible)
     start = _floats(q0, "--q0")
     velocity = _floats(qd0, "--qd0")
-    for values, option in ((start, "--q0"), (velocity, "--qd0")):
-        if values is not None and len(values) != model.dof:
-            raise AnalysisError(f"{option}: {model.name} has {plural(model.dof, 'joint')} "
-                                f"({', '.join(model.joint_names)}), got {len(values)} values")
+    for values, option, names in ((start, "--q0", model.configuration_names),
+                                  (velocity, "--qd0", model.joint_names)):
+        if values is not None and len(values) != len(names):
+            raise AnalysisError(f"{option}: {model.name} takes {len(names)} values "
+                                f"({', '.join(names)}), got {len(values)}")
+    if contacts and model.free_flyer:
+        raise AnalysisError("simulate: contacts are held by eomgen.numeric, which has no "
+                            "quaternion free flyer yet; use floating_base: euler in the scene")
     if contacts:
         _simulate_contacts(model, contacts, integrators, duration, start, velocity,
                            gain_list, outdir, progress)
