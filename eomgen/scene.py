@@ -262,7 +262,7 @@ def _read(data: dict, source: str, strict: bool) -> Scene:
     if not isinstance(fixed_base, bool):
         raise r.error("fixed_base", f"expected true or false, got {fixed_base!r}")
     floating_base = data.get("floating_base", False)
-    if floating_base not in FLOATING_CHARTS:
+    if not (isinstance(floating_base, bool) or floating_base in ("euler", "quaternion")):
         raise r.error("floating_base", "expected true, false, 'euler' or 'quaternion', got "
                       f"{floating_base!r}")
     if data.get("base") == FLOATING:  # the spelling: base: floating

@@ -206,3 +206,14 @@ def test_small_floating_robot_symbolic_matches_numeric():
         assert relative(out["M"], numeric.M_rnea(nm, q)) <= 1e-12
         assert relative(out["C"] @ qd, numeric.coriolis_times_qd(nm, q, qd)) <= 1e-12
         assert relative(out["g"].ravel(), numeric.gravity_torques(nm, q)) <= 1e-12
+
+
+def test_scene_floating_base_takes_its_chart():
+    for text, chart in (("true", "euler"), ("euler", "euler"), ("quaternion", "quaternion"),
+                        ("false", False)):
+        assert load_scene("s.yaml", text=f"version: 1\nfloating_base: {text}").floating_base \
+            == chart
+    for text in ("[1]", "quaternions", "1"):
+        with pytest.raises(SceneError, match="^s.yaml: floating_base: expected true, false, "
+                                             "'euler' or 'quaternion'"):
+            load_scene("s.yaml", text=f"version: 1\nfloating_base: {text}")
