@@ -60,11 +60,12 @@ _AXES = ((1, 0, 0), (0, 1, 0), (0, 0, 1)) * 2
 _TYPES = (JointType.PRISMATIC,) * 3 + (JointType.CONTINUOUS,) * 3
 
 
-def add_free_flyer(model: RobotModel) -> RobotModel:
+def add_free_flyer(model: RobotModel, origin: Transform | None = None) -> RobotModel:
     """``model`` with a quaternion free flyer between a fixed ``world`` link and its root link
     (module docstring): six virtual joints (massless links between them) come first, the
     robot's joints follow in depth-first order. The floating-base notice of the description is
-    dropped (the root is now free).
+    dropped (the root is now free). ``origin`` places the free flyer in the world (the origin
+    of a URDF ``floating`` joint): the root's pose is then ``origin · (R(quaternion), p)``.
 
     Raises
     ------
@@ -86,7 +87,8 @@ def add_free_flyer(model: RobotModel) -> RobotModel:
                                      "the name is taken by the free flyer's virtual joints")
     check_spatial_inertia(model)
     chain = [WORLD, *links, model.root]
-    virtual = tuple(Joint(name, kind, chain[k], chain[k + 1], Transform(), vec3(axis))
+    virtual = tuple(Joint(name, kind, chain[k], chain[k + 1],
+                          (origin or Transform()) if k == 0 else Transform(), vec3(axis))
                     for k, (name, kind, axis) in enumerate(zip(VELOCITY_NAMES, _TYPES, _AXES)))
     return replace(
         model,

@@ -34,7 +34,10 @@ Decisions
 * An ``<inertial>`` must hold ``<mass>`` and ``<inertia>`` with all six attributes, as urdfdom
   (ROS, Pinocchio) requires; a point mass is written with zero moments of inertia. A missing
   ``<inertia>`` is more often an authoring slip than a deliberate point mass.
-* ``floating`` and ``planar`` joints raise :class:`~eomgen.errors.UnsupportedError`.
+* A ``floating`` joint from a massless root link with nothing else attached is read as the
+  quaternion free flyer (:func:`eomgen.free_flyer.add_free_flyer` with the joint's origin, as
+  Pinocchio reads it); any other ``floating`` joint and ``planar`` joints raise
+  :class:`~eomgen.errors.UnsupportedError`.
 * A root link that looks like the floating base of a legged robot (quadrupeds and humanoids
   are written as trees rooted at the trunk, without a floating joint) is read as bolted to
   the world, with one :class:`~eomgen.errors.UnsupportedFeatureWarning` naming the file and
@@ -114,6 +117,7 @@ from ..model import (
     scalar,
     vec3,
 )
+from ..free_flyer import add_free_flyer
 from . import register
 
 #: Gravitational acceleration [m/s²] in the root link frame (URDF: z up).
@@ -206,13 +210,20 @@ def _read_robot(data: str | bytes, source: str, strict: bool, defer_notices: boo
     check_size(source, len(root.findall("link")), len(root.findall("joint")))
     links = [_read_link(element, index, source)
              for index, element in enumerate(root.findall("link"), start=1)]
-    joints, mimics = [], []
+    joints, mimics, free_flyer = [], [], None
     for index, element in enumerate(root.findall("joint"), start=1):
+        if element.get("type") == "floating":
+            free_flyer = _read_floating_joint(element, index, source, root, free_flyer)
+            continue
         joint, mimicked = _read_joint(element, index, source)
         joints.append(joint)
         if mimicked is not None and joint.type.is_movable:  # a fixed joint has nothing to couple
             mimics.append((joint.name, mimicked))
+    if free_flyer is not None:  # the massless root the floating joint hangs from goes
+        links = [link for link in links if link.name != free_flyer.parent]
     model = build_model(source, name, links, joints, gravity=GRAVITY, defer_notices=True)
+    if free_flyer is not None:
+        model = add_free_flyer(model, free_flyer.origin)
     names = {joint.name for joint in joints}
     for joint_name, mimicked in mimics:
         if mimicked not in names:
@@ -537,6 +548,40 @@ def _read_joint(element: ET.Element, index: int, source: str) -> tuple[Joint, st
                   actuator), mimicked)
 
 
+def _read_floating_joint(element: ET.Element, index: int, source: str, document: ET.Element,
+                         found: Joint | None) -> Joint:
+    """A ``floating`` joint, read as the robot's quaternion free flyer
+    (:mod:`eomgen.free_flyer`, Pinocchio's reading) when it joins a massless root link with
+    nothing else attached to the robot: returned as a fixed joint whose origin places the
+    free flyer and whose parent is the root link to leave out. Anywhere else it is refused."""
+    name = _required_name(element, source, f"<joint> number {index}")
+    where = f"joint '{name}'"
+    parent = _link_reference(element, "parent", source, where)
+    child = _link_reference(element, "child", source, where)
+    others = [j for j in document.findall("joint") if j is not element]
+    massless = all(link.find("inertial") is None for link in document.findall("link")
+                   if link.get("name") == parent)
+    if found is not None or not massless or any(
+            parent in (_link_attribute(j, "parent"), _link_attribute(j, "child"))
+            for j in others):
+        raise UnsupportedError(
+            source, where,
+            f"a floating joint is read as the robot's free flyer only from a massless root link "
+            f"with nothing else attached (one per robot); here link '{parent}' "
+            + ("has a second floating joint" if found is not None else
+               "has mass" if not massless else "is not such a root")
+            + f": to let link '{child}' fly, remove this joint and give a scene "
+            f"'floating_base: quaternion' or 'floating_base: true' (docs/legged.md)")
+    xyz, rpy = _read_origin(_single_child(element, "origin", source, where), source,
+                            f"{where} <origin>")
+    return Joint(name, JointType.FIXED, parent, child, Transform.from_xyz_rpy(xyz, rpy))
+
+
+def _link_attribute(element: ET.Element, tag: str) -> str | None:
+    found = element.find(tag)
+    return None if found is None else found.get("link")
+
+
 def _read_dynamics(element: ET.Element, source: str, where: str) -> Actuator | None:
     """``<dynamics damping friction>``: viscous [N m s/rad] and Coulomb [N m] friction (both
     default 0, as urdfdom); None when both are zero."""
@@ -556,15 +601,6 @@ def _read_joint_type(element: ET.Element, source: str, where: str) -> JointType:
     text = element.get("type")
     if text is None:
         raise SchemaError(source, where, "no 'type' attribute")
-    if text == "floating":
-        parent = _link_reference(element, "parent", source, where)
-        child = _link_reference(element, "child", source, where)
-        raise UnsupportedError(
-            source, where,
-            f"floating joints are not supported: to let link '{child}' fly, remove this joint "
-            f"and link '{parent}' (so that '{child}' is the root) and give a scene "
-            f"'floating_base: true' (docs/scenes.md); to bolt it to the world, make it a "
-            f"fixed joint")
     if text == "planar":
         raise UnsupportedError(
             source, where,

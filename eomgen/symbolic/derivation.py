@@ -151,7 +151,7 @@ def new_derivation(model: RobotModel, inputs: Iterable[str] | None = None) -> De
         return Derivation(model, tree, ordered, builder)
     q = ordered["q"]
     root = tree.bodies[0]
-    placed = replace(root, placement=root_placement(q, builder) @ root.placement)
+    placed = replace(root, placement=root.placement @ root_placement(q, builder))
     tree = replace(tree, bodies=(placed,) + tree.bodies[1:])
     coordinates = (sp.Integer(0),) * 6 + tuple(q[7:])
     return Derivation(model, tree, ordered, builder, coordinates=coordinates)

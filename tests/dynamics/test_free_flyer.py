@@ -316,3 +316,38 @@ def test_simulate_takes_a_quaternion_q0_of_nq_values(tmp_path):
     assert result.returncode == 2 and not (tmp_path / "out").exists()
     line, = result.stderr.strip().splitlines()
     assert "--q0: solo takes 19 values (base_x, base_y, base_z, base_qx" in line
+
+
+def test_urdf_floating_joint_is_read_as_the_free_flyer(tmp_path):
+    """A URDF whose massless root holds the trunk by a ``floating`` joint (with an origin) is
+    read as a quaternion free flyer, as Pinocchio's URDF reader reads it: same layout, same
+    M, C, g and frame positions with the same arrays."""
+    import eomgen
+    fixed = floating_tree(5, 2)
+    text = to_urdf(fixed).replace(
+        f'<link name="{fixed.root}"',
+        '<link name="world"/>\n  <joint name="root_joint" type="floating">\n'
+        f'    <parent link="world"/>\n    <child link="{fixed.root}"/>\n'
+        '    <origin xyz="0.1 -0.2 0.5" rpy="0.3 0.1 -0.2"/>\n  </joint>\n'
+        f'  <link name="{fixed.root}"', 1)
+    path = tmp_path / "floating.urdf"
+    path.write_text(text, encoding="utf-8")
+    model = eomgen.load(path)
+    assert model.free_flyer and model.nq == model.dof + 1
+    pm = pin.buildModelFromUrdf(str(path))  # URDF gravity on both sides: −9.81 along z
+    assert pm.names[1] == "root_joint" and (pm.nq, pm.nv) == (model.nq, model.dof)
+    calls, _ = generated(model, ("M", "C", "g", "p_f"), tmp_path, backends=("numpy",))
+    call, data = calls["numpy"], pm.createData()
+    for q, v, _ in states(pm, count=2, seed=37):
+        M = pin.crba(pm, data, q)
+        assert relative(call("mass_matrix", q), np.triu(M) + np.triu(M, 1).T) < 1e-10
+        assert relative(call("coriolis_matrix", q, v),
+                        pin.computeCoriolisMatrix(pm, data, q, v)) < 1e-10
+        assert relative(call("gravity_vector", q).ravel(),
+                        pin.computeGeneralizedGravity(pm, data, q)) < 1e-10
+        pin.framesForwardKinematics(pm, data, q)
+        leaf = [f.name for f in pm.frames][-1]
+        rows = call("frame_positions", q)
+        names = [l.name for l in model.links if l.name not in {j.parent for j in model.joints}]
+        assert relative(rows[names.index(leaf)], data.oMf[pm.getFrameId(leaf)].translation) \
+            < 1e-10

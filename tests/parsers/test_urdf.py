@@ -522,7 +522,9 @@ BAD = {
     "unknown joint type": (chain("", "ball"), D, "joint 'j2'", "unknown joint type 'ball'"),
     "joint without type": (robot(link("a"), link("b"), '<joint name="j"><parent link="a"/>'
                                  '<child link="b"/></joint>'), D, "joint 'j'", "'type'"),
-    "floating joint": (chain("", "floating"), U, "joint 'j2'", "floating joints"),
+    "floating joint": (chain("", "floating"), U, "joint 'j2'",
+                       "a floating joint is read as the robot's free flyer only from a massless "
+                       "root link"),
     "planar joint": (chain("", "planar"), U, "joint 'j2'", "planar joints"),
     "mimic without joint": (robot(link("a"), link("b"), link("c"), joint("j1", "a", "b"),
                                   joint("j2", "a", "c", body='<mimic multiplier="2"/>')),
@@ -681,40 +683,46 @@ def test_deferred_notices_warn_nothing_and_emit_as_loading_would(tmp_path):
     assert model == eomgen.load(path, defer_notices=True)  # notices take no part in equality
 
 
-def test_floating_joint_error_says_what_to_do(tmp_path):
-    """Issue 29: the error points to the scene's floating_base, and doing what it says works
-    (through the command, as a user would)."""
+def test_floating_joint_from_a_massless_root_is_the_free_flyer(tmp_path):
+    """A floating joint from a massless root link is read as the quaternion free flyer (as
+    Pinocchio reads it; tests/dynamics/test_free_flyer.py checks the dynamics), through the
+    command as a user would; elsewhere it is refused in one line that says what to do, and
+    doing that works."""
     from support import ERROR, run_in_process
 
     document = robot(link("world", None), link("trunk"),
                      joint("root_joint", "world", "trunk", "floating", ""))
-    with pytest.raises(UnsupportedError) as caught:
-        parse_urdf_string(document, source="f.urdf")
-    assert str(caught.value) == (
-        "f.urdf: joint 'root_joint': floating joints are not supported: to let link 'trunk' "
-        "fly, remove this joint and link 'world' (so that 'trunk' is the root) and give a "
-        "scene 'floating_base: true' (docs/scenes.md); to bolt it to the world, make it a "
-        "fixed joint")
+    model = parse_urdf_string(document, source="f.urdf", defer_notices=True)
+    assert model.free_flyer and (model.nq, model.dof) == (7, 6) and not model.notices
     urdf = tmp_path / "f.urdf"
     urdf.write_text(document, encoding="utf-8")
     out = tmp_path / "out"
-    failed = run_in_process("generate", urdf, "--backend", "numpy", "-o", out, "--no-cache")
+    flying = run_in_process("generate", urdf, "--backend", "numpy", "-o", out, "--no-cache",
+                            "--quiet")
+    assert flying.returncode == 0, flying.stderr
+    text = next(out.glob("*_numpy.py")).read_text(encoding="utf-8")
+    assert "NQ = 7" in text and "NV = 6" in text
+
+    heavy = document.replace('<link name="world"></link>', '<link name="world"><inertial><mass '
+                             'value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" '
+                             'izz="1"/></inertial></link>')
+    assert heavy != document
+    urdf.write_text(heavy, encoding="utf-8")
+    failed = run_in_process("generate", urdf, "--backend", "numpy", "-o", tmp_path / "no",
+                            "--no-cache")
     lines = failed.stderr.strip().splitlines()
-    assert failed.returncode == 2 and len(lines) == 1 and not out.exists()
+    assert failed.returncode == 2 and len(lines) == 1 and not (tmp_path / "no").exists()
     assert lines[0].startswith(f"{ERROR}{urdf}: joint 'root_joint': ")
-    assert "'floating_base: true'" in lines[0]
+    assert "'floating_base: quaternion'" in lines[0]
 
     urdf.write_text(robot(link("trunk")), encoding="utf-8")  # as the message says
     scene = tmp_path / "fly.yaml"
-    scene.write_text("version: 1\nfloating_base: true\n", encoding="utf-8")
+    scene.write_text("version: 1\nfloating_base: quaternion\n", encoding="utf-8")
+    out = tmp_path / "scene_out"
     flying = run_in_process("generate", urdf, "--scene", scene, "--backend", "numpy", "-o", out,
                             "--no-cache", "--quiet")
     assert flying.returncode == 0, flying.stderr
-    assert "NQ = 6" in next(out.glob("*_numpy.py")).read_text(encoding="utf-8")
-
-    fixed = parse_urdf_string(document.replace('type="floating"', 'type="fixed"'),
-                              defer_notices=True)
-    assert fixed.root == "world" and not fixed.notices  # as the message says: no warning left
+    assert "NQ = 7" in next(out.glob("*_numpy.py")).read_text(encoding="utf-8")
 
 
 #: example-robot-data's own loader (python/example_robot_data/robots_loader.py, version 4.x)
