@@ -105,7 +105,7 @@ class FastConfig:
     flags: tuple[str, ...] = ("-O2", "-fPIC", "-shared", "-fno-math-errno")
 
 
-def _render_source(job: Job, config: FastConfig) -> str:
+def _render_source(job: Job, config: FastConfig, **extra) -> str:
     n = job.model.dof
     names: dict[sp.Symbol, sp.Symbol] = {}
     for k, parameter in enumerate(job.parameters):
@@ -211,7 +211,15 @@ def _render_source(job: Job, config: FastConfig) -> str:
         nc=nc,
         constrained_doc=constrained_doc,
         runtime={name: runtime_source(name) for name in RUNTIME_FILES},
+        **extra,
     )
+
+
+def render_source(job: Job, config, **extra) -> str:
+    """``config.template`` rendered with the fast module's context (and ``extra``): what the
+    C kernels backend (:mod:`.kernels_backend`) prints its files with, so that its kernels are the
+    fast module's."""
+    return _render_source(job, config, **extra)
 
 
 def python_headers() -> tuple[str, ...] | None:
@@ -280,5 +288,5 @@ def generate_fast(job: Job, config: FastConfig = FastConfig()) -> list[Generated
     return emitted + build_fast(job, emitted, config)
 
 
-__all__ = ["FastCPrinter", "FastConfig", "generate_fast", "emit_fast", "build_fast",
+__all__ = ["FastCPrinter", "FastConfig", "generate_fast", "render_source", "emit_fast", "build_fast",
            "compile_module", "c_string_literal", "python_headers"]
