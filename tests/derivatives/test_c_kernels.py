@@ -69,3 +69,23 @@ def test_kernels_called_from_c_and_cpp_equal_the_numpy_module(tmp_path):
         out = subprocess.run([str(exe)], check=True, capture_output=True, text=True).stdout
         got = np.array([float(v) for v in out.split()])
         np.testing.assert_allclose(got, expected, rtol=1e-13, atol=1e-13, err_msg=compiler)
+
+
+@pytest.mark.skipif(c_compiler() is None, reason="needs a C compiler")
+def test_casadi_c_library_linearize_equals_the_numpy_module(tmp_path):
+    casadi = pytest.importorskip("casadi")
+    model = eomgen.load(eomgen.example_path("planar_2link"))
+    for f in render_files(model, ["c", "numpy"], functions=["linearize"]):
+        path = tmp_path / f.name
+        path.write_bytes(f.content) if isinstance(f.content, bytes) else path.write_text(
+            f.content, encoding="utf-8")
+    numpy_module = load_module(tmp_path / "planar_2link_numpy.py", "planar_2link_numpy_c")
+    library = next(p for p in tmp_path.iterdir() if p.name.startswith("planar_2link_casadi.")
+                   and p.suffix in (".so", ".dylib", ".dll"))
+    linearize = casadi.external("linearize", str(library))
+    q, qd, tau = np.array([0.3, -0.8]), np.array([0.5, 0.2]), np.array([1.0, -2.0])
+    out = linearize.call({"q": q, "qd": qd, "tau": tau, "m2": 1.7})
+    A, B = numpy_module.linearize(q, qd, tau, m2=1.7)
+    np.testing.assert_allclose(np.array(out["A_lin"]), A, rtol=1e-13, atol=1e-13)
+    np.testing.assert_allclose(np.array(out["B_lin"]), B, rtol=1e-13, atol=1e-13)
+    assert not np.allclose(B, numpy_module.linearize(q, qd, tau)[1])  # m2 was passed on
