@@ -195,7 +195,13 @@ def _pinocchio_agreement(model, tmp_path, count=3, backends=("numpy",)):
     return worst
 
 
-@pytest.mark.parametrize("make", [robots.puma, robots.ur5], ids=["puma560", "ur5"])
+def _bundled(name):
+    return lambda: eomgen.load(eomgen.example_path(name))
+
+
+@pytest.mark.parametrize("make", [_bundled("planar_2link"), _bundled("stanford_rrp"),
+                                  robots.puma, robots.ur5],
+                         ids=["planar_2link", "stanford_rrp (prismatic)", "puma560", "ur5"])
 def test_derivatives_agree_with_pinocchio(make, tmp_path):
     pytest.importorskip("pinocchio")
     worst = _pinocchio_agreement(make(), tmp_path)
