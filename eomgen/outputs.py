@@ -113,6 +113,9 @@ class Output:
         the symbols of the printed outputs it returns, in order. Its own ``symbol`` is then the
         side-by-side matrix of those results (each n rows; a vector is one column), which the
         module splits into the tuple it returns. Empty for a function of one result.
+    width:
+        The columns of a matrix result in units of n (2 for the 2n × 2n state matrix of
+        ``linearize``), for :func:`splits`.
     """
 
     function: str
@@ -128,6 +131,7 @@ class Output:
     constants: str | None = None
     backends: tuple[str, ...] | None = None
     returns: tuple[str, ...] = ()
+    width: int = 1
 
     @property
     def composed(self) -> bool:
@@ -339,8 +343,9 @@ def splits(output: Output, n: int) -> tuple[tuple[str, int, int | None], ...]:
             out.append((symbol, column, None))
             column += 1
         else:
-            out.append((symbol, column, column + n))
-            column += n
+            width = n * BY_SYMBOL[symbol].width
+            out.append((symbol, column, column + width))
+            column += width
     return tuple(out)
 
 
@@ -433,6 +438,57 @@ CONSTRAINED_FORWARD = register_output(Output(
     ("q", "qd", "tau"), True, "rad/s^2, m/s^2; N, N m", ("M", "tau", "J_c", "dJqd_c"),
     composed_from=(MASS.function, INVERSE.function, CONTACT_JACOBIAN.function,
                    CONTACT_BIAS.function), default=False, constants=_CONTACT_NAMES))
+
+
+# --- issue 25: exact derivatives of the dynamics (eomgen.symbolic.derivatives), fixed bases;
+# derivatives with respect to q are in the velocity (tangent) coordinates (nv columns).
+_DERIVATIVES = "eomgen.symbolic.derivatives:build_derivatives"
+_PER_Q = "of the joint efforts per rad (revolute columns) or m (prismatic)"
+DTAU_DQ = register_output(Output(
+    "inverse_dynamics_derivative_q", "dtau_dq", "dtau/dq (n, nv) of tau(q, qd, qdd) "
+    "(Newton-Euler differentiated in forward mode).", ("q", "qd", "qdd"), False, _PER_Q,
+    ("dtau_dq",), build=_DERIVATIVES, default=False))
+DTAU_DQD = register_output(Output(
+    "inverse_dynamics_derivative_qd", "dtau_dqd", "dtau/dqd (n, nv) of tau(q, qd, qdd).",
+    ("q", "qd", "qdd"), False, "of the joint efforts per rad/s or m/s", ("dtau_dqd",),
+    build=_DERIVATIVES, default=False))
+INVERSE_DERIVATIVES = register_output(Output(
+    "inverse_dynamics_derivatives", "dtau", "(dtau/dq, dtau/dqd) of tau(q, qd, qdd) in one "
+    "call (dtau/dqdd is M).", ("q", "qd", "qdd"), False,
+    "the units of inverse_dynamics_derivative_q and _qd", ("dtau",), build=_DERIVATIVES,
+    default=False, returns=("dtau_dq", "dtau_dqd")))
+GRAVITY_DERIVATIVE = register_output(Output(
+    "gravity_derivative", "dg_dq", "dg/dq (n, nv) of the gravity vector g(q).", ("q",), False,
+    _PER_Q, ("dg_dq",), build=_DERIVATIVES, default=False))
+DQDD_DQ = register_output(Output(
+    "forward_dynamics_derivative_q", "dqdd_dq", "dqdd/dq (nv, nv) of qdd(q, qd, tau) = -M^-1 "
+    "dtau/dq at qdd (ABA).", ("q", "qd", "tau"), False, "1/s^2", ("dqdd_dq",),
+    build=_DERIVATIVES, default=False))
+DQDD_DQD = register_output(Output(
+    "forward_dynamics_derivative_qd", "dqdd_dqd", "dqdd/dqd (nv, nv) of qdd(q, qd, tau) = "
+    "-M^-1 dtau/dqd at qdd (ABA).", ("q", "qd", "tau"), False, "1/s", ("dqdd_dqd",),
+    build=_DERIVATIVES, default=False))
+INVERSE_MASS = register_output(Output(
+    "inverse_mass_matrix", "Minv", "M(q)^-1 = dqdd/dtau (nv, nv), the ABA program "
+    "differentiated along tau.", ("q",), False, "1/(kg m^2) (revolute), 1/kg (prismatic)",
+    ("Minv",), build=_DERIVATIVES, default=False))
+FORWARD_DERIVATIVES = register_output(Output(
+    "forward_dynamics_derivatives", "dqdd", "(dqdd/dq, dqdd/dqd, M^-1 = dqdd/dtau) of "
+    "qdd(q, qd, tau) in one call.", ("q", "qd", "tau"), False,
+    "the units of forward_dynamics_derivative_q, _qd and inverse_mass_matrix", ("dqdd",),
+    build=_DERIVATIVES, default=False, returns=("dqdd_dq", "dqdd_dqd", "Minv")))
+STATE_MATRIX = register_output(Output(
+    "state_matrix", "A_lin", "A = df/dx (2 nv, 2 nv) of xdot = f(x, tau), x = (q, qd): "
+    "[[0, I], [dqdd/dq, dqdd/dqd]].", ("q", "qd", "tau"), False, "1, 1/s, 1/s^2",
+    ("A_lin",), build=_DERIVATIVES, default=False, width=2))
+INPUT_MATRIX = register_output(Output(
+    "input_matrix", "B_lin", "B = df/dtau (2 nv, nv) of xdot = f(x, tau): [[0], [M^-1]].",
+    ("q", "qd", "tau"), False, "1/(kg m^2) (revolute)", ("B_lin",), build=_DERIVATIVES,
+    default=False))
+LINEARIZE = register_output(Output(
+    "linearize", "AB", "(A, B) of xdot = f(x, tau) ~ A dx + B dtau, x = (q, qd), in one call.",
+    ("q", "qd", "tau"), False, "the units of state_matrix and input_matrix", ("AB",),
+    build=_DERIVATIVES, default=False, returns=("A_lin", "B_lin")))
 
 
 def exported(functions, backend: str) -> tuple[str, ...]:

@@ -105,7 +105,7 @@ class FastConfig:
     flags: tuple[str, ...] = ("-O2", "-fPIC", "-shared", "-fno-math-errno")
 
 
-def _render_source(job: Job, config: FastConfig) -> str:
+def _render_source(job: Job, config: FastConfig, **extra) -> str:
     n = job.model.dof
     names: dict[sp.Symbol, sp.Symbol] = {}
     for k, parameter in enumerate(job.parameters):
@@ -147,9 +147,10 @@ def _render_source(job: Job, config: FastConfig) -> str:
                         for p in job.parameters)
     for f in functions:
         shape = f"({f['rows']}, {f['cols']})" if f["cols"] else f"({f['rows']},)"
-        if f["returns"]:  # a tuple of results, each (NV, NV) or (NV,)
-            shape = "(" + ", ".join(f"{symbol} (NV, NV)" if stop is not None else
-                                    f"{symbol} (NV,)" for symbol, _, stop in f["returns"]) + ")"
+        if f["returns"]:  # a tuple of results, each (rows, its columns) or (rows,)
+            shape = "(" + ", ".join(f"{symbol} ({f['rows']}, {stop - start})" if stop is not None
+                                    else f"{symbol} ({f['rows']},)"
+                                    for symbol, start, stop in f["returns"]) + ")"
         keywords = ", *" + signature if signature else ""
         f["doc"] = c_string_literal(
             f"{f['name']}({', '.join(f['inputs'])}{keywords})\n--\n\n"
@@ -214,7 +215,15 @@ def _render_source(job: Job, config: FastConfig) -> str:
         nc=nc,
         constrained_doc=constrained_doc,
         runtime={name: runtime_source(name) for name in RUNTIME_FILES},
+        **extra,
     )
+
+
+def render_source(job: Job, config, **extra) -> str:
+    """``config.template`` rendered with the fast module's context (and ``extra``): what the
+    C kernels backend (:mod:`.kernels_backend`) prints its files with, so that its kernels are the
+    fast module's."""
+    return _render_source(job, config, **extra)
 
 
 def python_headers() -> tuple[str, ...] | None:
@@ -283,5 +292,5 @@ def generate_fast(job: Job, config: FastConfig = FastConfig()) -> list[Generated
     return emitted + build_fast(job, emitted, config)
 
 
-__all__ = ["FastCPrinter", "FastConfig", "generate_fast", "emit_fast", "build_fast",
+__all__ = ["FastCPrinter", "FastConfig", "generate_fast", "render_source", "emit_fast", "build_fast",
            "compile_module", "c_string_literal", "python_headers"]

@@ -1,0 +1,255 @@
+"""Exact derivatives of the dynamics as straight-line programs (issue 25, fixed bases).
+
+The derivatives are the dynamics' own programs differentiated once in forward mode
+(:func:`forward_mode`): each assignment ``x = f(a, b, …)`` of the Newton–Euler (or ABA) program
+that depends on a seeded input gets, per direction ``d``, the assignment
+``dx_d = Σ ∂f/∂a · da_d`` over the arguments whose derivative along ``d`` is not a structural
+zero. The partials ``∂f/∂a`` are named once and shared by every direction; every derivative is
+defined in the derivation's builder, so it reuses the dynamics' intermediates (sines, rotations,
+velocities) and identical terms are shared (hash-consing). A quantity that does not depend on a
+direction has no derivative along it (nothing is computed), which is where the structure of the
+tree shows: ∂/∂q_j of a body's velocity exists only below joint j.
+
+Outputs (symbols of :mod:`eomgen.outputs`), n joints, ``JOINT_NAMES`` order; derivatives with
+respect to q are in the velocity (tangent) coordinates, n_v columns (= n for fixed bases):
+
+* ``dtau_dq``, ``dtau_dqd`` (n × n): ∂τ/∂q and ∂τ/∂q̇ of τ(q, q̇, q̈) (Newton–Euler); ∂τ/∂q̈ = M.
+* ``dg_dq`` (n × n): ∂g/∂q of g(q) = τ(q, 0, 0).
+* ``Minv`` (n × n): M(q)⁻¹ = ∂q̈/∂τ, the derivative of the ABA program along τ (the articulated
+  inertias do not depend on τ, so only the τ-dependent chain is differentiated); symmetric, the
+  upper triangle is computed and mirrored.
+* ``dqdd_dq``, ``dqdd_dqd`` (n × n): ∂q̈/∂q = −M⁻¹ ∂τ/∂q and ∂q̈/∂q̇ = −M⁻¹ ∂τ/∂q̇, the
+  Newton–Euler derivatives taken at q̈ = ABA(q, q̇, τ) held fixed (the implicit function
+  theorem on τ(q, q̇, q̈(q, q̇, τ)) = τ; what Pinocchio's ``computeABADerivatives`` does).
+* ``A_lin`` (2n × 2n) and ``B_lin`` (2n × n): ẋ = f(x, τ), x = (q, q̇), linearized:
+  A = [[0, I], [∂q̈/∂q, ∂q̈/∂q̇]], B = [[0], [M⁻¹]].
+* ``dtau``, ``dqdd``, ``AB``: the several-result functions, side by side.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from ..outputs import BY_SYMBOL
+from .aba import forward_dynamics_program
+from .newton_euler import inverse_dynamics_program
+from .program import ProgramBuilder, name_expr
+
+#: the key of this module's work in ``Derivation.shared``
+_SHARED = __name__
+
+
+def _relevant(assignments, outputs, seeds, frozen) -> list:
+    """The assignments that depend on a seed and that ``outputs`` need, in program order
+    (dependencies through ``frozen`` symbols cut)."""
+    active = set(seeds)
+    depends = []
+    for assignment in assignments:
+        symbol, expr = assignment
+        if symbol in frozen:
+            continue
+        free = getattr(assignment, "free", None) or expr.free_symbols
+        if free & active:
+            active.add(symbol)
+            depends.append((symbol, expr, free))
+    needed: set = set()
+    for e in outputs:
+        needed |= e.free_symbols
+    kept = []
+    for symbol, expr, free in reversed(depends):
+        if symbol in needed:
+            kept.append((symbol, expr, free))
+            needed |= free
+    return kept[::-1]
+
+
+def _differentiate(b: ProgramBuilder, expr, free, D, hint: str, name: bool, partials: dict):
+    """``{direction: d expr}`` of ``expr`` given the derivatives ``D`` of its free symbols,
+    zeros left out; each derivative named in ``b`` (with ``name``) with the hint
+    ``<hint>_<direction>``."""
+    args = [a for a in free if a in D]
+    if not args:
+        return {}
+    terms: dict = {}
+    for a in sorted(args, key=lambda s: s.name):
+        p = sp.diff(expr, a)
+        if p == 0:
+            continue
+        if not p.is_Number:
+            p = partials.setdefault(p, name_expr(b, p, f"p{hint}"))
+        for direction, da in D[a].items():
+            terms.setdefault(direction, []).append(p * da)
+    out = {}
+    for direction, parts in terms.items():
+        total = sp.Add(*parts)
+        if total == 0:
+            continue
+        out[direction] = name_expr(b, total, f"d{hint}_{direction[0]}{direction[1] + 1}") \
+            if name else total
+    return out
+
+
+def forward_mode(b: ProgramBuilder, outputs, seeds: dict, frozen=frozenset()) -> list[dict]:
+    """Forward-mode derivatives of the expressions ``outputs`` (in terms of ``b``'s
+    intermediates) along the seeded inputs, defined in ``b``.
+
+    Parameters
+    ----------
+    b:
+        The builder the outputs' intermediates were defined in.
+    outputs:
+        Expressions to differentiate.
+    seeds:
+        ``{input symbol: direction}``: the input is the direction's variable (derivative 1).
+    frozen:
+        Intermediates held constant (their derivative is zero, their definition not followed).
+
+    Returns
+    -------
+    list of dict
+        Per output, ``{direction: derivative}`` with the structural zeros left out.
+
+    Examples
+    --------
+    >>> x, y = sp.symbols("x y", real=True)
+    >>> b = ProgramBuilder({"x", "y"})
+    >>> s = b.define(sp.sin(x) * y, "s")
+    >>> forward_mode(b, [s * s], {x: ("x", 0), y: ("y", 0)})
+    [{('x', 0): d_x1, ('y', 0): d_y1}]
+    >>> b.assignments[1:]
+    [(ps, y*cos(x)), (ps_, sin(x)), (d_x1, 2*ps*s), (d_y1, 2*ps_*s)]
+    """
+    D: dict = {s: {d: sp.Integer(1)} for s, d in seeds.items()}
+    outputs = [sp.sympify(e) for e in outputs]
+    partials: dict = {}
+    for symbol, expr, free in _relevant(list(b.assignments), outputs, seeds, frozen):
+        derivative = _differentiate(b, expr, free, D, symbol.name, True, partials)
+        if derivative:
+            D[symbol] = derivative
+    return [_differentiate(b, e, e.free_symbols, D, "", True, partials) for e in outputs]
+
+
+def _jacobian(rows: list[dict], prefix: str, n: int) -> sp.Matrix:
+    return sp.Matrix(len(rows), n, lambda i, j: rows[i].get((prefix, j), sp.Integer(0)))
+
+
+def _seeds(symbols, prefix: str) -> dict:
+    return {s: (prefix, k) for k, s in enumerate(symbols)}
+
+
+def _product(b: ProgramBuilder, A: sp.Matrix, B: sp.Matrix, hint: str) -> sp.Matrix:
+    """−A B, each nonzero entry named ``<hint><i><j>``."""
+    rows, inner, cols = A.rows, A.cols, B.cols
+    out = sp.zeros(rows, cols)
+    for i in range(rows):
+        for j in range(cols):
+            total = sp.Add(*[A[i, k] * B[k, j] for k in range(inner)
+                             if A[i, k] != 0 and B[k, j] != 0])
+            if total != 0:
+                out[i, j] = name_expr(b, -total, f"{hint}{i + 1}_{j + 1}")
+    return out
+
+
+def _work(derivation) -> dict:
+    return derivation.shared.setdefault(_SHARED, {})
+
+
+def inverse_dynamics_jacobians(derivation) -> tuple[sp.Matrix, sp.Matrix]:
+    """(∂τ/∂q, ∂τ/∂q̇) of the derivation's τ output (both n × n)."""
+    work = _work(derivation)
+    if "dtau" not in work:
+        tau = derivation.output("tau")
+        n = len(derivation.q)
+        seeds = {**_seeds(derivation.q, "q"), **_seeds(derivation.qd, "qd")}
+        rows = forward_mode(derivation.builder, list(tau), seeds)
+        work["dtau"] = (_jacobian(rows, "q", n), _jacobian(rows, "qd", n))
+    return work["dtau"]
+
+
+def gravity_jacobian(derivation) -> sp.Matrix:
+    """∂g/∂q of g(q) = τ(q, 0, 0) (Newton–Euler), n × n."""
+    n = len(derivation.q)
+    zero = (sp.Integer(0),) * n
+    g = inverse_dynamics_program(derivation.tree, derivation.q, zero, zero,
+                                 derivation.model.gravity, derivation.builder, hint="g")
+    rows = forward_mode(derivation.builder, list(g), _seeds(derivation.q, "q"))
+    return _jacobian(rows, "q", n)
+
+
+def inverse_mass_matrix(derivation) -> sp.Matrix:
+    """M(q)⁻¹ as ∂q̈/∂τ of the ABA program (n × n, upper triangle computed, mirrored)."""
+    work = _work(derivation)
+    if "Minv" not in work:
+        qdd = _aba(derivation)
+        n = len(derivation.q)
+        rows = forward_mode(derivation.builder, list(qdd[:n]), _seeds(derivation.tau, "tau"))
+        full = _jacobian(rows, "tau", n)
+        work["Minv"] = sp.Matrix(n, n, lambda i, j: full[min(i, j), max(i, j)])
+    return work["Minv"]
+
+
+def _aba(derivation) -> sp.Matrix:
+    work = _work(derivation)
+    if "qdd" not in work:
+        b = derivation.builder
+        qdd = forward_dynamics_program(derivation.tree, derivation.q, derivation.qd,
+                                       derivation.tau, derivation.model.gravity, b)
+        work["qdd"] = sp.Matrix([b.define(e, f"qdd_a{k + 1}") for k, e in enumerate(qdd)])
+    return work["qdd"]
+
+
+def forward_dynamics_jacobians(derivation) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
+    """(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹) at q̈ = ABA(q, q̇, τ), each n × n."""
+    work = _work(derivation)
+    if "dqdd" not in work:
+        b, n = derivation.builder, len(derivation.q)
+        qdd = _aba(derivation)
+        frozen = set()
+        for e in qdd:
+            frozen |= {e} if e.is_Symbol else set()
+            if not e.is_Symbol and not (e.is_Mul and e.args[0] == -1 and e.args[1].is_Symbol):
+                raise ValueError(f"ABA acceleration {e} is not a named intermediate")
+            frozen |= e.free_symbols
+        tau = inverse_dynamics_program(derivation.tree, derivation.q, derivation.qd, tuple(qdd),
+                                       derivation.model.gravity, b, hint="tau_a")
+        seeds = {**_seeds(derivation.q, "q"), **_seeds(derivation.qd, "qd")}
+        rows = forward_mode(b, list(tau), seeds, frozenset(frozen))
+        Minv = inverse_mass_matrix(derivation)
+        work["dqdd"] = (_product(b, Minv, _jacobian(rows, "q", n), "dqdd_dq"),
+                        _product(b, Minv, _jacobian(rows, "qd", n), "dqdd_dqd"), Minv)
+    return work["dqdd"]
+
+
+def linearization(derivation) -> tuple[sp.Matrix, sp.Matrix]:
+    """A (2n × 2n) and B (2n × n) of ẋ = f(x, τ), x = (q, q̇)."""
+    n = len(derivation.q)
+    dq, dqd, Minv = forward_dynamics_jacobians(derivation)
+    A = sp.Matrix.vstack(sp.Matrix.hstack(sp.zeros(n, n), sp.eye(n)),
+                         sp.Matrix.hstack(dq, dqd))
+    B = sp.Matrix.vstack(sp.zeros(n, n), Minv)
+    return A, B
+
+
+def build_derivatives(derivation, wanted) -> dict:
+    """The builder of the derivative outputs of :mod:`eomgen.outputs` (see the module's
+    docstring for each symbol)."""
+    result = {}
+    for symbol in sorted(wanted):
+        if symbol in ("dtau_dq", "dtau_dqd"):
+            value = inverse_dynamics_jacobians(derivation)[symbol == "dtau_dqd"]
+        elif symbol == "dg_dq":
+            value = gravity_jacobian(derivation)
+        elif symbol in ("dqdd_dq", "dqdd_dqd", "Minv"):
+            value = forward_dynamics_jacobians(derivation)[
+                ("dqdd_dq", "dqdd_dqd", "Minv").index(symbol)]
+        elif symbol in ("A_lin", "B_lin"):
+            value = linearization(derivation)[symbol == "B_lin"]
+        else:  # a several-result function: its results side by side
+            value = sp.Matrix.hstack(*(derivation.output(p) for p in BY_SYMBOL[symbol].returns))
+        result[symbol] = value
+    return result
+
+
+__all__ = ["build_derivatives", "forward_dynamics_jacobians", "forward_mode",
+           "gravity_jacobian", "inverse_dynamics_jacobians", "inverse_mass_matrix",
+           "linearization"]
