@@ -436,7 +436,7 @@ def test_M_alone_has_no_coriolis_intermediates():
     assert not [n for n in names if C_ONLY.match(n) or G_ENTRY.match(n)], names
 
 
-@pytest.mark.parametrize("outputs", [["M", "Cqd"], ["c"], ["Minv"]])
+@pytest.mark.parametrize("outputs", [["M", "Cqd"], ["c"], ["Mdot"]])
 def test_unknown_output_is_a_value_error(outputs):
     with pytest.raises(ValueError, match="unknown outputs"):
         derive(planar().model, outputs=outputs)
