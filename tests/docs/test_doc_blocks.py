@@ -82,9 +82,10 @@ def workspace(tmp_path, erd_robots_dir, monkeypatch):
             del sys.modules[name]
 
 
-@pytest.mark.parametrize("path", [p for p in FILES if _runnable(p)],
-                         ids=lambda p: str(p.relative_to(ROOT)))
-def test_the_code_blocks_run(path, workspace):
+def run_blocks(path: Path, workspace: Path) -> list[str]:
+    """Run the blocks of ``path`` in order (python in one namespace, console commands one by
+    one); an AssertionError names the block that failed. Returns the blocks left out because
+    the optional modules they need are missing."""
     namespace = {"__name__": "__doc__"}
     missing = []
     for block in blocks(path):
@@ -96,7 +97,10 @@ def test_the_code_blocks_run(path, workspace):
             continue
         if block.language == PYTHON:
             code = compile(block.text, block.where, "exec")
-            exec(code, namespace)  # noqa: S102 - the documentation's own example
+            try:
+                exec(code, namespace)  # noqa: S102 - the documentation's own example
+            except Exception as error:
+                raise AssertionError(f"{block.where}: {type(error).__name__}: {error}") from error
         elif block.language == CONSOLE:
             commands = block.commands()
             assert commands, f"{block.where}: a console block without a '$ ' command"
@@ -106,9 +110,36 @@ def test_the_code_blocks_run(path, workspace):
                 done = run_command(command, workspace)
                 assert done.returncode == 0, (
                     f"{block.where}: `{command}` exited with {done.returncode}\n{done.stderr}")
+    return missing
+
+
+@pytest.mark.parametrize("path", [p for p in FILES if _runnable(p)],
+                         ids=lambda p: str(p.relative_to(ROOT)))
+def test_the_code_blocks_run(path, workspace):
+    missing = run_blocks(path, workspace)
     if missing:
         pytest.skip(f"the other blocks ran; not these, whose extras are not installed: "
                     f"{'; '.join(missing)}")
+
+
+STALE = {
+    "an option that is gone": "```console\n$ eomgen generate --backend numpy --no-such-option\n```\n",
+    "a renamed function": "```python\nimport eomgen\neomgen.derive_dynamics\n```\n",
+    "a changed value": "```python\nimport eomgen\n"
+                       "assert eomgen.load(eomgen.example_path('planar_2link')).dof == 3\n```\n",
+    "a robot not at hand": "```console\n$ eomgen verify no_such_robot.urdf\n```\n",
+}
+
+
+@pytest.mark.parametrize("text", STALE.values(), ids=STALE.keys())
+def test_a_stale_block_fails_and_says_where(text, workspace):
+    page = workspace / "stale.md"
+    page.write_text("# A page\n\nSome text.\n\n" + text, encoding="utf-8")
+    with pytest.raises(AssertionError, match="stale.md:5"):
+        run_blocks(page, workspace)
+    marked = workspace / "marked.md"
+    marked.write_text("<!-- not-run: shows a mistake -->\n" + text, encoding="utf-8")
+    assert run_blocks(marked, workspace) == []
 
 
 def test_every_block_says_what_it_is():
