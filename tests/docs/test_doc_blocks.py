@@ -113,8 +113,17 @@ def run_blocks(path: Path, workspace: Path) -> list[str]:
     return missing
 
 
-@pytest.mark.parametrize("path", [p for p in FILES if _runnable(p)],
-                         ids=lambda p: str(p.relative_to(ROOT)))
+#: Pages whose blocks take more than about 5 s together (each block is small; a page runs its
+#: blocks in one test because they share a namespace): 12–32 s each in a run of tests/docs on
+#: 2 busy cores. The other pages, the README among them, stay in the quick subset.
+SLOW_PAGES = {"docs/cli.md", "docs/backends.md", "docs/contact.md", "docs/actuators.md",
+              "docs/regressor.md"}
+
+
+@pytest.mark.parametrize("path", [
+    pytest.param(p, marks=[pytest.mark.slow] if str(p.relative_to(ROOT)) in SLOW_PAGES else [],
+                 id=str(p.relative_to(ROOT)))
+    for p in FILES if _runnable(p)])
 def test_the_code_blocks_run(path, workspace):
     missing = run_blocks(path, workspace)
     if missing:
@@ -156,6 +165,7 @@ def test_every_block_says_what_it_is():
     for block in ALL:
         if block.language == "yaml":
             yaml.safe_load(block.text)
+    assert SLOW_PAGES <= {str(p.relative_to(ROOT)) for p in FILES if _runnable(p)}
 
 
 def test_at_most_one_block_in_ten_is_not_run():
