@@ -4,6 +4,8 @@ and doctest rather than Markdown:
 * Sphinx's cross-reference roles (:func:`derive`, :class:`~eomgen.model.RobotModel`), which
   Markdown would show as they are, become inline code of the name (the last component after
   ``~``);
+* reST's ``text::`` before an indented literal block loses one colon (Markdown shows the
+  block as code anyway);
 * a doctest outside a NumPy-style ``Examples`` section (lines from ``>>>`` to a blank line),
   which Markdown would run together as a paragraph, becomes a ``pycon`` code block.
 """
@@ -15,6 +17,7 @@ import re
 import griffe
 
 ROLE = re.compile(r":(?:py:)?(?:mod|func|class|meth|attr|data|obj|exc|const):`(~?)([^`]+)`")
+LITERAL = re.compile(r"(?<=\S)::$", re.M)  # reST's "text::" before a literal block
 EXAMPLES = re.compile(r"^\s*Examples?\s*\n\s*-{3,}\s*$", re.M)
 
 
@@ -46,7 +49,7 @@ def _fence_doctests(text: str) -> str:
 
 def markdown_docstring(text: str) -> str:
     """The docstring ``text`` with roles as inline code and free doctests fenced."""
-    text = ROLE.sub(_code, text)
+    text = LITERAL.sub(":", ROLE.sub(_code, text))
     found = EXAMPLES.search(text)
     head, rest = (text[:found.start()], text[found.start():]) if found else (text, "")
     return _fence_doctests(head) + rest
@@ -56,3 +59,6 @@ class SphinxRoles(griffe.Extension):
     def on_object(self, *, obj, **kwargs) -> None:
         if obj.docstring is not None:
             obj.docstring.value = markdown_docstring(obj.docstring.value)
+
+    def on_package(self, *, pkg, **kwargs) -> None:  # on_object does not see the root package
+        self.on_object(obj=pkg)
