@@ -142,6 +142,8 @@ class PinocchioFreeFlyer:
     """Pinocchio's free-flyer model of a URDF (its own reader, ``JointModelFreeFlyer``),
     evaluated in eomgen's Euler coordinates: for interoperation and as a reference.
 
+    Pinocchio is optional; it is imported when an instance is made.
+
     Parameters
     ----------
     urdf:
@@ -151,8 +153,6 @@ class PinocchioFreeFlyer:
         eomgen's q.
     locked:
         Joints Pinocchio locks at 0 (``buildReducedModel``), as a scene locks them.
-
-    Pinocchio is optional; it is imported when an instance is made.
 
     Attributes
     ----------
