@@ -101,7 +101,7 @@ class System:
         self.model = numeric_only(model)
         dyn = derive(self.model, outputs=("M", "C", "g", "tau"), simplify=False)
         self.n = n = len(dyn.qd)
-        self.nq = len(dyn.q)
+        self._extra = len(dyn.q) - n  # 1 for a free flyer's quaternion
         zero_qdd = {s: 0 for s in dyn.qdd}
         self._M = compile_scalar(dyn.program, dyn.q, ["M"])
         self._bias = compile_scalar(dyn.program, dyn.q + dyn.qd, ["tau"], fixed=zero_qdd)
@@ -114,6 +114,11 @@ class System:
         self._shape = (n, n)
         self.evaluations = 0
         self._worst: tuple[float, list] = (1.0, [])
+
+    @property
+    def nq(self) -> int:
+        """Entries of the configuration: :attr:`n`, one more for a free flyer."""
+        return self.n + self._extra
 
     def reset(self) -> None:
         self.evaluations = 0
@@ -207,6 +212,14 @@ class System:
 # Integrators
 # ----------------------------------------------------------------------------------------------
 
+def _rate(system, q, qd):
+    """``q̇`` for the integrators: :meth:`System.configuration_rate` where the system has one
+    (a free flyer's quaternion), else the velocities themselves (the flexible-joint and contact
+    systems, whose q and q̇ have one size)."""
+    rate = getattr(system, "configuration_rate", None)
+    return qd if rate is None else rate(q, qd)
+
+
 class Integrator(Protocol):
     name: str
 
@@ -256,7 +269,7 @@ class ExplicitEuler(FixedStep):
 
     def step(self, system, state, h):
         q, qd = state
-        return q + h * system.configuration_rate(q, qd), qd + h * system.forward_dynamics(q, qd)
+        return q + h * _rate(system, q, qd), qd + h * system.forward_dynamics(q, qd)
 
 
 @dataclass(frozen=True)
@@ -266,7 +279,7 @@ class SemiImplicitEuler(FixedStep):
     def step(self, system, state, h):
         q, qd = state
         qd = qd + h * system.forward_dynamics(q, qd)
-        return q + h * system.configuration_rate(q, qd), qd
+        return q + h * _rate(system, q, qd), qd
 
 
 @dataclass(frozen=True)
@@ -275,7 +288,11 @@ class RK4(FixedStep):
 
     def step(self, system, state, h):
         q, qd = state
-        f, rate = system.forward_dynamics, system.configuration_rate
+        f = system.forward_dynamics
+
+        def rate(q, v):
+            return _rate(system, q, v)
+
         k1q, k1v = rate(q, qd), f(q, qd)
         q2, v2 = q + h / 2 * k1q, qd + h / 2 * k1v
         k2q, k2v = rate(q2, v2), f(q2, v2)
@@ -311,11 +328,11 @@ class ImplicitMidpoint(FixedStep):
     def step(self, system, state, h):
         q0, p0 = state
         qd, pdot = system.velocity_and_momentum_rate(q0, p0)
-        q1, p1 = q0 + h * system.configuration_rate(q0, qd), p0 + h * pdot
+        q1, p1 = q0 + h * _rate(system, q0, qd), p0 + h * pdot
         for _ in range(self.max_iterations):
             middle = (q0 + q1) / 2
             qd, pdot = system.velocity_and_momentum_rate(middle, (p0 + p1) / 2)
-            q_next, p_next = q0 + h * system.configuration_rate(middle, qd), p0 + h * pdot
+            q_next, p_next = q0 + h * _rate(system, middle, qd), p0 + h * pdot
             change = max(np.max(np.abs(q_next - q1)), np.max(np.abs(p_next - p1)))
             scale = 1 + max(np.max(np.abs(q_next)), np.max(np.abs(p_next)))
             q1, p1 = q_next, p_next
@@ -344,10 +361,10 @@ class Adaptive:
     def run(self, system: System, q0, qd0, times: np.ndarray):
         from scipy.integrate import solve_ivp  # optional dependency (the analysis extra)
 
-        n = system.nq
+        n = getattr(system, "nq", system.n)
 
         def rhs(t, z):
-            return np.concatenate([system.configuration_rate(z[:n], z[n:]),
+            return np.concatenate([_rate(system, z[:n], z[n:]),
                                    system.forward_dynamics(z[:n], z[n:])])
 
         z0 = np.concatenate([np.asarray(q0, float), np.asarray(qd0, float)])

@@ -286,7 +286,7 @@ def test_cli_simulate_writes_table_csv_and_plot(tmp_path):
 @pytest.mark.parametrize("args, message", [
     (["--dt", "fast"], "--dt: expected comma-separated numbers"),
     (["--integrators", "leapfrog"], "unknown integrator leapfrog"),
-    (["--q0", "1,2,3"], "has 2 joints"),
+    (["--q0", "1,2,3"], "takes 2 values (joint1, joint2), got 3"),
     (["--dt", "-1"], "must be positive"),
 ])
 def test_cli_simulate_refuses_bad_options_in_one_line(args, message, tmp_path):

@@ -21,18 +21,18 @@ MAIN = r"""
 #include "planar_2link_kernels.h"
 int main(void)
 {
-    double q[PLANAR_2LINK_NQ], qd[PLANAR_2LINK_NQ], x[PLANAR_2LINK_NQ];
-    double tau[PLANAR_2LINK_NQ], d[PLANAR_2LINK_NQ * 2 * PLANAR_2LINK_NQ], qdd[PLANAR_2LINK_NQ];
+    double q[PLANAR_2LINK_NQ], qd[PLANAR_2LINK_NV], x[PLANAR_2LINK_NV];
+    double tau[PLANAR_2LINK_NV], d[PLANAR_2LINK_NV * 2 * PLANAR_2LINK_NV], qdd[PLANAR_2LINK_NV];
     int k;
-    for (k = 0; k < PLANAR_2LINK_NQ; ++k) {
+    for (k = 0; k < PLANAR_2LINK_NV; ++k) {
         q[k] = 0.3 + 0.5 * k; qd[k] = -0.7 + k; x[k] = 1.1 - 0.4 * k;
     }
     planar_2link_inverse_dynamics(q, qd, x, planar_2link_parameter_defaults, tau);
     planar_2link_inverse_dynamics_derivatives(q, qd, x, planar_2link_parameter_defaults, d);
     planar_2link_forward_dynamics_aba(q, qd, x, planar_2link_parameter_defaults, qdd);
-    for (k = 0; k < PLANAR_2LINK_NQ; ++k) printf("%.17g ", tau[k]);
-    for (k = 0; k < PLANAR_2LINK_NQ * 2 * PLANAR_2LINK_NQ; ++k) printf("%.17g ", d[k]);
-    for (k = 0; k < PLANAR_2LINK_NQ; ++k) printf("%.17g ", qdd[k]);
+    for (k = 0; k < PLANAR_2LINK_NV; ++k) printf("%.17g ", tau[k]);
+    for (k = 0; k < PLANAR_2LINK_NV * 2 * PLANAR_2LINK_NV; ++k) printf("%.17g ", d[k]);
+    for (k = 0; k < PLANAR_2LINK_NV; ++k) printf("%.17g ", qdd[k]);
     printf("\n");
     return 0;
 }
