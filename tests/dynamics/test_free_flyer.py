@@ -136,11 +136,18 @@ def erd_path(relative_path):
     return robots / relative_path
 
 
+GO1 = "go1_description/urdf/go1.urdf"
+
+
 @pytest.mark.parametrize("robot, tips", [
-    (SOLO, None), (TALOS, ("leg_left_6_link", "leg_right_6_link"))], ids=["solo12", "talos_legs"])
+    pytest.param(SOLO, None, id="solo12"),
+    pytest.param(GO1, None, id="go1", marks=pytest.mark.slow),
+    pytest.param(TALOS, ("leg_left_6_link", "leg_right_6_link"), id="talos_legs",
+                 marks=pytest.mark.slow)])
 def test_scene_quaternion_base_equals_pinocchio(robot, tips, tmp_path):
-    """``floating_base: quaternion`` in a scene: the NumPy module of solo12 and of Talos's
-    legs (the rest locked at 0) takes Pinocchio's arrays unchanged."""
+    """``floating_base: quaternion`` in a scene: the NumPy module of solo12, of Go1 (its rotors
+    written as fixed links) and of Talos's legs (the rest locked at 0) takes Pinocchio's arrays
+    unchanged: M, C, g, τ, h, the ABA and the centroidal quantities."""
     from eomgen.reduction import apply_scene
     from eomgen.scene import load_scene
     from support import load_quietly
@@ -154,17 +161,27 @@ def test_scene_quaternion_base_equals_pinocchio(robot, tips, tmp_path):
     if locked:
         pm = pin.buildReducedModel(pm, locked, pin.neutral(pm))
     assert list(model.joint_names[6:]) == list(pm.names[2:])
-    calls, _ = generated(model, ("M", "C", "g", "tau"), tmp_path, backends=("numpy",))
+    calls, _ = generated(model, ("M", "C", "g", "tau", "h", "qdd_aba", "c_G", "J_G", "A_G",
+                                 "dAGv"), tmp_path, backends=("numpy",))
     call, data = calls["numpy"], pm.createData()
     for q, v, a in states(pm, count=2, seed=17):
         M = pin.crba(pm, data, q)
-        assert relative(call("mass_matrix", q), np.triu(M) + np.triu(M, 1).T) < 1e-10
-        assert relative(call("coriolis_matrix", q, v),
-                        pin.computeCoriolisMatrix(pm, data, q, v)) < 1e-10
-        assert relative(call("gravity_vector", q).ravel(),
-                        pin.computeGeneralizedGravity(pm, data, q)) < 1e-10
-        assert relative(call("inverse_dynamics", q, v, a).ravel(),
-                        pin.rnea(pm, data, q, v, a)) < 1e-10
+        tau = pin.rnea(pm, data, q, v, a).copy()
+        expected = [
+            ("mass_matrix", (q,), np.triu(M) + np.triu(M, 1).T),
+            ("coriolis_matrix", (q, v), pin.computeCoriolisMatrix(pm, data, q, v).copy()),
+            ("gravity_vector", (q,), pin.computeGeneralizedGravity(pm, data, q).copy()),
+            ("inverse_dynamics", (q, v, a), tau),
+            ("nonlinear_effects", (q, v), pin.nonLinearEffects(pm, data, q, v).copy()),
+            ("forward_dynamics_aba", (q, v, tau), a),
+            ("center_of_mass", (q,), pin.centerOfMass(pm, data, q).copy()),
+            ("center_of_mass_jacobian", (q,), pin.jacobianCenterOfMass(pm, data, q).copy()),
+            ("centroidal_momentum_matrix", (q,), pin.computeCentroidalMap(pm, data, q).copy()),
+            ("centroidal_momentum_bias", (q, v),
+             pin.computeCentroidalMapTimeVariation(pm, data, q, v) @ v)]
+        for function, inputs, value in expected:
+            got = call(function, *inputs).reshape(value.shape)
+            assert relative(got, value) < 1e-10, function
 
 
 def test_outputs_not_derived_for_the_chart_are_refused():
