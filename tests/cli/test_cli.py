@@ -104,9 +104,9 @@ BAD = {
                                        "joints: []\n", ["links[0] 'base'", "colour"]),
     "YAML neither format": ("robot.yaml", "name: r\n", ["cannot tell which format"]),
     "floating joint": ("float.urdf",
-                       f'<robot name="r"><link name="base"/>{LINK.format(mass=1)}'
-                       f'{JOINT.replace("revolute", "floating")}</robot>',
-                       ["joint 'j'", "floating joints are not supported"]),
+                       f'<robot name="r">{LINK.replace("arm", "base").format(mass=1)}'
+                       f'{LINK.format(mass=1)}{JOINT.replace("revolute", "floating")}</robot>',
+                       ["joint 'j'", "read as the robot's free flyer only from a massless root"]),
 }
 
 

@@ -13,6 +13,7 @@ import re
 import shlex
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -75,6 +76,10 @@ def workspace(tmp_path, erd_robots_dir, monkeypatch):
     monkeypatch.setenv("MPLBACKEND", "Agg")
     monkeypatch.chdir(work)
     monkeypatch.syspath_prepend(str(work))
+    temporary = str(Path(tempfile.gettempdir()).resolve())
+    for name, module in list(sys.modules.items()):  # a generated module another test imported
+        if str(getattr(module, "__file__", "") or "").startswith(temporary):
+            del sys.modules[name]  # would shadow the one a block generates under its name
     before = set(sys.modules)
     yield work
     for name in set(sys.modules) - before:  # the generated modules the blocks imported

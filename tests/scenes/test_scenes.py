@@ -211,11 +211,19 @@ def test_ur5_payload_mass_stays_a_parameter_that_changes_the_dynamics():
     assert not np.allclose(f(*q, 2.0)["g"], g0)
 
 
+#: Example scenes for the bundled robots (eomgen.example_path) and the robot each applies to.
+BUNDLED_EXAMPLES = {"planar_2link_mixed_drives": "planar_2link"}  # docs/actuators.md
+
+
 def test_every_example_scene_loads_and_names_its_robot():
-    assert sorted(p.stem for p in SCENES.glob("*.yaml")) == sorted(EXAMPLES)
+    assert sorted(p.stem for p in SCENES.glob("*.yaml")) == sorted({**EXAMPLES,
+                                                                     **BUNDLED_EXAMPLES})
     for name, relative in EXAMPLES.items():
         scene = load_scene(SCENES / f"{name}.yaml")
         assert scene.robot == erd_model(relative).name
+    for name, robot in BUNDLED_EXAMPLES.items():
+        scene = load_scene(SCENES / f"{name}.yaml")
+        assert scene.robot in (None, eomgen.load(eomgen.example_path(robot)).name)
 
 
 # ----------------------------------------------------------------------------------------------
