@@ -41,6 +41,25 @@ def included_source() -> str:
 _TASK_SINGULAR = 1e-10
 
 
+def _frame_selection(frames, names, who=""):
+    """(indices, one) of the frames asked for: ``frames`` None (every one of ``names``), a name
+    or index (``one``: the result drops the frame axis), or a sequence of names and indices."""
+    one = isinstance(frames, (str, int, np.integer))
+    chosen = range(len(names)) if frames is None else [frames] if one else list(frames)
+    indices = []
+    for frame in chosen:
+        if isinstance(frame, str):
+            if frame not in names:
+                raise ValueError(f"{who}unknown frame {frame!r} (FRAME_NAMES: "
+                                 f"{', '.join(names)})")
+            indices.append(list(names).index(frame))
+        elif -len(names) <= int(frame) < len(names):
+            indices.append(int(frame) % len(names))
+        else:
+            raise ValueError(f"{who}frame index {frame} out of range for {len(names)} frames")
+    return np.array(indices, dtype=int), one
+
+
 def _operational_space(M, J, damping=0.0, linear=False, names=None, single=False, who=""):
     """Lambda and Jbar of every frame at every state.
 
@@ -108,5 +127,6 @@ def _task_at(k, single):
 #: J M^-1 J^T counts as singular at damping 0 below this eigenvalue ratio.
 TASK_SINGULAR = _TASK_SINGULAR
 operational_space = _operational_space
+frame_selection = _frame_selection
 
-__all__ = ["TASK_SINGULAR", "included_source", "operational_space"]
+__all__ = ["TASK_SINGULAR", "frame_selection", "included_source", "operational_space"]

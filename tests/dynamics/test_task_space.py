@@ -1,0 +1,151 @@
+"""Task-space quantities (issue 27 item 3): operational_space_inertia Λ, operational_space_bias
+(μ, p) and dynamically_consistent_inverse J̄ of the NumPy module against Pinocchio
+(computeMinverse, getFrameJacobian(LOCAL_WORLD_ALIGNED), getFrameClassicalAcceleration,
+nonLinearEffects, computeGeneralizedGravity) on the UR5 (fixed base) and on a random tree with
+a quaternion free flyer (q of NQ, the rest NV); identities (J J̄ = 1, Λ symmetric positive
+definite), damping against its formula, and the errors.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from eomgen.free_flyer import add_free_flyer
+from support import relative
+from support.generated import generated
+from support.reference import random_inertial, random_robot, to_urdf
+from support.robots import ur5
+
+pin = pytest.importorskip("pinocchio", reason="task-space quantities are checked against "
+                          "Pinocchio")
+
+FUNCTIONS = ("operational_space_inertia", "operational_space_bias",
+             "dynamically_consistent_inverse")
+
+
+def floating_tree(seed: int, joints: int):
+    """A random tree whose links all carry mass (M positive definite under a free flyer)."""
+    rng = np.random.default_rng(seed)
+    fixed = random_robot(rng, joints, tree=True)
+    links = tuple(replace(link, inertial=random_inertial(rng)) if link.inertial is None
+                  or link.name == fixed.root else link for link in fixed.links)
+    return replace(fixed, links=links)
+
+
+@pytest.fixture(scope="module")
+def arm(tmp_path_factory):
+    """The UR5: its NumPy module, Pinocchio's model of the same URDF, the frames that move
+    (its leaf ``base`` is fixed to the ground)."""
+    model = ur5()
+    pm = pin.buildModelFromUrdf(str(model.source))
+    _, modules = generated(model, FUNCTIONS, tmp_path_factory.mktemp("task_arm"),
+                           backends=("numpy",))
+    return modules["numpy"], pm, ("ee_link", "tool0")
+
+
+@pytest.fixture(scope="module")
+def flyer(tmp_path_factory):
+    """A random three-joint tree on a quaternion free flyer, every leaf a frame."""
+    fixed = floating_tree(5, 3)
+    folder = tmp_path_factory.mktemp("task_flyer")
+    (folder / "tree.urdf").write_text(to_urdf(fixed), encoding="utf-8")
+    pm = pin.buildModelFromUrdf(str(folder / "tree.urdf"), pin.JointModelFreeFlyer())
+    pm.gravity = pin.Motion(np.array([float(x) for x in fixed.gravity]), np.zeros(3))
+    _, modules = generated(add_free_flyer(fixed), FUNCTIONS, folder, backends=("numpy",))
+    module = modules["numpy"]
+    return module, pm, tuple(module["FRAME_NAMES"])
+
+
+def states(pm, count, seed):
+    rng = np.random.default_rng(seed)
+    return [(pin.randomConfiguration(pm, -np.ones(pm.nq), np.ones(pm.nq)),
+             rng.normal(size=pm.nv)) for _ in range(count)]
+
+
+def pinocchio_task_space(pm, q, v, frame, r):
+    """Λ, μ, p, J̄ of ``frame`` from Pinocchio's M⁻¹, frame Jacobian and accelerations (r = 6,
+    or 3 for the linear rows)."""
+    data = pm.createData()
+    Minv = pin.computeMinverse(pm, data, q)
+    Minv = np.triu(Minv) + np.triu(Minv, 1).T
+    h = pin.nonLinearEffects(pm, data, q, v).copy()
+    g = pin.computeGeneralizedGravity(pm, data, q).copy()
+    pin.forwardKinematics(pm, data, q, v, np.zeros(pm.nv))
+    pin.computeJointJacobians(pm, data, q)
+    pin.updateFramePlacements(pm, data)
+    fid = pm.getFrameId(frame)
+    world = pin.LOCAL_WORLD_ALIGNED
+    J = pin.getFrameJacobian(pm, data, fid, world)[:r]
+    drift = pin.getFrameClassicalAcceleration(pm, data, fid, world).vector[:r]
+    Lam = np.linalg.inv(J @ Minv @ J.T)
+    Jbar = Minv @ J.T @ Lam
+    return Lam, Jbar.T @ (h - g) - Lam @ drift, Jbar.T @ g, Jbar
+
+
+@pytest.mark.parametrize("robot", ["arm", "flyer"])
+@pytest.mark.parametrize("linear", [False, True])
+def test_task_space_equals_pinocchio(robot, linear, request):
+    module, pm, frames = request.getfixturevalue(robot)
+    r = 3 if linear else 6
+    qs, vs = zip(*states(pm, 2, seed=11))
+    for q, v in zip(qs, vs):
+        Lam = module["operational_space_inertia"](q, linear=linear, frames=frames)
+        mu, p = module["operational_space_bias"](q, v, linear=linear, frames=frames)
+        Jbar = module["dynamically_consistent_inverse"](q, linear=linear, frames=frames)
+        assert Lam.shape == (len(frames), r, r) and mu.shape == p.shape == (len(frames), r)
+        assert Jbar.shape == (len(frames), pm.nv, r)
+        for k, frame in enumerate(frames):
+            expected = pinocchio_task_space(pm, q, v, frame, r)
+            for got, want in zip((Lam[k], mu[k], p[k], Jbar[k]), expected):
+                assert relative(got, want) < 1e-10
+    # a batch gives the single states stacked; one frame by name drops the frame axis
+    batch = module["operational_space_bias"](np.array(qs), np.array(vs), linear=linear,
+                                             frames=frames[-1])
+    for k, (q, v) in enumerate(zip(qs, vs)):
+        single = module["operational_space_bias"](q, v, linear=linear, frames=frames)
+        assert np.array_equal(batch[0][k], single[0][-1])
+        assert np.array_equal(batch[1][k], single[1][-1])
+
+
+def test_identities_and_damping(flyer):
+    """Λ symmetric positive definite, J J̄ = 1; with damping, Λ = (J M⁻¹ Jᵀ + d 1)⁻¹ and
+    J̄ = M⁻¹ Jᵀ Λ exactly as the formula (Pinocchio's M⁻¹ and J)."""
+    module, pm, frames = flyer
+    data = pm.createData()
+    for q, _ in states(pm, 2, seed=13):
+        Lam = module["operational_space_inertia"](q)
+        Jbar = module["dynamically_consistent_inverse"](q)
+        Minv = pin.computeMinverse(pm, data, q)
+        Minv = np.triu(Minv) + np.triu(Minv, 1).T
+        pin.computeJointJacobians(pm, data, q)
+        pin.updateFramePlacements(pm, data)
+        damped = module["operational_space_inertia"](q, damping=0.1)
+        damped_inverse = module["dynamically_consistent_inverse"](q, damping=0.1)
+        for k, frame in enumerate(frames):
+            J = pin.getFrameJacobian(pm, data, pm.getFrameId(frame), pin.LOCAL_WORLD_ALIGNED)
+            assert np.array_equal(Lam[k], Lam[k].T)
+            assert np.linalg.eigvalsh(Lam[k]).min() > 0
+            assert np.abs(J @ Jbar[k] - np.eye(6)).max() < 1e-10
+            expected = np.linalg.inv(J @ Minv @ J.T + 0.1 * np.eye(6))
+            assert relative(damped[k], expected) < 1e-10
+            assert relative(damped_inverse[k], Minv @ J.T @ expected) < 1e-10
+
+
+def test_singular_frames_are_refused_unless_damped(arm):
+    """The UR5's leaf ``base`` does not move: J M⁻¹ Jᵀ = 0, a LinAlgError naming it (and the
+    state of a batch), finite with damping; the stretched arm (q = 0) is singular at tool0."""
+    module, pm, _ = arm
+    q = pin.randomConfiguration(pm, -np.ones(pm.nq), np.ones(pm.nq))
+    with pytest.raises(np.linalg.LinAlgError, match="frame 'base' .* is singular \\("):
+        module["operational_space_inertia"](q)
+    assert np.all(np.isfinite(module["operational_space_bias"](q, q, damping=1e-6)[0]))
+    with pytest.raises(np.linalg.LinAlgError, match="frame 'tool0' \\(6x6\\) is singular at "
+                       "state 1 \\(.*use damping > 0"):
+        module["dynamically_consistent_inverse"](np.array([q, np.zeros(6)]), frames="tool0")
+    with pytest.raises(ValueError, match="unknown frame 'hand'"):
+        module["operational_space_inertia"](q, frames="hand")
+    with pytest.raises(ValueError, match="damping must be a finite number >= 0"):
+        module["operational_space_inertia"](q, damping=-1.0)
