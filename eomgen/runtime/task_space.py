@@ -14,8 +14,9 @@ For each frame with world-aligned Jacobian J at its origin (6 × NV, linear rows
   Cholesky factor of ``A = Zᵀ Z + damping 1`` (so Λ is symmetric to the last bit);
 * ``J̄ = M⁻¹ Jᵀ Λ = L⁻ᵀ Z Λ``, the dynamically consistent inverse (J J̄ = 1 at damping 0).
 
-At damping 0 a frame whose ``A`` has its smallest eigenvalue at most ``1e-10`` times its largest
-(cond ≳ 1e10: a kinematic singularity, or a direction no joint moves the frame in) raises
+At damping 0 a frame whose ``A`` has a Cholesky pivot at most ``1e-10`` times its largest
+diagonal entry (cond ≳ 1e10: a kinematic singularity, or a direction no joint moves the frame
+in) raises
 :class:`numpy.linalg.LinAlgError` naming the frame and the state: Λ does not exist there.
 """
 
@@ -36,8 +37,9 @@ def included_source() -> str:
 
 
 # --- included in the generated NumPy modules from here on ---
-#: At damping 0, J M^-1 J^T counts as singular when its smallest eigenvalue is at most this
-#: times its largest (cond >~ 1e10).
+#: At damping 0, J M^-1 J^T counts as singular when a pivot of its Cholesky factorisation is
+#: at most this times its largest diagonal entry (cond >~ 1e10), as in the fast module and as
+#: constrained_forward_dynamics' contact rows.
 _TASK_SINGULAR = 1e-10
 
 
@@ -70,7 +72,8 @@ def _operational_space(M, J, damping=0.0, linear=False, names=None, single=False
 
     Raises ValueError for a damping not finite or < 0, FloatingPointError when M or J is not
     finite, numpy.linalg.LinAlgError when M is not positive definite or, at damping 0, when
-    J M^-1 J^T of a frame is singular (see _TASK_SINGULAR)."""
+    J M^-1 J^T of a frame is singular (see _TASK_SINGULAR); with damping > 0, when
+    J M^-1 J^T + damping 1 is not positive definite (damping lost in rounding)."""
     damping = float(damping)
     if not (np.isfinite(damping) and damping >= 0.0):
         raise ValueError(f"{who}damping must be a finite number >= 0, got {damping!r}")
@@ -88,7 +91,7 @@ def _operational_space(M, J, damping=0.0, linear=False, names=None, single=False
     try:
         L = np.linalg.cholesky(M)
     except np.linalg.LinAlgError:
-        bad = next(k for k in range(N) if np.any(np.linalg.eigvalsh(M[k]) <= 0))
+        bad = next((k for k in range(N) if np.any(np.linalg.eigvalsh(M[k]) <= 0)), 0)
         raise np.linalg.LinAlgError(
             f"{who}M(q) is not positive definite{_task_at(bad, single)}: a joint moves no mass "
             "or inertia, or the inertias are not physical") from None
@@ -96,27 +99,41 @@ def _operational_space(M, J, damping=0.0, linear=False, names=None, single=False
     Z = np.linalg.solve(Lb, np.swapaxes(J, -1, -2))              # L^-1 J^T: (N, nf, n, r)
     A = np.swapaxes(Z, -1, -2) @ Z
     A = 0.5 * (A + np.swapaxes(A, -1, -2)) + damping * np.eye(r)
-    if damping == 0.0 and A.size:
-        eigenvalues = np.linalg.eigvalsh(A)                         # ascending, (N, nf, r)
-        ratio = eigenvalues[..., 0] / np.maximum(eigenvalues[..., -1], np.finfo(float).tiny)
-        k, f = np.unravel_index(int(np.argmin(ratio)), ratio.shape)
-        if ratio[k, f] <= _TASK_SINGULAR:
-            frame = f"frame {names[f]!r}" if names is not None else f"frame {f}"
+    LA, bad = _task_cholesky(A, 0.0 if damping > 0.0 else _TASK_SINGULAR)
+    if bad is not None:
+        k, f = bad
+        if damping > 0.0:
             raise np.linalg.LinAlgError(
-                f"{who}J M^-1 J^T of {frame} ({r}x{r}) is singular{_task_at(k, single)} "
-                f"(smallest eigenvalue {eigenvalues[k, f, 0]:.3g} <= 1e-10 of the largest: a "
-                "kinematic singularity, or a direction no joint moves the frame in); use "
-                "damping > 0")
-    try:
-        LA = np.linalg.cholesky(A)
-    except np.linalg.LinAlgError:
+                f"{who}J M^-1 J^T + damping 1 is not positive definite{_task_at(k, single)} "
+                f"(damping {damping:g} is lost in rounding); use a larger damping")
+        frame = f"frame {names[f]!r}" if names is not None else f"frame {f}"
         raise np.linalg.LinAlgError(
-            f"{who}J M^-1 J^T + damping 1 is not positive definite (damping {damping:g} is "
-            "lost in rounding); use a larger damping") from None
+            f"{who}J M^-1 J^T of {frame} ({r}x{r}) is singular{_task_at(k, single)} (a "
+            "Cholesky pivot <= 1e-10 of its largest diagonal entry, cond >~ 1e10: a kinematic "
+            "singularity, or a direction no joint moves the frame in); use damping > 0")
     W = np.linalg.solve(LA, np.broadcast_to(np.eye(r), A.shape))  # L_A^-1
     Lam = np.swapaxes(W, -1, -2) @ W
     Jbar = np.linalg.solve(np.swapaxes(Lb, -1, -2), Z) @ Lam       # L^-T Z Lambda
     return Lam, Jbar
+
+
+def _task_cholesky(A, tol):
+    """(L, None) with A = L L^T for the (N, nf, r, r) matrices A, or (None, (state, frame)) of
+    the first whose Cholesky pivot (before its square root) is not above ``tol`` times its
+    largest diagonal entry (the rule of the fast module's task_space_frame)."""
+    N, nf, r, _ = A.shape
+    L = np.zeros_like(A)
+    scale = tol * np.max(np.diagonal(A, axis1=-2, axis2=-1), axis=-1, initial=0.0)
+    for j in range(r):
+        d = A[..., j, j] - np.einsum("bfk,bfk->bf", L[..., j, :j], L[..., j, :j])
+        failed = ~(d > scale)
+        if np.any(failed):
+            k, f = np.unravel_index(int(np.argmax(failed)), failed.shape)
+            return None, (int(k), int(f))
+        L[..., j, j] = np.sqrt(d)
+        L[..., j + 1:, j] = (A[..., j + 1:, j] - np.einsum(
+            "bfik,bfk->bfi", L[..., j + 1:, :j], L[..., j, :j])) / L[..., j, j][..., None]
+    return L, None
 
 
 def _task_at(k, single):
@@ -124,7 +141,8 @@ def _task_at(k, single):
 
 
 # --- end of the included text: public names for eomgen's own use ---
-#: J M^-1 J^T counts as singular at damping 0 below this eigenvalue ratio.
+#: J M^-1 J^T counts as singular at damping 0 at a Cholesky pivot below this times its
+#: largest diagonal entry.
 TASK_SINGULAR = _TASK_SINGULAR
 operational_space = _operational_space
 frame_selection = _frame_selection
