@@ -1,5 +1,5 @@
 """Task-space quantities (issue 27 item 3): operational_space_inertia Λ, operational_space_bias
-(μ, p) and dynamically_consistent_inverse J̄ of the NumPy module against Pinocchio
+(μ, p) and dynamically_consistent_inverse J̄ of the NumPy and fast modules against Pinocchio
 (computeMinverse, getFrameJacobian(LOCAL_WORLD_ALIGNED), getFrameClassicalAcceleration,
 nonLinearEffects, computeGeneralizedGravity) on the UR5 (fixed base) and on a random tree with
 a quaternion free flyer (q of NQ, the rest NV); identities (J J̄ = 1, Λ symmetric positive
@@ -24,6 +24,8 @@ pin = pytest.importorskip("pinocchio", reason="task-space quantities are checked
 
 FUNCTIONS = ("operational_space_inertia", "operational_space_bias",
              "dynamically_consistent_inverse")
+#: The backends whose modules compose the task-space functions.
+BACKENDS = ("numpy", "fast")
 
 
 def floating_tree(seed: int, joints: int):
@@ -42,8 +44,8 @@ def arm(tmp_path_factory):
     model = ur5()
     pm = pin.buildModelFromUrdf(str(model.source))
     _, modules = generated(model, FUNCTIONS, tmp_path_factory.mktemp("task_arm"),
-                           backends=("numpy",))
-    return modules["numpy"], pm, ("ee_link", "tool0")
+                           backends=BACKENDS)
+    return modules, pm, ("ee_link", "tool0")
 
 
 @pytest.fixture(scope="module")
@@ -54,9 +56,14 @@ def flyer(tmp_path_factory):
     (folder / "tree.urdf").write_text(to_urdf(fixed), encoding="utf-8")
     pm = pin.buildModelFromUrdf(str(folder / "tree.urdf"), pin.JointModelFreeFlyer())
     pm.gravity = pin.Motion(np.array([float(x) for x in fixed.gravity]), np.zeros(3))
-    _, modules = generated(add_free_flyer(fixed), FUNCTIONS, folder, backends=("numpy",))
-    module = modules["numpy"]
-    return module, pm, tuple(module["FRAME_NAMES"])
+    _, modules = generated(add_free_flyer(fixed), FUNCTIONS, folder, backends=BACKENDS)
+    return modules, pm, tuple(modules["numpy"]["FRAME_NAMES"])
+
+
+def module_of(modules, backend):
+    if backend not in modules:
+        pytest.skip(f"the {backend} module cannot be loaded here")
+    return modules[backend]
 
 
 def states(pm, count, seed):
@@ -85,10 +92,12 @@ def pinocchio_task_space(pm, q, v, frame, r):
     return Lam, Jbar.T @ (h - g) - Lam @ drift, Jbar.T @ g, Jbar
 
 
+@pytest.mark.parametrize("backend", BACKENDS)
 @pytest.mark.parametrize("robot", ["arm", "flyer"])
 @pytest.mark.parametrize("linear", [False, True])
-def test_task_space_equals_pinocchio(robot, linear, request):
-    module, pm, frames = request.getfixturevalue(robot)
+def test_task_space_equals_pinocchio(robot, linear, backend, request):
+    modules, pm, frames = request.getfixturevalue(robot)
+    module = module_of(modules, backend)
     r = 3 if linear else 6
     qs, vs = zip(*states(pm, 2, seed=11))
     for q, v in zip(qs, vs):
@@ -110,10 +119,12 @@ def test_task_space_equals_pinocchio(robot, linear, request):
         assert np.array_equal(batch[1][k], single[1][-1])
 
 
-def test_identities_and_damping(flyer):
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_identities_and_damping(flyer, backend):
     """Λ symmetric positive definite, J J̄ = 1; with damping, Λ = (J M⁻¹ Jᵀ + d 1)⁻¹ and
     J̄ = M⁻¹ Jᵀ Λ exactly as the formula (Pinocchio's M⁻¹ and J)."""
-    module, pm, frames = flyer
+    modules, pm, frames = flyer
+    module = module_of(modules, backend)
     data = pm.createData()
     for q, _ in states(pm, 2, seed=13):
         Lam = module["operational_space_inertia"](q)
@@ -134,10 +145,12 @@ def test_identities_and_damping(flyer):
             assert relative(damped_inverse[k], Minv @ J.T @ expected) < 1e-10
 
 
-def test_singular_frames_are_refused_unless_damped(arm):
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_singular_frames_are_refused_unless_damped(arm, backend):
     """The UR5's leaf ``base`` does not move: J M⁻¹ Jᵀ = 0, a LinAlgError naming it (and the
     state of a batch), finite with damping; the stretched arm (q = 0) is singular at tool0."""
-    module, pm, _ = arm
+    modules, pm, _ = arm
+    module = module_of(modules, backend)
     q = pin.randomConfiguration(pm, -np.ones(pm.nq), np.ones(pm.nq))
     with pytest.raises(np.linalg.LinAlgError, match="frame 'base' .* is singular \\("):
         module["operational_space_inertia"](q)
