@@ -25,7 +25,7 @@ pin = pytest.importorskip("pinocchio", reason="task-space quantities are checked
 FUNCTIONS = ("operational_space_inertia", "operational_space_bias",
              "dynamically_consistent_inverse")
 #: The backends whose modules compose the task-space functions.
-BACKENDS = ("numpy", "fast")
+BACKENDS = ("numpy", "fast", "jax")
 
 
 def floating_tree(seed: int, joints: int):
@@ -96,6 +96,8 @@ def pinocchio_task_space(pm, q, v, frame, r):
 @pytest.mark.parametrize("robot", ["arm", "flyer"])
 @pytest.mark.parametrize("linear", [False, True])
 def test_task_space_equals_pinocchio(robot, linear, backend, request):
+    if backend == "jax" and linear and robot == "arm":
+        pytest.skip("JAX runs op by op here (slow): its linear rows are checked on the flyer")
     modules, pm, frames = request.getfixturevalue(robot)
     module = module_of(modules, backend)
     r = 3 if linear else 6
@@ -115,8 +117,8 @@ def test_task_space_equals_pinocchio(robot, linear, backend, request):
                                              frames=frames[-1])
     for k, (q, v) in enumerate(zip(qs, vs)):
         single = module["operational_space_bias"](q, v, linear=linear, frames=frames)
-        assert np.array_equal(batch[0][k], single[0][-1])
-        assert np.array_equal(batch[1][k], single[1][-1])
+        assert relative(batch[0][k], single[0][-1]) < 1e-13  # JAX: rounding of XLA's order
+        assert relative(batch[1][k], single[1][-1]) < 1e-13
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
@@ -152,6 +154,10 @@ def test_singular_frames_are_refused_unless_damped(arm, backend):
     modules, pm, _ = arm
     module = module_of(modules, backend)
     q = pin.randomConfiguration(pm, -np.ones(pm.nq), np.ones(pm.nq))
+    if backend == "jax":  # pure under jax.jit: nothing raises on values, the results are NaN
+        assert not np.all(np.isfinite(module["operational_space_inertia"](q, frames="base")))
+        assert np.all(np.isfinite(module["operational_space_inertia"](q, frames=[0, 2])))
+        return
     with pytest.raises(np.linalg.LinAlgError, match="frame 'base' .* is singular \\("):
         module["operational_space_inertia"](q)
     assert np.all(np.isfinite(module["operational_space_bias"](q, q, damping=1e-6)[0]))

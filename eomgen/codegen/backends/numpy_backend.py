@@ -13,7 +13,6 @@ from sympy.printing.numpy import NumPyPrinter
 from .. import GeneratedFile, Job, register
 from ...symbolic.printing import NumPyModulePrinter
 from ...templating import render
-from ...outputs import TASK_SPACE, exported, task_space_names
 from ...runtime.cholesky import included_source
 from ...runtime import task_space
 from .common import python_loader, python_module_context, warning_exports
@@ -50,9 +49,7 @@ def numpy_source(job: Job, printer, config: NumPyConfig = NumPyConfig()) -> str:
     """The NumPy module's text for ``job`` printed with ``printer`` (also what
     :func:`eomgen.lambdify` executes): the template, with the Cholesky runtime
     (:mod:`eomgen.runtime.cholesky`) included where forward dynamics needs it."""
-    task = any(o.function in exported(job.functions, "numpy") for o in TASK_SPACE)
     return render(config.template, cholesky_runtime=included_source(),
-                  task_space=task, ts=task_space_names(),
                   task_space_runtime=task_space.included_source(),
                   **python_module_context(job, printer, config.template, warning_exports(job),
                                           backend="numpy"))
