@@ -437,7 +437,7 @@ CONSTRAINED_FORWARD = register_output(Output(
 
 # --- issue 27: task-space quantities, composed from M, J_f, J_f-dot qd and tau (templates) --
 #: The backends whose templates compose the task-space functions.
-_TASK_BACKENDS = ("numpy", "fast", "jax")
+_TASK_BACKENDS = ("numpy", "fast", "jax", "torch")
 _TASK_NOTE = ("Per frame of FRAME_NAMES, from its world-aligned Jacobian J at the frame origin "
               "(linear=True: its 3 linear rows)")
 OPERATIONAL_SPACE_INERTIA = register_output(Output(

@@ -25,7 +25,7 @@ pin = pytest.importorskip("pinocchio", reason="task-space quantities are checked
 FUNCTIONS = ("operational_space_inertia", "operational_space_bias",
              "dynamically_consistent_inverse")
 #: The backends whose modules compose the task-space functions.
-BACKENDS = ("numpy", "fast", "jax")
+BACKENDS = ("numpy", "fast", "jax", "torch")
 
 
 def floating_tree(seed: int, joints: int):
@@ -61,9 +61,18 @@ def flyer(tmp_path_factory):
 
 
 def module_of(modules, backend):
+    """``backend``'s module, its task-space functions returning NumPy arrays."""
     if backend not in modules:
         pytest.skip(f"the {backend} module cannot be loaded here")
-    return modules[backend]
+    namespace = modules[backend]
+
+    def as_numpy(function):
+        def call(*args, **keywords):
+            out = function(*args, **keywords)
+            return tuple(map(np.asarray, out)) if isinstance(out, tuple) else np.asarray(out)
+        return call
+
+    return {**namespace, **{name: as_numpy(namespace[name]) for name in FUNCTIONS}}
 
 
 def states(pm, count, seed):
@@ -158,10 +167,14 @@ def test_singular_frames_are_refused_unless_damped(arm, backend):
         assert not np.all(np.isfinite(module["operational_space_inertia"](q, frames="base")))
         assert np.all(np.isfinite(module["operational_space_inertia"](q, frames=[0, 2])))
         return
-    with pytest.raises(np.linalg.LinAlgError, match="frame 'base' .* is singular \\("):
+    error = np.linalg.LinAlgError
+    if backend == "torch":
+        import torch  # the PyTorch module raises torch's LinAlgError
+        error = torch.linalg.LinAlgError
+    with pytest.raises(error, match="frame 'base' .* is singular \\("):
         module["operational_space_inertia"](q)
     assert np.all(np.isfinite(module["operational_space_bias"](q, q, damping=1e-6)[0]))
-    with pytest.raises(np.linalg.LinAlgError, match="frame 'tool0' \\(6x6\\) is singular at "
+    with pytest.raises(error, match="frame 'tool0' \\(6x6\\) is singular at "
                        "state 1 \\(.*use damping > 0"):
         module["dynamically_consistent_inverse"](np.array([q, np.zeros(6)]), frames="tool0")
     with pytest.raises(ValueError, match="unknown frame 'hand'"):
