@@ -491,6 +491,45 @@ LINEARIZE = register_output(Output(
     build=_DERIVATIVES, default=False, returns=("A_lin", "B_lin")))
 
 
+# --- issue 27: task-space quantities, composed from M, J_f, J_f-dot qd and tau (templates) --
+#: The backends whose templates compose the task-space functions.
+_TASK_BACKENDS = ("numpy", "fast", "jax", "torch")
+_TASK_NOTE = ("Per frame of FRAME_NAMES, from its world-aligned Jacobian J at the frame origin "
+              "(linear=True: its 3 linear rows)")
+OPERATIONAL_SPACE_INERTIA = register_output(Output(
+    "operational_space_inertia", None, "Operational-space inertia Lambda = (J M^-1 J^T + "
+    "damping 1)^-1. " + _TASK_NOTE + ": (nf, 6, 6) or (nf, 3, 3).", ("q",), False,
+    "kg (linear block), kg m (mixed), kg m^2 (angular block)", (MASS.symbol, "J_f"),
+    composed_from=(MASS.function, FRAME_JACOBIANS.function), default=False,
+    constants=_FRAME_NAMES, backends=_TASK_BACKENDS))
+OPERATIONAL_SPACE_BIAS = register_output(Output(
+    "operational_space_bias", None, "(mu, p) of the operational-space equations F = Lambda "
+    "xdd + mu + p: mu = Lambda J M^-1 C qd - Lambda Jdot qd, p = Lambda J M^-1 g. " + _TASK_NOTE
+    + ": (nf, 6) each, or (nf, 3).", ("q", "qd"), False, "N (linear rows), N m (angular rows)",
+    (MASS.symbol, INVERSE.symbol, "J_f", "dJqd_f"),
+    composed_from=(MASS.function, INVERSE.function, FRAME_JACOBIANS.function,
+                   FRAME_JACOBIANS_DOT_QD.function), default=False, constants=_FRAME_NAMES,
+    backends=_TASK_BACKENDS))
+DYNAMICALLY_CONSISTENT_INVERSE = register_output(Output(
+    "dynamically_consistent_inverse", None, "Dynamically consistent inverse Jbar = M^-1 J^T "
+    "Lambda (J Jbar = 1 at damping 0). " + _TASK_NOTE + ": (nf, n, 6) or (nf, n, 3).", ("q",),
+    False, "rad/m or 1 (linear columns), rad or m (angular columns)", (MASS.symbol, "J_f"),
+    composed_from=(MASS.function, FRAME_JACOBIANS.function), default=False,
+    constants=_FRAME_NAMES, backends=_TASK_BACKENDS))
+TASK_SPACE = (OPERATIONAL_SPACE_INERTIA, OPERATIONAL_SPACE_BIAS, DYNAMICALLY_CONSISTENT_INVERSE)
+
+
+def task_space_names() -> dict[str, str]:
+    """The names a template needs to compose the task-space functions: theirs (``inertia``,
+    ``bias``, ``inverse``), and ``mass`` (M), ``jacobian`` (J_f), ``drift`` (J_f-dot qd) and
+    ``tau`` (inverse dynamics: C qd + g = tau(q, qd, 0), g = tau(q, 0, 0))."""
+    return {"inertia": OPERATIONAL_SPACE_INERTIA.function,
+            "bias": OPERATIONAL_SPACE_BIAS.function,
+            "inverse": DYNAMICALLY_CONSISTENT_INVERSE.function, "mass": MASS.function,
+            "jacobian": FRAME_JACOBIANS.function, "drift": FRAME_JACOBIANS_DOT_QD.function,
+            "tau": INVERSE.function}
+
+
 def exported(functions, backend: str) -> tuple[str, ...]:
     """``functions`` less the composed ones ``backend`` does not compose
     (:attr:`Output.backends`)."""
@@ -566,4 +605,5 @@ def composition_names(output: Output = FORWARD) -> dict[str, str]:
 
 __all__ = ["INPUTS", "splits", "DYNAMICS", "MASS_AND_BIAS", "INPUT_SIZES", "input_size", "Output", "OUTPUTS", "resolve", "BY_SYMBOL", "register_output", "derived_symbols",
            "function_names", "select", "composition_names", "MASS", "CORIOLIS", "GRAVITY", "INVERSE",
-           "FORWARD", "exported", "constrained_names", "CONSTRAINED_FORWARD"]
+           "FORWARD", "exported", "constrained_names", "CONSTRAINED_FORWARD",
+           "TASK_SPACE", "task_space_names"]

@@ -36,7 +36,8 @@ static const int parameter_has_default[NP + 1] = {1, 0};
 """
 
 #: What each runtime file needs defined before it.
-PRELUDES = {"call": MODULE_CONSTANTS, "contact_call": MODULE_CONSTANTS}
+PRELUDES = {"call": MODULE_CONSTANTS, "contact_call": MODULE_CONSTANTS,
+            "task_call": MODULE_CONSTANTS}
 
 #: A static function or variable defined at the start of a line of the runtime's text.
 STATIC = re.compile(r"^static\s+[^;(]*?\**\b(\w+)\s*(?:\(|=|\[)", re.M)

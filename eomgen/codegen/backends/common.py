@@ -11,8 +11,8 @@ from typing import Callable
 import sympy as sp
 
 from .. import Job, Loaded
-from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, INPUTS, composition_names,
-                       constrained_names, exported)
+from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, INPUTS, TASK_SPACE,
+                       composition_names, constrained_names, exported, task_space_names)
 from ..functions import FunctionSpec
 
 
@@ -193,6 +193,9 @@ def python_module_context(job: Job, printer, template: str, extra_exports=(),
         fd=composition_names(FORWARD),
         constrained_forward_dynamics=CONSTRAINED_FORWARD.function in functions,
         cfd=constrained_names(),
+        # the task-space functions (composed from M, J_f, J_f-dot qd and tau) it exports
+        task_space=any(o.function in functions for o in TASK_SPACE),
+        ts=task_space_names(),
     )
 
 

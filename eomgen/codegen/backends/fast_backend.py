@@ -28,8 +28,8 @@ from sympy.printing.precedence import PRECEDENCE
 
 from ...compiler import c_compiler, shared_library
 from .. import GeneratedFile, Job, Loaded, register
-from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, composition_names,
-                       constrained_names, exported)
+from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, TASK_SPACE,
+                       composition_names, constrained_names, exported, task_space_names)
 from ...symbolic.printing import FloatLiteralMixin
 from ...templating import TEMPLATES_DIR, render
 from .common import import_file, positional, warning_exports
@@ -38,7 +38,8 @@ from .common import import_file, positional, warning_exports
 #: warning-checked on their own by tests/backends/test_fast_runtime_c.py), by the name the template
 #: gives their text (``runtime.cholesky`` ...).
 RUNTIME_DIR = TEMPLATES_DIR / "fast" / "runtime"
-RUNTIME_FILES = ("cholesky", "kkt", "call", "split_columns", "contact_call")
+RUNTIME_FILES = ("cholesky", "kkt", "call", "split_columns", "contact_call", "task_space",
+                 "task_call")
 #: The line of a runtime file below which its text goes into the generated module (above it:
 #: the file's own comment and the #includes that let it compile alone).
 RUNTIME_MARKER = "/* eomgen: the generated module holds the text below this line. */\n"
@@ -183,6 +184,7 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
         "<= 1e-10 of A's largest diagonal entry: dependent contact rows, use damping > 0); "
         "FloatingPointError when M, C qd + g, tau, J_c or J_c-dot qd is not finite; "
         "ValueError for a damping not finite or < 0.")
+    task = _task_space_context(job, functions, signature)
     parameters = [dict(name=c_string_literal(p.identifier),
                        default=("NAN" if p.default is None
                                 else printer.doprint(sp.Float(p.default))),
@@ -215,6 +217,7 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
         nc=nc,
         constrained_doc=constrained_doc,
         runtime={name: runtime_source(name) for name in RUNTIME_FILES},
+        **task,
         **extra,
     )
 
@@ -224,6 +227,39 @@ def render_source(job: Job, config, **extra) -> str:
     C kernels backend (:mod:`.kernels_backend`) prints its files with, so that its kernels are the
     fast module's."""
     return _render_source(job, config, **extra)
+
+
+#: The kind of result of each task-space function (TASK_INERTIA ... in runtime/task_call.c).
+_TASK_KINDS = ("TASK_INERTIA", "TASK_BIAS", "TASK_INVERSE")
+
+
+def _task_space_context(job: Job, functions: list[dict], signature: str) -> dict:
+    """What the template needs to compose the task-space functions the module exports: the
+    frames (``task_frames``, C literals), the names of the functions composed from
+    (``ts``), each exported one's name, kind, inputs and docstring (``task_functions``), and
+    whether the bias (which needs tau and J-dot qd) is among them (``task_bias``)."""
+    wanted = [(o, kind) for o, kind in zip(TASK_SPACE, _TASK_KINDS)
+              if o.function in exported(job.functions, "fast")]
+    names = task_space_names()
+    rows = next((f["rows"] for f in functions if f["name"] == names["jacobian"]), 0)
+    frames = dict(job.constants).get("FRAME_NAMES", ())
+    task_functions = []
+    for output, kind in wanted:
+        keywords = ", *" + signature + ", damping=0.0, linear=False, frames=None"
+        task_functions.append(dict(
+            name=output.function, kind=kind, inputs=output.inputs,
+            doc=c_string_literal(
+                f"{output.function}({', '.join(output.inputs)}{keywords})\n--\n\n"
+                f"{output.summary}\n\nAs the NumPy module's (docs/legged.md): frames None "
+                "(all of FRAME_NAMES), a name or index (no frame axis) or a sequence of them; "
+                "linear=True keeps the 3 linear rows of J; (N,) in front for a batch. Raises "
+                "numpy.linalg.LinAlgError when M is not positive definite or, at damping 0, "
+                "when J M^-1 J^T of a frame is singular (a Cholesky pivot <= 1e-10 of its "
+                "largest diagonal entry; use damping > 0)")))
+    return dict(task_space=bool(wanted), task_functions=task_functions,
+                task_bias=any(kind == "TASK_BIAS" for _, kind in wanted), ts=names,
+                task_frames=[c_string_literal(name) for name in frames],
+                task_nf=rows // 6)
 
 
 def python_headers() -> tuple[str, ...] | None:

@@ -14,6 +14,7 @@ from .. import GeneratedFile, Job, register
 from ...symbolic.printing import NumPyModulePrinter
 from ...templating import render
 from ...runtime.cholesky import included_source
+from ...runtime import task_space
 from .common import python_loader, python_module_context, warning_exports
 
 
@@ -49,5 +50,6 @@ def numpy_source(job: Job, printer, config: NumPyConfig = NumPyConfig()) -> str:
     :func:`eomgen.lambdify` executes): the template, with the Cholesky runtime
     (:mod:`eomgen.runtime.cholesky`) included where forward dynamics needs it."""
     return render(config.template, cholesky_runtime=included_source(),
+                  task_space_runtime=task_space.included_source(),
                   **python_module_context(job, printer, config.template, warning_exports(job),
                                           backend="numpy"))
