@@ -51,6 +51,8 @@ INPUTS: dict[str, str] = {
     "qdddd": "fourth time derivatives of the joint positions (snap) [rad/s^4 or m/s^4]",
     "F_c": "contact forces on the robot, rows CONTACT_ROWS (point contacts: force [N] in world "
            "axes; surface contacts: force [N] and moment [N m] in the contact frame's axes)",
+    "qd_r": "reference joint velocities of the Slotine-Li controller [rad/s or m/s]",
+    "qdd_r": "reference joint accelerations of the Slotine-Li controller [rad/s^2 or m/s^2]",
 }
 
 #: The inputs whose length is not the number of joints: ``"module:function"`` of
@@ -438,6 +440,19 @@ CONSTRAINED_FORWARD = register_output(Output(
     ("q", "qd", "tau"), True, "rad/s^2, m/s^2; N, N m", ("M", "tau", "J_c", "dJqd_c"),
     composed_from=(MASS.function, INVERSE.function, CONTACT_JACOBIAN.function,
                    CONTACT_BIAS.function), default=False, constants=_CONTACT_NAMES))
+
+# Issue 28: the Slotine-Li regressor Y_SL(q, qd, qd_r, qdd_r) pi = M qdd_r + C(q, qd) qd_r + g
+# (C Christoffel) and its base columns, for adaptive control (docs/control.md).
+_SLOTINE_LI = "eomgen.regressor.slotine_li:build_slotine_li"
+SLOTINE_LI_REGRESSOR = register_output(Output(
+    "slotine_li_regressor", "Y_SL", "Slotine-Li regressor Y_SL(q, qd, qd_r, qdd_r), n x p: "
+    "Y_SL pi = M qdd_r + C(q, qd) qd_r + g (Christoffel C), columns PARAMETER_NAMES.",
+    ("q", "qd", "qd_r", "qdd_r"), False, _PER_PARAMETER, ("Y_SL",), build=_SLOTINE_LI,
+    default=False, constants=_NAMES))
+SLOTINE_LI_BASE_REGRESSOR = register_output(Output(
+    "slotine_li_base_regressor", "Y_SL_base", "Base Slotine-Li regressor, n x b: Y_SL_base "
+    "beta = Y_SL pi, columns BASE_PARAMETER_NAMES.", ("q", "qd", "qd_r", "qdd_r"), False,
+    _PER_PARAMETER, ("Y_SL_base",), build=_SLOTINE_LI, default=False, constants=_BASE_NAMES))
 
 
 # --- issue 25: exact derivatives of the dynamics (eomgen.symbolic.derivatives), fixed bases;

@@ -1,0 +1,121 @@
+"""Control laws over generated dynamics: computed torque, PD plus gravity compensation and the
+adaptive passivity-based controller of Slotine and Li (docs/control.md).
+
+Each law is a small frozen object with ``torque(t, q, qd, ...)``; the dynamics it uses are the
+functions of a generated NumPy module (:meth:`eomgen.Dynamics.lambdify`'s ``module``, or the
+module itself), so a law evaluated on a model with wrong parameters is simply a law given other
+keyword values. Vectors are (n,) in JOINT_NAMES order [rad, rad/s, rad/s², N m].
+
+Desired motions are callables ``desired(t) -> (q_d, qd_d, qdd_d)``, e.g.
+:func:`fourier_reference` of an excitation trajectory of ``eomgen excite``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Mapping
+
+import numpy as np
+
+Desired = Callable[[float], tuple]
+
+
+def fourier_reference(trajectory) -> Desired:
+    """``desired(t) = (q_d, qd_d, qdd_d)`` of a :class:`~eomgen.identification.excitation.
+    FourierTrajectory` (the excitation trajectories of ``eomgen excite``)."""
+    def desired(t):
+        q, qd, qdd = trajectory.states(np.array([float(t)]))
+        return q[0], qd[0], qdd[0]
+
+    return desired
+
+
+@dataclass(frozen=True)
+class ComputedTorque:
+    """τ = M(q) (q̈_d − K_d ė − K_p e) + C(q, q̇) q̇ + g(q), e = q − q_d: with the model's
+    own parameters the error obeys ë + K_d ė + K_p e = 0 exactly.
+
+    ``module``: a generated NumPy module with ``mass_matrix`` and ``inverse_dynamics``;
+    ``parameters``: keyword values the law uses (the caller's estimate; {} = the description's).
+    """
+
+    module: object
+    desired: Desired
+    Kp: np.ndarray
+    Kd: np.ndarray
+    parameters: Mapping = field(default_factory=dict)
+
+    def torque(self, t, q, qd):
+        q_d, qd_d, qdd_d = self.desired(t)
+        e, de = q - q_d, qd - qd_d
+        v = qdd_d - self.Kd @ de - self.Kp @ e
+        m = self.module
+        bias = m.inverse_dynamics(q, qd, np.zeros_like(q), **self.parameters)
+        return m.mass_matrix(q, **self.parameters) @ v + bias
+
+
+@dataclass(frozen=True)
+class PDGravity:
+    """τ = −K_p (q − q_d) − K_d q̇ + g(q) for a set point q_d: with the model's own g the energy
+    E = ½ q̇ᵀ M q̇ + ½ eᵀ K_p e decreases as dE/dt = −q̇ᵀ K_d q̇ (Ṁ − 2C skew)."""
+
+    module: object
+    q_d: np.ndarray
+    Kp: np.ndarray
+    Kd: np.ndarray
+    parameters: Mapping = field(default_factory=dict)
+
+    def torque(self, t, q, qd):
+        g = self.module.gravity_vector(q, **self.parameters)
+        return -self.Kp @ (q - self.q_d) - self.Kd @ qd + g
+
+    def energy(self, q, qd, **true_parameters) -> float:
+        """E = ½ q̇ᵀ M(q) q̇ + ½ (q − q_d)ᵀ K_p (q − q_d), M at ``true_parameters``."""
+        e = q - self.q_d
+        M = self.module.mass_matrix(q, **true_parameters)
+        return 0.5 * qd @ M @ qd + 0.5 * e @ self.Kp @ e
+
+
+@dataclass(frozen=True)
+class SlotineLi:
+    """The adaptive passivity-based controller of Slotine and Li (1987)::
+
+        e = q − q_d,  q̇_r = q̇_d − Λ e,  q̈_r = q̈_d − Λ ė,  s = q̇ − q̇_r = ė + Λ e
+        τ   = Y_SL(q, q̇, q̇_r, q̈_r) β̂ − K_D s
+        dβ̂/dt = −Γ Y_SLᵀ s
+
+    with Y_SL the base Slotine–Li regressor (``slotine_li_base_regressor`` of ``module``; β̂
+    estimates its base parameters β, ``base_parameters``). Closed loop: M ṡ + (C + K_D) s =
+    Y_SL β̃ (β̃ = β̂ − β); with V = ½ sᵀ M s + ½ β̃ᵀ Γ⁻¹ β̃, dV/dt = −sᵀ K_D s ≤ 0, because
+    sᵀ (Ṁ − 2C) s = 0 for the Christoffel C the regressor is built on.
+    """
+
+    module: object
+    desired: Desired
+    Lambda: np.ndarray
+    KD: np.ndarray
+    Gamma: np.ndarray
+
+    def reference(self, t, q, qd):
+        """(q̇_r, q̈_r, s) at time ``t``."""
+        q_d, qd_d, qdd_d = self.desired(t)
+        e, de = q - q_d, qd - qd_d
+        qd_r = qd_d - self.Lambda @ e
+        qdd_r = qdd_d - self.Lambda @ de
+        return qd_r, qdd_r, qd - qd_r
+
+    def torque_and_adaptation(self, t, q, qd, beta_hat):
+        """(τ, dβ̂/dt)."""
+        qd_r, qdd_r, s = self.reference(t, q, qd)
+        Y = self.module.slotine_li_base_regressor(q, qd, qd_r, qdd_r)
+        return Y @ beta_hat - self.KD @ s, -self.Gamma @ (Y.T @ s)
+
+    def lyapunov(self, t, q, qd, beta_hat, beta, **true_parameters) -> float:
+        """V = ½ sᵀ M(q) s + ½ β̃ᵀ Γ⁻¹ β̃, M at ``true_parameters`` (the plant's)."""
+        s = self.reference(t, q, qd)[2]
+        M = self.module.mass_matrix(q, **true_parameters)
+        err = beta_hat - beta
+        return 0.5 * s @ M @ s + 0.5 * err @ np.linalg.solve(self.Gamma, err)
+
+
+__all__ = ["Desired", "fourier_reference", "ComputedTorque", "PDGravity", "SlotineLi"]
