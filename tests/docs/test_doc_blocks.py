@@ -77,8 +77,10 @@ def workspace(tmp_path, erd_robots_dir, monkeypatch):
     monkeypatch.chdir(work)
     monkeypatch.syspath_prepend(str(work))
     temporary = str(Path(tempfile.gettempdir()).resolve())
+    kept = tuple(str(Path(p).resolve()) for p in (ROOT, sys.prefix, sys.base_prefix))
     for name, module in list(sys.modules.items()):  # a generated module another test imported
-        if str(getattr(module, "__file__", "") or "").startswith(temporary):
+        file = str(getattr(module, "__file__", "") or "")
+        if "." not in name and file.startswith(temporary) and not file.startswith(kept):
             del sys.modules[name]  # would shadow the one a block generates under its name
     before = set(sys.modules)
     yield work
