@@ -106,27 +106,35 @@ def add_floating_base(model: RobotModel) -> RobotModel:
         line, e.g. a massless root with nothing below): its six base equations would have a
         singular mass matrix.
     """
-    names = {link.name for link in model.links} | {j.name for j in model.joints}
-    if model.root == WORLD:
-        raise KinematicTreeError(model.source, f"root link '{WORLD}'",
-                                 "a root named 'world' is the fixed world by convention; it "
-                                 "cannot float (give the robot's trunk as the root)")
-    links = [f"{model.root}_{name}" for name in EULER_JOINTS[:5]]
-    for name in (WORLD, *EULER_JOINTS, *links):
-        if name in names:
-            raise KinematicTreeError(model.source, f"link or joint '{name}'",
-                                     "the name is taken by the floating base's virtual joints")
-    check_spatial_inertia(model)
-    chain = [WORLD, *links, model.root]
+    chain = virtual_chain(model, EULER_JOINTS, "the floating base's virtual joints")
     joints = tuple(
         Joint(name, kind, chain[k], chain[k + 1], Transform(), vec3(axis))
         for k, (name, kind, axis) in enumerate(zip(EULER_JOINTS, _TYPES, _AXES)))
     return replace(
         model,
-        links=(Link(WORLD), *(Link(name) for name in links), *model.links),
+        links=(*(Link(name) for name in chain[:-1]), *model.links),
         joints=joints + model.joints,
         root=WORLD,
         notices=tuple(n for n in model.notices if n.kind is not NoticeKind.FLOATING_BASE))
+
+
+def virtual_chain(model: RobotModel, joints: tuple[str, ...], what: str) -> list[str]:
+    """The links from a new fixed ``world`` link to ``model``'s root for six virtual joints
+    named ``joints`` (massless links ``<root>_<joint>`` between them), after the checks every
+    floating base needs: a root not named ``world``, no name taken, a total spatial inertia
+    that is not singular (:func:`check_spatial_inertia`). ``what`` names the joints in errors."""
+    names = {link.name for link in model.links} | {j.name for j in model.joints}
+    if model.root == WORLD:
+        raise KinematicTreeError(model.source, f"root link '{WORLD}'",
+                                 "a root named 'world' is the fixed world by convention; it "
+                                 "cannot float (give the robot's trunk as the root)")
+    links = [f"{model.root}_{name}" for name in joints[:5]]
+    for name in (WORLD, *joints, *links):
+        if name in names:
+            raise KinematicTreeError(model.source, f"link or joint '{name}'",
+                                     f"the name is taken by {what}")
+    check_spatial_inertia(model)
+    return [WORLD, *links, model.root]
 
 
 def check_spatial_inertia(model: RobotModel) -> None:

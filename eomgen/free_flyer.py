@@ -48,8 +48,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from .errors import KinematicTreeError
-from .floating import WORLD, check_spatial_inertia
+from .floating import WORLD, virtual_chain
 from .model import (FREE_FLYER_CONFIGURATION, FREE_FLYER_VELOCITY, Joint, JointType, Link,
                     NoticeKind, RobotModel, Transform, vec3)
 
@@ -75,24 +74,13 @@ def add_free_flyer(model: RobotModel, origin: Transform | None = None) -> RobotM
         The robot's total spatial inertia is singular (see
         :func:`eomgen.floating.add_floating_base`).
     """
-    names = {link.name for link in model.links} | {j.name for j in model.joints}
-    if model.root == WORLD:
-        raise KinematicTreeError(model.source, f"root link '{WORLD}'",
-                                 "a root named 'world' is the fixed world by convention; it "
-                                 "cannot float (give the robot's trunk as the root)")
-    links = [f"{model.root}_{name}" for name in VELOCITY_NAMES[:5]]
-    for name in (WORLD, *VELOCITY_NAMES, *links):
-        if name in names:
-            raise KinematicTreeError(model.source, f"link or joint '{name}'",
-                                     "the name is taken by the free flyer's virtual joints")
-    check_spatial_inertia(model)
-    chain = [WORLD, *links, model.root]
+    chain = virtual_chain(model, VELOCITY_NAMES, "the free flyer's virtual joints")
     virtual = tuple(Joint(name, kind, chain[k], chain[k + 1],
                           (origin or Transform()) if k == 0 else Transform(), vec3(axis))
                     for k, (name, kind, axis) in enumerate(zip(VELOCITY_NAMES, _TYPES, _AXES)))
     return replace(
         model,
-        links=(Link(WORLD), *(Link(name) for name in links), *model.links),
+        links=(*(Link(name) for name in chain[:-1]), *model.links),
         joints=virtual + pinocchio_order(model),
         root=WORLD, free_flyer=True,
         notices=tuple(n for n in model.notices if n.kind is not NoticeKind.FLOATING_BASE))

@@ -17,19 +17,13 @@ import pytest
 from eomgen.free_flyer import add_free_flyer, difference, integrate, neutral
 from support import relative
 from support.generated import generated
-from support.reference import random_inertial, random_robot, to_urdf
+from support.reference import massive_tree as floating_tree, to_urdf
 
 pin = pytest.importorskip("pinocchio", reason="the free flyer is checked against Pinocchio")
 
 FUNCTIONS = ("M", "C", "g", "tau", "h", "qdd_aba", "forward_dynamics")
 
 
-def floating_tree(seed: int, joints: int):
-    rng = np.random.default_rng(seed)
-    fixed = random_robot(rng, joints, tree=True)
-    links = tuple(replace(link, inertial=random_inertial(rng)) if link.inertial is None
-                  or link.name == fixed.root else link for link in fixed.links)
-    return replace(fixed, links=links)
 
 
 @pytest.fixture(scope="module")

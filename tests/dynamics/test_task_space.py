@@ -8,15 +8,13 @@ definite), damping against its formula, and the errors.
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 import pytest
 
 from eomgen.free_flyer import add_free_flyer
 from support import relative
 from support.generated import generated
-from support.reference import random_inertial, random_robot, to_urdf
+from support.reference import massive_tree as floating_tree, to_urdf
 from support.robots import ur5
 
 pin = pytest.importorskip("pinocchio", reason="task-space quantities are checked against "
@@ -28,13 +26,6 @@ FUNCTIONS = ("operational_space_inertia", "operational_space_bias",
 BACKENDS = ("numpy", "fast", "jax", "torch")
 
 
-def floating_tree(seed: int, joints: int):
-    """A random tree whose links all carry mass (M positive definite under a free flyer)."""
-    rng = np.random.default_rng(seed)
-    fixed = random_robot(rng, joints, tree=True)
-    links = tuple(replace(link, inertial=random_inertial(rng)) if link.inertial is None
-                  or link.name == fixed.root else link for link in fixed.links)
-    return replace(fixed, links=links)
 
 
 @pytest.fixture(scope="module")

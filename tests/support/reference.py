@@ -7,6 +7,7 @@ Import from a test module as ``from support.reference import ...`` (see :mod:`su
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
@@ -325,6 +326,16 @@ def random_robot(
         [joints[i] for i in order],
         gravity=g.tolist(),
     )
+
+
+def massive_tree(seed: int, joints: int) -> RobotModel:
+    """A random tree (:func:`random_robot` with branches) whose links all carry mass, so that
+    M stays positive definite with a floating base above its root."""
+    rng = np.random.default_rng(seed)
+    fixed = random_robot(rng, joints, tree=True)
+    links = tuple(replace(link, inertial=random_inertial(rng)) if link.inertial is None
+                  or link.name == fixed.root else link for link in fixed.links)
+    return replace(fixed, links=links)
 
 
 def planar_2link_by_hand():
