@@ -49,6 +49,7 @@ from dataclasses import replace
 import numpy as np
 
 from .floating import WORLD, virtual_chain
+from .numeric.floating_base import matrix_quaternion, quaternion_matrix
 from .model import (FREE_FLYER_CONFIGURATION, FREE_FLYER_VELOCITY, Joint, JointType, Link,
                     NoticeKind, RobotModel, Transform, vec3)
 
@@ -108,34 +109,6 @@ def pinocchio_order(model: RobotModel) -> tuple[Joint, ...]:
 
 def _skew(w):
     return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
-
-
-def quaternion_matrix(quaternion) -> np.ndarray:
-    """The rotation matrix of quaternion ``(x, y, z, w)``, normalised first (module docstring)."""
-    x, y, z, w = np.asarray(quaternion, dtype=float) / np.linalg.norm(quaternion)
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
-
-
-def matrix_quaternion(R) -> np.ndarray:
-    """The unit quaternion ``(x, y, z, w)`` of rotation matrix ``R``, with ``w ≥ 0``."""
-    R = np.asarray(R, dtype=float)
-    trace = np.trace(R)
-    k = int(np.argmax([R[0, 0], R[1, 1], R[2, 2], trace]))
-    if k == 3:
-        w = np.sqrt(1.0 + trace) / 2
-        xyz = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]]) / (4 * w)
-        quaternion = np.array([*xyz, w])
-    else:
-        i, j, m = k, (k + 1) % 3, (k + 2) % 3
-        quaternion = np.zeros(4)
-        quaternion[i] = np.sqrt(max(1.0 + R[i, i] - R[j, j] - R[m, m], 0.0)) / 2
-        quaternion[j] = (R[j, i] + R[i, j]) / (4 * quaternion[i])
-        quaternion[m] = (R[m, i] + R[i, m]) / (4 * quaternion[i])
-        quaternion[3] = (R[m, j] - R[j, m]) / (4 * quaternion[i])
-    return quaternion * (1.0 if quaternion[3] >= 0 else -1.0)
 
 
 def _so3_exp(w):

@@ -21,6 +21,7 @@ __all__ = [
     "SINGULARITY_TOLERANCE", "EulerSingularityError", "base_rotation", "euler_angles",
     "euler_rate_matrix", "euler_singularity", "check_euler", "velocity_map",
     "velocity_map_dot_qd", "to_free_flyer", "from_free_flyer", "dynamics_from_free_flyer",
+    "matrix_quaternion", "quaternion_matrix",
 ]
 
 #: :func:`check_euler` refuses states with ``|cos θ|`` below this.
@@ -116,7 +117,7 @@ def velocity_map_dot_qd(q, qd) -> np.ndarray:
     return out
 
 
-def _quaternion(R) -> np.ndarray:
+def matrix_quaternion(R) -> np.ndarray:
     """Unit quaternion (x, y, z, w), w ≥ 0, of a rotation matrix."""
     R = np.asarray(R, dtype=float)
     t = np.trace(R)
@@ -136,7 +137,9 @@ def _quaternion(R) -> np.ndarray:
     return q if q[3] >= 0 else -q
 
 
-def _rotation_of_quaternion(xyzw) -> np.ndarray:
+def quaternion_matrix(xyzw) -> np.ndarray:
+    """The rotation matrix of quaternion ``(x, y, z, w)``, normalised first (any nonzero
+    multiple gives the same rotation)."""
     x, y, z, w = np.asarray(xyzw, dtype=float) / np.linalg.norm(xyzw)
     return np.array([
         [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
@@ -162,7 +165,7 @@ def to_free_flyer(q, qd) -> tuple[np.ndarray, np.ndarray]:
     q = np.asarray(q, dtype=float)
     qd = np.asarray(qd, dtype=float)
     R = base_rotation(*q[3:6])
-    return (np.concatenate([q[:3], _quaternion(R), q[6:]]),
+    return (np.concatenate([q[:3], matrix_quaternion(R), q[6:]]),
             velocity_map(q) @ qd)
 
 
@@ -176,7 +179,7 @@ def from_free_flyer(q_pin, v) -> tuple[np.ndarray, np.ndarray]:
     """
     q_pin = np.asarray(q_pin, dtype=float)
     v = np.asarray(v, dtype=float)
-    R = _rotation_of_quaternion(q_pin[3:7])
+    R = quaternion_matrix(q_pin[3:7])
     q = np.concatenate([q_pin[:3], euler_angles(R), q_pin[7:]])
     check_euler(q)
     return q, np.linalg.solve(velocity_map(q), v)
