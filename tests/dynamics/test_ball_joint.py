@@ -1,0 +1,289 @@
+"""Ball (spherical) joints (eomgen.model.quaternion): the generated M, C, g, τ, h, q̈ and the
+centroidal quantities against Pinocchio's JointModelSpherical (and JointModelFreeFlyer) with
+the same arrays, q (NQ) and v (NV) passed unchanged; integrate and difference against
+Pinocchio's; Ṁ − 2C skew by finite differences along integrate.
+
+Pinocchio's models are built by hand from the same list of joints (pin.Model.addJoint with
+JointModelSpherical, appendBodyToJoint), not through eomgen's adapter or its expansion of a
+ball joint into three virtual joints.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from eomgen.model import Joint, JointType, Link, Transform, build_model, mat3, vec3
+from eomgen.quaternion_joints import difference, integrate, neutral
+from support import relative
+from support.generated import generated
+from support.reference import random_inertial, random_rotation
+
+pin = pytest.importorskip("pinocchio", reason="ball joints are checked against Pinocchio")
+
+#: A chain with two ball joints mid-chain and a branch: (name, type, parent joint index).
+CHAIN = (("j0", "revolute", -1), ("ball", "spherical", 0), ("j2", "prismatic", 1),
+         ("ball2", "spherical", 1), ("j4", "revolute", 3))
+#: A ragdoll on a free flyer: ball hips and shoulders, revolute knees and elbows; names sort
+#: in depth-first order (the free flyer's joint order is Pinocchio's URDF reader's).
+RAGDOLL = (("a_hip", "spherical", -1), ("b_knee", "revolute", 0), ("c_hip", "spherical", -1),
+           ("d_knee", "revolute", 2), ("e_shoulder", "spherical", -1))
+KINDS = {"revolute": JointType.REVOLUTE, "prismatic": JointType.PRISMATIC,
+         "spherical": JointType.SPHERICAL}
+GRAVITY = np.array([0.3, -0.2, -9.81])
+
+
+def robots(spec, seed, free_flyer=False):
+    """The eomgen model (build_model, so ball joints are expanded) and Pinocchio's model built
+    by hand from ``spec``: random joint placements and axes, every link with mass."""
+    from eomgen.free_flyer import add_free_flyer
+    rng = np.random.default_rng(seed)
+    root_inertia = random_inertial(rng)
+    links, joints = [Link("trunk", root_inertia)], []
+    pm = pin.Model()
+    parent_id = 0
+    if free_flyer:
+        parent_id = pm.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), "root_joint")
+        pm.appendBodyToJoint(parent_id, pin_inertia(root_inertia), pin.SE3.Identity())
+    ids = []
+    for k, (name, kind, parent) in enumerate(spec):
+        R, p = random_rotation(rng), rng.uniform(-0.5, 0.5, 3)
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        inertial = random_inertial(rng)
+        links.append(Link(f"link_{name}", inertial))
+        joints.append(Joint(name, KINDS[kind], "trunk" if parent < 0 else f"link_{spec[parent][0]}",
+                            f"link_{name}", Transform(mat3(R.tolist()), vec3(p.tolist())),
+                            vec3(axis.tolist())))
+        model = {"revolute": pin.JointModelRevoluteUnaligned, "spherical": pin.JointModelSpherical,
+                 "prismatic": pin.JointModelPrismaticUnaligned}[kind]
+        jid = pm.addJoint(parent_id if parent < 0 else ids[parent],
+                          model() if kind == "spherical" else model(axis), pin.SE3(R, p), name)
+        pm.appendBodyToJoint(jid, pin_inertia(inertial), pin.SE3.Identity())
+        pm.addBodyFrame(f"link_{name}", jid, pin.SE3.Identity(), 0)
+        ids.append(jid)
+    model = build_model("<test>", "ragdoll" if free_flyer else "ball_chain", links, joints,
+                        gravity=GRAVITY.tolist())
+    pm.gravity = pin.Motion(GRAVITY, np.zeros(3))
+    return (add_free_flyer(model) if free_flyer else model), pm
+
+
+def pin_inertia(inertial):
+    return pin.Inertia(float(inertial.mass), np.array([float(x) for x in inertial.com]),
+                       np.array([[float(x) for x in row] for row in inertial.inertia]))
+
+
+def states(pm, count=2, seed=0):
+    rng = np.random.default_rng(seed)
+    for _ in range(count):
+        q = pin.randomConfiguration(pm, -np.ones(pm.nq), np.ones(pm.nq))
+        yield q, rng.normal(size=pm.nv), rng.normal(size=pm.nv)
+
+
+DYNAMICS = ("M", "C", "g", "tau", "h", "qdd_aba", "forward_dynamics")
+CENTROIDAL = ("c_G", "J_G", "A_G", "dAGv")
+
+
+@pytest.fixture(scope="module")
+def chain(tmp_path_factory):
+    model, pm = robots(CHAIN, seed=1)
+    calls, modules = generated(model, DYNAMICS + CENTROIDAL, tmp_path_factory.mktemp("ball"))
+    return model, pm, calls, modules
+
+
+@pytest.fixture(scope="module")
+def ragdoll(tmp_path_factory):
+    model, pm = robots(RAGDOLL, seed=2, free_flyer=True)
+    calls, modules = generated(model, DYNAMICS + CENTROIDAL + ("p_f", "J_f", "dJqd_f"),
+                               tmp_path_factory.mktemp("ragdoll"), backends=("numpy",))
+    return model, pm, calls, modules
+
+
+def expected(pm, q, v, a):
+    """Pinocchio's values of the generated functions at ``(q, v, a)``."""
+    data = pm.createData()
+    M = pin.crba(pm, data, q)
+    tau = pin.rnea(pm, data, q, v, a).copy()
+    return [
+        ("mass_matrix", (q,), np.triu(M) + np.triu(M, 1).T),
+        ("coriolis_matrix", (q, v), pin.computeCoriolisMatrix(pm, data, q, v).copy()),
+        ("gravity_vector", (q,), pin.computeGeneralizedGravity(pm, data, q).copy()),
+        ("inverse_dynamics", (q, v, a), tau),
+        ("nonlinear_effects", (q, v), pin.nonLinearEffects(pm, data, q, v).copy()),
+        ("forward_dynamics_aba", (q, v, tau), pin.aba(pm, data, q, v, tau).copy()),
+        ("forward_dynamics", (q, v, tau), a),
+        ("center_of_mass", (q,), pin.centerOfMass(pm, data, q).copy()),
+        ("center_of_mass_jacobian", (q,), pin.jacobianCenterOfMass(pm, data, q).copy()),
+        ("centroidal_momentum_matrix", (q,), pin.computeCentroidalMap(pm, data, q).copy()),
+        ("centroidal_momentum_bias", (q, v),
+         pin.computeCentroidalMapTimeVariation(pm, data, q, v) @ v)]
+
+
+def test_layout_is_pinocchios(chain, ragdoll):
+    for model, pm, _, modules in (chain, ragdoll):
+        assert (model.nq, model.dof) == (pm.nq, pm.nv)
+        for namespace in modules.values():
+            assert (namespace["NQ"], namespace["NV"]) == (pm.nq, pm.nv)
+    model, pm, _, modules = chain
+    assert model.configuration_names[1:5] == ("ball_qx", "ball_qy", "ball_qz", "ball_qw")
+    assert model.joint_names[1:4] == ("ball_wx", "ball_wy", "ball_wz")
+    for namespace in modules.values():
+        if "CONFIGURATION_NAMES" in namespace:
+            assert tuple(namespace["CONFIGURATION_NAMES"]) == model.configuration_names
+    model, pm, _, _ = ragdoll
+    assert pm.names[1] == "root_joint" and model.quaternion_joints[0].kind == "free_flyer"
+    starts, found = {j.name: j for j in model.quaternion_joints}, 0
+    for jid in range(2, pm.njoints):
+        if pm.names[jid] in starts:
+            found += 1
+            assert (starts[pm.names[jid]].q_index, starts[pm.names[jid]].v_index) == \
+                (pm.joints[jid].idx_q, pm.joints[jid].idx_v)
+    assert found == 3
+
+
+@pytest.mark.parametrize("backend", ["numpy", "fast", "casadi", "jax", "torch"])
+def test_ball_chain_equals_pinocchio(chain, backend):
+    """A fixed-base chain with two ball joints mid-chain and a branch, every backend."""
+    _, pm, calls, _ = chain
+    if backend not in calls:
+        pytest.skip(f"the {backend} backend cannot be loaded here")
+    call = calls[backend]
+    for q, v, a in states(pm, seed=3):
+        for function, inputs, value in expected(pm, q, v, a):
+            if backend == "casadi" and function == "forward_dynamics":
+                continue  # CasADi's module has no Cholesky forward_dynamics
+            got = call(function, *inputs).ravel()[:value.size].reshape(value.shape)
+            assert relative(got, value) < 1e-10, function
+
+
+def test_ragdoll_equals_pinocchio(ragdoll):
+    """A free flyer with ball hips and shoulders: dynamics, centroidal quantities, and the
+    leaf links' positions, world-aligned Jacobians and J̇ v (Pinocchio's classical
+    acceleration at v̇ = 0)."""
+    model, pm, calls, modules = ragdoll
+    call, names = calls["numpy"], modules["numpy"]["FRAME_NAMES"]
+    data = pm.createData()
+    for q, v, a in states(pm, seed=5):
+        for function, inputs, value in expected(pm, q, v, a):
+            got = call(function, *inputs).ravel()[:value.size].reshape(value.shape)
+            assert relative(got, value) < 1e-10, function
+        pin.forwardKinematics(pm, data, q, v, np.zeros(pm.nv))
+        pin.computeJointJacobians(pm, data, q)
+        pin.updateFramePlacements(pm, data)
+        p_f, J_f, dJ = call("frame_positions", q), call("frame_jacobians", q), \
+            call("frame_jacobians_dot_qd", q, v)
+        world = pin.LOCAL_WORLD_ALIGNED
+        for k, name in enumerate(names):
+            fid = pm.getFrameId(name)
+            assert relative(p_f[k], data.oMf[fid].translation) < 1e-10
+            assert relative(J_f[6 * k:6 * k + 6], pin.getFrameJacobian(pm, data, fid, world)) \
+                < 1e-10
+            assert relative(dJ[6 * k:6 * k + 6], pin.getFrameClassicalAcceleration(
+                pm, data, fid, world).vector) < 1e-10
+
+
+def test_coriolis_is_skew_compatible(chain, ragdoll):
+    """Ṁ − 2C skew-symmetric, Ṁ by a central difference along integrate(q, v, ±h)."""
+    for model, pm, calls, _ in (chain, ragdoll):
+        call = calls["numpy"]
+        for q, v, _ in states(pm, count=1, seed=7):
+            h = 1e-6
+            Mdot = (call("mass_matrix", integrate(q, v, h, model))
+                    - call("mass_matrix", integrate(q, v, -h, model))) / (2 * h)
+            N = Mdot - 2 * call("coriolis_matrix", q, v)
+            assert np.abs(N + N.T).max() < 1e-6 * max(1.0, np.abs(Mdot).max())
+            assert np.abs(Mdot).max() > 1e-3  # the check is not vacuous
+
+
+def test_non_unit_quaternions_are_normalised(chain):
+    model, pm, calls, _ = chain
+    call = calls["numpy"]
+    q, v, a = next(states(pm, seed=9))
+    scaled = q.copy()
+    for joint in model.quaternion_joints:
+        scaled[joint.quaternion:joint.quaternion + 4] *= 2.5
+    assert relative(call("inverse_dynamics", scaled, v, a), call("inverse_dynamics", q, v, a)) \
+        < 1e-12
+    assert relative(call("coriolis_matrix", scaled, v), call("coriolis_matrix", q, v)) < 1e-12
+
+
+def test_integrate_and_difference_equal_pinocchio(chain, ragdoll):
+    rng = np.random.default_rng(11)
+    for model, pm, _, _ in (chain, ragdoll):
+        assert np.array_equal(neutral(model), pin.neutral(pm))
+        for q, v, _ in states(pm, count=2, seed=13):
+            dt = rng.uniform(0.1, 2.0)
+            q1, reference = integrate(q, v, dt, model), pin.integrate(pm, q, v * dt)
+            for joint in model.quaternion_joints:  # q and −q are the same rotation
+                k = joint.quaternion
+                if q1[k:k + 4] @ reference[k:k + 4] < 0:
+                    q1[k:k + 4] *= -1
+            assert relative(q1, reference) < 1e-12
+            assert relative(difference(q, q1, model), pin.difference(pm, q, reference)) < 1e-10
+
+
+def test_yaml_spherical_joint_through_the_pinocchio_adapter(tmp_path):
+    """``type: spherical`` in eomgen's YAML format: the model's Pinocchio adapter
+    (eomgen.numeric.pinocchio.to_pinocchio) has a JointModelSpherical with the same layout,
+    and the generated M and τ take its arrays unchanged."""
+    import eomgen
+    from eomgen.numeric.pinocchio import to_pinocchio
+    text = """name: pendulum
+gravity: [0, 0, -9.81]
+links:
+  - {name: base}
+  - {name: upper, mass: 1.5, com: [0, 0, -0.4], inertia: {ixx: 0.05, iyy: 0.06, izz: 0.01}}
+  - {name: lower, mass: 0.7, com: [0.1, 0, -0.3], inertia: {ixx: 0.02, iyy: 0.03, izz: 0.01}}
+joints:
+  - {name: shoulder, type: spherical, parent: base, child: upper,
+     origin: {xyz: [0, 0.1, 0], rpy: [0.2, 0, 0]}}
+  - {name: elbow, type: revolute, parent: upper, child: lower, origin: {xyz: [0, 0, -0.8]},
+     axis: [0, 1, 0]}
+"""
+    path = tmp_path / "pendulum.yaml"
+    path.write_text(text, encoding="utf-8")
+    model = eomgen.load(path)
+    assert model.ball_joints == ("shoulder",) and (model.nq, model.dof) == (5, 4)
+    pm = to_pinocchio(model)
+    assert pm.identity and pm.model.names[1] == "shoulder" and pm.model.nq == 5
+    calls, _ = generated(model, ("M", "tau"), tmp_path, backends=("numpy",))
+    call = calls["numpy"]
+    for q, v, a in states(pm.model, seed=17):
+        assert relative(call("inverse_dynamics", q, v, a),
+                        pin.rnea(pm.model, pm.data, q, v, a)) < 1e-10
+        assert relative(call("mass_matrix", q), pm.crba(q)) < 1e-10
+
+
+@pytest.mark.parametrize("text, message", [
+    ("axis: [0, 0, 1]", r"joints\[0\] 'shoulder' axis: a spherical joint has no axis"),
+    ("actuator: {armature: 0.1}", r"ball joint 'shoulder': a ball joint takes no actuator"),
+])
+def test_yaml_spherical_joint_errors(tmp_path, text, message):
+    import eomgen
+    from eomgen.errors import DescriptionError
+    path = tmp_path / "bad.yaml"
+    path.write_text("name: bad\nlinks:\n  - {name: base}\n  - {name: upper, mass: 1}\n"
+                    "joints:\n  - {name: shoulder, type: spherical, parent: base, "
+                    f"child: upper, {text}}}\n", encoding="utf-8")
+    with pytest.raises(DescriptionError, match=message):
+        eomgen.load(path)
+
+
+def test_outputs_not_derived_for_the_chart_are_refused():
+    from eomgen import derive
+    from eomgen.errors import UnsupportedError
+    model, _ = robots(CHAIN[:2], seed=19)
+    with pytest.raises(UnsupportedError, match="Y not derived for a ball joint"):
+        derive(model, outputs=("M", "Y"))
+
+
+def test_a_broken_ball_chain_is_refused():
+    """Locking one of a ball joint's virtual joints leaves no ball joint: refused by name."""
+    from eomgen.errors import KinematicTreeError
+    model, _ = robots(CHAIN[:2], seed=19)
+    joints = tuple(replace(j, type=JointType.FIXED) if j.name == "ball_wy" else j
+                   for j in model.joints)
+    with pytest.raises(KinematicTreeError, match="ball joint 'ball': its joints ball_wx"):
+        replace(model, joints=joints).nq
