@@ -35,15 +35,10 @@ replaces it by the chain.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
-
 from ..errors import KinematicTreeError, UnsupportedError
 from .parts import Joint, JointType, Link
 from .scalars import vec3
 from .transforms import Transform
-
-if TYPE_CHECKING:  # annotations only: robot.py imports this module
-    from .robot import RobotModel
 
 #: A free flyer's configuration entries (q[0:7]): the root link origin in the world [m], then
 #: the unit quaternion (x, y, z, w) of its orientation (Pinocchio's ``JointModelFreeFlyer``).
