@@ -96,7 +96,7 @@ def case(request, tmp_path_factory):
     """The chain (fixed base, two ball joints, slow) or the ragdoll (free flyer, ball hips and
     shoulder below it) in a NumPy module, and Pinocchio's model."""
     model, pm = robots(*SPECS[request.param])
-    calls, modules = generated(model, DYNAMICS + CENTROIDAL + FRAMES,
+    calls, modules = generated(model, DYNAMICS + CENTROIDAL + FRAMES + ("Y", "pi"),
                                tmp_path_factory.mktemp(request.param), backends=("numpy",))
     return model, pm, calls["numpy"], modules["numpy"]
 
@@ -185,6 +185,27 @@ def test_every_backend_equals_pinocchio(chain_backends, backend):
                 continue  # CasADi's module has no Cholesky forward_dynamics
             got = call(function, *inputs).ravel()[:value.size].reshape(value.shape)
             assert relative(got, value) < 1e-10, function
+
+
+def test_regressor_equals_pinocchio(case):
+    """Y against computeJointTorqueRegressor: the columns of each Pinocchio joint's body are
+    those of the last virtual joint of its chain (a quaternion joint) or of the joint itself;
+    the virtual joints' massless bodies add columns of their own, which multiply zero
+    parameters; Y π = τ (rnea)."""
+    model, pm, call, _ = case
+    columns = []
+    for jid in range(1, pm.njoints):
+        last = pm.joints[jid].idx_v + pm.joints[jid].nv - 1
+        columns += range(10 * last, 10 * last + 10)
+    pi = call("inertial_parameters").ravel()
+    others = np.setdiff1d(np.arange(len(pi)), columns)
+    assert len(others) == 10 * (model.dof - pm.njoints + 1) and not pi[others].any()
+    data = pm.createData()
+    for q, v, a in states(pm, seed=21):
+        Y = call("regressor", q, v, a)
+        assert relative(Y[:, columns], pin.computeJointTorqueRegressor(pm, data, q, v, a)) \
+            < 1e-10
+        assert relative(Y @ pi, pin.rnea(pm, data, q, v, a)) < 1e-10
 
 
 def test_coriolis_is_skew_compatible(case):
@@ -277,8 +298,8 @@ def test_outputs_not_derived_for_the_chart_are_refused():
     from eomgen import derive
     from eomgen.errors import UnsupportedError
     model, _ = robots(CHAIN[:2], seed=19)
-    with pytest.raises(UnsupportedError, match="Y not derived for a ball joint"):
-        derive(model, outputs=("M", "Y"))
+    with pytest.raises(UnsupportedError, match="Y_base not derived for a ball joint"):
+        derive(model, outputs=("M", "Y_base"))
 
 
 def test_a_broken_ball_chain_is_refused():
