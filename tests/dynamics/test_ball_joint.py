@@ -333,3 +333,15 @@ def test_scene_keeps_or_refuses_a_ball_joint(tmp_path):
                                               text="version: 1\nlocked: {shoulder_wy: 0}\n"))
     with pytest.raises(KinematicTreeError, match="ball joint 'shoulder': its joints"):
         eomgen.derive(broken)
+
+
+def test_verify_refuses_quaternion_joints_in_one_line():
+    """eomgen verify's reference Newton–Euler works in joint coordinates: a model with a ball
+    joint is refused with the reason, not a traceback."""
+    from eomgen import derive
+    from eomgen.errors import UnsupportedError
+    from eomgen.verify import verify
+    model, _ = robots(CHAIN[:2], seed=19)
+    with pytest.raises(UnsupportedError, match="verify: the reference Newton-Euler has no "
+                                               "quaternion joints"):
+        verify(derive(model, outputs=("M", "C", "g")))
