@@ -37,11 +37,12 @@ DEFAULT_OUTPUTS = ("M", "C", "g")
 #: The outputs derived for a model with a quaternion free flyer or ball joints
 #: (:mod:`eomgen.model.quaternion`), each checked against Pinocchio's free flyer and spherical
 #: joints (Y against ``computeJointTorqueRegressor``: a virtual joint's massless body has
-#: columns of its own, multiplied by zero parameters); the others (the regressor, the drives and
+#: columns of its own, multiplied by zero parameters; Y_base by the numeric route, without
+#: them); the others (the regressor, the drives and
 #: flexible joints, flatness) differentiate by q, which its chart holds at zero.
 FREE_FLYER_OUTPUTS = ("M", "C", "g", "P", "tau", "h", "qdd_aba", "MCg", "Mh", "p_f", "R_f",
                       "J_f", "Jb_f", "dJqd_f", "dJbqd_f", "J_c", "dJqd_c", "tau_c", "cone_c",
-                      "pyramid_c", "c_G", "J_G", "A_G", "dAGv", "I_G", "Y", "pi")
+                      "pyramid_c", "c_G", "J_G", "A_G", "dAGv", "I_G", "Y", "pi", "Y_base", "beta")
 
 #: ``derive(model, simplify=True)`` refuses models with more movable joints: trigonometric
 #: simplification of the expanded expressions grows exponentially with the number of joints

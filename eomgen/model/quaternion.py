@@ -88,6 +88,12 @@ class QuaternionJoint:
         return tuple(range(6)) if self.kind == FREE_FLYER else (3, 4, 5)
 
     @property
+    def virtual(self) -> range:
+        """The velocity indices whose bodies are the chain's massless links (all its joints but
+        the last, whose body is the real child): their inertial parameters are zero."""
+        return range(self.v_index, self.v_index + self.nv - 1)
+
+    @property
     def velocity_names(self) -> tuple[str, ...]:
         if self.kind == FREE_FLYER:
             return FREE_FLYER_VELOCITY
