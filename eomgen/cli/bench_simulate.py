@@ -183,9 +183,10 @@ def simulate(description, outdir, duration, dts, rtols, names, q0, qd0, gains, s
         if values is not None and len(values) != len(names):
             raise AnalysisError(f"{option}: {model.name} takes {len(names)} values "
                                 f"({', '.join(names)}), got {len(values)}")
-    if contacts and model.free_flyer:
+    if contacts and model.quaternion_joints:
         raise AnalysisError("simulate: contacts are held by eomgen.numeric, which has no "
-                            "quaternion free flyer yet; use floating_base: euler in the scene")
+                            "quaternion joints (free flyer, ball) yet; use floating_base: "
+                            "euler in the scene")
     if contacts:
         _simulate_contacts(model, contacts, integrators, duration, start, velocity,
                            gain_list, outdir, progress)
