@@ -431,3 +431,17 @@ def test_pinocchio_adapter_maps_quaternion_joints_in_any_joint_order():
         M = np.triu(M) + np.triu(M, 1).T
         assert relative(adapted.rnea(q[q_map], v[v_map], a[v_map]), tau[v_map]) < 1e-12
         assert relative(adapted.crba(q[q_map]), M[np.ix_(v_map, v_map)]) < 1e-12
+
+
+def test_bench_refuses_quaternion_joints_in_one_line(tmp_path):
+    """``eomgen bench`` of a model with a ball joint: exit 2, one line, nothing written."""
+    from support import run_in_process
+    path = tmp_path / "pendulum.yaml"
+    path.write_text("name: pendulum\nlinks:\n  - {name: base}\n  - {name: upper, mass: 1}\n"
+                    "joints:\n  - {name: shoulder, type: spherical, parent: base, "
+                    "child: upper}\n", encoding="utf-8")
+    result = run_in_process("bench", path, "-o", tmp_path / "out")
+    assert result.returncode == 2 and not (tmp_path / "out").exists()
+    line, = result.stderr.strip().splitlines()
+    assert "bench: its references (eomgen.numeric, the mpmath Newton-Euler) have no " \
+           "quaternion joints" in line
