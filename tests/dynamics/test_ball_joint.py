@@ -86,7 +86,7 @@ DYNAMICS = ("M", "C", "g", "tau", "h", "qdd_aba", "forward_dynamics")
 CENTROIDAL = ("c_G", "J_G", "A_G", "dAGv")
 
 
-FRAMES = ("p_f", "J_f", "dJqd_f")
+FRAMES = ("p_f", "J_f", "dJqd_f", "Jb_f", "dJbqd_f")
 SPECS = {"chain": (CHAIN, 1, False), "ragdoll": (RAGDOLL, 2, True)}
 
 
@@ -157,8 +157,8 @@ def test_layout_is_pinocchios(case):
 
 def test_dynamics_equal_pinocchio(case):
     """M, C, g, τ, h, both forward dynamics, the centroidal quantities, and the leaf links'
-    positions, world-aligned Jacobians and J̇ v (Pinocchio's classical acceleration at
-    v̇ = 0)."""
+    positions, world-aligned and body Jacobians and both J̇ v (Pinocchio's classical and
+    spatial frame accelerations at v̇ = 0)."""
     _, pm, call, namespace = case
     data = pm.createData()
     for q, v, a in states(pm, seed=5):
@@ -170,6 +170,7 @@ def test_dynamics_equal_pinocchio(case):
         pin.updateFramePlacements(pm, data)
         p_f, J_f, dJ = call("frame_positions", q), call("frame_jacobians", q), \
             call("frame_jacobians_dot_qd", q, v)
+        Jb_f, dJb = call("frame_body_jacobians", q), call("frame_body_jacobians_dot_qd", q, v)
         world = pin.LOCAL_WORLD_ALIGNED
         for k, name in enumerate(namespace["FRAME_NAMES"]):
             fid = pm.getFrameId(name)
@@ -178,6 +179,10 @@ def test_dynamics_equal_pinocchio(case):
                 < 1e-10
             assert relative(dJ[6 * k:6 * k + 6], pin.getFrameClassicalAcceleration(
                 pm, data, fid, world).vector) < 1e-10
+            assert relative(Jb_f[6 * k:6 * k + 6],
+                            pin.getFrameJacobian(pm, data, fid, pin.LOCAL)) < 1e-10
+            assert relative(dJb[6 * k:6 * k + 6], pin.getFrameAcceleration(
+                pm, data, fid, pin.LOCAL).vector) < 1e-10
 
 
 @pytest.mark.slow
