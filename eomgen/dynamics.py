@@ -34,12 +34,15 @@ from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS, textbo
 ALL_OUTPUTS = derived_symbols(default_only=True)  # ("M", "C", "g", "tau")
 DEFAULT_OUTPUTS = ("M", "C", "g")
 
-#: The outputs derived for a model with a quaternion free flyer (:mod:`eomgen.free_flyer`),
-#: each checked against Pinocchio's free flyer; the others (the regressor, the drives and
+#: The outputs derived for a model with a quaternion free flyer or ball joints
+#: (:mod:`eomgen.model.quaternion`), each checked against Pinocchio's free flyer and spherical
+#: joints (Y against ``computeJointTorqueRegressor``: a virtual joint's massless body has
+#: columns of its own, multiplied by zero parameters; Y_base by the numeric route, without
+#: them); the others (the regressor, the drives and
 #: flexible joints, flatness) differentiate by q, which its chart holds at zero.
 FREE_FLYER_OUTPUTS = ("M", "C", "g", "P", "tau", "h", "qdd_aba", "MCg", "Mh", "p_f", "R_f",
                       "J_f", "Jb_f", "dJqd_f", "dJbqd_f", "J_c", "dJqd_c", "tau_c", "cone_c",
-                      "pyramid_c", "c_G", "J_G", "A_G", "dAGv", "I_G")
+                      "pyramid_c", "c_G", "J_G", "A_G", "dAGv", "I_G", "Y", "pi", "Y_base", "beta")
 
 #: ``derive(model, simplify=True)`` refuses models with more movable joints: trigonometric
 #: simplification of the expanded expressions grows exponentially with the number of joints
@@ -290,12 +293,14 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     unknown = outputs - set(known)
     if unknown:
         raise ValueError(f"unknown outputs {sorted(unknown)}; choose from {known}")
-    if model.free_flyer and outputs - set(FREE_FLYER_OUTPUTS):
+    if model.quaternion_joints and outputs - set(FREE_FLYER_OUTPUTS):
+        what, where, hint = (("a quaternion free flyer", "floating_base: quaternion",
+                              "; use floating_base: euler") if model.free_flyer else
+                             ("a ball joint", f"ball joint '{model.ball_joints[0]}'", ""))
         raise UnsupportedError(
-            model.source, "floating_base: quaternion",
-            f"{', '.join(sorted(outputs - set(FREE_FLYER_OUTPUTS)))} not derived for a "
-            f"quaternion free flyer yet (it has {', '.join(FREE_FLYER_OUTPUTS)}); use "
-            "floating_base: euler")
+            model.source, where,
+            f"{', '.join(sorted(outputs - set(FREE_FLYER_OUTPUTS)))} not derived for "
+            f"{what} yet (it has {', '.join(FREE_FLYER_OUTPUTS)}){hint}")
     if simplify and model.dof > MAX_SIMPLIFY_JOINTS:
         raise TooLargeError(
             model.source, "derive(simplify=True)",
@@ -313,7 +318,7 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     timings.append(("program", time.perf_counter() - start))
     program = derivation.program(result.items())
     steps = _steps(program, result)
-    if model.free_flyer:  # the textbook forms differentiate by q: not in a free flyer's chart
+    if model.quaternion_joints:  # the textbook forms differentiate by q: not in the chart
         simplify = False
     if simplify is None:  # teaching-sized: few joints and a small program (a cheap estimate)
         counted = [o for o in ("M", "C", "g") if o in outputs]

@@ -60,7 +60,7 @@ from ..numeric import kinetic_energy, numeric_model, potential_energy
 from .conditioning import (CONDITION_LIMIT, EXACT_FROM, IllConditionedWarning,
                            ill_conditioned_message)
 from .report import csv_text, fmt, markdown_table, pyplot
-from ..free_flyer import configuration_rate
+from ..quaternion_joints import configuration_rate, neutral
 from .routes import compile_scalar, numeric_only
 
 #: Points of the output grid (both ends included).
@@ -101,13 +101,14 @@ class System:
         self.model = numeric_only(model)
         dyn = derive(self.model, outputs=("M", "C", "g", "tau"), simplify=False)
         self.n = n = len(dyn.qd)
-        self._extra = len(dyn.q) - n  # 1 for a free flyer's quaternion
+        self._extra = len(dyn.q) - n  # 1 for each quaternion (free flyer, ball joint)
         zero_qdd = {s: 0 for s in dyn.qdd}
         self._M = compile_scalar(dyn.program, dyn.q, ["M"])
         self._bias = compile_scalar(dyn.program, dyn.q + dyn.qd, ["tau"], fixed=zero_qdd)
         self._Cg = compile_scalar(dyn.program, dyn.q + dyn.qd, ["C", "g"])
-        self.free_flyer = self.model.free_flyer
-        if self.free_flyer:  # eomgen.numeric has no free flyer: energy from the program
+        #: True when q holds quaternions (a free flyer, ball joints): NQ ≠ NV.
+        self.quaternion = bool(self.model.quaternion_joints)
+        if self.quaternion:  # eomgen.numeric has no quaternion joints: energy from the program
             self._P = compile_scalar(dyn.program, dyn.q, ["P"])
         else:
             self._nm = numeric_model(self.model)
@@ -191,21 +192,21 @@ class System:
         return qd, np.array(pdot)
 
     def energy(self, q: np.ndarray, qd: np.ndarray) -> tuple[float, float]:
-        """``(K, P)`` [J] from :mod:`eomgen.numeric` (not the derived program); for a free
-        flyer, which it does not model, ``K = ½ vᵀ M v`` and P from the program."""
-        if self.free_flyer:
+        """``(K, P)`` [J] from :mod:`eomgen.numeric` (not the derived program); with quaternion
+        joints, which it does not model, ``K = ½ vᵀ M v`` and P from the program."""
+        if self.quaternion:
             return 0.5 * float(qd @ self.M(q) @ qd), float(self._P(*q.tolist())[0][0])
         return kinetic_energy(self._nm, q, qd), potential_energy(self._nm, q)
 
     def configuration_rate(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
-        """``q̇`` of the configuration at velocity ``qd``: ``qd`` itself, or for a free flyer
-        (:mod:`eomgen.free_flyer`) the rates of the root position (``R v``) and of its
-        quaternion (``½ quaternion ⊗ (ω, 0)``) followed by the joints' rates; so every
-        integrator integrates the quaternion as a vector (its norm drifts with the error of the
-        method; the dynamics normalise it)."""
-        if not self.free_flyer:
+        """``q̇`` of the configuration at velocity ``qd``: ``qd`` itself, or with quaternion
+        joints (:mod:`eomgen.quaternion_joints`) a free flyer's root position rate (``R v``),
+        each quaternion's rate (``½ quaternion ⊗ (ω, 0)``) and the other joints' rates; so
+        every integrator integrates a quaternion as a vector (its norm drifts with the error
+        of the method; the dynamics normalise it)."""
+        if not self.quaternion:
             return qd
-        return configuration_rate(q, qd)
+        return configuration_rate(q, qd, self.model)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -507,15 +508,16 @@ def run_study(model: RobotModel, integrators: Sequence, duration: float, q0=None
     against the reference (see the module docstring). A run that diverges is reported with
     status ``diverged`` and infinite errors, not raised.
 
-    ``q0`` defaults to 1 rad (or m) per joint, ``qd0`` to zero; a free flyer's ``q0`` has its
-    NQ entries (root position and quaternion x, y, z, w first; default: at the origin,
-    identity quaternion).
+    ``q0`` defaults to 1 rad (or m) per joint, ``qd0`` to zero; with quaternion joints ``q0``
+    has its NQ entries (``CONFIGURATION_NAMES``; default: a free flyer at the origin, identity
+    quaternions, 1 rad or m for the other joints).
     """
     system = system or System(model)
-    if getattr(system, "free_flyer", False):  # q0: NQ values, the root at rest by default
+    if getattr(system, "quaternion", False):  # q0: NQ values, quaternions at rest by default
         names = system.model.configuration_names
         if q0 is None:
-            q0 = np.concatenate([[0.0] * 6 + [1.0], np.ones(system.nq - 7)])
+            q0 = neutral(system.model)
+            q0[[k for k, name in enumerate(names) if name in system.model.joint_names]] = 1.0
         if len(q0) != system.nq:
             raise ValueError(f"q0 must have {system.nq} values ({', '.join(names)})")
         q0, qd0 = np.asarray(q0, float), initial_state(None, qd0, system.n,

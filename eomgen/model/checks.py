@@ -20,6 +20,7 @@ from ..errors import (
 )
 from .notices import Notice, NoticeKind, emit_notices
 from .parts import Inertial, Joint, Link, Parameter
+from .quaternion import expand_ball_joints
 from .robot import RobotModel
 from .scalars import Vec3, scalar, vec3
 from .snapping import snap
@@ -329,6 +330,7 @@ def build_model(
     model = RobotModel(name=name, links=links, joints=joints, root=root, gravity=gravity,
                        parameters=params, source=str(source),
                        info=tuple((info or {}).items()), notices=tuple(notices))
+    model = expand_ball_joints(model)  # a parser's SPHERICAL joints: eomgen.model.quaternion
     undeclared = sorted((s for s in model.free_symbols if s.name not in names), key=str)
     if undeclared:
         model = replace(model, parameters=params + tuple(Parameter(s) for s in undeclared))

@@ -13,12 +13,16 @@ from .transforms import Transform
 
 class JointType(enum.Enum):
     """Joint types eomgen models. Floating and planar joints are refused by the parsers; a URDF
-    ``<mimic>`` joint is read as an independent joint (see :mod:`eomgen.parsers.urdf`)."""
+    ``<mimic>`` joint is read as an independent joint (see :mod:`eomgen.parsers.urdf`).
+    ``SPHERICAL`` (a ball joint, three rotational freedoms, its configuration a unit
+    quaternion) is what a parser writes; :func:`~eomgen.model.build_model` turns it into three
+    virtual joints (:func:`eomgen.model.expand_ball_joints`), so no model holds one."""
 
     REVOLUTE = "revolute"
     CONTINUOUS = "continuous"
     PRISMATIC = "prismatic"
     FIXED = "fixed"
+    SPHERICAL = "spherical"
 
     @property
     def is_movable(self) -> bool:

@@ -16,16 +16,11 @@ from .actuator import Actuator
 from .contact import Contact
 from .notices import Notice
 from .parts import Inertial, Joint, JointType, Link, Parameter
+from .quaternion import (FREE_FLYER_CONFIGURATION, FREE_FLYER_VELOCITY, QuaternionJoint,
+                         quaternion_layout)
 from .scalars import IDENTITY3, ZERO3, Vec3, scalar, vec3
 from .transforms import Transform, rotation_about_axis
 
-#: A free flyer's configuration entries (q[0:7]): the root link origin in the world [m], then
-#: the unit quaternion (x, y, z, w) of its orientation (Pinocchio's ``JointModelFreeFlyer``).
-FREE_FLYER_CONFIGURATION = ("base_x", "base_y", "base_z", "base_qx", "base_qy", "base_qz",
-                            "base_qw")
-#: A free flyer's velocity entries (v[0:6], its joints' names): the twist of the root link in
-#: its own frame, linear [m/s] then angular [rad/s].
-FREE_FLYER_VELOCITY = ("base_vx", "base_vy", "base_vz", "base_wx", "base_wy", "base_wz")
 
 
 def configuration_size(model: "RobotModel") -> int:
@@ -66,6 +61,10 @@ class RobotModel:
     #: coordinates (:mod:`eomgen.free_flyer`): the configuration ``q`` then has ``dof + 1``
     #: entries (root position, unit quaternion), the velocity ``v`` has ``dof``.
     free_flyer: bool = False
+    #: The names of the model's ball (spherical) joints, each three movable virtual joints
+    #: ``<name>_wx … <name>_wz`` whose configuration is a unit quaternion
+    #: (:mod:`eomgen.model.quaternion`, :func:`~eomgen.model.expand_ball_joints`).
+    ball_joints: tuple[str, ...] = ()
 
     @cached_property
     def link_by_name(self) -> dict[str, Link]:
@@ -89,19 +88,27 @@ class RobotModel:
         """The number of velocity coordinates (NV): one per movable joint."""
         return len(self.movable_joints)
 
+    @cached_property
+    def quaternion_joints(self) -> tuple[QuaternionJoint, ...]:
+        """The free flyer and the ball joints, with their places in ``q`` and ``v``
+        (:func:`~eomgen.model.quaternion_layout`); empty for a model without them."""
+        return quaternion_layout(self)
+
     @property
     def nq(self) -> int:
         """The number of configuration coordinates (NQ): :attr:`dof`, plus one for the
-        quaternion of a free flyer (seven entries for its six velocities)."""
-        return self.dof + 1 if self.free_flyer else self.dof
+        quaternion of each quaternion joint (a free flyer: seven entries for its six
+        velocities; a ball joint: four for three)."""
+        return self.dof + len(self.quaternion_joints)
 
     @property
     def configuration_names(self) -> tuple[str, ...]:
-        """The names of the NQ entries of ``q``: :attr:`joint_names`, except that a free
-        flyer's six velocity coordinates give way to its seven configuration entries."""
-        if not self.free_flyer:
-            return self.joint_names
-        return FREE_FLYER_CONFIGURATION + self.joint_names[6:]
+        """The names of the NQ entries of ``q``: :attr:`joint_names`, except that each
+        quaternion joint's velocity coordinates give way to its configuration entries."""
+        names = list(self.joint_names)
+        for joint in reversed(self.quaternion_joints):
+            names[joint.v_index:joint.v_index + joint.nv] = joint.configuration_names
+        return tuple(names)
 
     @cached_property
     def topological_joints(self) -> tuple[Joint, ...]:

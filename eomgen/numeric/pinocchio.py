@@ -12,11 +12,15 @@ joint stays one coordinate (Pinocchio's URDF reader gives it two: cos and sin).
 
 * Every movable joint becomes ``JointModelRevoluteUnaligned`` / ``JointModelPrismaticUnaligned``
   about its axis, placed at the composite of the fixed transforms from its last movable
-  ancestor (or the root) to its origin.
+  ancestor (or the root) to its origin; the virtual joints of a quaternion joint
+  (:mod:`eomgen.model.quaternion`) become one ``JointModelFreeFlyer`` (named ``root_joint``)
+  or ``JointModelSpherical`` (named as the ball joint), so that ``q`` (NQ) and ``v`` (NV) are
+  Pinocchio's arrays.
 * Every link's inertia is appended to the Pinocchio joint it moves with, at the composite
   placement; links fixed to the root do not move and are left out.
 * Joints are numbered in depth-first preorder (Pinocchio's CRBA assumes every subtree is a
-  contiguous range); :class:`PinocchioModel` maps coordinates to eomgen's ``JOINT_NAMES`` order.
+  contiguous range); :class:`PinocchioModel` maps coordinates to eomgen's ``JOINT_NAMES`` order
+  (``perm``, and ``qperm`` for the configuration when NQ ≠ NV).
 * Gravity is the model's, in the root frame; parameters take their values.
 """
 
@@ -50,11 +54,21 @@ class PinocchioModel:
         ``pinocchio.Model`` and ``pinocchio.Data``.
     perm:
         (n,) ints: Pinocchio's coordinate k is eomgen's ``perm[k]`` (``q_pin = q[perm]``).
+    qperm:
+        (nq,) ints, the same for the configuration (``q_pin = q[qperm]``); None: ``perm``.
     """
 
     model: object
     data: object
     perm: np.ndarray
+    qperm: np.ndarray | None = None
+
+    @property
+    def identity(self) -> bool:
+        """True when Pinocchio's arrays are eomgen's (same order)."""
+        q = self.perm if self.qperm is None else self.qperm
+        return (np.array_equal(self.perm, np.arange(len(self.perm)))
+                and np.array_equal(q, np.arange(len(q))))
 
     def rnea(self, q, qd, qdd) -> np.ndarray:
         """τ (n,) in eomgen's order, by ``pinocchio.rnea``."""
@@ -62,7 +76,8 @@ class PinocchioModel:
 
         p = self.perm
         tau = np.empty(len(p))
-        tau[p] = pin.rnea(self.model, self.data, np.asarray(q, float)[p],
+        qp = p if self.qperm is None else self.qperm
+        tau[p] = pin.rnea(self.model, self.data, np.asarray(q, float)[qp],
                           np.asarray(qd, float)[p], np.asarray(qdd, float)[p])
         return tau
 
@@ -71,7 +86,8 @@ class PinocchioModel:
         import pinocchio as pin  # optional dependency: imported when used
 
         p = self.perm
-        upper = np.triu(pin.crba(self.model, self.data, np.asarray(q, float)[p]))
+        qp = p if self.qperm is None else self.qperm
+        upper = np.triu(pin.crba(self.model, self.data, np.asarray(q, float)[qp]))
         M_pin = upper + np.triu(upper, 1).T
         inverse = np.argsort(p)
         return M_pin[np.ix_(inverse, inverse)]
@@ -92,10 +108,23 @@ def to_pinocchio(model: RobotModel) -> PinocchioModel:
     pmodel = pin.Model()
     pmodel.name = model.name
     anchor = {model.root: (0, pin.SE3.Identity())}  # link -> (joint id, placement in it)
+    movable = {j.name: k for k, j in enumerate(model.movable_joints)}
+    chains = {model.movable_joints[j.v_index].name: j for j in model.quaternion_joints}
+    inside: dict[str, int] = {}  # a quaternion joint's later virtual joints -> its Pinocchio id
     for joint in model.topological_joints:  # depth-first preorder
         parent_id, placement = anchor[joint.parent]
         T = placement * pin.SE3(_matrix(joint.origin.rotation), _floats(joint.origin.translation))
-        if joint.type.is_movable:
+        if joint.name in inside:
+            anchor[joint.child] = (inside[joint.name], pin.SE3.Identity())
+        elif joint.name in chains:
+            q_joint = chains[joint.name]
+            kind, name = ((pin.JointModelFreeFlyer(), "root_joint") if q_joint.nv == 6
+                          else (pin.JointModelSpherical(), q_joint.name))
+            jid = pmodel.addJoint(parent_id, kind, T, name)
+            anchor[joint.child] = (jid, pin.SE3.Identity())
+            for later in model.movable_joints[q_joint.v_index + 1:q_joint.v_index + q_joint.nv]:
+                inside[later.name] = jid
+        elif joint.type.is_movable:
             axis = _floats(joint.axis)
             kind = (pin.JointModelRevoluteUnaligned(axis) if joint.type.is_revolute
                     else pin.JointModelPrismaticUnaligned(axis))
@@ -111,11 +140,31 @@ def to_pinocchio(model: RobotModel) -> PinocchioModel:
         inertia = pin.Inertia(float(i.mass), _floats(i.com), _matrix(i.inertia))
         pmodel.appendBodyToJoint(jid, inertia, T)
     pmodel.gravity = pin.Motion(_floats(model.gravity), np.zeros(3))
-    ours = {name: k for k, name in enumerate(model.joint_names)}
-    perm = np.empty(pmodel.nv, dtype=int)
+    starts = {j.name if j.nv == 3 else "root_joint": j for j in model.quaternion_joints}
+    q_index = _configuration_indices(model)
+    perm, qperm = np.empty(pmodel.nv, dtype=int), np.empty(pmodel.nq, dtype=int)
     for jid in range(1, pmodel.njoints):
-        perm[pmodel.joints[jid].idx_q] = ours[pmodel.names[jid]]
-    return PinocchioModel(pmodel, pmodel.createData(), perm)
+        name, pj = pmodel.names[jid], pmodel.joints[jid]
+        if name in starts:
+            v0, q0 = starts[name].v_index, starts[name].q_index
+        else:
+            v0 = movable[name]
+            q0 = q_index[v0]
+        perm[pj.idx_v:pj.idx_v + pj.nv] = np.arange(v0, v0 + pj.nv)
+        qperm[pj.idx_q:pj.idx_q + pj.nq] = np.arange(q0, q0 + pj.nq)
+    return PinocchioModel(pmodel, pmodel.createData(), perm,
+                          None if np.array_equal(perm, qperm) else qperm)
+
+
+def _configuration_indices(model: RobotModel) -> list[int]:
+    """The index in ``q`` of each velocity coordinate's joint (quaternion joints: their first
+    entry)."""
+    out, shift, starts = [], 0, {j.v_index: j for j in model.quaternion_joints}
+    for k in range(model.dof):
+        out.append(k + shift)
+        if k in starts:
+            shift += 1
+    return out
 
 
 def plain_calls(pm: PinocchioModel, n: int):
@@ -129,7 +178,7 @@ def plain_calls(pm: PinocchioModel, n: int):
     import pinocchio as pin  # optional dependency: imported when used
 
     model, data = pm.model, pm.data
-    if np.array_equal(pm.perm, np.arange(n)):
+    if pm.identity:
         return (lambda q, qd, qdd: pin.rnea(model, data, q, qd, qdd),
                 lambda q: pin.crba(model, data, q),
                 f"pinocchio {pin.__version__}: plain pin.rnea and pin.crba calls")

@@ -17,7 +17,7 @@
         inertia: {izz: I1}         # about the COM, link-frame axes; missing entries are 0
     joints:
       - name: joint1
-        type: revolute             # revolute | continuous | prismatic | fixed
+        type: revolute             # revolute | continuous | prismatic | fixed | spherical
         parent: base
         child: link1
         origin: {xyz: [0, 0, 0], rpy: [0, 0, 0]}   # optional, default identity
@@ -31,7 +31,9 @@
 
 Frames and units follow :mod:`eomgen.model` (URDF's conventions). Values are numbers or
 expressions read by :func:`eomgen.expressions.parse_scalar`; every symbol must be declared under
-``parameters``. Unknown keys are errors. The full reference is ``docs/formats.md``.
+``parameters``. A ``spherical`` joint (a ball joint, no ``axis``) is Pinocchio's
+``JointModelSpherical``: its configuration is a unit quaternion, its velocity the angular
+velocity of the child in the child frame (:mod:`eomgen.model.quaternion`). Unknown keys are errors. The full reference is ``docs/formats.md``.
 """
 
 from __future__ import annotations
@@ -50,7 +52,7 @@ LINK_KEYS = ("name", "mass", "com", "inertia")
 JOINT_KEYS = ("name", "type", "parent", "child", "origin", "axis", "actuator")
 ORIGIN_KEYS = ("xyz", "rpy")
 JOINT_TYPES = {t.value: t for t in JointType}
-UNSUPPORTED_TYPES = ("floating", "planar", "spherical", "mimic")
+UNSUPPORTED_TYPES = ("floating", "planar", "mimic")
 
 
 def sniff(text: str) -> bool:
@@ -118,6 +120,9 @@ def parse(data: dict, source: str, strict: bool = False, default_name: str = "ro
             xyz = r.vector(o["xyz"], f"{where} origin xyz") if "xyz" in o else (0, 0, 0)
             rpy = r.vector(o["rpy"], f"{where} origin rpy") if "rpy" in o else (0, 0, 0)
             origin = Transform.from_xyz_rpy(xyz, rpy)
+        if kind is JointType.SPHERICAL and "axis" in entry:
+            raise UnsupportedError(source, f"{where} axis", "a spherical joint has no axis "
+                                   "(it turns about all three)")
         axis = r.vector(entry["axis"], f"{where} axis") if "axis" in entry else vec3([0, 0, 1])
         actuator = r.actuator(entry["actuator"], f"{where} actuator") \
             if "actuator" in entry else None

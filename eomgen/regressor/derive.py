@@ -41,7 +41,9 @@ class Regressor:
     tree:
         Its moving bodies (one 10-column block per body, in JOINT_NAMES order).
     q, qd, qdd:
-        Joint symbols in JOINT_NAMES order.
+        Joint symbols in JOINT_NAMES order: the inputs of :meth:`compiled` (with quaternion
+        joints ``q`` has NQ entries, ``CONFIGURATION_NAMES``, and ``qdd`` the true
+        accelerations the program's chart accelerations are expressions of).
     program:
         Straight-line program with outputs ``"Y"`` (n × p), ``"K"`` and ``"P"`` (1 × p):
         ``τ = Y π``, kinetic energy ``K = Y_K π``, potential energy ``P = Y_P π``.
@@ -62,7 +64,8 @@ class Regressor:
 
     @property
     def n(self) -> int:
-        return len(self.q)
+        """The number of joints (NV): one 10-column block per body."""
+        return len(self.qd)
 
     @cached_property
     def PARAMETER_NAMES(self) -> tuple[str, ...]:
@@ -196,5 +199,5 @@ def derive_regressor(model: RobotModel, actuators: Iterable[str] = ()) -> Regres
     d = new_derivation(model, ("q", "qd", "qdd"))
     out = regressor_program(d.tree, d.q, d.qd, d.qdd, model.gravity, d.builder, actuators)
     program = d.program((k, out[k]) for k in ("Y", "K", "P"))
-    return Regressor(model, d.tree, d.q, d.qd, d.qdd, program, actuators,
+    return Regressor(model, d.tree, d.inputs["q"], d.qd, d.inputs["qdd"], program, actuators,
                      time.perf_counter() - start)

@@ -139,8 +139,9 @@ def generated_base(model: RobotModel) -> GeneratedBase:
     the output builder and the module constants ask for the same).
 
     The closed-form grouping (:func:`symbolic_base_parameters`, exact in geometry symbols when
-    it leaves no residual column) is used where its rules apply; otherwise the numeric route
-    (:func:`base_parameters`, needs SciPy). Both sample the regressor at the parameters' values.
+    it leaves no residual column) is used where its rules apply; otherwise, and for a model
+    with quaternion joints (its rules read the virtual joints as joints that turn), the numeric
+    route (:func:`base_parameters`, needs SciPy). Both sample the regressor at the parameters' values.
 
     Raises
     ------
@@ -153,6 +154,8 @@ def generated_base(model: RobotModel) -> GeneratedBase:
     pi = description_parameters(reg)
     subs = dict(zip(reg.parameter_symbols, pi))
     try:
+        if model.quaternion_joints:
+            raise UnsupportedError(model.source, "base parameters", "quaternion joints")
         base = symbolic_base_parameters(reg)
         names, columns, route = base.names, base.base, "symbolic"
         exprs = base.expressions

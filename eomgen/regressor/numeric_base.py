@@ -91,15 +91,23 @@ class BaseParameters:
 def sample_regressor(reg: Regressor, samples: int | None = None, seed: int = 0,
                      values: Mapping | None = None) -> np.ndarray:
     """Y stacked over random states, (samples · n, p): q uniform in [−π, π], q̇ and q̈
-    standard normal (prismatic joints too)."""
+    standard normal (prismatic joints too). A quaternion's four entries drawn so are a
+    non-unit quaternion, which the program normalises: a random rotation. The columns of the
+    massless links inside a quaternion joint's chain (:attr:`QuaternionJoint.virtual
+    <eomgen.model.QuaternionJoint.virtual>`, parameters zero by construction) are zero, so
+    that no base parameter stands for them."""
     f = reg.compiled(values)
     n, p = reg.n, reg.p
     samples = samples or max(20, 3 * p // max(n, 1) + 10)
     rng = np.random.default_rng(seed)
     rows = []
+    virtual = [10 * k + c for joint in reg.model.quaternion_joints for k in joint.virtual
+               for c in range(10)]
     for _ in range(samples):
-        q = rng.uniform(-np.pi, np.pi, n)
-        rows.append(f(q, rng.standard_normal(n), rng.standard_normal(n))["Y"])
+        q = rng.uniform(-np.pi, np.pi, len(reg.q))
+        Y = np.array(f(q, rng.standard_normal(n), rng.standard_normal(n))["Y"], dtype=float)
+        Y[:, virtual] = 0.0
+        rows.append(Y)
     return np.vstack(rows)
 
 

@@ -40,7 +40,7 @@ from ..model import RobotModel, Vec3
 from .derivation import new_derivation
 from .crba import M_program
 from .newton_euler import grouped_inertials, inverse_dynamics_program
-from .free_flyer import true_accelerations as chart_to_true
+from .quaternion_joints import true_accelerations as chart_to_true
 from .program import Program, ProgramBuilder, name_expr, name_exprs, name_matrix, name_symmetric
 from .spatial import JointFrames, add, cross, dot, matvec, scale, skew, transpose
 
@@ -276,12 +276,13 @@ def build_forward_dynamics_aba(derivation, wanted) -> dict:
 
 
 def true_accelerations(derivation, qdd: sp.Matrix) -> sp.Matrix:
-    """``qdd`` (n×1) from a forward-dynamics program, as the model's accelerations: for a free
-    flyer the chart's turned into the root twist's derivative
-    (:func:`eomgen.symbolic.free_flyer.true_accelerations`), named ``vd…``."""
-    if not derivation.model.free_flyer:
+    """``qdd`` (n×1) from a forward-dynamics program, as the model's accelerations: for
+    quaternion joints (free flyer, ball) the chart's turned into the derivative of the joint's
+    velocity (:func:`eomgen.symbolic.quaternion_joints.true_accelerations`), named ``vd…``."""
+    joints = derivation.model.quaternion_joints
+    if not joints:
         return qdd
     b = derivation.builder
-    true = chart_to_true(derivation.qd, list(qdd))
-    return sp.Matrix([b.define(e, f"vd{k + 1}", ("qdd", k + 1)) if k < 6 else e
+    true = chart_to_true(joints, derivation.qd, list(qdd))
+    return sp.Matrix([b.define(e, f"vd{k + 1}", ("qdd", k + 1)) if e != qdd[k] else e
                       for k, e in enumerate(true)])

@@ -18,8 +18,8 @@ the centre of mass ``c`` (from o) the linear momentum is the same and the angula
   the rotational inertia of the whole robot about its centre of mass, world axes.
 
 The centroidal equations ``ḣ_G = A_G v̇ + Ȧ_G v = Σ external wrenches about c + [m g; 0]`` are
-what a legged robot's planner uses. For a free flyer the chart's ``Ȧ_G v`` is corrected by
-``A_G[:, 0:6] n(v)`` (:mod:`eomgen.symbolic.free_flyer`). Units: SI.
+what a legged robot's planner uses. With quaternion joints (free flyer, ball) the chart's ``Ȧ_G v`` is corrected by
+``A_G n(v)`` (:mod:`eomgen.symbolic.quaternion_joints`). Units: SI.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from __future__ import annotations
 import sympy as sp
 
 from .composite import world_composites
-from .free_flyer import chart_offset
+from .quaternion_joints import chart_offset
 from .spatial import cross, force_cross, motion_cross
 
 
@@ -108,10 +108,10 @@ def build_centroidal(derivation, wanted) -> dict:
         n_o, f = rate[:3], rate[3:]
         c_f = cross(c, f)
         bias = list(f) + [n_o[r] - c_f[r] for r in range(3)]
-        if derivation.model.free_flyer:
-            offset = chart_offset(derivation.qd)
-            bias = [bias[r] - sp.Add(*[A_G[r, k] * offset[k] for k in range(6)])
-                    for r in range(6)]
+        if derivation.model.quaternion_joints:
+            offset = chart_offset(derivation.model.quaternion_joints, derivation.qd)
+            bias = [bias[r] - sp.Add(*[A_G[r, k] * offset[k] for k in range(len(offset))
+                                       if offset[k] != 0]) for r in range(6)]
         result["dAGv"] = sp.Matrix(b.define_all(tuple(bias), "dAGv", ("dAGv",)))
     if "I_G" in wanted:
         I_o = [[sp.Add(*[comp[i].I[r][k] for i in roots]) for k in range(3)] for r in range(3)]

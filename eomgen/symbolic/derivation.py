@@ -9,7 +9,7 @@ start from it, so that the symbols, the reserved names and the sizes of the inpu
 once.
 
 Symbols: ``q1 … qn`` [rad or m] (``n`` = NQ, the configuration size: seven entries more
-than the joints for a free flyer, :mod:`eomgen.free_flyer`), ``qd1 … qdn`` [rad/s or m/s], ``qdd1 … qddn`` [rad/s² or
+than the joints for a free flyer or ball joints, :mod:`eomgen.model.quaternion`), ``qd1 … qdn`` [rad/s or m/s], ``qdd1 … qddn`` [rad/s² or
 m/s²], ``tau1 … taun`` [N m or N]; an input of :data:`eomgen.outputs.INPUTS` is
 ``<name>1 … <name>k`` with ``k`` its own size (:func:`eomgen.outputs.input_size`: the number of
 joints unless the registry says otherwise, e.g. the contact rows of ``F_c``).
@@ -25,7 +25,7 @@ import sympy as sp
 from ..bodies import BodyTree, body_tree
 from ..model import RobotModel
 from ..outputs import BY_SYMBOL, INPUTS, input_size
-from .free_flyer import chart_accelerations, root_placement
+from .quaternion_joints import chart_accelerations, coordinates, placements
 from .program import Program, ProgramBuilder
 
 
@@ -54,14 +54,15 @@ class Derivation:
     builder: ProgramBuilder
     shared: dict = field(default_factory=dict)
     #: The joint coordinates the algorithms index by ``RigidBody.q_index`` (NV entries), when
-    #: they are not ``inputs["q"]``: a free flyer's six virtual joints are held at zero, its
-    #: pose from ``q[0:7]`` placed above them (:mod:`eomgen.symbolic.free_flyer`).
+    #: they are not ``inputs["q"]``: the virtual joints of a free flyer or a ball joint are
+    #: held at zero, the pose from its quaternion placed above them
+    #: (:mod:`eomgen.symbolic.quaternion_joints`).
     coordinates: tuple | None = None
 
     @property
     def q(self) -> tuple:
         """The joint coordinates the algorithms use, one per velocity (NV): the ``q`` input
-        itself unless the model has a free flyer (:attr:`coordinates`)."""
+        itself unless the model has quaternion joints (:attr:`coordinates`)."""
         return self.inputs["q"] if self.coordinates is None else self.coordinates
 
     @property
@@ -70,16 +71,16 @@ class Derivation:
 
     @property
     def qdd(self) -> tuple:
-        """The accelerations the algorithms take: the ``qdd`` input, for a free flyer turned
-        into the chart's (:func:`eomgen.symbolic.free_flyer.chart_accelerations`)."""
+        """The accelerations the algorithms take: the ``qdd`` input, with quaternion joints
+        turned into the chart's (:func:`eomgen.symbolic.quaternion_joints.chart_accelerations`)."""
         return self.accelerations(self.inputs["qdd"])
 
     def accelerations(self, qdd) -> tuple:
         """The accelerations an algorithm must be given for the true accelerations ``qdd``
-        (with velocities ``qd``): ``qdd`` itself, or for a free flyer the chart's."""
-        if not self.model.free_flyer:
+        (with velocities ``qd``): ``qdd`` itself, or with quaternion joints the chart's."""
+        if not self.model.quaternion_joints:
             return tuple(qdd)
-        return chart_accelerations(self.qd, qdd)
+        return chart_accelerations(self.model.quaternion_joints, self.qd, qdd)
 
     @property
     def tau(self) -> tuple[sp.Symbol, ...]:
@@ -147,14 +148,16 @@ def new_derivation(model: RobotModel, inputs: Iterable[str] | None = None) -> De
         symbols.setdefault(name, vector_symbols(name, input_size(name, model)))
     ordered = {name: symbols[name] for name in INPUTS if name in symbols}
     builder, tree = ProgramBuilder(reserved), body_tree(model)
-    if not model.free_flyer:
+    joints = model.quaternion_joints
+    if not joints:
         return Derivation(model, tree, ordered, builder)
     q = ordered["q"]
-    root = tree.bodies[0]
-    placed = replace(root, placement=root.placement @ root_placement(q, builder))
-    tree = replace(tree, bodies=(placed,) + tree.bodies[1:])
-    coordinates = (sp.Integer(0),) * 6 + tuple(q[7:])
-    return Derivation(model, tree, ordered, builder, coordinates=coordinates)
+    placed = placements(joints, q, builder)
+    tree = replace(tree, bodies=tuple(
+        replace(body, placement=body.placement @ placed[body.q_index])
+        if body.q_index in placed else body for body in tree.bodies))
+    return Derivation(model, tree, ordered, builder,
+                      coordinates=coordinates(joints, q, model.dof))
 
 
 __all__ = ["Derivation", "joint_symbols", "new_derivation", "vector_symbols"]

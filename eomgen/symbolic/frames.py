@@ -38,7 +38,7 @@ from ..model import IDENTITY3, POINT, RobotModel, Transform, ZERO3
 from .composite import forward_kinematics
 from .derivation import new_derivation
 from .evaluate import compile_program
-from .free_flyer import chart_offset
+from .quaternion_joints import chart_offset
 from .program import Program, ProgramBuilder
 from .spatial import cross, matmul, matvec, motion_cross, transpose
 
@@ -224,9 +224,9 @@ def frame_kinematics(model: RobotModel, tree, q, qd, b: ProgramBuilder,
                         Jw[half + r, col] = b.define(rotated[r], f"Jw{k}_{half + r}_{col + 1}")
             J = Jw
             dJqd = b.define_all(matvec(R0, dJqd[:3]) + matvec(R0, dJqd[3:]), f"dJw{k}_")
-        if model.free_flyer:  # the chart's J̇ q̇ less J n(v) (eomgen.symbolic.free_flyer)
-            dJqd = corrected_bias(J, dJqd, qd, b, f"dJff{k}_")
-            dJbqd = corrected_bias(Jb, dJbqd, qd, b, f"dJbff{k}_")
+        if model.quaternion_joints:  # the chart's J̇ q̇ less J n(v)
+            dJqd = corrected_bias(model, J, dJqd, qd, b, f"dJff{k}_")
+            dJbqd = corrected_bias(model, Jb, dJbqd, qd, b, f"dJbff{k}_")
         result.append({
             "p": sp.Matrix(3, 1, list(p)),
             "R": sp.Matrix(3, 3, [x for row in R for x in row]),
@@ -238,11 +238,13 @@ def frame_kinematics(model: RobotModel, tree, q, qd, b: ProgramBuilder,
     return result
 
 
-def corrected_bias(J: sp.Matrix, bias, qd, b: ProgramBuilder, hint: str) -> tuple:
-    """A free flyer's ``J̇ v`` from the chart's: ``bias − J[:, 0:6] n(v)``
-    (:func:`eomgen.symbolic.free_flyer.chart_offset`), named with ``hint``."""
-    n = chart_offset(qd)
-    return b.define_all(tuple(bias[r] - sp.Add(*[J[r, c] * n[c] for c in range(6)])
+def corrected_bias(model: RobotModel, J: sp.Matrix, bias, qd, b: ProgramBuilder,
+                   hint: str) -> tuple:
+    """``J̇ v`` of a model with quaternion joints from the chart's: ``bias − J n(v)``
+    (:func:`eomgen.symbolic.quaternion_joints.chart_offset`), named with ``hint``."""
+    n = chart_offset(model.quaternion_joints, qd)
+    return b.define_all(tuple(bias[r] - sp.Add(*[J[r, c] * n[c] for c in range(len(n))
+                                                 if n[c] != 0])
                               for r in range(J.rows)), hint)
 
 

@@ -1,0 +1,177 @@
+"""The configuration space of a model with quaternion joints (a free flyer, ball joints):
+Pinocchio's ``integrate``, ``difference`` and ``neutral`` and the configuration rate ``q̇(q, v)``,
+NumPy, one state.
+
+``q`` has NQ entries and ``v`` NV, laid out as :mod:`eomgen.model.quaternion` says (Pinocchio's
+layout): a free flyer moves along the SE(3) exponential of its twist (root frame), a ball joint
+along the SO(3) exponential of its angular velocity (child frame), ``R(t) = R exp([ω t]×)``, the
+other joints by ``q + v t``. Every function takes the model (or its
+:attr:`~eomgen.model.RobotModel.quaternion_joints`) as ``model``; without it ``q`` is taken to
+start with a free flyer and to hold no other quaternion joint (:mod:`eomgen.free_flyer`).
+
+**Non-unit quaternions** on input: every generated function and these ones use the normalised
+quaternion (any nonzero multiple of a unit quaternion gives the same result; a zero quaternion
+has no orientation and gives results that are not finite); :func:`integrate` returns unit
+quaternions, with ``w ≥ 0`` when it rebuilds them from a rotation.
+
+Examples
+--------
+>>> import numpy as np
+>>> import eomgen
+>>> from eomgen.model import Joint, JointType, Link, build_model
+>>> ball = build_model("<memory>", "pendulum",
+...     [Link("base"), Link("bob", eomgen.model.Inertial(1.0, (0, 0, -1), [[0.1, 0, 0], [0, 0.1, 0], [0, 0, 0.1]]))],
+...     [Joint("hip", JointType.SPHERICAL, "base", "bob")])
+>>> ball.configuration_names, ball.joint_names
+(('hip_qx', 'hip_qy', 'hip_qz', 'hip_qw'), ('hip_wx', 'hip_wy', 'hip_wz'))
+>>> q1 = integrate(neutral(ball), np.array([0.0, 0.0, np.pi / 2]), 1.0, model=ball)
+>>> bool(np.allclose(q1, [0, 0, np.sin(np.pi / 4), np.cos(np.pi / 4)]))
+True
+>>> bool(np.allclose(difference(neutral(ball), q1, model=ball), [0, 0, np.pi / 2]))
+True
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .model import QuaternionJoint, RobotModel
+from .model.quaternion import FREE_FLYER
+from .numeric.floating_base import matrix_quaternion, quaternion_matrix
+
+
+def layout(model, nv: int | None = None) -> tuple[QuaternionJoint, ...]:
+    """The quaternion joints of ``model`` (a :class:`~eomgen.model.RobotModel` or its
+    ``quaternion_joints``); None: one free flyer at the start."""
+    if model is None:
+        return (QuaternionJoint(FREE_FLYER, "base", 0, 0),)
+    if isinstance(model, RobotModel):
+        return model.quaternion_joints
+    return tuple(model)
+
+
+def skew(w) -> np.ndarray:
+    """``[w]×``: the 3×3 matrix of ``w ×``."""
+    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+
+
+def so3_exp(w) -> np.ndarray:
+    """The rotation ``exp([w]×)`` (Rodrigues)."""
+    theta = np.linalg.norm(w)
+    K = skew(w)
+    if theta < 1e-8:
+        return np.eye(3) + K + K @ K / 2
+    return np.eye(3) + np.sin(theta) / theta * K + (1 - np.cos(theta)) / theta ** 2 * K @ K
+
+
+def left_jacobian(w) -> np.ndarray:
+    """V(ω) with exp([ν, ω]) = (exp(ω), V ν): the SE(3) exponential's translation part."""
+    theta = np.linalg.norm(w)
+    K = skew(w)
+    if theta < 1e-6:
+        return np.eye(3) + K / 2 + K @ K / 6
+    return (np.eye(3) + (1 - np.cos(theta)) / theta ** 2 * K
+            + (theta - np.sin(theta)) / theta ** 3 * K @ K)
+
+
+def so3_log(R) -> np.ndarray:
+    """The rotation vector ``w`` (|w| ≤ π) with ``exp([w]×) = R``."""
+    cos = np.clip((np.trace(R) - 1) / 2, -1.0, 1.0)
+    theta = np.arccos(cos)
+    vee = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    if theta < 1e-8:
+        return vee / 2
+    if np.pi - theta < 1e-6:  # near π: the axis from the symmetric part
+        axis = np.sqrt(np.maximum((np.diag(R) + 1) / 2, 0.0))
+        k = int(np.argmax(axis))
+        axis = (R[k] + np.eye(3)[k]) / (2 * axis[k]) if axis[k] > 0 else axis
+        axis /= np.linalg.norm(axis)
+        return theta * axis * (1.0 if axis @ vee >= 0 else -1.0)
+    return theta / (2 * np.sin(theta)) * vee
+
+
+def _pieces(joints, nv: int):
+    """``(joint or None, v slice, q slice)`` for every joint of the layout, in order."""
+    starts = {j.v_index: j for j in joints}
+    k = iq = 0
+    while k < nv:
+        joint = starts.get(k)
+        width, length = (1, 1) if joint is None else (joint.nv, joint.nq)
+        yield joint, slice(k, k + width), slice(iq, iq + length)
+        k, iq = k + width, iq + length
+
+
+def configuration_rate(q, v, model=None) -> np.ndarray:
+    """``q̇`` (NQ) at velocity ``v`` (NV): a free flyer's origin moves at ``R v_lin``, a
+    quaternion at ``½ (x, y, z, w) ⊗ (ω, 0)``, the other joints at ``v``."""
+    q, v = np.asarray(q, dtype=float), np.asarray(v, dtype=float)
+    out = np.empty(len(q))
+    for joint, sv, sq in _pieces(layout(model), len(v)):
+        if joint is None:
+            out[sq] = v[sv]
+            continue
+        quat, omega = q[joint.quaternion:joint.quaternion + 4], v[sv][-3:]
+        if joint.kind == FREE_FLYER:
+            out[sq.start:sq.start + 3] = quaternion_matrix(quat) @ v[sv][:3]
+        k = joint.quaternion
+        out[k:k + 3] = 0.5 * (quat[3] * omega + np.cross(quat[:3], omega))
+        out[k + 3] = -0.5 * (quat[:3] @ omega)
+    return out
+
+
+def integrate(q, v, dt: float = 1.0, model=None) -> np.ndarray:
+    """The configuration reached from ``q`` (NQ) moving with the constant velocity ``v`` (NV)
+    for ``dt`` seconds (Pinocchio's ``integrate(model, q, v dt)``): a free flyer along the
+    SE(3) exponential of its twist (root frame), a ball joint ``R exp([ω dt]×)``, the other
+    joints by ``q + v dt``. The quaternions of the result are unit."""
+    q, v = np.asarray(q, dtype=float), np.asarray(v, dtype=float) * dt
+    out = np.empty(len(q))
+    for joint, sv, sq in _pieces(layout(model), len(v)):
+        if joint is None:
+            out[sq] = q[sq] + v[sv]
+            continue
+        k, step = joint.quaternion, v[sv]
+        R = quaternion_matrix(q[k:k + 4])
+        if joint.kind == FREE_FLYER:
+            out[sq.start:sq.start + 3] = q[sq.start:sq.start + 3] + R @ (
+                left_jacobian(step[3:]) @ step[:3])
+        out[k:k + 4] = matrix_quaternion(R @ so3_exp(step[-3:]))
+    return out
+
+
+def difference(q0, q1, model=None) -> np.ndarray:
+    """The velocity ``v`` (NV) with ``integrate(q0, v, 1) = q1`` (Pinocchio's
+    ``difference``): a free flyer's SE(3) logarithm of ``(R0, p0)⁻¹ (R1, p1)`` (root frame of
+    ``q0``), a ball joint's ``log(R0ᵀ R1)``, ``q1 − q0`` for the other joints."""
+    q0, q1 = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
+    joints = layout(model)
+    out = np.empty(len(q0) - len(joints))
+    for joint, sv, sq in _pieces(joints, len(out)):
+        if joint is None:
+            out[sv] = q1[sq] - q0[sq]
+            continue
+        k = joint.quaternion
+        R0, R1 = quaternion_matrix(q0[k:k + 4]), quaternion_matrix(q1[k:k + 4])
+        w = so3_log(R0.T @ R1)
+        if joint.kind == FREE_FLYER:
+            p = slice(sq.start, sq.start + 3)
+            out[sv.start:sv.start + 3] = np.linalg.solve(left_jacobian(w), R0.T @ (q1[p] - q0[p]))
+        out[sv.stop - 3:sv.stop] = w
+    return out
+
+
+def neutral(model) -> np.ndarray:
+    """The neutral configuration (Pinocchio's ``neutral``): identity quaternions (0, 0, 0, 1),
+    everything else zero. ``model``: a :class:`~eomgen.model.RobotModel`, or the NQ of a model
+    whose only quaternion joint is a free flyer at the start."""
+    if isinstance(model, RobotModel):
+        q, joints = np.zeros(model.nq), model.quaternion_joints
+    else:
+        q, joints = np.zeros(int(model)), layout(None)
+    for joint in joints:
+        q[joint.quaternion + 3] = 1.0
+    return q
+
+
+__all__ = ["configuration_rate", "difference", "integrate", "layout", "left_jacobian",
+           "neutral", "skew", "so3_exp", "so3_log"]
