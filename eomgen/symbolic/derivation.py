@@ -24,7 +24,9 @@ import sympy as sp
 
 from ..bodies import BodyTree, body_tree
 from ..model import RobotModel
+from ..errors import UnsupportedError
 from ..outputs import BY_SYMBOL, INPUTS, input_size
+from .couplings import coupled_inputs, project, refused
 from .free_flyer import chart_accelerations, root_placement
 from .program import Program, ProgramBuilder
 
@@ -57,6 +59,12 @@ class Derivation:
     #: they are not ``inputs["q"]``: a free flyer's six virtual joints are held at zero, its
     #: pose from ``q[0:7]`` placed above them (:mod:`eomgen.symbolic.free_flyer`).
     coordinates: tuple | None = None
+    #: For a model with coupled joints (:mod:`eomgen.symbolic.couplings`): ``T`` of
+    #: ``q_full = T q + c`` and the full velocities ``T q̇``; :attr:`model` is then the
+    #: whole tree (every movable joint a coordinate) and :meth:`program` projects each output
+    #: to the independent coordinates.
+    coupling: sp.Matrix | None = None
+    velocities: tuple | None = None
 
     @property
     def q(self) -> tuple:
@@ -65,8 +73,10 @@ class Derivation:
         return self.inputs["q"] if self.coordinates is None else self.coordinates
 
     @property
-    def qd(self) -> tuple[sp.Symbol, ...]:
-        return self.inputs["qd"]
+    def qd(self) -> tuple:
+        """The joint velocities the algorithms use (NV): the ``qd`` input, or with coupled
+        joints the full velocities ``T q̇`` (:attr:`coupling`)."""
+        return self.inputs["qd"] if self.velocities is None else self.velocities
 
     @property
     def qdd(self) -> tuple:
@@ -76,7 +86,11 @@ class Derivation:
 
     def accelerations(self, qdd) -> tuple:
         """The accelerations an algorithm must be given for the true accelerations ``qdd``
-        (with velocities ``qd``): ``qdd`` itself, or for a free flyer the chart's."""
+        (with velocities ``qd``): ``qdd`` itself, or for a free flyer the chart's; with coupled
+        joints, independent accelerations (``len(qdd)`` the ``qdd`` input's) become the full
+        ``T q̈``."""
+        if self.coupling is not None and len(qdd) == self.coupling.cols:
+            return tuple(self.coupling * sp.Matrix(qdd))
         if not self.model.free_flyer:
             return tuple(qdd)
         return chart_accelerations(self.qd, qdd)
@@ -116,9 +130,19 @@ class Derivation:
 
     def program(self, outputs: Iterable[tuple[str, sp.Matrix]]) -> Program:
         """The straight-line program of ``outputs`` (``(name, matrix)`` pairs, in order): the
-        builder's intermediates, pruned to those the outputs need."""
+        builder's intermediates, pruned to those the outputs need. With coupled joints each
+        registered output is first projected to the independent coordinates
+        (:func:`eomgen.symbolic.couplings.project`); another name is refused."""
         outputs = tuple(outputs)
+        if self.coupling is not None:
+            outputs = tuple((name, self._projected(name, matrix)) for name, matrix in outputs)
         return Program(tuple(self.builder.assignments), outputs).pruned([n for n, _ in outputs])
+
+    def _projected(self, name: str, matrix: sp.Matrix) -> sp.Matrix:
+        if refused([name]):
+            raise UnsupportedError(self.model.source, f"output {name}", "not derived for a "
+                                   "model with coupled joints (eomgen.symbolic.couplings)")
+        return project(name, sp.Matrix(matrix), self.coupling)
 
 
 def new_derivation(model: RobotModel, inputs: Iterable[str] | None = None) -> Derivation:
@@ -146,6 +170,13 @@ def new_derivation(model: RobotModel, inputs: Iterable[str] | None = None) -> De
     for name in ("q", "qd", "qdd"):
         symbols.setdefault(name, vector_symbols(name, input_size(name, model)))
     ordered = {name: symbols[name] for name in INPUTS if name in symbols}
+    if model.couplings:
+        if model.free_flyer:
+            raise UnsupportedError(model.source, "couplings", "coupled joints on a model "
+                                   "with a quaternion free flyer are not derived yet")
+        full, T, q_full, qd_full = coupled_inputs(model, ordered["q"], ordered["qd"])
+        return Derivation(full, body_tree(full), ordered, ProgramBuilder(reserved),
+                          coordinates=q_full, coupling=T, velocities=qd_full)
     builder, tree = ProgramBuilder(reserved), body_tree(model)
     if not model.free_flyer:
         return Derivation(model, tree, ordered, builder)
