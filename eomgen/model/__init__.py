@@ -42,7 +42,7 @@ from .checks import (
     check_tree,
 )
 from .contact import POINT, SURFACE, Contact
-from .coupling import Coupling, couple, coupling_map, uncoupled, with_couplings
+from .coupling import Coupling, couple, coupling_map, make_coupling, uncoupled, with_couplings
 from .notices import Notice, NoticeKind, emit_notices
 from .parts import Inertial, Joint, JointType, Link, Parameter
 from .robot import (
@@ -63,7 +63,7 @@ from .transforms import Transform, rotation_about_axis, rotation_from_rpy
 __all__ = [
     "DEFAULT_FRICTION_WIDTH", "FREE_FLYER_CONFIGURATION", "FREE_FLYER_VELOCITY", "IDENTITY3", "MAX_JOINTS", "POINT", "SNAP_TOLERANCE", "SURFACE",
     "ZERO3", "Actuator", "Contact", "Coupling", "couple", "coupling_map", "uncoupled",
-    "with_couplings", "Inertial", "Joint", "JointType", "Link", "Mat3", "Notice",
+    "make_coupling", "with_couplings", "Inertial", "Joint", "JointType", "Link", "Mat3", "Notice",
     "NoticeKind", "Parameter", "RobotModel", "Scalar", "Snap", "Transform", "Vec3",
     "all_scalars", "build_model", "check_actuator", "check_axis", "check_inertial",
     "check_size", "check_tree", "configuration_size", "emit_notices", "flexible_indices", "joint_actuators",
