@@ -123,6 +123,9 @@ class Dynamics:
         ``sin² + cos² = 1``, in angle sums ``cos(q2 + q3)`` along parallel joint axes, exact
         numbers. Computed in a polynomial ring (seconds for 3 joints), on first use. A façade
         for the README's API: the work is :func:`eomgen.symbolic.textbook.textbook_derivation`."""
+        if self.model.couplings:
+            raise UnsupportedError(self.model.source, "couplings", "no textbook derivation of "
+                                   "a model with coupled joints")
         return textbook_derivation(self.model, max_dof=MAX_SIMPLIFY_JOINTS)
 
     @cached_property

@@ -461,7 +461,7 @@ def test_example_robot_data(robot, erd_robots_dir):
     with warnings.catch_warnings():
         # Panda's second finger <mimic>s the first: both tools read it as an independent joint
         warnings.simplefilter("ignore", UnsupportedFeatureWarning)
-        model = eomgen.load(path)
+        model = eomgen.load(path, couplings=False)
     nm = numeric_model(model)
     pmodel = pin.buildModelFromUrdf(str(path))
     pmodel.gravity = pin.Motion(nm.gravity.copy(), np.zeros(3))
