@@ -26,6 +26,7 @@ from ..model import (
     lock_joints,
     scalar,
     vec3,
+    with_couplings,
 )
 from ..outputs import select
 from ..parsers import load
@@ -80,6 +81,7 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
                      f"{', '.join(EULER_JOINTS)} (position, ZYX Euler angles) from the fixed "
                      f"link '{model.root}' (see eomgen.floating)")
     _check_names(model, scene, payloads)
+    model = _with_scene_couplings(model, scene)
     base = scene.base or model.root
     moving = _moving_joints(model, scene, base)
     listed = scene.locked_positions
@@ -128,6 +130,23 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
         virtual_joints=(VELOCITY_NAMES if scene.floating_base == "quaternion" else
                         EULER_JOINTS if scene.floating_base else ()))
     return Reduction(reduced, report)
+
+
+def _with_scene_couplings(model: RobotModel, scene: Scene) -> RobotModel:
+    """``model`` with the scene's ``couplings`` added (:mod:`eomgen.model.coupling`); errors
+    name the scene file and the entry, and a coupling of a joint the scene locks is refused."""
+    if not scene.couplings:
+        return model
+    locked = scene.locked_positions
+    for coupling in scene.couplings:
+        for name in [coupling.follower] + [n for n, _ in coupling.leaders]:
+            if name in locked:
+                raise scene.error(coupling.where, f"joint '{name}' is locked by the scene: "
+                                  "a locked joint cannot be coupled")
+    try:
+        return with_couplings(model, model.couplings + scene.couplings)
+    except DescriptionError as exc:
+        raise scene_error(type(exc))(scene.source, exc.element, exc.problem) from None
 
 
 def _float(model: RobotModel, scene: Scene, add) -> RobotModel:
@@ -441,7 +460,8 @@ def _merge(model: RobotModel, payloads: Sequence[Payload]):
     info = tuple((k, v) for k, v in model.info if not str(k).startswith("dh"))
     reduced = RobotModel(name=model.name, links=tuple(links), joints=tuple(joints),
                          root=model.root, gravity=model.gravity, parameters=model.parameters,
-                         source=model.source, info=info, free_flyer=model.free_flyer)
+                         source=model.source, info=info, free_flyer=model.free_flyer,
+                         couplings=model.couplings)
     return reduced, tuple(merged), tuple(dropped), tuple(dropped_payloads)
 
 
