@@ -13,7 +13,8 @@ from .transforms import Transform
 
 class JointType(enum.Enum):
     """Joint types eomgen models. Floating and planar joints are refused by the parsers; a URDF
-    ``<mimic>`` joint is read as an independent joint (see :mod:`eomgen.parsers.urdf`)."""
+    ``<mimic>`` joint is a movable joint that a coupling makes follow another
+    (:mod:`eomgen.model.coupling`)."""
 
     REVOLUTE = "revolute"
     CONTINUOUS = "continuous"

@@ -225,7 +225,7 @@ def load_for_scene(path, scene: Scene | None = None, strict: bool = False,
 
     The findings that warn (:class:`~eomgen.model.Notice`: a ``<mimic>`` joint, an inertia
     that breaks the triangle inequality, a root that looks like a floating base) are emitted
-    once the scene is applied, for what remains: a mimic finger the scene locks, a link it
+    once the scene is applied, for what remains: a follower the scene locks, a link it
     drops, a floating base it declares fixed (``fixed_base: true``) say nothing.
 
     Parameters
