@@ -28,6 +28,7 @@ from ..model import (
     vec3,
     with_couplings,
 )
+from ..model.coupling import locked_couplings
 from ..outputs import select
 from ..parsers import load
 from ..scene import Payload, Scene, did_you_mean, scene_error
@@ -87,6 +88,7 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
     listed = scene.locked_positions
     locks = [LockedJoint(j.name, float(listed.get(j.name, 0.0)), j.name in listed)
              for j in model.movable_joints if j.name not in moving]
+    locks = _coupled_locks(model, locks)
     locked_model = lock_joints(model, {j.name: j.position for j in locks})
     reduced, merged, dropped, dropped_payloads = _merge(locked_model, payloads)
     gravity = model.gravity if scene_gravity is None else scene_gravity
@@ -130,6 +132,18 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
         virtual_joints=(VELOCITY_NAMES if scene.floating_base == "quaternion" else
                         EULER_JOINTS if scene.floating_base else ()))
     return Reduction(reduced, report)
+
+
+def _coupled_locks(model: RobotModel, locks: list[LockedJoint]) -> list[LockedJoint]:
+    """``locks`` with each follower the scene does not list (:attr:`RobotModel.couplings`) at
+    the position its locked leaders give it, or left moving with a leader that moves."""
+    if not model.couplings:
+        return locks
+    followers = {c.follower for c in model.couplings}
+    given = {j.name: j.position for j in locks if j.listed or j.name not in followers}
+    positions, _ = locked_couplings(model, given)
+    return [replace(j, position=float(positions[j.name])) for j in locks
+            if j.name in positions]
 
 
 def _with_scene_couplings(model: RobotModel, scene: Scene) -> RobotModel:

@@ -246,3 +246,17 @@ def test_scene_couplings_key(tmp_path):
         with pytest.raises(eomgen.errors.SceneError) as caught:
             eomgen.apply_scene(arm, eomgen.load_scene("s.yaml", text="version: 1\n" + text))
         assert str(caught.value).startswith(message), str(caught.value)
+
+
+def test_a_follower_outside_the_moving_part_goes_with_its_leader():
+    arm = couple(eomgen.load(eomgen.example_path("elbow_rrr")), "elbow", "waist", ratio=2,
+                 offset=0.1)
+    locked = eomgen.apply_scene(arm, eomgen.load_scene(
+        "s.yaml", text="version: 1\nlocked: {waist: 0.4}\ntips: [link2]\n"))
+    assert locked.model.joint_names == ("shoulder",) and not locked.model.couplings
+    assert [(j.name, round(j.position, 12), j.listed) for j in locked.report.locked] == [
+        ("waist", 0.4, True), ("elbow", 0.9, False)]  # 2 * 0.4 + 0.1, not 0
+    moving = eomgen.apply_scene(arm, eomgen.load_scene("s.yaml", text="version: 1\n"
+                                                       "tips: [link2]\n"))
+    assert moving.model.joint_names == ("waist", "shoulder")
+    assert moving.model.couplings == arm.couplings  # elbow still follows the waist
