@@ -16,7 +16,8 @@ Lagrangian: the symbols ``c_ijk`` are multilinear in the directions, and ``T`` i
 ``g_r = Tᵀ g``, ``τ_r = Tᵀ τ(T q + c, T q̇, T q̈)``, ``Y_r = Tᵀ Y``, ``J_r = J T``. Outputs
 absent from the table are refused under couplings (:func:`refused`): the ABA and its
 derivatives solve the unconstrained tree, the base regressor's columns are those of the
-uncoupled tree, the flexible joints' motor states are per joint.
+uncoupled tree, the flexible joints' motor states are per joint. (Y_SL: its ``q̇_r``, ``q̈_r`` enter as
+``T q̇_r``, ``T q̈_r``, :meth:`~eomgen.symbolic.derivation.Derivation.tangent`.)
 """
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ PROJECTIONS: dict[str, tuple[bool, bool]] = {
     "tau": (True, False), "h": (True, False),
     "M_a": (True, True), "tau_f": (True, False), "tau_f_smooth": (True, False),
     "tau_a": (True, False),
-    "Y": (True, False), "pi": (False, False), "Y_K": (False, False), "Y_P": (False, False),
+    "Y": (True, False), "Y_SL": (True, False), "pi": (False, False), "Y_K": (False, False), "Y_P": (False, False),
     "p_f": (False, False), "R_f": (False, False), "J_f": (False, True),
     "Jb_f": (False, True), "dJqd_f": (False, False), "dJbqd_f": (False, False),
     "J_c": (False, True), "dJqd_c": (False, False), "tau_c": (True, False),

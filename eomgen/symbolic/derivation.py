@@ -95,6 +95,13 @@ class Derivation:
             return tuple(qdd)
         return chart_accelerations(self.qd, qdd)
 
+    def tangent(self, vector) -> tuple:
+        """A velocity-like input vector (``qd_r``, ``qdd_r``) as the algorithms take it: itself,
+        or with coupled joints the whole tree's ``T x``."""
+        if self.coupling is None:
+            return tuple(vector)
+        return tuple(self.coupling * sp.Matrix(vector))
+
     @property
     def tau(self) -> tuple[sp.Symbol, ...]:
         return self.inputs["tau"]

@@ -260,3 +260,13 @@ def test_a_follower_outside_the_moving_part_goes_with_its_leader():
                                                        "tips: [link2]\n"))
     assert moving.model.joint_names == ("waist", "shoulder")
     assert moving.model.couplings == arm.couplings  # elbow still follows the waist
+
+
+def test_slotine_li_regressor_under_couplings(differential):
+    """Y_SL π = M_r q̈_r + C_r(q, q̇) q̇_r + g_r with the reduced M, Christoffel C and g."""
+    _, model = differential
+    f = eomgen.derive(model, ("M", "C", "g", "Y_SL", "pi")).lambdify()
+    q, qd, qd_r, qdd_r = np.random.default_rng(8).normal(size=(4, 2))
+    Y = f.module.slotine_li_regressor(q, qd, qd_r, qdd_r)
+    expected = f.M(q) @ qdd_r + f.C(q, qd) @ qd_r + f.g(q)
+    assert relative(Y @ f.module.inertial_parameters(), expected) <= 1e-12
