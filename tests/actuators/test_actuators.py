@@ -159,7 +159,7 @@ def test_mujoco_reads_the_same_urdf_damping_as_eomgen():
     urdf = robots / "panda_description/urdf/panda.urdf"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        model = eomgen.load(urdf)
+        model = eomgen.load(urdf, couplings=False)  # MuJoCo reads every joint
     mujoco, m = _mujoco_model(urdf, {}, {})
     ours = [float(j.actuator.damping) if j.actuator else 0.0 for j in model.movable_joints]
     theirs = [float(m.dof_damping[m.joint(n).dofadr[0]]) for n in model.joint_names]
