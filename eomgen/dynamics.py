@@ -24,6 +24,7 @@ from .outputs import derived_symbols
 # Derivation, joint_symbols and vector_symbols live in eomgen.symbolic.derivation; re-exported here
 # because the docs and earlier code import them from eomgen.dynamics.
 from .symbolic.derivation import Derivation, joint_symbols, new_derivation, vector_symbols  # noqa: F401
+from .symbolic.couplings import refused
 from .symbolic.program import Program
 from .symbolic.named import AUTO_EXPAND_WORK, ExpansionTooLargeError, ProgramMatrix
 from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS, textbook_derivation
@@ -125,6 +126,9 @@ class Dynamics:
         ``sin² + cos² = 1``, in angle sums ``cos(q2 + q3)`` along parallel joint axes, exact
         numbers. Computed in a polynomial ring (seconds for 3 joints), on first use. A façade
         for the README's API: the work is :func:`eomgen.symbolic.textbook.textbook_derivation`."""
+        if self.model.couplings:
+            raise UnsupportedError(self.model.source, "couplings", "no textbook derivation of "
+                                   "a model with coupled joints")
         return textbook_derivation(self.model, max_dof=MAX_SIMPLIFY_JOINTS)
 
     @cached_property
@@ -301,6 +305,11 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
             model.source, where,
             f"{', '.join(sorted(outputs - set(FREE_FLYER_OUTPUTS)))} not derived for "
             f"{what} yet (it has {', '.join(FREE_FLYER_OUTPUTS)}){hint}")
+    if model.couplings and refused(outputs):
+        raise UnsupportedError(
+            model.source, "couplings", f"{', '.join(refused(outputs))} not derived for a model "
+            "with coupled joints (see eomgen.symbolic.couplings); read the followers as "
+            "independent joints (eomgen.model.uncoupled) for them")
     if simplify and model.dof > MAX_SIMPLIFY_JOINTS:
         raise TooLargeError(
             model.source, "derive(simplify=True)",
@@ -317,8 +326,10 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     result = derivation.built
     timings.append(("program", time.perf_counter() - start))
     program = derivation.program(result.items())
+    if model.couplings:  # the projected outputs (eomgen.symbolic.couplings)
+        result = dict(program.outputs)
     steps = _steps(program, result)
-    if model.quaternion_joints:  # the textbook forms differentiate by q: not in the chart
+    if model.quaternion_joints or model.couplings:  # the textbook forms take the joints as coordinates
         simplify = False
     if simplify is None:  # teaching-sized: few joints and a small program (a cheap estimate)
         counted = [o for o in ("M", "C", "g") if o in outputs]

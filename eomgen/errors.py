@@ -28,7 +28,8 @@ tests) can tell them apart without reading messages::
     │   │                         motor inertia
     │   ├── KinematicTreeError    duplicate names, undefined links or joints, two parents,
     │   │                         cycles, disconnected links, no root
-    │   ├── UnsupportedError      floating and planar joints; mimic joints under strict
+    │   ├── UnsupportedError      floating and planar joints; mimic joints read as
+    │   │                         independent (couplings=False) under strict
     │   └── SceneError            a scene file (eomgen.scene) that is malformed or does not fit
     │                             the robot: unknown key, link or joint, a lock on a joint that
     │                             is not movable, a tip not below the base, a bad payload
@@ -167,12 +168,13 @@ class InvalidActuatorError(DescriptionError):
 class KinematicTreeError(DescriptionError):
     """Links and joints do not form one tree: duplicate names, a joint naming an undefined link
     (or a mimic naming an undefined joint), a link with two parents or joined to itself, a
-    cycle, links not connected to the root, no root."""
+    cycle, links not connected to the root, no root; couplings (URDF ``<mimic>``) of missing or
+    fixed joints, in a cycle, or of a follower that leads another."""
 
 
 class UnsupportedError(DescriptionError):
     """The description is valid but uses a feature eomgen does not model yet (floating and
-    planar joints; URDF ``<mimic>`` joints under ``strict``)."""
+    planar joints; URDF ``<mimic>`` joints read as independent under ``strict``)."""
 
 
 class SceneError(DescriptionError):

@@ -40,6 +40,10 @@ Version 1 of the format (every key but ``version`` is optional)::
         baumgarte: {kp: 0, kd: 0} # optional stabilisation gains [1/s², 1/s]
     frames: [FL_FOOT, base_link] # links whose pose, Jacobians and J̇ q̇ frame_* outputs give
                                  #   (default: the contact frames, else the leaf links)
+    couplings:                    # coupled joints: q_joint = ratio q_to + offset, or the
+      - {joint: finger2, to: finger1, ratio: 1, offset: 0}   # linear form below; the
+      - {joint: diff_out, to: {wheel_l: 0.5, wheel_r: 0.5}}  # follower is no coordinate
+                                  #   (eomgen.model.coupling; ratio 1, offset 0 by default)
 
 The file is read like eomgen's robot YAML (:mod:`eomgen.parsers._yaml`): safe loading, no
 aliases, size and depth limits, and an unknown key is an error that lists the known ones. Keys
@@ -64,7 +68,7 @@ from typing import Iterable
 
 from .model import POINT, SURFACE, Contact
 from .errors import DescriptionError, SceneError
-from .model import Inertial, Parameter, Vec3, check_inertial, mat3, vec3
+from .model import Coupling, Inertial, Parameter, Vec3, check_inertial, make_coupling, mat3, vec3
 from .outputs import select
 from .parsers._yaml import Reader, read_document
 
@@ -74,7 +78,7 @@ SCENE_VERSION = 1
 #: Top-level keys of a version-1 scene, in documentation order.
 SCENE_KEYS = ("version", "robot", "description", "fixed_base", "floating_base", "base", "tips",
               "locked", "payloads", "actuators", "gravity", "parameters", "symbolic", "outputs",
-              "contacts", "frames")
+              "contacts", "frames", "couplings")
 
 #: Keys reserved for later versions of the format; refused with a message saying so (those of
 #: :data:`ACTUATOR_ALIASES` with a pointer to ``actuators``, which holds them per joint now).
@@ -93,6 +97,8 @@ FLOATING_CHARTS = {False: False, True: "euler", "euler": "euler", "quaternion": 
 FLOATING = "floating"
 
 CONTACT_KEYS = ("frame", "type", "mu", "baumgarte", "normal", "name")
+
+COUPLING_KEYS = ("joint", "to", "ratio", "offset")
 
 
 @dataclass(frozen=True)
@@ -147,6 +153,9 @@ class Scene:
     frames:
         Links whose kinematics the ``frame_*`` outputs give (``FRAME_NAMES``), in file order;
         empty for the default (the contact frames, else the leaf links).
+    couplings:
+        Coupled joints (:class:`eomgen.model.Coupling`), in file order: each ``joint``
+        follows ``ratio · to + offset`` (or ``Σ gain · leader + offset`` for ``to`` a mapping).
     """
 
     source: str = "<scene>"
@@ -166,6 +175,7 @@ class Scene:
     floating_base: bool | str = False
     contacts: tuple[Contact, ...] = ()
     frames: tuple[str, ...] = ()
+    couplings: tuple[Coupling, ...] = ()
 
     @property
     def locked_positions(self) -> dict[str, float]:
@@ -321,12 +331,16 @@ def _read(data: dict, source: str, strict: bool) -> Scene:
             if names.count(c.name) > 1:
                 raise r.error(f"contacts '{c.name}'", "two contacts have this name")
     frames = _frames(r, data["frames"]) if data.get("frames") is not None else ()
+    couplings = tuple(_coupling(r, entry, k) for k, entry in
+                      enumerate(r.sequence(data["couplings"], "couplings"))
+                      ) if data.get("couplings") is not None else ()
     declared = tuple(r.declared.values())
     return Scene(frames=frames, source=source, version=version, robot=robot, description=description,
                  floating_base=floating_base, contacts=tuple(contacts),
                  fixed_base=fixed_base, base=base, tips=tuple(tips), locked=tuple(locked),
                  payloads=tuple(payloads), actuators=tuple(actuators),
-                 gravity=gravity, parameters=declared, symbolic=symbolic, outputs=outputs)
+                 gravity=gravity, parameters=declared, symbolic=symbolic, outputs=outputs,
+                 couplings=couplings)
 
 
 def _payload(r: _SceneReader, entry, k: int, source: str, strict: bool) -> Payload:
@@ -387,6 +401,24 @@ def _contact(r: _SceneReader, entry, k: int) -> Contact:
             raise r.error(f"{where} normal", "the normal is zero")
         normal = tuple(x / norm for x in vector)
     return Contact(frame, kind, mu, gains["kp"], gains["kd"], normal, name)
+
+
+def _coupling(r: _SceneReader, entry, k: int) -> Coupling:
+    where = f"couplings[{k}]"
+    r.mapping(entry, where, required=("joint", "to"), optional=COUPLING_KEYS)
+    follower = r.name(entry["joint"], f"{where} joint")
+    where = f"{where} '{follower}'"
+    target = entry["to"]
+    if isinstance(target, dict):
+        if "ratio" in entry:
+            raise r.error(f"{where} ratio", "give the gains in 'to' ({leader: gain, ...})")
+        leaders = {r.name(name, f"{where} to"): r.number(gain, f"{where} to '{name}'")
+                   for name, gain in target.items()}
+    else:
+        leaders = {r.name(target, f"{where} to"):
+                   r.number(entry.get("ratio", 1), f"{where} ratio")}
+    offset = r.number(entry.get("offset", 0), f"{where} offset")
+    return make_coupling(follower, leaders, offset, where)
 
 
 def _at(value, values: dict):

@@ -28,8 +28,9 @@ import sympy as sp
 
 from .dynamics import Dynamics
 from .errors import ParameterError, UnsupportedError
-from .model import all_scalars
-from .numeric import numeric_model, rnea
+from .model import all_scalars, coupling_map, uncoupled
+from .numeric import numeric_model
+from .numeric import rnea as numeric_rnea
 from .symbolic.evaluate import compile_program
 
 #: Default relative tolerance of the numeric identities.
@@ -114,6 +115,18 @@ def sample_states(n: int, samples: int, rng: np.random.Generator):
         yield rng.uniform(-np.pi, np.pi, n), rng.normal(size=n), rng.normal(size=n)
 
 
+def reference_rnea(model):
+    """``rnea(q, qd, qdd)`` of ``model`` by the float Newton–Euler recursion, in its
+    ``joint_names`` coordinates: with coupled joints, ``Tᵀ RNEA(T q + c, T q̇, T q̈)`` on the
+    whole tree (:func:`eomgen.model.coupling_map`)."""
+    nm = numeric_model(uncoupled(model))
+    if not model.couplings:
+        return lambda q, qd, qdd: numeric_rnea(nm, q, qd, qdd)
+    T, c = (np.array(m.evalf(), dtype=float) for m in coupling_map(model))
+    c = c[:, 0]
+    return lambda q, qd, qdd: T.T @ numeric_rnea(nm, T @ q + c, T @ qd, T @ qdd)
+
+
 def verify(dynamics: Dynamics, samples: int = 20, seed: int = 0,
            tolerance: float = TOLERANCE) -> VerificationReport:
     """Check ``dynamics`` (see module docstring) and return a report; raises nothing on failure.
@@ -155,7 +168,7 @@ def verify(dynamics: Dynamics, samples: int = 20, seed: int = 0,
                             *values[2 * n_q:])
 
     pvals = [values[s] for s in params]
-    nm = numeric_model(model)
+    rnea = reference_rnea(model)
     rng = np.random.default_rng(seed)
     states = list(sample_states(n, samples, rng))
     checks: list[CheckResult] = []
@@ -211,16 +224,16 @@ def verify(dynamics: Dynamics, samples: int = 20, seed: int = 0,
                                   abs_err / scale <= tolerance, how))
 
     zeros = np.zeros(n)
-    record("g = RNEA(q,0,0)", [(r["g"][:, 0], rnea(nm, q, zeros, zeros))
+    record("g = RNEA(q,0,0)", [(r["g"][:, 0], rnea(q, zeros, zeros))
                                for (q, _, _), r in zip(states, results)])
     columns = []
     for (q, _, _), r in zip(states, results):
-        g_ref = rnea(nm, q, zeros, zeros)
-        ref = np.column_stack([rnea(nm, q, zeros, e) - g_ref for e in np.eye(n)]) if n else np.zeros((0, 0))
+        g_ref = rnea(q, zeros, zeros)
+        ref = np.column_stack([rnea(q, zeros, e) - g_ref for e in np.eye(n)]) if n else np.zeros((0, 0))
         columns.append((r["M"], ref))
     record("M columns = RNEA(q,0,e_i) - RNEA(q,0,0)", columns)
     record("M qdd + C qd + g = RNEA(q,qd,qdd)",
-           [(r["M"] @ qdd + r["C"] @ qd + r["g"][:, 0], rnea(nm, q, qd, qdd))
+           [(r["M"] @ qdd + r["C"] @ qd + r["g"][:, 0], rnea(q, qd, qdd))
             for (q, qd, qdd), r in zip(states, results)])
     if "tau" in dynamics.outputs:
         record("symbolic Newton-Euler tau = M qdd + C qd + g",

@@ -43,9 +43,8 @@ def _file_or_example(ctx, param, value: Path | None) -> Path | None:
 
 strict_option = click.option(
     "--strict", is_flag=True,
-    help="Refuse inertias that break the triangle inequality, URDF <mimic> joints and a URDF "
-         "root that looks like a floating base, instead of warning (only about what a "
-         "--scene keeps).")
+    help="Refuse inertias that break the triangle inequality and a URDF root that looks like a "
+         "floating base, instead of warning (only about what a --scene keeps).")
 
 
 def quiet_option(help: str = QUIET_HELP):

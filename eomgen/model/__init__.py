@@ -23,8 +23,9 @@ The package holds one concept per module, bottom up: :mod:`~eomgen.model.scalars
 3-vectors, 3×3 matrices), :mod:`~eomgen.model.snapping`, :mod:`~eomgen.model.transforms`
 (rotations, rigid transforms), :mod:`~eomgen.model.actuator`, :mod:`~eomgen.model.contact`,
 :mod:`~eomgen.model.parts` (joint types, links, joints, parameters),
-:mod:`~eomgen.model.notices`, :mod:`~eomgen.model.quaternion` (free flyer and ball joints:
-the layout of q and v), :mod:`~eomgen.model.robot` (:class:`RobotModel`) and
+:mod:`~eomgen.model.notices`, :mod:`~eomgen.model.coupling` (coupled joints),
+:mod:`~eomgen.model.quaternion` (free flyer and ball joints: the layout of q and v),
+:mod:`~eomgen.model.robot` (:class:`RobotModel`) and
 :mod:`~eomgen.model.checks` (validation, :func:`build_model`). Import every name from
 ``eomgen.model``.
 """
@@ -42,6 +43,7 @@ from .checks import (
     check_tree,
 )
 from .contact import POINT, SURFACE, Contact
+from .coupling import Coupling, couple, coupling_map, make_coupling, uncoupled, with_couplings
 from .notices import Notice, NoticeKind, emit_notices
 from .parts import Inertial, Joint, JointType, Link, Parameter
 from .quaternion import (
@@ -66,7 +68,8 @@ from .transforms import Transform, rotation_about_axis, rotation_from_rpy
 
 __all__ = [
     "DEFAULT_FRICTION_WIDTH", "FREE_FLYER_CONFIGURATION", "FREE_FLYER_VELOCITY", "IDENTITY3", "MAX_JOINTS", "POINT", "SNAP_TOLERANCE", "SURFACE",
-    "ZERO3", "Actuator", "Contact", "Inertial", "Joint", "JointType", "Link", "Mat3", "Notice",
+    "ZERO3", "Actuator", "Contact", "Coupling", "couple", "coupling_map", "uncoupled",
+    "make_coupling", "with_couplings", "Inertial", "Joint", "JointType", "Link", "Mat3", "Notice",
     "NoticeKind", "Parameter", "QuaternionJoint", "RobotModel", "Scalar", "Snap", "Transform", "Vec3",
     "all_scalars", "build_model", "check_actuator", "check_axis", "check_inertial",
     "check_size", "check_tree", "configuration_size", "emit_notices", "expand_ball_joints", "flexible_indices", "joint_actuators",

@@ -13,7 +13,8 @@ from .transforms import Transform
 
 class JointType(enum.Enum):
     """Joint types eomgen models. Floating and planar joints are refused by the parsers; a URDF
-    ``<mimic>`` joint is read as an independent joint (see :mod:`eomgen.parsers.urdf`).
+    ``<mimic>`` joint is a movable joint that a coupling makes follow another
+    (:mod:`eomgen.model.coupling`).
     ``SPHERICAL`` (a ball joint, three rotational freedoms, its configuration a unit
     quaternion) is what a parser writes; :func:`~eomgen.model.build_model` turns it into three
     virtual joints (:func:`eomgen.model.expand_ball_joints`), so no model holds one."""

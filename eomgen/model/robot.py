@@ -14,6 +14,7 @@ from .. import reprs
 from ..errors import KinematicTreeError, ParameterError
 from .actuator import Actuator
 from .contact import Contact
+from .coupling import Coupling, locked_couplings
 from .notices import Notice
 from .parts import Inertial, Joint, JointType, Link, Parameter
 from .quaternion import (FREE_FLYER_CONFIGURATION, FREE_FLYER_VELOCITY, QuaternionJoint,
@@ -65,6 +66,9 @@ class RobotModel:
     #: ``<name>_wx … <name>_wz`` whose configuration is a unit quaternion
     #: (:mod:`eomgen.model.quaternion`, :func:`~eomgen.model.expand_ball_joints`).
     ball_joints: tuple[str, ...] = ()
+    #: Coupled joints (:mod:`eomgen.model.coupling`): each follower's position is an affine
+    #: function of its leaders'; followers are no coordinates (``joint_names``, ``dof``).
+    couplings: tuple[Coupling, ...] = ()
 
     @cached_property
     def link_by_name(self) -> dict[str, Link]:
@@ -79,14 +83,23 @@ class RobotModel:
     def movable_joints(self) -> tuple[Joint, ...]:
         return tuple(j for j in self.joints if j.type.is_movable)
 
+    @cached_property
+    def coordinate_joints(self) -> tuple[Joint, ...]:
+        """The movable joints that are coordinates: all but the followers of
+        :attr:`couplings`, in description order."""
+        followers = {c.follower for c in self.couplings}
+        return tuple(j for j in self.movable_joints if j.name not in followers)
+
     @property
     def joint_names(self) -> tuple[str, ...]:
-        return tuple(j.name for j in self.movable_joints)
+        """``JOINT_NAMES``: the coordinates' joints (:attr:`coordinate_joints`)."""
+        return tuple(j.name for j in self.coordinate_joints)
 
     @property
     def dof(self) -> int:
-        """The number of velocity coordinates (NV): one per movable joint."""
-        return len(self.movable_joints)
+        """The number of velocity coordinates (NV): one per movable joint that follows no
+        other (:attr:`couplings`)."""
+        return len(self.coordinate_joints)
 
     @cached_property
     def quaternion_joints(self) -> tuple[QuaternionJoint, ...]:
@@ -243,19 +256,25 @@ def joint_motion(joint: Joint, value) -> Transform:
 def lock_joints(model: RobotModel, positions: Mapping[str, object]) -> RobotModel:
     """A copy of ``model`` with the named movable joints made fixed at the given positions.
 
+    A follower of a coupling (:attr:`RobotModel.couplings`) whose leaders are all locked is
+    locked where its coupling puts it; locked leaders of a coupling that keeps others move its
+    offset (:func:`eomgen.model.coupling.locked_couplings`).
+
     Raises
     ------
     KinematicTreeError
-        When a name is not a movable joint of the model.
+        When a name is not a movable joint of the model, or a coupled joint is locked against
+        its coupling.
     """
     movable = {j.name for j in model.movable_joints}
     for name in positions:
         if name not in movable:
             raise KinematicTreeError(model.source, f"joint '{name}'",
                                    "cannot lock: not a movable joint of this model")
+    positions, couplings = locked_couplings(model, positions)
     joints = tuple(
         replace(j, type=JointType.FIXED, origin=j.origin @ joint_motion(j, positions[j.name]))
         if j.name in positions else j
         for j in model.joints
     )
-    return replace(model, joints=joints)
+    return replace(model, joints=joints, couplings=couplings)

@@ -49,6 +49,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
+from ..errors import UnsupportedError
 from ..model import JointType, RobotModel, parameter_symbol
 
 #: Joint type codes stored in :attr:`NumericModel.joint_type`.
@@ -239,9 +240,16 @@ def numeric_model(model: RobotModel, values: Mapping | None = None,
     ------
     eomgen.DescriptionError
         When a parameter has neither a default nor a given value.
+    eomgen.UnsupportedError
+        For a model with coupled joints (its coordinates are not one per body): build it of
+        ``eomgen.model.uncoupled(model)`` and map with ``eomgen.model.coupling_map``.
     ValueError
         When a quantity is still not a real number after substitution.
     """
+    if model.couplings:
+        raise UnsupportedError(model.source, "couplings", "the float recursions take every "
+                               "movable joint as a coordinate: lock the coupled joints with a "
+                               "scene, or load with couplings=False (eomgen.model.uncoupled)")
     values = {
         (parameter_symbol(k) if isinstance(k, str) else k): v for k, v in (values or {}).items()
     }

@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Callable
 
 from ..errors import TooLargeError, UnknownFormatError, UnreadableFileError
-from ..model import RobotModel, snapping
+from ..model import Notice, NoticeKind, RobotModel, emit_notices, snapping, uncoupled
 
 #: ``load(path, strict, defer_notices=False)``.
 Loader = Callable[..., RobotModel]
@@ -45,7 +45,7 @@ MAX_FILE_BYTES = 50 * 1024 * 1024
 
 
 def load(path, strict: bool = False, defer_notices: bool = False,
-         snap: bool = True) -> RobotModel:
+         snap: bool = True, couplings: bool = True) -> RobotModel:
     """Read a robot description: URDF (``.urdf``), DH table (``.yaml`` with ``dh:``) or eomgen
     YAML (``.yaml`` with ``links:``/``joints:``).
 
@@ -55,8 +55,8 @@ def load(path, strict: bool = False, defer_notices: bool = False,
         The description file.
     strict:
         Refuse (rather than warn about) inertias that break the triangle inequality and
-        features read in a simpler way than described (URDF ``<mimic>`` joints, a URDF root
-        that looks like a floating base).
+        features read in a simpler way than described (a URDF root that looks like a floating
+        base; followers read as independent joints with ``couplings=False``).
     defer_notices:
         Neither warn nor refuse yet: record these findings in the model's ``notices``
         (:class:`~eomgen.model.Notice`) for the caller to emit once it knows which still
@@ -67,6 +67,10 @@ def load(path, strict: bool = False, defer_notices: bool = False,
         exactly. The entries snapped are listed in ``model.info`` under ``"snapped"``
         (:class:`~eomgen.model.Snap`: what, value, target; see
         :func:`~eomgen.model.snap_summary`).
+    couplings:
+        Honour the description's coupled joints (URDF ``<mimic>``: the follower is no
+        coordinate, :mod:`eomgen.model.coupling`). ``False`` reads every follower as an
+        independent joint, with one notice (a warning) per follower saying so.
 
     Raises
     ------
@@ -109,4 +113,23 @@ def load(path, strict: bool = False, defer_notices: bool = False,
         model = candidates[0].load(path, strict, defer_notices=defer_notices)
     if snaps:
         model = replace(model, info=model.info + (("snapped", tuple(snaps)),))
+    if not couplings and model.couplings:
+        model = independent_followers(model, strict, defer_notices)
     return model
+
+
+def independent_followers(model: RobotModel, strict: bool = False,
+                          defer_notices: bool = False) -> RobotModel:
+    """``model`` with its followers read as independent joints, one
+    :attr:`~eomgen.model.NoticeKind.MIMIC` notice per follower (warned, refused under
+    ``strict``, or kept in ``model.notices`` with ``defer_notices``)."""
+    found = tuple(
+        Notice(NoticeKind.MIMIC, model.source, c.where,
+               f"the coupling to joint{'s' if len(c.leaders) > 1 else ''} "
+               + ", ".join(f"'{name}'" for name, _ in c.leaders) + " is not modelled",
+               "read as an independent joint (couplings=False)",
+               joints=(c.follower,) + tuple(name for name, _ in c.leaders))
+        for c in model.couplings)
+    if not defer_notices:
+        emit_notices(found, strict)
+    return replace(uncoupled(model), notices=model.notices + found)

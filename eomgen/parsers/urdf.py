@@ -45,16 +45,17 @@ Decisions
   :class:`~eomgen.errors.UnsupportedError`. A ``world`` root link (the ROS convention for a
   model bolted to the world) or a scene with ``fixed_base: true`` says the fixed base is
   meant.
-* A joint with ``<mimic joint="...">`` is read as an ordinary independent joint with its own
-  coordinate, as Pinocchio's ``buildModelFromUrdf`` does by default, so that descriptions such
-  as the Franka Panda and Talos (gripper fingers coupled by ``<mimic>``) load unchanged. The
-  coupling ``q = multiplier · q_other + offset`` is *not* modelled: each such joint issues one
-  :class:`~eomgen.errors.UnsupportedFeatureWarning` naming the file and the joint, and
-  ``strict=True`` raises :class:`~eomgen.errors.UnsupportedError` instead. To remove the extra
-  coordinates, lock the joints (a scene's ``locked``: the warning is then left out). The
-  ``joint`` attribute is required (as urdfdom requires it) and must name a joint of the file;
-  ``multiplier`` and ``offset`` are not read. A ``<mimic>`` on a *fixed* joint (Talos'
-  reduced models) couples nothing and is ignored without a warning.
+* A joint with ``<mimic joint="..." multiplier="k" offset="c">`` follows the joint it names:
+  ``q = k · q_other + c`` (``k`` 1 and ``c`` 0 when left out), a coupling of the model
+  (:mod:`eomgen.model.coupling`); the follower is no coordinate (it leaves ``joint_names``),
+  and the dynamics are those of the independent joints, as Pinocchio's
+  ``buildModelFromUrdf(path, mimic=True)`` builds them. ``eomgen.load(path, couplings=False)``
+  reads followers as independent joints instead (eomgen before 0.x, Pinocchio's default),
+  with one :class:`~eomgen.errors.UnsupportedFeatureWarning` per follower (an error under
+  ``strict``). The ``joint`` attribute is required (as urdfdom requires it) and must name a
+  movable joint of the file; a follower that another joint mimics, or a cycle of mimics, is
+  refused (:class:`~eomgen.errors.KinematicTreeError`). A ``<mimic>`` on a *fixed* joint
+  (Talos' reduced models) couples nothing and is ignored.
 * Numbers are plain decimal numbers read with :func:`float` (URDF has no expressions); they
   must be finite. Exact integers stay exact (see :func:`eomgen.model.scalar`).
 * A singleton element (``<inertial>``, ``<origin>``, ``<axis>``, ...) given twice is an error
@@ -111,6 +112,9 @@ from ..model import (
     Transform,
     build_model,
     check_size,
+    Coupling,
+    make_coupling,
+    with_couplings,
     emit_notices,
     mat3,
     rotation_from_rpy,
@@ -141,8 +145,8 @@ def load_urdf(path: Path, strict: bool = False, defer_notices: bool = False) -> 
     path:
         The ``.urdf`` file.
     strict:
-        Refuse (rather than warn about) inertias that break the triangle inequality,
-        ``<mimic>`` joints and a root that looks like a floating base.
+        Refuse (rather than warn about) inertias that break the triangle inequality and a
+        root that looks like a floating base.
     defer_notices:
         Neither warn nor refuse: record these findings in ``RobotModel.notices`` (see
         :func:`eomgen.parsers.load`).
@@ -160,14 +164,13 @@ def load_urdf(path: Path, strict: bool = False, defer_notices: bool = False) -> 
         :class:`~eomgen.errors.SchemaError`, :class:`~eomgen.errors.InvalidNumberError`, and
         those of :func:`eomgen.model.build_model`).
     UnsupportedError
-        For floating and planar joints, and under ``strict`` for mimic joints and a root that
-        looks like a floating base.
+        For floating and planar joints, and under ``strict`` for a root that looks like a
+        floating base.
 
     Warns
     -----
     UnsupportedFeatureWarning
-        For each ``<mimic>`` joint (read as an independent joint) and for a root link that
-        looks like a floating base (:func:`floating_base_notice`; read as fixed), unless
+        For a root link that looks like a floating base (:func:`floating_base_notice`; read as fixed), unless
         ``strict``.
     PhysicalConsistencyWarning
         For inertias that break the triangle inequality, unless ``strict``.
@@ -215,27 +218,19 @@ def _read_robot(data: str | bytes, source: str, strict: bool, defer_notices: boo
         if element.get("type") == "floating":
             free_flyer = _read_floating_joint(element, index, source, root, free_flyer)
             continue
-        joint, mimicked = _read_joint(element, index, source)
+        joint, mimic = _read_joint(element, index, source)
         joints.append(joint)
-        if mimicked is not None and joint.type.is_movable:  # a fixed joint has nothing to couple
-            mimics.append((joint.name, mimicked))
+        if mimic is not None and joint.type.is_movable:  # a fixed joint has nothing to couple
+            mimics.append(mimic)
     if free_flyer is not None:  # the massless root the floating joint hangs from goes
         links = [link for link in links if link.name != free_flyer.parent]
     model = build_model(source, name, links, joints, gravity=GRAVITY, defer_notices=True)
     if free_flyer is not None:
         model = add_free_flyer(model, free_flyer.origin)
-    names = {joint.name for joint in joints}
-    for joint_name, mimicked in mimics:
-        if mimicked not in names:
-            raise KinematicTreeError(source, f"joint '{joint_name}' <mimic>",
-                                   f"joint '{mimicked}' is not defined")
+    model = with_couplings(model, mimics)
     # only once the file is known to be valid: the whole model first, then links, then joints
     floating = floating_base_notice(model)
-    notices = ([floating] if floating is not None else []) + list(model.notices) + [
-        Notice(NoticeKind.MIMIC, source, f"joint '{joint_name}' <mimic>",
-               f"the coupling to joint '{mimicked}' is not modelled",
-               "read as an independent joint", joints=(joint_name, mimicked))
-        for joint_name, mimicked in mimics]
+    notices = ([floating] if floating is not None else []) + list(model.notices)
     model = replace(model, notices=tuple(notices))
     if not defer_notices:
         emit_notices(model.notices, strict)
@@ -521,17 +516,21 @@ def rotate_inertia(inertia: list[list[float]], rpy: Iterable[float]) -> Mat3:
 # Joints
 # ----------------------------------------------------------------------------------------------
 
-def _read_joint(element: ET.Element, index: int, source: str) -> tuple[Joint, str | None]:
-    """The joint, and the name of the joint it mimics (None without ``<mimic>``)."""
+def _read_joint(element: ET.Element, index: int, source: str) -> tuple[Joint, Coupling | None]:
+    """The joint, and its coupling to the joint it mimics (None without ``<mimic>``)."""
     name = _required_name(element, source, f"<joint> number {index}")
     where = f"joint '{name}'"
     joint_type = _read_joint_type(element, source, where)
-    mimic = _single_child(element, "mimic", source, where)
-    mimicked = None
-    if mimic is not None:
-        mimicked = mimic.get("joint")
+    element_mimic = _single_child(element, "mimic", source, where)
+    mimic = None
+    if element_mimic is not None:
+        mimicked = element_mimic.get("joint")
         if not mimicked:
             raise SchemaError(source, f"{where} <mimic>", "no 'joint' attribute")
+        ratio, offset = (_number_attribute(element_mimic, key, source, f"{where} <mimic>")
+                         if element_mimic.get(key) is not None else default
+                         for key, default in (("multiplier", 1), ("offset", 0)))
+        mimic = make_coupling(name, {mimicked: ratio}, offset, f"{where} <mimic>")
     parent = _link_reference(element, "parent", source, where)
     child = _link_reference(element, "child", source, where)
     xyz, rpy = _read_origin(_single_child(element, "origin", source, where), source,
@@ -545,7 +544,7 @@ def _read_joint(element: ET.Element, index: int, source: str) -> tuple[Joint, st
     if joint_type.is_movable and dynamics is not None:
         actuator = _read_dynamics(dynamics, source, f"{where} <dynamics>")
     return (Joint(name, joint_type, parent, child, Transform.from_xyz_rpy(xyz, rpy), vec3(axis),
-                  actuator), mimicked)
+                  actuator), mimic)
 
 
 def _read_floating_joint(element: ET.Element, index: int, source: str, document: ET.Element,

@@ -26,7 +26,9 @@ from ..model import (
     lock_joints,
     scalar,
     vec3,
+    with_couplings,
 )
+from ..model.coupling import locked_couplings
 from ..outputs import select
 from ..parsers import load
 from ..scene import Payload, Scene, did_you_mean, scene_error
@@ -80,11 +82,13 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
                      f"{', '.join(EULER_JOINTS)} (position, ZYX Euler angles) from the fixed "
                      f"link '{model.root}' (see eomgen.floating)")
     _check_names(model, scene, payloads)
+    model = _with_scene_couplings(model, scene)
     base = scene.base or model.root
     moving = _moving_joints(model, scene, base)
     listed = scene.locked_positions
     locks = [LockedJoint(j.name, float(listed.get(j.name, 0.0)), j.name in listed)
              for j in model.movable_joints if j.name not in moving]
+    locks = _coupled_locks(model, locks)
     locked_model = lock_joints(model, {j.name: j.position for j in locks})
     reduced, merged, dropped, dropped_payloads = _merge(locked_model, payloads)
     gravity = model.gravity if scene_gravity is None else scene_gravity
@@ -128,6 +132,35 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
         virtual_joints=(VELOCITY_NAMES if scene.floating_base == "quaternion" else
                         EULER_JOINTS if scene.floating_base else ()))
     return Reduction(reduced, report)
+
+
+def _coupled_locks(model: RobotModel, locks: list[LockedJoint]) -> list[LockedJoint]:
+    """``locks`` with each follower the scene does not list (:attr:`RobotModel.couplings`) at
+    the position its locked leaders give it, or left moving with a leader that moves."""
+    if not model.couplings:
+        return locks
+    followers = {c.follower for c in model.couplings}
+    given = {j.name: j.position for j in locks if j.listed or j.name not in followers}
+    positions, _ = locked_couplings(model, given)
+    return [replace(j, position=float(positions[j.name])) for j in locks
+            if j.name in positions]
+
+
+def _with_scene_couplings(model: RobotModel, scene: Scene) -> RobotModel:
+    """``model`` with the scene's ``couplings`` added (:mod:`eomgen.model.coupling`); errors
+    name the scene file and the entry, and a coupling of a joint the scene locks is refused."""
+    if not scene.couplings:
+        return model
+    locked = scene.locked_positions
+    for coupling in scene.couplings:
+        for name in [coupling.follower] + [n for n, _ in coupling.leaders]:
+            if name in locked:
+                raise scene.error(coupling.where, f"joint '{name}' is locked by the scene: "
+                                  "a locked joint cannot be coupled")
+    try:
+        return with_couplings(model, model.couplings + scene.couplings)
+    except DescriptionError as exc:
+        raise scene_error(type(exc))(scene.source, exc.element, exc.problem) from None
 
 
 def _float(model: RobotModel, scene: Scene, add) -> RobotModel:
@@ -206,7 +239,7 @@ def load_for_scene(path, scene: Scene | None = None, strict: bool = False,
 
     The findings that warn (:class:`~eomgen.model.Notice`: a ``<mimic>`` joint, an inertia
     that breaks the triangle inequality, a root that looks like a floating base) are emitted
-    once the scene is applied, for what remains: a mimic finger the scene locks, a link it
+    once the scene is applied, for what remains: a follower the scene locks, a link it
     drops, a floating base it declares fixed (``fixed_base: true``) say nothing.
 
     Parameters
@@ -442,7 +475,7 @@ def _merge(model: RobotModel, payloads: Sequence[Payload]):
     reduced = RobotModel(name=model.name, links=tuple(links), joints=tuple(joints),
                          root=model.root, gravity=model.gravity, parameters=model.parameters,
                          source=model.source, info=info, free_flyer=model.free_flyer,
-                         ball_joints=model.ball_joints)
+                         ball_joints=model.ball_joints, couplings=model.couplings)
     return reduced, tuple(merged), tuple(dropped), tuple(dropped_payloads)
 
 

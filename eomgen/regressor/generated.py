@@ -212,9 +212,10 @@ def parameter_names(dynamics) -> dict[str, tuple[str, ...]]:
     """``PARAMETER_NAMES``: the columns of the generated regressor (module constant)."""
     model = dynamics.model
     terms = declared_actuator_terms(model)
-    names = [f"{name}{k + 1}" for k in range(model.dof) for name in INERTIAL_NAMES]
+    bodies = len(model.movable_joints)  # one per movable joint, coupled followers included
+    names = [f"{name}{k + 1}" for k in range(bodies) for name in INERTIAL_NAMES]
     for term in terms:
-        names += [f"{ACTUATOR_NAMES[term]}{k + 1}" for k in range(model.dof)]
+        names += [f"{ACTUATOR_NAMES[term]}{k + 1}" for k in range(bodies)]
     return {"PARAMETER_NAMES": tuple(names)}
 
 

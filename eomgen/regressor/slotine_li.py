@@ -22,7 +22,8 @@ def build_slotine_li(derivation, wanted) -> dict:
     the actuator columns the model declares (:func:`declared_actuator_terms`)."""
     model = derivation.model
     Y = slotine_li_program(derivation.tree, derivation.q, derivation.qd,
-                           derivation.inputs["qd_r"], derivation.inputs["qdd_r"], model.gravity,
+                           derivation.tangent(derivation.inputs["qd_r"]),
+                           derivation.tangent(derivation.inputs["qdd_r"]), model.gravity,
                            derivation.builder, declared_actuator_terms(model))
     out: dict[str, sp.Matrix] = {}
     if "Y_SL" in wanted:

@@ -24,7 +24,9 @@ import sympy as sp
 
 from ..bodies import BodyTree, body_tree
 from ..model import RobotModel
+from ..errors import UnsupportedError
 from ..outputs import BY_SYMBOL, INPUTS, input_size
+from .couplings import coupled_inputs, project, refused
 from .quaternion_joints import chart_accelerations, coordinates, placements
 from .program import Program, ProgramBuilder
 
@@ -58,6 +60,12 @@ class Derivation:
     #: held at zero, the pose from its quaternion placed above them
     #: (:mod:`eomgen.symbolic.quaternion_joints`).
     coordinates: tuple | None = None
+    #: For a model with coupled joints (:mod:`eomgen.symbolic.couplings`): ``T`` of
+    #: ``q_full = T q + c`` and the full velocities ``T q̇``; :attr:`model` is then the
+    #: whole tree (every movable joint a coordinate) and :meth:`program` projects each output
+    #: to the independent coordinates.
+    coupling: sp.Matrix | None = None
+    velocities: tuple | None = None
 
     @property
     def q(self) -> tuple:
@@ -66,8 +74,10 @@ class Derivation:
         return self.inputs["q"] if self.coordinates is None else self.coordinates
 
     @property
-    def qd(self) -> tuple[sp.Symbol, ...]:
-        return self.inputs["qd"]
+    def qd(self) -> tuple:
+        """The joint velocities the algorithms use (NV): the ``qd`` input, or with coupled
+        joints the full velocities ``T q̇`` (:attr:`coupling`)."""
+        return self.inputs["qd"] if self.velocities is None else self.velocities
 
     @property
     def qdd(self) -> tuple:
@@ -77,10 +87,21 @@ class Derivation:
 
     def accelerations(self, qdd) -> tuple:
         """The accelerations an algorithm must be given for the true accelerations ``qdd``
-        (with velocities ``qd``): ``qdd`` itself, or with quaternion joints the chart's."""
+        (with velocities ``qd``): ``qdd`` itself, or with quaternion joints the chart's; with coupled
+        joints, independent accelerations (``len(qdd)`` the ``qdd`` input's) become the full
+        ``T q̈``."""
+        if self.coupling is not None and len(qdd) == self.coupling.cols:
+            return tuple(self.coupling * sp.Matrix(qdd))
         if not self.model.quaternion_joints:
             return tuple(qdd)
         return chart_accelerations(self.model.quaternion_joints, self.qd, qdd)
+
+    def tangent(self, vector) -> tuple:
+        """A velocity-like input vector (``qd_r``, ``qdd_r``) as the algorithms take it: itself,
+        or with coupled joints the whole tree's ``T x``."""
+        if self.coupling is None:
+            return tuple(vector)
+        return tuple(self.coupling * sp.Matrix(vector))
 
     @property
     def tau(self) -> tuple[sp.Symbol, ...]:
@@ -117,9 +138,19 @@ class Derivation:
 
     def program(self, outputs: Iterable[tuple[str, sp.Matrix]]) -> Program:
         """The straight-line program of ``outputs`` (``(name, matrix)`` pairs, in order): the
-        builder's intermediates, pruned to those the outputs need."""
+        builder's intermediates, pruned to those the outputs need. With coupled joints each
+        registered output is first projected to the independent coordinates
+        (:func:`eomgen.symbolic.couplings.project`); another name is refused."""
         outputs = tuple(outputs)
+        if self.coupling is not None:
+            outputs = tuple((name, self._projected(name, matrix)) for name, matrix in outputs)
         return Program(tuple(self.builder.assignments), outputs).pruned([n for n, _ in outputs])
+
+    def _projected(self, name: str, matrix: sp.Matrix) -> sp.Matrix:
+        if refused([name]):
+            raise UnsupportedError(self.model.source, f"output {name}", "not derived for a "
+                                   "model with coupled joints (eomgen.symbolic.couplings)")
+        return project(name, sp.Matrix(matrix), self.coupling)
 
 
 def new_derivation(model: RobotModel, inputs: Iterable[str] | None = None) -> Derivation:
@@ -147,6 +178,14 @@ def new_derivation(model: RobotModel, inputs: Iterable[str] | None = None) -> De
     for name in ("q", "qd", "qdd"):
         symbols.setdefault(name, vector_symbols(name, input_size(name, model)))
     ordered = {name: symbols[name] for name in INPUTS if name in symbols}
+    if model.couplings:
+        if model.quaternion_joints:
+            raise UnsupportedError(model.source, "couplings", "coupled joints on a model "
+                                   "with a quaternion free flyer or ball joint are not derived "
+                                   "yet")
+        full, T, q_full, qd_full = coupled_inputs(model, ordered["q"], ordered["qd"])
+        return Derivation(full, body_tree(full), ordered, ProgramBuilder(reserved),
+                          coordinates=q_full, coupling=T, velocities=qd_full)
     builder, tree = ProgramBuilder(reserved), body_tree(model)
     joints = model.quaternion_joints
     if not joints:

@@ -117,7 +117,7 @@ def test_mass_matrix_bias_and_damping_match_mujoco(robot, scene_head):
     urdf = robots / robot
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the Panda's mimic fingers: independent in both
-        model = eomgen.load(urdf)
+        model = eomgen.load(urdf, couplings=False)
     names = model.joint_names
     rng = np.random.default_rng(7)
     armature = {n: float(v) for n, v in zip(names, rng.uniform(0.05, 0.5, len(names)))}
@@ -159,7 +159,7 @@ def test_mujoco_reads_the_same_urdf_damping_as_eomgen():
     urdf = robots / "panda_description/urdf/panda.urdf"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        model = eomgen.load(urdf)
+        model = eomgen.load(urdf, couplings=False)  # MuJoCo reads every joint
     mujoco, m = _mujoco_model(urdf, {}, {})
     ours = [float(j.actuator.damping) if j.actuator else 0.0 for j in model.movable_joints]
     theirs = [float(m.dof_damping[m.joint(n).dofadr[0]]) for n in model.joint_names]

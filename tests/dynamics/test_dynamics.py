@@ -242,7 +242,7 @@ def erd_path(name: str) -> Path:
 def erd_model(name: str) -> RobotModel:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UnsupportedFeatureWarning)  # Panda's finger <mimic>
-        return eomgen.load(erd_path(name))
+        return eomgen.load(erd_path(name), couplings=False)  # as Pinocchio's default
 
 
 @functools.cache

@@ -461,7 +461,7 @@ def test_example_robot_data(robot, erd_robots_dir):
     with warnings.catch_warnings():
         # Panda's second finger <mimic>s the first: both tools read it as an independent joint
         warnings.simplefilter("ignore", UnsupportedFeatureWarning)
-        model = eomgen.load(path)
+        model = eomgen.load(path, couplings=False)
     nm = numeric_model(model)
     pmodel = pin.buildModelFromUrdf(str(path))
     pmodel.gravity = pin.Motion(nm.gravity.copy(), np.zeros(3))
@@ -491,7 +491,7 @@ def test_one_rnea_in_float64_and_mpmath(robot, erd_robots_dir):
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UnsupportedFeatureWarning)
-        model = eomgen.load(erd_robots_dir / ERD_ROBOTS[robot])
+        model = eomgen.load(erd_robots_dir / ERD_ROBOTS[robot], couplings=False)
     nm = numeric_model(model)
     mm = numeric_model(model, numbers=MPMATH)
     assert mm.mass.dtype == object and isinstance(mm.mass[1], mpmath.mpf)

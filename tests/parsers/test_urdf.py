@@ -169,11 +169,12 @@ def document_joint_order(path: Path) -> list[str]:
 # ----------------------------------------------------------------------------------------------
 
 def load_expecting_mimic_warnings(path: Path, has_mimic: bool) -> RobotModel:
-    """``eomgen.load(path)``, checking that mimic warnings come exactly when the file has
-    mimics (a humanoid's floating-base warning is tested on its own)."""
+    """``eomgen.load(path, couplings=False)`` (every joint a coordinate, as Pinocchio's
+    default ``buildModelFromUrdf``), checking that mimic warnings come exactly when the file
+    has mimics (a humanoid's floating-base warning is tested on its own)."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        model = eomgen.load(path)
+        model = eomgen.load(path, couplings=False)
     mimics = [w for w in caught if issubclass(w.category, UnsupportedFeatureWarning)
               and "<mimic>" in str(w.message)]
     assert bool(mimics) == has_mimic, [str(w.message) for w in caught]
@@ -209,16 +210,16 @@ MIMICS = [
 @pytest.mark.parametrize("relative, joint, mimicked", MIMICS, ids=["panda", "talos"])
 def test_mimic_joints_are_independent_with_a_warning(erd_robots_dir, pin, relative, joint,
                                                      mimicked):
-    """By default a mimic joint is an ordinary joint (as in Pinocchio) and each one warns, on
-    one line naming the file and the joint."""
+    """With couplings=False a mimic joint is an ordinary joint (as in Pinocchio's default)
+    and each one warns, on one line naming the file and the joint."""
     path = erd_robots_dir / relative
     with pytest.warns(UnsupportedFeatureWarning) as record:
-        model = eomgen.load(path)
+        model = eomgen.load(path, couplings=False)
     messages = [str(w.message) for w in record
                 if issubclass(w.category, UnsupportedFeatureWarning)
                 and "root link" not in str(w.message)]  # Talos' floating base: tested below
     expected = (f"{path}: joint '{joint}' <mimic>: the coupling to joint '{mimicked}' is not "
-                "modelled; read as an independent joint")
+                "modelled; read as an independent joint (couplings=False)")
     assert expected in messages
     assert all(len(m.splitlines()) == 1 and m.startswith(f"{path}: joint '") for m in messages)
     mimic_joints = [j.get("name") for j in ET.parse(path).getroot().iter("joint")
@@ -229,16 +230,19 @@ def test_mimic_joints_are_independent_with_a_warning(erd_robots_dir, pin, relati
 
 
 @pytest.mark.parametrize("relative, joint, mimicked", MIMICS, ids=["panda", "talos"])
-def test_mimic_joints_are_refused_under_strict(erd_robots_dir, relative, joint, mimicked):
+def test_mimic_joints_are_honoured_by_default(erd_robots_dir, pin, relative, joint, mimicked):
+    """By default (even under strict) a mimic joint follows its leader: no coordinate, no
+    warning, the coordinates of Pinocchio's buildModelFromUrdf(path, mimic=True)."""
     path = erd_robots_dir / relative
     fixed = Scene(fixed_base=True)  # Talos' floating base, else refused first, is meant
     with warnings.catch_warnings():
         warnings.simplefilter("error", UnsupportedFeatureWarning)
-        with pytest.raises(UnsupportedError) as caught:
-            load_for_scene(path, fixed, strict=True)
-    message = str(caught.value)
-    assert message.startswith(f"{path}: joint '") and "<mimic>" in message
-    assert "refused under --strict" in message and len(message.splitlines()) == 1
+        model = load_for_scene(path, fixed, strict=True)
+    assert joint not in model.joint_names and mimicked in model.joint_names
+    followers = [j.get("name") for j in ET.parse(path).getroot().iter("joint")
+                 if j.find("mimic") is not None and j.get("type") != "fixed"]
+    assert model.dof == pin.buildModelFromUrdf(str(path)).nv - len(followers)
+    assert {c.follower for c in model.couplings} == set(followers)
 
 
 def test_robot_name_and_massless_links(erd_robots_dir):
@@ -350,27 +354,34 @@ MIMIC = robot(link("a"), link("b"), link("c"), joint("j1", "a", "b"),
               joint("j2", "a", "c", body='<axis xyz="0 1 0"/><mimic joint="j1" multiplier="2"/>'))
 
 
-def test_mimic_joint_is_read_as_an_ordinary_joint_with_a_warning():
-    with pytest.warns(UnsupportedFeatureWarning) as record:
-        model = parse_urdf_string(MIMIC, source="m.urdf")
-    assert [str(w.message) for w in record] == [
-        "m.urdf: joint 'j2' <mimic>: the coupling to joint 'j1' is not modelled; "
-        "read as an independent joint"]
-    assert model.joint_names == ("j1", "j2")
-    assert model.joints[1].axis == (0, 1, 0)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", UnsupportedFeatureWarning)
-        plain = parse_urdf_string(MIMIC.replace('<mimic joint="j1" multiplier="2"/>', ""),
-                                  source="m.urdf")
-    assert model == plain  # the mimic element changes nothing else
-
-
-def test_mimic_joint_is_refused_under_strict():
+def test_mimic_joint_is_a_coupling():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        with pytest.raises(UnsupportedError) as caught:
-            parse_urdf_string(MIMIC, source="m.urdf", strict=True)
-    assert str(caught.value) == ("m.urdf: joint 'j2' <mimic>: the coupling to joint 'j1' is "
+        model = parse_urdf_string(MIMIC, source="m.urdf", strict=True)
+    assert model.joint_names == ("j1",)
+    (coupling,) = model.couplings
+    assert (coupling.follower, coupling.leaders, coupling.offset) == ("j2", (("j1", 2),), 0)
+    assert coupling.where == "joint 'j2' <mimic>"
+    offset = parse_urdf_string(MIMIC.replace('multiplier="2"', 'offset="-0.25"'))
+    assert offset.couplings[0].leaders == (("j1", 1),) and float(offset.couplings[0].offset) == -0.25
+
+
+def test_mimic_joint_read_as_independent_warns_and_is_refused_under_strict(tmp_path):
+    path = tmp_path / "m.urdf"
+    path.write_text(MIMIC)
+    with pytest.warns(UnsupportedFeatureWarning) as record:
+        model = eomgen.load(path, couplings=False)
+    assert [str(w.message) for w in record] == [
+        f"{path}: joint 'j2' <mimic>: the coupling to joint 'j1' is not modelled; "
+        "read as an independent joint (couplings=False)"]
+    assert model.joint_names == ("j1", "j2")
+    assert model.joints[1].axis == (0, 1, 0)
+    plain = parse_urdf_string(MIMIC.replace('<mimic joint="j1" multiplier="2"/>', ""),
+                              source=str(path))
+    assert model == plain  # the mimic element changes nothing else
+    with pytest.raises(UnsupportedError) as caught:
+        eomgen.load(path, couplings=False, strict=True)
+    assert str(caught.value) == (f"{path}: joint 'j2' <mimic>: the coupling to joint 'j1' is "
                                  "not modelled (refused under --strict)")
 
 

@@ -42,7 +42,7 @@ def load(name: str):
         pytest.skip("example-robot-data is not installed")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UnsupportedFeatureWarning)  # Panda's finger <mimic>
-        return eomgen.load(robots / URDF[name])
+        return eomgen.load(robots / URDF[name], couplings=False)  # as Pinocchio's default
 
 
 @functools.cache

@@ -128,7 +128,7 @@ def load_urdf(relative: str):
         pytest.skip("example-robot-data is not installed")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UnsupportedFeatureWarning)  # Panda's finger <mimic>
-        return eomgen.load(robots / relative), robots / relative
+        return eomgen.load(robots / relative, couplings=False), robots / relative
 
 
 def test_ur5_regressor_is_pinocchios_column_by_column(tmp_path):

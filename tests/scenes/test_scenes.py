@@ -56,8 +56,8 @@ def erd_model(relative: str) -> RobotModel:
     if robots is None:
         pytest.skip("example-robot-data is not installed")
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # the Panda's mimic finger reads as independent
-        return eomgen.load(robots / relative)
+        warnings.simplefilter("ignore")  # the Panda's mimic finger read as independent
+        return eomgen.load(robots / relative, couplings=False)  # as Pinocchio's default
 
 
 def scene_text(text: str, name: str = "scene.yaml") -> Scene:
@@ -607,9 +607,13 @@ GRIPPER_ARM = "<robot name=\"gripper_arm\">" + "".join([
 
 
 def gripper_arm():
+    """The gripper arm with its follower finger read as independent (couplings=False), the
+    notice deferred."""
+    from eomgen.parsers import independent_followers
     from eomgen.parsers.urdf import parse_urdf_string
 
-    return parse_urdf_string(GRIPPER_ARM, source="gripper_arm.urdf", defer_notices=True)
+    model = parse_urdf_string(GRIPPER_ARM, source="gripper_arm.urdf", defer_notices=True)
+    return independent_followers(model, defer_notices=True)
 
 
 def kept(reduction: Reduction) -> list[str]:
@@ -690,7 +694,8 @@ def test_cli_warns_and_refuses_only_about_what_the_scene_keeps(tmp_path):
     common = ("--backend", "numpy", "--quiet")
     whole = run_process("generate", description, "-o", tmp_path / "a", *common)
     assert whole.returncode == 0, whole.stderr
-    assert len(warning_lines(whole.stderr)) == 4  # without a scene: everything, as before
+    assert len(warning_lines(whole.stderr)) == 3  # without a scene: everything (the mimic
+    # finger follows: no warning)
     locked = run_process("generate", description, "--scene", fingers, "-o", tmp_path / "b",
                          *common)
     assert locked.returncode == 0, locked.stderr
@@ -700,9 +705,10 @@ def test_cli_warns_and_refuses_only_about_what_the_scene_keeps(tmp_path):
     refused = run_process("generate", description, "--scene", one_finger, "-o", tmp_path / "c",
                           "--strict", *common)
     assert refused.returncode == 2 and not (tmp_path / "c").exists()
-    assert refused.stderr.splitlines() == [
-        f"eomgen: error: {description}: link 'sensor' inertial: principal moments 1, 1, 3 "
-        "break the triangle inequality (not a physical rigid body) (refused under --strict)"]
+    assert refused.stderr.splitlines() == [  # finger2 follows finger1, which moves
+        f"eomgen: error: {description}: joint 'finger_joint2': cannot lock a coupled joint "
+        "while its leader 'finger_joint1' moves (joint 'finger_joint2' <mimic>): lock the "
+        "leader"]
 
 
 def test_cli_floating_base_warns_is_refused_and_silenced_by_fixed_base(tmp_path):
@@ -754,8 +760,8 @@ def test_floating_base_counts_the_described_joints_and_the_virtual_ones_apart(tm
 
 @pytest.mark.slow
 def test_cli_panda_with_its_mimic_finger_locked_passes_strict(tmp_path):
-    """The issue's case: panda_fingers_locked.yaml locks the mimic finger, so neither the
-    warning nor --strict's refusal concerns what is generated."""
+    """The issue's case: panda_fingers_locked.yaml locks both fingers (finger2 <mimic>
+    finger1, at the position its coupling gives), nothing warns."""
     robots = erd_robots_dir()
     if robots is None:
         pytest.skip("example-robot-data is not installed")
@@ -765,5 +771,4 @@ def test_cli_panda_with_its_mimic_finger_locked_passes_strict(tmp_path):
     assert result.returncode == 0, result.stderr
     assert result.stderr == ""
     report = (tmp_path / "out" / "panda_scene_report.md").read_text(encoding="utf-8")
-    assert "warnings left out, about what the scene locks or drops (1): joint " \
-           "'panda_finger_joint2' <mimic>" in report
+    assert "<mimic>" not in report

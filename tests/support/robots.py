@@ -99,9 +99,10 @@ def panda() -> RobotModel:
     robots = erd_robots_or_skip()
     from eomgen.model import lock_joints
 
-    with pytest.warns(Warning):  # the <mimic> finger joint is read as independent
-        model = eomgen.load(robots / "panda_description" / "urdf" / "panda.urdf")
-    return lock_joints(model, {n: 0 for n in model.joint_names if "finger" in n})
+    model = eomgen.load(robots / "panda_description" / "urdf" / "panda.urdf")
+    locked = lock_joints(model, {n: 0 for n in model.joint_names if "finger" in n})
+    assert not locked.couplings  # finger_joint2 <mimic> finger_joint1: locked with its leader
+    return locked
 
 
 def ur5() -> RobotModel:

@@ -1,0 +1,96 @@
+"""The dynamics of a model with coupled joints, in its independent coordinates.
+
+A model with couplings (:mod:`eomgen.model.coupling`) is derived on its whole tree: the
+derivation's joint coordinates are ``q_full = T q + c``, its velocities ``T q̇`` and its
+accelerations ``T q̈`` (:func:`coupled_inputs`), so every algorithm runs unchanged in the full
+coordinates. Each output then goes through :func:`project`, the one place that turns a
+full-coordinate result into the independent coordinates, by what its rows and columns are
+(:data:`PROJECTIONS`):
+
+* rows that are joint efforts (τ, g, C q̇ + g, M's rows, Y's rows) are multiplied by ``Tᵀ``
+  (virtual work: ``δqᵀ_full τ = δqᵀ Tᵀ τ``);
+* columns that multiply joint velocities (M's, C's columns, Jacobians) by ``T``.
+
+So ``M_r = Tᵀ M T``, ``C_r = Tᵀ C(T q + c, T q̇) T`` (exactly the Christoffel C of the reduced
+Lagrangian: the symbols ``c_ijk`` are multilinear in the directions, and ``T`` is constant),
+``g_r = Tᵀ g``, ``τ_r = Tᵀ τ(T q + c, T q̇, T q̈)``, ``Y_r = Tᵀ Y``, ``J_r = J T``. Outputs
+absent from the table are refused under couplings (:func:`refused`): the ABA and its
+derivatives solve the unconstrained tree, the base regressor's columns are those of the
+uncoupled tree, the flexible joints' motor states are per joint. (Y_SL: its ``q̇_r``, ``q̈_r`` enter as
+``T q̇_r``, ``T q̈_r``, :meth:`~eomgen.symbolic.derivation.Derivation.tangent`.)
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from ..model import coupling_map, uncoupled
+from ..outputs import BY_SYMBOL, splits
+
+#: Per output symbol: ``(rows, columns)``, whether its rows are joint efforts (× Tᵀ) and its
+#: columns joint velocities (× T). Outputs not listed are refused under couplings.
+PROJECTIONS: dict[str, tuple[bool, bool]] = {
+    "M": (True, True), "C": (True, True), "g": (True, False), "P": (False, False),
+    "tau": (True, False), "h": (True, False),
+    "M_a": (True, True), "tau_f": (True, False), "tau_f_smooth": (True, False),
+    "tau_a": (True, False),
+    "Y": (True, False), "Y_SL": (True, False), "pi": (False, False), "Y_K": (False, False), "Y_P": (False, False),
+    "p_f": (False, False), "R_f": (False, False), "J_f": (False, True),
+    "Jb_f": (False, True), "dJqd_f": (False, False), "dJbqd_f": (False, False),
+    "J_c": (False, True), "dJqd_c": (False, False), "tau_c": (True, False),
+    "cone_c": (False, False), "pyramid_c": (False, False),
+    "c_G": (False, False), "J_G": (False, True), "A_G": (False, True), "dAGv": (False, False),
+    "I_G": (False, False),
+}
+
+#: Several-result outputs (:attr:`eomgen.outputs.Output.returns`) projected block by block.
+COMBINED = ("MCg", "Mh")
+
+
+def supported(symbol: str) -> bool:
+    """Whether output ``symbol`` is derived under couplings."""
+    if symbol in COMBINED:
+        return all(s in PROJECTIONS for s in BY_SYMBOL[symbol].returns)
+    return symbol in PROJECTIONS
+
+
+def refused(symbols) -> list[str]:
+    """The symbols of ``symbols`` not derived under couplings, sorted."""
+    return sorted(s for s in symbols if not supported(s))
+
+
+def coupled_inputs(model, q, qd):
+    """``(full model, T, q_full, qd_full)`` of a model with couplings and the symbols of its
+    independent ``q`` and ``qd``: the model the algorithms walk (every movable joint a
+    coordinate) and the full coordinates and velocities."""
+    T, c = coupling_map(model)
+    q_full = tuple(T * sp.Matrix(q) + c)
+    qd_full = tuple(T * sp.Matrix(qd))
+    return uncoupled(model), T, q_full, qd_full
+
+
+def project(symbol: str, matrix: sp.Matrix, T: sp.Matrix) -> sp.Matrix:
+    """Output ``symbol``'s full-coordinate ``matrix`` in the independent coordinates (see the
+    module docstring).
+
+    Raises
+    ------
+    KeyError
+        For a symbol not derived under couplings (callers check :func:`supported` first).
+    """
+    if symbol in COMBINED:
+        output = BY_SYMBOL[symbol]
+        blocks = []
+        for part, start, end in splits(output, T.rows):
+            block = matrix[:, start:start + 1] if end is None else matrix[:, start:end]
+            blocks.append(project(part, block, T))
+        return sp.Matrix.hstack(*blocks)
+    rows, columns = PROJECTIONS[symbol]
+    if rows:
+        matrix = T.T * matrix
+    if columns:
+        matrix = matrix * T
+    return matrix
+
+
+__all__ = ["COMBINED", "PROJECTIONS", "coupled_inputs", "project", "refused", "supported"]
