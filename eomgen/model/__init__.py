@@ -41,6 +41,7 @@ from .checks import (
     check_tree,
 )
 from .contact import POINT, SURFACE, Contact
+from .loop import HINGE, LOOP_KINDS, POINT_LOOP, WELD, Loop, LoopFrame
 from .notices import Notice, NoticeKind, emit_notices
 from .parts import Inertial, Joint, JointType, Link, Parameter
 from .robot import (
@@ -59,6 +60,7 @@ from .snapping import SNAP_TOLERANCE, Snap, snap, snap_summary, snapping
 from .transforms import Transform, rotation_about_axis, rotation_from_rpy
 
 __all__ = [
+    "HINGE", "LOOP_KINDS", "POINT_LOOP", "WELD", "Loop", "LoopFrame",
     "DEFAULT_FRICTION_WIDTH", "FREE_FLYER_CONFIGURATION", "FREE_FLYER_VELOCITY", "IDENTITY3", "MAX_JOINTS", "POINT", "SNAP_TOLERANCE", "SURFACE",
     "ZERO3", "Actuator", "Contact", "Inertial", "Joint", "JointType", "Link", "Mat3", "Notice",
     "NoticeKind", "Parameter", "RobotModel", "Scalar", "Snap", "Transform", "Vec3",
