@@ -197,4 +197,38 @@ class LoopDynamics:
                             "steps (actuated joints out of reach, or a singular configuration)")
 
 
-__all__ = ["RANK_TOLERANCE", "AssemblyError", "LoopDynamics", "kkt_solve"]
+__all__ = ["RANK_TOLERANCE", "AssemblyError", "LoopDynamics", "kkt_solve", "pinocchio_loops"]
+
+
+def pinocchio_loops(model: RobotModel, pm, reference=None):
+    """Pinocchio's ``RigidConstraintModel`` of each loop of ``model`` between the Pinocchio
+    joints of its two frames (``pm``: :func:`eomgen.numeric.pinocchio.to_pinocchio` of
+    ``model``): ``CONTACT_3D`` for a point loop (a planar one too: its third row is then
+    dependent), ``CONTACT_6D`` for a weld, joint 1 the loop's frame a, joint 2 its frame b,
+    placements the frames in the joints' frames, in ``reference`` (default ``LOCAL``: the
+    forces in frame a's axes).
+
+    Raises
+    ------
+    ValueError
+        For a hinge loop (Pinocchio has no 5-row constraint).
+    """
+    import pinocchio as pin  # optional dependency: imported when used
+
+    from ..symbolic.frames import frame_site  # the numeric layer reads the tree's frames
+
+    reference = pin.ReferenceFrame.LOCAL if reference is None else reference
+    models = pin.StdVec_RigidConstraintModel()
+    for loop in model.loops:
+        if loop.kind == "hinge":
+            raise ValueError(f"loop '{loop.name}': Pinocchio has no hinge (5-row) constraint")
+        ends = []
+        for frame in (loop.a, loop.b):
+            body, pose = frame_site(model, frame.link)
+            T = pose @ frame.pose
+            joint = pm.model.getJointId(model.parent_joint[body].name) if body else 0
+            R = np.array([[float(x) for x in row] for row in T.rotation])
+            ends += [joint, pin.SE3(R, np.array([float(x) for x in T.translation]))]
+        kind = pin.ContactType.CONTACT_3D if loop.kind == "point" else pin.ContactType.CONTACT_6D
+        models.append(pin.RigidConstraintModel(kind, pm.model, *ends, reference))
+    return models

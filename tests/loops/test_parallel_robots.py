@@ -1,0 +1,122 @@
+"""The five-bar and the Delta robot (examples/robots/, closed by examples/loops/) against
+Pinocchio's ``constraintDynamics`` with loop ``RigidConstraintModel``s between two joints
+(``CONTACT_3D``, ``LOCAL``): q̈ and the loop forces within 1e-8 relative. Pinocchio's
+``lambda_c`` is the force on joint 1's side (the loop's frame a) in frame a's axes; eomgen's λ
+is the force on frame b in world axes: ``λ = −R_a λ_pin``.
+
+Also the parallel inverse dynamics (the actuated efforts and loop forces that give back a
+constrained motion), and contacts and loops in one KKT system (generated).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import eomgen
+from eomgen.loops import LoopDynamics
+from eomgen.reduction import apply_scene
+from eomgen.scene import load_scene
+from support import ROOT, relative
+
+ROBOTS = {"fivebar": ("fivebar_loop", [1.2, 1.0, 1.9, -1.0]),
+          "delta": ("delta_loops", [0.3, 2.13, 0.0] * 3 + [0.0, 0.0, -0.35])}
+
+
+def _model(robot: str, extra: str = ""):
+    scene, _ = ROBOTS[robot]
+    text = (ROOT / f"examples/loops/{scene}.yaml").read_text() + extra
+    return apply_scene(eomgen.load(ROOT / f"examples/robots/{robot}.yaml"),
+                       load_scene(f"{scene}.yaml", text=text)).model
+
+
+@pytest.fixture(scope="module", params=sorted(ROBOTS))
+def robot(request):
+    dyn = LoopDynamics(_model(request.param))
+    return request.param, dyn, dyn.assemble(ROBOTS[request.param][1])
+
+
+def _states(dyn, q0, count=2, seed=0):
+    """Closed configurations near ``q0`` (motors moved, passive joints by Newton), velocities in
+    the null space of J_l, random efforts."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for _ in range(count):
+        q = q0.copy()
+        q[dyn.actuated] += rng.uniform(-0.15, 0.15, len(dyn.actuated))
+        q = dyn.assemble(q)
+        J = dyn.loop_jacobian(q)
+        N = np.linalg.svd(J)[2][np.linalg.matrix_rank(J):].T
+        out.append((q, N @ rng.uniform(-1, 1, N.shape[1]), rng.uniform(-1, 1, len(q))))
+    return out
+
+
+def test_against_pinocchio_constraint_dynamics(robot):
+    pin = pytest.importorskip("pinocchio")
+    from eomgen.numeric.loops import pinocchio_loops
+    from eomgen.numeric.pinocchio import to_pinocchio
+
+    name, dyn, q0 = robot
+    pm = to_pinocchio(dyn.model)
+    p = pm.perm
+    models = pinocchio_loops(dyn.model, pm)
+    datas = pin.StdVec_RigidConstraintData([c.createData() for c in models])
+    pin.initConstraintDynamics(pm.model, pm.data, models, datas)
+    # mu = 0: the exact KKT system; the planar five-bar's third rows are dependent, so a
+    # proximal mu there (its iterations converge to the exact solution)
+    settings = pin.ProximalSettings(1e-14, 1e-12 if name == "fivebar" else 0.0, 100)
+    for q, qd, tau in _states(dyn, q0):
+        qdd, lam = dyn.constrained_forward_dynamics(q, qd, tau)
+        a = pin.constraintDynamics(pm.model, pm.data, q[p], qd[p], tau[p], models, datas,
+                                   settings)
+        qdd_pin = np.empty_like(qdd)
+        qdd_pin[p] = a
+        assert relative(qdd, qdd_pin) <= 1e-8, name
+        forces = []
+        for k, data in enumerate(datas):
+            f = -data.oMc1.rotation @ pm.data.lambda_c[3 * k:3 * k + 3]
+            forces.append(f[:2] if dyn.model.loops[k].plane is not None else f)
+        assert relative(lam, np.concatenate(forces)) <= 1e-8, name
+
+
+def test_parallel_inverse_dynamics_gives_back_the_motion(robot):
+    """With efforts on the actuated joints only, the constrained forward dynamics' q̈ fed to
+    the parallel inverse dynamics gives back those efforts and the same loop forces (the square
+    system [S^T J_l^T]: n_a + m_l = n for both robots)."""
+    name, dyn, q0 = robot
+    assert len(dyn.actuated) + dyn.loop_jacobian(q0).shape[0] == dyn.model.dof
+    for q, qd, tau in _states(dyn, q0, count=1, seed=1):
+        tau[dyn.passive] = 0.0
+        qdd, lam = dyn.constrained_forward_dynamics(q, qd, tau)
+        tau_a, lam_id = dyn.parallel_inverse_dynamics(q, qd, qdd)
+        assert relative(tau_a, tau[dyn.actuated]) <= 1e-9, name
+        assert relative(lam_id, lam) <= 1e-9, name
+
+
+def test_contacts_and_loops_in_one_kkt_system(tmp_path):
+    """The five-bar's elbows also held by point contacts (world rows x, y, z, of rank 1 each:
+    an elbow moves on a circle; the damped solve): the generated J_c stacks the contact rows
+    then the loop rows, and its KKT solution holds both (q̈ = 0: the 4 independent rows lock
+    the 4 joints) and matches the numeric one."""
+    from support.generated import generated
+
+    model = _model("fivebar", "contacts:\n  - {frame: left_distal, name: left}\n"
+                   "  - {frame: right_distal, name: right}\n")
+    dyn = LoopDynamics(model)
+    q = dyn.assemble(ROBOTS["fivebar"][1])
+    _, modules = generated(model, ["constrained_forward_dynamics"], tmp_path, ("numpy",))
+    module = modules["numpy"]
+    assert tuple(module["CONTACT_ROWS"]) == ("left.f_x", "left.f_y", "left.f_z", "right.f_x",
+                                             "right.f_y", "right.f_z", "effector.u",
+                                             "effector.v")
+    tau = np.array([0.3, 0.0, -0.2, 0.0])
+    qdd, F = module["constrained_forward_dynamics"](q, np.zeros(4), tau, damping=1e-12)
+    qdd_ref, F_ref = dyn.constrained_forward_dynamics(q, np.zeros(4), tau, damping=1e-12)
+    e = dyn.evaluate(q)
+    # an elbow contact's radial force is the pivot's (not unique): compare J_c^T F and the
+    # loop forces, which are
+    assert np.abs(qdd).max() < 1e-9 and relative(F[-2:], F_ref[-2:]) < 1e-8
+    assert relative(e["J_c"].T @ F, e["J_c"].T @ F_ref) < 1e-8
+    # statics: g = tau + J_c^T F
+    np.testing.assert_allclose(module["contact_jacobian"](q), e["J_c"], atol=1e-14)
+    assert np.abs(e["J_c"].T @ F + tau - e["h"]).max() < 1e-9
