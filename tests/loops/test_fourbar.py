@@ -172,3 +172,17 @@ def test_a_loop_on_one_rigid_body_is_refused():
     with pytest.raises(SceneError, match=r"actuated\[0\].*did you mean 'crank_joint'"):
         apply_scene(eomgen.load(ROBOT), load_scene("act.yaml", text=SCENE.read_text().replace(
             "actuated: [crank_joint]", "actuated: [crank_jiont]")))
+
+
+def test_documented_loop_errors_are_what_eomgen_prints():
+    text = (ROOT / "docs/scenes.md").read_text(encoding="utf-8")
+    documented = [line[len("eomgen: error: "):] for line in text.splitlines()
+                  if line.startswith("eomgen: error: fourbar_scene.yaml")]
+    scene = SCENE.read_text()
+    printed = []
+    for bad in (scene.replace("link: rocker", "link: coupler"),
+                scene.replace("actuated: [crank_joint]", "actuated: [crank_jiont]")):
+        with pytest.raises(SceneError) as caught:
+            apply_scene(eomgen.load(ROBOT), load_scene("fourbar_scene.yaml", text=bad))
+        printed.append(str(caught.value))
+    assert printed == documented
