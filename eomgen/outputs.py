@@ -458,6 +458,14 @@ CONSTRAINED_FORWARD = register_output(Output(
     composed_from=(MASS.function, INVERSE.function, CONTACT_JACOBIAN.function,
                    CONTACT_BIAS.function), default=False, constants=_CONTACT_NAMES))
 
+PARALLEL_INVERSE = register_output(Output(
+    "parallel_inverse_dynamics", None, "(tau, lambda) of a parallel robot: joint efforts zero "
+    "on the passive joints (ACTUATED_JOINTS carry them) and loop forces (LOOP_ROWS) with "
+    "M qdd + C qd + g = tau + J_l^T lambda, for a qdd consistent with the loops.",
+    ("q", "qd", "qdd"), True, "N m, N; N, N m", (INVERSE.symbol, "J_l"),
+    composed_from=(INVERSE.function, LOOP_JACOBIAN.function), default=False,
+    constants="eomgen.symbolic.loops:parallel_constants", backends=("numpy", "fast")))
+
 # Issue 28: the Slotine-Li regressor Y_SL(q, qd, qd_r, qdd_r) pi = M qdd_r + C(q, qd) qd_r + g
 # (C Christoffel) and its base columns, for adaptive control (docs/control.md).
 _SLOTINE_LI = "eomgen.regressor.slotine_li:build_slotine_li"
@@ -577,6 +585,13 @@ def constrained_names() -> dict[str, str]:
             "jacobian": jacobian, "drift": drift}
 
 
+def parallel_names() -> dict[str, str]:
+    """The names a template needs to compose ``parallel_inverse_dynamics``: ``name``,
+    ``inverse`` (tau) and ``jacobian`` (J_l)."""
+    inverse, jacobian = PARALLEL_INVERSE.composed_from
+    return {"name": PARALLEL_INVERSE.function, "inverse": inverse, "jacobian": jacobian}
+
+
 def derived_symbols(default_only: bool = False) -> tuple[str, ...]:
     """The symbols :func:`eomgen.derive` can build, in registry order (with ``default_only``,
     those of the outputs exported by default: ``("M", "C", "g", "tau")``)."""
@@ -638,4 +653,5 @@ def composition_names(output: Output = FORWARD) -> dict[str, str]:
 __all__ = ["INPUTS", "splits", "DYNAMICS", "MASS_AND_BIAS", "INPUT_SIZES", "input_size", "Output", "OUTPUTS", "resolve", "BY_SYMBOL", "register_output", "derived_symbols",
            "function_names", "select", "composition_names", "MASS", "CORIOLIS", "GRAVITY", "INVERSE",
            "FORWARD", "exported", "constrained_names", "CONSTRAINED_FORWARD",
+           "PARALLEL_INVERSE", "parallel_names",
            "TASK_SPACE", "task_space_names"]

@@ -85,6 +85,13 @@ def loop_constants(dynamics) -> dict[str, tuple[str, ...]]:
             "LOOP_ROWS": loop_rows(model)}
 
 
+def parallel_constants(dynamics) -> dict[str, tuple[str, ...]]:
+    """``ACTUATED_JOINTS`` (the scene's ``actuated:``, else every joint) and ``LOOP_ROWS``."""
+    model = dynamics.model
+    return {"ACTUATED_JOINTS": tuple(model.actuated or model.joint_names),
+            "LOOP_ROWS": loop_rows(model)}
+
+
 def constraint_constants(dynamics) -> dict[str, tuple[str, ...]]:
     """``CONTACT_NAMES`` and ``CONTACT_ROWS`` (:func:`constraint_rows`): contacts, then
     loops."""
@@ -223,4 +230,4 @@ def build_constraints(derivation, wanted) -> dict:
 
 
 __all__ = ["LOOP_SYMBOLS", "plane_axes", "loop_rows", "constraint_rows", "constraint_row_count",
-           "loop_constants", "constraint_constants", "loop_program", "build_constraints"]
+           "loop_constants", "parallel_constants", "constraint_constants", "loop_program", "build_constraints"]

@@ -120,3 +120,28 @@ def test_contacts_and_loops_in_one_kkt_system(tmp_path):
     # statics: g = tau + J_c^T F
     np.testing.assert_allclose(module["contact_jacobian"](q), e["J_c"], atol=1e-14)
     assert np.abs(e["J_c"].T @ F + tau - e["h"]).max() < 1e-9
+
+
+def test_generated_parallel_inverse_dynamics(tmp_path):
+    """The NumPy and fast modules' parallel_inverse_dynamics on the Delta: the efforts that
+    produced a constrained motion (zero on the passive joints) and its loop forces, one state
+    and a batch; the other backends leave it out (NumPy and C only)."""
+    from support.generated import generated
+
+    model = _model("delta")
+    dyn = LoopDynamics(model)
+    (q, qd, tau), = _states(dyn, dyn.assemble(ROBOTS["delta"][1]), count=1, seed=2)
+    tau[dyn.passive] = 0.0
+    qdd, lam = dyn.constrained_forward_dynamics(q, qd, tau)
+    _, modules = generated(model, ["parallel_inverse_dynamics"], tmp_path, ("numpy", "fast"))
+    if "fast" not in modules:
+        pytest.skip("no C compiler: the fast module was not built")
+    for backend, module in modules.items():
+        assert tuple(module["ACTUATED_JOINTS"]) == ("motor1", "motor2", "motor3")
+        f = module["parallel_inverse_dynamics"]
+        t, l = (np.asarray(x) for x in f(q, qd, qdd))
+        assert relative(t, tau) < 1e-9 and relative(l, lam) < 1e-9, backend
+        t2, l2 = f(np.array([q, q]), np.array([qd, qd]), np.array([qdd, qdd]))
+        assert np.allclose(t2[1], t) and np.allclose(l2[1], l), backend
+        with pytest.raises(FloatingPointError, match="not finite"), np.errstate(invalid="ignore"):
+            f(np.full(12, np.inf), qd, qdd)
