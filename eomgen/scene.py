@@ -399,14 +399,7 @@ def _contact(r: _SceneReader, entry, k: int) -> Contact:
     if entry.get("normal") is not None:
         if kind != POINT:
             raise r.error(f"{where} normal", "a surface contact's normal is its frame's z axis")
-        value = entry["normal"]
-        if not isinstance(value, list) or len(value) != 3:
-            raise r.error(f"{where} normal", "expected a list of 3 numbers [x, y, z]")
-        vector = [r.number(x, f"{where} normal[{i}]") for i, x in enumerate(value)]
-        norm = sum(x * x for x in vector) ** 0.5
-        if not norm > 0:
-            raise r.error(f"{where} normal", "the normal is zero")
-        normal = tuple(x / norm for x in vector)
+        normal = _unit(r, entry, "normal", where, "the normal is zero")
     return Contact(frame, kind, mu, gains["kp"], gains["kd"], normal, name)
 
 
@@ -436,14 +429,17 @@ def _loops(r: _SceneReader, value) -> tuple[Loop, ...]:
     return tuple(loops)
 
 
-def _unit(r: _SceneReader, entry: dict, key: str, where: str) -> tuple[float, float, float]:
+def _unit(r: _SceneReader, entry: dict, key: str, where: str,
+          zero: str = "the vector is zero") -> tuple[float, float, float]:
+    """``entry[key]``, a list of 3 numbers, made a unit vector (``zero``: the error when it is
+    zero)."""
     value = entry[key]
     if not isinstance(value, list) or len(value) != 3:
         raise r.error(f"{where} {key}", "expected a list of 3 numbers [x, y, z]")
     vector = [r.number(x, f"{where} {key}[{i}]") for i, x in enumerate(value)]
     norm = sum(x * x for x in vector) ** 0.5
     if not norm > 0:
-        raise r.error(f"{where} {key}", "the vector is zero")
+        raise r.error(f"{where} {key}", zero)
     return tuple(x / norm for x in vector)
 
 

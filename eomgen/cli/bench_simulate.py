@@ -245,7 +245,11 @@ def _simulate_loops(model, integrators, duration, start, velocity, gains, outdir
         study = run_loop_study(model, integrators, duration, start, velocity, gains,
                                progress=lambda name: steps.update(1, name))
     progress("writing the report")
-    paths = write_loop_outputs(study, outdir, f"simulate_{output_stem(model)}")
+    _echo(study, write_loop_outputs(study, outdir, f"simulate_{output_stem(model)}"), progress)
+
+
+def _echo(study, paths, progress) -> None:
+    """A constrained study's description, table and files, on standard output."""
     progress.clear()
     click.echo(study.describe())
     click.echo(study.markdown_table())
@@ -263,9 +267,5 @@ def _simulate_contacts(model, contacts, integrators, duration, start, velocity, 
                                   None if gains is None else tuple(gains),
                                   progress=lambda name: steps.update(1, name))
     progress("writing the report and plot")
-    paths = write_contact_outputs(study, outdir, f"simulate_{output_stem(model)}")
-    progress.clear()
-    click.echo(study.describe())
-    click.echo(study.markdown_table())
-    for path in paths:
-        click.echo(str(path))
+    _echo(study, write_contact_outputs(study, outdir, f"simulate_{output_stem(model)}"),
+          progress)

@@ -26,6 +26,7 @@ def fourbar():
     return apply_scene(eomgen.load(ROBOT), load_scene(SCENE)).model
 
 
+@pytest.mark.slow  # every backend generated and loaded (the fast one compiled): about 7 s
 def test_every_backend_prints_the_loop_rows(fourbar, tmp_path):
     calls, modules = generated(fourbar, LOOP_FUNCTIONS, tmp_path)
     ref = LoopDynamics(fourbar)
