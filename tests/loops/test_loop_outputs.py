@@ -58,3 +58,13 @@ def test_loop_outputs_need_loops():
     model = eomgen.load(ROBOT)
     with pytest.raises(GenerationError, match="need loops"):
         eomgen.derive(model, outputs=("J_l",))
+
+
+def test_parallel_inverse_dynamics_is_refused_where_no_backend_composes_it(fourbar):
+    from eomgen.codegen.functions import select_functions
+    from eomgen.codegen.generate import render_files
+
+    with pytest.raises(GenerationError, match=r"parallel_inverse_dynamics is composed by the "
+                                              r"numpy, fast backends only; casadi"):
+        render_files(fourbar, ["casadi"], functions=select_functions(
+            ["parallel_inverse_dynamics"]), build=False)
