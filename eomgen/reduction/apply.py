@@ -154,9 +154,11 @@ def _keep_contact_frames(locked: RobotModel, reduced: RobotModel, scene: Scene,
               for k, c in enumerate(scene.contacts)]
     wanted += [(f"frames[{k}]", name, "its pose is constant")
                for k, name in enumerate(scene.frames)]
-    wanted += [(f"loops[{k}] '{loop.name}' {end} link", getattr(loop, end).link,
-                "the loop would hold the world to itself")
-               for k, loop in enumerate(scene.loops) for end in ("a", "b")]
+    # a loop may end on the world: its root link (still present), not a link dropped with it
+    loop_ends = [(f"loops[{k}] '{loop.name}' {end} link", getattr(loop, end).link,
+                  f"give the pose on the root link '{reduced.root}' instead")
+                 for k, loop in enumerate(scene.loops) for end in ("a", "b")]
+    wanted += [w for w in loop_ends if w[1] not in present]
     for where, frame, moot in wanted:
         if frame not in locked.link_by_name:
             raise scene.error(where, f"no link '{frame}' in robot '{locked.name}'"

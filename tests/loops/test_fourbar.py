@@ -186,3 +186,19 @@ def test_documented_loop_errors_are_what_eomgen_prints():
             apply_scene(eomgen.load(ROBOT), load_scene("fourbar_scene.yaml", text=bad))
         printed.append(str(caught.value))
     assert printed == documented
+
+
+def test_a_loop_may_end_on_the_fixed_root():
+    """Frame a on the root link (the world): the crank and coupler alone, their tip held at a
+    point of the ground, close by Newton to the two-link arm's inverse kinematics."""
+    text = SCENE.read_text().replace("a: {link: rocker, xyz: [0.5, 0, 0]}",
+                                     "a: {link: ground, xyz: [0.6, 0.5, 0]}").replace(
+        "actuated: [crank_joint]", "actuated: [rocker_joint]")
+    dyn = LoopDynamics(apply_scene(eomgen.load(ROBOT), load_scene("root.yaml", text=text)).model)
+    q = dyn.assemble([0.5, 1.0, 2.0])
+    tip = a * np.array([np.cos(q[0]), np.sin(q[0])]) + 0.6 * np.array(
+        [np.cos(q[0] + q[1]), np.sin(q[0] + q[1])])
+    assert np.allclose(tip, [0.6, 0.5], atol=1e-12) and q[2] == 2.0
+    J = dyn.loop_jacobian(q)
+    assert np.allclose(J[:, 2], 0) and np.allclose(J[:, 1], 0.6 * np.array(
+        [-np.sin(q[0] + q[1]), np.cos(q[0] + q[1])]))
