@@ -1,4 +1,5 @@
-"""The five-bar and the Delta robot (examples/robots/, closed by examples/loops/) against
+"""The five-bar and the Delta robot (examples/robots/, closed by examples/loops/), and the
+five-bar welded in the plane, against
 Pinocchio's ``constraintDynamics`` with loop ``RigidConstraintModel``s between two joints
 (``CONTACT_3D``, ``LOCAL``): q̈ and the loop forces within 1e-8 relative. Pinocchio's
 ``lambda_c`` is the force on joint 1's side (the loop's frame a) in frame a's axes; eomgen's λ
@@ -9,6 +10,8 @@ constrained motion), and contacts and loops in one KKT system (generated).
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -145,3 +148,44 @@ def test_generated_parallel_inverse_dynamics(tmp_path):
         assert np.allclose(t2[1], t) and np.allclose(l2[1], l), backend
         with pytest.raises(FloatingPointError, match="not finite"), np.errstate(invalid="ignore"):
             f(np.full(12, np.inf), qd, qdd)
+
+
+def test_planar_weld_against_pinocchio_6d():
+    """The five-bar's distal links welded in the plane (rows u, v, rn: 3 of 4 joints held):
+    against Pinocchio's CONTACT_6D between them, whose 3 out-of-plane rows are dependent (a
+    proximal mu), q̈ and the in-plane force and moment."""
+    pin = pytest.importorskip("pinocchio")
+    from eomgen.model import WELD, Loop, LoopFrame, Transform, mat3, vec3
+    from eomgen.numeric.loops import pinocchio_loops
+    from eomgen.numeric.pinocchio import to_pinocchio
+    from eomgen.symbolic.frames import derive_frames
+
+    base = _model("fivebar")
+    q_star = LoopDynamics(base).assemble(ROBOTS["fivebar"][1])
+    kin = derive_frames(base, ["left_distal", "right_distal"]).evaluate(q_star)
+    La, Rb = kin["left_distal"], kin["right_distal"]
+    tip = La["p"] + La["R"] @ np.array([0.3, 0, 0])
+    pose = Transform(mat3((Rb["R"].T @ La["R"]).tolist()),
+                     vec3((Rb["R"].T @ (tip - Rb["p"])).tolist()))
+    loop = Loop("effector", WELD, LoopFrame("left_distal",
+                                            Transform(translation=vec3([0.3, 0, 0]))),
+                LoopFrame("right_distal", pose), plane=(0.0, 0.0, 1.0))
+    dyn = LoopDynamics(replace(base, loops=(loop,)))
+    assert dyn.loop_jacobian(q_star).shape == (3, 4)
+    assert np.abs(dyn.loop_constraint(q_star)).max() < 1e-12
+    qd = np.linalg.svd(dyn.loop_jacobian(q_star))[2][3:].T @ np.array([0.7])
+    tau = np.array([0.4, -0.3, 0.2, 0.1])
+    qdd, lam = dyn.constrained_forward_dynamics(q_star, qd, tau)
+    pm = to_pinocchio(dyn.model)
+    p = pm.perm
+    models = pinocchio_loops(dyn.model, pm)
+    datas = pin.StdVec_RigidConstraintData([c.createData() for c in models])
+    pin.initConstraintDynamics(pm.model, pm.data, models, datas)
+    a = pin.constraintDynamics(pm.model, pm.data, q_star[p], qd[p], tau[p], models, datas,
+                               pin.ProximalSettings(1e-14, 1e-12, 100))
+    qdd_pin = np.empty(4)
+    qdd_pin[p] = a
+    R = datas[0].oMc1.rotation
+    force, moment = -R @ pm.data.lambda_c[:3], -R @ pm.data.lambda_c[3:]
+    assert relative(qdd, qdd_pin) <= 1e-8
+    assert relative(lam, np.array([force[0], force[1], moment[2]])) <= 1e-8
