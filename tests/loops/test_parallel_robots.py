@@ -1,7 +1,7 @@
 """The five-bar and the Delta robot (examples/robots/, closed by examples/loops/), and the
-five-bar welded in the plane, against
-Pinocchio's ``constraintDynamics`` with loop ``RigidConstraintModel``s between two joints
-(``CONTACT_3D``, ``LOCAL``): q̈ and the loop forces within 1e-8 relative. Pinocchio's
+five-bar welded in the plane, against Pinocchio's ``constraintDynamics`` with loop
+``RigidConstraintModel``s between two joints (``CONTACT_3D`` or ``CONTACT_6D``, ``LOCAL``): q̈
+and the loop forces within 1e-8 relative. Pinocchio's
 ``lambda_c`` is the force on joint 1's side (the loop's frame a) in frame a's axes; eomgen's λ
 is the force on frame b in world axes: ``λ = −R_a λ_pin``.
 
