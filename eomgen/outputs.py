@@ -50,7 +50,8 @@ INPUTS: dict[str, str] = {
     "qddd": "third time derivatives of the joint positions (jerk) [rad/s^3 or m/s^3]",
     "qdddd": "fourth time derivatives of the joint positions (snap) [rad/s^4 or m/s^4]",
     "F_c": "contact forces on the robot, rows CONTACT_ROWS (point contacts: force [N] in world "
-           "axes; surface contacts: force [N] and moment [N m] in the contact frame's axes)",
+           "axes; surface contacts: force [N] and moment [N m] in the contact frame's axes; "
+           "then the loop forces on each loop's frame b, in its rows' axes)",
     "qd_r": "reference joint velocities of the Slotine-Li controller [rad/s or m/s]",
     "qdd_r": "reference joint accelerations of the Slotine-Li controller [rad/s^2 or m/s^2]",
 }
@@ -59,7 +60,7 @@ INPUTS: dict[str, str] = {
 #: ``function(model) -> int``, their length for a model (``F_c``: the contact rows).
 INPUT_SIZES: dict[str, str] = {
     "q": "eomgen.model.robot:configuration_size",
-    "F_c": "eomgen.symbolic.frames:contact_row_count",
+    "F_c": "eomgen.symbolic.loops:constraint_row_count",
 }
 
 
@@ -378,8 +379,9 @@ CENTROIDAL_INERTIA = register_output(Output(
 # --- issue 16: frame kinematics and contacts (eomgen.symbolic.frames) -----------------------
 _FRAMES = "eomgen.symbolic.frames:build_frames"
 _FRAME_NAMES = "eomgen.symbolic.frames:frame_constants"
-_CONTACTS = "eomgen.symbolic.frames:build_contacts"
-_CONTACT_NAMES = "eomgen.symbolic.frames:contact_constants"
+# the contact rows, then the loop rows (eomgen.symbolic.loops): J_c, F_c cover both
+_CONTACTS = "eomgen.symbolic.loops:build_constraints"
+_CONTACT_NAMES = "eomgen.symbolic.loops:constraint_constants"
 FRAME_POSITIONS = register_output(Output(
     "frame_positions", "p_f", "Frame origins in world coordinates, one row per frame of "
     "FRAME_NAMES: (nf, 3).", ("q",), False, "m", ("p_f",), build=_FRAMES, default=False,
@@ -405,9 +407,24 @@ FRAME_JACOBIANS_DOT_QD = register_output(Output(
     constants=_FRAME_NAMES))
 CONTACT_JACOBIAN = register_output(Output(
     "contact_jacobian", "J_c", "Contact Jacobian J_c (m, n): the rows of the scene's contacts "
-    "(point: world-aligned linear rows; surface: body rows), CONTACT_ROWS order.", ("q",), False,
+    "(point: world-aligned linear rows; surface: body rows), then of its loops (J_l), "
+    "CONTACT_ROWS order.", ("q",), False,
     "m/rad (force rows), 1 (moment rows)", ("J_c",), build=_CONTACTS, default=False,
     constants=_CONTACT_NAMES))
+LOOP_CONSTRAINT = register_output(Output(
+    "loop_constraint", "Phi_l", "Loop closure error Phi_l(q) (m_l,), zero on closed loops: "
+    "frame b less frame a, LOOP_ROWS order (eomgen.symbolic.loops).", ("q",), True,
+    "m (translational rows), 1 (rotational rows: sines)", ("Phi_l",), build=_CONTACTS,
+    default=False, constants="eomgen.symbolic.loops:loop_constants"))
+LOOP_JACOBIAN = register_output(Output(
+    "loop_jacobian", "J_l", "Loop Jacobian J_l(q) (m_l, n): the velocity of each loop's frame "
+    "b relative to its frame a in the rows' axes, J_l qd, LOOP_ROWS order.", ("q",), False,
+    "m/rad (translational rows), 1 (rotational rows)", ("J_l",), build=_CONTACTS,
+    default=False, constants="eomgen.symbolic.loops:loop_constants"))
+LOOP_BIAS = register_output(Output(
+    "loop_bias", "dJqd_l", "Loop bias J_l-dot qd (m_l,): the loops' relative accelerations at "
+    "qdd = 0, LOOP_ROWS order.", ("q", "qd"), True, "m/s^2, rad/s^2", ("dJqd_l",),
+    build=_CONTACTS, default=False, constants="eomgen.symbolic.loops:loop_constants"))
 CONTACT_BIAS = register_output(Output(
     "contact_bias", "dJqd_c", "Contact bias J_c-dot qd (m,): the constraint accelerations at "
     "qdd = 0, CONTACT_ROWS order.", ("q", "qd"), True, "m/s^2, rad/s^2", ("dJqd_c",),
@@ -440,6 +457,14 @@ CONSTRAINED_FORWARD = register_output(Output(
     ("q", "qd", "tau"), True, "rad/s^2, m/s^2; N, N m", ("M", "tau", "J_c", "dJqd_c"),
     composed_from=(MASS.function, INVERSE.function, CONTACT_JACOBIAN.function,
                    CONTACT_BIAS.function), default=False, constants=_CONTACT_NAMES))
+
+PARALLEL_INVERSE = register_output(Output(
+    "parallel_inverse_dynamics", None, "(tau, lambda) of a parallel robot: joint efforts zero "
+    "on the passive joints (ACTUATED_JOINTS carry them) and loop forces (LOOP_ROWS) with "
+    "M qdd + C qd + g = tau + J_l^T lambda, for a qdd consistent with the loops.",
+    ("q", "qd", "qdd"), True, "N m, N; N, N m", (INVERSE.symbol, "J_l"),
+    composed_from=(INVERSE.function, LOOP_JACOBIAN.function), default=False,
+    constants="eomgen.symbolic.loops:parallel_constants", backends=("numpy", "fast")))
 
 # Issue 28: the Slotine-Li regressor Y_SL(q, qd, qd_r, qdd_r) pi = M qdd_r + C(q, qd) qd_r + g
 # (C Christoffel) and its base columns, for adaptive control (docs/control.md).
@@ -560,6 +585,13 @@ def constrained_names() -> dict[str, str]:
             "jacobian": jacobian, "drift": drift}
 
 
+def parallel_names() -> dict[str, str]:
+    """The names a template needs to compose ``parallel_inverse_dynamics``: ``name``,
+    ``inverse`` (tau) and ``jacobian`` (J_l)."""
+    inverse, jacobian = PARALLEL_INVERSE.composed_from
+    return {"name": PARALLEL_INVERSE.function, "inverse": inverse, "jacobian": jacobian}
+
+
 def derived_symbols(default_only: bool = False) -> tuple[str, ...]:
     """The symbols :func:`eomgen.derive` can build, in registry order (with ``default_only``,
     those of the outputs exported by default: ``("M", "C", "g", "tau")``)."""
@@ -621,4 +653,5 @@ def composition_names(output: Output = FORWARD) -> dict[str, str]:
 __all__ = ["INPUTS", "splits", "DYNAMICS", "MASS_AND_BIAS", "INPUT_SIZES", "input_size", "Output", "OUTPUTS", "resolve", "BY_SYMBOL", "register_output", "derived_symbols",
            "function_names", "select", "composition_names", "MASS", "CORIOLIS", "GRAVITY", "INVERSE",
            "FORWARD", "exported", "constrained_names", "CONSTRAINED_FORWARD",
+           "PARALLEL_INVERSE", "parallel_names",
            "TASK_SPACE", "task_space_names"]

@@ -44,6 +44,16 @@ Version 1 of the format (every key but ``version`` is optional)::
       - {joint: finger2, to: finger1, ratio: 1, offset: 0}   # linear form below; the
       - {joint: diff_out, to: {wheel_l: 0.5, wheel_r: 0.5}}  # follower is no coordinate
                                   #   (eomgen.model.coupling; ratio 1, offset 0 by default)
+    loops:                        # loop closures: frame b held on frame a (docs/loops.md)
+      - name: closure             # names its rows (closure.x, ...) and forces
+        type: point               # point (3 rows), hinge (5) or weld (6)
+        a: {link: rocker, xyz: [0.5, 0, 0], rpy: [0, 0, 0]}   # a link, a pose in it
+        b: {link: coupler, xyz: [1, 0, 0]}
+        axis: [0, 0, 1]           # a hinge's axis, in frame a's (and b's) axes
+        plane: [0, 0, 1]          # planar loop: the plane's normal (world axes); keeps the
+                                  #   2 in-plane translations (+ the rotation of a weld)
+    actuated: [crank_joint]       # the driven joints of a parallel robot (the others are
+                                  #   passive), for the parallel inverse dynamics
 
 The file is read like eomgen's robot YAML (:mod:`eomgen.parsers._yaml`): safe loading, no
 aliases, size and depth limits, and an unknown key is an error that lists the known ones. Keys
@@ -66,7 +76,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Iterable
 
-from .model import POINT, SURFACE, Contact
+from .model import HINGE, LOOP_KINDS, POINT, SURFACE, Contact, Loop, LoopFrame, Transform
 from .errors import DescriptionError, SceneError
 from .model import Coupling, Inertial, Parameter, Vec3, check_inertial, make_coupling, mat3, vec3
 from .outputs import select
@@ -78,7 +88,7 @@ SCENE_VERSION = 1
 #: Top-level keys of a version-1 scene, in documentation order.
 SCENE_KEYS = ("version", "robot", "description", "fixed_base", "floating_base", "base", "tips",
               "locked", "payloads", "actuators", "gravity", "parameters", "symbolic", "outputs",
-              "contacts", "frames", "couplings")
+              "contacts", "frames", "couplings", "loops", "actuated")
 
 #: Keys reserved for later versions of the format; refused with a message saying so (those of
 #: :data:`ACTUATOR_ALIASES` with a pointer to ``actuators``, which holds them per joint now).
@@ -97,6 +107,8 @@ FLOATING_CHARTS = {False: False, True: "euler", "euler": "euler", "quaternion": 
 FLOATING = "floating"
 
 CONTACT_KEYS = ("frame", "type", "mu", "baumgarte", "normal", "name")
+LOOP_KEYS = ("name", "type", "a", "b", "axis", "plane")
+LOOP_FRAME_KEYS = ("link", "xyz", "rpy")
 
 COUPLING_KEYS = ("joint", "to", "ratio", "offset")
 
@@ -156,6 +168,10 @@ class Scene:
     couplings:
         Coupled joints (:class:`eomgen.model.Coupling`), in file order: each ``joint``
         follows ``ratio · to + offset`` (or ``Σ gain · leader + offset`` for ``to`` a mapping).
+    loops:
+        Loop closures (:class:`eomgen.model.Loop`), in file order.
+    actuated:
+        The driven joints (``actuated:``), in file order; empty: every joint.
     """
 
     source: str = "<scene>"
@@ -176,6 +192,8 @@ class Scene:
     contacts: tuple[Contact, ...] = ()
     frames: tuple[str, ...] = ()
     couplings: tuple[Coupling, ...] = ()
+    loops: tuple[Loop, ...] = ()
+    actuated: tuple[str, ...] = ()
 
     @property
     def locked_positions(self) -> dict[str, float]:
@@ -334,8 +352,11 @@ def _read(data: dict, source: str, strict: bool) -> Scene:
     couplings = tuple(_coupling(r, entry, k) for k, entry in
                       enumerate(r.sequence(data["couplings"], "couplings"))
                       ) if data.get("couplings") is not None else ()
+    loops = _loops(r, data["loops"]) if data.get("loops") is not None else ()
+    actuated = (_names(r, data["actuated"], "actuated", "a joint name")
+                if data.get("actuated") is not None else ())
     declared = tuple(r.declared.values())
-    return Scene(frames=frames, source=source, version=version, robot=robot, description=description,
+    return Scene(frames=frames, loops=loops, actuated=actuated, source=source, version=version, robot=robot, description=description,
                  floating_base=floating_base, contacts=tuple(contacts),
                  fixed_base=fixed_base, base=base, tips=tuple(tips), locked=tuple(locked),
                  payloads=tuple(payloads), actuators=tuple(actuators),
@@ -392,14 +413,7 @@ def _contact(r: _SceneReader, entry, k: int) -> Contact:
     if entry.get("normal") is not None:
         if kind != POINT:
             raise r.error(f"{where} normal", "a surface contact's normal is its frame's z axis")
-        value = entry["normal"]
-        if not isinstance(value, list) or len(value) != 3:
-            raise r.error(f"{where} normal", "expected a list of 3 numbers [x, y, z]")
-        vector = [r.number(x, f"{where} normal[{i}]") for i, x in enumerate(value)]
-        norm = sum(x * x for x in vector) ** 0.5
-        if not norm > 0:
-            raise r.error(f"{where} normal", "the normal is zero")
-        normal = tuple(x / norm for x in vector)
+        normal = _unit(r, entry, "normal", where, "the normal is zero")
     return Contact(frame, kind, mu, gains["kp"], gains["kd"], normal, name)
 
 
@@ -419,6 +433,55 @@ def _coupling(r: _SceneReader, entry, k: int) -> Coupling:
                    r.number(entry.get("ratio", 1), f"{where} ratio")}
     offset = r.number(entry.get("offset", 0), f"{where} offset")
     return make_coupling(follower, leaders, offset, where)
+def _loops(r: _SceneReader, value) -> tuple[Loop, ...]:
+    loops: list[Loop] = []
+    for k, entry in enumerate(r.sequence(value, "loops")):
+        where = f"loops[{k}]"
+        r.mapping(entry, where, required=("a", "b"), optional=LOOP_KEYS)
+        name = r.name(entry["name"], f"{where} name") if "name" in entry else f"loop{k + 1}"
+        where = f"{where} '{name}'"
+        if any(loop.name == name for loop in loops):
+            raise r.error(where, "two loops have this name")
+        kind = r.choice(entry.get("type", "point"), f"{where} type", LOOP_KINDS)
+        ends = []
+        for end in ("a", "b"):
+            frame = entry[end]
+            r.mapping(frame, f"{where} {end}", required=("link",), optional=LOOP_FRAME_KEYS)
+            link = r.name(frame["link"], f"{where} {end} link")
+            xyz = r.vector(frame["xyz"], f"{where} {end} xyz") if "xyz" in frame else (0, 0, 0)
+            rpy = r.vector(frame["rpy"], f"{where} {end} rpy") if "rpy" in frame else (0, 0, 0)
+            ends.append(LoopFrame(link, Transform.from_xyz_rpy(xyz, rpy)))
+        axis = _unit(r, entry, "axis", where) if entry.get("axis") is not None else (0., 0., 1.)
+        if "axis" in entry and kind != HINGE:
+            raise r.error(f"{where} axis", f"only a hinge loop has an axis (this one is a {kind})")
+        plane = _unit(r, entry, "plane", where) if entry.get("plane") is not None else None
+        loops.append(Loop(name, kind, ends[0], ends[1], axis, plane))
+    return tuple(loops)
+
+
+def _unit(r: _SceneReader, entry: dict, key: str, where: str,
+          zero: str = "the vector is zero") -> tuple[float, float, float]:
+    """``entry[key]``, a list of 3 numbers, made a unit vector (``zero``: the error when it is
+    zero)."""
+    value = entry[key]
+    if not isinstance(value, list) or len(value) != 3:
+        raise r.error(f"{where} {key}", "expected a list of 3 numbers [x, y, z]")
+    vector = [r.number(x, f"{where} {key}[{i}]") for i, x in enumerate(value)]
+    norm = sum(x * x for x in vector) ** 0.5
+    if not norm > 0:
+        raise r.error(f"{where} {key}", zero)
+    return tuple(x / norm for x in vector)
+
+
+def _names(r: _SceneReader, value, key: str, what: str) -> tuple[str, ...]:
+    names: list[str] = []
+    for k, entry in enumerate(r.sequence(value, key)):
+        if not isinstance(entry, str) or not entry:
+            raise r.error(f"{key}[{k}]", f"expected {what}")
+        if entry in names:
+            raise r.error(f"{key}[{k}]", f"'{entry}' is listed twice")
+        names.append(entry)
+    return tuple(names)
 
 
 def _at(value, values: dict):

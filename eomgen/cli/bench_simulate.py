@@ -137,7 +137,9 @@ def simulate(description, outdir, duration, dts, rtols, names, q0, qd0, gains, s
     against the error of q versus a DOP853 reference at rtol = atol = 1e-12. Writes
     simulate_<robot>.md, .csv and .png into OUTPUT.
 
-    With a scene that has contacts, the contacts are held (bilateral) where they are at
+    With a scene that has loops, they are held (q0 closed by Newton, qd0 projected), and
+    each integrator runs without and with Baumgarte: loop drift and energy drift
+    (docs/loops.md). With a scene that has contacts, the contacts are held (bilateral) where they are at
     q0, and each integrator (not the implicit midpoint) runs without and with Baumgarte
     stabilisation: constraint drift (position, orientation, velocity) and energy drift.
     With flexible joints (actuators with a stiffness), the 2n-state Spong model is
@@ -191,6 +193,10 @@ def simulate(description, outdir, duration, dts, rtols, names, q0, qd0, gains, s
         raise AnalysisError("simulate: contacts are held by eomgen.numeric, which has no "
                             "quaternion joints (free flyer, ball) yet; use floating_base: "
                             "euler in the scene")
+    if model.loops:
+        _simulate_loops(model, integrators, duration, start, velocity, gain_list, outdir,
+                        progress)
+        return
     if contacts:
         _simulate_contacts(model, contacts, integrators, duration, start, velocity,
                            gain_list, outdir, progress)
@@ -236,6 +242,26 @@ def simulate(description, outdir, duration, dts, rtols, names, q0, qd0, gains, s
         click.echo(str(path))
 
 
+def _simulate_loops(model, integrators, duration, start, velocity, gains, outdir, progress):
+    # NumPy, SciPy (optional): only when the command runs
+    from ..analysis.simulate_loops import run_loop_study, write_loop_outputs
+
+    with progress.steps(2 * len(integrators) + 1, "integrating") as steps:
+        study = run_loop_study(model, integrators, duration, start, velocity, gains,
+                               progress=lambda name: steps.update(1, name))
+    progress("writing the report")
+    _echo(study, write_loop_outputs(study, outdir, f"simulate_{output_stem(model)}"), progress)
+
+
+def _echo(study, paths, progress) -> None:
+    """A constrained study's description, table and files, on standard output."""
+    progress.clear()
+    click.echo(study.describe())
+    click.echo(study.markdown_table())
+    for path in paths:
+        click.echo(str(path))
+
+
 def _simulate_contacts(model, contacts, integrators, duration, start, velocity, gains,
                        outdir, progress):
     # NumPy, SciPy (optional): only when the command runs
@@ -246,9 +272,5 @@ def _simulate_contacts(model, contacts, integrators, duration, start, velocity, 
                                   None if gains is None else tuple(gains),
                                   progress=lambda name: steps.update(1, name))
     progress("writing the report and plot")
-    paths = write_contact_outputs(study, outdir, f"simulate_{output_stem(model)}")
-    progress.clear()
-    click.echo(study.describe())
-    click.echo(study.markdown_table())
-    for path in paths:
-        click.echo(str(path))
+    _echo(study, write_contact_outputs(study, outdir, f"simulate_{output_stem(model)}"),
+          progress)

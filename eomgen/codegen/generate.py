@@ -17,6 +17,7 @@ from ..errors import GenerationError
 from ..model import RobotModel, snap_summary
 from ..output import checked_stem, write_atomically  # noqa: F401  (re-exported)
 from ..progress import plural
+from ..outputs import OUTPUTS
 from . import GeneratedFile, available_backends, make_job
 from .functions import derived_outputs, select_functions
 
@@ -108,6 +109,18 @@ def render_job(job, backends: Sequence[str], progress: Progress = lambda _: None
     """
     files: list[GeneratedFile] = []
     registry = available_backends()
+    for function in job.functions:  # a composed function some backends leave out
+        composing = OUTPUTS[function].backends
+        if composing is None:
+            continue
+        left = [name for name in backends if name not in composing]
+        if left and len(left) == len(backends):
+            raise GenerationError(
+                f"{function} is composed by the {', '.join(composing)} backends only; "
+                f"{', '.join(left)} cannot export it: choose one of those")
+        if left:
+            progress(f"{', '.join(left)}: {function} left out (composed by "
+                     f"{', '.join(composing)} only)")
     for name in backends:
         missing = [o for o in registry[name].needs if o not in job.dynamics.outputs]
         if missing:

@@ -44,6 +44,7 @@ from .checks import (
 )
 from .contact import POINT, SURFACE, Contact
 from .coupling import Coupling, couple, coupling_map, make_coupling, uncoupled, with_couplings
+from .loop import HINGE, LOOP_KINDS, POINT_LOOP, WELD, Loop, LoopFrame
 from .notices import Notice, NoticeKind, emit_notices
 from .parts import Inertial, Joint, JointType, Link, Parameter
 from .quaternion import (
@@ -67,6 +68,7 @@ from .snapping import SNAP_TOLERANCE, Snap, snap, snap_summary, snapping
 from .transforms import Transform, rotation_about_axis, rotation_from_rpy
 
 __all__ = [
+    "HINGE", "LOOP_KINDS", "POINT_LOOP", "WELD", "Loop", "LoopFrame",
     "DEFAULT_FRICTION_WIDTH", "FREE_FLYER_CONFIGURATION", "FREE_FLYER_VELOCITY", "IDENTITY3", "MAX_JOINTS", "POINT", "SNAP_TOLERANCE", "SURFACE",
     "ZERO3", "Actuator", "Contact", "Coupling", "couple", "coupling_map", "uncoupled",
     "make_coupling", "with_couplings", "Inertial", "Joint", "JointType", "Link", "Mat3", "Notice",

@@ -15,6 +15,7 @@ from ..errors import KinematicTreeError, ParameterError
 from .actuator import Actuator
 from .contact import Contact
 from .coupling import Coupling, locked_couplings
+from .loop import Loop
 from .notices import Notice
 from .parts import Inertial, Joint, JointType, Link, Parameter
 from .quaternion import (FREE_FLYER_CONFIGURATION, FREE_FLYER_VELOCITY, QuaternionJoint,
@@ -54,6 +55,11 @@ class RobotModel:
     #: (:mod:`eomgen.symbolic.frames`); empty for a model without a scene.
     contacts: tuple[Contact, ...] = ()
     frames: tuple[str, ...] = ()
+    #: The scene's loop closures (:class:`~eomgen.model.Loop`, rows of ``J_l`` in this order,
+    #: after the contacts' in ``J_c``) and its actuated joints (``actuated:``, for the parallel
+    #: inverse dynamics; empty: every joint), :mod:`eomgen.symbolic.loops`.
+    loops: tuple[Loop, ...] = ()
+    actuated: tuple[str, ...] = ()
     #: Pose of the root link's frame in the frame of the description's root link, when a scene
     #: moved the fixed frame (:func:`eomgen.reduction.apply_scene`); None when they coincide.
     #: Frame kinematics are given in the description's frame.

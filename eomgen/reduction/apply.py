@@ -36,6 +36,7 @@ from ..symbolic.frames import frame_site
 from .inertia import (clean_transform, combined_inertial, inertial_scalars, is_zero_inertial,
                       substituted_inertial, tidy)
 from .planar import in_plane, planar_motion
+from .loops import with_loops
 from .report import LockedJoint, MergedBody, ModelSize, Reduction, ReductionReport
 
 
@@ -105,6 +106,7 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
     reduced, world = _reroot(reduced)
     reduced = _keep_contact_frames(locked_model, reduced, scene, set(dropped))
     reduced = replace(reduced, contacts=scene.contacts, frames=scene.frames)
+    reduced = with_loops(reduced, scene, notes)
     if scene.contacts:
         notes.append("contacts (generated with --outputs contact_jacobian, contact_bias, constrained_forward_dynamics; numerically eomgen.contacts.ContactDynamics): "
                      + ", ".join(f"{c.name} on '{c.frame}' ({c.kind}"
@@ -185,6 +187,11 @@ def _keep_contact_frames(locked: RobotModel, reduced: RobotModel, scene: Scene,
               for k, c in enumerate(scene.contacts)]
     wanted += [(f"frames[{k}]", name, "its pose is constant")
                for k, name in enumerate(scene.frames)]
+    # a loop may end on the world: its root link (still present), not a link dropped with it
+    loop_ends = [(f"loops[{k}] '{loop.name}' {end} link", getattr(loop, end).link,
+                  f"give the pose on the root link '{reduced.root}' instead")
+                 for k, loop in enumerate(scene.loops) for end in ("a", "b")]
+    wanted += [w for w in loop_ends if w[1] not in present]
     for where, frame, moot in wanted:
         if frame not in locked.link_by_name:
             raise scene.error(where, f"no link '{frame}' in robot '{locked.name}'"

@@ -360,8 +360,10 @@ def build_contact_inverse_dynamics(derivation, wanted) -> dict:
     give the accelerations ``q̈`` while the contacts push on the robot with ``F_c`` (rows
     ``CONTACT_ROWS``, in the axes of :func:`build_contacts`' rows: a point contact's force in
     world axes at the frame origin, a surface contact's force and moment in the frame's axes).
-    It reuses the Newton–Euler ``tau`` and ``J_c`` already in the program."""
-    _require_contacts(derivation.model)
+    It reuses the Newton–Euler ``tau`` and ``J_c`` already in the program (with loops, ``J_c``
+    and ``F_c`` hold their rows too: :mod:`eomgen.symbolic.loops`)."""
+    if not derivation.model.loops:
+        _require_contacts(derivation.model)
     tau = derivation.output("tau")
     J = derivation.output("J_c")
     F = sp.Matrix(derivation.inputs["F_c"])

@@ -44,6 +44,7 @@ from ..present.sections import program_sections
 from ..progress import plural
 from ..symbolic.textbook import TextbookDerivation
 from ..verify import VerificationReport, verify
+from .loops import loop_section, loop_symbol_names
 from .contacts import (contact_equations, contact_forces,  # noqa: F401  (re-exported)
                        contact_section, contact_symbol_names)
 from .document import (Equation, Equations, Figure, Handout, Paragraph, Section, Table, code,
@@ -491,6 +492,7 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
     spong = spong_dynamics(dyn) if has_drives(model) else None
     contacts = tuple(getattr(scene, "contacts", ()) or ())
     extra_names.update(contact_symbol_names(contacts))
+    extra_names.update(loop_symbol_names(model))
     if spong is not None:  # the drives' own symbols, printed by the document's printer
         extra_names.update(drive_symbol_names(spong, w.tex))
     w = Writer(nt.printing(dyn, HANDOUT_CONFIG, compact_trig=book is not None,
@@ -513,6 +515,8 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
         sections.append(drives_section(spong, book, coriolis, w))
     if contacts:
         sections.append(contact_section(dyn, contacts, book, coriolis, w))
+    if model.loops:
+        sections.append(loop_section(dyn, book, coriolis, w))
     report, missing = None, "the check was switched off"
     if check:
         progress("checking the derivation against Newton-Euler")

@@ -11,8 +11,9 @@ from typing import Callable
 import sympy as sp
 
 from .. import Job, Loaded
-from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, INPUTS, TASK_SPACE,
-                       composition_names, constrained_names, exported, task_space_names)
+from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, INPUTS, PARALLEL_INVERSE,
+                       TASK_SPACE, composition_names, constrained_names, exported,
+                       parallel_names, task_space_names)
 from ..functions import FunctionSpec
 
 
@@ -151,6 +152,16 @@ def dunder_all_lines(names, width: int = 79) -> list[str]:
     return lines
 
 
+def parallel_indices(model) -> dict[str, list[int]]:
+    """``actuated_indices`` and ``passive_indices``: the joints (``JOINT_NAMES`` positions)
+    the scene's ``actuated:`` drives (all when it names none) and the others, for
+    ``parallel_inverse_dynamics``."""
+    names = model.joint_names
+    actuated = [names.index(j) for j in (model.actuated or names)]
+    return {"actuated_indices": actuated,
+            "passive_indices": [k for k in range(len(names)) if k not in actuated]}
+
+
 def warning_exports(job: Job) -> list[str]:
     """``["IllConditionedWarning"]`` when the module composes forward dynamics (whose Cholesky
     solve warns of an ill-conditioned M, in the NumPy, PyTorch and fast modules), else ``[]``."""
@@ -193,6 +204,9 @@ def python_module_context(job: Job, printer, template: str, extra_exports=(),
         fd=composition_names(FORWARD),
         constrained_forward_dynamics=CONSTRAINED_FORWARD.function in functions,
         cfd=constrained_names(),
+        parallel_inverse=PARALLEL_INVERSE.function in functions,
+        pid=parallel_names(),
+        **parallel_indices(job.model),
         # the task-space functions (composed from M, J_f, J_f-dot qd and tau) it exports
         task_space=any(o.function in functions for o in TASK_SPACE),
         ts=task_space_names(),

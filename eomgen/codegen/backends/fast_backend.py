@@ -28,11 +28,12 @@ from sympy.printing.precedence import PRECEDENCE
 
 from ...compiler import c_compiler, shared_library
 from .. import GeneratedFile, Job, Loaded, register
-from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, TASK_SPACE,
-                       composition_names, constrained_names, exported, task_space_names)
+from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, PARALLEL_INVERSE,
+                       TASK_SPACE, composition_names, constrained_names, exported,
+                       parallel_names, task_space_names)
 from ...symbolic.printing import FloatLiteralMixin
 from ...templating import TEMPLATES_DIR, render
-from .common import import_file, positional, warning_exports
+from .common import import_file, parallel_indices, positional, warning_exports
 
 #: The fixed C runtime every generated module includes parts of: real C files (compiled and
 #: warning-checked on their own by tests/backends/test_fast_runtime_c.py), by the name the template
@@ -185,6 +186,18 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
         "FloatingPointError when M, C qd + g, tau, J_c or J_c-dot qd is not finite; "
         "ValueError for a damping not finite or < 0.")
     task = _task_space_context(job, functions, signature)
+    pid = parallel_names()
+    parallel = PARALLEL_INVERSE.function in exported(job.functions, "fast")
+    nl = next((f["rows"] for f in functions if f["name"] == pid["jacobian"]), 0)
+    parallel_doc = c_string_literal(
+        f"{pid['name']}({', '.join(PARALLEL_INVERSE.inputs)}, *{signature}, damping=0.0)"
+        f"\n--\n\n{PARALLEL_INVERSE.summary}\n\nReturns (tau, lambda) of shapes (NV,), "
+        f"({nl},) for one state, (N, NV), (N, {nl}) for a batch. With t = inverse dynamics and "
+        "J_p, J_a the passive and actuated columns of J_l: (J_p J_p^T + damping 1) lambda = "
+        "J_p t_p (Cholesky; least squares, exact for a square invertible J_p), tau_a = t_a - "
+        "J_a^T lambda. Raises numpy.linalg.LinAlgError at damping 0 when J_p J_p^T is "
+        "numerically singular (a singularity of the parallel robot), FloatingPointError when t "
+        "or J_l is not finite.")
     parameters = [dict(name=c_string_literal(p.identifier),
                        default=("NAN" if p.default is None
                                 else printer.doprint(sp.Float(p.default))),
@@ -216,6 +229,11 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
         cfd=cfd,
         nc=nc,
         constrained_doc=constrained_doc,
+        parallel_inverse=parallel,
+        pid=pid,
+        nl=nl,
+        parallel_doc=parallel_doc,
+        **parallel_indices(job.model),
         runtime={name: runtime_source(name) for name in RUNTIME_FILES},
         **task,
         **extra,

@@ -17,9 +17,12 @@ typedef int (*contact_kernel_t)(const double *, const double *, const double *, 
 /* The function f (inputs q, qd, tau; keyword damping) called from Python: (qdd, F_c) of
  * shapes (NV,), (nc,) for one state, (N, NV), (N, nc) for a batch, solved state by state with
  * `one`; FloatingPointError or numpy.linalg.LinAlgError named after f at the first state that
- * fails. */
+ * fails. `messages` (or NULL for the contact ones): what status 1 (not finite) and status 3
+ * (singular at damping 0) say, for another function solved alike (the parallel inverse
+ * dynamics: inputs q, qd, qdd; results tau, lambda). */
 static PyObject *contact_call(const function_t *f, contact_kernel_t one, int nc,
-                              PyObject *const *args, Py_ssize_t nargs, PyObject *kwnames)
+                              const char *const *messages, PyObject *const *args,
+                              Py_ssize_t nargs, PyObject *kwnames)
 {
     call_t call;
     npy_intp dims[2], k, failed = -1;
@@ -60,7 +63,11 @@ static PyObject *contact_call(const function_t *f, contact_kernel_t one, int nc,
         char at[64] = "";
         if (!call.single)
             PyOS_snprintf(at, sizeof(at), " at state %zd", (Py_ssize_t)failed);
-        if (status == 1)
+        if (messages != NULL && status == 1)
+            PyErr_Format(PyExc_FloatingPointError, "%s: %s%s", f->name, messages[0], at);
+        else if (messages != NULL && status == 3 && !(call.damping > 0.0))
+            PyErr_Format(lin_alg_error, "%s: %s%s; use damping > 0", f->name, messages[1], at);
+        else if (status == 1)
             PyErr_Format(PyExc_FloatingPointError, "%s: M(q), C(q, qd) qd + g(q), tau, J_c(q) "
                          "or J_c-dot qd is not finite%s (overflow, or non-finite input)",
                          f->name, at);
