@@ -266,3 +266,14 @@ def test_cli_generates_from_mjcf(tmp_path):
     exec((tmp_path / "hopper_numpy.py").read_text(encoding="utf-8"), namespace)
     assert namespace["JOINT_NAMES"] == ("rootx", "rootz", "rooty", "thigh_joint", "leg_joint",
                                         "foot_joint")
+
+
+def test_compiler_warnings_are_python_warnings(tmp_path, capfd):
+    path = tmp_path / "w.xml"
+    path.write_text(WORLD.replace("<worldbody>", "<compiler settotalmass='5'/><worldbody>")
+                    .format(extra_bodies="", extra=""), encoding="utf-8")
+    with pytest.warns(UserWarning, match="MuJoCo's compiler: compiler attribute 'settotalmass'"):
+        model = eomgen.load(path)
+    assert "settotalmass" not in capfd.readouterr().err  # not also printed by MuJoCo
+    masses = [float(link.inertial.mass) for link in model.links if link.inertial is not None]
+    assert sum(masses) == pytest.approx(5.0, rel=1e-12)  # the compiler's masses

@@ -57,6 +57,7 @@ equations of motion and are ignored.
 from __future__ import annotations
 
 import re
+import warnings
 from dataclasses import replace
 from pathlib import Path
 
@@ -122,13 +123,30 @@ def compile_mjcf(path) -> "mujoco.MjModel":  # noqa: F821
         MuJoCo is not installed.
     MujocoCompileError
         The compiler's message, on one line.
+
+    Warns
+    -----
+    UserWarning
+        Each warning of the compiler (a deprecated attribute), on one line.
     """
     mujoco = import_mujoco(str(path))
+    said: list[str] = []
+    handler = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(said.append)  # the compiler's warnings, else on stderr
     try:
-        return mujoco.MjModel.from_xml_path(str(path))
+        m = mujoco.MjModel.from_xml_path(str(path))
     except ValueError as exc:
-        message = "; ".join(line.strip() for line in str(exc).splitlines() if line.strip())
-        raise MujocoCompileError(str(path), "", f"MuJoCo's compiler: {message}") from None
+        raise MujocoCompileError(str(path), "", f"MuJoCo's compiler: {_one_line(exc)}") from None
+    finally:
+        mujoco.set_mju_user_warning(handler)
+    for message in said:
+        warnings.warn(f"{path}: MuJoCo's compiler: {_one_line(message)}", UserWarning,
+                      stacklevel=2)
+    return m
+
+
+def _one_line(message) -> str:
+    return "; ".join(line.strip() for line in str(message).splitlines() if line.strip())
 
 
 def import_mujoco(source: str):

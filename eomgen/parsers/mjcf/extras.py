@@ -104,9 +104,12 @@ def model_notices(m, source: str) -> tuple[Notice, ...]:
                                "actuators on them)", "left out", joints=joints))
     for i in range(m.nu):
         if not _is_motor(m, i):
+            on_joint = int(m.actuator_trntype[i]) in (_TRN_JOINT, _TRN_JOINT_IN_PARENT)
             notices.append(_notice(source, f"actuator '{_name(m, 'actuator', i)}'",
                                    f"{_actuator_kind(m, i)} is not modelled",
-                                   "eomgen's input is the joint torque"))
+                                   "eomgen's input is the joint torque",
+                                   joints=(jnames[int(m.actuator_trnid[i, 0])],) if on_joint
+                                   else ()))
     for e in range(m.neq):
         reader = EQUALITY_READERS.get(int(m.eq_type[e]), other_equality)
         notices.append(reader(m, e, source))

@@ -17,7 +17,7 @@ from dataclasses import replace
 import numpy as np
 
 from ...errors import KinematicTreeError, UnsupportedError
-from ...free_flyer import add_free_flyer
+from ...free_flyer import add_free_flyer, quaternion_matrix
 from ...model import (
     Actuator,
     Inertial,
@@ -80,12 +80,9 @@ def _unique(name: str, taken: set[str]) -> str:
 
 
 def rotation_of_quaternion(wxyz) -> np.ndarray:
-    """The rotation matrix of MuJoCo's quaternion ``(w, x, y, z)`` (normalised here)."""
-    w, x, y, z = np.asarray(wxyz, dtype=float) / np.linalg.norm(wxyz)
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+    """The rotation matrix of MuJoCo's quaternion ``(w, x, y, z)`` (normalised first)."""
+    w, x, y, z = np.asarray(wxyz, dtype=float)
+    return quaternion_matrix((x, y, z, w))
 
 
 def _axis_rotation(axis, angle: float) -> np.ndarray:
