@@ -122,8 +122,10 @@ def test_names_order_and_motors(derived):
     floating, m, _ = derived["floating.xml"]
     assert floating.free_flyer and floating.nq == 10
     assert floating.joint_names[6:] == ("hip", "knee", "rail_x")  # free flyer first
-    assert [m.joint(j).name for j in range(m.njnt)] == ["rail_x", "root", "hip", "knee"]
+    assert [m.joint(j).name for j in range(m.njnt)] == ["rail_x", "ball_root", "root", "hip",
+                                                         "knee"]
     assert dict(floating.info)["mujoco_free_joint"] == "root"
+    assert "ball" not in floating.link_by_name  # the second free body, dropped
 
 
 def test_free_joint_layout_against_mujoco_qpos(derived):
@@ -132,12 +134,25 @@ def test_free_joint_layout_against_mujoco_qpos(derived):
     the world-frame one."""
     model, m, _ = derived["floating.xml"]
     lay = layout(m, model)
-    qpos = np.array([0.7, 1, 2, 3, 0.5, 0.5, 0.5, 0.5, -0.4, 0.9])
-    qvel = np.array([0.3, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0])
+    ball = [9, 9, 9, 1, 0, 0, 0]
+    qpos = np.array([0.7, *ball, 1, 2, 3, 0.5, 0.5, 0.5, 0.5, -0.4, 0.9])
+    qvel = np.array([0.3, *[9] * 6, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0])
     q, v = to_eomgen(lay, qpos, qvel)
     assert list(q) == [1, 2, 3, 0.5, 0.5, 0.5, 0.5, -0.4, 0.9, 0.7]
-    R = rotation_of_quaternion(qpos[4:8])
-    assert np.allclose(v[:3], R.T @ qvel[1:4]) and list(v[3:]) == [4, 5, 6, 7, 8, 0.3]
+    R = rotation_of_quaternion(qpos[11:15])
+    assert np.allclose(v[:3], R.T @ qvel[7:10]) and list(v[3:]) == [4, 5, 6, 7, 8, 0.3]
+
+
+def test_a_second_free_body_is_dropped_with_a_warning():
+    with pytest.warns(UnsupportedFeatureWarning) as caught:
+        model = eomgen.load(DATA / "floating.xml")
+    messages = [str(w.message) for w in caught]
+    assert any("joint 'ball_root' (free, body 'ball'): a second free body (body 'trunk' "
+               "flies)" in text and "dropped with the 1 bodies and 1 joints" in text
+               for text in messages), messages
+    assert "ball_root" not in model.joint_names
+    with pytest.raises(UnsupportedError, match="ball_root"):
+        eomgen.load(DATA / "floating.xml", strict=True)
 
 
 def test_warnings_name_what_is_left_out():
@@ -170,9 +185,6 @@ WORLD = """<mujoco model="t"><worldbody>
 REFUSED = {
     "ball": ("<body name='d' pos='1 0 0'><joint name='socket' type='ball'/><geom size='.1'/>"
              "</body>", "", "joint 'socket' (ball, body 'd')"),
-    "second free": ("<body name='d'><freejoint name='f1'/><geom size='.1'/></body>"
-                    "<body name='e'><freejoint name='f2'/><geom size='.1'/></body>", "",
-                    "joint 'f2' (free, body 'e'): a second free joint"),
     "quadratic joint equality": ("", "<equality><joint name='couple' joint1='j1' joint2='j2' "
                                  "polycoef='0 1 0.5 0 0'/></equality>",
                                  "equality 'couple' (joint): a joint equality of order 2"),

@@ -24,13 +24,15 @@ What is read
   massless links ``<body>_<joint>`` (the frame of each joint but the last), applied in MuJoCo's
   order.
 * A body without joints is welded to its parent by a fixed joint ``<body>_weld``.
-* One ``free`` joint (a body of the world) is the quaternion free flyer of
+* The ``free`` joint (a body of the world) is the quaternion free flyer of
   :mod:`eomgen.free_flyer` (Pinocchio's layout): ``q[0:7] = (x, y, z, qx, qy, qz, qw)`` where
   MuJoCo's ``qpos`` has ``(x, y, z, qw, qx, qy, qz)``; ``v[0:6]`` is the body twist in the body
   frame (linear, then angular) where MuJoCo's ``qvel`` has the linear velocity in *world* axes
   (the angular one in the body frame, as eomgen's). The joint's MuJoCo name is in
   ``model.info`` (``"mujoco_free_joint"``); the six velocity coordinates keep the free
-  flyer's names ``base_vx … base_wz``.
+  flyer's names ``base_vx … base_wz``. With several free bodies (dm_control's quadruped and
+  its ball), the one with the most joints below it flies and the others are dropped with
+  their subtrees (warned by name: nothing but contacts and equalities joins them to it).
 * Each hinge or slide joint's ``armature``, ``damping`` and ``frictionloss`` are its
   :class:`~eomgen.model.Actuator` (``armature``, viscous ``damping``, Coulomb ``friction``;
   docs/actuators.md); those of the free joint go to the six free-flyer coordinates (equal on
@@ -47,8 +49,8 @@ by name: joint springs (``stiffness``, ``springref``: not modelled), tendons, ac
 than motors on hinge and slide joints, equality constraints (``connect``, ``weld``, first-order
 ``joint``, ``tendon``: not read yet, the model is the tree without them), fluid forces
 (``density``, ``viscosity``), gravity compensation (``gravcomp``). Refused
-(:class:`~eomgen.errors.UnsupportedError`), by name: ``ball`` joints (not read yet), a second
-``free`` joint, and ``joint`` equalities of order above one.
+(:class:`~eomgen.errors.UnsupportedError`), by name: ``ball`` joints (not read yet) and
+``joint`` equalities of order above one.
 
 Contacts, joint limits, geoms, sites, sensors and the rendering options do not enter the
 equations of motion and are ignored.
@@ -96,8 +98,8 @@ def load_mjcf(path: Path, strict: bool = False, defer_notices: bool = False) -> 
     Raises
     ------
     UnsupportedError
-        MuJoCo is not installed (naming the extra); ball joints, a second free joint,
-        higher-order joint equalities; under ``strict``, every warned feature.
+        MuJoCo is not installed (naming the extra); ball joints, higher-order joint
+        equalities; under ``strict``, every warned feature.
     MujocoCompileError
         The compiler rejected the file (its message).
     UnknownFormatError
@@ -164,9 +166,13 @@ def model_from_mujoco(m, source: str = "<mujoco>", strict: bool = False,
     """eomgen's model of the compiled MuJoCo model ``m`` (``mujoco.MjModel``); see the module
     docstring. ``source`` names it in messages."""
     model = build_tree(m, source)
-    notices = model_notices(m, source)
+    present = {joint.name for joint in model.joints}
+    # what concerns only the joints of a dropped free body goes with it
+    notices = tuple(n for n in model_notices(m, source)
+                    if not n.joints or any(j in present for j in n.joints))
     model = replace(model, notices=tuple(model.notices) + notices,
-                    info=model.info + (("mujoco_motors", motors(m)),))
+                    info=model.info + (("mujoco_motors", tuple(
+                        motor for motor in motors(m) if motor[1] in present)),))
     if not defer_notices:
         emit_notices(model.notices, strict)
     return model

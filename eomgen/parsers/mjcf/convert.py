@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...model import RobotModel
-from .tree import FREE, joint_names, rotation_of_quaternion
+from .tree import joint_names, rotation_of_quaternion
 
 
 @dataclass(frozen=True)
@@ -47,7 +47,7 @@ def layout(m, model: RobotModel) -> Layout:
     by_name = {name: j for j, name in enumerate(joint_names(m))}
     qpos, dofs, free = [], [], None
     if model.free_flyer:
-        j = next(j for j in range(m.njnt) if int(m.jnt_type[j]) == FREE)
+        j = by_name[dict(model.info)["mujoco_free_joint"]]
         qa, da = int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])
         free = (qa, da)
         qpos += [qa, qa + 1, qa + 2, qa + 4, qa + 5, qa + 6, qa + 3]
@@ -88,7 +88,8 @@ def velocity_map(lay: Layout, qpos) -> np.ndarray:
 
 
 def mujoco_dynamics(m, lay: Layout, q, v) -> dict[str, np.ndarray]:
-    """MuJoCo's quantities at eomgen's state ``(q, v)``, in eomgen's coordinates:
+    """MuJoCo's quantities at eomgen's state ``(q, v)``, in eomgen's coordinates (the joints
+    eomgen dropped, a second free body's, at ``qpos0`` and at rest):
     ``M_a`` (``mj_fullM``, armature included), ``M`` (armature removed), ``h`` (``qfrc_bias``
     with the free joint's ``Ṫ v``), ``passive`` (``qfrc_passive``: damping, springs, fluid,
     gravity compensation), and its parts ``damper`` and ``spring`` (``qfrc_damper``,

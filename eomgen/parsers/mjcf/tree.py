@@ -20,6 +20,8 @@ from ...errors import KinematicTreeError, UnsupportedError
 from ...free_flyer import add_free_flyer, quaternion_matrix
 from ...model import (
     Actuator,
+    Notice,
+    NoticeKind,
     Inertial,
     Joint,
     JointType,
@@ -139,15 +141,22 @@ def build_tree(m, source: str) -> RobotModel:
     """The links and joints of the compiled model ``m`` (module docstring), validated by
     :func:`eomgen.model.build_model`, with the free flyer of its free joint if it has one.
 
+    Several free bodies (a robot and a ball): the one with the most joints below it (the
+    first of those) flies; the others are dropped with their subtrees, one notice each (a
+    free body joined to the rest by nothing but contacts and equalities: the tree's dynamics
+    of the rest do not depend on it).
+
     Raises
     ------
     UnsupportedError
-        A ball joint, a second free joint, a free joint with other joints in its body.
+        A ball joint, a free joint with other joints in its body.
     """
     bodies, jnames = body_names(m), joint_names(m)
+    kept, dropped = _free_bodies(m)
     taken_links, taken_joints = set(bodies), set(jnames)
     links: list[Link] = [Link(WORLD)]
     joints: list[Joint] = []
+    notices = []
     free: tuple[int, int] | None = None  # (body, joint)
     for b in range(1, m.nbody):
         name = bodies[b]
@@ -157,16 +166,15 @@ def build_tree(m, source: str) -> RobotModel:
         body_joints = list(range(int(m.body_jntadr[b]), int(m.body_jntadr[b])
                                  + int(m.body_jntnum[b])))
         types = [int(m.jnt_type[j]) for j in body_joints]
+        if b in dropped:
+            if FREE in types:
+                notices.append(_dropped_notice(m, source, b, dropped, bodies, jnames, kept))
+            continue
         for j, kind in zip(body_joints, types):
             if kind == BALL:
                 refuse_ball(source, jnames[j], name)
         if FREE in types:
             j = body_joints[types.index(FREE)]
-            if free is not None:
-                raise UnsupportedError(
-                    source, f"joint '{jnames[j]}' (free, body '{name}')",
-                    f"a second free joint (the first is '{jnames[free[1]]}'): eomgen models "
-                    "one floating base")
             if len(types) > 1:
                 raise UnsupportedError(source, f"joint '{jnames[j]}' (free, body '{name}')",
                                        "a free joint with other joints in its body")
@@ -218,7 +226,47 @@ def build_tree(m, source: str) -> RobotModel:
                         defer_notices=True)
     if free is not None:
         model = _with_free_flyer(model, m, bodies[free[0]], jnames[free[1]], free[1], source)
-    return model
+    return replace(model, notices=tuple(notices) + tuple(model.notices))
+
+
+def _free_bodies(m) -> tuple[int | None, set[int]]:
+    """``(kept, dropped)``: the free body that flies (the most joints below it, the first of
+    those; None without one) and every body in the subtree of another free body."""
+    free = [b for b in range(1, m.nbody)
+            if FREE in [int(m.jnt_type[j]) for j in range(int(m.body_jntadr[b]),
+                                                          int(m.body_jntadr[b])
+                                                          + int(m.body_jntnum[b]))]]
+    if not free:
+        return None, set()
+    root_of = {}
+    for b in range(1, m.nbody):  # parents come before children in MuJoCo's body order
+        parent = int(m.body_parentid[b])
+        root_of[b] = b if b in free else root_of.get(parent)
+    counts = {f: sum(int(m.body_jntnum[b]) for b in root_of if root_of[b] == f) for f in free}
+    kept = max(free, key=lambda f: (counts[f], -f))
+    return kept, {b for b, root in root_of.items() if root is not None and root != kept}
+
+
+def _dropped_notice(m, source, body, dropped, bodies, jnames, kept) -> Notice:
+    j = int(m.body_jntadr[body])
+    below = [b for b in dropped if b == body or _below(m, b, body)]
+    joints = tuple(jnames[k] for b in below for k in range(int(m.body_jntadr[b]),
+                                                           int(m.body_jntadr[b])
+                                                           + int(m.body_jntnum[b])))
+    return Notice(NoticeKind.NOT_MODELLED, source,
+                  f"joint '{jnames[j]}' (free, body '{bodies[body]}')",
+                  f"a second free body (body '{bodies[kept]}' flies): eomgen models one "
+                  "floating base",
+                  f"dropped with the {len(below)} bodies and {len(joints)} joints of its "
+                  "subtree", links=tuple(bodies[b] for b in below), joints=joints)
+
+
+def _below(m, b: int, root: int) -> bool:
+    while b > 0:
+        b = int(m.body_parentid[b])
+        if b == root:
+            return True
+    return False
 
 
 def _model_name(m, source: str) -> str:
