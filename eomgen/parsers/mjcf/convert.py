@@ -93,7 +93,7 @@ def mujoco_dynamics(m, lay: Layout, q, v) -> dict[str, np.ndarray]:
     ``M_a`` (``mj_fullM``, armature included), ``M`` (armature removed), ``h`` (``qfrc_bias``
     with the free joint's ``Ṫ v``), ``passive`` (``qfrc_passive``: damping, springs, fluid,
     gravity compensation), and its parts ``damper`` and ``spring`` (``qfrc_damper``,
-    ``qfrc_spring``)."""
+    ``qfrc_spring``, where this MuJoCo has them)."""
     import mujoco  # an optional dependency, present whenever a compiled model is
 
     data = mujoco.MjData(m)
@@ -117,8 +117,9 @@ def mujoco_dynamics(m, lay: Layout, q, v) -> dict[str, np.ndarray]:
     rigid = full - np.diag(m.dof_armature)
     return {"M_a": T.T @ full @ T, "M": T.T @ rigid @ T,
             "h": T.T @ (data.qfrc_bias + rigid @ drift),
-            "passive": T.T @ data.qfrc_passive, "damper": T.T @ data.qfrc_damper,
-            "spring": T.T @ data.qfrc_spring}
+            "passive": T.T @ data.qfrc_passive,
+            **{part: T.T @ getattr(data, f"qfrc_{part}") for part in ("damper", "spring")
+               if hasattr(data, f"qfrc_{part}")}}  # parts kept apart since MuJoCo 3.1
 
 
 def _absent(m, lay: Layout) -> np.ndarray:
