@@ -27,7 +27,8 @@ mujoco = pytest.importorskip("mujoco", reason="MJCF is read by MuJoCo's compiler
 
 from eomgen.numeric.newton_euler import link_poses, numeric_model  # noqa: E402
 from eomgen.parsers.mjcf import MujocoCompileError, compile_mjcf, is_mjcf  # noqa: E402
-from eomgen.parsers.mjcf.convert import layout, mujoco_dynamics, to_eomgen  # noqa: E402
+from eomgen.parsers.mjcf.convert import (  # noqa: E402
+    layout, mujoco_dynamics, to_eomgen, to_mujoco)
 from eomgen.parsers.mjcf.tree import rotation_of_quaternion  # noqa: E402
 
 DATA = Path(__file__).resolve().parent.parent / "data" / "mjcf"
@@ -289,3 +290,26 @@ def test_compiler_warnings_are_python_warnings(tmp_path, capfd):
     assert "settotalmass" not in capfd.readouterr().err  # not also printed by MuJoCo
     masses = [float(link.inertial.mass) for link in model.links if link.inertial is not None]
     assert sum(masses) == pytest.approx(5.0, rel=1e-12)  # the compiler's masses
+
+
+def test_states_round_trip_and_a_last_free_body_is_left_at_rest(tmp_path, derived):
+    model, m, _ = derived["floating.xml"]
+    lay = layout(m, model)
+    q, v = next(states(model))
+    qpos, qvel = to_mujoco(lay, q, v)
+    assert (qpos.shape, qvel.shape) == ((m.nq,), (m.nv,))
+    q2, v2 = to_eomgen(lay, qpos, qvel)
+    assert np.allclose(q2, q, rtol=0, atol=1e-15) and np.allclose(v2, v, rtol=0, atol=1e-15)
+    path = tmp_path / "last.xml"  # the dropped ball's coordinates after every other one
+    path.write_text("<mujoco><worldbody><body name='box'><freejoint name='root'/>"
+                    "<geom type='box' size='.1 .2 .3'/><body name='arm' pos='.1 0 0'>"
+                    "<joint name='j' axis='0 1 1'/><geom size='.05' pos='.1 0 0'/></body>"
+                    "</body><body name='ball' pos='1 0 0'><freejoint/><geom size='.1'/>"
+                    "</body></worldbody></mujoco>", encoding="utf-8")
+    small, m = quiet_load(path), compile_mjcf(path)
+    module = eomgen.derive(small, outputs=("M", "h")).lambdify().module
+    lay = layout(m, small)
+    for q, v in states(small, count=2):
+        ref = mujoco_dynamics(m, lay, q, v)
+        assert relative(module.mass_matrix(q), ref["M"]) < TOLERANCE
+        assert relative(module.nonlinear_effects(q, v).ravel(), ref["h"]) < TOLERANCE

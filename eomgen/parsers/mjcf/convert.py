@@ -35,11 +35,13 @@ class Layout:
     """Where each entry of eomgen's ``q`` (NQ) and ``v`` (NV) sits in MuJoCo's ``qpos`` and
     ``qvel``: ``qpos[qpos_index]`` gives ``q`` (the quaternion reordered), ``T`` the velocity
     map at a configuration. ``free`` is MuJoCo's qpos and dof address of the free joint (None
-    without one)."""
+    without one); ``nq``, ``nv`` are MuJoCo's sizes."""
 
     qpos_index: np.ndarray
     dof_index: np.ndarray
     free: tuple[int, int] | None
+    nq: int
+    nv: int
 
 
 def layout(m, model: RobotModel) -> Layout:
@@ -56,7 +58,8 @@ def layout(m, model: RobotModel) -> Layout:
         j = by_name[joint.name]
         qpos.append(int(m.jnt_qposadr[j]))
         dofs.append(int(m.jnt_dofadr[j]))
-    return Layout(np.array(qpos), np.array(dofs), free)
+    return Layout(np.array(qpos, dtype=int), np.array(dofs, dtype=int), free, int(m.nq),
+                  int(m.nv))
 
 
 def to_eomgen(lay: Layout, qpos, qvel=None):
@@ -69,17 +72,17 @@ def to_eomgen(lay: Layout, qpos, qvel=None):
     return q, v
 
 
-def to_mujoco(lay: Layout, q, v, nq: int, nv: int):
-    """MuJoCo's ``(qpos, qvel)`` (sizes ``nq``, ``nv``) from eomgen's ``q`` and ``v``; entries
-    of joints eomgen does not have stay zero."""
-    qpos = np.zeros(nq)
+def to_mujoco(lay: Layout, q, v):
+    """MuJoCo's ``(qpos, qvel)`` from eomgen's ``q`` and ``v``; entries of joints eomgen does
+    not have (a dropped free body's) stay zero."""
+    qpos = np.zeros(lay.nq)
     qpos[lay.qpos_index] = np.asarray(q, dtype=float)
     return qpos, velocity_map(lay, qpos) @ np.asarray(v, dtype=float)
 
 
 def velocity_map(lay: Layout, qpos) -> np.ndarray:
-    """``T`` (nv_mj × NV): ``qvel = T v``."""
-    T = np.zeros((int(max(lay.dof_index.max(initial=-1) + 1, 0)), len(lay.dof_index)))
+    """``T`` (MuJoCo's nv × NV): ``qvel = T v``."""
+    T = np.zeros((lay.nv, len(lay.dof_index)))
     T[lay.dof_index, np.arange(len(lay.dof_index))] = 1.0
     if lay.free is not None:
         qa, da = lay.free
@@ -97,7 +100,7 @@ def mujoco_dynamics(m, lay: Layout, q, v) -> dict[str, np.ndarray]:
     import mujoco  # an optional dependency, present whenever a compiled model is
 
     data = mujoco.MjData(m)
-    qpos, qvel = to_mujoco(lay, q, v, m.nq, m.nv)
+    qpos, qvel = to_mujoco(lay, q, v)
     qpos[_absent(m, lay)] = m.qpos0[_absent(m, lay)]
     data.qpos[:], data.qvel[:] = qpos, qvel
     mujoco.mj_forward(m, data)
@@ -107,8 +110,6 @@ def mujoco_dynamics(m, lay: Layout, q, v) -> dict[str, np.ndarray]:
     else:
         mujoco.mj_fullM(m, data, full)
     T = velocity_map(lay, qpos)
-    if T.shape[0] < m.nv:
-        T = np.vstack([T, np.zeros((m.nv - T.shape[0], T.shape[1]))])
     drift = np.zeros(m.nv)  # Ṫ v
     if lay.free is not None:
         qa, da = lay.free
