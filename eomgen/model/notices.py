@@ -22,6 +22,7 @@ class NoticeKind(enum.Enum):
     TRIANGLE_INEQUALITY = "triangle inequality"  # a link inertia that is not physical
     MIMIC = "mimic"                              # a URDF <mimic> coupling read as independent
     FLOATING_BASE = "floating base"              # a root that looks free, read as fixed
+    NOT_MODELLED = "not modelled"                # a feature left out (MJCF tendons, springs)
 
 
 @dataclass(frozen=True)

@@ -46,8 +46,9 @@ MAX_FILE_BYTES = 50 * 1024 * 1024
 
 def load(path, strict: bool = False, defer_notices: bool = False,
          snap: bool = True, couplings: bool = True) -> RobotModel:
-    """Read a robot description: URDF (``.urdf``), DH table (``.yaml`` with ``dh:``) or eomgen
-    YAML (``.yaml`` with ``links:``/``joints:``).
+    """Read a robot description: URDF (``.urdf``), MuJoCo MJCF (``.xml`` with a ``<mujoco>``
+    root, read by MuJoCo's compiler: :mod:`eomgen.parsers.mjcf`), DH table (``.yaml`` with
+    ``dh:``) or eomgen YAML (``.yaml`` with ``links:``/``joints:``).
 
     Parameters
     ----------
@@ -82,7 +83,7 @@ def load(path, strict: bool = False, defer_notices: bool = False,
     """
     # Importing a format registers it; here, so that each parser and its dependencies load on
     # first use (start-up time), not with eomgen.parsers.
-    from . import dh, urdf, yaml_format  # noqa: F401
+    from . import dh, mjcf, urdf, yaml_format  # noqa: F401
 
     path = Path(path)
     if not path.is_file():

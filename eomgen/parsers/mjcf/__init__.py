@@ -1,0 +1,182 @@
+"""Read a MuJoCo MJCF model (``.xml`` with a ``<mujoco>`` root) into a
+:class:`~eomgen.model.RobotModel`.
+
+MuJoCo's own compiler reads the file (the ``simulators`` extra: ``pip install
+'eomgen[simulators]'``): default classes, ``childclass``, ``<include>``, angle units, Euler
+sequences, ``inertiafromgeom`` and the other compiler options are MuJoCo's to resolve. eomgen's
+model is built from the compiled ``mujoco.MjModel`` (:mod:`eomgen.parsers.mjcf.tree` for the
+bodies and joints, :mod:`eomgen.parsers.mjcf.extras` for what is warned about or refused). A
+file the compiler rejects is a :class:`MujocoCompileError` carrying the compiler's message on
+one line.
+
+What is read
+------------
+* Bodies, each a link named as in MuJoCo, with the compiled mass, centre of mass and inertia
+  (``body_mass``, ``body_ipos``, ``body_iquat``, ``body_inertia``); the link frame *is* the
+  MuJoCo body frame. The world body is the link ``world``.
+* ``hinge`` and ``slide`` joints, in MuJoCo's joint order, so ``q`` is MuJoCo's ``qpos`` and
+  ``JOINT_NAMES`` MuJoCo's joint names. The body frame as written is the pose at
+  ``qpos = ref`` (MuJoCo's ``qpos0``); eomgen's ``q`` equals MuJoCo's ``qpos`` (not
+  ``qpos − ref``): the joint origin carries the rotation (or translation) by ``−ref``. A
+  joint whose ``pos`` is not the body origin rotates about its anchor: its eomgen joint frame
+  sits at the anchor, and a fixed joint ``<body>_anchor`` leads back to the body frame.
+* Several joints in one body (planar walkers: ``rootz``, ``rootx``, ``rooty``) are a chain of
+  massless links ``<body>_<joint>`` (the frame of each joint but the last), applied in MuJoCo's
+  order.
+* A body without joints is welded to its parent by a fixed joint ``<body>_weld``.
+* The ``free`` joint (a body of the world) is the quaternion free flyer of
+  :mod:`eomgen.free_flyer` (Pinocchio's layout): ``q[0:7] = (x, y, z, qx, qy, qz, qw)`` where
+  MuJoCo's ``qpos`` has ``(x, y, z, qw, qx, qy, qz)``; ``v[0:6]`` is the body twist in the body
+  frame (linear, then angular) where MuJoCo's ``qvel`` has the linear velocity in *world* axes
+  (the angular one in the body frame, as eomgen's). The joint's MuJoCo name is in
+  ``model.info`` (``"mujoco_free_joint"``); the six velocity coordinates keep the free
+  flyer's names ``base_vx … base_wz``. With several free bodies (dm_control's quadruped and
+  its ball), the one with the most joints below it flies and the others are dropped with
+  their subtrees (warned by name: nothing but contacts and equalities joins them to it).
+* Each hinge or slide joint's ``armature``, ``damping`` and ``frictionloss`` are its
+  :class:`~eomgen.model.Actuator` (``armature``, viscous ``damping``, Coulomb ``friction``;
+  docs/actuators.md); those of the free joint go to the six free-flyer coordinates (equal on
+  all six, so they map exactly).
+* ``<option gravity>`` (zero when the ``gravity`` flag is disabled).
+* ``<motor>`` actuators on hinge and slide joints: the joint torque is ``gear · ctrl``;
+  ``model.info["mujoco_motors"]`` lists ``(actuator, joint, gear)``.
+
+Unnamed bodies and joints are named ``body<i>`` and ``joint<i>`` with MuJoCo's id ``i``;
+a name that is taken gets ``_2``, ``_3``, … appended.
+
+Warned about (:class:`~eomgen.errors.UnsupportedFeatureWarning`, refused under ``strict``),
+by name: joint springs (``stiffness``, ``springref``: not modelled), tendons, actuators other
+than motors on hinge and slide joints, equality constraints (``connect``, ``weld``, first-order
+``joint``, ``tendon``: not read yet, the model is the tree without them), fluid forces
+(``density``, ``viscosity``), gravity compensation (``gravcomp``). Refused
+(:class:`~eomgen.errors.UnsupportedError`), by name: ``ball`` joints (not read yet) and
+``joint`` equalities of order above one.
+
+Contacts, joint limits, geoms, sites, sensors and the rendering options do not enter the
+equations of motion and are ignored.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from dataclasses import replace
+from pathlib import Path
+
+from ...errors import DescriptionError, UnknownFormatError, UnreadableFileError, UnsupportedError
+from ...model import RobotModel, emit_notices
+from .. import register
+from .extras import model_notices, motors
+from .tree import build_tree
+
+#: The optional extra that installs MuJoCo.
+EXTRA = "simulators"
+
+_LEADING = re.compile(r"\s*(<\?.*?\?>|<!--.*?-->|<!DOCTYPE[^>]*>)", re.S)
+
+
+class MujocoCompileError(DescriptionError):
+    """MuJoCo's compiler rejected the MJCF file: its message, on one line."""
+
+
+def is_mjcf(text: str) -> bool:
+    """Whether XML ``text`` has a ``<mujoco>`` root element (after the declaration, comments
+    and a doctype)."""
+    position = 0
+    while True:
+        match = _LEADING.match(text, position)
+        if not match:
+            break
+        position = match.end()
+    return re.match(r"\s*<mujoco[\s/>]", text[position:]) is not None
+
+
+@register("MJCF", (".xml",), sniff=is_mjcf)
+def load_mjcf(path: Path, strict: bool = False, defer_notices: bool = False) -> RobotModel:
+    """Read the MJCF file ``path`` with MuJoCo's compiler (see the module docstring).
+
+    Raises
+    ------
+    UnsupportedError
+        MuJoCo is not installed (naming the extra); ball joints, higher-order joint
+        equalities; under ``strict``, every warned feature.
+    MujocoCompileError
+        The compiler rejected the file (its message).
+    UnknownFormatError
+        The root element is not ``<mujoco>``.
+    """
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise UnreadableFileError(source, "", f"cannot read the file ({exc})") from None
+    if not is_mjcf(text):
+        raise UnknownFormatError(source, "", "not an MJCF file: the root element is not "
+                                 "<mujoco>")
+    return model_from_mujoco(compile_mjcf(path), source, strict, defer_notices)
+
+
+def compile_mjcf(path) -> "mujoco.MjModel":  # noqa: F821
+    """MuJoCo's compiled model of the MJCF file ``path``.
+
+    Raises
+    ------
+    UnsupportedError
+        MuJoCo is not installed.
+    MujocoCompileError
+        The compiler's message, on one line.
+
+    Warns
+    -----
+    UserWarning
+        Each warning of the compiler (a deprecated attribute), on one line.
+    """
+    mujoco = import_mujoco(str(path))
+    said: list[str] = []
+    handler = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(said.append)  # the compiler's warnings, else on stderr
+    try:
+        m = mujoco.MjModel.from_xml_path(str(path))
+    except ValueError as exc:
+        raise MujocoCompileError(str(path), "", f"MuJoCo's compiler: {_one_line(exc)}") from None
+    finally:
+        mujoco.set_mju_user_warning(handler)
+    for message in said:
+        warnings.warn(f"{path}: MuJoCo's compiler: {_one_line(message)}", UserWarning,
+                      stacklevel=2)
+    return m
+
+
+def _one_line(message) -> str:
+    return "; ".join(line.strip() for line in str(message).splitlines() if line.strip())
+
+
+def import_mujoco(source: str):
+    """The ``mujoco`` module, or an :class:`UnsupportedError` naming the extra."""
+    try:
+        import mujoco  # here: an optional dependency, loaded only to read MJCF
+    except ImportError:
+        raise UnsupportedError(source, "", "reading MJCF needs MuJoCo: pip install "
+                               f"'eomgen[{EXTRA}]'") from None
+    return mujoco
+
+
+def model_from_mujoco(m, source: str = "<mujoco>", strict: bool = False,
+                      defer_notices: bool = False) -> RobotModel:
+    """eomgen's model of the compiled MuJoCo model ``m`` (``mujoco.MjModel``); see the module
+    docstring. ``source`` names it in messages."""
+    model = build_tree(m, source)
+    present = {joint.name for joint in model.joints}
+    # what concerns only the joints of a dropped free body goes with it
+    notices = tuple(n for n in model_notices(m, source)
+                    if not n.joints or any(j in present for j in n.joints))
+    model = replace(model, notices=tuple(model.notices) + notices,
+                    info=model.info + (("mujoco_motors", tuple(
+                        motor for motor in motors(m) if motor[1] in present)),))
+    if not defer_notices:
+        emit_notices(model.notices, strict)
+    return model
+
+
+__all__ = ["EXTRA", "MujocoCompileError", "compile_mjcf", "import_mujoco", "is_mjcf",
+           "load_mjcf", "model_from_mujoco"]

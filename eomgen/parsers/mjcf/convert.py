@@ -1,0 +1,130 @@
+"""MuJoCo's arrays in eomgen's coordinates, for a model read from MJCF
+(:mod:`eomgen.parsers.mjcf`): states both ways, and MuJoCo's own mass matrix, bias and passive
+forces mapped onto eomgen's ``(q, v)`` (the independent reference of the MJCF tests).
+
+Hinge and slide joints: eomgen's ``q`` and ``v`` entries *are* MuJoCo's ``qpos`` and ``qvel``
+entries (same names, same values); only their order can differ, when the free joint is not
+MuJoCo's first joint (the free flyer always comes first in eomgen).
+
+The free joint: MuJoCo's ``qpos`` block is ``(x, y, z, qw, qx, qy, qz)``, eomgen's
+``(x, y, z, qx, qy, qz, qw)``; MuJoCo's ``qvel`` block is ``(ṗ in world axes, ω in body
+axes)``, eomgen's ``(Rᵀ ṗ, ω)`` (both in body axes). So ``v_mj = T(q) v`` with ``T`` the
+identity but for the block ``R`` on the linear velocity; generalised forces map by the
+transpose (virtual work): ``M = Tᵀ M_mj T``, ``h(q, v) = Tᵀ (bias_mj + M_mj Ṫ v)`` where
+``Ṫ v`` is ``R (ω × Rᵀ ṗ)`` on the linear block, ``τ = Tᵀ qfrc`` (``M_mj`` of the rigid
+bodies: armature excluded).
+
+A free joint's ``armature`` ``a`` is MuJoCo's on *its* coordinates: ``Tᵀ (a I) T = a I``, so
+eomgen's drive mass matrix is exact, but MuJoCo's equations then also hold ``a (ω × Rᵀ ṗ)`` on
+the linear rows (``Tᵀ a Ṫ v``), which eomgen's drives (armature on each velocity coordinate) do
+not: the parser warns when a free joint has armature.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...model import RobotModel
+from .tree import joint_names, rotation_of_quaternion
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Where each entry of eomgen's ``q`` (NQ) and ``v`` (NV) sits in MuJoCo's ``qpos`` and
+    ``qvel``: ``qpos[qpos_index]`` gives ``q`` (the quaternion reordered), ``T`` the velocity
+    map at a configuration. ``free`` is MuJoCo's qpos and dof address of the free joint (None
+    without one); ``nq``, ``nv`` are MuJoCo's sizes."""
+
+    qpos_index: np.ndarray
+    dof_index: np.ndarray
+    free: tuple[int, int] | None
+    nq: int
+    nv: int
+
+
+def layout(m, model: RobotModel) -> Layout:
+    """The :class:`Layout` of ``model`` (read from the compiled MuJoCo model ``m``)."""
+    by_name = {name: j for j, name in enumerate(joint_names(m))}
+    qpos, dofs, free = [], [], None
+    if model.free_flyer:
+        j = by_name[dict(model.info)["mujoco_free_joint"]]
+        qa, da = int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])
+        free = (qa, da)
+        qpos += [qa, qa + 1, qa + 2, qa + 4, qa + 5, qa + 6, qa + 3]
+        dofs += list(range(da, da + 6))
+    for joint in model.movable_joints[6 if model.free_flyer else 0:]:
+        j = by_name[joint.name]
+        qpos.append(int(m.jnt_qposadr[j]))
+        dofs.append(int(m.jnt_dofadr[j]))
+    return Layout(np.array(qpos, dtype=int), np.array(dofs, dtype=int), free, int(m.nq),
+                  int(m.nv))
+
+
+def to_eomgen(lay: Layout, qpos, qvel=None):
+    """eomgen's ``q`` (and ``v`` when ``qvel`` is given) from MuJoCo's ``qpos`` (``qvel``)."""
+    qpos = np.asarray(qpos, dtype=float)
+    q = qpos[lay.qpos_index]
+    if qvel is None:
+        return q
+    v = velocity_map(lay, qpos).T @ np.asarray(qvel, dtype=float)  # T orthogonal: T⁻¹ = Tᵀ
+    return q, v
+
+
+def to_mujoco(lay: Layout, q, v):
+    """MuJoCo's ``(qpos, qvel)`` from eomgen's ``q`` and ``v``; entries of joints eomgen does
+    not have (a dropped free body's) stay zero."""
+    qpos = np.zeros(lay.nq)
+    qpos[lay.qpos_index] = np.asarray(q, dtype=float)
+    return qpos, velocity_map(lay, qpos) @ np.asarray(v, dtype=float)
+
+
+def velocity_map(lay: Layout, qpos) -> np.ndarray:
+    """``T`` (MuJoCo's nv × NV): ``qvel = T v``."""
+    T = np.zeros((lay.nv, len(lay.dof_index)))
+    T[lay.dof_index, np.arange(len(lay.dof_index))] = 1.0
+    if lay.free is not None:
+        qa, da = lay.free
+        T[da:da + 3, 0:3] = rotation_of_quaternion(np.asarray(qpos)[qa + 3:qa + 7])
+    return T
+
+
+def mujoco_dynamics(m, lay: Layout, q, v) -> dict[str, np.ndarray]:
+    """MuJoCo's quantities at eomgen's state ``(q, v)``, in eomgen's coordinates (the joints
+    eomgen dropped, a second free body's, at ``qpos0`` and at rest):
+    ``M_a`` (``mj_fullM``, armature included), ``M`` (armature removed), ``h`` (``qfrc_bias``
+    with the free joint's ``Ṫ v``), ``passive`` (``qfrc_passive``: damping, springs, fluid,
+    gravity compensation), and its parts ``damper`` and ``spring`` (``qfrc_damper``,
+    ``qfrc_spring``, where this MuJoCo has them)."""
+    import mujoco  # an optional dependency, present whenever a compiled model is
+
+    data = mujoco.MjData(m)
+    qpos, qvel = to_mujoco(lay, q, v)
+    qpos[_absent(m, lay)] = m.qpos0[_absent(m, lay)]
+    data.qpos[:], data.qvel[:] = qpos, qvel
+    mujoco.mj_forward(m, data)
+    full = np.zeros((m.nv, m.nv))
+    if hasattr(data, "qM"):  # MuJoCo before 3.3: mj_fullM(m, dst, qM)
+        mujoco.mj_fullM(m, full, data.qM)
+    else:
+        mujoco.mj_fullM(m, data, full)
+    T = velocity_map(lay, qpos)
+    drift = np.zeros(m.nv)  # Ṫ v
+    if lay.free is not None:
+        qa, da = lay.free
+        R = rotation_of_quaternion(qpos[qa + 3:qa + 7])
+        drift[da:da + 3] = R @ np.cross(v[3:6], v[0:3])
+    rigid = full - np.diag(m.dof_armature)
+    return {"M_a": T.T @ full @ T, "M": T.T @ rigid @ T,
+            "h": T.T @ (data.qfrc_bias + rigid @ drift),
+            "passive": T.T @ data.qfrc_passive,
+            **{part: T.T @ getattr(data, f"qfrc_{part}") for part in ("damper", "spring")
+               if hasattr(data, f"qfrc_{part}")}}  # parts kept apart since MuJoCo 3.1
+
+
+def _absent(m, lay: Layout) -> np.ndarray:
+    """MuJoCo qpos entries eomgen has no coordinate for."""
+    mask = np.ones(m.nq, dtype=bool)
+    mask[lay.qpos_index] = False
+    return mask

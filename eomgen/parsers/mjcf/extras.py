@@ -1,0 +1,180 @@
+"""What a compiled MuJoCo model holds besides its tree: the motors eomgen maps to joint torques,
+and the findings warned about (or refused) by name: joint springs, tendons, other actuators,
+equality constraints, fluid forces, gravity compensation (:mod:`eomgen.parsers.mjcf`).
+
+Each equality kind has its reader in :data:`EQUALITY_READERS` (``connect`` and ``weld`` will
+be loops, first-order ``joint`` equalities couplings); today each returns the notice that it is
+not read yet, and a ``joint`` equality of higher order is refused.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+from ...errors import UnsupportedError
+from ...model import Notice, NoticeKind
+from .tree import FREE, HINGE, SLIDE, disabled, joint_names
+
+#: MuJoCo's transmission, dynamics, gain and bias types of a plain motor (``mjTRN_JOINT``,
+#: ``mjDYN_NONE``, ``mjGAIN_FIXED``, ``mjBIAS_NONE``) and of ``mjTRN_JOINTINPARENT``.
+_TRN_JOINT, _TRN_JOINT_IN_PARENT = 0, 1
+_TRN_NAMES = {2: "slider-crank", 3: "tendon", 4: "site", 5: "body"}
+_DYN_NAMES = {1: "integrator", 2: "filter", 3: "filter", 4: "muscle", 5: "DC motor", 6: "PID"}
+_GAIN_MUSCLE, _BIAS_AFFINE = 2, 1
+#: MuJoCo's equality types (``mjtEq``) and wrap type of a joint in a fixed tendon.
+CONNECT, WELD, JOINT, TENDON = 0, 1, 2, 3
+_WRAP_JOINT = 1
+
+_NOT_READ = "not read yet: the model is the tree without it"
+
+
+def _name(m, kind: str, i: int) -> str:
+    return getattr(m, kind)(i).name or f"{kind}{i}"
+
+
+def _notice(source: str, element: str, problem: str, fallback: str = "",
+            joints: tuple[str, ...] = (), links: tuple[str, ...] = ()) -> Notice:
+    return Notice(NoticeKind.NOT_MODELLED, source, element, problem, fallback, links, joints)
+
+
+def motors(m) -> tuple[tuple[str, str, float], ...]:
+    """``(actuator, joint, gear)`` of each plain motor on a hinge or slide joint: MuJoCo applies
+    the joint torque ``gear · ctrl`` [N m or N] (``gear`` includes a ``<general>``'s gain)."""
+    jnames = joint_names(m)
+    return tuple((_name(m, "actuator", i), jnames[int(m.actuator_trnid[i, 0])],
+                  float(m.actuator_gear[i, 0] * m.actuator_gainprm[i, 0]))
+                 for i in range(m.nu) if _is_motor(m, i))
+
+
+def _is_motor(m, i: int) -> bool:
+    if int(m.actuator_trntype[i]) not in (_TRN_JOINT, _TRN_JOINT_IN_PARENT):
+        return False
+    joint = int(m.actuator_trnid[i, 0])
+    return (int(m.jnt_type[joint]) in (HINGE, SLIDE) and int(m.actuator_dyntype[i]) == 0
+            and int(m.actuator_gaintype[i]) == 0 and int(m.actuator_biastype[i]) == 0)
+
+
+def _actuator_kind(m, i: int) -> str:
+    trn = int(m.actuator_trntype[i])
+    if trn in _TRN_NAMES:
+        return f"an actuator on a {_TRN_NAMES[trn]}"
+    if int(m.actuator_gaintype[i]) == _GAIN_MUSCLE or int(m.actuator_dyntype[i]) == 4:
+        return "a muscle"
+    if int(m.jnt_type[int(m.actuator_trnid[i, 0])]) == FREE:
+        return "an actuator on a free joint"
+    if int(m.actuator_biastype[i]) == _BIAS_AFFINE:
+        return "a servo (position or velocity feedback)"
+    return f"an actuator with {_DYN_NAMES.get(int(m.actuator_dyntype[i]), 'its own')} dynamics"
+
+
+def model_notices(m, source: str) -> tuple[Notice, ...]:
+    """The findings about ``m`` eomgen warns about (or refuses under ``strict``), in this
+    order: joint springs, tendons, actuators other than motors, equalities, fluid forces,
+    gravity compensation.
+
+    Raises
+    ------
+    UnsupportedError
+        A ``joint`` equality of order above one.
+    """
+    jnames = joint_names(m)
+    notices: list[Notice] = []
+    if not disabled(m, "SPRING"):
+        for j in range(m.njnt):
+            k = float(m.jnt_stiffness[j])
+            if k:
+                ref = float(m.qpos_spring[int(m.jnt_qposadr[j])])
+                notices.append(_notice(source, f"joint '{jnames[j]}' stiffness",
+                                       f"the joint spring -{k:g} (q - {ref:g}) (stiffness, "
+                                       "springref) is not modelled", "left out",
+                                       joints=(jnames[j],)))
+    for j in range(m.njnt):
+        if int(m.jnt_type[j]) == FREE and float(m.dof_armature[int(m.jnt_dofadr[j])]):
+            notices.append(_notice(source, f"joint '{jnames[j]}' (free) armature",
+                                   "MuJoCo's armature acts on the world-frame linear velocity "
+                                   "of a free joint, eomgen's on the body-frame one (the same "
+                                   "M + a I, a bias a (omega x v) apart)",
+                                   "read on eomgen's coordinates", joints=(jnames[j],)))
+    for t in range(m.ntendon):
+        start, count = int(m.tendon_adr[t]), int(m.tendon_num[t])
+        joints = tuple(jnames[int(m.wrap_objid[w])] for w in range(start, start + count)
+                       if int(m.wrap_type[w]) == _WRAP_JOINT)
+        notices.append(_notice(source, f"tendon '{_name(m, 'tendon', t)}'",
+                               "tendons are not modelled (their springs, damping and the "
+                               "actuators on them)", "left out", joints=joints))
+    for i in range(m.nu):
+        if not _is_motor(m, i):
+            on_joint = int(m.actuator_trntype[i]) in (_TRN_JOINT, _TRN_JOINT_IN_PARENT)
+            notices.append(_notice(source, f"actuator '{_name(m, 'actuator', i)}'",
+                                   f"{_actuator_kind(m, i)} is not modelled",
+                                   "eomgen's input is the joint torque",
+                                   joints=(jnames[int(m.actuator_trnid[i, 0])],) if on_joint
+                                   else ()))
+    for e in range(m.neq):
+        reader = EQUALITY_READERS.get(int(m.eq_type[e]), other_equality)
+        notices.append(reader(m, e, source))
+    if m.opt.density or m.opt.viscosity:
+        notices.append(_notice(source, "option density, viscosity",
+                               "fluid forces are not modelled", "left out"))
+    for b in range(1, m.nbody):
+        if float(m.body_gravcomp[b]):
+            notices.append(_notice(source, f"body '{_name(m, 'body', b)}' gravcomp",
+                                   "gravity compensation is not modelled", "left out"))
+    return tuple(notices)
+
+
+def _equality_where(m, e: int, kind: str) -> str:
+    inactive = "" if bool(m.eq_active0[e]) else ", inactive"
+    return f"equality '{_name(m, 'eq', e)}' ({kind}{inactive})"
+
+
+def _equality_bodies(m, e: int) -> tuple[str, ...]:
+    return tuple(_name(m, "body", int(b)) for b in m.eq_obj1id[e:e + 1].tolist()
+                 + m.eq_obj2id[e:e + 1].tolist() if int(b) > 0)
+
+
+def equality_connect(m, e: int, source: str) -> Notice:
+    """A ``connect`` equality (a ball-and-socket loop closure): not read yet."""
+    return _notice(source, _equality_where(m, e, "connect"), "loop closures are " + _NOT_READ,
+                   links=_equality_bodies(m, e))
+
+
+def equality_weld(m, e: int, source: str) -> Notice:
+    """A ``weld`` equality (a rigid loop closure): not read yet."""
+    return _notice(source, _equality_where(m, e, "weld"), "loop closures are " + _NOT_READ,
+                   links=_equality_bodies(m, e))
+
+
+def equality_joint(m, e: int, source: str) -> Notice:
+    """A ``joint`` equality ``q1 = c0 + c1 q2 (+ c2 q2² + …)``: a coupling when first-order
+    (not read yet), refused above.
+
+    Raises
+    ------
+    UnsupportedError
+        A polynomial of order above one.
+    """
+    jnames = joint_names(m)
+    where = _equality_where(m, e, "joint")
+    coefficients = [float(c) for c in m.eq_data[e, :5]]
+    order = max((k for k, c in enumerate(coefficients) if c), default=0)
+    if order > 1:
+        raise UnsupportedError(source, where, f"a joint equality of order {order} (polycoef "
+                               f"{' '.join(f'{c:g}' for c in coefficients)}): only first-order "
+                               "couplings q1 = c0 + c1 q2 are read")
+    joints = (jnames[int(m.eq_obj1id[e])],) + (
+        (jnames[int(m.eq_obj2id[e])],) if int(m.eq_obj2id[e]) >= 0 else ())
+    return _notice(source, where, "joint couplings are " + _NOT_READ, joints=joints)
+
+
+def other_equality(m, e: int, source: str) -> Notice:
+    """A tendon, flex or distance equality: not modelled."""
+    kinds = {TENDON: "tendon", 4: "flex", 5: "flexvert", 6: "flexstrain", 7: "distance"}
+    return _notice(source, _equality_where(m, e, kinds.get(int(m.eq_type[e]), "other")),
+                   "this equality is not modelled: the model is the tree without it")
+
+
+#: The reader of each equality kind (MuJoCo's ``mjtEq`` code): a notice today; the loop and
+#: coupling readers when those exist.
+EQUALITY_READERS: dict[int, Callable[..., Notice]] = {
+    CONNECT: equality_connect, WELD: equality_weld, JOINT: equality_joint}
