@@ -44,6 +44,8 @@ from ..present.sections import program_sections
 from ..progress import plural
 from ..symbolic.textbook import TextbookDerivation
 from ..verify import VerificationReport, verify
+from .control import (control_section, control_symbol_names, has_control_section,
+                      slotine_li_equations)
 from .contacts import (contact_equations, contact_forces,  # noqa: F401  (re-exported)
                        contact_section, contact_symbol_names)
 from .document import (Equation, Equations, Figure, Handout, Paragraph, Section, Table, code,
@@ -493,6 +495,9 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
     extra_names.update(contact_symbol_names(contacts))
     if spong is not None:  # the drives' own symbols, printed by the document's printer
         extra_names.update(drive_symbol_names(spong, w.tex))
+    control = has_control_section(book, spong is not None, contacts)
+    if control:
+        extra_names.update(control_symbol_names(dyn))
     w = Writer(nt.printing(dyn, HANDOUT_CONFIG, compact_trig=book is not None,
                             extra_names=extra_names))
     geometry = sketch_geometry(model)
@@ -513,6 +518,9 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
         sections.append(drives_section(spong, book, coriolis, w))
     if contacts:
         sections.append(contact_section(dyn, contacts, book, coriolis, w))
+    if control:
+        progress("deriving the Slotine-Li regressor")
+        sections.append(control_section(slotine_li_equations(dyn, book, coriolis), book, dyn, w))
     report, missing = None, "the check was switched off"
     if check:
         progress("checking the derivation against Newton-Euler")
