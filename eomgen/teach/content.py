@@ -15,6 +15,8 @@ Control*, the planar two-link arm):
    for flexible joints, or ``M + diag(a)`` and the friction torque for rigid ones, joint by
    joint (:func:`drive_equations`); when the scene has contacts: ``M q̈ + C q̇ + g = τ +
    J_cᵀ F_c``, ``J_c q̈ + J̇_c q̇ = 0`` and ``J_c`` written out (:func:`contact_equations`);
+   for teaching-sized arms with neither: the Slotine–Li regressor and the skew symmetry of
+   ``Ṁ − 2C`` (:mod:`eomgen.teach.control`);
 5. the verified properties, with the numbers of :func:`eomgen.verify`.
 
 Every expression is printed by eomgen's LaTeX printer
