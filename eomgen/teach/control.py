@@ -76,13 +76,27 @@ def slotine_li_equations(dyn: Dynamics, book: TextbookDerivation, coriolis) -> C
     named = {nf.value: nf.symbol for nf in names_h}
 
     def in_names(e):
+        """``e`` in compact trigonometric form, written with step 6's named factors when
+        that leaves no sine or cosine (``-2 h q̇_2``), else as it is (an entry of Ṁ that
+        no factor covers)."""
         e = simplify_trig(e, dyn.q)
+        if e == 0:
+            return e
+        short = e
         for value, symbol in named.items():
-            e = e.subs(value, symbol)
-        return sp.factor(e) if e != 0 else e
+            short = short.subs(value, symbol)
+        return sp.factor(short) if not short.has(sp.sin, sp.cos) else e
 
+    raw = M_dot - 2 * book.C
     M_dot = M_dot.applyfunc(in_names)
-    N = (M_dot - 2 * C).applyfunc(in_names)
+    N = sp.zeros(model.dof, model.dof)
+    for i in range(model.dof):
+        for j in range(model.dof):
+            if simplify_trig(raw[i, j], dyn.q) == 0:
+                continue
+            with_names = sp.factor(sp.expand(M_dot[i, j] - 2 * C[i, j]))
+            N[i, j] = (with_names if not with_names.has(sp.sin, sp.cos)
+                       else in_names(raw[i, j]))
     values = {nf.symbol: nf.value for nf in names_h}
     if (N + N.T).subs(values).applyfunc(lambda e: sp.expand(simplify_trig(e, dyn.q))) != \
             sp.zeros(model.dof, model.dof):

@@ -22,13 +22,17 @@ pin = pytest.importorskip("pinocchio")
 TITLE = "Adaptive control: the Slotine–Li regressor"
 
 
-@pytest.fixture(scope="module")
-def arm():
-    model = eomgen.load(eomgen.example_path("planar_2link"))
+def section_equations(name):
+    model = eomgen.load(eomgen.example_path(name))
     dyn = eomgen.derive(model, outputs=("M", "C", "g"), simplify=False)
     book = nt.textbook_for(dyn, HANDOUT_CONFIG)
     coriolis = named_coriolis(dyn, book)
     return model, dyn, coriolis, slotine_li_equations(dyn, book, coriolis)
+
+
+@pytest.fixture(scope="module")
+def arm():
+    return section_equations("planar_2link")
 
 
 def pinocchio_terms(model):
@@ -56,8 +60,7 @@ def pinocchio_terms(model):
     return M, C, M_dot, g
 
 
-def test_printed_regressor_times_beta_is_M_qdd_r_plus_C_qd_r_plus_g(arm):
-    model, dyn, _, eqs = arm
+def check_regressor(model, dyn, eqs):
     values = model.parameter_values
     beta = np.array([float(b.subs(values)) for b in eqs.beta])
     Y = sp.lambdify([dyn.q, dyn.qd, eqs.qd_r, eqs.qdd_r], eqs.Y.subs(values), "numpy")
@@ -66,7 +69,26 @@ def test_printed_regressor_times_beta_is_M_qdd_r_plus_C_qd_r_plus_g(arm):
         expected = M(q) @ qdd_r + C(q, qd) @ qd_r + g(q)
         np.testing.assert_allclose(np.array(Y(q, qd, qd_r, qdd_r), float) @ beta, expected,
                                    rtol=0, atol=1e-8)
-    # the textbook's entries: the second column of the second link is l1 (qdd_r1 c2 + qd1 qd_r1 s2) + g c12
+
+
+def check_skew(model, dyn, coriolis, eqs):
+    values = {nf.symbol: nf.value for nf in coriolis[0]}
+    n = model.dof
+    N = eqs.N.subs(values).subs(model.parameter_values)
+    assert (N + N.T).applyfunc(lambda e: sp.simplify(sp.expand_trig(e))) == sp.zeros(n, n)
+    _, C, M_dot, _ = pinocchio_terms(model)
+    f = sp.lambdify([dyn.q, dyn.qd], N, "numpy")
+    f_dot = sp.lambdify([dyn.q, dyn.qd], eqs.M_dot.subs(values).subs(model.parameter_values))
+    for q, qd in np.random.default_rng(6).uniform(-2, 2, (4, 2, n)):
+        np.testing.assert_allclose(np.array(f_dot(q, qd), float), M_dot(q, qd), atol=1e-8)
+        np.testing.assert_allclose(np.array(f(q, qd), float), M_dot(q, qd) - 2 * C(q, qd),
+                                   atol=1e-8)
+
+
+def test_printed_regressor_times_beta_is_M_qdd_r_plus_C_qd_r_plus_g(arm):
+    model, dyn, _, eqs = arm
+    check_regressor(model, dyn, eqs)
+    # the textbook's entry: row 2, column MX2 is g c12 + l1 (qdd_r1 c2 + qd1 qd_r1 s2)
     q1, q2 = dyn.q
     l1, g_ = (next(p.symbol for p in model.parameters if p.name == n) for n in ("l1", "g"))
     k = eqs.names.index("MX2")
@@ -76,16 +98,7 @@ def test_printed_regressor_times_beta_is_M_qdd_r_plus_C_qd_r_plus_g(arm):
 
 def test_printed_Mdot_minus_2C_is_skew_and_is_pinocchios(arm):
     model, dyn, coriolis, eqs = arm
-    values = {nf.symbol: nf.value for nf in coriolis[0]}
-    N = eqs.N.subs(values).subs(model.parameter_values)
-    assert sp.simplify(N + N.T) == sp.zeros(2, 2)
-    _, C, M_dot, _ = pinocchio_terms(model)
-    f = sp.lambdify([dyn.q, dyn.qd], N, "numpy")
-    f_dot = sp.lambdify([dyn.q, dyn.qd], eqs.M_dot.subs(values).subs(model.parameter_values))
-    for q, qd in np.random.default_rng(6).uniform(-2, 2, (4, 2, model.dof)):
-        np.testing.assert_allclose(np.array(f_dot(q, qd), float), M_dot(q, qd), atol=1e-8)
-        np.testing.assert_allclose(np.array(f(q, qd), float), M_dot(q, qd) - 2 * C(q, qd),
-                                   atol=1e-8)
+    check_skew(model, dyn, coriolis, eqs)
     h = coriolis[0][0].symbol  # the printed form is the textbook's
     qd1, qd2 = dyn.qd
     assert sp.expand(eqs.N[0, 1] - h * (2 * qd1 + qd2)) == 0 and eqs.N[0, 0] == 0
@@ -105,3 +118,14 @@ def test_handout_has_the_section_for_a_plain_arm_only():
         assert needle in section, needle
     flexible = eomgen.load(Path(__file__).parents[2] / "examples" / "robots" / "flexible_2link.yaml")
     assert TITLE not in handout_files(flexible, ["md"], check=False)[0].content
+
+
+@pytest.mark.slow
+def test_elbow_arm_section_against_pinocchio():
+    """The 3-joint elbow arm: three named factors; Ṁ − 2C printed as
+    [[0, 2 h₁ q̇₁, −2 h₂ q̇₁], …, [2 h₂ q̇₁, −h₃ (2 q̇₂ + q̇₃), 0]] (zero diagonal)."""
+    model, dyn, coriolis, eqs = section_equations("elbow_rrr")
+    check_regressor(model, dyn, eqs)
+    check_skew(model, dyn, coriolis, eqs)
+    assert all(eqs.N[i, i] == 0 for i in range(3))
+    assert not any(e.has(sp.sin, sp.cos) for e in eqs.N)  # every entry in the named factors
