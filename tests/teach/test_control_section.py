@@ -116,7 +116,8 @@ def test_handout_has_the_section_for_a_plain_arm_only():
                    r"\dot{M} - 2C &= \begin{pmatrix} 0 & h \left(2 \dot{q}_{1} + \dot{q}_{2}"
                    r"\right)", r"\mathrm{MX}_{1}^{R} &= l_{1} m_{2} + l_{c1} m_{1}"):
         assert needle in section, needle
-    flexible = eomgen.load(Path(__file__).parents[2] / "examples" / "robots" / "flexible_2link.yaml")
+    examples = Path(__file__).parents[2] / "examples" / "robots"
+    flexible = eomgen.load(examples / "flexible_2link.yaml")
     assert TITLE not in handout_files(flexible, ["md"], check=False)[0].content
 
 
