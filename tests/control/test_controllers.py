@@ -99,8 +99,11 @@ def test_slotine_li_lyapunov_function_falls_by_the_dissipated_power(arm, excitat
 
 
 @pytest.mark.slow
-def test_slotine_li_meets_the_issue_targets_over_ten_seconds(arm, excitation):
+@pytest.mark.parametrize("tuned", [False, True], ids=["fixed gains", "tuned gains"])
+def test_slotine_li_meets_the_issue_targets_over_ten_seconds(arm, excitation, tuned):
     law, beta = slotine_li(arm, excitation)
+    if tuned:  # SlotineLi.tuned: about 6 times fewer evaluations, and beta converges further
+        law = SlotineLi.tuned(arm[1], law.desired, 1.3 * beta, period=2.0)
     q0, qd0, _ = law.desired(0.0)
     run = simulate(law, q0, qd0, 10.0, beta0=1.3 * beta, t_eval=np.linspace(0, 10.0, 1001))
     q_d = excitation.states(run.t)[0]
@@ -110,7 +113,7 @@ def test_slotine_li_meets_the_issue_targets_over_ten_seconds(arm, excitation):
                   for t, q, qd, b in zip(run.t, run.q, run.qd, run.beta_hat)])
     assert np.all(np.diff(V) <= 1e-6 * V[:-1])
     start, end = np.linalg.norm(0.3 * beta), np.linalg.norm(run.beta_hat[-1] - beta)
-    assert end < 0.2 * start
+    assert end < (1e-3 if tuned else 0.2) * start
 
 
 def test_estimated_mass_matrix_is_the_crba_one_at_the_true_estimate(arm):
