@@ -231,6 +231,41 @@ at.update(zip(reg.parameter_symbols, np.random.default_rng(0).uniform(0.5, 1.5, 
 print("largest |Y_base beta - Y pi|:",
       max(abs(float(e)) for e in (form.Y_base * sp.Matrix(form.beta) - form.Y * form.pi).xreplace(at)))
 """)
+    if small:
+        md("""
+## Adaptive control: the Slotine–Li regressor
+
+With $\\tilde q = q - q_d$, the reference velocity $\\dot q_r = \\dot q_d - \\Lambda \\tilde q$
+and $s = \\dot q - \\dot q_r$, the adaptive controller of Slotine and Li applies
+$\\tau = Y(q, \\dot q, \\dot q_r, \\ddot q_r)\\,\\hat\\beta - K_D s$ and adapts
+$\\dot{\\hat\\beta} = -\\Gamma Y^T s$, where $Y \\beta = M \\ddot q_r + C \\dot q_r + g$ (the
+base parameters $\\beta$). With $V = \\tfrac12 s^T M s + \\tfrac12 \\tilde\\beta^T \\Gamma^{-1}
+\\tilde\\beta$, $\\dot V = -s^T K_D s + \\tfrac12 s^T (\\dot M - 2C) s = -s^T K_D s$: the
+skew symmetry of $\\dot M - 2C$ for the Christoffel $C$, checked below, is what the regressor
+needs (docs/control.md).
+""")
+        code("""
+n = model.dof
+sl = eomgen.derive(model, outputs=("Y_SL_base", "beta"))
+Y_SL = sl.named("Y_SL_base").expand()
+beta = sl.named("beta").expand()
+for k, value in enumerate(beta):
+    show(f"\\\\beta_{{{k + 1}}}", value)
+for k in range(Y_SL.cols):
+    show(f"Y_{{:,{k + 1}}}", Y_SL[:, k])
+# Mdot - 2C is skew-symmetric
+M_dot = sum((dyn.M.diff(qk) * qdk for qk, qdk in zip(dyn.q, dyn.qd)), sp.zeros(n, n))
+N = M_dot - 2 * dyn.C
+show("\\\\dot{M} - 2C", N.applyfunc(sp.simplify))
+assert (N + N.T).applyfunc(sp.simplify) == sp.zeros(n, n)
+# the check, at a state: Y_SL beta = M qdd_r + C qd_r + g
+qd_r, qdd_r = sl.input_symbols["qd_r"], sl.input_symbols["qdd_r"]
+at = dict(zip([*dyn.q, *dyn.qd, *qd_r, *qdd_r], np.linspace(0.3, 1.4, 4 * n)))
+at.update(model.parameter_values)
+tau_r = dyn.M * sp.Matrix(qdd_r) + dyn.C * sp.Matrix(qd_r) + dyn.g
+print("largest |Y_SL beta - (M qdd_r + C qd_r + g)|:",
+      max(abs(float(e)) for e in (Y_SL * beta - tau_r).xreplace(at)))
+""")
     md("""
 ## Property checks
 

@@ -6,7 +6,8 @@ the Slotine–Li regressor (:mod:`~eomgen.control.laws`), and their closed loops
 from __future__ import annotations
 
 from .closed_loop import ClosedLoop, simulate
-from .laws import ComputedTorque, Desired, PDGravity, SlotineLi, fourier_reference
+from .laws import (ComputedTorque, Desired, PDGravity, SlotineLi, estimated_mass_matrix,
+                   fourier_reference)
 
 __all__ = ["ClosedLoop", "simulate", "ComputedTorque", "Desired", "PDGravity", "SlotineLi",
-           "fourier_reference"]
+           "estimated_mass_matrix", "fourier_reference"]

@@ -110,6 +110,41 @@ class SlotineLi:
         Y = self.module.slotine_li_base_regressor(q, qd, qd_r, qdd_r)
         return Y @ beta_hat - self.KD @ s, -self.Gamma @ (Y.T @ s)
 
+    @classmethod
+    def tuned(cls, module, desired: Desired, beta_hat, period: float, Lambda: float = 5.0,
+              damping: float = 10.0, adaptation: float = 2.0, regularization: float = 1e-10,
+              samples: int = 100) -> "SlotineLi":
+        """The law with gains that scale with the robot (what a 6-joint arm whose wrist is
+        10⁵ times lighter than its shoulder needs; one K_D and one Γ for every joint would
+        make its closed loop stiff):
+
+        * Λ = ``Lambda`` · I [1/s];
+        * K_D = ``damping`` · M̂(q_d(0)), M̂ from the estimate ``beta_hat``
+          (:func:`estimated_mass_matrix`), so that s decays at about ``damping`` [1/s] on
+          every joint;
+        * Γ = ``adaptation`` · (A + ε λ_max(A) I)⁻¹, A = ⟨Y_SLᵀ K_D⁻¹ Y_SL⟩ averaged over
+          ``samples`` points of one ``period`` of the desired motion (on it, q̇_r = q̇_d):
+          with s ≈ K_D⁻¹ Y_SL β̃, the estimate's error then decays at about ``adaptation``
+          [1/s] in every direction the motion excites; ε = ``regularization`` bounds the
+          gain of directions it barely excites.
+
+        ``desired`` should be persistently exciting (A positive definite), e.g. an
+        excitation trajectory of ``eomgen excite`` through :func:`fourier_reference`."""
+        beta_hat = np.asarray(beta_hat, dtype=float)
+        q0 = np.asarray(desired(0.0)[0], dtype=float)
+        n = len(q0)
+        KD = damping * estimated_mass_matrix(module, q0, beta_hat)
+        KD_inv = np.linalg.inv(KD)
+        A = np.zeros((len(beta_hat), len(beta_hat)))
+        for t in np.linspace(0.0, period, samples, endpoint=False):
+            q, qd, qdd = desired(t)
+            Y = module.slotine_li_base_regressor(q, qd, qd, qdd)
+            A += Y.T @ KD_inv @ Y / samples
+        A = (A + A.T) / 2
+        Gamma = adaptation * np.linalg.inv(
+            A + regularization * np.linalg.eigvalsh(A)[-1] * np.eye(len(A)))
+        return cls(module, desired, Lambda * np.eye(n), KD, (Gamma + Gamma.T) / 2)
+
     def lyapunov(self, t, q, qd, beta_hat, beta, **true_parameters) -> float:
         """V = ½ sᵀ M(q) s + ½ β̃ᵀ Γ⁻¹ β̃, M at ``true_parameters`` (the plant's)."""
         s = self.reference(t, q, qd)[2]
@@ -118,4 +153,18 @@ class SlotineLi:
         return 0.5 * s @ M @ s + 0.5 * err @ np.linalg.solve(self.Gamma, err)
 
 
-__all__ = ["Desired", "fourier_reference", "ComputedTorque", "PDGravity", "SlotineLi"]
+def estimated_mass_matrix(module, q, beta_hat) -> np.ndarray:
+    """M̂(q) (n, n) of the base-parameter estimate ``beta_hat``, from the Slotine–Li regressor
+    alone: column j is Y_SL(q, 0, 0, e_j) β̂ − Y_SL(q, 0, 0, 0) β̂ (the law knows no more of
+    the robot than β̂)."""
+    q = np.asarray(q, dtype=float)
+    n = len(q)
+    zero = np.zeros(n)
+    Y = module.slotine_li_base_regressor
+    g = Y(q, zero, zero, zero) @ beta_hat
+    M = np.column_stack([Y(q, zero, zero, e) @ beta_hat - g for e in np.eye(n)])
+    return (M + M.T) / 2
+
+
+__all__ = ["Desired", "fourier_reference", "ComputedTorque", "PDGravity", "SlotineLi",
+           "estimated_mass_matrix"]

@@ -15,6 +15,8 @@ Control*, the planar two-link arm):
    for flexible joints, or ``M + diag(a)`` and the friction torque for rigid ones, joint by
    joint (:func:`drive_equations`); when the scene has contacts: ``M q̈ + C q̇ + g = τ +
    J_cᵀ F_c``, ``J_c q̈ + J̇_c q̇ = 0`` and ``J_c`` written out (:func:`contact_equations`);
+   for teaching-sized arms with neither: the Slotine–Li regressor and the skew symmetry of
+   ``Ṁ − 2C`` (:mod:`eomgen.teach.control`);
 5. the verified properties, with the numbers of :func:`eomgen.verify`.
 
 Every expression is printed by eomgen's LaTeX printer
@@ -45,6 +47,8 @@ from ..progress import plural
 from ..symbolic.textbook import TextbookDerivation
 from ..verify import VerificationReport, verify
 from .loops import loop_section, loop_symbol_names
+from .control import (control_section, control_symbol_names, has_control_section,
+                      slotine_li_equations)
 from .contacts import (contact_equations, contact_forces,  # noqa: F401  (re-exported)
                        contact_section, contact_symbol_names)
 from .document import (Equation, Equations, Figure, Handout, Paragraph, Section, Table, code,
@@ -495,6 +499,9 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
     extra_names.update(loop_symbol_names(model))
     if spong is not None:  # the drives' own symbols, printed by the document's printer
         extra_names.update(drive_symbol_names(spong, w.tex))
+    control = has_control_section(book, spong is not None, contacts or model.loops)
+    if control:
+        extra_names.update(control_symbol_names(dyn))
     w = Writer(nt.printing(dyn, HANDOUT_CONFIG, compact_trig=book is not None,
                             extra_names=extra_names))
     geometry = sketch_geometry(model)
@@ -517,6 +524,9 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
         sections.append(contact_section(dyn, contacts, book, coriolis, w))
     if model.loops:
         sections.append(loop_section(dyn, book, coriolis, w))
+    if control:
+        progress("deriving the Slotine-Li regressor")
+        sections.append(control_section(slotine_li_equations(dyn, book, coriolis), book, dyn, w))
     report, missing = None, "the check was switched off"
     if check:
         progress("checking the derivation against Newton-Euler")

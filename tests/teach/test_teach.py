@@ -156,7 +156,8 @@ def test_two_link_handout_follows_the_textbook_sequence(arm_handout):
         "The robot", "Method and notation", "Step 1: positions of the centres of mass",
         "Step 2: velocities", "Step 3: kinetic energy", "Step 4: potential energy",
         "Step 5: the mass matrix", "Step 6: Christoffel symbols and the Coriolis matrix",
-        "Step 7: the gravity vector", "Step 8: the equations of motion", "Verified properties"]
+        "Step 7: the gravity vector", "Step 8: the equations of motion",
+        "Adaptive control: the Slotine–Li regressor", "Verified properties"]
     robot = arm_handout.sections[0].blocks
     assert any(isinstance(b, Figure) and b.name == "sketch" for b in robot)
     tables = [b for b in robot if isinstance(b, Table)]
