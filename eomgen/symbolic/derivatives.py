@@ -23,15 +23,24 @@ respect to q are in the velocity (tangent) coordinates, n_v columns (= n for fix
   theorem on τ(q, q̇, q̈(q, q̇, τ)) = τ; what Pinocchio's ``computeABADerivatives`` does).
 * ``A_lin`` (2n × 2n) and ``B_lin`` (2n × n): ẋ = f(x, τ), x = (q, q̇), linearized:
   A = [[0, I], [∂q̈/∂q, ∂q̈/∂q̇]], B = [[0], [M⁻¹]].
-* ``dtau``, ``dqdd``, ``AB``: the several-result functions, side by side.
+* ``dtau_a_dqd`` (n × n): ∂τ_a/∂q̇ = ∂τ/∂q̇ + diag(d) of the drive torques
+  τ_a = τ + a q̈ + d q̇ + f sign(q̇) (∂τ_a/∂q = ∂τ/∂q; the Coulomb sign's derivative is 0 for
+  q̇_i ≠ 0).
+* ``dqdd_a_dq``, ``dqdd_a_dqd``, ``Minv_a`` (n × n): the drives' forward dynamics
+  q̈ = (M + diag(a))⁻¹ (τ − C q̇ − g − d q̇ − f tanh(q̇ / w)) differentiated
+  (:func:`drive_forward_dynamics_jacobians`).
+* ``dtau``, ``dqdd``, ``AB``, ``dtau_a``, ``dqdd_a``: the several-result functions, side by
+  side.
 """
 
 from __future__ import annotations
 
 import sympy as sp
 
+from ..model import joint_actuators
 from ..outputs import BY_SYMBOL
 from .aba import forward_dynamics_program
+from .drives import friction_torque_expr
 from .newton_euler import inverse_dynamics_program
 from .program import ProgramBuilder, name_expr
 
@@ -198,26 +207,71 @@ def _aba(derivation) -> sp.Matrix:
     return work["qdd"]
 
 
+def _efforts_at(derivation, qdd, hint: str) -> tuple[sp.Matrix, sp.Matrix]:
+    """(∂τ/∂q, ∂τ/∂q̇) of the Newton–Euler τ(q, q̇, q̈) at the named accelerations ``qdd``
+    held fixed (the implicit function theorem's half of ∂q̈)."""
+    b, n = derivation.builder, len(derivation.q)
+    frozen = set()
+    for e in qdd:
+        if not e.is_Symbol and not (e.is_Mul and e.args[0] == -1 and e.args[1].is_Symbol):
+            raise ValueError(f"forward-dynamics acceleration {e} is not a named intermediate")
+        frozen |= e.free_symbols
+    tau = inverse_dynamics_program(derivation.tree, derivation.q, derivation.qd, tuple(qdd),
+                                   derivation.model.gravity, b, hint=hint)
+    seeds = {**_seeds(derivation.q, "q"), **_seeds(derivation.qd, "qd")}
+    rows = forward_mode(b, list(tau), seeds, frozenset(frozen))
+    return _jacobian(rows, "q", n), _jacobian(rows, "qd", n)
+
+
 def forward_dynamics_jacobians(derivation) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
     """(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹) at q̈ = ABA(q, q̇, τ), each n × n."""
     work = _work(derivation)
     if "dqdd" not in work:
-        b, n = derivation.builder, len(derivation.q)
-        qdd = _aba(derivation)
-        frozen = set()
-        for e in qdd:
-            frozen |= {e} if e.is_Symbol else set()
-            if not e.is_Symbol and not (e.is_Mul and e.args[0] == -1 and e.args[1].is_Symbol):
-                raise ValueError(f"ABA acceleration {e} is not a named intermediate")
-            frozen |= e.free_symbols
-        tau = inverse_dynamics_program(derivation.tree, derivation.q, derivation.qd, tuple(qdd),
-                                       derivation.model.gravity, b, hint="tau_a")
-        seeds = {**_seeds(derivation.q, "q"), **_seeds(derivation.qd, "qd")}
-        rows = forward_mode(b, list(tau), seeds, frozenset(frozen))
+        b = derivation.builder
+        dq, dqd = _efforts_at(derivation, _aba(derivation), "tau_a")
         Minv = inverse_mass_matrix(derivation)
-        work["dqdd"] = (_product(b, Minv, _jacobian(rows, "q", n), "dqdd_dq"),
-                        _product(b, Minv, _jacobian(rows, "qd", n), "dqdd_dqd"), Minv)
+        work["dqdd"] = (_product(b, Minv, dq, "dqdd_dq"), _product(b, Minv, dqd, "dqdd_dqd"),
+                        Minv)
     return work["dqdd"]
+
+
+def drive_inverse_dynamics_jacobians(derivation) -> tuple[sp.Matrix, sp.Matrix]:
+    """(∂τ_a/∂q, ∂τ_a/∂q̇) of the drive torques τ_a = τ + a q̈ + d q̇ + f sign(q̇): ∂τ/∂q, and
+    ∂τ/∂q̇ + diag(d) (the exact Coulomb sign has derivative 0 wherever q̇_i ≠ 0)."""
+    dq, dqd = inverse_dynamics_jacobians(derivation)
+    damping = [a.damping for a in joint_actuators(derivation.model)]
+    return dq, dqd + sp.diag(*damping)
+
+
+def drive_forward_dynamics_jacobians(derivation) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
+    """(∂q̈/∂q, ∂q̈/∂q̇, M_a⁻¹) of the drives' forward dynamics
+    q̈ = M_a⁻¹ (τ − C q̇ − g − τ_f(q̇)), M_a = M + diag(a), τ_f = d q̇ + f tanh(q̇ / w) (the
+    smoothed Coulomb friction of simulation), each n × n:
+
+    * M_a⁻¹ = ∂q̈/∂τ: the ABA with the armature on each joint's articulated inertia, along τ;
+    * ∂q̈/∂q = −M_a⁻¹ ∂τ/∂q and ∂q̈/∂q̇ = −M_a⁻¹ (∂τ/∂q̇ + diag(τ_f′(q̇))), with the rigid
+      bodies' ∂τ taken at that q̈ held fixed (implicit function theorem on
+      τ(q, q̇, q̈) + a q̈ + τ_f(q̇) = τ).
+    """
+    work = _work(derivation)
+    if "dqdd_a" not in work:
+        b, n, qd = derivation.builder, len(derivation.q), derivation.qd
+        actuators = joint_actuators(derivation.model)
+        friction = friction_torque_expr(actuators, qd, smooth=True)
+        effort = tuple(t - friction[k, 0] for k, t in enumerate(derivation.tau))
+        qdd = forward_dynamics_program(derivation.tree, derivation.q, qd, effort,
+                                       derivation.model.gravity, b,
+                                       armature=[a.armature for a in actuators])
+        qdd = sp.Matrix([b.define(e, f"qdd_d{k + 1}") for k, e in enumerate(qdd)])
+        rows = forward_mode(b, list(qdd), _seeds(derivation.tau, "tau"))
+        full = _jacobian(rows, "tau", n)
+        Minv = sp.Matrix(n, n, lambda i, j: full[min(i, j), max(i, j)])
+        dq, dqd = _efforts_at(derivation, qdd, "tau_d")
+        slope = [sp.diff(friction[k, 0], qd[k]) for k in range(n)]
+        dqd = dqd + sp.diag(*[name_expr(b, s, f"dtau_f{k + 1}") for k, s in enumerate(slope)])
+        work["dqdd_a"] = (_product(b, Minv, dq, "dqdd_a_dq"),
+                          _product(b, Minv, dqd, "dqdd_a_dqd"), Minv)
+    return work["dqdd_a"]
 
 
 def linearization(derivation) -> tuple[sp.Matrix, sp.Matrix]:
@@ -242,6 +296,11 @@ def build_derivatives(derivation, wanted) -> dict:
         elif symbol in ("dqdd_dq", "dqdd_dqd", "Minv"):
             value = forward_dynamics_jacobians(derivation)[
                 ("dqdd_dq", "dqdd_dqd", "Minv").index(symbol)]
+        elif symbol == "dtau_a_dqd":
+            value = drive_inverse_dynamics_jacobians(derivation)[1]
+        elif symbol in ("dqdd_a_dq", "dqdd_a_dqd", "Minv_a"):
+            value = drive_forward_dynamics_jacobians(derivation)[
+                ("dqdd_a_dq", "dqdd_a_dqd", "Minv_a").index(symbol)]
         elif symbol in ("A_lin", "B_lin"):
             value = linearization(derivation)[symbol == "B_lin"]
         else:  # a several-result function: its results side by side
@@ -250,6 +309,7 @@ def build_derivatives(derivation, wanted) -> dict:
     return result
 
 
-__all__ = ["build_derivatives", "forward_dynamics_jacobians", "forward_mode",
+__all__ = ["build_derivatives", "drive_forward_dynamics_jacobians",
+           "drive_inverse_dynamics_jacobians", "forward_dynamics_jacobians", "forward_mode",
            "gravity_jacobian", "inverse_dynamics_jacobians", "inverse_mass_matrix",
            "linearization"]

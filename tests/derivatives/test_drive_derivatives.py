@@ -1,0 +1,85 @@
+"""Derivatives of the dynamics with drives (issue 25 with issue 17's armature and friction):
+``drive_inverse_dynamics_derivatives`` and ``drive_forward_dynamics_derivatives``.
+
+References: Pinocchio 4 with ``model.armature`` set (its ``aba``, ``crba`` and
+``computeABADerivatives`` take the armature; they know no friction), the friction's derivative
+added by hand from its formula, d + f/w (1 − tanh²(q̇/w)); and central differences of the
+generated NumPy ``drive_inverse_dynamics``. PUMA 560 with a drive on every joint.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from eomgen.model import Actuator
+from support import robots
+from support.generated import generated
+from support.reference import pin_q_order, to_pinocchio
+
+FUNCTIONS = ["drive_inverse_dynamics_derivatives", "drive_forward_dynamics_derivatives",
+             "drive_inverse_dynamics"]
+
+
+@pytest.fixture(scope="module")
+def driven(tmp_path_factory):
+    """The PUMA 560 with armature, viscous and Coulomb friction on every joint, its NumPy
+    module, the drive values and Pinocchio's model with the same armature."""
+    pytest.importorskip("pinocchio")
+    model = robots.puma()
+    n = model.dof
+    a, d = 0.1 + 0.1 * np.arange(n), 0.2 + 0.05 * np.arange(n)
+    f, w = 0.3 + 0.1 * np.arange(n), 0.4
+    drives = iter(Actuator(armature=float(a[k]), damping=float(d[k]), friction=float(f[k]),
+                           friction_width=w) for k in range(n))
+    joints = tuple(replace(j, actuator=next(drives)) if j.type.is_movable else j
+                   for j in model.joints)
+    model = replace(model, joints=joints)
+    _, modules = generated(model, FUNCTIONS, tmp_path_factory.mktemp("driven"),
+                           backends=("numpy",))
+    pm = to_pinocchio(model)
+    perm = pin_q_order(model, pm)
+    pm.armature = a[perm]
+    return model, modules["numpy"], (a, d, f, w), pm, perm
+
+
+def test_drive_forward_dynamics_derivatives_agree_with_pinocchio(driven):
+    import pinocchio as pin
+
+    model, module, (a, d, f, w), pm, perm = driven
+    data, inv, n = pm.createData(), np.argsort(perm), model.dof
+    rng = np.random.default_rng(3)
+    for _ in range(3):
+        q, qd, tau = (rng.uniform(-1.5, 1.5, n) for _ in range(3))
+        effort = tau - d * qd - f * np.tanh(qd / w)        # what the rigid bodies receive
+        pin.computeABADerivatives(pm, data, q[perm], qd[perm], effort[perm])
+        Minv = np.triu(data.Minv) + np.triu(data.Minv, 1).T
+        Minv, dq, dqd = (x[np.ix_(inv, inv)] for x in (Minv, data.ddq_dq, data.ddq_dv))
+        slope = d + f / w * (1 - np.tanh(qd / w) ** 2)
+        expected = (dq, dqd - Minv * slope, Minv)          # Minv @ diag(slope)
+        got = module["drive_forward_dynamics_derivatives"](q, qd, tau)
+        M_a = pin.crba(pm, data, q[perm])
+        M_a = (np.triu(M_a) + np.triu(M_a, 1).T)[np.ix_(inv, inv)]
+        np.testing.assert_allclose(got[2] @ M_a, np.eye(n), atol=1e-10)  # M + diag(a)
+        for ours, theirs in zip(got, expected):
+            assert np.abs(ours - theirs).max() <= 1e-10 * np.abs(theirs).max()
+
+
+def test_drive_inverse_dynamics_derivatives_agree_with_pinocchio_and_differences(driven):
+    import pinocchio as pin
+
+    model, module, (a, d, f, w), pm, perm = driven
+    data, inv, n = pm.createData(), np.argsort(perm), model.dof
+    rng = np.random.default_rng(5)
+    q, qd, qdd = (rng.uniform(-1.5, 1.5, n) for _ in range(3))
+    pin.computeRNEADerivatives(pm, data, q[perm], qd[perm], qdd[perm])
+    expected = (data.dtau_dq[np.ix_(inv, inv)], data.dtau_dv[np.ix_(inv, inv)] + np.diag(d))
+    got = module["drive_inverse_dynamics_derivatives"](q, qd, qdd)
+    for ours, theirs in zip(got, expected):
+        assert np.abs(ours - theirs).max() <= 1e-10 * np.abs(theirs).max()
+    tau_a, h = module["drive_inverse_dynamics"], 1e-6  # exact-sign Coulomb: qd away from 0
+    columns = [(tau_a(q, qd + h * e, qdd) - tau_a(q, qd - h * e, qdd)) / (2 * h)
+               for e in np.eye(n)]
+    np.testing.assert_allclose(got[1], np.stack(columns, axis=1), rtol=1e-6, atol=1e-6)
