@@ -211,11 +211,13 @@ def _efforts_at(derivation, qdd, hint: str) -> tuple[sp.Matrix, sp.Matrix]:
     """(∂τ/∂q, ∂τ/∂q̇) of the Newton–Euler τ(q, q̇, q̈) at the named accelerations ``qdd``
     held fixed (the implicit function theorem's half of ∂q̈)."""
     b, n = derivation.builder, len(derivation.q)
+    inputs = set(derivation.q) | set(derivation.qd)
     frozen = set()
-    for e in qdd:
-        if not e.is_Symbol and not (e.is_Mul and e.args[0] == -1 and e.args[1].is_Symbol):
+    for e in qdd:  # a named intermediate (±), or free of q and q̇ (e.g. τ_1 / m of a lone body)
+        named = e.is_Symbol or (e.is_Mul and e.args[0] == -1 and e.args[1].is_Symbol)
+        if not named and e.free_symbols & inputs:
             raise ValueError(f"forward-dynamics acceleration {e} is not a named intermediate")
-        frozen |= e.free_symbols
+        frozen |= e.free_symbols - inputs
     tau = inverse_dynamics_program(derivation.tree, derivation.q, derivation.qd, tuple(qdd),
                                    derivation.model.gravity, b, hint=hint)
     seeds = {**_seeds(derivation.q, "q"), **_seeds(derivation.qd, "qd")}

@@ -83,3 +83,34 @@ def test_drive_inverse_dynamics_derivatives_agree_with_pinocchio_and_differences
     columns = [(tau_a(q, qd + h * e, qdd) - tau_a(q, qd - h * e, qdd)) / (2 * h)
                for e in np.eye(n)]
     np.testing.assert_allclose(got[1], np.stack(columns, axis=1), rtol=1e-6, atol=1e-6)
+
+
+def test_forward_dynamics_derivatives_of_a_lone_floating_body(tmp_path):
+    """The spinning top floating free (one body, the 6-joint virtual chain of the Euler chart):
+    some of its ABA accelerations are τ_k / m, no named intermediate; the forward-dynamics
+    derivatives (plain and with drives, here none) are the central differences of the
+    generated ``forward_dynamics_aba``."""
+    import eomgen
+    from eomgen.reduction import apply_scene
+    from eomgen.scene import load_scene
+
+    root = robots.ROOT
+    model = apply_scene(eomgen.load(root / "examples/robots/spinning_top.yaml"),
+                        load_scene(root / "examples/contacts/top_on_a_point.yaml"))[0]
+    _, modules = generated(model, ["forward_dynamics_derivatives", "forward_dynamics_aba",
+                                   "drive_forward_dynamics_derivatives"], tmp_path,
+                           backends=("numpy",))
+    module, n, h = modules["numpy"], model.dof, 1e-6
+    rng = np.random.default_rng(11)
+    q, qd, tau = (rng.uniform(-1.0, 1.0, n) for _ in range(3))
+    aba = module["forward_dynamics_aba"]
+    expected = (
+        np.stack([(aba(q + h * e, qd, tau) - aba(q - h * e, qd, tau)) / (2 * h)
+                  for e in np.eye(n)], axis=1),
+        np.stack([(aba(q, qd + h * e, tau) - aba(q, qd - h * e, tau)) / (2 * h)
+                  for e in np.eye(n)], axis=1),
+        np.stack([(aba(q, qd, tau + h * e) - aba(q, qd, tau - h * e)) / (2 * h)
+                  for e in np.eye(n)], axis=1))
+    for function in ("forward_dynamics_derivatives", "drive_forward_dynamics_derivatives"):
+        for ours, theirs in zip(module[function](q, qd, tau), expected):
+            np.testing.assert_allclose(ours, theirs, rtol=1e-6, atol=1e-6, err_msg=function)
