@@ -4,9 +4,10 @@ The derivatives are the dynamics' own programs differentiated once in forward mo
 (:func:`forward_mode`): each assignment ``x = f(a, b, …)`` of the Newton–Euler (or ABA) program
 that depends on a seeded input gets, per direction ``d``, the assignment
 ``dx_d = Σ ∂f/∂a · da_d`` over the arguments whose derivative along ``d`` is not a structural
-zero. The partials ``∂f/∂a`` are named once and shared by every direction; every derivative is
-defined in the derivation's builder, so it reuses the dynamics' intermediates (sines, rotations,
-velocities) and identical terms are shared (hash-consing). A quantity that does not depend on a
+zero. The partials ``∂f/∂a`` are named once and shared by every direction (a number times a
+symbol too, such as ``2 ω_x`` of ``ω_x²``, when it multiplies several derivatives); every
+derivative is defined in the derivation's builder, so it reuses the dynamics' intermediates
+(sines, rotations, velocities) and identical terms are shared (hash-consing). A quantity that does not depend on a
 direction has no derivative along it (nothing is computed), which is where the structure of the
 tree shows: ∂/∂q_j of a body's velocity exists only below joint j.
 
@@ -85,7 +86,14 @@ def _differentiate(b: ProgramBuilder, expr, free, D, hint: str, name: bool, part
         if p == 0:
             continue
         if not p.is_Number:
-            p = partials.setdefault(p, name_expr(b, p, f"p{hint}"))
+            if p in partials:
+                p = partials[p]
+            else:  # a number times a symbol too, when it multiplies several derivatives
+                uses = sum(1 for da in D[a].values() if not da.is_Number)
+                named = name_expr(b, p, f"p{hint}", scaled=uses > 1)
+                if named is not p:
+                    partials[p] = named
+                p = named
         for direction, da in D[a].items():
             terms.setdefault(direction, []).append(p * da)
     out = {}
@@ -126,7 +134,7 @@ def forward_mode(b: ProgramBuilder, outputs, seeds: dict, frozen=frozenset()) ->
     >>> forward_mode(b, [s * s], {x: ("x", 0), y: ("y", 0)})
     [{('x', 0): d_x1, ('y', 0): d_y1}]
     >>> b.assignments[1:]
-    [(ps, y*cos(x)), (ps_, sin(x)), (d_x1, 2*ps*s), (d_y1, 2*ps_*s)]
+    [(ps, y*cos(x)), (ps_, sin(x)), (p, 2*s), (d_x1, p*ps), (d_y1, p*ps_)]
     """
     D: dict = {s: {d: sp.Integer(1)} for s, d in seeds.items()}
     outputs = [sp.sympify(e) for e in outputs]
