@@ -50,7 +50,7 @@ from codegen_speed import erd_robots_dir  # noqa: E402
 from eomgen.batch import dask_map  # noqa: E402
 from eomgen.codegen.generate import render_files  # noqa: E402
 from eomgen.model import lock_joints  # noqa: E402
-from fair_speed import LOCKED  # noqa: E402
+from fair_speed import LOCKED, spread  # noqa: E402
 
 FUNCTION = "inverse_dynamics_derivative_q"
 
@@ -139,9 +139,6 @@ def main() -> None:
             for cluster in clusters.values():
                 cluster.close()
 
-    def spread(values):
-        return (f"{statistics.median(values):.2f} ({min(values):.2f}–{max(values):.2f})")
-
     one = statistics.median(times["one process"])
     say(f"Panda, 7 joints (fingers locked): max |dtau/dq| over {args.states:,} random states in "
         f"chunks of {args.chunks:,}; Python {platform.python_version()}, dask "
@@ -159,7 +156,7 @@ def main() -> None:
             ("es" if way > 1 else "")
         ratio = one / statistics.median(times[way])
         target = (f"≥ 1.6: {'met' if ratio >= 1.6 else 'NOT met'}" if way == 2 else "")
-        say(f"| {label} | {spread(times[way])} | {ratio:.2f} | {target} |")
+        say(f"| {label} | {spread(times[way], '.2f')} | {ratio:.2f} | {target} |")
     say()
     worst = np.unravel_index(np.argmax(reference), reference.shape)
     say(f"Largest entry: |dtau_{worst[0] + 1}/dq_{worst[1] + 1}| = {reference.max():.1f} N m/rad; "
