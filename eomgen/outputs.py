@@ -529,6 +529,35 @@ LINEARIZE = register_output(Output(
     "linearize", "AB", "(A, B) of xdot = f(x, tau) ~ A dx + B dtau, x = (q, qd), in one call.",
     ("q", "qd", "tau"), False, "the units of state_matrix and input_matrix", ("AB",),
     build=_DERIVATIVES, default=False, returns=("A_lin", "B_lin")))
+# with the drives of issue 17 (armature a, viscous d and Coulomb f friction; docs/actuators.md)
+DRIVE_DTAU_DQD = register_output(Output(
+    "drive_inverse_dynamics_derivative_qd", "dtau_a_dqd", "dtau_a/dqd (n, nv) of the drive "
+    "torques tau_a = tau + a qdd + d qd + f sign(qd): dtau/dqd + diag(d) (sign: 0 at qd != 0).",
+    ("q", "qd", "qdd"), False, "of the joint efforts per rad/s or m/s", ("dtau_a_dqd",),
+    build=_DERIVATIVES, default=False))
+DRIVE_INVERSE_DERIVATIVES = register_output(Output(
+    "drive_inverse_dynamics_derivatives", "dtau_a", "(dtau_a/dq, dtau_a/dqd) of the drive "
+    "torques in one call (dtau_a/dq is dtau/dq).", ("q", "qd", "qdd"), False,
+    "the units of inverse_dynamics_derivative_q and _qd", ("dtau_a",), build=_DERIVATIVES,
+    default=False, returns=("dtau_dq", "dtau_a_dqd")))
+DRIVE_DQDD_DQ = register_output(Output(
+    "drive_forward_dynamics_derivative_q", "dqdd_a_dq", "dqdd/dq (nv, nv) of the drives' "
+    "qdd = (M + diag(a))^-1 (tau - C qd - g - d qd - f tanh(qd / w)).", ("q", "qd", "tau"),
+    False, "1/s^2", ("dqdd_a_dq",), build=_DERIVATIVES, default=False))
+DRIVE_DQDD_DQD = register_output(Output(
+    "drive_forward_dynamics_derivative_qd", "dqdd_a_dqd", "dqdd/dqd (nv, nv) of the drives' "
+    "forward dynamics (friction included).", ("q", "qd", "tau"), False, "1/s",
+    ("dqdd_a_dqd",), build=_DERIVATIVES, default=False))
+DRIVE_INVERSE_MASS = register_output(Output(
+    "drive_inverse_mass_matrix", "Minv_a", "(M(q) + diag(a))^-1 = dqdd/dtau (nv, nv) of the "
+    "drives' forward dynamics (ABA with the armature).", ("q",), False,
+    "1/(kg m^2) (revolute), 1/kg (prismatic)", ("Minv_a",), build=_DERIVATIVES, default=False))
+DRIVE_FORWARD_DERIVATIVES = register_output(Output(
+    "drive_forward_dynamics_derivatives", "dqdd_a", "(dqdd/dq, dqdd/dqd, (M + diag(a))^-1) of "
+    "the drives' forward dynamics in one call.", ("q", "qd", "tau"), False,
+    "the units of drive_forward_dynamics_derivative_q, _qd and drive_inverse_mass_matrix",
+    ("dqdd_a",), build=_DERIVATIVES, default=False,
+    returns=("dqdd_a_dq", "dqdd_a_dqd", "Minv_a")))
 
 
 # --- issue 27: task-space quantities, composed from M, J_f, J_f-dot qd and tau (templates) --

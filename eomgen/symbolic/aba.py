@@ -48,7 +48,7 @@ _ZERO = sp.Integer(0)
 
 
 def forward_dynamics_program(tree: BodyTree, q, qd, tau, gravity: Vec3, b: ProgramBuilder,
-                             grouped: bool = True) -> sp.Matrix:
+                             grouped: bool = True, armature=None) -> sp.Matrix:
     """Build q̈(q, q̇, τ) into ``b`` by the Articulated-Body Algorithm.
 
     Parameters
@@ -66,6 +66,10 @@ def forward_dynamics_program(tree: BodyTree, q, qd, tau, gravity: Vec3, b: Progr
         Run on the grouped inertial parameters of :func:`~eomgen.symbolic.newton_euler.
         grouped_inertials` (the default): they give the same M(q) and C q̇ + g, hence the same
         q̈, with fewer non-zero parameters and so fewer operations.
+    armature:
+        Per joint in ``JOINT_NAMES`` order, a drive's reflected rotor inertia [kg m² or kg]
+        added to the joint's articulated inertia ``D`` (Featherstone's armature): the result is
+        then ``(M + diag(armature))⁻¹ (τ − C q̇ − g)``. None: no armature.
 
     Returns
     -------
@@ -126,7 +130,10 @@ def forward_dynamics_program(tree: BodyTree, q, qd, tau, gravity: Vec3, b: Progr
                         ("UA", tag, 0))
         U_f = name_exprs(b, add(matvec(transpose(B), S_ang), matvec(C, S_lin)), f"U{tag}f",
                         ("UA", tag, 1))
-        D = name_expr(b, dot(S_ang, U_n) + dot(S_lin, U_f), f"D{tag}", ("D", tag))
+        D = dot(S_ang, U_n) + dot(S_lin, U_f)
+        if armature is not None:  # a drive's reflected rotor inertia on its joint: M + diag(a)
+            D = D + armature[body.q_index]
+        D = name_expr(b, D, f"D{tag}", ("D", tag))
         Dinv[i] = name_expr(b, 1 / D, f"Dinv{tag}", ("Dinv", tag))
         uval[i] = name_expr(b, tau[body.q_index] - dot(S_ang, p_n) - dot(S_lin, p_f), f"u{tag}",
                         ("u", tag))
@@ -135,11 +142,14 @@ def forward_dynamics_program(tree: BodyTree, q, qd, tau, gravity: Vec3, b: Progr
         if p < 0:
             continue
         # I^a = I^A − U Uᵀ / D; along a coordinate-axis S its row and column vanish exactly
+        # (not with an armature: then D = Sᵀ I^A S + a is no longer U's entry along S)
         Ud_n = name_exprs(b, scale(U_n, Dinv[i]), f"Ud{tag}n", ("Ud", tag, 0))
         Ud_f = name_exprs(b, scale(U_f, Dinv[i]), f"Ud{tag}f", ("Ud", tag, 1))
         six_S = S_ang + S_lin
         axis = [j for j in range(6) if six_S[j] != 0]
         exact_zero = set(axis) if len(axis) == 1 and abs(six_S[axis[0]]) == 1 else set()
+        if armature is not None and armature[body.q_index] != 0:
+            exact_zero = set()
         U6, Ud6 = U_n + U_f, Ud_n + Ud_f
         full6 = [[(A[r][c] if r < 3 and c < 3 else B[r][c - 3] if r < 3 else
                    B[c][r - 3] if c < 3 else C[r - 3][c - 3]) for c in range(6)] for r in range(6)]

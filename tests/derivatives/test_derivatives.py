@@ -224,3 +224,30 @@ def test_a_structural_zero_is_not_computed():
     column = spec.output[:, 0]
     assert all(e == 0 for e in column)
     assert any(e != 0 for e in spec.output[:, 1])
+
+
+def test_fma_clones_of_the_fast_kernels_give_the_numpy_modules_derivatives(planar, tmp_path,
+                                                                          monkeypatch):
+    """Every kernel compiled in two versions (with and without fused multiply-add, the loader
+    picking one; here forced on for the planar arm's small kernels) gives the NumPy module's
+    derivatives, for one state and for a batch."""
+    from eomgen.codegen.backends import fast_backend
+
+    model, _, modules = planar
+    if "fast" not in modules:
+        pytest.skip("no C compiler: the fast module was not built")
+    monkeypatch.setattr(fast_backend, "FMA_CLONE_OPERATIONS", 0)
+    _, cloned = generated(model, FUNCTIONS, tmp_path, backends=("fast",))
+    source = (tmp_path / "planar_2link_fast.c").read_text(encoding="utf-8")
+    assert source.count("FMA_CLONES static void") == len(FUNCTIONS)
+    rng = np.random.default_rng(7)
+    Q, QD, U = (rng.uniform(-1.5, 1.5, (4, model.dof)) for _ in range(3))
+    for function in FUNCTIONS:
+        args = (Q,) if function == "gravity_derivative" else (Q, QD, U)
+        batch = results("fast", cloned["fast"], function, *args)
+        for k in range(len(Q)):
+            expected = results("numpy", modules["numpy"], function, *(a[k] for a in args))
+            single = results("fast", cloned["fast"], function, *(a[k] for a in args))
+            for a, s, b in zip(batch, single, expected):
+                np.testing.assert_allclose(s, b, rtol=1e-12, atol=1e-12, err_msg=function)
+                np.testing.assert_allclose(a[k], b, rtol=1e-12, atol=1e-12, err_msg=function)

@@ -1,0 +1,170 @@
+"""A workspace study with the generated derivatives on a dask cluster (issue 25; Franka Panda,
+fingers locked).
+
+The statistic: over N random states (q, q̇, q̈ uniform in [−1.5, 1.5] per joint, drawn lazily by
+dask chunk by chunk), the largest |∂τ_i/∂q_j| of each entry, a 7 × 7 table of the arm's
+worst-case torque sensitivity to its joint angles (N m/rad). ∂τ/∂q comes from the Panda's fast
+module (``inverse_dynamics_derivative_q``, the loop over a chunk in C) through
+``eomgen.batch.dask_map``; the maximum is reduced by dask.
+
+The same graph (same chunks, same seeds, so the same numbers and the same table, checked) is
+computed three ways, in turns, wall clock (parallel speed-up is a wall-clock matter):
+
+* one process: dask's synchronous scheduler in this process (no workers, no pickling);
+* a LocalCluster of 1 worker process (1 thread): the cluster's own overhead;
+* a LocalCluster of 2 worker processes (1 thread each): issue 25's target is
+  one process / 2 workers ≥ 1.6 for N = 10⁷.
+
+Times are medians over the repeats with the spread (min–max); the load average of the machine
+before and after is printed (on a shared machine, the other processes take cores away from the
+2 workers). The cluster listens on 127.0.0.1 only, without its dashboard. Nothing asserts on a
+time.
+
+Usage::
+
+    python benchmarks/derivatives_dask.py                    # 10⁷ states, a few minutes
+    python benchmarks/derivatives_dask.py --states 1000000 --repeats 2
+    python benchmarks/derivatives_dask.py --markdown benchmarks/results/derivatives_dask.md
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import sys
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))  # measure this checkout, not some installed copy
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+import eomgen  # noqa: E402
+from codegen_speed import erd_robots_dir  # noqa: E402
+from eomgen.batch import dask_map  # noqa: E402
+from eomgen.codegen.generate import render_files  # noqa: E402
+from eomgen.model import lock_joints  # noqa: E402
+from fair_speed import LOCKED, spread  # noqa: E402
+
+FUNCTION = "inverse_dynamics_derivative_q"
+
+
+def build_module(folder: Path) -> None:
+    """Write and compile the Panda's fast module with ∂τ/∂q into ``folder``."""
+    path = erd_robots_dir() / "panda_description" / "urdf" / "panda.urdf"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = lock_joints(eomgen.load(path), LOCKED)
+    for f in render_files(model, ["fast"], functions=(FUNCTION,)):
+        (folder / f.name).write_bytes(f.content if isinstance(f.content, bytes)
+                                      else f.content.encode("utf-8"))
+
+
+def statistic(function, states: int, chunks: int):
+    """The lazy 7 × 7 table max |∂τ/∂q| over ``states`` random states."""
+    import dask.array as da
+
+    rng = da.random.default_rng(0)
+    Q, QD, QDD = (rng.uniform(-1.5, 1.5, size=(states, 7), chunks=(chunks, 7))
+                  for _ in range(3))
+    return abs(dask_map(function, Q, QD, QDD)).max(axis=0)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--states", type=int, default=10_000_000)
+    parser.add_argument("--chunks", type=int, default=250_000, help="states per chunk")
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--markdown", type=Path, help="also write the table to this file")
+    args = parser.parse_args()
+    import dask
+    from dask.distributed import Client, LocalCluster
+
+    lines: list[str] = []
+
+    def say(text: str = "") -> None:
+        print(text, flush=True)
+        lines.append(text)
+
+    with tempfile.TemporaryDirectory() as tmp:
+        build_module(Path(tmp))
+        # the workers import the module by name (the function is pickled by reference)
+        sys.path.insert(0, tmp)
+        os.environ["PYTHONPATH"] = os.pathsep.join(
+            [tmp, str(ROOT)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep)
+                                if p])
+        import panda_fast
+
+        function = getattr(panda_fast, FUNCTION)
+        graph = statistic(function, args.states, args.chunks)
+        clusters = {n: LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                    host="127.0.0.1", dashboard_address=None)
+                    for n in (1, 2)}
+        clients = {n: Client(cluster, set_as_default=False) for n, cluster in clusters.items()}
+        try:
+            cpu: list = []  # the one process's CPU seconds (its share of a core, if busy)
+
+            def run(way):
+                start, start_cpu = time.perf_counter(), time.process_time()
+                if way == "one process":
+                    table = graph.compute(scheduler="synchronous")
+                    cpu.append(time.process_time() - start_cpu)
+                else:
+                    table = clients[way].compute(graph).result()
+                return time.perf_counter() - start, np.asarray(table)
+
+            ways = ("one process", 1, 2)
+            load_before = os.getloadavg()
+            reference = run("one process")[1]  # also warms the module and the workers up
+            for n in (1, 2):
+                if not np.array_equal(run(n)[1], reference):
+                    sys.exit(f"derivatives_dask: the {n}-worker table differs")
+            times: dict = {way: [] for way in ways}
+            for _ in range(args.repeats):
+                for way in ways:
+                    seconds, table = run(way)
+                    if not np.array_equal(table, reference):
+                        sys.exit(f"derivatives_dask: the table of {way} differs")
+                    times[way].append(seconds)
+            load_after = os.getloadavg()
+        finally:
+            for client in clients.values():
+                client.close()
+            for cluster in clusters.values():
+                cluster.close()
+
+    one = statistics.median(times["one process"])
+    say(f"Panda, 7 joints (fingers locked): max |dtau/dq| over {args.states:,} random states in "
+        f"chunks of {args.chunks:,}; Python {platform.python_version()}, dask "
+        f"{dask.__version__}, {os.cpu_count()} CPUs; load average "
+        f"{load_before[0]:.1f} before, {load_after[0]:.1f} after.")
+    say()
+    say(f"Wall-clock seconds, median (min–max) over {args.repeats} repeats, in turns; the one "
+        f"process used {statistics.median(cpu):.2f} CPU seconds (median), "
+        f"{statistics.median(cpu) / args.states * 1e6:.2f} µs per state.")
+    say()
+    say("| run | s | one process / this | target |")
+    say("|---|---:|---:|---|")
+    for way in ways:
+        label = way if isinstance(way, str) else f"LocalCluster, {way} worker process" + \
+            ("es" if way > 1 else "")
+        ratio = one / statistics.median(times[way])
+        target = (f"≥ 1.6: {'met' if ratio >= 1.6 else 'NOT met'}" if way == 2 else "")
+        say(f"| {label} | {spread(times[way], '.2f')} | {ratio:.2f} | {target} |")
+    say()
+    worst = np.unravel_index(np.argmax(reference), reference.shape)
+    say(f"Largest entry: |dtau_{worst[0] + 1}/dq_{worst[1] + 1}| = {reference.max():.1f} N m/rad; "
+        f"column q_1 all zero: {not reference[:, 0].any()} (joint 1 turns about gravity).")
+    if args.markdown:
+        args.markdown.parent.mkdir(parents=True, exist_ok=True)
+        args.markdown.write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+if __name__ == "__main__":
+    main()
