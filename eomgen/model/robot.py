@@ -18,7 +18,7 @@ from .coupling import Coupling, locked_couplings
 from .loop import Loop
 from .notices import Notice
 from .parts import Inertial, Joint, JointType, Link, Parameter
-from .quaternion import (FREE_FLYER_CONFIGURATION, FREE_FLYER_VELOCITY, QuaternionJoint,
+from .quaternion import (QuaternionJoint,
                          quaternion_layout)
 from .scalars import IDENTITY3, ZERO3, Vec3, scalar, vec3
 from .transforms import Transform, rotation_about_axis

@@ -92,7 +92,6 @@ from ..errors import (
     ForbiddenXMLError,
     InvalidActuatorError,
     InvalidNumberError,
-    KinematicTreeError,
     SchemaError,
     UnreadableFileError,
     UnsupportedError,
