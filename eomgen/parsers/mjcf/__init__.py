@@ -49,8 +49,10 @@ by name: joint springs (``stiffness``, ``springref``: not modelled), tendons, ac
 than motors on hinge and slide joints, equality constraints (``connect``, ``weld``, first-order
 ``joint``, ``tendon``: not read yet, the model is the tree without them), fluid forces
 (``density``, ``viscosity``), gravity compensation (``gravcomp``). Refused
-(:class:`~eomgen.errors.UnsupportedError`), by name: ``ball`` joints (not read yet) and
-``joint`` equalities of order above one.
+(:class:`~eomgen.errors.UnsupportedError`), by name: ``joint`` equalities of order above
+one. ``ball`` joints are ball joints (:mod:`eomgen.model.quaternion`): MuJoCo's ``(qw, qx, qy,
+qz)`` is eomgen's ``(qx, qy, qz, qw)``; the velocity is the same (the child's angular velocity
+in the child frame); their armature, damping and frictionloss are warned about and left out.
 
 Contacts, joint limits, geoms, sites, sensors and the rendering options do not enter the
 equations of motion and are ignored.
@@ -98,8 +100,7 @@ def load_mjcf(path: Path, strict: bool = False, defer_notices: bool = False) -> 
     Raises
     ------
     UnsupportedError
-        MuJoCo is not installed (naming the extra); ball joints, higher-order joint
-        equalities; under ``strict``, every warned feature.
+        MuJoCo is not installed (naming the extra); higher-order joint equalities; under ``strict``, every warned feature.
     MujocoCompileError
         The compiler rejected the file (its message).
     UnknownFormatError

@@ -6,6 +6,9 @@ Hinge and slide joints: eomgen's ``q`` and ``v`` entries *are* MuJoCo's ``qpos``
 entries (same names, same values); only their order can differ, when the free joint is not
 MuJoCo's first joint (the free flyer always comes first in eomgen).
 
+A ball joint: MuJoCo's ``qpos`` block is ``(qw, qx, qy, qz)``, eomgen's
+``(qx, qy, qz, qw)``; both take ``ω`` of the child in the child frame as the velocity.
+
 The free joint: MuJoCo's ``qpos`` block is ``(x, y, z, qw, qx, qy, qz)``, eomgen's
 ``(x, y, z, qx, qy, qz, qw)``; MuJoCo's ``qvel`` block is ``(ṗ in world axes, ω in body
 axes)``, eomgen's ``(Rᵀ ṗ, ω)`` (both in body axes). So ``v_mj = T(q) v`` with ``T`` the
@@ -54,10 +57,19 @@ def layout(m, model: RobotModel) -> Layout:
         free = (qa, da)
         qpos += [qa, qa + 1, qa + 2, qa + 4, qa + 5, qa + 6, qa + 3]
         dofs += list(range(da, da + 6))
+    balls = {f"{name}_wx": name for name in model.ball_joints}
+    virtual = {f"{name}_{axis}" for name in model.ball_joints for axis in ("wy", "wz")}
     for joint in model.movable_joints[6 if model.free_flyer else 0:]:
-        j = by_name[joint.name]
-        qpos.append(int(m.jnt_qposadr[j]))
-        dofs.append(int(m.jnt_dofadr[j]))
+        if joint.name in virtual:  # taken with the ball joint's first entry
+            continue
+        j = by_name[balls.get(joint.name, joint.name)]
+        qa, da = int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])
+        if joint.name in balls:  # MuJoCo's (w, x, y, z) as (x, y, z, w); ω in the child frame
+            qpos += [qa + 1, qa + 2, qa + 3, qa]
+            dofs += [da, da + 1, da + 2]
+        else:
+            qpos.append(qa)
+            dofs.append(da)
     return Layout(np.array(qpos, dtype=int), np.array(dofs, dtype=int), free, int(m.nq),
                   int(m.nv))
 

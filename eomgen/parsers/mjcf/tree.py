@@ -130,11 +130,14 @@ def _actuator(m, joint: int) -> Actuator | None:
     return Actuator(**values)
 
 
-def refuse_ball(source: str, joint: str, body: str) -> None:
-    """A ball joint: not read yet (the quaternion joints of the legged issue will take it)."""
-    raise UnsupportedError(source, f"joint '{joint}' (ball, body '{body}')",
-                           "ball joints are not read yet (quaternion joints): make it three "
-                           "hinges, or remove it")
+def ball_drive_notice(m, source: str, joint: int, name: str, body: str) -> Notice | None:
+    """A ball joint's armature, damping or frictionloss: eomgen's drives act on one-axis
+    joints only, so they are left out, said by name (None when the joint has none)."""
+    if _actuator(m, joint) is None:
+        return None
+    return Notice(NoticeKind.NOT_MODELLED, source, f"joint '{name}' (ball, body '{body}')",
+                  "armature, damping and frictionloss of a ball joint are not modelled",
+                  "left out", joints=(name,))
 
 
 def build_tree(m, source: str) -> RobotModel:
@@ -149,7 +152,7 @@ def build_tree(m, source: str) -> RobotModel:
     Raises
     ------
     UnsupportedError
-        A ball joint, a free joint with other joints in its body.
+        A free joint with other joints in its body.
     """
     bodies, jnames = body_names(m), joint_names(m)
     kept, dropped = _free_bodies(m)
@@ -170,9 +173,6 @@ def build_tree(m, source: str) -> RobotModel:
             if FREE in types:
                 notices.append(_dropped_notice(m, source, b, dropped, bodies, jnames, kept))
             continue
-        for j, kind in zip(body_joints, types):
-            if kind == BALL:
-                refuse_ball(source, jnames[j], name)
         if FREE in types:
             j = body_joints[types.index(FREE)]
             if len(types) > 1:
@@ -196,7 +196,11 @@ def build_tree(m, source: str) -> RobotModel:
             anchor = np.asarray(m.jnt_pos[j], dtype=float)
             axis = np.asarray(m.jnt_axis[j], dtype=float)
             ref = float(m.qpos0[int(m.jnt_qposadr[j])])
-            if types[k] == HINGE:
+            if types[k] == BALL:  # a quaternion joint at its anchor, MuJoCo's axes
+                R_j, p_j, kind = R, p + R @ anchor, JointType.SPHERICAL
+                notices.extend(n for n in [ball_drive_notice(m, source, j, jnames[j], name)]
+                               if n is not None)
+            elif types[k] == HINGE:
                 R_j, p_j = R @ _axis_rotation(axis, -ref), p + R @ anchor
                 kind = JointType.CONTINUOUS
             else:
@@ -211,7 +215,8 @@ def build_tree(m, source: str) -> RobotModel:
                 links.append(Link(child))
             joints.append(Joint(jnames[j], kind, previous, child,
                                 _transform(R_j, p_j, f"joint '{jnames[j]}'"),
-                                vec3(float(a) for a in axis), _actuator(m, j)))
+                                vec3(float(a) for a in axis),
+                                None if types[k] == BALL else _actuator(m, j)))
             previous = child
             # what follows is placed from this joint's frame: back from its anchor
             R, p = np.eye(3), -anchor
