@@ -100,7 +100,7 @@ ACTUATOR_ALIASES = ("friction", "armature", "flexible_joints")
 PAYLOAD_KEYS = ("link", "name", "mass", "com", "inertia")
 
 #: The values of ``floating_base`` and what they mean: no floating base, or its chart.
-FLOATING_CHARTS = {False: False, True: "euler", "euler": "euler", "quaternion": "quaternion"}
+FLOATING_CHARTS = {False: False, True: "quaternion", "euler": "euler", "quaternion": "quaternion"}
 
 #: ``base: floating`` is short for ``floating_base: true`` (a link of this name cannot be a
 #: scene's base).
