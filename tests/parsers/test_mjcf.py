@@ -206,8 +206,8 @@ WARNED = {
     "connect": ("<connect name='loop' body1='a' body2='c' anchor='0 0 0'/>",
                 "equality 'loop' (connect): loop closures are not read yet"),
     "weld": ("<weld body1='a' body2='c'/>", "equality 'eq0' (weld): loop closures are not"),
-    "joint": ("<joint name='mimic' joint1='j3' joint2='j2' polycoef='0 2 0 0 0'/>",
-              "equality 'mimic' (joint): joint couplings are not read yet"),
+    "joint": ("<joint name='mimic' joint1='j3' joint2='j2' polycoef='0 2 0 0 0' active='false'/>",
+              "equality 'mimic' (joint, inactive): an inactive equality is not modelled"),
 }
 
 

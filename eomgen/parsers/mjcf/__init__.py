@@ -68,7 +68,7 @@ from pathlib import Path
 from ...errors import DescriptionError, UnknownFormatError, UnreadableFileError, UnsupportedError
 from ...model import RobotModel, emit_notices
 from .. import register
-from .extras import model_notices, motors
+from .extras import model_notices, motors, with_equalities
 from .tree import build_tree
 
 #: The optional extra that installs MuJoCo.
@@ -166,7 +166,7 @@ def model_from_mujoco(m, source: str = "<mujoco>", strict: bool = False,
                       defer_notices: bool = False) -> RobotModel:
     """eomgen's model of the compiled MuJoCo model ``m`` (``mujoco.MjModel``); see the module
     docstring. ``source`` names it in messages."""
-    model = build_tree(m, source)
+    model = with_equalities(build_tree(m, source), m, source)
     present = {joint.name for joint in model.joints}
     # what concerns only the joints of a dropped free body goes with it
     notices = tuple(n for n in model_notices(m, source)

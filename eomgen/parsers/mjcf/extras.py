@@ -2,17 +2,20 @@
 and the findings warned about (or refused) by name: joint springs, tendons, other actuators,
 equality constraints, fluid forces, gravity compensation (:mod:`eomgen.parsers.mjcf`).
 
-Each equality kind has its reader in :data:`EQUALITY_READERS` (``connect`` and ``weld`` will
-be loops, first-order ``joint`` equalities couplings); today each returns the notice that it is
-not read yet, and a ``joint`` equality of higher order is refused.
+Each equality kind has its reader in :data:`EQUALITY_READERS`: a first-order ``joint``
+equality is a coupling (:class:`~eomgen.model.Coupling`) or, without a second joint, a locked
+joint (:class:`JointLock`); ``connect`` and ``weld`` return the notice that they are not read
+yet; a ``joint`` equality of higher order is refused.
 """
 
 from __future__ import annotations
 
-from typing import Callable
+from dataclasses import replace
+from typing import Callable, NamedTuple, Union
 
 from ...errors import UnsupportedError
-from ...model import Notice, NoticeKind
+from ...model import Coupling, Notice, NoticeKind, RobotModel, lock_joints, make_coupling, \
+    with_couplings
 from .tree import FREE, HINGE, SLIDE, disabled, joint_names
 
 #: MuJoCo's transmission, dynamics, gain and bias types of a plain motor (``mjTRN_JOINT``,
@@ -110,9 +113,7 @@ def model_notices(m, source: str) -> tuple[Notice, ...]:
                                    "eomgen's input is the joint torque",
                                    joints=(jnames[int(m.actuator_trnid[i, 0])],) if on_joint
                                    else ()))
-    for e in range(m.neq):
-        reader = EQUALITY_READERS.get(int(m.eq_type[e]), other_equality)
-        notices.append(reader(m, e, source))
+    notices += [found for found in equalities(m, source) if isinstance(found, Notice)]
     if m.opt.density or m.opt.viscosity:
         notices.append(_notice(source, "option density, viscosity",
                                "fluid forces are not modelled", "left out"))
@@ -145,14 +146,26 @@ def equality_weld(m, e: int, source: str) -> Notice:
                    links=_equality_bodies(m, e))
 
 
-def equality_joint(m, e: int, source: str) -> Notice:
-    """A ``joint`` equality ``q1 = c0 + c1 q2 (+ c2 q2² + …)``: a coupling when first-order
-    (not read yet), refused above.
+class JointLock(NamedTuple):
+    """A joint held at ``position`` [rad or m] by a ``joint`` equality without a second
+    joint (``element`` names it)."""
+
+    joint: str
+    position: float
+    element: str
+
+
+def equality_joint(m, e: int, source: str) -> Union[Coupling, JointLock, Notice]:
+    """A ``joint`` equality, MuJoCo's ``q1 − ref1 = c0 + c1 (q2 − ref2)`` (``polycoef``
+    ``c0 … c4``, the refs the joints' ``ref``, MuJoCo's ``qpos0``): first-order, the coupling
+    ``q1 = c1 q2 + (ref1 + c0 − c1 ref2)`` (eomgen's ``q`` is MuJoCo's ``qpos``); without
+    ``joint2`` (or with ``c1 = 0``) the lock ``q1 = ref1 + c0``; inactive (``active="false"``),
+    a notice (MuJoCo does not enforce it unless it is switched on).
 
     Raises
     ------
     UnsupportedError
-        A polynomial of order above one.
+        A polynomial of order above one; a joint that is not a hinge or a slide.
     """
     jnames = joint_names(m)
     where = _equality_where(m, e, "joint")
@@ -162,9 +175,20 @@ def equality_joint(m, e: int, source: str) -> Notice:
         raise UnsupportedError(source, where, f"a joint equality of order {order} (polycoef "
                                f"{' '.join(f'{c:g}' for c in coefficients)}): only first-order "
                                "couplings q1 = c0 + c1 q2 are read")
-    joints = (jnames[int(m.eq_obj1id[e])],) + (
-        (jnames[int(m.eq_obj2id[e])],) if int(m.eq_obj2id[e]) >= 0 else ())
-    return _notice(source, where, "joint couplings are " + _NOT_READ, joints=joints)
+    ids = [int(m.eq_obj1id[e])] + ([int(m.eq_obj2id[e])] if int(m.eq_obj2id[e]) >= 0 else [])
+    for j in ids:
+        if int(m.jnt_type[j]) not in (HINGE, SLIDE):
+            raise UnsupportedError(source, where, f"joint '{jnames[j]}' is not a hinge or a "
+                                   "slide: only one-axis joints are coupled")
+    joints = tuple(jnames[j] for j in ids)
+    if not bool(m.eq_active0[e]):
+        return _notice(source, where, "an inactive equality is not modelled (MuJoCo enforces "
+                       "it only once switched on)", "left out", joints=joints)
+    ref = [float(m.qpos0[int(m.jnt_qposadr[j])]) for j in ids]
+    c0, c1 = coefficients[:2]
+    if len(ids) == 1 or c1 == 0:
+        return JointLock(joints[0], ref[0] + c0, where)
+    return make_coupling(joints[0], {joints[1]: c1}, ref[0] + c0 - c1 * ref[1], where)
 
 
 def other_equality(m, e: int, source: str) -> Notice:
@@ -174,7 +198,75 @@ def other_equality(m, e: int, source: str) -> Notice:
                    "this equality is not modelled: the model is the tree without it")
 
 
-#: The reader of each equality kind (MuJoCo's ``mjtEq`` code): a notice today; the loop and
-#: coupling readers when those exist.
-EQUALITY_READERS: dict[int, Callable[..., Notice]] = {
+#: The reader of each equality kind (MuJoCo's ``mjtEq`` code): what the equality is in
+#: eomgen's model (a coupling, a locked joint), or the notice that it is not modelled.
+EQUALITY_READERS: dict[int, Callable[..., Union[Coupling, JointLock, Notice]]] = {
     CONNECT: equality_connect, WELD: equality_weld, JOINT: equality_joint}
+
+
+def equalities(m, source: str) -> list:
+    """What each equality of ``m`` is (:data:`EQUALITY_READERS`), in MuJoCo's order."""
+    return [EQUALITY_READERS.get(int(m.eq_type[e]), other_equality)(m, e, source)
+            for e in range(m.neq)]
+
+
+def with_equalities(model: RobotModel, m, source: str) -> RobotModel:
+    """``model`` (the tree of ``m``) with its ``joint`` equalities: the couplings (a chain of
+    them, ``q3`` following ``q2`` following ``q1``, written in the independent joints), then
+    the locked joints (``model.info["mujoco_locks"]``: ``(joint, position)`` pairs, for
+    :func:`eomgen.parsers.mjcf.convert.layout`). An equality on a joint of a dropped free
+    body is left out with that body; one joining such a joint to a kept one is a notice.
+
+    Raises
+    ------
+    KinematicTreeError
+        Two equalities on one follower, a cycle of them (:func:`eomgen.model.check_couplings`),
+        a joint locked against its coupling.
+    """
+    present = {joint.name for joint in model.joints}
+    couplings, locks, notices = [], {}, []
+    for found in equalities(m, source):
+        if isinstance(found, Notice):
+            continue  # in model_notices
+        joints = ((found.joint,) if isinstance(found, JointLock)
+                  else (found.follower,) + tuple(name for name, _ in found.leaders))
+        if not any(name in present for name in joints):
+            continue
+        if not all(name in present for name in joints):
+            element = found.element if isinstance(found, JointLock) else found.where
+            notices.append(_notice(source, element, "it joins a joint of a dropped free body",
+                                   "left out", joints=tuple(n for n in joints if n in present)))
+        elif isinstance(found, JointLock):
+            locks[found.joint] = found.position
+        else:
+            couplings.append(found)
+    model = with_couplings(model, _resolved(couplings)) if couplings else model
+    if locks:
+        model = replace(lock_joints(model, locks), info=model.info + (
+            ("mujoco_locks", tuple(locks.items())),))
+    return replace(model, notices=tuple(model.notices) + tuple(notices))
+
+
+def _resolved(couplings: list[Coupling]) -> list[Coupling]:
+    """``couplings`` with each leader that follows another coupling replaced by its own
+    leaders (MuJoCo allows chains of joint equalities, eomgen's couplings name independent
+    joints); a cycle is left for :func:`eomgen.model.check_couplings` to refuse."""
+    by_follower = {c.follower: c for c in couplings}
+    out = []
+    for coupling in couplings:
+        seen = {coupling.follower}
+        while any(name in by_follower and name not in seen for name, _ in coupling.leaders):
+            leaders: dict = {}
+            offset = coupling.offset
+            for name, gain in coupling.leaders:
+                inner = by_follower.get(name)
+                if inner is None or name in seen:
+                    leaders[name] = leaders.get(name, 0) + gain
+                    continue
+                seen.add(name)
+                offset += gain * inner.offset
+                for leader, k in inner.leaders:
+                    leaders[leader] = leaders.get(leader, 0) + gain * k
+            coupling = replace(coupling, leaders=tuple(leaders.items()), offset=offset)
+        out.append(coupling)
+    return out
