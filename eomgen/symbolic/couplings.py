@@ -38,6 +38,7 @@ PROJECTIONS: dict[str, tuple[bool, bool]] = {
     "p_f": (False, False), "R_f": (False, False), "J_f": (False, True),
     "Jb_f": (False, True), "dJqd_f": (False, False), "dJbqd_f": (False, False),
     "J_c": (False, True), "dJqd_c": (False, False), "tau_c": (True, False),
+    "Phi_l": (False, False), "J_l": (False, True), "dJqd_l": (False, False),
     "cone_c": (False, False), "pyramid_c": (False, False),
     "c_G": (False, False), "J_G": (False, True), "A_G": (False, True), "dAGv": (False, False),
     "I_G": (False, False),

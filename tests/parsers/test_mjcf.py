@@ -203,9 +203,12 @@ def test_refused_by_name(tmp_path, case):
 
 
 WARNED = {
-    "connect": ("<connect name='loop' body1='a' body2='c' anchor='0 0 0'/>",
-                "equality 'loop' (connect): loop closures are not read yet"),
-    "weld": ("<weld body1='a' body2='c'/>", "equality 'eq0' (weld): loop closures are not"),
+    "connect": ("<connect name='loop' body1='a' body2='c' anchor='0 0 0' active='false'/>",
+                "equality 'loop' (connect, inactive): an inactive equality is not modelled"),
+    "weld": ("<weld body1='a' body2='c' active='false'/>",
+             "equality 'eq0' (weld, inactive): an inactive equality"),
+    "tendon": ("<tendon name='te' tendon1='t'/>", "equality 'te' (tendon): this equality is "
+               "not modelled"),
     "joint": ("<joint name='mimic' joint1='j3' joint2='j2' polycoef='0 2 0 0 0' active='false'/>",
               "equality 'mimic' (joint, inactive): an inactive equality is not modelled"),
 }
@@ -215,8 +218,10 @@ WARNED = {
 def test_equalities_are_warned_by_name_and_dropped(tmp_path, case):
     element, message = WARNED[case]
     path = tmp_path / "e.xml"
-    path.write_text(WORLD.format(extra_bodies="", extra=f"<equality>{element}</equality>"),
-                    encoding="utf-8")
+    tendon = ("<tendon><fixed name='t'><joint joint='j1' coef='1'/></fixed></tendon>"
+              if case == "tendon" else "")
+    path.write_text(WORLD.format(extra_bodies="", extra=f"{tendon}<equality>{element}"
+                                 "</equality>"), encoding="utf-8")
     with pytest.warns(UnsupportedFeatureWarning, match=message.replace("(", r"\(")
                       .replace(")", r"\)")):
         model = eomgen.load(path)

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 import eomgen
-from eomgen.errors import KinematicTreeError, UnsupportedError, UnsupportedFeatureWarning
+from eomgen.errors import KinematicTreeError, UnsupportedFeatureWarning
 from support import relative
 
 mujoco = pytest.importorskip("mujoco", reason="MJCF is read by MuJoCo's compiler")

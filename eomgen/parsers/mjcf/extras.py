@@ -4,8 +4,9 @@ equality constraints, fluid forces, gravity compensation (:mod:`eomgen.parsers.m
 
 Each equality kind has its reader in :data:`EQUALITY_READERS`: a first-order ``joint``
 equality is a coupling (:class:`~eomgen.model.Coupling`) or, without a second joint, a locked
-joint (:class:`JointLock`); ``connect`` and ``weld`` return the notice that they are not read
-yet; a ``joint`` equality of higher order is refused.
+joint (:class:`JointLock`); ``connect`` is a point loop and ``weld`` a weld loop
+(:class:`~eomgen.model.Loop`); a ``joint`` equality of higher order is refused; an inactive
+equality, a ``tendon`` or flex one is a notice.
 """
 
 from __future__ import annotations
@@ -14,9 +15,23 @@ from dataclasses import replace
 from typing import Callable, NamedTuple, Union
 
 from ...errors import UnsupportedError
-from ...model import Coupling, Notice, NoticeKind, RobotModel, lock_joints, make_coupling, \
-    with_couplings
-from .tree import FREE, HINGE, SLIDE, disabled, joint_names
+from ...model import (
+    POINT_LOOP,
+    WELD as WELD_LOOP,
+    Coupling,
+    Loop,
+    LoopFrame,
+    Notice,
+    NoticeKind,
+    RobotModel,
+    Transform,
+    lock_joints,
+    make_coupling,
+    scalar,
+    vec3,
+    with_couplings,
+)
+from .tree import FREE, HINGE, SLIDE, body_names, disabled, joint_names, rotation_of_quaternion
 
 #: MuJoCo's transmission, dynamics, gain and bias types of a plain motor (``mjTRN_JOINT``,
 #: ``mjDYN_NONE``, ``mjGAIN_FIXED``, ``mjBIAS_NONE``) and of ``mjTRN_JOINTINPARENT``.
@@ -27,6 +42,8 @@ _GAIN_MUSCLE, _BIAS_AFFINE = 2, 1
 #: MuJoCo's equality types (``mjtEq``) and wrap type of a joint in a fixed tendon.
 CONNECT, WELD, JOINT, TENDON = 0, 1, 2, 3
 _WRAP_JOINT = 1
+#: MuJoCo's object type of a site (``mjOBJ_SITE``): an equality between two sites.
+_OBJ_SITE = 6
 
 _NOT_READ = "not read yet: the model is the tree without it"
 
@@ -134,16 +151,63 @@ def _equality_bodies(m, e: int) -> tuple[str, ...]:
                  + m.eq_obj2id[e:e + 1].tolist() if int(b) > 0)
 
 
-def equality_connect(m, e: int, source: str) -> Notice:
-    """A ``connect`` equality (a ball-and-socket loop closure): not read yet."""
-    return _notice(source, _equality_where(m, e, "connect"), "loop closures are " + _NOT_READ,
-                   links=_equality_bodies(m, e))
+def equality_connect(m, e: int, source: str) -> Union[Loop, Notice]:
+    """A ``connect`` equality: the point loop ``<name>`` (3 rows, world axes) holding the
+    anchor on ``body1`` (frame b, ``eq_data[0:3]`` in body1's frame) on the same point of
+    ``body2`` (frame a, ``eq_data[3:6]``, where the compiler put it at ``qpos0``): ``Φ = p_1 −
+    p_2``, MuJoCo's own residual and rows, and λ the force on body1 (MuJoCo's
+    ``efc_force``). Between sites, the two sites' origins."""
+    where = _equality_where(m, e, "connect")
+    if not bool(m.eq_active0[e]):
+        return _inactive(m, e, source, where)
+    data = m.eq_data[e]
+    one, two = (_site_frame(m, e, k) if int(m.eq_objtype[e]) == _OBJ_SITE
+                else _body_frame(m, e, k, data[3 * k:3 * k + 3]) for k in (0, 1))
+    return Loop(_name(m, "eq", e), POINT_LOOP, two, one)
 
 
-def equality_weld(m, e: int, source: str) -> Notice:
-    """A ``weld`` equality (a rigid loop closure): not read yet."""
-    return _notice(source, _equality_where(m, e, "weld"), "loop closures are " + _NOT_READ,
-                   links=_equality_bodies(m, e))
+def equality_weld(m, e: int, source: str) -> Union[Loop, Notice]:
+    """A ``weld`` equality: the weld loop ``<name>`` (6 rows, world axes) holding frame b on
+    ``body1`` (origin ``eq_data[3:6]``, axes ``relpose``, ``eq_data[6:10]``) on frame a on
+    ``body2`` (origin the ``anchor``, ``eq_data[0:3]``): MuJoCo's ``R_1 · relpose = R_2`` and
+    its anchor; λ acts on body1. ``torquescale="0"`` leaves the rotation free: a point loop.
+    Between sites, the two site frames."""
+    where = _equality_where(m, e, "weld")
+    if not bool(m.eq_active0[e]):
+        return _inactive(m, e, source, where)
+    data = m.eq_data[e]
+    if int(m.eq_objtype[e]) == _OBJ_SITE:
+        one, two = _site_frame(m, e, 0), _site_frame(m, e, 1)
+    else:
+        one = _body_frame(m, e, 0, data[3:6], rotation_of_quaternion(data[6:10]))
+        two = _body_frame(m, e, 1, data[0:3])
+    kind = WELD_LOOP if float(data[10]) else POINT_LOOP
+    return Loop(_name(m, "eq", e), kind, two, one)
+
+
+def _inactive(m, e: int, source: str, where: str) -> Notice:
+    return _notice(source, where, "an inactive equality is not modelled (MuJoCo enforces it "
+                   "only once switched on)", "left out", links=_equality_bodies(m, e))
+
+
+def _body_frame(m, e: int, k: int, anchor, rotation=None) -> LoopFrame:
+    """Equality ``e``'s frame on its body ``k`` (0: body1, 1: body2) at ``anchor`` [m] in
+    the body frame, with axes ``rotation`` (the body's when None)."""
+    body = int((m.eq_obj1id if k == 0 else m.eq_obj2id)[e])
+    return LoopFrame(body_names(m)[body], _pose(anchor, rotation))
+
+
+def _site_frame(m, e: int, k: int) -> LoopFrame:
+    site = int((m.eq_obj1id if k == 0 else m.eq_obj2id)[e])
+    return LoopFrame(body_names(m)[int(m.site_bodyid[site])],
+                     _pose(m.site_pos[site], rotation_of_quaternion(m.site_quat[site])))
+
+
+def _pose(anchor, rotation) -> Transform:
+    if rotation is None:
+        return Transform(translation=vec3(float(v) for v in anchor))
+    return Transform(tuple(tuple(scalar(float(v)) for v in row) for row in rotation),
+                     vec3(float(v) for v in anchor))
 
 
 class JointLock(NamedTuple):
@@ -182,8 +246,7 @@ def equality_joint(m, e: int, source: str) -> Union[Coupling, JointLock, Notice]
                                    "slide: only one-axis joints are coupled")
     joints = tuple(jnames[j] for j in ids)
     if not bool(m.eq_active0[e]):
-        return _notice(source, where, "an inactive equality is not modelled (MuJoCo enforces "
-                       "it only once switched on)", "left out", joints=joints)
+        return replace(_inactive(m, e, source, where), links=(), joints=joints)
     ref = [float(m.qpos0[int(m.jnt_qposadr[j])]) for j in ids]
     c0, c1 = coefficients[:2]
     if len(ids) == 1 or c1 == 0:
@@ -211,11 +274,13 @@ def equalities(m, source: str) -> list:
 
 
 def with_equalities(model: RobotModel, m, source: str) -> RobotModel:
-    """``model`` (the tree of ``m``) with its ``joint`` equalities: the couplings (a chain of
-    them, ``q3`` following ``q2`` following ``q1``, written in the independent joints), then
-    the locked joints (``model.info["mujoco_locks"]``: ``(joint, position)`` pairs, for
-    :func:`eomgen.parsers.mjcf.convert.layout`). An equality on a joint of a dropped free
-    body is left out with that body; one joining such a joint to a kept one is a notice.
+    """``model`` (the tree of ``m``) with its equalities: the couplings of ``joint``
+    equalities (a chain of them, ``q3`` following ``q2`` following ``q1``, written in the
+    independent joints), the locked joints (``model.info["mujoco_locks"]``: ``(joint,
+    position)`` pairs, for :func:`eomgen.parsers.mjcf.convert.layout`) and the loops of
+    ``connect`` and ``weld`` (:attr:`~eomgen.model.RobotModel.loops`, in MuJoCo's order). An
+    equality on a dropped free body's joints or bodies is left out with that body; one
+    joining such a joint or body to a kept one is a notice.
 
     Raises
     ------
@@ -223,19 +288,27 @@ def with_equalities(model: RobotModel, m, source: str) -> RobotModel:
         Two equalities on one follower, a cycle of them (:func:`eomgen.model.check_couplings`),
         a joint locked against its coupling.
     """
-    present = {joint.name for joint in model.joints}
-    couplings, locks, notices = [], {}, []
+    present = {joint.name for joint in model.joints} | {link.name for link in model.links}
+    couplings, locks, loops, notices = [], {}, [], []
     for found in equalities(m, source):
         if isinstance(found, Notice):
             continue  # in model_notices
-        joints = ((found.joint,) if isinstance(found, JointLock)
-                  else (found.follower,) + tuple(name for name, _ in found.leaders))
-        if not any(name in present for name in joints):
+        if isinstance(found, Loop):
+            names, element = (found.a.link, found.b.link), f"equality '{found.name}'"
+        elif isinstance(found, JointLock):
+            names, element = (found.joint,), found.element
+        else:
+            names = (found.follower,) + tuple(name for name, _ in found.leaders)
+            element = found.where
+        if not any(name in present for name in names):
             continue
-        if not all(name in present for name in joints):
-            element = found.element if isinstance(found, JointLock) else found.where
-            notices.append(_notice(source, element, "it joins a joint of a dropped free body",
-                                   "left out", joints=tuple(n for n in joints if n in present)))
+        if not all(name in present for name in names):
+            kept = tuple(n for n in names if n in present)
+            notices.append(_notice(source, element, "it joins a dropped free body", "left out",
+                                   **({"links": kept} if isinstance(found, Loop)
+                                      else {"joints": kept})))
+        elif isinstance(found, Loop):
+            loops.append(found)
         elif isinstance(found, JointLock):
             locks[found.joint] = found.position
         else:
@@ -244,7 +317,7 @@ def with_equalities(model: RobotModel, m, source: str) -> RobotModel:
     if locks:
         model = replace(lock_joints(model, locks), info=model.info + (
             ("mujoco_locks", tuple(locks.items())),))
-    return replace(model, notices=tuple(model.notices) + tuple(notices))
+    return replace(model, loops=tuple(loops), notices=tuple(model.notices) + tuple(notices))
 
 
 def _resolved(couplings: list[Coupling]) -> list[Coupling]:
