@@ -21,7 +21,7 @@ import pytest
 import eomgen
 from eomgen.errors import UnknownFormatError, UnsupportedError, UnsupportedFeatureWarning
 from eomgen.model import joint_actuators
-from support import relative, run_cli
+from support import model_states, relative, run_cli
 
 mujoco = pytest.importorskip("mujoco", reason="MJCF is read by MuJoCo's compiler")
 
@@ -55,14 +55,7 @@ def derived():
     return out
 
 
-def states(model, count=3, seed=0):
-    rng = np.random.default_rng(seed)
-    for _ in range(count):
-        q = rng.uniform(-1, 1, model.nq)
-        for joint in model.quaternion_joints:  # unit quaternions: MuJoCo takes them as given
-            k = joint.quaternion
-            q[k:k + 4] /= np.linalg.norm(q[k:k + 4])
-        yield q, rng.normal(size=model.dof)
+states = model_states
 
 
 @pytest.mark.parametrize("name", ["arm.xml", "floating.xml", "ball.xml",

@@ -13,15 +13,14 @@ coupled_floating.xml (a free joint and a ball joint with a coupling below them).
 
 from __future__ import annotations
 
-import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import eomgen
-from eomgen.errors import KinematicTreeError, UnsupportedFeatureWarning
-from support import relative
+from eomgen.errors import KinematicTreeError
+from support import load_quietly, model_states, relative
 
 mujoco = pytest.importorskip("mujoco", reason="MJCF is read by MuJoCo's compiler")
 
@@ -33,31 +32,18 @@ DATA = Path(__file__).resolve().parent.parent / "data" / "mjcf"
 TOLERANCE = 1e-10
 
 
-def quiet_load(path, **options):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", UnsupportedFeatureWarning)
-        return eomgen.load(path, **options)
-
-
 @pytest.fixture(scope="module")
 def derived():
     out = {}
     for name in ("coupled.xml", "coupled_floating.xml"):
-        model = quiet_load(DATA / name)
+        model = load_quietly(DATA / name)
         outputs = ("M", "h") if model.quaternion_joints else ("M", "h", "M_a", "tau_f")
         out[name] = (model, compile_mjcf(DATA / name),
                      eomgen.derive(model, outputs=outputs).lambdify().module)
     return out
 
 
-def states(model, count=3, seed=0):
-    rng = np.random.default_rng(seed)
-    for _ in range(count):
-        q = rng.uniform(-1, 1, model.nq)
-        for joint in model.quaternion_joints:
-            k = joint.quaternion
-            q[k:k + 4] /= np.linalg.norm(q[k:k + 4])
-        yield q, rng.normal(size=model.dof)
+states = model_states
 
 
 def test_followers_and_locked_joints_leave_the_coordinates(derived):
@@ -119,12 +105,12 @@ def test_a_follower_coupled_twice_is_refused_by_name(tmp_path):
     path = write(tmp_path, "<joint name='e1' joint1='j3' joint2='j1'/>"
                  "<joint name='e2' joint1='j3' joint2='j2'/>")
     with pytest.raises(KinematicTreeError, match=r"equality 'e2' \(joint\).*'j3' already follows"):
-        quiet_load(path)
+        load_quietly(path)
 
 
 def test_a_cycle_of_equalities_is_refused_by_name(tmp_path):
     path = write(tmp_path, "<joint name='e1' joint1='j1' joint2='j2'/>"
                  "<joint name='e2' joint1='j2' joint2='j1'/>")
     with pytest.raises(KinematicTreeError, match="cycle|is itself a follower"):
-        quiet_load(path)
+        load_quietly(path)
 
