@@ -71,16 +71,20 @@ def test_rows_are_mujocos(case):
         assert np.abs(pos[6:]).max() > 1e-3  # the state is off the loop: the rows say so
 
 
-def test_qpos0_closes_the_loops_and_the_constrained_accelerations_are_mujocos(case):
-    model, m, lay, f = case
+def closed_state(m, lay, model):
+    """``(q, v, tau)``: qpos0 (which closes the loops), a velocity of the two free motions
+    (MuJoCo's efc_J null space), random efforts."""
     q = np.asarray(m.qpos0)[lay.qpos_index]
-    J_mj, pos = equality_rows(m, lay, q, np.zeros(model.dof))
-    assert np.abs(pos).max() < 1e-12 and np.abs(f.loop_constraint(q)).max() < 1e-12
+    J_mj, _ = equality_rows(m, lay, q, np.zeros(model.dof))
     rng = np.random.default_rng(1)
-    v = np.linalg.svd(J_mj)[2][-2:].T @ rng.normal(size=2)  # the two free motions
-    tau = rng.normal(size=model.dof)
-    J = f.loop_jacobian(q).reshape(9, model.dof)
-    assert np.abs(J @ v).max() < 1e-12
+    v = np.linalg.svd(J_mj)[2][-2:].T @ rng.normal(size=2)
+    return q, v, rng.normal(size=model.dof)
+
+
+def mujoco_kkt(m, lay, model, q, v, tau):
+    """q̈ of the KKT system of MuJoCo's M, bias, efc_J and J̇ q̇ (a central difference of
+    efc_J along the motion), the loops held exactly."""
+    J_mj, _ = equality_rows(m, lay, q, np.zeros(model.dof))
 
     def J_at(step):
         qpos = np.array(m.qpos0)
@@ -89,10 +93,19 @@ def test_qpos0_closes_the_loops_and_the_constrained_accelerations_are_mujocos(ca
 
     bias = (J_at(1e-5) - J_at(-1e-5)) @ v / 2e-5
     ref = mujoco_dynamics(m, lay, q, v)
-    expected, _ = kkt_solve(ref["M"], ref["h"], tau, J_mj, bias)
+    return kkt_solve(ref["M"], ref["h"], tau, J_mj, bias)[0]
+
+
+def test_qpos0_closes_the_loops_and_the_constrained_accelerations_are_mujocos(case):
+    model, m, lay, f = case
+    q, v, tau = closed_state(m, lay, model)
+    _, pos = equality_rows(m, lay, q, np.zeros(model.dof))
+    assert np.abs(pos).max() < 1e-12 and np.abs(f.loop_constraint(q)).max() < 1e-12
+    J = f.loop_jacobian(q).reshape(9, model.dof)
+    assert np.abs(J @ v).max() < 1e-12
     qdd, _ = kkt_solve(f.mass_matrix(q).reshape(11, 11), f.nonlinear_effects(q, v).ravel(),
                        tau, J, f.loop_bias(q, v).ravel())
-    assert relative(qdd, expected) < 1e-8
+    assert relative(qdd, mujoco_kkt(m, lay, model, q, v, tau)) < 1e-8
     assert np.abs(J @ qdd + f.loop_bias(q, v).ravel()).max() < 1e-9
 
 
@@ -136,11 +149,17 @@ def test_site_connect_rotation_free_weld_and_a_coupling(tmp_path):
     assert relative(f.loop_constraint(q).ravel(), pos[:6]) < 1e-12
 
 
-def test_cli_generates_the_loop_outputs_without_a_scene(tmp_path):
+def test_cli_generates_the_constrained_dynamics_without_a_scene(case, tmp_path):
+    """The generated constrained_forward_dynamics (the loops as the file's equalities, no
+    scene) gives MuJoCo's constrained q̈."""
+    model, m, lay, _ = case
     result = run_cli("generate", LOOPS, "--backend", "numpy", "--no-cache", "--outputs",
-                     "loop_jacobian,loop_constraint", "-o", tmp_path)
+                     "constrained_forward_dynamics", "-o", tmp_path)
     assert result.exit_code == 0, result.output
     namespace: dict = {}
     exec((tmp_path / "mjcf_loops_numpy.py").read_text(encoding="utf-8"), namespace)
-    assert namespace["LOOP_ROWS"][:3] == ("pin.x", "pin.y", "pin.z")
-    assert len(namespace["LOOP_ROWS"]) == 9
+    assert namespace["CONTACT_ROWS"][:3] == ("pin.x", "pin.y", "pin.z")
+    assert len(namespace["CONTACT_ROWS"]) == 9
+    q, v, tau = closed_state(m, lay, model)
+    qdd, _ = namespace["constrained_forward_dynamics"](q, v, tau)
+    assert relative(np.ravel(qdd), mujoco_kkt(m, lay, model, q, v, tau)) < 1e-8
