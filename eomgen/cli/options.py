@@ -1,7 +1,8 @@
 """The arguments and options several ``eomgen`` commands take, declared once.
 
 Each is a click decorator (or a function making one, where commands differ in a default or a
-help text): the DESCRIPTION argument (a file, or a bundled example's name), ``--scene``, ``--quiet``, ``--strict`` and ``-o/--output``
+help text): the DESCRIPTION argument (a file, or a bundled example's name; with it
+``--mimic``), ``--scene``, ``--quiet``, ``--strict`` and ``-o/--output``
 (a folder or a file). Whether an output can be written is checked by the command itself
 (:mod:`eomgen.output`: one error line, not click's usage text). ``--debug`` comes with the error
 handling (:func:`eomgen.cli.handling.handle_errors`).
