@@ -114,3 +114,27 @@ def test_a_cycle_of_equalities_is_refused_by_name(tmp_path):
     with pytest.raises(KinematicTreeError, match="cycle|is itself a follower"):
         load_quietly(path)
 
+
+
+def test_an_equality_joining_a_dropped_free_body_is_left_out_by_name(tmp_path):
+    """A second free body is dropped (tests/parsers/test_mjcf.py); a joint equality or a
+    connect between it and the robot goes with it, said by name."""
+    path = tmp_path / "d.xml"
+    path.write_text("""<mujoco model="d"><worldbody>
+      <body name="robot"><freejoint/><geom size="0.1"/>
+        <body name="arm" pos="0.3 0 0"><joint name="j1" axis="0 1 0"/><geom size="0.1"/>
+          <body name="hand" pos="0.3 0 0"><joint name="j2" axis="0 1 0"/><geom size="0.1"/>
+      </body></body></body>
+      <body name="ball" pos="2 0 0"><freejoint/><geom size="0.1"/>
+        <body name="flap"><joint name="f" axis="1 0 0"/><geom size="0.05"/></body></body>
+      </worldbody><equality><joint name="across" joint1="f" joint2="j1"/>
+      <connect name="tie" body1="flap" body2="hand" anchor="0 0 0"/>
+      <joint name="kept" joint1="j2" joint2="j1" polycoef="0 0.5 0 0 0"/></equality></mujoco>""",
+                    encoding="utf-8")
+    with pytest.warns(UserWarning) as caught:
+        model = eomgen.load(path)
+    said = " | ".join(str(w.message) for w in caught)
+    assert "equality 'across' (joint): it joins a dropped free body" in said
+    assert "equality 'tie': it joins a dropped free body" in said
+    assert model.loops == () and [c.follower for c in model.couplings] == ["j2"]
+    assert model.joint_names[6:] == ("j1",)
