@@ -106,26 +106,38 @@ def test_simulation_matches_pinocchio(model):
     assert np.abs(trajectory.q[-1] - q0).max() > 0.1  # it moved
 
 
-def test_baumgarte_pulls_the_contact_back_critically_damped(model):
-    """The elbow started 2.5 mm from its anchor (the left motor turned 0.01 rad, the loop
-    closed): with kp = 100, kd = 20 its error follows ë + kd ė + kp e = 0 from rest,
-    e0 (1 + ωt) e^{−ωt} with ω = 10 rad/s; without Baumgarte it stays (the elbow is held)."""
+SURFACE = ("{frame: left_distal, name: elbow}",
+           "{frame: right_distal, name: elbow, type: surface}")
+
+
+@pytest.mark.parametrize("surface", [False, True], ids=["point", "surface"])
+def test_baumgarte_pulls_the_contact_back_critically_damped(model, surface):
+    """A contact started off its anchor (a motor turned 0.01 rad, the loop closed): the left
+    elbow held by the point contact 2.5 mm away, or the right distal link held by a surface
+    contact (position and angle), 2.5 mm and 0.024 rad away. With kp = 100, kd = 20 each error
+    follows ë + kd ė + kp e = 0 from rest, e0 (1 + ωt) e^{−ωt} with ω = 10 rad/s; without
+    Baumgarte it stays (the contact holds the frame where it is)."""
     pytest.importorskip("scipy")
     from eomgen.analysis.simulate import integrators_named, simulate
     from eomgen.analysis.simulate_loops import HeldContacts, LoopSystem, consistent_start
 
+    if surface:
+        model = apply_scene(eomgen.load(ROBOT), load_scene(
+            "fivebar_surface.yaml", text=SCENE.read_text().replace(*SURFACE))).model
     program = LoopDynamics(model)
     q0, _ = consistent_start(program, Q0, np.zeros(4))
-    q1 = program.assemble(q0 + np.array([0.01, 0.0, 0.0, 0.0]))
+    q1 = program.assemble(q0 + 0.01 * np.eye(4)[2 if surface else 0])
     (rk4,) = integrators_named(["rk4"], [0.002], [1e-8])
-    times = np.linspace(0.0, 0.5, 6)
+    law = (1 + 10 * np.linspace(0.0, 0.5, 6)) * np.exp(-10 * np.linspace(0.0, 0.5, 6))
     for on in (False, True):
         held = HeldContacts(model, q0, on)
         system = LoopSystem(model, (100.0, 20.0) if on else (0.0, 0.0), program, held, 1e-12)
         trajectory, _ = simulate(system, rk4, q1, np.zeros(4), 0.5, points=6)
-        error = np.array([held.drift(q)[0] for q in trajectory.q])
-        expected = error[0] * (1 + 10 * times) * np.exp(-10 * times) if on else error[0]
-        assert 2e-3 < error[0] < 3e-3 and relative(error, expected) <= 0.01, on
+        error = np.array([held.drift(q) for q in trajectory.q])  # position, angle
+        assert 2e-3 < error[0, 0] < 3e-3 and (error[0, 1] > 0.02) == surface
+        for k in range(2 if surface else 1):
+            expected = error[0, k] * (law if on else 1.0)
+            assert relative(error[:, k], expected) <= 0.01, (on, k)
         assert max(system.drift(q, v)[0] for q, v in zip(trajectory.q, trajectory.qd)) < 1e-9
 
 
