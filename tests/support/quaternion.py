@@ -106,4 +106,5 @@ def pinocchio_parameters(pm) -> np.ndarray:
     return np.concatenate([pm.inertias[j].toDynamicParameters() for j in range(1, pm.njoints)])
 
 
-__all__ = ["BALL_CHAIN", "body_columns", "pinocchio_parameters", "GRAVITY", "TWO_LEGS", "pinocchio_states", "quaternion_robot"]
+__all__ = ["BALL_CHAIN", "GRAVITY", "TWO_LEGS", "body_columns", "pinocchio_parameters",
+           "pinocchio_states", "quaternion_robot"]
