@@ -287,6 +287,88 @@ print("largest |Y_SL beta - (M qdd_r + C qd_r + g)|:",
     return nb
 
 
+#: The simulation cell of the notebook: the parts that differ between a model without and with
+#: quaternion joints (q̇ = v, or configuration_rate and normalised quaternions) are filled in.
+_SIMULATION = """
+import io
+
+import matplotlib
+from IPython.display import Image
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+from scipy.integrate import solve_ivp
+{setup}
+budget = 50_000
+calls = 0
+
+
+class OverBudget(Exception):
+    pass
+
+
+def rhs(t, state):
+    global calls
+    calls += 1
+    if calls > budget:
+        raise OverBudget
+{rhs}
+
+t_all, y_all = [0.0], [np.concatenate([q0, np.zeros(n)])]
+for start in np.arange(0.0, 2.0, 0.1):
+    try:
+        chunk = solve_ivp(rhs, (start, start + 0.1), y_all[-1], rtol=1e-8, atol=1e-10,
+                          t_eval=np.linspace(start, start + 0.1, 11)[1:])
+    except OverBudget:
+        print(f"stopped at t = {{start:.1f}} s after {{budget}} evaluations: the robot is stiff")
+        break
+    assert chunk.success, chunk.message
+    t_all += list(chunk.t)
+{collect}
+fig, ax = plt.subplots(figsize=(7, 3.5))
+for k, name in enumerate(dyn.joint_names):
+    ax.plot(t_all, {plotted}[k], label=name)
+ax.set_xlabel("time [s]")
+ax.set_ylabel({ylabel})
+ax.legend({legend})
+ax.set_title(f"{{model.name}}: free motion from rest")
+fig.tight_layout()
+buffer = io.BytesIO()
+fig.savefig(buffer, format="png", dpi=100)
+plt.close(fig)
+display(Image(buffer.getvalue()))
+"""
+_JOINT_SPACE = {
+    "setup": "\n",
+    "rhs": '''    q, qd = state[:n], state[n:]
+    out = evaluate(*q, *qd, *values)
+    qdd = np.linalg.solve(out["M"], -out["C"] @ qd - out["g"][:, 0])
+    return np.concatenate([qd, qdd])
+''',
+    "collect": '''    y_all += list(chunk.y.T)
+t_all, y_all = np.array(t_all), np.array(y_all).T''',
+    "plotted": "y_all", "ylabel": '"joint position"', "legend": ""}
+_CHART_SPACE = {
+    "setup": "\nnq = model.nq",
+    "rhs": '''    q, v = state[:nq], state[nq:]
+    out = evaluate(*q, *v, *values)
+    vdot = np.linalg.solve(out["M"], -out["C"] @ v - out["g"][:, 0])
+    return np.concatenate([configuration_rate(q, v, model), vdot])
+
+
+def normalised(state):
+    state = state.copy()
+    for joint in model.quaternion_joints:
+        k = joint.quaternion
+        state[k:k + 4] /= np.linalg.norm(state[k:k + 4])
+    return state
+''',
+    "collect": '''    y_all += [normalised(y) for y in chunk.y.T]
+t_all = np.array(t_all)
+moved = np.array([difference(q0, y[:nq], model=model) for y in y_all]).T''',
+    "plotted": "moved", "ylabel": '"difference(q0, q)"', "legend": 'fontsize="small"'}
+
+
 def _checks(md, code) -> None:
     """The cells of a model without quaternion joints: eomgen.verify, the comparison with the
     numeric Newton–Euler and the simulation."""
@@ -337,61 +419,7 @@ under gravity), integrated with SciPy's `solve_ivp` in steps of 0.1 s. A very st
 tiny inertia next to a large one) would need millions of steps: the simulation stops after
 `budget` evaluations of the dynamics and says so, so that the notebook always finishes.
 """)
-    code("""
-import io
-
-import matplotlib
-from IPython.display import Image
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
-from scipy.integrate import solve_ivp
-
-
-budget = 50_000
-calls = 0
-
-
-class OverBudget(Exception):
-    pass
-
-
-def rhs(t, state):
-    global calls
-    calls += 1
-    if calls > budget:
-        raise OverBudget
-    q, qd = state[:n], state[n:]
-    out = evaluate(*q, *qd, *values)
-    qdd = np.linalg.solve(out["M"], -out["C"] @ qd - out["g"][:, 0])
-    return np.concatenate([qd, qdd])
-
-
-t_all, y_all = [0.0], [np.concatenate([q0, np.zeros(n)])]
-for start in np.arange(0.0, 2.0, 0.1):
-    try:
-        chunk = solve_ivp(rhs, (start, start + 0.1), y_all[-1], rtol=1e-8, atol=1e-10,
-                          t_eval=np.linspace(start, start + 0.1, 11)[1:])
-    except OverBudget:
-        print(f"stopped at t = {start:.1f} s after {budget} evaluations: the robot is stiff")
-        break
-    assert chunk.success, chunk.message
-    t_all += list(chunk.t)
-    y_all += list(chunk.y.T)
-t_all, y_all = np.array(t_all), np.array(y_all).T
-fig, ax = plt.subplots(figsize=(7, 3.5))
-for k, name in enumerate(dyn.joint_names):
-    ax.plot(t_all, y_all[k], label=name)
-ax.set_xlabel("time [s]")
-ax.set_ylabel("joint position")
-ax.legend()
-ax.set_title(f"{model.name}: free motion from rest")
-fig.tight_layout()
-buffer = io.BytesIO()
-fig.savefig(buffer, format="png", dpi=100)
-plt.close(fig)
-display(Image(buffer.getvalue()))
-""")
+    code(_SIMULATION.format(**_JOINT_SPACE))
 
 
 _CHART_INTRO = """
@@ -482,70 +510,7 @@ The plot shows `difference(q0, q(t))`: how far each velocity coordinate has carr
 A very stiff robot would need millions of steps: the simulation stops after `budget`
 evaluations of the dynamics and says so.
 """)
-    code("""
-import io
-
-import matplotlib
-from IPython.display import Image
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
-from scipy.integrate import solve_ivp
-
-nq = model.nq
-budget = 50_000
-calls = 0
-
-
-class OverBudget(Exception):
-    pass
-
-
-def rhs(t, state):
-    global calls
-    calls += 1
-    if calls > budget:
-        raise OverBudget
-    q, v = state[:nq], state[nq:]
-    out = evaluate(*q, *v, *values)
-    vdot = np.linalg.solve(out["M"], -out["C"] @ v - out["g"][:, 0])
-    return np.concatenate([configuration_rate(q, v, model), vdot])
-
-
-def normalised(state):
-    state = state.copy()
-    for joint in model.quaternion_joints:
-        k = joint.quaternion
-        state[k:k + 4] /= np.linalg.norm(state[k:k + 4])
-    return state
-
-
-t_all, y_all = [0.0], [np.concatenate([q0, np.zeros(n)])]
-for start in np.arange(0.0, 2.0, 0.1):
-    try:
-        chunk = solve_ivp(rhs, (start, start + 0.1), y_all[-1], rtol=1e-8, atol=1e-10,
-                          t_eval=np.linspace(start, start + 0.1, 11)[1:])
-    except OverBudget:
-        print(f"stopped at t = {start:.1f} s after {budget} evaluations: the robot is stiff")
-        break
-    assert chunk.success, chunk.message
-    t_all += list(chunk.t)
-    y_all += [normalised(y) for y in chunk.y.T]
-t_all = np.array(t_all)
-moved = np.array([difference(q0, y[:nq], model=model) for y in y_all]).T
-fig, ax = plt.subplots(figsize=(7, 3.5))
-for k, name in enumerate(dyn.joint_names):
-    ax.plot(t_all, moved[k], label=name)
-ax.set_xlabel("time [s]")
-ax.set_ylabel("difference(q0, q)")
-ax.legend(fontsize="small")
-ax.set_title(f"{model.name}: free motion from rest")
-fig.tight_layout()
-buffer = io.BytesIO()
-fig.savefig(buffer, format="png", dpi=100)
-plt.close(fig)
-display(Image(buffer.getvalue()))
-""")
+    code(_SIMULATION.format(**_CHART_SPACE))
 
 
 def write_notebook(nb: nbformat.NotebookNode, path: Path) -> Path:

@@ -24,26 +24,11 @@ from eomgen.quaternion_joints import configuration_rate
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import relative, run_cli, write
+from support.quaternion import HOPPER, HOPPER_SCENE as SCENE
 
 pin = pytest.importorskip("pinocchio", reason="the data come from Pinocchio")
 pytest.importorskip("scipy", reason="identification needs scipy (pip install 'eomgen[identify]')")
 
-HOPPER = """name: hopper
-links:
-  - {name: trunk, mass: 3.0, com: [0.02, -0.01, 0.05],
-     inertia: {ixx: 0.05, iyy: 0.06, izz: 0.04, ixy: 0.002}}
-  - {name: thigh, mass: 1.0, com: [0.0, 0.01, -0.15], inertia: {ixx: 0.02, iyy: 0.021, izz: 0.004}}
-  - {name: shin, mass: 0.6, com: [0.01, 0.0, -0.12], inertia: {ixx: 0.01, iyy: 0.011, izz: 0.002}}
-joints:
-  - {name: hip, type: spherical, parent: trunk, child: thigh, origin: {xyz: [0.1, 0.0, -0.05]}}
-  - {name: knee, type: revolute, parent: thigh, child: shin, origin: {xyz: [0.0, 0.0, -0.3]},
-     axis: [0, 1, 0]}
-"""
-SCENE = """version: 1
-floating_base: quaternion
-actuators:
-  knee: {armature: 0.05, damping: 0.3, friction: 0.4}
-"""
 ARMATURE, DAMPING, FRICTION = 0.05, 0.3, 0.4
 
 

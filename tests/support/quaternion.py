@@ -24,6 +24,27 @@ TWO_LEGS = (("a_hip", "spherical", -1), ("b_knee", "revolute", 0), ("c_arm", "re
 BALL_CHAIN = (("j0", "revolute", -1), ("ball", "spherical", 0), ("j2", "prismatic", 1))
 
 
+#: A hopper in eomgen's YAML: a trunk, a ball hip, a revolute knee (``HOPPER_SCENE`` lets the
+#: trunk fly on the quaternion free flyer and gives the knee a drive: armature, viscous and
+#: Coulomb friction).
+HOPPER = """name: hopper
+links:
+  - {name: trunk, mass: 3.0, com: [0.02, -0.01, 0.05],
+     inertia: {ixx: 0.05, iyy: 0.06, izz: 0.04, ixy: 0.002}}
+  - {name: thigh, mass: 1.0, com: [0.0, 0.01, -0.15], inertia: {ixx: 0.02, iyy: 0.021, izz: 0.004}}
+  - {name: shin, mass: 0.6, com: [0.01, 0.0, -0.12], inertia: {ixx: 0.01, iyy: 0.011, izz: 0.002}}
+joints:
+  - {name: hip, type: spherical, parent: trunk, child: thigh, origin: {xyz: [0.1, 0.0, -0.05]}}
+  - {name: knee, type: revolute, parent: thigh, child: shin, origin: {xyz: [0.0, 0.0, -0.3]},
+     axis: [0, 1, 0]}
+"""
+HOPPER_SCENE = """version: 1
+floating_base: quaternion
+actuators:
+  knee: {armature: 0.05, damping: 0.3, friction: 0.4}
+"""
+
+
 def pin_inertia(pin, inertial):
     return pin.Inertia(float(inertial.mass), np.array([float(x) for x in inertial.com]),
                        np.array([[float(x) for x in row] for row in inertial.inertia]))
@@ -106,5 +127,5 @@ def pinocchio_parameters(pm) -> np.ndarray:
     return np.concatenate([pm.inertias[j].toDynamicParameters() for j in range(1, pm.njoints)])
 
 
-__all__ = ["BALL_CHAIN", "GRAVITY", "TWO_LEGS", "body_columns", "pinocchio_parameters",
+__all__ = ["BALL_CHAIN", "GRAVITY", "HOPPER", "HOPPER_SCENE", "TWO_LEGS", "body_columns", "pinocchio_parameters",
            "pinocchio_states", "quaternion_robot"]
