@@ -64,3 +64,18 @@ def test_notebook_runs_and_agrees_with_pinocchio(pendulum, tmp_path):
     for check in ("largest |tau - rnea|:", "largest |M - crba|:"):
         assert float(printed.split(check)[1].split()[0]) < 1e-9, check
     assert any("image/png" in o.get("data", {}) for o in outputs)
+
+
+def test_a_lone_ball_joint_is_never_shown_in_textbook_form(tmp_path):
+    """Three virtual joints and a small program would pass the teaching-size bound, but the
+    textbook form would print the chart's angles (s_2, c_3) as if they were coordinates: the
+    rich display (the notebook's ``dyn`` cell) shows the program's summary instead."""
+    from eomgen.present.notation import teaching_sized
+
+    path = write(tmp_path / "ball.yaml", PENDULUM.replace("name: pendulum", "name: ball").split(
+        "  - {name: lower")[0] + "joints:\n  - {name: shoulder, type: spherical, parent: base, "
+        "child: upper}\n")
+    dyn = eomgen.derive(eomgen.load(path))
+    assert dyn.model.dof == 3 and not teaching_sized(dyn)
+    tex = dyn._repr_latex_()
+    assert "s_{2}" not in tex and "c_{3}" not in tex and "shoulder" in tex
