@@ -74,9 +74,9 @@ def build_drives(derivation, wanted) -> dict:
     flexible = flexible_indices(model)
     require_flexible(model, FLEXIBLE & set(wanted))
     q, qd = derivation.q, derivation.qd
-    # the true accelerations v̇ (a quaternion joint's chart takes others, but no quaternion
-    # joint has a drive: every armature term is on a real joint)
-    qdd = derivation.inputs["qdd"] if model.quaternion_joints else derivation.qdd
+    # the true accelerations v̇ (T q̈ with coupled joints): a quaternion joint's chart takes
+    # others (derivation.qdd), but no quaternion joint has a drive
+    qdd = derivation.tangent(derivation.inputs["qdd"])
     armature = [a.armature for a in actuators]
     out = {}
     if "M_a" in wanted:

@@ -185,7 +185,7 @@ def build_flat(derivation, wanted) -> dict:
     flexible = flexible_indices(model)
     inputs = derivation.inputs
     # the true accelerations (a quaternion joint's chart takes others, derivation.qdd)
-    q, qd, qdd = derivation.q, derivation.qd, inputs["qdd"]
+    q, qd, qdd = derivation.q, derivation.qd, derivation.tangent(inputs["qdd"])
     qddd, qdddd = inputs["qddd"], inputs["qdddd"]
     n, b = len(q), derivation.builder
     tau_L = derivation.output("tau")
