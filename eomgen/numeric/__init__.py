@@ -3,6 +3,8 @@
 * :mod:`eomgen.numeric.newton_euler`: rigid-body dynamics by Newton–Euler recursions on a
   :class:`NumericModel` (the independent reference for the symbolic engine); its names are
   importable from ``eomgen.numeric`` itself (``eomgen.numeric.rnea``, ``numeric_model``, ...).
+* :mod:`eomgen.numeric.quaternion_chart`: quaternion joints (a free flyer, ball joints) in those
+  recursions: ``q`` of NQ entries, ``qd``, ``qdd``, ``tau`` of NV (Pinocchio's layout).
 * :mod:`eomgen.numeric.contacts`: rigid contacts (:class:`~eomgen.numeric.contacts.ContactDynamics`,
   KKT constrained dynamics).
 * :mod:`eomgen.numeric.actuated`: armature, friction and Spong's flexible joints

@@ -215,7 +215,7 @@ class ContactDynamics:
         q, qd, tau = (np.asarray(x, dtype=float) for x in (q, qd, tau))
         M, h = self._mh(q, qd)
         J, bias, gamma = self._rows(q, qd)
-        n, m = len(q), len(bias)
+        n, m = len(qd), len(bias)
         if damping <= 0 and m:
             sv = np.linalg.svd(J, compute_uv=False)
             if len(sv) < m or sv.min() <= RANK_TOLERANCE * sv.max():

@@ -21,6 +21,12 @@ Frames are those of :mod:`eomgen.model` (URDF's):
   links rigidly attached to others keep their own frame and inertia (no merging).
 * Generalised coordinates: ``q[k]`` belongs to ``model.movable_joints[k]``, i.e. description
   order (``JOINT_NAMES`` order), which may differ from the tree order the recursions use.
+* Quaternion joints (a free flyer, ball joints: :mod:`eomgen.model.quaternion`): ``q`` is the
+  configuration (NQ entries, ``CONFIGURATION_NAMES``, Pinocchio's layout) and ``qd``, ``qdd``,
+  ``tau`` are velocities (NV entries, ``JOINT_NAMES``): a free flyer's root twist in the root
+  frame (linear then angular) and the wrench on the root, a ball joint's angular velocity of the
+  child in the child frame. The recursions hold the joint's virtual joints at zero and place its
+  pose from ``q`` (:mod:`eomgen.numeric.quaternion_chart`), as the derivation does.
 * Units: SI. ``tau[k]`` is a torque [N m] for a revolute joint and a force [N] for a
   prismatic one; it is the generalised force the joint actuator applies to the child body
   (and, reacting, to the parent), positive along ``+axis``.
@@ -50,7 +56,8 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from ..errors import UnsupportedError
-from ..model import JointType, RobotModel, parameter_symbol
+from ..model import JointType, QuaternionJoint, RobotModel, parameter_symbol
+from .quaternion_chart import chart_coordinates, chart_offset, placements
 
 #: Joint type codes stored in :attr:`NumericModel.joint_type`.
 FIXED, REVOLUTE, PRISMATIC = 0, 1, 2
@@ -174,6 +181,12 @@ class NumericModel:
     numbers : Numbers
         The number type of the arrays above (not of the index arrays) and of every result of
         the algorithms: :data:`FLOAT64` unless built for another one.
+    quaternion_joints : tuple of QuaternionJoint
+        The free flyer and ball joints with their places in ``q`` and ``v``
+        (:attr:`eomgen.model.RobotModel.quaternion_joints`); empty without them.
+    quaternion_bodies : tuple of int
+        For each of ``quaternion_joints``, the body whose joint starts its chain (where its pose
+        from ``q`` is placed).
     """
 
     name: str
@@ -191,11 +204,19 @@ class NumericModel:
     inertia: np.ndarray
     gravity: np.ndarray
     numbers: Numbers = FLOAT64
+    quaternion_joints: tuple[QuaternionJoint, ...] = ()
+    quaternion_bodies: tuple[int, ...] = ()
 
     @property
     def n(self) -> int:
-        """Number of degrees of freedom (length of ``q``)."""
+        """Number of degrees of freedom (NV: the length of ``qd``; of ``q`` too without
+        quaternion joints)."""
         return len(self.joint_names)
+
+    @property
+    def nq(self) -> int:
+        """Length of the configuration ``q`` (NQ): :attr:`n`, plus one per quaternion joint."""
+        return self.n + len(self.quaternion_joints)
 
     @property
     def nb(self) -> int:
@@ -296,12 +317,15 @@ def numeric_model(model: RobotModel, values: Mapping | None = None,
         if not numbers.all_finite(a):
             raise ValueError(f"model '{model.name}' has a non-finite quantity")
         a.flags.writeable = False
+    joints = model.quaternion_joints
     return NumericModel(
         name=model.name,
         body_names=names,
         joint_of_body=("",) + tuple(j.name for j in order),
         joint_names=model.joint_names,
         numbers=numbers,
+        quaternion_joints=joints,
+        quaternion_bodies=tuple(int(np.flatnonzero(q_index == j.v_index)[0]) for j in joints),
         **arrays,
     )
 
@@ -310,19 +334,30 @@ def numeric_model(model: RobotModel, values: Mapping | None = None,
 # Kinematics shared by the algorithms
 # ----------------------------------------------------------------------------------------------
 
-def _check(nm: NumericModel, name: str, x) -> np.ndarray:
-    """``x`` as an (n,) array of the model's numbers, or a ValueError naming the argument."""
+def _check(nm: NumericModel, name: str, x, size: int | None = None) -> np.ndarray:
+    """``x`` as an (n,) array of the model's numbers (``size`` entries when given), or a
+    ValueError naming the argument."""
     if not isinstance(nm, NumericModel):
         raise ValueError(f"expected a NumericModel (see numeric_model), got {type(nm).__name__}")
     a = nm.numbers.vector(x)
-    if a.shape != (nm.n,):
-        raise ValueError(
-            f"{name} must have shape ({nm.n},) (joints {', '.join(nm.joint_names) or 'none'}), "
-            f"got shape {a.shape}"
-        )
+    size = nm.n if size is None else size
+    if a.shape != (size,):
+        what = (f"joints {', '.join(nm.joint_names) or 'none'}" if size == nm.n else
+                f"the configuration of {nm.name}, quaternions included")
+        raise ValueError(f"{name} must have shape ({size},) ({what}), got shape {a.shape}")
     if not nm.numbers.all_finite(a):
         raise ValueError(f"{name} has a non-finite entry")
     return a
+
+
+def _configuration(nm: NumericModel, q) -> tuple[np.ndarray, dict]:
+    """The coordinates the recursions index (n,) and the poses placed from the quaternions
+    (:func:`~eomgen.numeric.quaternion_chart.placements`), from ``q`` (nq,)."""
+    q = _check(nm, "q", q, nm.nq)
+    if not nm.quaternion_joints:
+        return q, {}
+    return (chart_coordinates(nm.quaternion_joints, q, nm.n, nm.numbers),
+            placements(nm.quaternion_joints, q, nm.numbers))
 
 
 def _rotation(numbers: Numbers, axis: np.ndarray, angle) -> np.ndarray:
@@ -332,8 +367,11 @@ def _rotation(numbers: Numbers, axis: np.ndarray, angle) -> np.ndarray:
     return numbers.eye(3) + numbers.sin(angle) * K + (1.0 - numbers.cos(angle)) * (K @ K)
 
 
-def _parent_transforms(nm: NumericModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Pose of every body frame in its parent's frame at ``q``.
+def _parent_transforms(nm: NumericModel, q: np.ndarray, placed: dict | None = None
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """Pose of every body frame in its parent's frame at the coordinates ``q`` (n,), the
+    quaternion joints' poses ``placed`` (by velocity index, :func:`_configuration`) after their
+    origins.
 
     Returns
     -------
@@ -348,6 +386,10 @@ def _parent_transforms(nm: NumericModel, q: np.ndarray) -> tuple[np.ndarray, np.
         k = nm.q_index[i]
         if k < 0:
             continue
+        if placed and k in placed:
+            Rq, pq = placed[k]
+            p[i] = p[i] + R[i] @ pq
+            R[i] = R[i] @ Rq
         if nm.joint_type[i] == REVOLUTE:
             R[i] = R[i] @ _rotation(nm.numbers, nm.axis[i], q[k])
         else:  # prismatic: the child frame moves along the axis, without rotating
@@ -402,33 +444,40 @@ def rnea(nm: NumericModel, q, qd, qdd) -> np.ndarray:
         n_i = N_i + c_i × F_i + Σ_children (ⁱR_c n_c + ⁱp_c × ⁱR_c f_c)
         tau = n_i · z  (revolute)   or   f_i · z  (prismatic)
 
-    Fixed joints are bodies with no joint motion; the root's forces are not returned.
+    Fixed joints are bodies with no joint motion; the root's forces are not returned. A
+    quaternion joint's chain runs with its virtual joints at zero below the pose placed from
+    ``q``, and takes the chart accelerations ``q̈ − n(q̇)``
+    (:mod:`eomgen.numeric.quaternion_chart`).
 
     Parameters
     ----------
     nm : NumericModel
-    q : (n,) array_like
-        Joint positions [rad or m] in ``nm.joint_names`` order.
+    q : (nq,) array_like
+        Joint positions [rad or m] in ``nm.joint_names`` order; with quaternion joints the
+        configuration (NQ entries, Pinocchio's layout, module docstring).
     qd : (n,) array_like
-        Joint velocities [rad/s or m/s], same order.
+        Joint velocities [rad/s or m/s] in ``nm.joint_names`` order.
     qdd : (n,) array_like
         Joint accelerations [rad/s² or m/s²], same order.
 
     Returns
     -------
     tau : (n,) ndarray
-        Joint torques [N m] / forces [N], same order, positive along ``+axis``.
+        Joint torques [N m] / forces [N], same order, positive along ``+axis`` (a free flyer:
+        the force then moment on the root, root frame).
 
     Raises
     ------
     ValueError
         When an argument does not have shape (n,) or is not finite.
     """
-    q = _check(nm, "q", q)
+    q, placed = _configuration(nm, q)
     qd = _check(nm, "qd", qd)
     qdd = _check(nm, "qdd", qdd)
+    if nm.quaternion_joints:
+        qdd = qdd - chart_offset(nm.quaternion_joints, qd, nm.numbers)
     nb = nm.nb
-    R, p = _parent_transforms(nm, q)
+    R, p = _parent_transforms(nm, q, placed)
     zeros = nm.numbers.zeros
 
     w = zeros((nb, 3))
@@ -474,7 +523,7 @@ def rnea(nm: NumericModel, q, qd, qdd) -> np.ndarray:
 
 def gravity_torques(nm: NumericModel, q) -> np.ndarray:
     """Gravity vector ``g(q) = rnea(q, 0, 0)``: the (n,) torques/forces that hold the robot
-    still at ``q`` (``q`` in ``nm.joint_names`` order)."""
+    still at ``q`` (``q`` (nq,) as :func:`rnea` takes it)."""
     zero = np.zeros(nm.n)
     return rnea(nm, q, zero, zero)
 
@@ -482,9 +531,10 @@ def gravity_torques(nm: NumericModel, q) -> np.ndarray:
 def M_rnea(nm: NumericModel, q) -> np.ndarray:
     """Joint-space mass matrix ``M(q)``, (n, n), rows and columns in ``nm.joint_names`` order.
 
-    Column ``i`` is ``rnea(q, 0, e_i) - rnea(q, 0, 0)`` (n + 1 RNEA calls, O(n²) overall).
+    Column ``i`` is ``rnea(q, 0, e_i) - rnea(q, 0, 0)`` (n + 1 RNEA calls, O(n²) overall);
+    ``q`` (nq,) as :func:`rnea` takes it.
     """
-    q = _check(nm, "q", q)
+    q = _check(nm, "q", q, nm.nq)
     zero = nm.numbers.zeros(nm.n)
     g = rnea(nm, q, zero, zero)
     M = nm.numbers.zeros((nm.n, nm.n))
@@ -497,8 +547,9 @@ def M_rnea(nm: NumericModel, q) -> np.ndarray:
 
 def coriolis_times_qd(nm: NumericModel, q, qd) -> np.ndarray:
     """Velocity product ``C(q, q̇) q̇ = rnea(q, q̇, 0) - rnea(q, 0, 0)``, shape (n,), in
-    ``nm.joint_names`` order (centrifugal and Coriolis torques/forces)."""
-    q = _check(nm, "q", q)
+    ``nm.joint_names`` order (centrifugal and Coriolis torques/forces); ``q`` (nq,) as
+    :func:`rnea` takes it."""
+    q = _check(nm, "q", q, nm.nq)
     zero = np.zeros(nm.n)
     return rnea(nm, q, qd, zero) - rnea(nm, q, zero, zero)
 
@@ -508,20 +559,23 @@ def kinetic_energy(nm: NumericModel, q, qd) -> float:
 
     Parameters
     ----------
-    q, qd : (n,) array_like
-        Joint positions and velocities in ``nm.joint_names`` order.
+    q : (nq,) array_like
+        Joint positions in ``nm.joint_names`` order (the configuration, as :func:`rnea`).
+    qd : (n,) array_like
+        Joint velocities in ``nm.joint_names`` order.
     """
-    q = _check(nm, "q", q)
+    q, placed = _configuration(nm, q)
     qd = _check(nm, "qd", qd)
-    R, p = _parent_transforms(nm, q)
+    R, p = _parent_transforms(nm, q, placed)
     w, v = _velocities(nm, R, p, qd)
     vc = v + np.cross(w, nm.com)
     Iw = np.einsum("ijk,ik->ij", nm.inertia, w)
     return float(0.5 * (nm.mass @ np.einsum("ij,ij->i", vc, vc)) + 0.5 * np.sum(w * Iw))
 
 
-def _world_poses(nm: NumericModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    R, p = _parent_transforms(nm, q)
+def _world_poses(nm: NumericModel, q: np.ndarray, placed: dict
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    R, p = _parent_transforms(nm, q, placed)
     Rw = np.empty_like(R)
     pw = np.empty_like(p)
     Rw[0] = nm.numbers.eye(3)
@@ -540,11 +594,10 @@ def potential_energy(nm: NumericModel, q) -> float:
 
     Parameters
     ----------
-    q : (n,) array_like
-        Joint positions in ``nm.joint_names`` order.
+    q : (nq,) array_like
+        Joint positions in ``nm.joint_names`` order (the configuration, as :func:`rnea`).
     """
-    q = _check(nm, "q", q)
-    Rw, pw = _world_poses(nm, q)
+    Rw, pw = _world_poses(nm, *_configuration(nm, q))
     pc = pw + np.einsum("ijk,ik->ij", Rw, nm.com)
     return float(-(nm.mass @ (pc @ nm.gravity)))
 
@@ -554,8 +607,11 @@ def link_poses(nm: NumericModel, q) -> dict[str, tuple[np.ndarray, np.ndarray]]:
 
     Parameters
     ----------
-    q : (n,) array_like
-        Joint positions in ``nm.joint_names`` order.
+    q : (nq,) or (n,) array_like
+        Joint positions in ``nm.joint_names`` order (the configuration, as :func:`rnea`). With
+        quaternion joints, (n,) values are taken as the coordinates of their virtual joints
+        (the chain of one-axis joints the model holds, :mod:`eomgen.model.quaternion`), with
+        no pose placed from a quaternion: how the chain draws.
 
     Returns
     -------
@@ -564,8 +620,10 @@ def link_poses(nm: NumericModel, q) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         coordinates and ``p`` (3,) the link origin [m] in the root frame; the root maps to
         ``(I, 0)``. Every link is present, massless and fixed-joint links included.
     """
-    q = _check(nm, "q", q)
-    Rw, pw = _world_poses(nm, q)
+    if nm.quaternion_joints and np.shape(q) == (nm.n,):
+        Rw, pw = _world_poses(nm, _check(nm, "q", q), {})
+    else:
+        Rw, pw = _world_poses(nm, *_configuration(nm, q))
     return {name: (Rw[i], pw[i]) for i, name in enumerate(nm.body_names)}
 
 
