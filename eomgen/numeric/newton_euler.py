@@ -19,8 +19,12 @@ Frames are those of :mod:`eomgen.model` (URDF's):
   unit vector in the child frame.
 * Fixed joints are bodies whose joint has no motion: the recursion passes through them, so
   links rigidly attached to others keep their own frame and inertia (no merging).
-* Generalised coordinates: ``q[k]`` belongs to ``model.movable_joints[k]``, i.e. description
+* Generalised coordinates: ``q[k]`` belongs to ``model.joint_names[k]``, i.e. description
   order (``JOINT_NAMES`` order), which may differ from the tree order the recursions use.
+* Coupled joints (:mod:`eomgen.model.coupling`, a URDF ``<mimic>``): ``q`` holds the
+  independent joints only; the recursions run the whole tree at ``q_tree = T q + c``,
+  ``q̇_tree = T q̇``, ``q̈_tree = T q̈`` and return ``Tᵀ τ_tree``, so that ``M = Tᵀ M_tree T`` and
+  ``C q̇ + g = Tᵀ (C q̇ + g)_tree`` are the reduced model's.
 * Quaternion joints (a free flyer, ball joints: :mod:`eomgen.model.quaternion`): ``q`` is the
   configuration (NQ entries, ``CONFIGURATION_NAMES``, Pinocchio's layout) and ``qd``, ``qdd``,
   ``tau`` are velocities (NV entries, ``JOINT_NAMES``): a free flyer's root twist in the root
@@ -50,285 +54,11 @@ A point mass ``m = 2`` kg hanging ``l = 0.5`` m below a joint about ``y`` (gravi
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any, Callable, Mapping
-
 import numpy as np
 
-from ..errors import UnsupportedError
-from ..model import JointType, QuaternionJoint, RobotModel, parameter_symbol
+from .model import (FIXED, FLOAT64, PRISMATIC, REVOLUTE, Numbers, NumericModel,
+                    numeric_model)
 from .quaternion_chart import chart_coordinates, chart_offset, placements
-
-#: Joint type codes stored in :attr:`NumericModel.joint_type`.
-FIXED, REVOLUTE, PRISMATIC = 0, 1, 2
-
-_TYPE_CODE = {
-    JointType.FIXED: FIXED,
-    JointType.REVOLUTE: REVOLUTE,
-    JointType.CONTINUOUS: REVOLUTE,
-    JointType.PRISMATIC: PRISMATIC,
-}
-
-
-@dataclass(frozen=True)
-class Numbers:
-    """The number type an algorithm computes in, and the few operations it needs on it.
-
-    The algorithms of this module are written once over NumPy arrays whose entries are these
-    numbers (Pinocchio's algorithms are templated on ``Scalar`` in the same way): float64
-    arrays for :data:`FLOAT64`, object arrays of ``mpmath.mpf`` for
-    :data:`eomgen.analysis.precision.MPMATH` (the high-precision reference).
-
-    Attributes
-    ----------
-    name : str
-        What the numbers are, for messages.
-    dtype : type
-        The NumPy dtype of the arrays: ``float`` or ``object``.
-    convert : callable
-        A number of the description (SymPy or Python) as this type; TypeError when it is not
-        a number.
-    value : callable
-        A caller's value (float, int, or already this type) as this type.
-    sin, cos : callable
-        The trigonometric functions on this type.
-    finite : callable
-        True when a number is finite.
-    """
-
-    name: str
-    dtype: type
-    convert: Callable[[Any], Any]
-    value: Callable[[Any], Any]
-    sin: Callable[[Any], Any]
-    cos: Callable[[Any], Any]
-    finite: Callable[[Any], bool]
-
-    def zeros(self, shape) -> np.ndarray:
-        """An array of exact zeros of this type."""
-        if self.dtype is float:
-            return np.zeros(shape)
-        return np.full(shape, self.value(0), dtype=object)
-
-    def eye(self, n: int) -> np.ndarray:
-        """The ``n × n`` identity matrix of this type."""
-        if self.dtype is float:
-            return np.eye(n)
-        out = self.zeros((n, n))
-        for i in range(n):
-            out[i, i] = self.value(1)
-        return out
-
-    def vector(self, x) -> np.ndarray:
-        """A caller's sequence of values as a 1-D array of this type."""
-        if self.dtype is float:
-            return np.asarray(x, dtype=float)
-        a = np.asarray(x, dtype=object)
-        out = np.empty(a.shape, dtype=object)
-        for index, v in np.ndenumerate(a):
-            out[index] = self.value(v)
-        return out
-
-    def all_finite(self, a: np.ndarray) -> bool:
-        """True when every entry of ``a`` is finite."""
-        if self.dtype is float or a.dtype != object:
-            return bool(np.all(np.isfinite(a)))
-        return all(self.finite(x) for x in a.ravel())
-
-
-#: IEEE double precision: float64 NumPy arrays, NumPy's functions (the default everywhere).
-FLOAT64 = Numbers("float64", float, float, float, np.sin, np.cos, np.isfinite)
-
-
-@dataclass(frozen=True, eq=False)
-class NumericModel:
-    """A robot with every quantity a number: the fixed description the algorithms read.
-
-    Bodies are the links in topological order (every body after its parent); body 0 is the
-    root. Arrays are float64 (indices int64) and read-only. ``nb`` is the number of bodies
-    (links), ``n`` the number of degrees of freedom.
-
-    Attributes
-    ----------
-    name : str
-        The robot's name.
-    body_names : tuple of str, (nb,)
-        Link name of each body.
-    joint_of_body : tuple of str, (nb,)
-        Name of the joint whose child is the body (``""`` for the root).
-    joint_names : tuple of str, (n,)
-        Movable joints in description order: the order of ``q``, ``qd``, ``qdd``, ``tau``.
-    parent : (nb,) int array
-        Parent body index; ``-1`` for the root.
-    joint_type : (nb,) int array
-        :data:`FIXED`, :data:`REVOLUTE` or :data:`PRISMATIC` (the root counts as fixed).
-    q_index : (nb,) int array
-        Index into ``q`` of the body's joint; ``-1`` for fixed joints and the root.
-    axis : (nb, 3) array
-        Joint axis, a unit vector in the body (child link) frame.
-    origin_rotation : (nb, 3, 3) array
-        Rotation of the joint frame in the parent frame (identity for the root).
-    origin_translation : (nb, 3) array
-        Position [m] of the joint frame origin in the parent frame (zero for the root).
-    mass : (nb,) array
-        Body mass [kg]; zero for massless links.
-    com : (nb, 3) array
-        Centre of mass [m] in the body frame.
-    inertia : (nb, 3, 3) array
-        Rotational inertia [kg m²] about the centre of mass, in body frame axes.
-    gravity : (3,) array
-        Gravitational acceleration [m/s²] in the root frame.
-    numbers : Numbers
-        The number type of the arrays above (not of the index arrays) and of every result of
-        the algorithms: :data:`FLOAT64` unless built for another one.
-    quaternion_joints : tuple of QuaternionJoint
-        The free flyer and ball joints with their places in ``q`` and ``v``
-        (:attr:`eomgen.model.RobotModel.quaternion_joints`); empty without them.
-    quaternion_bodies : tuple of int
-        For each of ``quaternion_joints``, the body whose joint starts its chain (where its pose
-        from ``q`` is placed).
-    """
-
-    name: str
-    body_names: tuple[str, ...]
-    joint_of_body: tuple[str, ...]
-    joint_names: tuple[str, ...]
-    parent: np.ndarray
-    joint_type: np.ndarray
-    q_index: np.ndarray
-    axis: np.ndarray
-    origin_rotation: np.ndarray
-    origin_translation: np.ndarray
-    mass: np.ndarray
-    com: np.ndarray
-    inertia: np.ndarray
-    gravity: np.ndarray
-    numbers: Numbers = FLOAT64
-    quaternion_joints: tuple[QuaternionJoint, ...] = ()
-    quaternion_bodies: tuple[int, ...] = ()
-
-    @property
-    def n(self) -> int:
-        """Number of degrees of freedom (NV: the length of ``qd``; of ``q`` too without
-        quaternion joints)."""
-        return len(self.joint_names)
-
-    @property
-    def nq(self) -> int:
-        """Length of the configuration ``q`` (NQ): :attr:`n`, plus one per quaternion joint."""
-        return self.n + len(self.quaternion_joints)
-
-    @property
-    def nb(self) -> int:
-        """Number of bodies (links, root included)."""
-        return len(self.body_names)
-
-
-def _number(numbers: Numbers, x, what: str):
-    try:
-        return numbers.convert(x)
-    except TypeError:
-        raise ValueError(f"{what} is not a number after substitution: {x}") from None
-
-
-def _vec(numbers: Numbers, v, what: str) -> np.ndarray:
-    return np.array([_number(numbers, x, what) for x in v], dtype=numbers.dtype)
-
-
-def _mat(numbers: Numbers, m, what: str) -> np.ndarray:
-    return np.array([[_number(numbers, x, what) for x in row] for row in m], dtype=numbers.dtype)
-
-
-def numeric_model(model: RobotModel, values: Mapping | None = None,
-                  numbers: Numbers = FLOAT64) -> NumericModel:
-    """Build the numeric description of ``model``.
-
-    Parameters
-    ----------
-    model : RobotModel
-        The robot; its expressions may contain parameter symbols.
-    values : mapping, optional
-        Parameter values overriding the model's defaults, keyed by SymPy symbol or by
-        parameter name.
-    numbers : Numbers, optional
-        The number type of the arrays (and of every algorithm's results): float64 by default.
-
-    Returns
-    -------
-    NumericModel
-
-    Raises
-    ------
-    eomgen.DescriptionError
-        When a parameter has neither a default nor a given value.
-    eomgen.UnsupportedError
-        For a model with coupled joints (its coordinates are not one per body): build it of
-        ``eomgen.model.uncoupled(model)`` and map with ``eomgen.model.coupling_map``.
-    ValueError
-        When a quantity is still not a real number after substitution.
-    """
-    if model.couplings:
-        raise UnsupportedError(model.source, "couplings", "the float recursions take every "
-                               "movable joint as a coordinate: lock the coupled joints with a "
-                               "scene, or load with couplings=False (eomgen.model.uncoupled)")
-    values = {
-        (parameter_symbol(k) if isinstance(k, str) else k): v for k, v in (values or {}).items()
-    }
-    model = model.with_numeric_parameters(values)
-    order = model.topological_joints
-    names = (model.root,) + tuple(j.child for j in order)
-    index = {name: i for i, name in enumerate(names)}
-    q_of_joint = {j.name: k for k, j in enumerate(model.movable_joints)}
-    nb = len(names)
-
-    parent = np.full(nb, -1, dtype=np.int64)
-    joint_type = np.full(nb, FIXED, dtype=np.int64)
-    q_index = np.full(nb, -1, dtype=np.int64)
-    axis = numbers.zeros((nb, 3))
-    axis[:, 2] = numbers.value(1)
-    rot = numbers.zeros((nb, 3, 3))
-    rot[:] = numbers.eye(3)
-    trans = numbers.zeros((nb, 3))
-    for i, joint in enumerate(order, start=1):
-        where = f"joint '{joint.name}'"
-        parent[i] = index[joint.parent]
-        joint_type[i] = _TYPE_CODE[joint.type]
-        q_index[i] = q_of_joint.get(joint.name, -1)
-        axis[i] = _vec(numbers, joint.axis, where + " axis")
-        rot[i] = _mat(numbers, joint.origin.rotation, where + " origin")
-        trans[i] = _vec(numbers, joint.origin.translation, where + " origin")
-
-    mass = numbers.zeros(nb)
-    com = numbers.zeros((nb, 3))
-    inertia = numbers.zeros((nb, 3, 3))
-    for i, name in enumerate(names):
-        inertial = model.link_by_name[name].inertial
-        if inertial is None:
-            continue
-        where = f"link '{name}' inertial"
-        mass[i] = _number(numbers, inertial.mass, where)
-        com[i] = _vec(numbers, inertial.com, where)
-        inertia[i] = _mat(numbers, inertial.inertia, where)
-
-    arrays = dict(parent=parent, joint_type=joint_type, q_index=q_index, axis=axis,
-                  origin_rotation=rot, origin_translation=trans, mass=mass, com=com,
-                  inertia=inertia, gravity=_vec(numbers, model.gravity, "gravity"))
-    for a in arrays.values():
-        if not numbers.all_finite(a):
-            raise ValueError(f"model '{model.name}' has a non-finite quantity")
-        a.flags.writeable = False
-    joints = model.quaternion_joints
-    return NumericModel(
-        name=model.name,
-        body_names=names,
-        joint_of_body=("",) + tuple(j.name for j in order),
-        joint_names=model.joint_names,
-        numbers=numbers,
-        quaternion_joints=joints,
-        quaternion_bodies=tuple(int(np.flatnonzero(q_index == j.v_index)[0]) for j in joints),
-        **arrays,
-    )
-
 
 # ----------------------------------------------------------------------------------------------
 # Kinematics shared by the algorithms
@@ -351,13 +81,23 @@ def _check(nm: NumericModel, name: str, x, size: int | None = None) -> np.ndarra
 
 
 def _configuration(nm: NumericModel, q) -> tuple[np.ndarray, dict]:
-    """The coordinates the recursions index (n,) and the poses placed from the quaternions
-    (:func:`~eomgen.numeric.quaternion_chart.placements`), from ``q`` (nq,)."""
+    """The coordinates the recursions index (n_tree,) and the poses placed from the quaternions
+    (:func:`~eomgen.numeric.quaternion_chart.placements`), from ``q`` (nq,): with couplings the
+    whole tree's ``T q + c``."""
     q = _check(nm, "q", q, nm.nq)
+    if nm.coupling is not None:
+        return nm.coupling @ q + nm.coupling_offset, {}
     if not nm.quaternion_joints:
         return q, {}
     return (chart_coordinates(nm.quaternion_joints, q, nm.n, nm.numbers),
             placements(nm.quaternion_joints, q, nm.numbers))
+
+
+def _tangent(nm: NumericModel, name: str, x) -> np.ndarray:
+    """A velocity-like argument (n,) as the recursions take it (n_tree,): itself, or with
+    couplings the whole tree's ``T x``."""
+    x = _check(nm, name, x)
+    return x if nm.coupling is None else nm.coupling @ x
 
 
 def _rotation(numbers: Numbers, axis: np.ndarray, angle) -> np.ndarray:
@@ -447,7 +187,8 @@ def rnea(nm: NumericModel, q, qd, qdd) -> np.ndarray:
     Fixed joints are bodies with no joint motion; the root's forces are not returned. A
     quaternion joint's chain runs with its virtual joints at zero below the pose placed from
     ``q``, and takes the chart accelerations ``q̈ − n(q̇)``
-    (:mod:`eomgen.numeric.quaternion_chart`).
+    (:mod:`eomgen.numeric.quaternion_chart`). With coupled joints the whole tree runs at
+    ``(T q + c, T q̇, T q̈)`` and the result is ``Tᵀ τ_tree`` (:attr:`NumericModel.coupling`).
 
     Parameters
     ----------
@@ -472,8 +213,8 @@ def rnea(nm: NumericModel, q, qd, qdd) -> np.ndarray:
         When an argument does not have shape (n,) or is not finite.
     """
     q, placed = _configuration(nm, q)
-    qd = _check(nm, "qd", qd)
-    qdd = _check(nm, "qdd", qdd)
+    qd = _tangent(nm, "qd", qd)
+    qdd = _tangent(nm, "qdd", qdd)
     if nm.quaternion_joints:
         qdd = qdd - chart_offset(nm.quaternion_joints, qd, nm.numbers)
     nb = nm.nb
@@ -508,7 +249,7 @@ def rnea(nm: NumericModel, q, qd, qdd) -> np.ndarray:
 
     f = F.copy()
     n = N + np.cross(nm.com, F)
-    tau = zeros(nm.n)
+    tau = zeros(nm.n_tree)
     for i in range(nb - 1, 0, -1):
         k = nm.q_index[i]
         if k >= 0:
@@ -518,7 +259,7 @@ def rnea(nm: NumericModel, q, qd, qdd) -> np.ndarray:
         fj = R[i] @ f[i]
         f[j] += fj
         n[j] += R[i] @ n[i] + np.cross(p[i], fj)
-    return tau
+    return tau if nm.coupling is None else nm.coupling.T @ tau
 
 
 def gravity_torques(nm: NumericModel, q) -> np.ndarray:
@@ -565,7 +306,7 @@ def kinetic_energy(nm: NumericModel, q, qd) -> float:
         Joint velocities in ``nm.joint_names`` order.
     """
     q, placed = _configuration(nm, q)
-    qd = _check(nm, "qd", qd)
+    qd = _tangent(nm, "qd", qd)
     R, p = _parent_transforms(nm, q, placed)
     w, v = _velocities(nm, R, p, qd)
     vc = v + np.cross(w, nm.com)

@@ -1,0 +1,119 @@
+"""eomgen.numeric on coupled joints (issue 26): the float and mpmath Newton–Euler take the
+independent coordinates, run the whole tree at q = T q_r + c, and project; ``eomgen bench`` and
+``eomgen simulate`` run the Panda with its <mimic> fingers free (8 coordinates).
+
+References: Pinocchio's mimic model of the Panda (``buildModelFromUrdf(path, mimic=True)``) for
+rnea, crba, nonLinearEffects, gravity and the energies; the symbolic reduced model (the
+derived program) on a differential whose gains and offset are not 1 and 0.
+"""
+
+from __future__ import annotations
+
+import csv
+import warnings
+
+import numpy as np
+import pytest
+
+import eomgen
+from eomgen.model import couple
+from eomgen.numeric import (M_rnea, coriolis_times_qd, gravity_torques, kinetic_energy,
+                            numeric_model, potential_energy, rnea)
+from support import erd_robots_or_skip, relative, run_cli
+
+
+@pytest.fixture(scope="module")
+def panda():
+    path = erd_robots_or_skip() / "panda_description" / "urdf" / "panda.urdf"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return path, eomgen.load(path)
+
+
+def test_panda_mimic_equals_pinocchio(panda):
+    pin = pytest.importorskip("pinocchio", reason="Pinocchio's mimic joints are the reference")
+    path, model = panda
+    nm = numeric_model(model)
+    assert (nm.n, nm.nq, nm.n_tree) == (8, 8, 9)
+    pm = pin.buildModelFromUrdf(str(path), mimic=True)
+    data, tree = pm.createData(), pin.buildModelFromUrdf(str(path))
+    assert [n for n in pm.names[1:] if n in model.joint_names] == list(model.joint_names)
+    rng = np.random.default_rng(8)
+    for _ in range(3):
+        q = np.append(rng.uniform(-1.5, 1.5, 7), rng.uniform(0, 0.04))
+        v, a = rng.normal(size=(2, 8))
+        M = pin.crba(pm, data, q)
+        M = np.triu(M) + np.triu(M, 1).T
+        assert relative(rnea(nm, q, v, a), pin.rnea(pm, data, q, v, a)) < 1e-12
+        assert relative(M_rnea(nm, q), M) < 1e-12
+        assert relative(coriolis_times_qd(nm, q, v) + gravity_torques(nm, q),
+                        pin.nonLinearEffects(pm, data, q, v)) < 1e-12
+        assert relative(gravity_torques(nm, q), pin.computeGeneralizedGravity(pm, data, q)) < 1e-12
+        assert abs(kinetic_energy(nm, q, v) - 0.5 * v @ M @ v) < 1e-12 * (1 + v @ M @ v)
+        # Pinocchio's energies refuse mimic joints: P of the whole tree, finger2 = finger1;
+        # it leaves out the fixed root link's constant term, so compare P(q) − P(0)
+        P = pin.computePotentialEnergy(tree, tree.createData(), np.append(q, q[7]))
+        P0 = pin.computePotentialEnergy(tree, tree.createData(), np.zeros(9))
+        ours = potential_energy(nm, q) - potential_energy(nm, np.zeros(8))
+        assert abs(ours - (P - P0)) < 1e-12 * (1 + abs(P))
+
+
+def test_differential_equals_the_symbolic_reduced_model():
+    """q3 = 0.5 q1 − 0.3 q2 + 0.1 on the elbow arm: float and mpmath Newton–Euler against the
+    derived reduced program (its M, C, g, tau), and against the 40-digit reference."""
+    arm = eomgen.load(eomgen.example_path("elbow_rrr"))
+    model = couple(arm, "elbow", {"waist": 0.5, "shoulder": -0.3}, offset=0.1)
+    f = eomgen.derive(model, ("M", "C", "g", "tau")).lambdify()
+    nm = numeric_model(model)
+    rng = np.random.default_rng(2)
+    for _ in range(3):
+        q, v, a = rng.uniform(-2, 2, (3, 2))
+        assert relative(rnea(nm, q, v, a), f.tau(q, v, a).ravel()) < 1e-12
+        assert relative(M_rnea(nm, q), f.M(q)) < 1e-12
+        assert relative(coriolis_times_qd(nm, q, v), f.C(q, v) @ v) < 1e-12
+        assert relative(gravity_torques(nm, q), f.g(q).ravel()) < 1e-12
+    pytest.importorskip("mpmath")
+    from eomgen.analysis.precision import Reference, relative_error
+
+    reference = Reference(model)
+    assert reference.cross_check([(q, v, a)]) < 1e-30
+    assert relative_error(rnea(nm, q, v, a), reference.tau(q, v, a)) < 1e-14
+
+
+def test_verify_and_simulate_a_coupled_model(tmp_path):
+    """eomgen verify on the differential, and eomgen simulate on it: the energy of the reduced
+    model's motion, from eomgen.numeric, is kept by DOP853 (the simulation refused coupled
+    models)."""
+    pytest.importorskip("scipy", reason="eomgen simulate needs the analysis extra")
+    pytest.importorskip("matplotlib", reason="eomgen simulate needs the analysis extra")
+    arm = eomgen.load(eomgen.example_path("elbow_rrr"))
+    model = couple(arm, "elbow", {"waist": 0.5, "shoulder": -0.3}, offset=0.1)
+    report = eomgen.verify(eomgen.derive(model, ("M", "C", "g")), samples=3)
+    assert report.passed, report.format()
+    from eomgen.analysis.simulate import Adaptive, run_study
+
+    study = run_study(model, [Adaptive("DOP853", 1e-10)], 1.0, [0.4, -0.7], [0.5, 1.0])
+    run, = study.runs
+    assert run.status == "ok" and run.relative_energy_drift < 1e-8
+
+
+@pytest.mark.slow
+def test_bench_and_simulate_run_the_panda_with_its_mimic_fingers(panda, tmp_path):
+    pytest.importorskip("scipy", reason="eomgen simulate needs the analysis extra")
+    pytest.importorskip("matplotlib", reason="eomgen bench and simulate need the analysis extra")
+    pytest.importorskip("mpmath", reason="eomgen bench needs the analysis extra")
+    path, _ = panda
+    result = run_cli("bench", str(path), "--samples", "2", "--repeats", "1", "--batch-size",
+                     "2", "--quiet", "-o", str(tmp_path / "bench"))
+    assert result.exit_code == 0, result.output
+    with open(tmp_path / "bench" / "bench_panda.csv", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    assert {"RNEA (eomgen.numeric)", "Pinocchio"} <= {row["route"] for row in rows}
+    for row in rows:
+        assert float(row["error_max"]) < (1e-5 if row["dtype"] == "float32" else 1e-13), row
+    result = run_cli("simulate", str(path), "--duration", "0.2", "--integrators", "dop853",
+                     "--rtol", "1e-8", "--quiet", "-o", str(tmp_path / "simulate"))
+    assert result.exit_code == 0, result.output
+    with open(tmp_path / "simulate" / "simulate_panda.csv", encoding="utf-8") as f:
+        run, = csv.DictReader(f)
+    assert run["status"] == "ok" and float(run["relative_energy_drift"]) < 1e-6
