@@ -5,6 +5,8 @@
   importable from ``eomgen.numeric`` itself (``eomgen.numeric.rnea``, ``numeric_model``, ...).
 * :mod:`eomgen.numeric.quaternion_chart`: quaternion joints (a free flyer, ball joints) in those
   recursions: ``q`` of NQ entries, ``qd``, ``qdd``, ``tau`` of NV (Pinocchio's layout).
+* :mod:`eomgen.numeric.frames`: pose, Jacobians and J̇ q̇ of named links by recursion (the
+  counterpart of the derived frame program).
 * :mod:`eomgen.numeric.contacts`: rigid contacts (:class:`~eomgen.numeric.contacts.ContactDynamics`,
   KKT constrained dynamics).
 * :mod:`eomgen.numeric.actuated`: armature, friction and Spong's flexible joints

@@ -121,6 +121,11 @@ class ContactDynamics:
         A function ``(q, qd) -> (M, h)`` with ``h = C q̇ + g``; None for eomgen's numeric
         Newton–Euler (:mod:`eomgen.numeric`, n + 2 passes). :func:`derived_mass_and_bias`
         gives the derived program's, faster for repeated calls.
+    frame_kinematics:
+        A function ``(q, qd) -> {frame: {"p", "R", "J", "Jb", "dJqd", "dJbqd"}}``; None for the
+        derived frame program (:func:`eomgen.symbolic.frames.derive_frames`).
+        :func:`eomgen.numeric.frames.frame_function` gives the numeric recursion's, so that
+        with ``mass_and_bias=None`` nothing comes from the derivation.
     """
 
     model: RobotModel
@@ -128,6 +133,7 @@ class ContactDynamics:
     anchors: Mapping[str, np.ndarray] = field(default_factory=dict)
     orientations: Mapping[str, np.ndarray] = field(default_factory=dict)
     mass_and_bias: Callable | None = None
+    frame_kinematics: Callable | None = None
 
     @cached_property
     def _numeric(self):
@@ -143,6 +149,8 @@ class ContactDynamics:
         return sum(c.size for c in self.contacts)
 
     def _kinematics(self, q, qd):
+        if self.frame_kinematics is not None:
+            return self.frame_kinematics(q, qd)
         return self._frames.evaluate(q, qd)
 
     def _rows(self, q, qd):

@@ -328,6 +328,41 @@ def _world_poses(nm: NumericModel, q: np.ndarray, placed: dict
     return Rw, pw
 
 
+def world_state(nm: NumericModel, q, qd) -> tuple[np.ndarray, ...]:
+    """Every body's motion in world (root) axes at ``q̈ = 0``, for the frame kinematics
+    (:mod:`eomgen.numeric.frames`, whose docstring has the recursion): ``(R, p, z, ω, v, ω̇,
+    a, q̇_tree)``, ``R`` (nb, 3, 3) and ``p`` (nb, 3) the body poses, ``z`` (nb, 3) the joint
+    axes, ``ω``, ``v`` the angular velocity and the origin's velocity, ``ω̇``, ``a`` their
+    classical accelerations (a quaternion joint's chain at the chart accelerations ``−n(v)``),
+    and the tree's joint velocities."""
+    x, placed = _configuration(nm, q)
+    qd = _tangent(nm, "qd", qd)
+    zeros = nm.numbers.zeros
+    qdd = zeros(nm.n_tree)
+    if nm.quaternion_joints:
+        qdd = -chart_offset(nm.quaternion_joints, qd, nm.numbers)
+    Rw, pw = _world_poses(nm, x, placed)
+    z = np.einsum("ijk,ik->ij", Rw, nm.axis)
+    w, v, wd, a = (zeros((nm.nb, 3)) for _ in range(4))
+    for i in range(1, nm.nb):
+        j = nm.parent[i]
+        r = pw[i] - pw[j]
+        w[i], wd[i] = w[j], wd[j]
+        v[i] = v[j] + np.cross(w[j], r)
+        a[i] = a[j] + np.cross(wd[j], r) + np.cross(w[j], np.cross(w[j], r))
+        k = nm.q_index[i]
+        if k < 0:
+            continue
+        motion = z[i] * qd[k]
+        if nm.joint_type[i] == REVOLUTE:
+            wd[i] = wd[i] + np.cross(w[j], motion) + z[i] * qdd[k]
+            w[i] = w[i] + motion
+        else:
+            v[i] = v[i] + motion
+            a[i] = a[i] + 2.0 * np.cross(w[j], motion) + z[i] * qdd[k]
+    return Rw, pw, z, w, v, wd, a, qd
+
+
 def potential_energy(nm: NumericModel, q) -> float:
     """Gravitational potential energy [J]: ``P = -Σ_i m_i gravityᵀ p_ci``, with ``p_ci`` the
     centre of mass of body ``i`` in the root frame (zero when every centre of mass is at the

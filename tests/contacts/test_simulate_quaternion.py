@@ -5,7 +5,7 @@ References: Pinocchio on solo12 from its own URDF reader with its own JointModel
 NQ and v of NV passed unchanged): getFrameJacobian and getFrameClassicalAcceleration
 (LOCAL_WORLD_ALIGNED for point contacts, LOCAL for surface contacts) and constraintDynamics; the
 energy of eomgen.numeric's Newton–Euler (independent of the derived program the simulation
-integrates).
+integrates). The frames come from the derived program and from eomgen.numeric.frames.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ import pytest
 
 from eomgen.contacts import Contact, ContactDynamics
 from eomgen.free_flyer import add_free_flyer
+from eomgen.numeric.frames import frame_function
 from support import erd_robots_or_skip, load_quietly, relative, run_cli, write
 
 pin = pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
@@ -43,11 +44,18 @@ def states(pm, count, seed):
         yield q, rng.uniform(-1, 1, pm.nv), rng.uniform(-2, 2, pm.nv)
 
 
-@pytest.mark.parametrize("kind, feet", [("point", FEET), ("surface", FEET[:1])])
-def test_contact_dynamics_equal_pinocchio(solo, kind, feet):
+@pytest.mark.parametrize("kind, feet, frames", [("point", FEET, "derived"),
+                                                ("surface", FEET[:1], "derived"),
+                                                ("point", FEET, "numeric"),
+                                                ("surface", FEET[1:2], "numeric")])
+def test_contact_dynamics_equal_pinocchio(solo, kind, feet, frames):
+    """J_c, J̇_c v and the KKT dynamics, the frames from the derived program or from the
+    numeric recursion (eomgen.numeric.frames: then nothing comes from the derivation)."""
     _, model, pm = solo
     pd = pm.createData()
-    cd = ContactDynamics(model, tuple(Contact(f, kind) for f in feet))
+    kinematics = frame_function(model, feet) if frames == "numeric" else None
+    cd = ContactDynamics(model, tuple(Contact(f, kind) for f in feet),
+                         frame_kinematics=kinematics)
     ctype, frame = ((pin.ContactType.CONTACT_3D, pin.LOCAL_WORLD_ALIGNED) if kind == "point"
                     else (pin.ContactType.CONTACT_6D, pin.LOCAL))
     models = pin.StdVec_RigidConstraintModel()

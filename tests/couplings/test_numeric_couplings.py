@@ -117,3 +117,24 @@ def test_bench_and_simulate_run_the_panda_with_its_mimic_fingers(panda, tmp_path
     with open(tmp_path / "simulate" / "simulate_panda.csv", encoding="utf-8") as f:
         run, = csv.DictReader(f)
     assert run["status"] == "ok" and float(run["relative_energy_drift"]) < 1e-6
+
+
+def test_frame_jacobians_of_a_coupled_model_are_derivatives_of_the_pose():
+    """eomgen.numeric.frames on the differential: J = J_tree T is the central difference of
+    the tip's position and rotation along each independent coordinate."""
+    from eomgen.numeric.frames import frame_kinematics
+
+    arm = eomgen.load(eomgen.example_path("elbow_rrr"))
+    model = couple(arm, "elbow", {"waist": 0.5, "shoulder": -0.3}, offset=0.1)
+    nm = numeric_model(model)
+    tip = nm.body_names[-1]
+    q = np.array([0.4, -0.9])
+    J = frame_kinematics(nm, q, frames=[tip])[tip]["J"]
+    assert J.shape == (6, 2)
+    h = 1e-6
+    for k in range(2):
+        e = np.eye(2)[k] * h
+        plus, minus = (frame_kinematics(nm, q + s * e, frames=[tip])[tip] for s in (1, -1))
+        assert np.abs((plus["p"] - minus["p"]) / (2 * h) - J[:3, k]).max() < 1e-8
+        W = (plus["R"] - minus["R"]) / (2 * h) @ frame_kinematics(nm, q, frames=[tip])[tip]["R"].T
+        assert np.abs(np.array([W[2, 1], W[0, 2], W[1, 0]]) - J[3:, k]).max() < 1e-8
