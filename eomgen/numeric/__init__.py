@@ -28,6 +28,7 @@ from .newton_euler import (
     Numbers,
     NumericModel,
     coriolis_times_qd,
+    forward_dynamics,
     gravity_torques,
     kinetic_energy,
     link_poses,
@@ -38,6 +39,6 @@ from .newton_euler import (
 
 __all__ = [
     "Numbers", "FLOAT64", "NumericModel", "numeric_model", "rnea", "gravity_torques", "M_rnea",
-    "coriolis_times_qd", "kinetic_energy", "potential_energy", "link_poses", "FIXED", "REVOLUTE",
-    "PRISMATIC",
+    "coriolis_times_qd", "forward_dynamics", "kinetic_energy", "potential_energy", "link_poses",
+    "FIXED", "REVOLUTE", "PRISMATIC",
 ]

@@ -295,6 +295,15 @@ def coriolis_times_qd(nm: NumericModel, q, qd) -> np.ndarray:
     return rnea(nm, q, qd, zero) - rnea(nm, q, zero, zero)
 
 
+def forward_dynamics(nm: NumericModel, q, qd, tau) -> np.ndarray:
+    """Joint accelerations ``q̈ = M(q)⁻¹ (τ − C(q, q̇) q̇ − g(q))``, shape (n,), from
+    :func:`M_rnea` and :func:`rnea` (a float64 model; ``q`` (nq,) as :func:`rnea` takes it, with
+    quaternion joints ``q̈`` is ``v̇``). Raises ``numpy.linalg.LinAlgError`` for a singular M."""
+    zero = nm.numbers.zeros(nm.n)
+    h = rnea(nm, q, qd, zero)
+    return np.linalg.solve(M_rnea(nm, q), _check(nm, "tau", tau) - h)
+
+
 def kinetic_energy(nm: NumericModel, q, qd) -> float:
     """Kinetic energy [J]: ``K = Σ_i ½ m_i |v_ci|² + ½ ω_iᵀ I_ci ω_i`` (= ½ q̇ᵀ M(q) q̇).
 
@@ -412,6 +421,7 @@ __all__ = [
     "gravity_torques",
     "M_rnea",
     "coriolis_times_qd",
+    "forward_dynamics",
     "kinetic_energy",
     "potential_energy",
     "link_poses",
