@@ -12,7 +12,8 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from ..errors import UnsupportedError
-from ..model import JointType, QuaternionJoint, RobotModel, coupling_map, parameter_symbol
+from ..model import (JointType, QuaternionJoint, RobotModel, coupling_map, parameter_symbol,
+                     uncoupled)
 
 #: Joint type codes stored in :attr:`NumericModel.joint_type`.
 FIXED, REVOLUTE, PRISMATIC = 0, 1, 2
@@ -151,8 +152,13 @@ class NumericModel:
         ``T`` of the coupling map ``q_tree = T q + c`` (:func:`eomgen.model.coupling_map`);
         None without couplings (``T = 1``). The algorithms run the whole tree at
         ``(T q + c, T q̇, T q̈)`` and return ``Tᵀ τ``: so ``M = Tᵀ M_tree T``, ``h = Tᵀ h_tree``.
-    coupling_offset : (len(tree_joint_names),) array or None
-        ``c`` of that map [rad or m].
+    configuration_coupling : (nq_tree, nq) array or None
+        The same map on configurations, ``q_tree = P q + c_q``: ``T``'s entries placed at the
+        joints' configuration indices, and a quaternion joint's entries (a free flyer's
+        position and quaternion, a ball joint's quaternion) copied; ``P = T`` without
+        quaternion joints.
+    coupling_offset : (nq_tree,) array or None
+        ``c_q`` of that map [rad or m]: the followers' offsets.
     """
 
     name: str
@@ -174,6 +180,7 @@ class NumericModel:
     quaternion_bodies: tuple[int, ...] = ()
     tree_joint_names: tuple[str, ...] = ()
     coupling: np.ndarray | None = None
+    configuration_coupling: np.ndarray | None = None
     coupling_offset: np.ndarray | None = None
 
     @property
@@ -213,6 +220,60 @@ def _mat(numbers: Numbers, m, what: str) -> np.ndarray:
     return np.array([[_number(numbers, x, what) for x in row] for row in m], dtype=numbers.dtype)
 
 
+def _velocity_to_configuration(joints, nv: int) -> dict[int, int]:
+    """The configuration index of each velocity index outside the quaternion joints."""
+    out, shift = {}, 0
+    inside = {k: j for j in joints for k in range(j.v_index, j.v_index + j.nv)}
+    for k in range(nv):
+        if k in inside:
+            shift += k == inside[k].v_index + inside[k].nv - 1
+            continue
+        out[k] = k + shift
+    return out
+
+
+def configuration_map(model: RobotModel, tree: RobotModel, T: np.ndarray, c: np.ndarray,
+                      numbers: Numbers = FLOAT64) -> tuple[np.ndarray, np.ndarray]:
+    """``(P, c_q)`` with ``q_tree = P q + c_q`` (:attr:`NumericModel.configuration_coupling`)
+    from the velocity map ``(T, c)`` of ``model`` (coupled; :func:`eomgen.model.coupling_map`
+    as arrays of ``numbers``) onto ``tree`` (``eomgen.model.uncoupled(model)``).
+
+    Raises
+    ------
+    eomgen.UnsupportedError
+        A coupling names a joint of a free flyer or of a ball joint."""
+    full_joints = tree.quaternion_joints
+    if not full_joints:
+        return T, c
+    names = model.joint_names
+    reduced = {}  # a quaternion joint's first velocity index in the model's coordinates
+    for j in full_joints:
+        reduced[j.v_index] = names.index(tree.movable_joints[j.v_index].name)
+    starts = sorted(reduced.values())
+    q_of = {v: v + starts.index(v) for v in starts}  # one more entry per quaternion before
+    full_cfg = _velocity_to_configuration(full_joints, tree.dof)
+    reduced_inside = {reduced[j.v_index] + i for j in full_joints for i in range(j.nv)}
+    reduced_cfg = {k: k + sum(1 for v in starts if v < k) for k in range(len(names))
+                   if k not in reduced_inside}
+    P = numbers.zeros((tree.nq, model.dof + len(full_joints)))
+    offset = numbers.zeros(tree.nq)
+    for row, col in np.argwhere(np.array([[x != 0 for x in r] for r in T])):
+        if row not in full_cfg and col not in reduced_cfg:
+            continue  # a quaternion joint's own velocity: its entries are copied below
+        if row not in full_cfg or col not in reduced_cfg:
+            raise UnsupportedError(model.source, "couplings", "a coupling names a joint of a "
+                                   "free flyer or ball joint: not mapped by the float "
+                                   "recursions")
+        P[full_cfg[row], reduced_cfg[col]] = T[row, col]
+    for k, q_index in full_cfg.items():
+        offset[q_index] = c[k]
+    for j in full_joints:
+        start = q_of[reduced[j.v_index]]
+        for i in range(j.nq):
+            P[j.q_index + i, start + i] = numbers.value(1)
+    return P, offset
+
+
 def numeric_model(model: RobotModel, values: Mapping | None = None,
                   numbers: Numbers = FLOAT64) -> NumericModel:
     """Build the numeric description of ``model``.
@@ -240,9 +301,6 @@ def numeric_model(model: RobotModel, values: Mapping | None = None,
     ValueError
         When a quantity is still not a real number after substitution.
     """
-    if model.couplings and model.quaternion_joints:
-        raise UnsupportedError(model.source, "couplings", "the float recursions do not map "
-                               "coupled joints on a model with a free flyer or ball joints yet")
     values = {
         (parameter_symbol(k) if isinstance(k, str) else k): v for k, v in (values or {}).items()
     }
@@ -289,12 +347,15 @@ def numeric_model(model: RobotModel, values: Mapping | None = None,
         if not numbers.all_finite(a):
             raise ValueError(f"model '{model.name}' has a non-finite quantity")
         a.flags.writeable = False
-    joints = model.quaternion_joints
+    tree = uncoupled(model)
+    joints = tree.quaternion_joints
     coupling = {}
     if model.couplings:
         T, c = coupling_map(model)
-        coupling = dict(coupling=_mat(numbers, T.tolist(), "coupling gain"),
-                        coupling_offset=_vec(numbers, list(c), "coupling offset"))
+        T = _mat(numbers, T.tolist(), "coupling gain")
+        P, c = configuration_map(model, tree, T, _vec(numbers, list(c), "coupling offset"),
+                                  numbers)
+        coupling = dict(coupling=T, configuration_coupling=P, coupling_offset=c)
         for a in coupling.values():
             a.flags.writeable = False
     return NumericModel(
@@ -312,4 +373,4 @@ def numeric_model(model: RobotModel, values: Mapping | None = None,
 
 
 __all__ = ["FIXED", "FLOAT64", "Numbers", "NumericModel", "PRISMATIC", "REVOLUTE",
-           "numeric_model"]
+           "configuration_map", "numeric_model"]

@@ -86,10 +86,10 @@ def _configuration(nm: NumericModel, q) -> tuple[np.ndarray, dict]:
     whole tree's ``T q + c``."""
     q = _check(nm, "q", q, nm.nq)
     if nm.coupling is not None:
-        return nm.coupling @ q + nm.coupling_offset, {}
+        q = nm.configuration_coupling @ q + nm.coupling_offset
     if not nm.quaternion_joints:
         return q, {}
-    return (chart_coordinates(nm.quaternion_joints, q, nm.n, nm.numbers),
+    return (chart_coordinates(nm.quaternion_joints, q, nm.n_tree, nm.numbers),
             placements(nm.quaternion_joints, q, nm.numbers))
 
 

@@ -36,6 +36,7 @@ import numpy as np
 
 from ..model import RobotModel, coupling_map, uncoupled
 from .floating_base import dynamics_from_free_flyer, to_free_flyer
+from .model import configuration_map
 
 __all__ = ["PinocchioModel", "to_pinocchio", "plain_calls", "PinocchioFreeFlyer"]
 
@@ -61,15 +62,16 @@ class PinocchioModel:
     qperm:
         (nq,) ints, the same for the configuration (``q_pin = q[qperm]``); None: ``perm``.
     coupling:
-        ``(T, c)`` of the model's coupled joints (float arrays), in whose whole-tree coordinates
-        ``perm`` is given; None without couplings.
+        ``(T, P, c_q)`` of the model's coupled joints (float arrays: ``v_tree = T v``,
+        ``q_tree = P q + c_q``, :func:`eomgen.numeric.model.configuration_map`), in whose
+        whole-tree coordinates ``perm`` is given; None without couplings.
     """
 
     model: object
     data: object
     perm: np.ndarray
     qperm: np.ndarray | None = None
-    coupling: tuple[np.ndarray, np.ndarray] | None = None
+    coupling: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
     @property
     def identity(self) -> bool:
@@ -85,8 +87,8 @@ class PinocchioModel:
         p = self.perm
         q, qd, qdd = (np.asarray(x, float) for x in (q, qd, qdd))
         if self.coupling is not None:
-            T, c = self.coupling
-            q, qd, qdd = T @ q + c, T @ qd, T @ qdd
+            T, P, c = self.coupling
+            q, qd, qdd = P @ q + c, T @ qd, T @ qdd
         tau = np.empty(len(p))
         qp = p if self.qperm is None else self.qperm
         tau[p] = pin.rnea(self.model, self.data, q[qp], qd[p], qdd[p])
@@ -99,7 +101,7 @@ class PinocchioModel:
         p = self.perm
         q = np.asarray(q, float)
         if self.coupling is not None:
-            q = self.coupling[0] @ q + self.coupling[1]
+            q = self.coupling[1] @ q + self.coupling[2]
         qp = p if self.qperm is None else self.qperm
         upper = np.triu(pin.crba(self.model, self.data, q[qp]))
         M_pin = upper + np.triu(upper, 1).T
@@ -123,8 +125,10 @@ def to_pinocchio(model: RobotModel) -> PinocchioModel:
     coupling = None
     if model.couplings:
         T, c = coupling_map(model)
-        coupling = (_matrix(T.tolist()), _floats(list(c)))
-        model = uncoupled(model)
+        T, c = _matrix(T.tolist()), _floats(list(c))
+        tree = uncoupled(model)
+        coupling = (T, *configuration_map(model, tree, T, c))
+        model = tree
     pmodel = pin.Model()
     pmodel.name = model.name
     anchor = {model.root: (0, pin.SE3.Identity())}  # link -> (joint id, placement in it)

@@ -133,3 +133,70 @@ def test_frame_jacobians_of_a_coupled_model_are_derivatives_of_the_pose():
         assert np.abs((plus["p"] - minus["p"]) / (2 * h) - J[:3, k]).max() < 1e-8
         W = (plus["R"] - minus["R"]) / (2 * h) @ frame_kinematics(nm, q, frames=[tip])[tip]["R"].T
         assert np.abs(np.array([W[2, 1], W[0, 2], W[1, 0]]) - J[3:, k]).max() < 1e-8
+
+
+def test_panda_with_a_free_flyer_and_mimic_fingers_equals_pinocchio(panda):
+    """Couplings on a quaternion model: q (NQ = 15) maps to the whole tree's configuration
+    (NQ = 16) with the free flyer's seven entries copied; against Pinocchio's free flyer with
+    mimic joints, arrays unchanged."""
+    pin = pytest.importorskip("pinocchio", reason="Pinocchio's mimic joints are the reference")
+    from eomgen.free_flyer import add_free_flyer
+    from eomgen.numeric.frames import frame_kinematics
+
+    path, model = panda
+    model = add_free_flyer(model)
+    nm = numeric_model(model)
+    pm = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer(), mimic=True)
+    data = pm.createData()
+    assert (nm.nq, nm.n) == (pm.nq, pm.nv) == (15, 14)
+    rng = np.random.default_rng(4)
+    pin.seed(4)
+    for _ in range(2):
+        q = pin.randomConfiguration(pm, -np.ones(pm.nq), np.ones(pm.nq))
+        v, a = rng.normal(size=(2, pm.nv))
+        M = pin.crba(pm, data, q)
+        assert relative(rnea(nm, q, v, a), pin.rnea(pm, data, q, v, a)) < 1e-12
+        assert relative(M_rnea(nm, q), np.triu(M) + np.triu(M, 1).T) < 1e-12
+        pin.computeJointJacobians(pm, data, q)
+        pin.updateFramePlacements(pm, data)
+        frame = pm.getFrameId("panda_rightfinger")
+        J = pin.getFrameJacobian(pm, data, frame, pin.LOCAL_WORLD_ALIGNED)
+        assert relative(frame_kinematics(nm, q, v, ["panda_rightfinger"])[
+            "panda_rightfinger"]["J"], J) < 1e-12
+
+
+def test_a_coupling_across_a_ball_joint_maps_by_name():
+    """A revolute joint after a ball joint follows one before it (q_j4 = −0.7 q_j0 + 0.2):
+    the coupled recursion equals the whole tree's at the configuration built entry by entry
+    from the names (the ball's quaternion copied), projected by Tᵀ."""
+    from eomgen.model import Joint, JointType, Link, Transform, build_model, mat3, uncoupled, vec3
+    from support.reference import random_inertial, random_rotation
+
+    rng = np.random.default_rng(12)
+    spec = (("j0", JointType.REVOLUTE, "trunk"), ("ball", JointType.SPHERICAL, "l_j0"),
+            ("j2", JointType.PRISMATIC, "l_ball"), ("j4", JointType.REVOLUTE, "l_j2"))
+    links = [Link("trunk", random_inertial(rng))]
+    joints = []
+    for name, kind, parent in spec:
+        axis = rng.normal(size=3)
+        links.append(Link(f"l_{name}", random_inertial(rng)))
+        joints.append(Joint(name, kind, parent, f"l_{name}",
+                            Transform(mat3(random_rotation(rng).tolist()),
+                                      vec3(rng.uniform(-0.4, 0.4, 3).tolist())),
+                            vec3((axis / np.linalg.norm(axis)).tolist())))
+    tree = build_model("<test>", "ball_differential", links, joints)
+    model = couple(tree, "j4", "j0", ratio=-0.7, offset=0.2)
+    nm, whole = numeric_model(model), numeric_model(uncoupled(model))
+    assert model.joint_names == ("j0", "ball_wx", "ball_wy", "ball_wz", "j2")
+    quaternion = rng.normal(size=4)
+    q = np.concatenate([[0.3], quaternion / np.linalg.norm(quaternion), [0.1]])
+    values = dict(zip(model.configuration_names, q))
+    values["j4"] = -0.7 * values["j0"] + 0.2
+    q_tree = np.array([values[name] for name in tree.configuration_names])
+    T = np.zeros((6, 5))
+    T[:5, :5] = np.eye(5)
+    T[5, 0] = -0.7
+    v, a = rng.normal(size=(2, 5))
+    assert relative(rnea(nm, q, v, a), T.T @ rnea(whole, q_tree, T @ v, T @ a)) < 1e-13
+    assert relative(M_rnea(nm, q), T.T @ M_rnea(whole, q_tree) @ T) < 1e-13
+    assert abs(potential_energy(nm, q) - potential_energy(whole, q_tree)) < 1e-13
