@@ -130,12 +130,22 @@ def test_sizes_are_checked(balls):
 def test_verify_checks_a_quaternion_model():
     """eomgen.verify (and so teach's check) on a free flyer with a ball joint: the derived
     program against the float Newton–Euler; a C without the chart correction would fail the
-    skew check, which takes Ṁ along the configuration rate."""
+    skew check, which takes Ṁ along the configuration rate. And the generated NumPy functions
+    against eomgen.numeric directly."""
     spec = (("ball", JointType.SPHERICAL, -1), ("knee", JointType.REVOLUTE, 0))
     model = ball_tree(spec, seed=4)
-    report = eomgen.verify(eomgen.derive(model, outputs=("M", "C", "g", "tau")), samples=4)
+    dynamics = eomgen.derive(model, outputs=("M", "C", "g", "tau"))
+    report = eomgen.verify(dynamics, samples=4)
     assert report.passed, report.format()
     assert {c.how for c in report.checks} >= {"4 samples"}
+    f, nm = dynamics.lambdify(), numeric_model(model)  # the generated NumPy module's functions
+    rng = np.random.default_rng(9)
+    for _ in range(2):
+        q = rng.normal(size=model.nq)  # a quaternion of any norm: both normalise it
+        v, a = rng.normal(size=(2, model.dof))
+        assert relative(rnea(nm, q, v, a), f.tau(q, v, a).ravel()) < 1e-12
+        assert relative(M_rnea(nm, q), f.M(q)) < 1e-12
+        assert relative(coriolis_times_qd(nm, q, v), f.C(q, v) @ v) < 1e-12
 
 
 def test_mpmath_references_agree_on_quaternion_joints():
