@@ -24,6 +24,7 @@ from .newton_euler import (
     FLOAT64,
     PRISMATIC,
     REVOLUTE,
+    M_crba,
     M_rnea,
     Numbers,
     NumericModel,
@@ -39,6 +40,7 @@ from .newton_euler import (
 
 __all__ = [
     "Numbers", "FLOAT64", "NumericModel", "numeric_model", "rnea", "gravity_torques", "M_rnea",
+    "M_crba",
     "coriolis_times_qd", "forward_dynamics", "kinetic_energy", "potential_energy", "link_poses",
     "FIXED", "REVOLUTE", "PRISMATIC",
 ]

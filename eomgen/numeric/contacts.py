@@ -55,7 +55,7 @@ from ..dynamics import derive
 from ..model import POINT, Contact, RobotModel
 from ..symbolic.evaluate import compile_program
 from ..symbolic.frames import derive_frames
-from .newton_euler import M_rnea, coriolis_times_qd, gravity_torques, numeric_model, rnea
+from .newton_euler import M_crba, coriolis_times_qd, gravity_torques, numeric_model, rnea
 
 #: ``constrained_forward_dynamics`` without damping refuses a contact Jacobian whose smallest
 #: singular value is below this fraction of its largest.
@@ -119,7 +119,7 @@ class ContactDynamics:
         contacts (module docstring).
     mass_and_bias:
         A function ``(q, qd) -> (M, h)`` with ``h = C q̇ + g``; None for eomgen's numeric
-        Newton–Euler (:mod:`eomgen.numeric`, n + 2 passes). :func:`derived_mass_and_bias`
+        Newton–Euler (:mod:`eomgen.numeric`: M by CRBA, h by two RNEA passes). :func:`derived_mass_and_bias`
         gives the derived program's, faster for repeated calls.
     frame_kinematics:
         A function ``(q, qd) -> {frame: {"p", "R", "J", "Jb", "dJqd", "dJbqd"}}``; None for the
@@ -204,7 +204,7 @@ class ContactDynamics:
         if self.mass_and_bias is not None:
             return self.mass_and_bias(q, qd)
         nm = self._numeric
-        return (M_rnea(nm, q),
+        return (M_crba(nm, q),
                 coriolis_times_qd(nm, q, qd) + gravity_torques(nm, q))
 
     def constrained_forward_dynamics(self, q, qd, tau, damping: float = 0.0

@@ -286,6 +286,65 @@ def M_rnea(nm: NumericModel, q) -> np.ndarray:
     return M
 
 
+def _skew(numbers, v) -> np.ndarray:
+    zero = numbers.value(0)
+    return np.array([[zero, -v[2], v[1]], [v[2], zero, -v[0]], [-v[1], v[0], zero]],
+                    dtype=numbers.dtype)
+
+
+def M_crba(nm: NumericModel, q) -> np.ndarray:
+    """Joint-space mass matrix ``M(q)`` by the composite-rigid-body algorithm, (n, n), the
+    same matrix as :func:`M_rnea` in one inward pass and one walk up from each joint.
+
+    Spatial quantities in body coordinates, angular part first: body ``i``'s inertia about
+    its origin ``[[I_ci − m [c]×², m [c]×], [−m [c]×, m 1]]``; the composite inertia ``I^c_i``
+    (the body and everything below it) gathers each child's through ``ᶜX_iᵀ I^c_c ᶜX_i``,
+    ``ᶜX_i = [[Rᵀ, 0], [−Rᵀ [p]×, Rᵀ]]`` taking motions from body ``i`` to its child
+    (pose ``(R, p)`` in ``i``). With ``S_i`` the joint's motion (``(z, 0)`` revolute, ``(0, z)``
+    prismatic), ``M[k_i, k_j] = S_jᵀ (ʲX_iᵀ I^c_i S_i)`` for every joint ``j`` on the path from
+    ``i`` to the root. ``q`` (nq,) as :func:`rnea` takes it; with couplings ``Tᵀ M_tree T``.
+    """
+    x, placed = _configuration(nm, q)
+    R, p = _parent_transforms(nm, x, placed)
+    numbers, nb = nm.numbers, nm.nb
+    zeros = numbers.zeros
+    X = zeros((nb, 6, 6))  # motion transform parent -> body i
+    Ic = zeros((nb, 6, 6))
+    S = zeros((nb, 6))
+    for i in range(1, nb):
+        Rt = R[i].T
+        X[i, :3, :3] = Rt
+        X[i, 3:, 3:] = Rt
+        X[i, 3:, :3] = -Rt @ _skew(numbers, p[i])
+        c, m = nm.com[i], nm.mass[i]
+        C = _skew(numbers, c)
+        Ic[i, :3, :3] = nm.inertia[i] - m * (C @ C)
+        Ic[i, :3, 3:] = m * C
+        Ic[i, 3:, :3] = -m * C
+        Ic[i, 3:, 3:] = m * numbers.eye(3)
+        half = 0 if nm.joint_type[i] == REVOLUTE else 3
+        S[i, half:half + 3] = nm.axis[i]
+    for i in range(nb - 1, 1, -1):
+        j = nm.parent[i]
+        if j > 0:
+            Ic[j] = Ic[j] + X[i].T @ Ic[i] @ X[i]
+    M = zeros((nm.n_tree, nm.n_tree))
+    for i in range(1, nb):
+        k = nm.q_index[i]
+        if k < 0:
+            continue
+        F = Ic[i] @ S[i]
+        M[k, k] = S[i] @ F
+        j = i
+        while nm.parent[j] > 0:
+            F = X[j].T @ F
+            j = nm.parent[j]
+            col = nm.q_index[j]
+            if col >= 0:
+                M[k, col] = M[col, k] = S[j] @ F
+    return M if nm.coupling is None else nm.coupling.T @ M @ nm.coupling
+
+
 def coriolis_times_qd(nm: NumericModel, q, qd) -> np.ndarray:
     """Velocity product ``C(q, q̇) q̇ = rnea(q, q̇, 0) - rnea(q, 0, 0)``, shape (n,), in
     ``nm.joint_names`` order (centrifugal and Coriolis torques/forces); ``q`` (nq,) as
@@ -297,11 +356,11 @@ def coriolis_times_qd(nm: NumericModel, q, qd) -> np.ndarray:
 
 def forward_dynamics(nm: NumericModel, q, qd, tau) -> np.ndarray:
     """Joint accelerations ``q̈ = M(q)⁻¹ (τ − C(q, q̇) q̇ − g(q))``, shape (n,), from
-    :func:`M_rnea` and :func:`rnea` (a float64 model; ``q`` (nq,) as :func:`rnea` takes it, with
+    :func:`M_crba` and :func:`rnea` (a float64 model; ``q`` (nq,) as :func:`rnea` takes it, with
     quaternion joints ``q̈`` is ``v̇``). Raises ``numpy.linalg.LinAlgError`` for a singular M."""
     zero = nm.numbers.zeros(nm.n)
     h = rnea(nm, q, qd, zero)
-    return np.linalg.solve(M_rnea(nm, q), _check(nm, "tau", tau) - h)
+    return np.linalg.solve(M_crba(nm, q), _check(nm, "tau", tau) - h)
 
 
 def kinetic_energy(nm: NumericModel, q, qd) -> float:
@@ -420,6 +479,7 @@ __all__ = [
     "rnea",
     "gravity_torques",
     "M_rnea",
+    "M_crba",
     "coriolis_times_qd",
     "forward_dynamics",
     "kinetic_energy",

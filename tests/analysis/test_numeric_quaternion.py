@@ -16,7 +16,7 @@ import pytest
 import eomgen
 from eomgen.free_flyer import add_free_flyer
 from eomgen.model import Joint, JointType, Link, Transform, build_model, mat3, vec3
-from eomgen.numeric import (M_rnea, coriolis_times_qd, forward_dynamics, gravity_torques,
+from eomgen.numeric import (M_crba, M_rnea, coriolis_times_qd, forward_dynamics, gravity_torques,
                             kinetic_energy, link_poses, numeric_model, potential_energy, rnea)
 from support import erd_robots_or_skip, load_quietly, relative
 from support.reference import random_inertial, random_rotation
@@ -85,6 +85,7 @@ def test_dynamics_equal_pinocchio(case, request):
         g = pin.computeGeneralizedGravity(pm, data, q)
         assert relative(rnea(nm, q, v, a), tau) < 1e-12
         assert relative(M_rnea(nm, q), M) < 1e-12
+        assert relative(M_crba(nm, q), M) < 1e-12
         assert relative(gravity_torques(nm, q), g) < 1e-12
         assert relative(coriolis_times_qd(nm, q, v) + gravity_torques(nm, q), h) < 1e-12
         qdd = forward_dynamics(nm, q, v, tau)
@@ -166,6 +167,12 @@ def test_mpmath_references_agree_on_quaternion_joints():
     nm = numeric_model(model)
     assert relative_error(rnea(nm, q[0], v[0], a[0]), reference.tau(q[0], v[0], a[0])) < 1e-14
     assert relative_error(M_rnea(nm, q[1]), reference.M(q[1])) < 1e-14
+    assert relative_error(M_crba(nm, q[1]), reference.M(q[1])) < 1e-14
+    import mpmath
+    from eomgen.analysis.precision import max_abs
+    with mpmath.workdps(reference.dps):  # the CRBA in mpmath, against the derived program
+        M = reference.M(q[0])
+        assert max_abs(M_crba(reference.mp_model, q[0]) - M) / max_abs(M) < 1e-30
 
 
 @pytest.mark.slow

@@ -17,7 +17,7 @@ import pytest
 
 import eomgen
 from eomgen.model import couple
-from eomgen.numeric import (M_rnea, coriolis_times_qd, gravity_torques, kinetic_energy,
+from eomgen.numeric import (M_crba, M_rnea, coriolis_times_qd, gravity_torques, kinetic_energy,
                             numeric_model, potential_energy, rnea)
 from support import erd_robots_or_skip, relative, run_cli
 
@@ -46,6 +46,7 @@ def test_panda_mimic_equals_pinocchio(panda):
         M = np.triu(M) + np.triu(M, 1).T
         assert relative(rnea(nm, q, v, a), pin.rnea(pm, data, q, v, a)) < 1e-12
         assert relative(M_rnea(nm, q), M) < 1e-12
+        assert relative(M_crba(nm, q), M) < 1e-12
         assert relative(coriolis_times_qd(nm, q, v) + gravity_torques(nm, q),
                         pin.nonLinearEffects(pm, data, q, v)) < 1e-12
         assert relative(gravity_torques(nm, q), pin.computeGeneralizedGravity(pm, data, q)) < 1e-12
@@ -157,6 +158,7 @@ def test_panda_with_a_free_flyer_and_mimic_fingers_equals_pinocchio(panda):
         M = pin.crba(pm, data, q)
         assert relative(rnea(nm, q, v, a), pin.rnea(pm, data, q, v, a)) < 1e-12
         assert relative(M_rnea(nm, q), np.triu(M) + np.triu(M, 1).T) < 1e-12
+        assert relative(M_crba(nm, q), np.triu(M) + np.triu(M, 1).T) < 1e-12
         pin.computeJointJacobians(pm, data, q)
         pin.updateFramePlacements(pm, data)
         frame = pm.getFrameId("panda_rightfinger")
