@@ -133,9 +133,9 @@ def simulate(description, outdir, duration, dts, rtols, names, q0, qd0, gains, s
     against the error of q versus a DOP853 reference at rtol = atol = 1e-12. Writes
     simulate_<robot>.md, .csv and .png into OUTPUT.
 
-    With a scene that has loops, they are held (q0 closed by Newton, qd0 projected), and
-    each integrator runs without and with Baumgarte: loop drift and energy drift
-    (docs/loops.md). With a scene that has contacts, the contacts are held (bilateral) where they are at
+    With a scene that has loops, they are held (q0 closed by Newton, qd0 projected), with
+    its contacts if any, and each integrator runs without and with Baumgarte: loop drift,
+    contact drift and energy drift (docs/loops.md). With a scene that has contacts, the contacts are held (bilateral) where they are at
     q0, and each integrator (not the implicit midpoint) runs without and with Baumgarte
     stabilisation: constraint drift (position, orientation, velocity) and energy drift.
     With flexible joints (actuators with a stiffness), the 2n-state Spong model is
