@@ -89,10 +89,6 @@ def bench(description, outdir, samples, seed, repeats, batch_size, quiet, strict
 
     progress = Progress(quiet)
     model = load_reduced(description, scene_path, strict)[0]
-    if model.quaternion_joints:  # its references take q of NV entries
-        raise AnalysisError("bench: its references (eomgen.numeric, the mpmath Newton-Euler) "
-                            "have no quaternion joints (free flyer, ball) yet (a free flyer: "
-                            "use floating_base: euler in the scene)")
     plan = prepare_bench(model, samples=samples, seed=seed, batch_size=batch_size,
                          repeats=repeats, log=progress)
     with progress.steps(plan.steps, "measuring") as steps:
@@ -189,10 +185,6 @@ def simulate(description, outdir, duration, dts, rtols, names, q0, qd0, gains, s
         if values is not None and len(values) != len(names):
             raise AnalysisError(f"{option}: {model.name} takes {len(names)} values "
                                 f"({', '.join(names)}), got {len(values)}")
-    if contacts and model.quaternion_joints:
-        raise AnalysisError("simulate: contacts are held by eomgen.numeric, which has no "
-                            "quaternion joints (free flyer, ball) yet; use floating_base: "
-                            "euler in the scene")
     if model.loops:
         _simulate_loops(model, integrators, duration, start, velocity, gain_list, outdir,
                         progress)
