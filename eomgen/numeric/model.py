@@ -10,10 +10,11 @@ from dataclasses import dataclass
 from typing import Any, Callable, Mapping
 
 import numpy as np
+import sympy as sp
 
-from ..errors import UnsupportedError
 from ..model import (JointType, QuaternionJoint, RobotModel, coupling_map, parameter_symbol,
                      uncoupled)
+from ..model.coupling import full_configuration
 
 #: Joint type codes stored in :attr:`NumericModel.joint_type`.
 FIXED, REVOLUTE, PRISMATIC = 0, 1, 2
@@ -220,58 +221,21 @@ def _mat(numbers: Numbers, m, what: str) -> np.ndarray:
     return np.array([[_number(numbers, x, what) for x in row] for row in m], dtype=numbers.dtype)
 
 
-def _velocity_to_configuration(joints, nv: int) -> dict[int, int]:
-    """The configuration index of each velocity index outside the quaternion joints."""
-    out, shift = {}, 0
-    inside = {k: j for j in joints for k in range(j.v_index, j.v_index + j.nv)}
-    for k in range(nv):
-        if k in inside:
-            shift += k == inside[k].v_index + inside[k].nv - 1
-            continue
-        out[k] = k + shift
-    return out
-
-
-def configuration_map(model: RobotModel, tree: RobotModel, T: np.ndarray, c: np.ndarray,
-                      numbers: Numbers = FLOAT64) -> tuple[np.ndarray, np.ndarray]:
-    """``(P, c_q)`` with ``q_tree = P q + c_q`` (:attr:`NumericModel.configuration_coupling`)
-    from the velocity map ``(T, c)`` of ``model`` (coupled; :func:`eomgen.model.coupling_map`
-    as arrays of ``numbers``) onto ``tree`` (``eomgen.model.uncoupled(model)``).
-
-    Raises
-    ------
-    eomgen.UnsupportedError
-        A coupling names a joint of a free flyer or of a ball joint."""
-    full_joints = tree.quaternion_joints
-    if not full_joints:
-        return T, c
-    names = model.joint_names
-    reduced = {}  # a quaternion joint's first velocity index in the model's coordinates
-    for j in full_joints:
-        reduced[j.v_index] = names.index(tree.movable_joints[j.v_index].name)
-    starts = sorted(reduced.values())
-    q_of = {v: v + starts.index(v) for v in starts}  # one more entry per quaternion before
-    full_cfg = _velocity_to_configuration(full_joints, tree.dof)
-    reduced_inside = {reduced[j.v_index] + i for j in full_joints for i in range(j.nv)}
-    reduced_cfg = {k: k + sum(1 for v in starts if v < k) for k in range(len(names))
-                   if k not in reduced_inside}
-    P = numbers.zeros((tree.nq, model.dof + len(full_joints)))
-    offset = numbers.zeros(tree.nq)
-    for row, col in np.argwhere(np.array([[x != 0 for x in r] for r in T])):
-        if row not in full_cfg and col not in reduced_cfg:
-            continue  # a quaternion joint's own velocity: its entries are copied below
-        if row not in full_cfg or col not in reduced_cfg:
-            raise UnsupportedError(model.source, "couplings", "a coupling names a joint of a "
-                                   "free flyer or ball joint: not mapped by the float "
-                                   "recursions")
-        P[full_cfg[row], reduced_cfg[col]] = T[row, col]
-    for k, q_index in full_cfg.items():
-        offset[q_index] = c[k]
-    for j in full_joints:
-        start = q_of[reduced[j.v_index]]
-        for i in range(j.nq):
-            P[j.q_index + i, start + i] = numbers.value(1)
-    return P, offset
+def configuration_map(model: RobotModel, numbers: Numbers = FLOAT64
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """``(P, c_q)`` with ``q_tree = P q + c_q`` (:attr:`NumericModel.configuration_coupling`):
+    :func:`eomgen.model.full_configuration` of the coupled ``model`` (affine in ``q``) as a
+    matrix and an offset of ``numbers``; ``P = T`` of :func:`eomgen.model.coupling_map`
+    without quaternion joints."""
+    zero = [sp.Integer(0)] * model.nq
+    offset = full_configuration(model, zero)
+    columns = []
+    for k in range(model.nq):
+        unit = list(zero)
+        unit[k] = sp.Integer(1)
+        columns.append([a - b for a, b in zip(full_configuration(model, unit), offset)])
+    P = _mat(numbers, [list(row) for row in zip(*columns)], "coupling gain")
+    return P, _vec(numbers, offset, "coupling offset")
 
 
 def numeric_model(model: RobotModel, values: Mapping | None = None,
@@ -296,8 +260,6 @@ def numeric_model(model: RobotModel, values: Mapping | None = None,
     ------
     eomgen.DescriptionError
         When a parameter has neither a default nor a given value.
-    eomgen.UnsupportedError
-        For a model with coupled joints and quaternion joints (not mapped yet).
     ValueError
         When a quantity is still not a real number after substitution.
     """
@@ -351,10 +313,8 @@ def numeric_model(model: RobotModel, values: Mapping | None = None,
     joints = tree.quaternion_joints
     coupling = {}
     if model.couplings:
-        T, c = coupling_map(model)
-        T = _mat(numbers, T.tolist(), "coupling gain")
-        P, c = configuration_map(model, tree, T, _vec(numbers, list(c), "coupling offset"),
-                                  numbers)
+        T = _mat(numbers, coupling_map(model)[0].tolist(), "coupling gain")
+        P, c = configuration_map(model, numbers)
         coupling = dict(coupling=T, configuration_coupling=P, coupling_offset=c)
         for a in coupling.values():
             a.flags.writeable = False

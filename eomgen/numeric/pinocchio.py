@@ -124,11 +124,8 @@ def to_pinocchio(model: RobotModel) -> PinocchioModel:
         model = model.with_numeric_parameters()
     coupling = None
     if model.couplings:
-        T, c = coupling_map(model)
-        T, c = _matrix(T.tolist()), _floats(list(c))
-        tree = uncoupled(model)
-        coupling = (T, *configuration_map(model, tree, T, c))
-        model = tree
+        coupling = (_matrix(coupling_map(model)[0].tolist()), *configuration_map(model))
+        model = uncoupled(model)
     pmodel = pin.Model()
     pmodel.name = model.name
     anchor = {model.root: (0, pin.SE3.Identity())}  # link -> (joint id, placement in it)

@@ -438,6 +438,8 @@ def _verification_section(dyn: Dynamics, report: VerificationReport | None,
     if report is None:
         return Section("Verified properties", (Paragraph(prose(
             "Not checked numerically: ", plain(missing or ""), ". " + hint)),))
+    quaternion = bool(dyn.model.quaternion_joints)  # velocities v, not q̇: say it in v
+    names, rate = _check_names(quaternion), "v" if quaternion else "\\dot{q}"
     rows = []
     for c in report.checks:
         if c.name == "M positive definite":
@@ -446,17 +448,20 @@ def _verification_section(dyn: Dynamics, report: VerificationReport | None,
             result = prose("identically zero")
         else:
             result = prose(f"{c.max_abs_error:.1e} (relative {c.max_rel_error:.1e})")
-        name = prose(_CHECK_NAMES[c.name]) if c.name in _CHECK_NAMES else (plain(c.name),)
+        name = prose(names[c.name]) if c.name in names else (plain(c.name),)
         how = "symbolic" if c.how == "exact" else c.how.split(";")[0]
         rows.append((name, (plain(how),), result, prose("passed" if c.passed else "FAILED")))
     return Section("Verified properties", (
         Paragraph(prose(
             "eomgen checked what it derived (parameters at the values of the table above): "
             "$M$ is symmetric and positive definite, $\\dot{M} - 2C$ is skew-symmetric "
-            "(the energy balance $\\dot{K} = \\dot{q}^{T} (\\tau - g)$ depends on it), and "
+            f"(the energy balance $\\dot{{K}} = {rate}^{{T}} "
+            "(\\tau - g)$ depends on it), and "
             "$g$, every column of $M$ and the whole equation agree with an independent "
             "numeric recursive Newton–Euler computation (RNEA) at random states "
-            "($|q_{i}| \\le \\pi$, velocities and accelerations of order one).")),
+            + ("(unit quaternions, joint angles $|q_{i}| \\le \\pi$, velocities $v$ and "
+               "accelerations $\\dot{v}$ of order one)." if quaternion else
+               "($|q_{i}| \\le \\pi$, velocities and accelerations of order one)."))),
         Table(tuple(prose(h) for h in ("property", "checked", "largest error", "")),
               tuple(rows)),
         Paragraph(prose(
@@ -466,7 +471,7 @@ def _verification_section(dyn: Dynamics, report: VerificationReport | None,
 
 
 #: The checks of :func:`eomgen.verify` as the handout names them (``$…$`` is math).
-_CHECK_NAMES = {
+CHECK_NAMES = {
     "M symmetric": "$M$ symmetric",
     "M positive definite": "$M$ positive definite",
     "Mdot - 2C skew-symmetric": "$\\dot{M} - 2C$ skew-symmetric",
@@ -476,6 +481,15 @@ _CHECK_NAMES = {
     "M qdd + C qd + g = RNEA(q,qd,qdd)":
         "$M \\ddot{q} + C \\dot{q} + g = \\mathrm{RNEA}(q, \\dot{q}, \\ddot{q})$",
 }
+
+
+def _check_names(quaternion: bool) -> dict[str, str]:
+    """:data:`CHECK_NAMES`, written in the velocities v and accelerations v̇ of a model with
+    quaternion joints (their q̇ is not v)."""
+    if not quaternion:
+        return CHECK_NAMES
+    return {key: text.replace("\\ddot{q}", "\\dot{v}").replace("\\dot{q}", "v")
+            for key, text in CHECK_NAMES.items()}
 
 
 # -- the handout ----------------------------------------------------------------------------

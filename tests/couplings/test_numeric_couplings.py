@@ -170,7 +170,7 @@ def test_panda_with_a_free_flyer_and_mimic_fingers_equals_pinocchio(panda):
 def test_a_coupling_across_a_ball_joint_maps_by_name():
     """A revolute joint after a ball joint follows one before it (q_j4 = −0.7 q_j0 + 0.2):
     the coupled recursion equals the whole tree's at the configuration built entry by entry
-    from the names (the ball's quaternion copied), projected by Tᵀ."""
+    from the names (the ball's quaternion copied), projected by Tᵀ; eomgen verify passes."""
     from eomgen.model import Joint, JointType, Link, Transform, build_model, mat3, uncoupled, vec3
     from support.reference import random_inertial, random_rotation
 
@@ -202,3 +202,6 @@ def test_a_coupling_across_a_ball_joint_maps_by_name():
     assert relative(rnea(nm, q, v, a), T.T @ rnea(whole, q_tree, T @ v, T @ a)) < 1e-13
     assert relative(M_rnea(nm, q), T.T @ M_rnea(whole, q_tree) @ T) < 1e-13
     assert abs(potential_energy(nm, q) - potential_energy(whole, q_tree)) < 1e-13
+    # and eomgen verify: the derived program of the coupled quaternion model against it
+    report = eomgen.verify(eomgen.derive(model, ("M", "C", "g")), samples=3)
+    assert report.passed, report.format()
