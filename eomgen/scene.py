@@ -12,9 +12,9 @@ Version 1 of the format (every key but ``version`` is optional)::
     robot: talos                  # the robot's name; another robot is an error
     description: Left arm, the rest of the robot held still.
     fixed_base: true              # the root link is bolted to the world, on purpose
-    floating_base: false          # or: the root link flies free: true or 'euler' (six
-                                  #   virtual joints, ZYX Euler angles), 'quaternion'
-                                  #   (Pinocchio's free flyer, NQ = NV + 1);
+    floating_base: false          # or: the root link flies free: true or 'quaternion'
+                                  #   (Pinocchio's free flyer, NQ = NV + 1), 'euler' (six
+                                  #   virtual joints, ZYX Euler angles);
                                   #   'base: floating' says the same as true
     base: torso_2_link            # the link the moving part hangs from (default: the root)
     tips: [arm_left_7_link]       # its ends (default: everything below base)
@@ -100,7 +100,7 @@ ACTUATOR_ALIASES = ("friction", "armature", "flexible_joints")
 PAYLOAD_KEYS = ("link", "name", "mass", "com", "inertia")
 
 #: The values of ``floating_base`` and what they mean: no floating base, or its chart.
-FLOATING_CHARTS = {False: False, True: "euler", "euler": "euler", "quaternion": "quaternion"}
+FLOATING_CHARTS = {False: False, True: "quaternion", "euler": "euler", "quaternion": "quaternion"}
 
 #: ``base: floating`` is short for ``floating_base: true`` (a link of this name cannot be a
 #: scene's base).
@@ -136,11 +136,12 @@ class Scene:
         root that looks like a floating base (:mod:`eomgen.parsers.urdf`), as the task holds
         the robot still (an arm of a humanoid on a fixed torso, a legged robot on a stand).
     floating_base:
-        The root link flies free: ``"euler"`` (what ``true`` means):
-        :func:`eomgen.floating.add_floating_base` puts six virtual joints (x, y, z, yaw,
-        pitch, roll) between a fixed ``world`` link and it; ``"quaternion"``:
+        The root link flies free: ``"quaternion"`` (what ``true`` means):
         :func:`eomgen.free_flyer.add_free_flyer`, Pinocchio's free flyer (a unit quaternion in
-        q, the root twist in v). False for a root that does not fly.
+        q, the root twist in v); ``"euler"``: :func:`eomgen.floating.add_floating_base` puts
+        six virtual joints (x, y, z, yaw, pitch, roll) between a fixed ``world`` link and it
+        (what ``true`` meant before the quaternion became the default). False for a root that
+        does not fly.
     base, tips:
         The moving part is every movable joint on a path from ``base`` (default: the root) to
         one of ``tips`` (default: every joint below ``base``).

@@ -20,6 +20,7 @@ from support import (
 from eomgen import floating, numeric
 from eomgen.contacts import Contact, ContactDynamics, derived_mass_and_bias
 from eomgen.errors import SceneError
+from eomgen.free_flyer import add_free_flyer
 from eomgen.model import Inertial, Joint, JointType, Link, Transform, build_model
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
@@ -247,7 +248,7 @@ def test_contacts_made_in_python_are_checked():
 def test_scene_contacts_through_apply_scene(solo):
     path, model = solo
     robot = load_quietly(path)
-    scene = load_scene("solo.yaml", text="version: 1\nfloating_base: true\ncontacts:\n"
+    scene = load_scene("solo.yaml", text="version: 1\nfloating_base: euler\ncontacts:\n"
                        + "".join(f"  - {{frame: {f}, mu: 0.7}}\n" for f in FEET))
     reduced, report = apply_scene(robot, scene)
     assert reduced.joint_names == model.joint_names
@@ -302,7 +303,10 @@ def test_example_contact_scene(solo):
     scene = load_scene(CONTACTS
                        / "solo12_standing.yaml")
     reduced, report = apply_scene(load_quietly(path), scene)
-    assert scene.robot == "solo" and reduced.joint_names == model.joint_names
+    # floating_base: true is Pinocchio's free flyer: its q and v, joints in its order
+    flyer = add_free_flyer(load_quietly(path))
+    assert scene.robot == "solo" and reduced.joint_names == flyer.joint_names
+    assert (reduced.nq, reduced.dof) == (19, 18)
     assert [(c.frame, c.kind, c.mu) for c in report.contacts] == [(f, "point", 0.7)
                                                                  for f in FEET]
 
@@ -312,4 +316,5 @@ def test_documented_contact_scene_loads(solo):
     text = (DOCS / "scenes.md").read_text(encoding="utf-8")
     block = [b for b in text.split("```yaml\n")[1:] if "robot: solo" in b][0].split("```")[0]
     reduced, report = apply_scene(load_quietly(path), load_scene("doc.yaml", text=block))
-    assert reduced.joint_names == model.joint_names and len(report.contacts) == 4
+    flyer = add_free_flyer(load_quietly(path))  # floating_base: true, the quaternion chart
+    assert reduced.joint_names == flyer.joint_names and len(report.contacts) == 4

@@ -9,6 +9,8 @@ eomgen.numeric's M and h.
 
 from __future__ import annotations
 
+import dataclasses
+
 
 import numpy as np
 import pytest
@@ -20,6 +22,8 @@ from eomgen import actuators as A
 from eomgen import numeric
 from eomgen.cli import _load_reduced, main
 from eomgen.contacts import Contact, ContactDynamics, derived_mass_and_bias, rotation_log
+from eomgen.reduction import apply_scene
+from eomgen.scene import load_scene
 
 pytest.importorskip("matplotlib", reason="eomgen simulate needs the analysis extra")
 pytest.importorskip("scipy", reason="eomgen simulate needs the analysis extra")
@@ -43,7 +47,10 @@ def _wall():
 
 
 def _top():
-    return _load_reduced(TOP, TOP_SCENE, False)
+    """The top on a point in the Euler chart (its q0 six numbers; the shipped scene's
+    ``floating_base: true`` is the quaternion free flyer, tests/contacts/test_simulate_quaternion)."""
+    scene = dataclasses.replace(load_scene(TOP_SCENE), floating_base="euler")
+    return apply_scene(eomgen.load(TOP), scene)
 
 
 def _rk4(f, x, dt, steps):
