@@ -43,7 +43,10 @@ DEFAULT_OUTPUTS = ("M", "C", "g")
 #: flexible joints, flatness) differentiate by q, which its chart holds at zero.
 FREE_FLYER_OUTPUTS = ("M", "C", "g", "P", "tau", "h", "qdd_aba", "MCg", "Mh", "p_f", "R_f",
                       "J_f", "Jb_f", "dJqd_f", "dJbqd_f", "J_c", "dJqd_c", "tau_c", "cone_c",
-                      "pyramid_c", "c_G", "J_G", "A_G", "dAGv", "I_G", "Y", "pi", "Y_base", "beta")
+                      "pyramid_c", "c_G", "J_G", "A_G", "dAGv", "I_G", "Y", "pi", "Y_base", "beta",
+                      # issue 25: derivatives along the tangent (eomgen.symbolic.tangent)
+                      "dtau_dq", "dtau_dqd", "dtau", "dg_dq", "dqdd_dq", "dqdd_dqd", "Minv",
+                      "dqdd", "A_lin", "B_lin", "AB")
 
 #: ``derive(model, simplify=True)`` refuses models with more movable joints: trigonometric
 #: simplification of the expanded expressions grows exponentially with the number of joints
