@@ -46,7 +46,7 @@ FREE_FLYER_OUTPUTS = ("M", "C", "g", "P", "tau", "h", "qdd_aba", "MCg", "Mh", "p
                       "pyramid_c", "c_G", "J_G", "A_G", "dAGv", "I_G", "Y", "pi", "Y_base", "beta",
                       # issue 25: derivatives along the tangent (eomgen.symbolic.tangent)
                       "dtau_dq", "dtau_dqd", "dtau", "dg_dq", "dqdd_dq", "dqdd_dqd", "Minv",
-                      "dqdd", "A_lin", "B_lin", "AB")
+                      "dqdd", "A_lin", "B_lin", "AB", "dKKT")
 
 #: ``derive(model, simplify=True)`` refuses models with more movable joints: trigonometric
 #: simplification of the expanded expressions grows exponentially with the number of joints
