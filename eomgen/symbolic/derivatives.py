@@ -1,4 +1,4 @@
-"""Exact derivatives of the dynamics as straight-line programs (issue 25, fixed bases).
+"""Exact derivatives of the dynamics as straight-line programs (issue 25).
 
 The derivatives are the dynamics' own programs differentiated once in forward mode
 (:func:`forward_mode`): each assignment ``x = f(a, b, …)`` of the Newton–Euler (or ABA) program
@@ -11,8 +11,10 @@ derivative is defined in the derivation's builder, so it reuses the dynamics' in
 direction has no derivative along it (nothing is computed), which is where the structure of the
 tree shows: ∂/∂q_j of a body's velocity exists only below joint j.
 
-Outputs (symbols of :mod:`eomgen.outputs`), n joints, ``JOINT_NAMES`` order; derivatives with
-respect to q are in the velocity (tangent) coordinates, n_v columns (= n for fixed bases):
+Outputs (symbols of :mod:`eomgen.outputs`), n = NV joints, ``JOINT_NAMES`` order; derivatives
+with respect to q are along the tangent, NV columns (:mod:`eomgen.symbolic.tangent`: for a
+quaternion free flyer or ball joints, ``d/dε f(q ⊕ ε eᵢ)`` with v held fixed, as Pinocchio's;
+each q entry's own direction otherwise):
 
 * ``dtau_dq``, ``dtau_dqd`` (n × n): ∂τ/∂q and ∂τ/∂q̇ of τ(q, q̇, q̈) (Newton–Euler); ∂τ/∂q̈ = M.
 * ``dg_dq`` (n × n): ∂g/∂q of g(q) = τ(q, 0, 0).
@@ -23,7 +25,8 @@ respect to q are in the velocity (tangent) coordinates, n_v columns (= n for fix
   Newton–Euler derivatives taken at q̈ = ABA(q, q̇, τ) held fixed (the implicit function
   theorem on τ(q, q̇, q̈(q, q̇, τ)) = τ; what Pinocchio's ``computeABADerivatives`` does).
 * ``A_lin`` (2n × 2n) and ``B_lin`` (2n × n): ẋ = f(x, τ), x = (q, q̇), linearized:
-  A = [[0, I], [∂q̈/∂q, ∂q̈/∂q̇]], B = [[0], [M⁻¹]].
+  A = [[T, I], [∂q̈/∂q, ∂q̈/∂q̇]], B = [[0], [M⁻¹]], T = 0 but for quaternion joints
+  (:func:`eomgen.symbolic.tangent.velocity_transport`).
 * ``dtau_a_dqd`` (n × n): ∂τ_a/∂q̇ = ∂τ/∂q̇ + diag(d) of the drive torques
   τ_a = τ + a q̈ + d q̇ + f sign(q̇) (∂τ_a/∂q = ∂τ/∂q; the Coulomb sign's derivative is 0 for
   q̇_i ≠ 0).
