@@ -37,6 +37,7 @@ import tempfile
 import time
 import warnings
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -69,14 +70,14 @@ def solo_modules(folder: Path):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         model = apply_scene(eomgen.load(path), load_scene("s.yaml", text=scene)).model
-    start = time.perf_counter()
-    for backend, functions in (("fast", FAST), ("numpy", NUMPY)):
-        for f in render_files(model, [backend], functions=functions):
-            (folder / f.name).write_bytes(f.content if isinstance(f.content, bytes)
-                                          else f.content.encode("utf-8"))
+    start, stem = time.perf_counter(), module_name(model.name)
+    if not list(folder.glob(f"{stem}_fast.*.so")):  # --build: modules made by an earlier run
+        for backend, functions in (("fast", FAST), ("numpy", NUMPY)):
+            for f in render_files(model, [backend], functions=functions):
+                (folder / f.name).write_bytes(f.content if isinstance(f.content, bytes)
+                                              else f.content.encode("utf-8"))
     seconds = time.perf_counter() - start
-    stem = module_name(model.name)
-    fast = loadable_backends()["fast"].load(folder, stem).namespace
+    fast = SimpleNamespace(**loadable_backends()["fast"].load(folder, stem).namespace)
     numpy_module = loadable_backends()["numpy"].load(folder, stem).namespace
     return path, model, fast, numpy_module, seconds
 
@@ -112,6 +113,8 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--clock", choices=sorted(CLOCK), default="cpu")
     parser.add_argument("--markdown", type=Path, help="also write the tables to this file")
+    parser.add_argument("--build", type=Path, help="keep the generated modules in this folder "
+                        "(and reuse them when it holds them already)")
     args = parser.parse_args()
     calls, repeats = (1_000, 5) if args.quick else (10_000, 9)
     lines: list[str] = []
@@ -121,13 +124,15 @@ def main() -> None:
         lines.append(text)
 
     with tempfile.TemporaryDirectory() as tmp:
-        path, model, fast, np_module, seconds = solo_modules(Path(tmp))
+        folder = args.build or Path(tmp)
+        folder.mkdir(parents=True, exist_ok=True)
+        path, model, fast, np_module, seconds = solo_modules(folder)
         pin, pm, data, constraints, datas = pinocchio_solo(path)
         assert list(pm.names[2:]) == list(model.joint_names[6:])
         say(f"solo12, quaternion base (NQ {model.nq}, NV {model.dof}), four feet held (m = 12). "
             f"Python {platform.python_version()}, NumPy {np.__version__}, Pinocchio "
             f"{pin.__version__}, eomgen {eomgen.__version__}, {platform.machine()}; "
-            f"{args.clock} clock; modules generated in {seconds:.0f} s.")
+            f"{args.clock} clock; modules generated (or loaded) in {seconds:.0f} s.")
         rng = np.random.default_rng(0)
         q = pin.randomConfiguration(pm, -np.ones(pm.nq), np.ones(pm.nq))
         v, a = rng.normal(size=pm.nv), rng.normal(size=pm.nv)
@@ -141,7 +146,7 @@ def main() -> None:
                     data.dlambda_dtau)
 
         ddq, F = np_module["constrained_forward_dynamics"](q, v, tau)
-        partials = fast["constrained_dynamics_partials"]
+        partials = fast.constrained_dynamics_partials
         namespace = dict(fast=fast, np_module=np_module, pin=pin, model=pm, data=data, q=q,
                          v=v, a=a, tau=tau, ddq=ddq, F=F, partials=partials,
                          pin_constrained=pin_constrained,

@@ -519,7 +519,8 @@ FORWARD_DERIVATIVES = register_output(Output(
     build=_DERIVATIVES, default=False, returns=("dqdd_dq", "dqdd_dqd", "Minv")))
 STATE_MATRIX = register_output(Output(
     "state_matrix", "A_lin", "A = df/dx (2 nv, 2 nv) of xdot = f(x, tau), x = (q, qd): "
-    "[[0, I], [dqdd/dq, dqdd/dqd]].", ("q", "qd", "tau"), False, "1, 1/s, 1/s^2",
+    "[[T, I], [dqdd/dq, dqdd/dqd]], T = 0 (quaternion joints: -ad_v / 2, the tangent chart's).",
+    ("q", "qd", "tau"), False, "1, 1/s, 1/s^2",
     ("A_lin",), build=_DERIVATIVES, default=False, width=2))
 INPUT_MATRIX = register_output(Output(
     "input_matrix", "B_lin", "B = df/dtau (2 nv, nv) of xdot = f(x, tau): [[0], [M^-1]].",
@@ -569,7 +570,8 @@ CONSTRAINED_DERIVATIVES = register_output(Output(
     "constrained_forward_dynamics: K^-1 (-dKKT, [1; 0]), K its KKT matrix.", ("q", "qd", "tau"),
     False, "those of the forward dynamics derivatives; N per unit", ("M", "tau", "J_c", "dJqd_c",
     "dKKT"), composed_from=(*CONSTRAINED_FORWARD.composed_from, CONSTRAINED_FORWARD.function,
-    CONSTRAINED_PARTIALS.function), default=False, constants=_CONTACT_NAMES, backends=("numpy",)))
+    CONSTRAINED_PARTIALS.function), default=False, constants=_CONTACT_NAMES,
+    backends=("numpy", "jax", "torch")))
 
 # --- issue 27: task-space quantities, composed from M, J_f, J_f-dot qd and tau (templates) --
 #: The backends whose templates compose the task-space functions.

@@ -152,12 +152,13 @@ def test_constrained_derivatives_are_central_differences(case):
                 np.testing.assert_allclose(exact[3 * part + k], fd, rtol=1e-6, atol=1e-6)
 
 
-@pytest.mark.slow  # a C compile and three array libraries (~40 s)
-def test_every_backend_gives_the_numpy_modules_partials(tmp_path_factory):
+@pytest.mark.slow  # a C compile and three array libraries (~20 s)
+def test_every_backend_gives_the_numpy_modules_partials_and_derivatives(tmp_path_factory):
     folder = tmp_path_factory.mktemp("partials")
     path = folder / "leg.urdf"
     path.write_text(leg(1), encoding="utf-8")
-    model, (calls, _), pm, _ = held(path, ["foot"], True, [PARTIALS], folder, BACKENDS)
+    model, (calls, modules), pm, _ = held(path, ["foot"], True, [PARTIALS, DERIVATIVES], folder,
+                                          BACKENDS)
     rng = np.random.default_rng(5)
     for q, v, a in states(pm, 1, seed=5):
         F = rng.normal(size=3)
@@ -166,6 +167,15 @@ def test_every_backend_gives_the_numpy_modules_partials(tmp_path_factory):
         for backend, call in calls.items():
             np.testing.assert_allclose(call(PARTIALS, q, v, a, F).reshape(expected.shape),
                                        expected, rtol=1e-11, atol=1e-11, err_msg=backend)
+        # the composed derivatives: NumPy, JAX and PyTorch (the others leave them out)
+        expected = modules["numpy"][DERIVATIVES](q, v, a)
+        composing = [b for b in ("jax", "torch") if b in modules]
+        assert all(DERIVATIVES not in modules[b] for b in modules if b not in composing + ["numpy"])
+        for backend in composing:
+            got = modules[backend][DERIVATIVES](q, v, a)
+            for k, (x, y) in enumerate(zip(got, expected)):
+                np.testing.assert_allclose(np.asarray(x), y, rtol=1e-10, atol=1e-10,
+                                           err_msg=f"{backend} result {k}")
 
 
 @pytest.mark.slow  # the Panda's derivation (~1 min)
