@@ -9,11 +9,12 @@ twist and the legs' rates, identical in both, so nothing is converted):
   ``pin.computeRNEADerivatives``;
 * ``fast.forward_dynamics_derivatives(q, v, tau)`` → (∂q̈/∂q, ∂q̈/∂v, M⁻¹) against
   ``pin.computeABADerivatives``;
-* the NumPy module's ``constrained_forward_dynamics_derivatives(q, v, tau)`` (the KKT solve for
-  q̈ and F_c, the partials, the solve for the six derivatives: composed in Python) against
-  ``pin.constraintDynamics`` followed by ``pin.computeConstraintDynamicsDerivatives``
-  (``CONTACT_3D``, ``LOCAL_WORLD_ALIGNED``); and the fast module's printed partials alone
-  (``constrained_dynamics_partials``, the part that is generated code) against the same pair.
+* ``constrained_forward_dynamics_derivatives(q, v, tau)`` (the KKT solve for q̈ and F_c, the
+  partials, the solve for the six derivatives with the same factors), of the fast module (in
+  C) and of the NumPy module (composed in Python), against ``pin.constraintDynamics`` followed
+  by ``pin.computeConstraintDynamicsDerivatives`` (``CONTACT_3D``, ``LOCAL_WORLD_ALIGNED``);
+  and the fast module's printed partials alone (``constrained_dynamics_partials``) against the
+  same pair.
 
 Both sides first agree (≤ 1e-8 relative to the largest entry: Pinocchio's proximal solver for
 the contacts). Times are medians over the repeats with the spread (min–max); ratios are medians
@@ -57,7 +58,7 @@ from fair_speed import CLOCK, spread, timed  # noqa: E402
 AGREEMENT = 1e-8
 FEET = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
 FAST = ("inverse_dynamics_derivatives", "forward_dynamics_derivatives",
-        "constrained_dynamics_partials")
+        "constrained_dynamics_partials", "constrained_forward_dynamics_derivatives")
 NUMPY = ("constrained_forward_dynamics_derivatives",)
 
 
@@ -156,7 +157,10 @@ def main() -> None:
              "pin.computeRNEADerivatives(model, data, q, v, a)", 2),
             ("∂q̈/∂(q, v, τ)", "fast.forward_dynamics_derivatives(q, v, tau)",
              "pin.computeABADerivatives(model, data, q, v, tau)", 3),
-            ("∂(q̈, F_c)/∂(q, v, τ)", "ours_constrained(q, v, tau)", "pin_constrained()", 6),
+            ("∂(q̈, F_c)/∂(q, v, τ)", "fast.constrained_forward_dynamics_derivatives(q, v, tau)",
+             "pin_constrained()", 6),
+            ("∂(q̈, F_c)/∂(q, v, τ), NumPy", "ours_constrained(q, v, tau)", "pin_constrained()",
+             6),
             ("KKT partials only (fast)", "partials(q, v, ddq, F)", "pin_constrained()", 0),
         )
         for label, ours, theirs, count in pairs:

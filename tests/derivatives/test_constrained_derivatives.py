@@ -1,5 +1,5 @@
 """Derivatives of the contact-constrained forward dynamics (issue 25):
-``constrained_forward_dynamics_derivatives`` (NumPy) and the printed KKT partials
+``constrained_forward_dynamics_derivatives`` (NumPy, fast, JAX, PyTorch) and the printed KKT partials
 ``constrained_dynamics_partials`` (every backend).
 
 References: Pinocchio's ``constraintDynamics`` and ``computeConstraintDynamicsDerivatives``
@@ -167,15 +167,22 @@ def test_every_backend_gives_the_numpy_modules_partials_and_derivatives(tmp_path
         for backend, call in calls.items():
             np.testing.assert_allclose(call(PARTIALS, q, v, a, F).reshape(expected.shape),
                                        expected, rtol=1e-11, atol=1e-11, err_msg=backend)
-        # the composed derivatives: NumPy, JAX and PyTorch (the others leave them out)
+        # the composed derivatives: NumPy, fast, JAX and PyTorch (CasADi leaves them out)
         expected = modules["numpy"][DERIVATIVES](q, v, a)
-        composing = [b for b in ("jax", "torch") if b in modules]
+        composing = [b for b in ("fast", "jax", "torch") if b in modules]
         assert all(DERIVATIVES not in modules[b] for b in modules if b not in composing + ["numpy"])
         for backend in composing:
             got = modules[backend][DERIVATIVES](q, v, a)
             for k, (x, y) in enumerate(zip(got, expected)):
                 np.testing.assert_allclose(np.asarray(x), y, rtol=1e-10, atol=1e-10,
                                            err_msg=f"{backend} result {k}")
+        if "fast" in modules:  # a batch, and the solve's errors, in C
+            Q, V, U = (np.stack([x, x]) for x in (q, v, a))
+            for x, y in zip(modules["fast"][DERIVATIVES](Q, V, U), expected):
+                np.testing.assert_allclose(x, np.stack([y, y]), rtol=1e-10, atol=1e-10)
+            with pytest.raises(FloatingPointError, match=f"{DERIVATIVES}: .* not finite at "
+                               "state 1"):
+                modules["fast"][DERIVATIVES](Q, V, U * np.array([[1.0], [np.nan]]))
 
 
 @pytest.mark.slow  # the Panda's derivation (~1 min)
