@@ -2,7 +2,11 @@
 against MuJoCo: M (armature removed) against ``mj_fullM`` minus the armature, the drive mass
 matrix M + diag(armature) against ``mj_fullM``, h = τ(q, v, 0) against ``qfrc_bias``, the
 drives' damping against ``qfrc_damper``; free joints through the velocity map of
-:mod:`eomgen.parsers.mjcf.convert`.
+:mod:`eomgen.parsers.mjcf.convert`. Equalities (issue 26): ``joint`` equalities are couplings
+(the references above are then projected, ``Tᵀ (·) T``, at states where the followers sit
+where their couplings put them) and ``connect``/``weld`` are loops, whose Jacobian's
+translational rows are compared with MuJoCo's ``efc_J`` (``J_l``); each file's equalities are
+listed.
 
 Usage::
 
@@ -36,9 +40,10 @@ sys.path.insert(0, str(ROOT))
 
 import eomgen  # noqa: E402
 from eomgen.errors import EomgenError  # noqa: E402
-from eomgen.model import joint_actuators  # noqa: E402
+from eomgen.model import coupling_map, joint_actuators  # noqa: E402
 from eomgen.parsers.mjcf import compile_mjcf  # noqa: E402
-from eomgen.parsers.mjcf.convert import layout, mujoco_dynamics  # noqa: E402
+from eomgen.parsers.mjcf.convert import (  # noqa: E402
+    layout, mujoco_dynamics, to_mujoco, velocity_map)
 
 TOLERANCE = 1e-10
 
@@ -75,22 +80,28 @@ def compare(path: Path, samples: int, seed: int = 0) -> tuple[dict[str, float], 
         model = eomgen.load(path)
         m = compile_mjcf(path)
     caught = [w for w in caught if "MuJoCo's compiler" not in str(w.message)]
-    module = eomgen.derive(model, outputs=("M", "h")).lambdify().module
+    outputs = ("M", "h", "J_l") if model.loops else ("M", "h")
+    module = eomgen.derive(model, outputs=outputs).lambdify().module
     lay = layout(m, model)
-    drives = joint_actuators(model)
-    armature = np.array([float(a.armature) for a in drives])
-    damping = np.array([float(a.damping) for a in drives])
+    drives = joint_actuators(model)  # every movable joint's, followers included
+    T = (np.array(coupling_map(model)[0].evalf(), dtype=float) if model.couplings
+         else np.eye(model.dof))
+    armature = T.T @ np.diag([float(a.armature) for a in drives]) @ T
+    damping = T.T @ np.diag([float(a.damping) for a in drives]) @ T
     rng = np.random.default_rng(seed)
     worst: dict[str, float] = {}
     for _ in range(samples):
         q = rng.uniform(-1, 1, model.nq)
-        if model.free_flyer:
-            q[3:7] /= np.linalg.norm(q[3:7])
+        for joint in model.quaternion_joints:
+            k = joint.quaternion
+            q[k:k + 4] /= np.linalg.norm(q[k:k + 4])
         v = rng.normal(size=model.dof)
         ref = mujoco_dynamics(m, lay, q, v)
         M = np.asarray(module.mass_matrix(q)).reshape(ref["M"].shape)
-        got = {"M": M, "M_a": M + np.diag(armature), "h": module.nonlinear_effects(q, v),
-               "damper": -damping * v}
+        got = {"M": M, "M_a": M + armature, "h": module.nonlinear_effects(q, v),
+               "damper": -damping @ v}
+        if model.loops:
+            got["J_l"], ref["J_l"] = loop_rows(m, lay, model, module, q)
         for name, value in got.items():
             if name == "damper" and not np.abs(ref[name]).any():
                 error = float(np.abs(value).max())  # both zero: an absolute check
@@ -101,6 +112,39 @@ def compare(path: Path, samples: int, seed: int = 0) -> tuple[dict[str, float], 
     in_order = list(lay.dof_index[nv_free:]) == sorted(lay.dof_index[nv_free:]) and (
         not model.free_flyer or lay.free[1] == 0)
     return worst, model.dof, len(caught), in_order
+
+
+def loop_rows(m, lay, model, module, q) -> tuple[np.ndarray, np.ndarray]:
+    """The translational rows of each loop's J_l, and MuJoCo's ``efc_J`` rows of the same
+    equality (its first three: world axes, the same signs), in eomgen's velocities."""
+    import mujoco
+
+    data = mujoco.MjData(m)
+    data.qpos[:], data.qvel[:] = to_mujoco(lay, q, np.zeros(model.dof))
+    mujoco.mj_forward(m, data)
+    J = np.asarray(data.efc_J).reshape(data.nefc, m.nv) @ velocity_map(lay, data.qpos)
+    equality = np.asarray(data.efc_type) == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+    names = [m.eq(e).name or f"eq{e}" for e in range(m.neq)]
+    ours = np.asarray(module.loop_jacobian(q)).reshape(-1, model.dof)
+    got, expected, row = [], [], 0
+    for loop in model.loops:
+        rows = np.flatnonzero(equality & (np.asarray(data.efc_id) == names.index(loop.name)))
+        got.append(ours[row:row + 3])
+        expected.append(J[rows[:3]])
+        row += loop.size
+    return np.vstack(got), np.vstack(expected)
+
+
+def equalities(path: Path) -> str:
+    """The kinds of the file's equalities (``2 joint, 1 connect``), or ""."""
+    m = compile_mjcf(path)
+    kinds = {0: "connect", 1: "weld", 2: "joint", 3: "tendon"}
+    counts: dict[str, int] = {}
+    for e in range(m.neq):
+        kind = kinds.get(int(m.eq_type[e]), "flex/other")
+        kind += "" if m.eq_active0[e] else " (inactive)"
+        counts[kind] = counts.get(kind, 0) + 1
+    return ", ".join(f"{n} {k}" for k, n in sorted(counts.items()))
 
 
 def classify(path: Path) -> tuple[str, str]:
@@ -131,13 +175,18 @@ def main() -> int:
                         help="load but do not derive models with more velocity coordinates")
     args = parser.parse_args()
     counts: dict[str, int] = {}
+    with_equalities: dict[str, int] = {}
     failures = 0
     with tempfile.TemporaryDirectory() as scratch:
         for label, path in xml_files(args.sources, Path(scratch)):
             status, detail = classify(path)
             counts[status] = counts.get(status, 0) + 1
+            kinds = equalities(path) if status in ("loads", "refused") else ""
+            if kinds:
+                with_equalities[status] = with_equalities.get(status, 0) + 1
             if status != "loads":
-                print(f"{status:10s} {label}: {detail}", flush=True)
+                print(f"{status:10s} {label}: {detail}"
+                      + (f" [equalities: {kinds}]" if kinds else ""), flush=True)
                 continue
             start = time.perf_counter()
             try:
@@ -152,9 +201,11 @@ def main() -> int:
             errors = "  ".join(f"{k} {v:.1e}" for k, v in worst.items())
             order = "MuJoCo's order" if in_order else "free flyer moved first"
             print(f"{'agrees' if ok else 'DIFFERS':10s} {label}: nv {dof} ({order}), "
-                  f"{warned} warnings, {errors}  ({seconds:.1f} s)", flush=True)
+                  f"{warned} warnings, {errors}  ({seconds:.1f} s)"
+                  + (f" [equalities: {kinds}]" if kinds else ""), flush=True)
     print("summary: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items()))
-          + f"; {failures} disagree")
+          + f"; {failures} disagree; with equalities: "
+          + ", ".join(f"{k} {v}" for k, v in sorted(with_equalities.items())))
     return 1 if failures else 0
 
 

@@ -66,7 +66,8 @@ def build_notebook(model: RobotModel, description: Path | None = None,
         raise ParameterError(model.source, "parameters",
                              "the notebook's numeric cells need a value for "
                              + ", ".join(missing))
-    small = model.dof <= TEXTBOOK_MAX_DOF and _teaching_sized(model)
+    chart = bool(model.quaternion_joints)  # q (NQ) and v (NV) differ: no textbook form
+    small = not chart and model.dof <= TEXTBOOK_MAX_DOF and _teaching_sized(model)
     cells = []
 
     def md(text: str) -> None:
@@ -75,7 +76,11 @@ def build_notebook(model: RobotModel, description: Path | None = None,
     def code(text: str) -> None:
         cells.append(v4.new_code_cell(text.strip()))
 
-    md(f"""
+    if chart:
+        md(_CHART_INTRO.format(name=model.name, nq=model.nq, nv=model.dof,
+                               joints=", ".join(f"`{j.name}`" for j in model.quaternion_joints)))
+    else:
+        md(f"""
 # Equations of motion of `{model.name}`
 
 This notebook derives the equations of motion
@@ -181,8 +186,11 @@ expressions, exponential in the number of joints) is shown for models of at most
 size (`dyn.lambdify()` turns it into NumPy functions):
 """)
         code('{name: dyn.operation_count([name]) for name in dyn.outputs}')
-    md("## The equations of motion\n\n$M(q)\\,\\ddot q + C(q, \\dot q)\\,\\dot q + g(q) = "
-       "\\tau$, in joint order:")
+    md("## The equations of motion\n\n" + (
+        "$M(q)\\,\\dot v + C(q, v)\\,v + g(q) = \\tau$, in the order of the velocity "
+        "coordinates (`dyn.qd` are the entries of $v$, `dyn.qdd` those of $\\dot v$, `dyn.q` "
+        "the NQ entries of $q$):" if chart else
+        "$M(q)\\,\\ddot q + C(q, \\dot q)\\,\\dot q + g(q) = \\tau$, in joint order:"))
     code("print(dyn.joint_names)\ndyn")
     if small:
         md("""
@@ -266,6 +274,104 @@ tau_r = dyn.M * sp.Matrix(qdd_r) + dyn.C * sp.Matrix(qd_r) + dyn.g
 print("largest |Y_SL beta - (M qdd_r + C qd_r + g)|:",
       max(abs(float(e)) for e in (Y_SL * beta - tau_r).xreplace(at)))
 """)
+    if chart:
+        _chart_checks(md, code)
+    else:
+        _checks(md, code)
+    nb = v4.new_notebook(cells=cells, metadata={
+        "kernelspec": {"display_name": "Python 3", "language": "python", "name": "python3"},
+        "language_info": {"name": "python"},
+    })
+    for k, cell in enumerate(nb.cells):  # deterministic ids (nbformat makes random ones)
+        cell["id"] = f"cell-{k:02d}"
+    return nb
+
+
+#: The simulation cell of the notebook: the parts that differ between a model without and with
+#: quaternion joints (q̇ = v, or configuration_rate and normalised quaternions) are filled in.
+_SIMULATION = """
+import io
+
+import matplotlib
+from IPython.display import Image
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+from scipy.integrate import solve_ivp
+{setup}
+budget = 50_000
+calls = 0
+
+
+class OverBudget(Exception):
+    pass
+
+
+def rhs(t, state):
+    global calls
+    calls += 1
+    if calls > budget:
+        raise OverBudget
+{rhs}
+
+t_all, y_all = [0.0], [np.concatenate([q0, np.zeros(n)])]
+for start in np.arange(0.0, 2.0, 0.1):
+    try:
+        chunk = solve_ivp(rhs, (start, start + 0.1), y_all[-1], rtol=1e-8, atol=1e-10,
+                          t_eval=np.linspace(start, start + 0.1, 11)[1:])
+    except OverBudget:
+        print(f"stopped at t = {{start:.1f}} s after {{budget}} evaluations: the robot is stiff")
+        break
+    assert chunk.success, chunk.message
+    t_all += list(chunk.t)
+{collect}
+fig, ax = plt.subplots(figsize=(7, 3.5))
+for k, name in enumerate(dyn.joint_names):
+    ax.plot(t_all, {plotted}[k], label=name)
+ax.set_xlabel("time [s]")
+ax.set_ylabel({ylabel})
+ax.legend({legend})
+ax.set_title(f"{{model.name}}: free motion from rest")
+fig.tight_layout()
+buffer = io.BytesIO()
+fig.savefig(buffer, format="png", dpi=100)
+plt.close(fig)
+display(Image(buffer.getvalue()))
+"""
+_JOINT_SPACE = {
+    "setup": "\n",
+    "rhs": '''    q, qd = state[:n], state[n:]
+    out = evaluate(*q, *qd, *values)
+    qdd = np.linalg.solve(out["M"], -out["C"] @ qd - out["g"][:, 0])
+    return np.concatenate([qd, qdd])
+''',
+    "collect": '''    y_all += list(chunk.y.T)
+t_all, y_all = np.array(t_all), np.array(y_all).T''',
+    "plotted": "y_all", "ylabel": '"joint position"', "legend": ""}
+_CHART_SPACE = {
+    "setup": "\nnq = model.nq",
+    "rhs": '''    q, v = state[:nq], state[nq:]
+    out = evaluate(*q, *v, *values)
+    vdot = np.linalg.solve(out["M"], -out["C"] @ v - out["g"][:, 0])
+    return np.concatenate([configuration_rate(q, v, model), vdot])
+
+
+def normalised(state):
+    state = state.copy()
+    for joint in model.quaternion_joints:
+        k = joint.quaternion
+        state[k:k + 4] /= np.linalg.norm(state[k:k + 4])
+    return state
+''',
+    "collect": '''    y_all += [normalised(y) for y in chunk.y.T]
+t_all = np.array(t_all)
+moved = np.array([difference(q0, y[:nq], model=model) for y in y_all]).T''',
+    "plotted": "moved", "ylabel": '"difference(q0, q)"', "legend": 'fontsize="small"'}
+
+
+def _checks(md, code) -> None:
+    """The cells of a model without quaternion joints: eomgen.verify, the comparison with the
+    numeric Newton–Euler and the simulation."""
     md("""
 ## Property checks
 
@@ -313,68 +419,98 @@ under gravity), integrated with SciPy's `solve_ivp` in steps of 0.1 s. A very st
 tiny inertia next to a large one) would need millions of steps: the simulation stops after
 `budget` evaluations of the dynamics and says so, so that the notebook always finishes.
 """)
-    code("""
-import io
-
-import matplotlib
-from IPython.display import Image
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
-from scipy.integrate import solve_ivp
+    code(_SIMULATION.format(**_JOINT_SPACE))
 
 
-budget = 50_000
-calls = 0
+_CHART_INTRO = """
+# Equations of motion of `{name}`
+
+`{name}` has quaternion joints ({joints}): its configuration $q$ has {nq} entries, with a
+unit quaternion $(x, y, z, w)$ per quaternion joint (and the free flyer's origin), and its
+velocity $v$ has {nv}: the root twist in the root frame (linear, then angular) for a free
+flyer, the angular velocity in the child frame for a ball joint, the rates of the other
+joints. This is Pinocchio's layout. So $\\dot q \\ne v$: a quaternion $(\\varepsilon, w)$
+turns at $\\dot\\varepsilon = \\tfrac12 (w\\,\\omega + \\varepsilon \\times \\omega)$,
+$\\dot w = -\\tfrac12 \\varepsilon^T \\omega$, the free flyer's origin at $R\\,v_{{lin}}$
+(`eomgen.quaternion_joints.configuration_rate`). The equations of motion are written in the
+velocity coordinates,
+
+$$M(q)\\,\\dot v + C(q, v)\\,v + g(q) = \\tau,$$
+
+with $K = \\tfrac12 v^T M v$ and $C$ Pinocchio's `computeCoriolisMatrix` ($\\dot M - 2C$
+skew-symmetric along the motion). A simulation integrates $\\dot v$ and moves $q$ with the
+exponential map, `eomgen.quaternion_joints.integrate(q, v, dt)`, never $q + v\\,dt$. The
+body-by-body textbook derivation takes every joint as a coordinate, so this notebook shows
+the derivation as a program, then checks it and simulates the robot.
+"""
 
 
-class OverBudget(Exception):
-    pass
+def _chart_checks(md, code) -> None:
+    """The cells of a model with quaternion joints: eomgen.verify where it has a reference
+    (else its reason is printed), M, C, g and τ against Pinocchio (when installed) at a
+    configuration from ``integrate``, and a simulation moving q with ``configuration_rate``."""
+    md("""
+## Property checks
 
-
-def rhs(t, state):
-    global calls
-    calls += 1
-    if calls > budget:
-        raise OverBudget
-    q, qd = state[:n], state[n:]
-    out = evaluate(*q, *qd, *values)
-    qdd = np.linalg.solve(out["M"], -out["C"] @ qd - out["g"][:, 0])
-    return np.concatenate([qd, qdd])
-
-
-t_all, y_all = [0.0], [np.concatenate([q0, np.zeros(n)])]
-for start in np.arange(0.0, 2.0, 0.1):
-    try:
-        chunk = solve_ivp(rhs, (start, start + 0.1), y_all[-1], rtol=1e-8, atol=1e-10,
-                          t_eval=np.linspace(start, start + 0.1, 11)[1:])
-    except OverBudget:
-        print(f"stopped at t = {start:.1f} s after {budget} evaluations: the robot is stiff")
-        break
-    assert chunk.success, chunk.message
-    t_all += list(chunk.t)
-    y_all += list(chunk.y.T)
-t_all, y_all = np.array(t_all), np.array(y_all).T
-fig, ax = plt.subplots(figsize=(7, 3.5))
-for k, name in enumerate(dyn.joint_names):
-    ax.plot(t_all, y_all[k], label=name)
-ax.set_xlabel("time [s]")
-ax.set_ylabel("joint position")
-ax.legend()
-ax.set_title(f"{model.name}: free motion from rest")
-fig.tight_layout()
-buffer = io.BytesIO()
-fig.savefig(buffer, format="png", dpi=100)
-plt.close(fig)
-display(Image(buffer.getvalue()))
+`eomgen.verify` checks M, C, g and the whole equation against an independent numeric
+Newton–Euler computation where it has one for quaternion joints; otherwise it says why, and
+the next cell compares with Pinocchio.
 """)
-    nb = v4.new_notebook(cells=cells, metadata={
-        "kernelspec": {"display_name": "Python 3", "language": "python", "name": "python3"},
-        "language_info": {"name": "python"},
-    })
-    for k, cell in enumerate(nb.cells):  # deterministic ids (nbformat makes random ones)
-        cell["id"] = f"cell-{k:02d}"
-    return nb
+    code("""
+try:
+    report = eomgen.verify(eomgen.derive(model, outputs=("M", "C", "g", "tau")), samples=5)
+    print(report.format())
+    assert report.passed
+except eomgen.UnsupportedError as exc:
+    print("not checked by eomgen.verify:", exc)
+""")
+    md("""
+## Comparison with Pinocchio at a sample state
+
+$M$, $C v$, $g$ and $\\tau = M \\dot v + C v + g$ from the derived program against
+Pinocchio's `crba`, `computeCoriolisMatrix`, `computeGeneralizedGravity` and `rnea` on the
+same arrays (`eomgen.numeric.pinocchio.to_pinocchio` builds its model with
+`JointModelFreeFlyer` and `JointModelSpherical`). The configuration comes from `integrate`:
+the neutral one (identity quaternions) moved by a velocity for one second.
+""")
+    code("""
+from eomgen.quaternion_joints import configuration_rate, difference, integrate, neutral
+from eomgen.symbolic.evaluate import compile_program
+
+params = [p.symbol for p in model.parameters]
+values = [model.parameter_values[p] for p in params]
+evaluate = compile_program(dyn.program, list(dyn.q) + list(dyn.qd) + params)
+
+n = model.dof
+q0 = integrate(neutral(model), np.linspace(0.3, 0.9, n), 1.0, model=model)
+qd0 = np.linspace(-0.5, 0.7, n)
+qdd0 = np.linspace(1.0, -1.0, n)
+out = evaluate(*q0, *qd0, *values)
+tau = out["M"] @ qdd0 + out["C"] @ qd0 + out["g"][:, 0]
+try:
+    import pinocchio
+except ImportError:
+    print("Pinocchio is not installed (pip install pin): no comparison")
+else:
+    from eomgen.numeric.pinocchio import to_pinocchio
+
+    pm = to_pinocchio(model)
+    tau_pin = pm.rnea(q0, qd0, qdd0)
+    print("largest |tau - rnea|:", np.max(np.abs(tau - tau_pin)))
+    print("largest |M - crba|:", np.max(np.abs(out["M"] - pm.crba(q0))))
+    assert np.allclose(tau, tau_pin, rtol=1e-9, atol=1e-9)
+""")
+    md("""
+## A short simulation
+
+$\\dot v = M^{-1}(\\tau - C v - g)$ with $\\tau = 0$ (the robot falls under gravity), and
+$\\dot q = $ `configuration_rate(q, v)`, integrated with SciPy's `solve_ivp` in steps of
+0.1 s; the quaternions are normalised after each step (`integrate` would keep them unit).
+The plot shows `difference(q0, q(t))`: how far each velocity coordinate has carried the robot.
+A very stiff robot would need millions of steps: the simulation stops after `budget`
+evaluations of the dynamics and says so.
+""")
+    code(_SIMULATION.format(**_CHART_SPACE))
 
 
 def write_notebook(nb: nbformat.NotebookNode, path: Path) -> Path:

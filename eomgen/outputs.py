@@ -464,7 +464,8 @@ PARALLEL_INVERSE = register_output(Output(
     "M qdd + C qd + g = tau + J_l^T lambda, for a qdd consistent with the loops.",
     ("q", "qd", "qdd"), True, "N m, N; N, N m", (INVERSE.symbol, "J_l"),
     composed_from=(INVERSE.function, LOOP_JACOBIAN.function), default=False,
-    constants="eomgen.symbolic.loops:parallel_constants", backends=("numpy", "fast")))
+    constants="eomgen.symbolic.loops:parallel_constants",
+    backends=("numpy", "fast", "casadi", "c", "jax", "torch")))
 
 # Issue 28: the Slotine-Li regressor Y_SL(q, qd, qd_r, qdd_r) pi = M qdd_r + C(q, qd) qd_r + g
 # (C Christoffel) and its base columns, for adaptive control (docs/control.md).

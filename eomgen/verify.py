@@ -17,6 +17,11 @@ Checks, in the order reported:
 The RNEA is :mod:`eomgen.numeric`, an independent O(n) algorithm on the same model. Parameters
 kept symbolic are given their default values. Errors are relative to the size of the reference
 (``|a − b|_max / max(1, |b|_max)``).
+
+With quaternion joints (a free flyer, ball joints) ``q`` is the configuration (NQ entries, each
+quaternion drawn uniformly on the unit sphere) and ``qd``, ``qdd`` the velocities and
+accelerations (NV); Ṁ is taken along ``q̇ = configuration_rate(q, v)``
+(:mod:`eomgen.quaternion_joints`), and the checks are sampled (never exact).
 """
 
 from __future__ import annotations
@@ -27,10 +32,11 @@ import numpy as np
 import sympy as sp
 
 from .dynamics import Dynamics
-from .errors import ParameterError, UnsupportedError
-from .model import all_scalars, coupling_map, uncoupled
+from .errors import ParameterError
+from .model import all_scalars
 from .numeric import numeric_model
 from .numeric import rnea as numeric_rnea
+from .quaternion_joints import configuration_rate
 from .symbolic.evaluate import compile_program
 
 #: Default relative tolerance of the numeric identities.
@@ -109,22 +115,46 @@ def _identically_zero(matrix: sp.Matrix, q) -> bool:
     return True
 
 
-def sample_states(n: int, samples: int, rng: np.random.Generator):
-    """Random states: angles in [−π, π], rates and accelerations ~ N(0, 1)."""
+def sample_states(n: int, samples: int, rng: np.random.Generator, model=None):
+    """Random states: angles in [−π, π], rates and accelerations ~ N(0, 1). With a ``model``
+    holding quaternion joints, ``q`` is its configuration (``model.nq`` entries): each
+    quaternion uniform on the unit sphere."""
     for _ in range(samples):
-        yield rng.uniform(-np.pi, np.pi, n), rng.normal(size=n), rng.normal(size=n)
+        q, qd, qdd = rng.uniform(-np.pi, np.pi, n), rng.normal(size=n), rng.normal(size=n)
+        yield (q if model is None else random_configuration(model, q, rng)), qd, qdd
+
+
+def random_configuration(model, coordinates: np.ndarray, rng: np.random.Generator
+                         ) -> np.ndarray:
+    """The configuration (``model.nq``) whose joints other than the quaternion joints take
+    ``coordinates`` (``model.dof`` values, by velocity index), a free flyer's origin too, and
+    whose quaternions are uniform on the unit sphere (normalised Gaussian draws)."""
+    joints = model.quaternion_joints
+    if not joints:
+        return coordinates
+    q = np.empty(model.nq)
+    starts = {j.v_index: j for j in joints}
+    k = iq = 0
+    while k < model.dof:
+        joint = starts.get(k)
+        if joint is None:
+            q[iq] = coordinates[k]
+            k, iq = k + 1, iq + 1
+            continue
+        if joint.nv == 6:
+            q[iq:iq + 3] = coordinates[k:k + 3]
+        quaternion = rng.normal(size=4)
+        q[joint.quaternion:joint.quaternion + 4] = quaternion / np.linalg.norm(quaternion)
+        k, iq = k + joint.nv, iq + joint.nq
+    return q
 
 
 def reference_rnea(model):
     """``rnea(q, qd, qdd)`` of ``model`` by the float Newton–Euler recursion, in its
-    ``joint_names`` coordinates: with coupled joints, ``Tᵀ RNEA(T q + c, T q̇, T q̈)`` on the
-    whole tree (:func:`eomgen.model.coupling_map`)."""
-    nm = numeric_model(uncoupled(model))
-    if not model.couplings:
-        return lambda q, qd, qdd: numeric_rnea(nm, q, qd, qdd)
-    T, c = (np.array(m.evalf(), dtype=float) for m in coupling_map(model))
-    c = c[:, 0]
-    return lambda q, qd, qdd: T.T @ numeric_rnea(nm, T @ q + c, T @ qd, T @ qdd)
+    ``joint_names`` coordinates (with coupled joints ``Tᵀ RNEA(T q + c, T q̇, T q̈)`` on the
+    whole tree, :mod:`eomgen.numeric.newton_euler`)."""
+    nm = numeric_model(model)
+    return lambda q, qd, qdd: numeric_rnea(nm, q, qd, qdd)
 
 
 def verify(dynamics: Dynamics, samples: int = 20, seed: int = 0,
@@ -143,11 +173,6 @@ def verify(dynamics: Dynamics, samples: int = 20, seed: int = 0,
         Relative tolerance of every numeric check.
     """
     model = dynamics.model
-    if model.quaternion_joints:  # the reference below works in joint coordinates (q of NV)
-        raise UnsupportedError(model.source, "verify", "the reference Newton-Euler has no "
-                               "quaternion joints (free flyer, ball) yet; their dynamics are "
-                               "checked against Pinocchio (tests/dynamics/test_ball_joint.py, "
-                               "test_free_flyer.py)")
     for name in ("M", "C", "g"):
         if name not in dynamics.outputs:
             raise ValueError(f"verification needs M, C and g; {name} was not derived")
@@ -160,20 +185,23 @@ def verify(dynamics: Dynamics, samples: int = 20, seed: int = 0,
     n = model.dof
     evaluate_all = compile_program(dynamics.program, list(dynamics.q) + list(dynamics.qd)
                                    + list(dynamics.qdd) + params)
-    zero_qdd = [0.0] * len(dynamics.q)
+    zero_qdd = [0.0] * len(dynamics.qd)
+    n_x = len(dynamics.q) + len(dynamics.qd)  # q (NQ) and qd (NV)
 
     def evaluate(*values, qdd=None):
-        n_q = len(dynamics.q)
-        return evaluate_all(*values[:2 * n_q], *(zero_qdd if qdd is None else qdd),
-                            *values[2 * n_q:])
+        return evaluate_all(*values[:n_x], *(zero_qdd if qdd is None else qdd),
+                            *values[n_x:])
 
     pvals = [values[s] for s in params]
     rnea = reference_rnea(model)
     rng = np.random.default_rng(seed)
-    states = list(sample_states(n, samples, rng))
+    states = list(sample_states(n, samples, rng, model))
     checks: list[CheckResult] = []
     how = f"{samples} samples"
-    exact = n <= EXACT_MAX_DOF and _is_exact(model)
+    # exact checks reduce polynomials in sin q_i, cos q_i: not a quaternion's entries, nor the
+    # sin(0.5 q1 − 0.3 q2) of a coupled joint
+    exact = (n <= EXACT_MAX_DOF and _is_exact(model) and not model.quaternion_joints
+             and not model.couplings)
 
     def record(name, pairs, how=how, extra_ok=True):
         abs_err = max((_rel(a, b)[0] for a, b in pairs), default=0.0)
@@ -213,7 +241,8 @@ def verify(dynamics: Dynamics, samples: int = 20, seed: int = 0,
         pairs = []
         h = 1e-20
         for (q, qd, _), r in zip(states, results):
-            stepped = evaluate(*(q + 1j * h * qd), *qd, *pvals)["M"]
+            rate = configuration_rate(q, qd, model) if model.quaternion_joints else qd
+            stepped = evaluate(*(q + 1j * h * rate), *qd, *pvals)["M"]
             Mdot = stepped.imag / h
             N = Mdot - 2 * r["C"]
             pairs.append((N + N.T, np.zeros_like(N)))

@@ -20,7 +20,10 @@ What is measured
 * **Pareto front**: the routes no other route beats in both time and error (errors
   within a factor of :data:`PARETO_TIE` = 2 count as equal: rounding noise).
 
-States: ``q`` uniform in [−π, π], ``q̇`` and ``q̈`` standard normal (seeded).
+States: ``q`` uniform in [−π, π], ``q̇`` and ``q̈`` standard normal (seeded). With quaternion
+joints (a free flyer, ball joints) ``q`` is the configuration (NQ entries) and each quaternion is
+uniform on the unit sphere (:func:`eomgen.verify.random_configuration`); ``q̇``, ``q̈``, τ and M
+have NV entries.
 """
 
 from __future__ import annotations
@@ -38,6 +41,7 @@ import numpy as np
 from ..compiler import c_compiler
 from ..model import RobotModel
 from ..progress import plural
+from ..verify import random_configuration
 from .precision import Reference, relative_error
 from .report import csv_text, fmt, markdown_table, pareto_front, pyplot
 from .routes import Route, build_routes, numeric_only
@@ -174,11 +178,16 @@ def _time(seconds: float) -> str:
     return f"{us:.3g} µs" if us < 1000 else f"{us / 1000:.3g} ms"
 
 
-def sample_states(n: int, samples: int, seed: int):
-    """(q, qd, qdd), each (samples, n): q uniform in [−π, π], qd and qdd standard normal."""
+def sample_states(n: int, samples: int, seed: int, model: RobotModel | None = None):
+    """(q, qd, qdd), each (samples, n): q uniform in [−π, π], qd and qdd standard normal.
+    With a ``model`` holding quaternion joints, q is (samples, model.nq): each quaternion
+    uniform on the unit sphere."""
     rng = np.random.default_rng(seed)
-    return (rng.uniform(-np.pi, np.pi, (samples, n)), rng.normal(size=(samples, n)),
-            rng.normal(size=(samples, n)))
+    q, qd, qdd = (rng.uniform(-np.pi, np.pi, (samples, n)), rng.normal(size=(samples, n)),
+                  rng.normal(size=(samples, n)))
+    if model is not None and model.quaternion_joints:
+        q = np.array([random_configuration(model, x, rng) for x in q])
+    return q, qd, qdd
 
 
 @dataclass
@@ -286,7 +295,8 @@ def prepare_bench(model: RobotModel, samples: int = 50, seed: int = 0, batch_siz
         skipped.append("C (CasADi): no C compiler found")
     if not any(r.name == "Pinocchio" for r in routes):
         skipped.append("Pinocchio: not installed")
-    return BenchPlan(model, routes, sample_states(model.dof, samples, seed), batch_size, repeats,
+    return BenchPlan(model, routes, sample_states(model.dof, samples, seed, model), batch_size,
+                     repeats,
                      min(timing_states, samples), workdir, tuple(skipped))
 
 

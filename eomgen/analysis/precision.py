@@ -275,7 +275,9 @@ class Reference:
     dps:
         Significant digits of the evaluations (at least 30).
 
-    Values are object arrays of mpf; inputs are float64 (converted exactly) or mpf.
+    Values are object arrays of mpf; inputs are float64 (converted exactly) or mpf. With
+    quaternion joints ``q`` is the configuration (NQ entries, :attr:`nq`) and the rest have NV
+    (:attr:`n`) entries; a quaternion need not be unit (both evaluations normalise it).
     """
 
     def __init__(self, model: RobotModel, dynamics: Dynamics | None = None, dps: int = DPS):
@@ -291,7 +293,7 @@ class Reference:
         else:
             self.dynamics = derive(self.model, outputs=("M", "tau"), simplify=False)
         d = self.dynamics
-        self.n = len(d.q)
+        self.n, self.nq = len(d.qd), len(d.q)
         self._M = compile_program_mp(d.program, list(d.q), ["M"])
         self._tau = compile_program_mp(d.program, list(d.q + d.qd + d.qdd), ["tau"])
         self.mp_model = mp_model(self.model)
@@ -299,12 +301,12 @@ class Reference:
     def M(self, q) -> np.ndarray:
         """Mass matrix (n, n) from the derived program."""
         with mpmath.workdps(self.dps):
-            return self._M(*_mp_values(q, self.n))["M"]
+            return self._M(*_mp_values(q, self.nq))["M"]
 
     def tau(self, q, qd, qdd) -> np.ndarray:
         """Inverse dynamics (n,) from the derived (Newton–Euler) program."""
         with mpmath.workdps(self.dps):
-            values = _mp_values(q, self.n) + _mp_values(qd, self.n) + _mp_values(qdd, self.n)
+            values = _mp_values(q, self.nq) + _mp_values(qd, self.n) + _mp_values(qdd, self.n)
             return self._tau(*values)["tau"][:, 0]
 
     def M_rnea(self, q) -> np.ndarray:

@@ -23,7 +23,7 @@ C (ctypes), one state      float64  the same library's C functions called throug
                                     plus about a microsecond of ctypes overhead)
 C extension, one state     float64  the compiled ``<robot>_fast`` module (``--backend fast``)
 C extension, batch         float64  the same on the whole batch (the loop runs in C)
-RNEA (eomgen.numeric)      float64  :func:`eomgen.numeric.rnea` and ``M_rnea``
+RNEA (eomgen.numeric)      float64  :func:`eomgen.numeric.rnea` and ``M_crba``
 Pinocchio                  float64  plain ``pin.rnea(model, data, q, qd, qdd)`` and
                                     ``pin.crba(model, data, q)`` on the model built by
                                     :mod:`~eomgen.numeric.pinocchio` (the joint
@@ -52,7 +52,7 @@ from ..compiler import c_compiler
 from ..dynamics import Dynamics, derive
 from ..model import RobotModel
 from ..progress import plural
-from ..numeric import M_rnea, numeric_model, rnea
+from ..numeric import M_crba, numeric_model, rnea
 from ..numeric.pinocchio import plain_calls, to_pinocchio
 from ..outputs import INVERSE, MASS
 from ..codegen.backends.numpy_backend import NumPyModulePrinter
@@ -266,8 +266,8 @@ def build_routes(model: RobotModel, workdir: Path, dynamics: Dynamics | None = N
     nm = numeric_model(model)
     routes.append(Route("RNEA (eomgen.numeric)", "float64", False,
                         _per_state(lambda q, qd, qdd: rnea(nm, q, qd, qdd), (n,)),
-                        _per_state(lambda q: M_rnea(nm, q), (n, n)),
-                        "eomgen.numeric.rnea; M by n + 1 RNEA calls"))
+                        _per_state(lambda q: M_crba(nm, q), (n, n)),
+                        "eomgen.numeric.rnea; M by its composite-rigid-body algorithm"))
     try:
         pm = to_pinocchio(model)
     except ImportError:

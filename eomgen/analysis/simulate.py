@@ -108,10 +108,7 @@ class System:
         self._Cg = compile_scalar(dyn.program, dyn.q + dyn.qd, ["C", "g"])
         #: True when q holds quaternions (a free flyer, ball joints): NQ ≠ NV.
         self.quaternion = bool(self.model.quaternion_joints)
-        if self.quaternion:  # eomgen.numeric has no quaternion joints: energy from the program
-            self._P = compile_scalar(dyn.program, dyn.q, ["P"])
-        else:
-            self._nm = numeric_model(self.model)
+        self._nm = numeric_model(self.model)
         self._shape = (n, n)
         self.evaluations = 0
         self._worst: tuple[float, list] = (1.0, [])
@@ -192,10 +189,8 @@ class System:
         return qd, np.array(pdot)
 
     def energy(self, q: np.ndarray, qd: np.ndarray) -> tuple[float, float]:
-        """``(K, P)`` [J] from :mod:`eomgen.numeric` (not the derived program); with quaternion
-        joints, which it does not model, ``K = ½ vᵀ M v`` and P from the program."""
-        if self.quaternion:
-            return 0.5 * float(qd @ self.M(q) @ qd), float(self._P(*q.tolist())[0][0])
+        """``(K, P)`` [J] from :mod:`eomgen.numeric` (not the derived program; with quaternion
+        joints ``q`` is the configuration, ``qd`` the velocity)."""
         return kinetic_energy(self._nm, q, qd), potential_energy(self._nm, q)
 
     def configuration_rate(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
@@ -501,6 +496,26 @@ def initial_state(q0, qd0, n: int, joint_names) -> tuple[np.ndarray, np.ndarray]
     return q0, qd0
 
 
+def quaternion_start(model: RobotModel, q0=None, qd0=None) -> tuple[np.ndarray, np.ndarray]:
+    """The start of a simulation of a model with quaternion joints: ``q0`` its configuration
+    (``model.nq`` values, ``CONFIGURATION_NAMES``; default: identity quaternions, a free flyer
+    at the origin, 1 rad or m for the other joints) and ``qd0`` its velocity (``model.dof``
+    values, default zero), as float arrays.
+
+    Raises
+    ------
+    ValueError
+        When either has another number of values (the message names the entries).
+    """
+    names = model.configuration_names
+    if q0 is None:
+        q0 = neutral(model)
+        q0[[k for k, name in enumerate(names) if name in model.joint_names]] = 1.0
+    if len(q0) != model.nq:
+        raise ValueError(f"q0 must have {model.nq} values ({', '.join(names)})")
+    return np.asarray(q0, float), initial_state(None, qd0, model.dof, model.joint_names)[1]
+
+
 def run_study(model: RobotModel, integrators: Sequence, duration: float, q0=None, qd0=None,
               progress: Callable[[str], None] = lambda _: None, system: System | None = None
               ) -> Study:
@@ -514,14 +529,7 @@ def run_study(model: RobotModel, integrators: Sequence, duration: float, q0=None
     """
     system = system or System(model)
     if getattr(system, "quaternion", False):  # q0: NQ values, quaternions at rest by default
-        names = system.model.configuration_names
-        if q0 is None:
-            q0 = neutral(system.model)
-            q0[[k for k, name in enumerate(names) if name in system.model.joint_names]] = 1.0
-        if len(q0) != system.nq:
-            raise ValueError(f"q0 must have {system.nq} values ({', '.join(names)})")
-        q0, qd0 = np.asarray(q0, float), initial_state(None, qd0, system.n,
-                                                       system.model.joint_names)[1]
+        q0, qd0 = quaternion_start(system.model, q0, qd0)
     else:
         q0, qd0 = initial_state(q0, qd0, system.n, system.model.joint_names)
     progress("reference (DOP853, rtol = atol = 1e-12)")
@@ -648,5 +656,6 @@ def write_outputs(studies: Sequence[Study], outdir, stem: str = "simulate") -> l
 
 __all__ = ["System", "ExplicitEuler", "SemiImplicitEuler", "RK4", "ImplicitMidpoint", "Adaptive",
            "Diverged", "Run", "Study", "Trajectory", "simulate", "run_study", "energies",
+           "initial_state", "quaternion_start",
            "default_integrators", "integrators_named", "INTEGRATORS", "STIFF", "plot",
            "write_outputs"]

@@ -24,6 +24,13 @@ where a contact gives some, else :data:`DEFAULT_GAINS`), and reports, sampled on
   work, so E is conserved up to the integrator's error; Baumgarte forces do work while they
   correct an error.
 
+With quaternion joints (a free flyer, ball joints) the state is the configuration ``q`` (NQ
+entries) and the velocity ``v`` (NV): every integrator moves ``q`` at
+:func:`eomgen.quaternion_joints.configuration_rate` (a quaternion integrated as a vector, as
+:class:`eomgen.analysis.simulate.System` does; the dynamics and the contact kinematics use the
+normalised quaternion), and the runs also report the **quaternion norm drift**
+``max_t max_j |‖quaternion_j‖ − 1|``, the integrator's error off the unit sphere.
+
 The implicit midpoint rule of :mod:`eomgen.analysis.simulate` works on the unconstrained
 canonical form and is not used here. Contacts whose rows are dependent at ``q0`` (a planar
 arm's contact cannot be pushed out of its plane: the z row of J_c is zero) are solved by the
@@ -44,9 +51,11 @@ from ..model import POINT, Contact, RobotModel
 from ..numeric.contacts import ContactDynamics, derived_mass_and_bias, rotation_log
 from ..numeric import kinetic_energy, numeric_model, potential_energy
 from ..progress import plural
+from ..quaternion_joints import configuration_rate
 from .report import csv_text, fmt, markdown_table, pyplot
 from .routes import numeric_only
-from .simulate import OUTPUT_POINTS, Diverged, ImplicitMidpoint, initial_state, simulate
+from .simulate import (OUTPUT_POINTS, Diverged, ImplicitMidpoint, initial_state,
+                       quaternion_start, simulate)
 
 #: ``(kp [1/s²], kd [1/s])`` for contacts whose scene gives no Baumgarte gains: the error
 #: equation ``ë + kd ė + kp e = 0`` critically damped at ω = 10 rad/s.
@@ -65,7 +74,8 @@ class ContactSystem:
     contacts:
         :class:`~eomgen.model.Contact` s, e.g. a scene report's ``contacts``.
     q0:
-        (n,) the configuration whose contact poses become the anchors.
+        (nq,) the configuration whose contact poses become the anchors (with quaternion joints
+        NQ entries, else n).
     baumgarte:
         False: every gain 0. True: each contact's gains, or ``gains`` when given (for every
         contact), or :data:`DEFAULT_GAINS` for a contact without any.
@@ -85,6 +95,9 @@ class ContactSystem:
                  mass_and_bias: Callable | None = None):
         self.model = numeric_only(model)
         self.n = n = self.model.dof
+        #: Entries of the configuration, and whether it holds quaternions (NQ ≠ NV).
+        self.nq = self.model.nq
+        self.quaternion = bool(self.model.quaternion_joints)
         q0 = np.asarray(q0, dtype=float)
         self.tau = np.zeros(n) if tau is None else np.asarray(tau, dtype=float)
         held = []
@@ -135,6 +148,17 @@ class ContactSystem:
         self.evaluations += 1
         return self.constrained(q, qd)[0]
 
+    def configuration_rate(self, q, qd) -> np.ndarray:
+        """``q̇`` at velocity ``qd``: ``qd`` itself, or with quaternion joints
+        :func:`eomgen.quaternion_joints.configuration_rate` (module docstring)."""
+        return configuration_rate(q, qd, self.model) if self.quaternion else qd
+
+    def quaternion_norm_error(self, q) -> float:
+        """``max_j |‖quaternion_j‖ − 1|`` over the quaternion joints at ``q`` (0 without)."""
+        q = np.asarray(q, float)
+        return max((abs(float(np.linalg.norm(q[j.quaternion:j.quaternion + 4])) - 1.0)
+                    for j in self.model.quaternion_joints), default=0.0)
+
     def energy(self, q, qd) -> tuple[float, float]:
         """``(K, P)`` [J] from :mod:`eomgen.numeric`."""
         return kinetic_energy(self._nm, q, qd), potential_energy(self._nm, q)
@@ -172,6 +196,7 @@ class ContactRun:
     energy_drift: float           # max_t |E - E0| [J]
     relative_energy_drift: float
     status: str = "ok"
+    quaternion_norm_drift: float = 0.0  # max_t max_j | |quaternion_j| - 1 | (NQ != NV)
 
 
 @dataclass(frozen=True)
@@ -189,27 +214,38 @@ class ContactStudy:
     dependent: bool
     runs: tuple[ContactRun, ...]
     drift_curves: tuple[tuple[str, np.ndarray, np.ndarray], ...]  # label, times, position drift
+    #: True when q holds quaternions: the runs report the quaternion norm drift too.
+    quaternion: bool = False
 
     CSV_HEADERS = ("robot", "integrator", "setting", "baumgarte", "evaluations", "seconds",
                    "position_drift_m", "final_position_drift_m", "orientation_drift_rad",
                    "velocity_drift", "energy_drift_J", "relative_energy_drift", "status")
+
+    @property
+    def csv_headers(self) -> tuple[str, ...]:
+        """:data:`CSV_HEADERS`, and ``quaternion_norm_drift`` for a quaternion model."""
+        return self.CSV_HEADERS + (("quaternion_norm_drift",) if self.quaternion else ())
 
     def csv_rows(self) -> list[tuple]:
         return [(self.robot, r.integrator, r.setting, r.baumgarte, r.evaluations,
                  f"{r.seconds:.4g}", f"{r.position_drift:.3e}",
                  f"{r.final_position_drift:.3e}", f"{r.orientation_drift:.3e}",
                  f"{r.velocity_drift:.3e}", f"{r.energy_drift:.3e}",
-                 f"{r.relative_energy_drift:.3e}", r.status) for r in self.runs]
+                 f"{r.relative_energy_drift:.3e}", r.status)
+                + ((f"{r.quaternion_norm_drift:.3e}",) if self.quaternion else ())
+                for r in self.runs]
 
     def markdown_table(self) -> str:
+        extra = ("max |‖quat‖ − 1|",) if self.quaternion else ()
         rows = [(r.integrator, r.setting, r.baumgarte, r.evaluations, f"{r.seconds:.3g}",
                  fmt(r.position_drift), fmt(r.final_position_drift), fmt(r.orientation_drift),
-                 fmt(r.velocity_drift), fmt(r.energy_drift), fmt(r.relative_energy_drift),
-                 r.status) for r in self.runs]
+                 fmt(r.velocity_drift), fmt(r.energy_drift), fmt(r.relative_energy_drift))
+                + ((fmt(r.quaternion_norm_drift),) if self.quaternion else ()) + (r.status,)
+                for r in self.runs]
         return markdown_table(["integrator", "step", "Baumgarte", "evaluations", "time [s]",
                                "max drift p [m]", "drift p(T) [m]", "max drift R [rad]",
-                               "max ‖J_c q̇‖", "energy drift [J]", "relative", "status"],
-                              rows, "lllrrrrrrrrl")
+                               "max ‖J_c q̇‖", "energy drift [J]", "relative", *extra,
+                               "status"], rows, "lllrrrrrrrr" + "r" * len(extra) + "l")
 
     def describe(self) -> str:
         text = (f"{self.robot} ({plural(self.dof, 'joint')}), contacts held (bilateral) at "
@@ -229,12 +265,17 @@ def run_contact_study(model: RobotModel, contacts: Sequence[Contact], integrator
                       progress: Callable[[str], None] = lambda _: None,
                       points: int = OUTPUT_POINTS) -> ContactStudy:
     """Run every integrator without and with Baumgarte on ``model`` holding ``contacts``
-    (module docstring). ``q0`` defaults to 1 rad (or m) per joint, ``qd0`` to zero;
-    ``gains = (kp, kd)`` overrides every contact's Baumgarte gains. A run that diverges is
-    reported with status ``diverged``, not raised."""
+    (module docstring). ``q0`` defaults to 1 rad (or m) per joint, ``qd0`` to zero (with
+    quaternion joints ``q0`` has NQ entries, identity quaternions by default:
+    :func:`~eomgen.analysis.simulate.quaternion_start`); ``gains = (kp, kd)`` overrides every
+    contact's Baumgarte gains. A run that diverges is reported with status ``diverged``, not
+    raised."""
     model = numeric_only(model)
     n = model.dof
-    q0, qd0 = initial_state(q0, qd0, n, model.joint_names)
+    if model.quaternion_joints:
+        q0, qd0 = quaternion_start(model, q0, qd0)
+    else:
+        q0, qd0 = initial_state(q0, qd0, n, model.joint_names)
     progress(f"deriving M, h and the contact frames of {model.name}")
     mass_and_bias = derived_mass_and_bias(model)
     systems = {on: ContactSystem(model, contacts, q0, on, gains, mass_and_bias=mass_and_bias)
@@ -267,11 +308,13 @@ def run_contact_study(model: RobotModel, contacts: Sequence[Contact], integrator
             E = np.array(K) + np.array(P)
             energy_drift = float(np.max(np.abs(E - E[0])))
             scale = max(float(np.max(K)), abs(float(E[0])), 1e-300)
+            norm = max(system.quaternion_norm_error(q) for q in trajectory.q)
             runs.append(ContactRun(integrator.name, integrator.label(), label,
                                    info["evaluations"], info["seconds"],
                                    float(drift[:, 0].max()), float(drift[-1, 0]),
                                    float(drift[:, 1].max()), float(drift[:, 2].max()),
-                                   energy_drift, energy_drift / scale))
+                                   energy_drift, energy_drift / scale,
+                                   quaternion_norm_drift=norm))
             curves.append((f"{integrator.name}, {integrator.label()}, Baumgarte "
                            f"{'on' if on else 'off'}", trajectory.times, drift[:, 0]))
     J0 = plain.cd.contact_jacobian(q0)
@@ -279,7 +322,7 @@ def run_contact_study(model: RobotModel, contacts: Sequence[Contact], integrator
                         float(duration), tuple(q0.tolist()), tuple(qd0.tolist()),
                         float(np.abs(J0 @ qd0).max()) if J0.size else 0.0,
                         tuple(float(x) for x in F0), plain.dependent, tuple(runs),
-                        tuple(curves))
+                        tuple(curves), plain.quaternion)
 
 
 def plot_drift(study: ContactStudy, path) -> None:
@@ -313,7 +356,7 @@ def write_contact_outputs(study: ContactStudy, outdir, stem: str) -> list:
                              "Baumgarte", "", study.describe(), "", study.markdown_table(), "",
                              f"![drift against time]({png.name})", ""]), encoding="utf-8")
     csv_path = outdir / f"{stem}.csv"
-    csv_path.write_text(csv_text(ContactStudy.CSV_HEADERS, study.csv_rows()), encoding="utf-8")
+    csv_path.write_text(csv_text(study.csv_headers, study.csv_rows()), encoding="utf-8")
     return [md, csv_path, png]
 
 

@@ -89,10 +89,6 @@ def bench(description, outdir, samples, seed, repeats, batch_size, quiet, strict
 
     progress = Progress(quiet)
     model = load_reduced(description, scene_path, strict)[0]
-    if model.quaternion_joints:  # its references take q of NV entries
-        raise AnalysisError("bench: its references (eomgen.numeric, the mpmath Newton-Euler) "
-                            "have no quaternion joints (free flyer, ball) yet (a free flyer: "
-                            "use floating_base: euler in the scene)")
     plan = prepare_bench(model, samples=samples, seed=seed, batch_size=batch_size,
                          repeats=repeats, log=progress)
     with progress.steps(plan.steps, "measuring") as steps:
@@ -137,9 +133,9 @@ def simulate(description, outdir, duration, dts, rtols, names, q0, qd0, gains, s
     against the error of q versus a DOP853 reference at rtol = atol = 1e-12. Writes
     simulate_<robot>.md, .csv and .png into OUTPUT.
 
-    With a scene that has loops, they are held (q0 closed by Newton, qd0 projected), and
-    each integrator runs without and with Baumgarte: loop drift and energy drift
-    (docs/loops.md). With a scene that has contacts, the contacts are held (bilateral) where they are at
+    With a scene that has loops, they are held (q0 closed by Newton, qd0 projected), with
+    its contacts if any, and each integrator runs without and with Baumgarte: loop drift,
+    contact drift and energy drift (docs/loops.md). With a scene that has contacts, the contacts are held (bilateral) where they are at
     q0, and each integrator (not the implicit midpoint) runs without and with Baumgarte
     stabilisation: constraint drift (position, orientation, velocity) and energy drift.
     With flexible joints (actuators with a stiffness), the 2n-state Spong model is
@@ -189,10 +185,6 @@ def simulate(description, outdir, duration, dts, rtols, names, q0, qd0, gains, s
         if values is not None and len(values) != len(names):
             raise AnalysisError(f"{option}: {model.name} takes {len(names)} values "
                                 f"({', '.join(names)}), got {len(values)}")
-    if contacts and model.quaternion_joints:
-        raise AnalysisError("simulate: contacts are held by eomgen.numeric, which has no "
-                            "quaternion joints (free flyer, ball) yet; use floating_base: "
-                            "euler in the scene")
     if model.loops:
         _simulate_loops(model, integrators, duration, start, velocity, gain_list, outdir,
                         progress)

@@ -97,7 +97,11 @@ def excite(description, output, duration, samples, harmonics, amplitude, max_vel
     no room to move is an error. Efforts from eomgen's numeric
     Newton-Euler with the description's parameters, plus the armature, viscous and Coulomb
     friction its joints declare (see --friction), plus --noise. Columns: t, q_<joint>,
-    qd_<joint>, qdd_<joint>, tau_<joint> (JOINT_NAMES order).
+    qd_<joint>, qdd_<joint>, tau_<joint> (JOINT_NAMES order). A model with quaternion
+    joints (a free flyer, ball joints) moves in a chart (a ball joint's three angles
+    Rx Ry Rz, the free flyer's position and angles, bounded as joints are); its q_ columns
+    are CONFIGURATION_NAMES (q_base_x ... q_base_qw), the others its NV velocity
+    coordinates (qd_base_vx: the root twist), and its efforts are Y(q, v, v̇) π.
 
     \b
     Examples:
@@ -122,6 +126,10 @@ def excite(description, output, duration, samples, harmonics, amplitude, max_vel
     check_output_file(output)
     progress = Progress(quiet)
     model, _ = load_reduced(description, scene_path, strict)
+    if positions_only and model.quaternion_joints:
+        raise IdentificationError(f"{description}: --positions-only: a model with quaternion "
+                                  "joints needs its qd_, qdd_ columns (a quaternion's rate is "
+                                  "not v)")
     terms = _terms(model, friction)
     limits = {}
     if description.suffix.lower() == ".urdf":
@@ -178,7 +186,9 @@ def identify(description, data, outdir, physical, friction, cutoff, scene_path, 
     DATA's header names its columns: t, q_<joint>, qd_<joint>, qdd_<joint>, tau_<joint>
     (t optional), or t, q_<joint>, tau_<joint> (q̇, q̈ then come from a zero-phase
     Butterworth filter and central differences), joints as in the description (after
-    --scene). With qd_, qdd_ columns and --cutoff, all four signals go through that filter
+    --scene). A model with quaternion joints names q_ after CONFIGURATION_NAMES (q_base_qx,
+    ...) and the rest after its velocity coordinates (qd_base_vx, ...), and needs the qd_,
+    qdd_ columns (v and v̇, Pinocchio's). With qd_, qdd_ columns and --cutoff, all four signals go through that filter
     (t needed). Weighted least squares (Gautier) with standard deviations and the condition
     number; --physical adds a fit with positive semi-definite pseudo-inertias. The
     friction (and armature) the description declares is fitted too (see --friction), and
@@ -204,7 +214,9 @@ def identify(description, data, outdir, physical, friction, cutoff, scene_path, 
     model, _ = load_reduced(description, scene_path, strict)
     terms = _terms(model, friction)
     progress(f"reading {data}")
-    measured = read_measurements(data, model.joint_names, cutoff)
+    quaternions = [j.quaternion for j in model.quaternion_joints]
+    measured = read_measurements(data, model.joint_names, cutoff,
+                                 model.configuration_names if quaternions else None, quaternions)
     reg, base = _regressor(model, terms, progress)
     progress(f"stacking the base regressor over {plural(measured.N, 'sample')}")
     W = observation_matrix(reg, base.base, measured.q, measured.qd, measured.qdd)

@@ -19,7 +19,7 @@ from ..errors import GenerationError, VerificationError
 from ..output import check_output_folder, checked_stem, write_atomically
 from ..progress import Progress, plural
 from .handling import handle_errors, recorded_warnings
-from .loading import default_description, load, load_reduced
+from .loading import command_params, default_description, load, load_reduced
 from .options import (description_argument, output_folder_option, quiet_option, scene_option,
                       strict_option)
 
@@ -200,8 +200,7 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
     if not no_cache:
         from ..cache import command_request  # start-up time (certifi): only when asked
 
-        request = command_request(description or default_description(),
-                                  click.get_current_context().params)
+        request = command_request(description or default_description(), command_params())
         paths = None if request is None else answer_from_cache(request, outdir, quiet,
                                                                  cache_dir)
         if paths is not None:

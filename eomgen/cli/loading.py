@@ -10,8 +10,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import click
+
 from ..output import module_name
 from ..robots import example_path
+from .options import MIMIC_KEY
 
 
 def default_description() -> Path:
@@ -22,10 +25,30 @@ def default_description() -> Path:
 def load(description: Path | None, strict: bool, scene=None, snap: bool = True):
     """The whole model; warns (refuses under ``strict``) only about what ``scene`` (a loaded
     :class:`eomgen.scene.Scene`, applied by the caller) keeps. ``snap=False`` keeps the
-    description's floats exactly (``--no-snap``)."""
+    description's floats exactly (``--no-snap``). Under ``--mimic independent``
+    (:func:`mimic_mode`) each follower of a coupling is an independent joint, warned about
+    (refused under ``strict``) one by one."""
+    from ..parsers import independent_followers  # SymPy, as below
     from ..reduction import load_for_scene  # SymPy: only when a command loads a model
 
-    return load_for_scene(description or default_description(), scene, strict, snap=snap)
+    model = load_for_scene(description or default_description(), scene, strict, snap=snap)
+    if mimic_mode() == "independent" and model.couplings:
+        model = independent_followers(model, strict, how="--mimic independent")
+    return model
+
+
+def mimic_mode() -> str:
+    """``--mimic`` of the running command: ``honour`` (the default) or ``independent``."""
+    ctx = click.get_current_context(silent=True)
+    return "honour" if ctx is None else ctx.meta.get(MIMIC_KEY, "honour")
+
+
+def command_params() -> dict:
+    """The running command's parameters (click's ``ctx.params``) with ``--mimic`` when given:
+    what keys its cached answer (:func:`eomgen.cache.command_request`)."""
+    ctx = click.get_current_context()
+    mimic = ctx.meta.get(MIMIC_KEY)
+    return {**ctx.params, **({"mimic": mimic} if mimic not in (None, "honour") else {})}
 
 
 def load_reduced(description: Path | None, scene_path: Path | None, strict: bool):

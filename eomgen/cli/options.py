@@ -1,7 +1,8 @@
 """The arguments and options several ``eomgen`` commands take, declared once.
 
 Each is a click decorator (or a function making one, where commands differ in a default or a
-help text): the DESCRIPTION argument (a file, or a bundled example's name), ``--scene``, ``--quiet``, ``--strict`` and ``-o/--output``
+help text): the DESCRIPTION argument (a file, or a bundled example's name; with it
+``--mimic``), ``--scene``, ``--quiet``, ``--strict`` and ``-o/--output``
 (a folder or a file). Whether an output can be written is checked by the command itself
 (:mod:`eomgen.output`: one error line, not click's usage text). ``--debug`` comes with the error
 handling (:func:`eomgen.cli.handling.handle_errors`).
@@ -24,13 +25,33 @@ QUIET_HELP = ("No progress on stderr (stage lines in a log, an updating line or 
               "terminal).")
 
 
+#: Where ``--mimic`` leaves its value in the command's context (``ctx.meta``), for
+#: :func:`eomgen.cli.loading.load`.
+MIMIC_KEY = "eomgen.mimic"
+MIMIC_CHOICES = ("honour", "independent")
+
+
 def description_argument(required: bool = False):
-    """DESCRIPTION: a URDF, DH-table YAML or eomgen YAML file, or the name of a bundled example
-    (:data:`eomgen.robots.EXAMPLES`, e.g. ``scara_rrp``; a file of that name wins); optional
-    (the bundled planar 2-link arm, :func:`eomgen.cli.loading.default_description`) unless
-    ``required``."""
-    return click.argument("description", required=required, callback=_file_or_example,
-                          type=click.Path(dir_okay=False, path_type=Path))
+    """DESCRIPTION: a URDF, DH-table YAML, eomgen YAML or MJCF file, or the name of a bundled
+    example (:data:`eomgen.robots.EXAMPLES`, e.g. ``scara_rrp``; a file of that name wins);
+    optional (the bundled planar 2-link arm, :func:`eomgen.cli.loading.default_description`)
+    unless ``required``. With it comes ``--mimic`` (how the description's coupled joints are
+    read), kept in the context, not passed to the command (:data:`MIMIC_KEY`)."""
+    argument = click.argument("description", required=required, callback=_file_or_example,
+                              type=click.Path(dir_okay=False, path_type=Path))
+    mimic = click.option(
+        "--mimic", type=click.Choice(MIMIC_CHOICES), default=None, expose_value=False,
+        callback=_remember_mimic,
+        help="Coupled joints of the description (URDF <mimic>, MJCF joint equalities): "
+             "'honour' (the default) makes each follower move with its leader, "
+             "'independent' reads each follower as an independent joint (one warning each).")
+    return lambda command: argument(mimic(command))
+
+
+def _remember_mimic(ctx, param, value: str | None) -> str | None:
+    if value is not None:
+        ctx.meta[MIMIC_KEY] = value
+    return value
 
 
 def _file_or_example(ctx, param, value: Path | None) -> Path | None:

@@ -5,6 +5,10 @@ is given (an adaptive law integrates its estimate alongside the state).
 
 Integrated with SciPy's ``solve_ivp`` (DOP853; ``rtol`` and ``atol`` 1e-10 by default), the
 state ``[q, q̇, β̂ (adaptive laws), ∫ rate dt (if asked)]`` reported at the times ``t_eval``.
+With quaternion joints (read off the module's names, :mod:`eomgen.control.configuration`) q
+has NQ entries and moves at ``configuration_rate(q, v)``; the quaternions are integrated as
+vectors (their norms drift with the integrator's error; every generated function normalises
+them).
 """
 
 from __future__ import annotations
@@ -14,6 +18,8 @@ from typing import Callable, Mapping
 
 import numpy as np
 
+from .configuration import module_layout, rate as configuration_rate
+
 
 @dataclass(frozen=True)
 class ClosedLoop:
@@ -22,7 +28,7 @@ class ClosedLoop:
     Attributes
     ----------
     t : (N,) [s]
-    q, qd : (N, n) joint positions and velocities
+    q, qd : (N, NQ), (N, NV) joint positions and velocities
     beta_hat : (N, b) the adaptive law's estimate (``None`` for a fixed law)
     integral : (N,) ∫ rate dt of ``simulate``'s ``rate`` (``None`` without one)
     steps : the integrator's right-hand-side evaluations
@@ -57,10 +63,11 @@ def simulate(law, q0, qd0, t_final: float, t_eval=None, beta0=None,
 
     plant = dict(plant or {})
     q0, qd0 = np.asarray(q0, dtype=float), np.asarray(qd0, dtype=float)
-    n = len(q0)
+    nq, n = len(q0), len(qd0)
     adaptive = beta0 is not None
     b = len(beta0) if adaptive else 0
     module = law.module
+    joints = module_layout(module)
     zero = np.zeros(n)
 
     def forward(q, qd, tau):
@@ -70,14 +77,14 @@ def simulate(law, q0, qd0, t_final: float, t_eval=None, beta0=None,
         return np.linalg.solve(module.mass_matrix(q, **plant), tau - bias)
 
     def rhs(t, y):
-        q, qd = y[:n], y[n:2 * n]
+        q, qd = y[:nq], y[nq:nq + n]
         if adaptive:
-            tau, dbeta = law.torque_and_adaptation(t, q, qd, y[2 * n:2 * n + b])
+            tau, dbeta = law.torque_and_adaptation(t, q, qd, y[nq + n:nq + n + b])
         else:
             tau, dbeta = law.torque(t, q, qd), np.zeros(0)
         qdd = forward(q, qd, tau)
         extra = [rate(t, q, qd)] if rate is not None else []
-        return np.concatenate([qd, qdd, dbeta, extra])
+        return np.concatenate([configuration_rate(joints, q, qd), qdd, dbeta, extra])
 
     y0 = np.concatenate([q0, qd0, np.asarray(beta0, dtype=float) if adaptive else [],
                          [0.0] if rate is not None else []])
@@ -88,7 +95,8 @@ def simulate(law, q0, qd0, t_final: float, t_eval=None, beta0=None,
     if not sol.success:
         raise RuntimeError(f"closed-loop simulation failed: {sol.message}")
     y = sol.y.T
-    return ClosedLoop(sol.t, y[:, :n], y[:, n:2 * n], y[:, 2 * n:2 * n + b] if adaptive else None,
+    return ClosedLoop(sol.t, y[:, :nq], y[:, nq:nq + n],
+                      y[:, nq + n:nq + n + b] if adaptive else None,
                       y[:, -1] if rate is not None else None, sol.nfev)
 
 

@@ -8,6 +8,15 @@ keyword values. Vectors are (n,) in JOINT_NAMES order [rad, rad/s, rad/s², N m]
 
 Desired motions are callables ``desired(t) -> (q_d, qd_d, qdd_d)``, e.g.
 :func:`fourier_reference` of an excitation trajectory of ``eomgen excite``.
+
+Models with quaternion joints (a free flyer, ball joints; read off the module's
+``CONFIGURATION_NAMES``, :mod:`eomgen.control.configuration`): ``q`` and ``q_d`` have NQ
+entries, every other vector NV (``q̇`` is the velocity v: the root twist, a ball's angular
+velocity in its child frame), and the position error is ``e = difference(q_d, q)`` (NV, the
+velocity that moves ``q_d`` to ``q`` in unit time) with ``ė`` taken as ``v − v_d``. That is
+the error's rate to first order in ``e``, so the statements below (exact error dynamics,
+energy and Lyapunov balances) hold to first order in ``e`` there: the laws converge from
+errors that are not too large (tests/control/test_quaternion_control.py).
 """
 
 from __future__ import annotations
@@ -17,17 +26,30 @@ from typing import Callable, Mapping
 
 import numpy as np
 
+from ..identification.charts import chart_states
+from .configuration import module_layout, position_error
+
 Desired = Callable[[float], tuple]
 
 
-def fourier_reference(trajectory) -> Desired:
+def fourier_reference(trajectory, model=None) -> Desired:
     """``desired(t) = (q_d, qd_d, qdd_d)`` of a :class:`~eomgen.identification.excitation.
-    FourierTrajectory` (the excitation trajectories of ``eomgen excite``)."""
+    FourierTrajectory` (the excitation trajectories of ``eomgen excite``); for a ``model`` with
+    quaternion joints (or a generated module of one) the trajectory is in the chart of
+    :mod:`eomgen.identification.charts` and ``q_d`` has NQ entries."""
+    joints = () if model is None else getattr(model, "quaternion_joints", None)
+    if joints is None:
+        joints = module_layout(model)
+
     def desired(t):
-        q, qd, qdd = trajectory.states(np.array([float(t)]))
+        q, qd, qdd = chart_states(joints, *trajectory.states(np.array([float(t)])))
         return q[0], qd[0], qdd[0]
 
     return desired
+
+
+def _error(module, q, q_d) -> np.ndarray:
+    return position_error(module_layout(module), q, q_d)
 
 
 @dataclass(frozen=True)
@@ -47,10 +69,10 @@ class ComputedTorque:
 
     def torque(self, t, q, qd):
         q_d, qd_d, qdd_d = self.desired(t)
-        e, de = q - q_d, qd - qd_d
+        e, de = _error(self.module, q, q_d), qd - qd_d
         v = qdd_d - self.Kd @ de - self.Kp @ e
         m = self.module
-        bias = m.inverse_dynamics(q, qd, np.zeros_like(q), **self.parameters)
+        bias = m.inverse_dynamics(q, qd, np.zeros_like(qd), **self.parameters)
         return m.mass_matrix(q, **self.parameters) @ v + bias
 
 
@@ -67,11 +89,11 @@ class PDGravity:
 
     def torque(self, t, q, qd):
         g = self.module.gravity_vector(q, **self.parameters)
-        return -self.Kp @ (q - self.q_d) - self.Kd @ qd + g
+        return -self.Kp @ _error(self.module, q, self.q_d) - self.Kd @ qd + g
 
     def energy(self, q, qd, **true_parameters) -> float:
         """E = ½ q̇ᵀ M(q) q̇ + ½ (q − q_d)ᵀ K_p (q − q_d), M at ``true_parameters``."""
-        e = q - self.q_d
+        e = _error(self.module, q, self.q_d)
         M = self.module.mass_matrix(q, **true_parameters)
         return 0.5 * qd @ M @ qd + 0.5 * e @ self.Kp @ e
 
@@ -99,7 +121,7 @@ class SlotineLi:
     def reference(self, t, q, qd):
         """(q̇_r, q̈_r, s) at time ``t``."""
         q_d, qd_d, qdd_d = self.desired(t)
-        e, de = q - q_d, qd - qd_d
+        e, de = _error(self.module, q, q_d), qd - qd_d
         qd_r = qd_d - self.Lambda @ e
         qdd_r = qdd_d - self.Lambda @ de
         return qd_r, qdd_r, qd - qd_r
@@ -132,7 +154,7 @@ class SlotineLi:
         excitation trajectory of ``eomgen excite`` through :func:`fourier_reference`."""
         beta_hat = np.asarray(beta_hat, dtype=float)
         q0 = np.asarray(desired(0.0)[0], dtype=float)
-        n = len(q0)
+        n = len(desired(0.0)[1])  # NV
         KD = damping * estimated_mass_matrix(module, q0, beta_hat)
         KD_inv = np.linalg.inv(KD)
         A = np.zeros((len(beta_hat), len(beta_hat)))
@@ -154,11 +176,11 @@ class SlotineLi:
 
 
 def estimated_mass_matrix(module, q, beta_hat) -> np.ndarray:
-    """M̂(q) (n, n) of the base-parameter estimate ``beta_hat``, from the Slotine–Li regressor
+    """M̂(q) (NV, NV) of the base-parameter estimate ``beta_hat``, from the Slotine–Li regressor
     alone: column j is Y_SL(q, 0, 0, e_j) β̂ − Y_SL(q, 0, 0, 0) β̂ (the law knows no more of
     the robot than β̂)."""
     q = np.asarray(q, dtype=float)
-    n = len(q)
+    n = len(getattr(module, "JOINT_NAMES", q))  # NV
     zero = np.zeros(n)
     Y = module.slotine_li_base_regressor
     g = Y(q, zero, zero, zero) @ beta_hat

@@ -16,6 +16,13 @@ importable from here (and from :mod:`eomgen.identification`):
   second-order central differences (``numpy.gradient``), then decimation. In the first form
   the columns are used as they are, unless a cut-off is given: then q, q̇, q̈ and τ all go
   through that same filter, trimming and decimation (:func:`filtered_signals`).
+
+  A model with quaternion joints (a free flyer, ball joints) names its ``q_`` columns after
+  ``CONFIGURATION_NAMES`` (NQ: ``q_base_x … q_base_qw``, ``q_<ball>_qx … q_<ball>_qw``, then
+  the joints) and the others after ``JOINT_NAMES`` (NV: ``qd_base_vx … qd_base_wz`` the root
+  twist in the root frame, ``qdd_<ball>_wx``, ``tau_base_vx`` the force on the root along its
+  x axis, ...): Pinocchio's q, v, v̇ and τ. Such a file must have the ``qd_`` and ``qdd_``
+  columns (a quaternion's rate is not v, so q is not differentiated).
 * **Estimation** (:mod:`~eomgen.identification.fit`: :func:`weighted_least_squares`; the
   observation matrix W is :func:`eomgen.regressor.observation_matrix`): Gautier's weighted
   least squares, standard deviations, condition number; :func:`physical_fit` adds the

@@ -1,7 +1,12 @@
 """Excitation trajectories: a finite Fourier series per joint (:class:`FourierTrajectory`,
 Swevers et al. 1997) whose coefficients minimise the condition number of the base regressor
 within motion bounds (:func:`excitation_trajectory`, :func:`motion_bounds`), and measurements
-simulated along it (:func:`simulate_measurements`)."""
+simulated along it (:func:`simulate_measurements`).
+
+A model with quaternion joints (a free flyer, ball joints) is excited through a chart: the
+series gives NV chart coordinates (a quaternion joint's three angles, and the free flyer's
+position), mapped to q (NQ), v and v̇ by :func:`eomgen.identification.charts.chart_states`;
+the bounds then apply to those coordinates (angles [rad], position [m])."""
 
 from __future__ import annotations
 
@@ -14,9 +19,10 @@ import numpy as np
 from ..errors import IdentificationError, one_line
 from ..model import joint_actuators
 from ..numeric import numeric_model, rnea
-from ..regressor.derive import by_symbol
-from ..regressor.generated import DECLARED_TERMS
+from ..regressor.derive import by_symbol, derive_regressor
+from ..regressor.generated import DECLARED_TERMS, declared_actuator_terms, description_values
 from ..regressor.least_squares import normalised_condition
+from .charts import trajectory_states
 from .measurements import Measurements
 
 
@@ -241,7 +247,7 @@ def excitation_trajectory(reg, base, period: float = 10.0, harmonics: int = 3,
 
     def condition(trajectory):
         count[0] += 1
-        q, qd, qdd = trajectory.states(t)
+        q, qd, qdd = trajectory_states(reg.model, trajectory, t)
         W = np.vstack([f(*row)["Y_base"] for row in zip(q, qd, qdd)])
         c = normalised_condition(W)
         value = math.log10(c) if math.isfinite(c) and c < 1e300 else 300.0
@@ -288,6 +294,11 @@ def simulate_measurements(model, trajectory: FourierTrajectory, t, noise: float 
     Gaussian noise of standard deviation ``noise`` times each joint's RMS effort
     (``noise=0.01``: 1 %), drawn from ``seed``.
 
+    A model with quaternion joints moves along the chart of :mod:`~eomgen.identification.
+    charts` (q with NQ entries, v and v̇ NV) and its efforts are its regressor's ``Y(q, v, v̇)
+    π`` with the description's π (drives included; the float recursions of eomgen.numeric
+    take one coordinate per joint), which the tests check against Pinocchio's ``rnea``.
+
     The drive terms are those of the regressor's actuator columns, for the terms in
     ``actuators`` (default all of :data:`~eomgen.regressor.DECLARED_TERMS`)::
 
@@ -301,15 +312,31 @@ def simulate_measurements(model, trajectory: FourierTrajectory, t, noise: float 
     IdentificationError
         For a flexible joint (a stiffness): its motor has an equation of its own.
     """
-    nm = numeric_model(model, values)
     t = np.asarray(t, dtype=float)
-    q, qd, qdd = trajectory.states(t)
-    tau = np.array([rnea(nm, *s) for s in zip(q, qd, qdd)]).reshape(len(t), model.dof)
-    tau = tau + _drive_efforts(model, values, tuple(actuators), qd, qdd)
+    q, qd, qdd = trajectory_states(model, trajectory, t)
+    if model.quaternion_joints:
+        tau = _regressor_efforts(model, values, tuple(actuators), q, qd, qdd)
+    else:
+        nm = numeric_model(model, values)
+        tau = np.array([rnea(nm, *s) for s in zip(q, qd, qdd)]).reshape(len(t), model.dof)
+        tau = tau + _drive_efforts(model, values, tuple(actuators), qd, qdd)
     if noise:
         rms = np.sqrt(np.mean(tau ** 2, axis=0))
         tau = tau + np.random.default_rng(seed).standard_normal(tau.shape) * (noise * rms)
-    return Measurements(tuple(model.joint_names), t, q, qd, qdd, tau, False, "<simulated>")
+    return Measurements(tuple(model.joint_names), t, q, qd, qdd, tau, False, "<simulated>",
+                        configuration_names=model.configuration_names)
+
+
+def _regressor_efforts(model, values, terms, q, qd, qdd) -> np.ndarray:
+    """``Y(q, v, v̇) π`` (N, NV) of the description's π, with the actuator columns of
+    ``terms`` that some joint declares (a flexible joint refused as by :func:`_drive_efforts`)."""
+    _drive_efforts(model, values, (), qd, qdd)  # refuses a flexible joint
+    declared = declared_actuator_terms(model)
+    reg = derive_regressor(model, tuple(term for term in DECLARED_TERMS
+                                        if term in terms and term in declared))
+    pi = description_values(reg, values)
+    f = reg.compiled(values)
+    return np.array([f(*s)["Y"] @ pi for s in zip(q, qd, qdd)]).reshape(len(q), model.dof)
 
 
 def _drive_efforts(model, values, terms, qd, qdd) -> np.ndarray:

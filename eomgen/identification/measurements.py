@@ -44,6 +44,10 @@ class Measurements:
     cutoff : float or None
         Cut-off frequency [Hz] of the zero-phase low-pass filter the samples went through
         (differentiated, or filtered at a given cut-off), None when they are as read.
+    configuration_names : tuple of str, (nq,), or None
+        The names of ``q``'s columns when they are not ``joint_names``: a model with
+        quaternion joints (``CONFIGURATION_NAMES``, NQ entries; q̇, q̈, τ keep the NV
+        ``joint_names``).
     """
 
     joint_names: tuple[str, ...]
@@ -55,19 +59,32 @@ class Measurements:
     differentiated: bool = False
     source: str = "<measurements>"
     cutoff: float | None = None
+    configuration_names: tuple[str, ...] | None = None
 
     @property
     def N(self) -> int:
         """Number of samples."""
         return self.q.shape[0]
 
+    @property
+    def position_names(self) -> tuple[str, ...]:
+        """The names of ``q``'s columns: :attr:`configuration_names`, else the joints'."""
+        return self.joint_names if self.configuration_names is None else self.configuration_names
 
-def column_names(joint_names: Sequence[str], derivatives: bool = True, time: bool = True
-                 ) -> list[str]:
+
+def column_names(joint_names: Sequence[str], derivatives: bool = True, time: bool = True,
+                 configuration_names: Sequence[str] | None = None) -> list[str]:
     """The CSV header: ``t`` (if ``time``), then ``q_<joint>`` for every joint, ``qd_``,
-    ``qdd_`` (if ``derivatives``) and ``tau_``."""
-    prefixes = PREFIXES if derivatives else ("q", "tau")
-    return (["t"] if time else []) + [f"{p}_{j}" for p in prefixes for j in joint_names]
+    ``qdd_`` (if ``derivatives``) and ``tau_``. With ``configuration_names`` (a model with
+    quaternion joints: ``CONFIGURATION_NAMES``) the ``q_`` columns are named after those
+    (``q_base_x … q_base_qw``, ``q_hip_qx … q_hip_qw``), the others after the NV joints
+    (``qd_base_vx``, ``qdd_hip_wz``, ``tau_base_wx``: v, v̇ and the effort along each
+    velocity coordinate)."""
+    positions = joint_names if configuration_names is None else configuration_names
+    names = ["t"] if time else []
+    for prefix in (PREFIXES if derivatives else ("q", "tau")):
+        names += [f"{prefix}_{j}" for j in (positions if prefix == "q" else joint_names)]
+    return names
 
 
 def measurements_csv(m: Measurements, derivatives: bool = True) -> str:
@@ -75,7 +92,8 @@ def measurements_csv(m: Measurements, derivatives: bool = True) -> str:
     reading it back gives the same numbers). ``derivatives=False`` leaves out q̇ and q̈."""
     out = io.StringIO()
     writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(column_names(m.joint_names, derivatives, m.t is not None))
+    writer.writerow(column_names(m.joint_names, derivatives, m.t is not None,
+                                 m.configuration_names))
     blocks = [m.q, m.qd, m.qdd, m.tau] if derivatives else [m.q, m.tau]
     data = np.hstack(([m.t[:, None]] if m.t is not None else []) + blocks)
     for row in data:
@@ -84,7 +102,9 @@ def measurements_csv(m: Measurements, derivatives: bool = True) -> str:
 
 
 def read_measurements(path: Path | str, joint_names: Sequence[str],
-                      cutoff: float | None = None) -> Measurements:
+                      cutoff: float | None = None,
+                      configuration_names: Sequence[str] | None = None,
+                      quaternions: Sequence[int] = ()) -> Measurements:
     """Read a CSV file of measurements (see the module docstring for its columns).
 
     Parameters
@@ -99,6 +119,14 @@ def read_measurements(path: Path | str, joint_names: Sequence[str],
         When the file has them, None (default) uses every column as read; a number filters
         q, q̇, q̈ and τ alike, drops the filter's transients at both ends and decimates
         (:func:`filtered_signals`), which needs the ``t`` column.
+    configuration_names:
+        ``CONFIGURATION_NAMES`` of a model with quaternion joints: its ``q_`` columns (NQ);
+        None: ``joint_names``.
+    quaternions:
+        The index in ``q`` of each quaternion's x (then y, z, w). Such a model's file must
+        have the ``qd_`` and ``qdd_`` columns (v and v̇: a quaternion's rate is not v, so q
+        is not differentiated); before a cut-off filters q, each quaternion's sign is made
+        continuous (q and −q are one rotation), so the filter smooths a continuous signal.
 
     Raises
     ------
@@ -123,7 +151,13 @@ def read_measurements(path: Path | str, joint_names: Sequence[str],
                                   "columns)")
     header = [name.strip() for name in rows[0]]
     differentiate = not any(name.startswith(("qd_", "qdd_")) for name in header)
-    expected = column_names(joint_names, derivatives=not differentiate, time=True)
+    if differentiate and quaternions:
+        raise IdentificationError(one_line(
+            f"{source}: line 1: no qd_, qdd_ columns: a model with quaternion joints needs "
+            "them (v and its rate, JOINT_NAMES), as a quaternion's rate is not v"))
+    positions = tuple(joint_names if configuration_names is None else configuration_names)
+    expected = column_names(joint_names, derivatives=not differentiate, time=True,
+                            configuration_names=positions)
     seen = set()
     for name in header:
         if name in seen:
@@ -158,23 +192,40 @@ def read_measurements(path: Path | str, joint_names: Sequence[str],
     column = {name: data[:, k] for k, name in enumerate(header)}
 
     def block(prefix):
-        return np.column_stack([column[f"{prefix}_{j}"] for j in joint_names]) if joint_names \
+        names = positions if prefix == "q" else joint_names
+        return np.column_stack([column[f"{prefix}_{j}"] for j in names]) if names \
             else np.zeros((data.shape[0], 0))
 
     t = column.get("t")
     q, tau = block("q"), block("tau")
+    named = positions if configuration_names is not None else None
     if not differentiate:
         if cutoff is None:
             return Measurements(tuple(joint_names), t, q, block("qd"), block("qdd"), tau, False,
-                                source)
+                                source, configuration_names=named)
         if t is None:
             raise IdentificationError(f"{source}: line 1: missing column 't' (needed to filter "
                                       f"at the cut-off {cutoff:.6g} Hz)")
+        q = continuous_quaternions(q, quaternions)
         t, (q, qd, qdd, tau), used = filtered_signals(t, (q, block("qd"), block("qdd"), tau),
                                                       cutoff, source)
-        return Measurements(tuple(joint_names), t, q, qd, qdd, tau, False, source, used)
+        return Measurements(tuple(joint_names), t, q, qd, qdd, tau, False, source, used,
+                            configuration_names=named)
     t, q, qd, qdd, tau, used = _filtered_derivatives(t, q, tau, cutoff, source)
     return Measurements(tuple(joint_names), t, q, qd, qdd, tau, True, source, used)
+
+
+def continuous_quaternions(q, quaternions: Sequence[int]) -> np.ndarray:
+    """``q`` (N, NQ) with the sign of each quaternion (columns ``k … k + 3`` for ``k`` in
+    ``quaternions``) flipped where it would jump: sample i + 1 takes the sign whose dot product
+    with sample i is not negative (``q`` and ``−q`` are one rotation)."""
+    q = np.array(q, dtype=float)
+    for k in quaternions:
+        block = q[:, k:k + 4]
+        for i in range(1, len(block)):
+            if block[i] @ block[i - 1] < 0:
+                block[i] = -block[i]
+    return q
 
 
 def filtered_derivatives(t, q, tau, cutoff: float | None = None, source: str = "<data>"):

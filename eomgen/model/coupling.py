@@ -87,6 +87,7 @@ def check_couplings(source: str, model, couplings: Sequence[Coupling]) -> None:
     joints = {j.name: j for j in model.joints}
     movable = {j.name for j in model.movable_joints}
     virtual = set(j.name for j in model.movable_joints[:6]) if model.free_flyer else set()
+    balls = {f"{ball}_{axis}": ball for ball in model.ball_joints for axis in ("wx", "wy", "wz")}
     followers: dict[str, Coupling] = {}
     for coupling in couplings:
         where = coupling.where
@@ -103,6 +104,10 @@ def check_couplings(source: str, model, couplings: Sequence[Coupling]) -> None:
             if name in virtual:
                 raise UnsupportedError(source, where, f"joint '{name}' is a virtual joint of "
                                        "the floating base: it cannot be coupled")
+            if name in balls:
+                raise UnsupportedError(source, where, f"joint '{name}' is a virtual joint of "
+                                       f"ball joint '{balls[name]}': only one-axis joints "
+                                       "can be coupled")
         leaders = [name for name, _ in coupling.leaders]
         if len(set(leaders)) != len(leaders):
             raise KinematicTreeError(source, where, "a leader is listed twice")
@@ -213,6 +218,43 @@ def coupling_map(model) -> tuple[sp.Matrix, sp.Matrix]:
     return T, c
 
 
+def full_configuration(model, q) -> tuple:
+    """The whole tree's configuration (``uncoupled(model).nq`` entries) of the independent
+    configuration ``q`` (``model.nq`` entries; SymPy or float entries): each independent
+    joint's entry copied, each quaternion joint's block copied (a quaternion joint is never
+    coupled), each follower ``Σ gain · q[leader] + offset``. Without quaternion joints this is
+    ``T q + c`` of :func:`coupling_map`."""
+    slots = dict((key, (index, size)) for key, index, size in _configuration_slots(model))
+    by_follower = {c.follower: c for c in model.couplings}
+    out: list = []
+    for key, _, size in _configuration_slots(uncoupled(model)):
+        coupling = by_follower.get(key)
+        if coupling is None:
+            start = slots[key][0]
+            out.extend(q[start:start + size])
+        else:
+            out.append(sum((gain * q[slots[leader][0]] for leader, gain in coupling.leaders),
+                           coupling.offset))
+    return tuple(out)
+
+
+def _configuration_slots(model) -> list[tuple[object, int, int]]:
+    """Per coordinate, in ``q`` order: ``(key, index in q, entries in q)``, the key a joint
+    name of ``joint_names`` or ``("quaternion", name)`` for a quaternion joint."""
+    starts = {j.v_index: j for j in model.quaternion_joints}
+    names = model.joint_names
+    slots, k, iq = [], 0, 0
+    while k < len(names):
+        joint = starts.get(k)
+        if joint is None:
+            slots.append((names[k], iq, 1))
+            k, iq = k + 1, iq + 1
+        else:
+            slots.append((("quaternion", joint.name), iq, joint.nq))
+            k, iq = k + joint.nv, iq + joint.nq
+    return slots
+
+
 def locked_couplings(model, positions: Mapping[str, object]
                      ) -> tuple[dict[str, object], tuple[Coupling, ...]]:
     """What locking ``positions`` (joint: value) does to ``model``'s couplings:
@@ -251,5 +293,6 @@ def locked_couplings(model, positions: Mapping[str, object]
     return positions, tuple(kept)
 
 
-__all__ = ["Coupling", "check_couplings", "couple", "coupling_map", "locked_couplings",
+__all__ = ["Coupling", "check_couplings", "couple", "coupling_map", "full_configuration",
+           "locked_couplings",
            "make_coupling", "uncoupled", "with_couplings"]

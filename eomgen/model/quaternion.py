@@ -178,7 +178,7 @@ def quaternion_layout(model: "RobotModel") -> tuple[QuaternionJoint, ...]:
             raise UnsupportedError(model.source, f"joint '{joint.name}'",
                                    "a spherical joint must be expanded first "
                                    "(eomgen.model.expand_ball_joints; build_model does it)")
-    movable = model.movable_joints
+    movable = model.coordinate_joints  # the followers of couplings are no coordinates
     index = {j.name: k for k, j in enumerate(movable)}
     found = [(0, FREE_FLYER, "base")] if model.free_flyer else []
     for ball in model.ball_joints:

@@ -3,6 +3,10 @@
 * :mod:`eomgen.numeric.newton_euler`: rigid-body dynamics by Newton–Euler recursions on a
   :class:`NumericModel` (the independent reference for the symbolic engine); its names are
   importable from ``eomgen.numeric`` itself (``eomgen.numeric.rnea``, ``numeric_model``, ...).
+* :mod:`eomgen.numeric.quaternion_chart`: quaternion joints (a free flyer, ball joints) in those
+  recursions: ``q`` of NQ entries, ``qd``, ``qdd``, ``tau`` of NV (Pinocchio's layout).
+* :mod:`eomgen.numeric.frames`: pose, Jacobians and J̇ q̇ of named links by recursion (the
+  counterpart of the derived frame program).
 * :mod:`eomgen.numeric.contacts`: rigid contacts (:class:`~eomgen.numeric.contacts.ContactDynamics`,
   KKT constrained dynamics).
 * :mod:`eomgen.numeric.actuated`: armature, friction and Spong's flexible joints
@@ -20,10 +24,12 @@ from .newton_euler import (
     FLOAT64,
     PRISMATIC,
     REVOLUTE,
+    M_crba,
     M_rnea,
     Numbers,
     NumericModel,
     coriolis_times_qd,
+    forward_dynamics,
     gravity_torques,
     kinetic_energy,
     link_poses,
@@ -34,6 +40,7 @@ from .newton_euler import (
 
 __all__ = [
     "Numbers", "FLOAT64", "NumericModel", "numeric_model", "rnea", "gravity_torques", "M_rnea",
-    "coriolis_times_qd", "kinetic_energy", "potential_energy", "link_poses", "FIXED", "REVOLUTE",
-    "PRISMATIC",
+    "M_crba",
+    "coriolis_times_qd", "forward_dynamics", "kinetic_energy", "potential_energy", "link_poses",
+    "FIXED", "REVOLUTE", "PRISMATIC",
 ]

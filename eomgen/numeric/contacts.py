@@ -55,7 +55,7 @@ from ..dynamics import derive
 from ..model import POINT, Contact, RobotModel
 from ..symbolic.evaluate import compile_program
 from ..symbolic.frames import derive_frames
-from .newton_euler import M_rnea, coriolis_times_qd, gravity_torques, numeric_model, rnea
+from .newton_euler import M_crba, coriolis_times_qd, gravity_torques, numeric_model, rnea
 
 #: ``constrained_forward_dynamics`` without damping refuses a contact Jacobian whose smallest
 #: singular value is below this fraction of its largest.
@@ -119,8 +119,13 @@ class ContactDynamics:
         contacts (module docstring).
     mass_and_bias:
         A function ``(q, qd) -> (M, h)`` with ``h = C q̇ + g``; None for eomgen's numeric
-        Newton–Euler (:mod:`eomgen.numeric`, n + 2 passes). :func:`derived_mass_and_bias`
+        Newton–Euler (:mod:`eomgen.numeric`: M by CRBA, h by two RNEA passes). :func:`derived_mass_and_bias`
         gives the derived program's, faster for repeated calls.
+    frame_kinematics:
+        A function ``(q, qd) -> {frame: {"p", "R", "J", "Jb", "dJqd", "dJbqd"}}``; None for the
+        derived frame program (:func:`eomgen.symbolic.frames.derive_frames`).
+        :func:`eomgen.numeric.frames.frame_function` gives the numeric recursion's, so that
+        with ``mass_and_bias=None`` nothing comes from the derivation.
     """
 
     model: RobotModel
@@ -128,6 +133,7 @@ class ContactDynamics:
     anchors: Mapping[str, np.ndarray] = field(default_factory=dict)
     orientations: Mapping[str, np.ndarray] = field(default_factory=dict)
     mass_and_bias: Callable | None = None
+    frame_kinematics: Callable | None = None
 
     @cached_property
     def _numeric(self):
@@ -143,6 +149,8 @@ class ContactDynamics:
         return sum(c.size for c in self.contacts)
 
     def _kinematics(self, q, qd):
+        if self.frame_kinematics is not None:
+            return self.frame_kinematics(q, qd)
         return self._frames.evaluate(q, qd)
 
     def _rows(self, q, qd):
@@ -196,7 +204,7 @@ class ContactDynamics:
         if self.mass_and_bias is not None:
             return self.mass_and_bias(q, qd)
         nm = self._numeric
-        return (M_rnea(nm, q),
+        return (M_crba(nm, q),
                 coriolis_times_qd(nm, q, qd) + gravity_torques(nm, q))
 
     def constrained_forward_dynamics(self, q, qd, tau, damping: float = 0.0
@@ -215,7 +223,7 @@ class ContactDynamics:
         q, qd, tau = (np.asarray(x, dtype=float) for x in (q, qd, tau))
         M, h = self._mh(q, qd)
         J, bias, gamma = self._rows(q, qd)
-        n, m = len(q), len(bias)
+        n, m = len(qd), len(bias)
         if damping <= 0 and m:
             sv = np.linalg.svd(J, compute_uv=False)
             if len(sv) < m or sv.min() <= RANK_TOLERANCE * sv.max():

@@ -131,13 +131,23 @@ class LoopDynamics:
         numpy.linalg.LinAlgError
             With ``damping = 0``, when the rows are dependent (redundant loops).
         """
+        qd = np.asarray(qd, dtype=float)
+        return self.solve(self.evaluate(q, qd), qd, tau, damping)
+
+    def solve(self, e: dict, qd, tau, damping: float = 0.0, contact_gamma=None
+              ) -> tuple[np.ndarray, np.ndarray]:
+        """``(q̈, F)`` of :meth:`constrained_forward_dynamics` from ``e``, an :meth:`evaluate`
+        at the state ``(q, qd)``; ``contact_gamma`` (m_c,): a stabilisation term added to the
+        contact rows' ``J̇ q̇`` (a simulation's Baumgarte term on contacts held at an anchor,
+        :mod:`eomgen.analysis.simulate_loops`)."""
         qd, tau = (np.asarray(x, dtype=float) for x in (qd, tau))
-        e = self.evaluate(q, qd)
         bias = e["dJqd_c"].copy()
         kp, kd = self.baumgarte
         m_l = len(e["Phi_l"])
         if kp or kd:
             bias[len(bias) - m_l:] += kd * (e["J_l"] @ qd) + kp * e["Phi_l"]
+        if contact_gamma is not None:
+            bias[:len(bias) - m_l] += contact_gamma
         return kkt_solve(e["M"], e["h"], tau, e["J_c"], bias, damping)
 
     def parallel_inverse_dynamics(self, q, qd, qdd, tolerance: float = 1e-8

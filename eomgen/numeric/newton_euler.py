@@ -19,8 +19,18 @@ Frames are those of :mod:`eomgen.model` (URDF's):
   unit vector in the child frame.
 * Fixed joints are bodies whose joint has no motion: the recursion passes through them, so
   links rigidly attached to others keep their own frame and inertia (no merging).
-* Generalised coordinates: ``q[k]`` belongs to ``model.movable_joints[k]``, i.e. description
+* Generalised coordinates: ``q[k]`` belongs to ``model.joint_names[k]``, i.e. description
   order (``JOINT_NAMES`` order), which may differ from the tree order the recursions use.
+* Coupled joints (:mod:`eomgen.model.coupling`, a URDF ``<mimic>``): ``q`` holds the
+  independent joints only; the recursions run the whole tree at ``q_tree = T q + c``,
+  ``q̇_tree = T q̇``, ``q̈_tree = T q̈`` and return ``Tᵀ τ_tree``, so that ``M = Tᵀ M_tree T`` and
+  ``C q̇ + g = Tᵀ (C q̇ + g)_tree`` are the reduced model's.
+* Quaternion joints (a free flyer, ball joints: :mod:`eomgen.model.quaternion`): ``q`` is the
+  configuration (NQ entries, ``CONFIGURATION_NAMES``, Pinocchio's layout) and ``qd``, ``qdd``,
+  ``tau`` are velocities (NV entries, ``JOINT_NAMES``): a free flyer's root twist in the root
+  frame (linear then angular) and the wrench on the root, a ball joint's angular velocity of the
+  child in the child frame. The recursions hold the joint's virtual joints at zero and place its
+  pose from ``q`` (:mod:`eomgen.numeric.quaternion_chart`), as the derivation does.
 * Units: SI. ``tau[k]`` is a torque [N m] for a revolute joint and a force [N] for a
   prismatic one; it is the generalised force the joint actuator applies to the child body
   (and, reacting, to the parent), positive along ``+axis``.
@@ -44,285 +54,50 @@ A point mass ``m = 2`` kg hanging ``l = 0.5`` m below a joint about ``y`` (gravi
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any, Callable, Mapping
-
 import numpy as np
 
-from ..errors import UnsupportedError
-from ..model import JointType, RobotModel, parameter_symbol
-
-#: Joint type codes stored in :attr:`NumericModel.joint_type`.
-FIXED, REVOLUTE, PRISMATIC = 0, 1, 2
-
-_TYPE_CODE = {
-    JointType.FIXED: FIXED,
-    JointType.REVOLUTE: REVOLUTE,
-    JointType.CONTINUOUS: REVOLUTE,
-    JointType.PRISMATIC: PRISMATIC,
-}
-
-
-@dataclass(frozen=True)
-class Numbers:
-    """The number type an algorithm computes in, and the few operations it needs on it.
-
-    The algorithms of this module are written once over NumPy arrays whose entries are these
-    numbers (Pinocchio's algorithms are templated on ``Scalar`` in the same way): float64
-    arrays for :data:`FLOAT64`, object arrays of ``mpmath.mpf`` for
-    :data:`eomgen.analysis.precision.MPMATH` (the high-precision reference).
-
-    Attributes
-    ----------
-    name : str
-        What the numbers are, for messages.
-    dtype : type
-        The NumPy dtype of the arrays: ``float`` or ``object``.
-    convert : callable
-        A number of the description (SymPy or Python) as this type; TypeError when it is not
-        a number.
-    value : callable
-        A caller's value (float, int, or already this type) as this type.
-    sin, cos : callable
-        The trigonometric functions on this type.
-    finite : callable
-        True when a number is finite.
-    """
-
-    name: str
-    dtype: type
-    convert: Callable[[Any], Any]
-    value: Callable[[Any], Any]
-    sin: Callable[[Any], Any]
-    cos: Callable[[Any], Any]
-    finite: Callable[[Any], bool]
-
-    def zeros(self, shape) -> np.ndarray:
-        """An array of exact zeros of this type."""
-        if self.dtype is float:
-            return np.zeros(shape)
-        return np.full(shape, self.value(0), dtype=object)
-
-    def eye(self, n: int) -> np.ndarray:
-        """The ``n × n`` identity matrix of this type."""
-        if self.dtype is float:
-            return np.eye(n)
-        out = self.zeros((n, n))
-        for i in range(n):
-            out[i, i] = self.value(1)
-        return out
-
-    def vector(self, x) -> np.ndarray:
-        """A caller's sequence of values as a 1-D array of this type."""
-        if self.dtype is float:
-            return np.asarray(x, dtype=float)
-        a = np.asarray(x, dtype=object)
-        out = np.empty(a.shape, dtype=object)
-        for index, v in np.ndenumerate(a):
-            out[index] = self.value(v)
-        return out
-
-    def all_finite(self, a: np.ndarray) -> bool:
-        """True when every entry of ``a`` is finite."""
-        if self.dtype is float or a.dtype != object:
-            return bool(np.all(np.isfinite(a)))
-        return all(self.finite(x) for x in a.ravel())
-
-
-#: IEEE double precision: float64 NumPy arrays, NumPy's functions (the default everywhere).
-FLOAT64 = Numbers("float64", float, float, float, np.sin, np.cos, np.isfinite)
-
-
-@dataclass(frozen=True, eq=False)
-class NumericModel:
-    """A robot with every quantity a number: the fixed description the algorithms read.
-
-    Bodies are the links in topological order (every body after its parent); body 0 is the
-    root. Arrays are float64 (indices int64) and read-only. ``nb`` is the number of bodies
-    (links), ``n`` the number of degrees of freedom.
-
-    Attributes
-    ----------
-    name : str
-        The robot's name.
-    body_names : tuple of str, (nb,)
-        Link name of each body.
-    joint_of_body : tuple of str, (nb,)
-        Name of the joint whose child is the body (``""`` for the root).
-    joint_names : tuple of str, (n,)
-        Movable joints in description order: the order of ``q``, ``qd``, ``qdd``, ``tau``.
-    parent : (nb,) int array
-        Parent body index; ``-1`` for the root.
-    joint_type : (nb,) int array
-        :data:`FIXED`, :data:`REVOLUTE` or :data:`PRISMATIC` (the root counts as fixed).
-    q_index : (nb,) int array
-        Index into ``q`` of the body's joint; ``-1`` for fixed joints and the root.
-    axis : (nb, 3) array
-        Joint axis, a unit vector in the body (child link) frame.
-    origin_rotation : (nb, 3, 3) array
-        Rotation of the joint frame in the parent frame (identity for the root).
-    origin_translation : (nb, 3) array
-        Position [m] of the joint frame origin in the parent frame (zero for the root).
-    mass : (nb,) array
-        Body mass [kg]; zero for massless links.
-    com : (nb, 3) array
-        Centre of mass [m] in the body frame.
-    inertia : (nb, 3, 3) array
-        Rotational inertia [kg m²] about the centre of mass, in body frame axes.
-    gravity : (3,) array
-        Gravitational acceleration [m/s²] in the root frame.
-    numbers : Numbers
-        The number type of the arrays above (not of the index arrays) and of every result of
-        the algorithms: :data:`FLOAT64` unless built for another one.
-    """
-
-    name: str
-    body_names: tuple[str, ...]
-    joint_of_body: tuple[str, ...]
-    joint_names: tuple[str, ...]
-    parent: np.ndarray
-    joint_type: np.ndarray
-    q_index: np.ndarray
-    axis: np.ndarray
-    origin_rotation: np.ndarray
-    origin_translation: np.ndarray
-    mass: np.ndarray
-    com: np.ndarray
-    inertia: np.ndarray
-    gravity: np.ndarray
-    numbers: Numbers = FLOAT64
-
-    @property
-    def n(self) -> int:
-        """Number of degrees of freedom (length of ``q``)."""
-        return len(self.joint_names)
-
-    @property
-    def nb(self) -> int:
-        """Number of bodies (links, root included)."""
-        return len(self.body_names)
-
-
-def _number(numbers: Numbers, x, what: str):
-    try:
-        return numbers.convert(x)
-    except TypeError:
-        raise ValueError(f"{what} is not a number after substitution: {x}") from None
-
-
-def _vec(numbers: Numbers, v, what: str) -> np.ndarray:
-    return np.array([_number(numbers, x, what) for x in v], dtype=numbers.dtype)
-
-
-def _mat(numbers: Numbers, m, what: str) -> np.ndarray:
-    return np.array([[_number(numbers, x, what) for x in row] for row in m], dtype=numbers.dtype)
-
-
-def numeric_model(model: RobotModel, values: Mapping | None = None,
-                  numbers: Numbers = FLOAT64) -> NumericModel:
-    """Build the numeric description of ``model``.
-
-    Parameters
-    ----------
-    model : RobotModel
-        The robot; its expressions may contain parameter symbols.
-    values : mapping, optional
-        Parameter values overriding the model's defaults, keyed by SymPy symbol or by
-        parameter name.
-    numbers : Numbers, optional
-        The number type of the arrays (and of every algorithm's results): float64 by default.
-
-    Returns
-    -------
-    NumericModel
-
-    Raises
-    ------
-    eomgen.DescriptionError
-        When a parameter has neither a default nor a given value.
-    eomgen.UnsupportedError
-        For a model with coupled joints (its coordinates are not one per body): build it of
-        ``eomgen.model.uncoupled(model)`` and map with ``eomgen.model.coupling_map``.
-    ValueError
-        When a quantity is still not a real number after substitution.
-    """
-    if model.couplings:
-        raise UnsupportedError(model.source, "couplings", "the float recursions take every "
-                               "movable joint as a coordinate: lock the coupled joints with a "
-                               "scene, or load with couplings=False (eomgen.model.uncoupled)")
-    values = {
-        (parameter_symbol(k) if isinstance(k, str) else k): v for k, v in (values or {}).items()
-    }
-    model = model.with_numeric_parameters(values)
-    order = model.topological_joints
-    names = (model.root,) + tuple(j.child for j in order)
-    index = {name: i for i, name in enumerate(names)}
-    q_of_joint = {j.name: k for k, j in enumerate(model.movable_joints)}
-    nb = len(names)
-
-    parent = np.full(nb, -1, dtype=np.int64)
-    joint_type = np.full(nb, FIXED, dtype=np.int64)
-    q_index = np.full(nb, -1, dtype=np.int64)
-    axis = numbers.zeros((nb, 3))
-    axis[:, 2] = numbers.value(1)
-    rot = numbers.zeros((nb, 3, 3))
-    rot[:] = numbers.eye(3)
-    trans = numbers.zeros((nb, 3))
-    for i, joint in enumerate(order, start=1):
-        where = f"joint '{joint.name}'"
-        parent[i] = index[joint.parent]
-        joint_type[i] = _TYPE_CODE[joint.type]
-        q_index[i] = q_of_joint.get(joint.name, -1)
-        axis[i] = _vec(numbers, joint.axis, where + " axis")
-        rot[i] = _mat(numbers, joint.origin.rotation, where + " origin")
-        trans[i] = _vec(numbers, joint.origin.translation, where + " origin")
-
-    mass = numbers.zeros(nb)
-    com = numbers.zeros((nb, 3))
-    inertia = numbers.zeros((nb, 3, 3))
-    for i, name in enumerate(names):
-        inertial = model.link_by_name[name].inertial
-        if inertial is None:
-            continue
-        where = f"link '{name}' inertial"
-        mass[i] = _number(numbers, inertial.mass, where)
-        com[i] = _vec(numbers, inertial.com, where)
-        inertia[i] = _mat(numbers, inertial.inertia, where)
-
-    arrays = dict(parent=parent, joint_type=joint_type, q_index=q_index, axis=axis,
-                  origin_rotation=rot, origin_translation=trans, mass=mass, com=com,
-                  inertia=inertia, gravity=_vec(numbers, model.gravity, "gravity"))
-    for a in arrays.values():
-        if not numbers.all_finite(a):
-            raise ValueError(f"model '{model.name}' has a non-finite quantity")
-        a.flags.writeable = False
-    return NumericModel(
-        name=model.name,
-        body_names=names,
-        joint_of_body=("",) + tuple(j.name for j in order),
-        joint_names=model.joint_names,
-        numbers=numbers,
-        **arrays,
-    )
-
+from .model import (FIXED, FLOAT64, PRISMATIC, REVOLUTE, Numbers, NumericModel,
+                    numeric_model)
+from .quaternion_chart import chart_coordinates, chart_offset, placements
 
 # ----------------------------------------------------------------------------------------------
 # Kinematics shared by the algorithms
 # ----------------------------------------------------------------------------------------------
 
-def _check(nm: NumericModel, name: str, x) -> np.ndarray:
-    """``x`` as an (n,) array of the model's numbers, or a ValueError naming the argument."""
+def _check(nm: NumericModel, name: str, x, size: int | None = None) -> np.ndarray:
+    """``x`` as an (n,) array of the model's numbers (``size`` entries when given), or a
+    ValueError naming the argument."""
     if not isinstance(nm, NumericModel):
         raise ValueError(f"expected a NumericModel (see numeric_model), got {type(nm).__name__}")
     a = nm.numbers.vector(x)
-    if a.shape != (nm.n,):
-        raise ValueError(
-            f"{name} must have shape ({nm.n},) (joints {', '.join(nm.joint_names) or 'none'}), "
-            f"got shape {a.shape}"
-        )
+    size = nm.n if size is None else size
+    if a.shape != (size,):
+        what = (f"joints {', '.join(nm.joint_names) or 'none'}" if size == nm.n else
+                f"the configuration of {nm.name}, quaternions included")
+        raise ValueError(f"{name} must have shape ({size},) ({what}), got shape {a.shape}")
     if not nm.numbers.all_finite(a):
         raise ValueError(f"{name} has a non-finite entry")
     return a
+
+
+def _configuration(nm: NumericModel, q) -> tuple[np.ndarray, dict]:
+    """The coordinates the recursions index (n_tree,) and the poses placed from the quaternions
+    (:func:`~eomgen.numeric.quaternion_chart.placements`), from ``q`` (nq,): with couplings the
+    whole tree's ``T q + c``."""
+    q = _check(nm, "q", q, nm.nq)
+    if nm.coupling is not None:
+        q = nm.configuration_coupling @ q + nm.coupling_offset
+    if not nm.quaternion_joints:
+        return q, {}
+    return (chart_coordinates(nm.quaternion_joints, q, nm.n_tree, nm.numbers),
+            placements(nm.quaternion_joints, q, nm.numbers))
+
+
+def _tangent(nm: NumericModel, name: str, x) -> np.ndarray:
+    """A velocity-like argument (n,) as the recursions take it (n_tree,): itself, or with
+    couplings the whole tree's ``T x``."""
+    x = _check(nm, name, x)
+    return x if nm.coupling is None else nm.coupling @ x
 
 
 def _rotation(numbers: Numbers, axis: np.ndarray, angle) -> np.ndarray:
@@ -332,8 +107,11 @@ def _rotation(numbers: Numbers, axis: np.ndarray, angle) -> np.ndarray:
     return numbers.eye(3) + numbers.sin(angle) * K + (1.0 - numbers.cos(angle)) * (K @ K)
 
 
-def _parent_transforms(nm: NumericModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Pose of every body frame in its parent's frame at ``q``.
+def _parent_transforms(nm: NumericModel, q: np.ndarray, placed: dict | None = None
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """Pose of every body frame in its parent's frame at the coordinates ``q`` (n,), the
+    quaternion joints' poses ``placed`` (by velocity index, :func:`_configuration`) after their
+    origins.
 
     Returns
     -------
@@ -348,6 +126,10 @@ def _parent_transforms(nm: NumericModel, q: np.ndarray) -> tuple[np.ndarray, np.
         k = nm.q_index[i]
         if k < 0:
             continue
+        if placed and k in placed:
+            Rq, pq = placed[k]
+            p[i] = p[i] + R[i] @ pq
+            R[i] = R[i] @ Rq
         if nm.joint_type[i] == REVOLUTE:
             R[i] = R[i] @ _rotation(nm.numbers, nm.axis[i], q[k])
         else:  # prismatic: the child frame moves along the axis, without rotating
@@ -402,33 +184,41 @@ def rnea(nm: NumericModel, q, qd, qdd) -> np.ndarray:
         n_i = N_i + c_i × F_i + Σ_children (ⁱR_c n_c + ⁱp_c × ⁱR_c f_c)
         tau = n_i · z  (revolute)   or   f_i · z  (prismatic)
 
-    Fixed joints are bodies with no joint motion; the root's forces are not returned.
+    Fixed joints are bodies with no joint motion; the root's forces are not returned. A
+    quaternion joint's chain runs with its virtual joints at zero below the pose placed from
+    ``q``, and takes the chart accelerations ``q̈ − n(q̇)``
+    (:mod:`eomgen.numeric.quaternion_chart`). With coupled joints the whole tree runs at
+    ``(T q + c, T q̇, T q̈)`` and the result is ``Tᵀ τ_tree`` (:attr:`NumericModel.coupling`).
 
     Parameters
     ----------
     nm : NumericModel
-    q : (n,) array_like
-        Joint positions [rad or m] in ``nm.joint_names`` order.
+    q : (nq,) array_like
+        Joint positions [rad or m] in ``nm.joint_names`` order; with quaternion joints the
+        configuration (NQ entries, Pinocchio's layout, module docstring).
     qd : (n,) array_like
-        Joint velocities [rad/s or m/s], same order.
+        Joint velocities [rad/s or m/s] in ``nm.joint_names`` order.
     qdd : (n,) array_like
         Joint accelerations [rad/s² or m/s²], same order.
 
     Returns
     -------
     tau : (n,) ndarray
-        Joint torques [N m] / forces [N], same order, positive along ``+axis``.
+        Joint torques [N m] / forces [N], same order, positive along ``+axis`` (a free flyer:
+        the force then moment on the root, root frame).
 
     Raises
     ------
     ValueError
         When an argument does not have shape (n,) or is not finite.
     """
-    q = _check(nm, "q", q)
-    qd = _check(nm, "qd", qd)
-    qdd = _check(nm, "qdd", qdd)
+    q, placed = _configuration(nm, q)
+    qd = _tangent(nm, "qd", qd)
+    qdd = _tangent(nm, "qdd", qdd)
+    if nm.quaternion_joints:
+        qdd = qdd - chart_offset(nm.quaternion_joints, qd, nm.numbers)
     nb = nm.nb
-    R, p = _parent_transforms(nm, q)
+    R, p = _parent_transforms(nm, q, placed)
     zeros = nm.numbers.zeros
 
     w = zeros((nb, 3))
@@ -459,7 +249,7 @@ def rnea(nm: NumericModel, q, qd, qdd) -> np.ndarray:
 
     f = F.copy()
     n = N + np.cross(nm.com, F)
-    tau = zeros(nm.n)
+    tau = zeros(nm.n_tree)
     for i in range(nb - 1, 0, -1):
         k = nm.q_index[i]
         if k >= 0:
@@ -469,12 +259,12 @@ def rnea(nm: NumericModel, q, qd, qdd) -> np.ndarray:
         fj = R[i] @ f[i]
         f[j] += fj
         n[j] += R[i] @ n[i] + np.cross(p[i], fj)
-    return tau
+    return tau if nm.coupling is None else nm.coupling.T @ tau
 
 
 def gravity_torques(nm: NumericModel, q) -> np.ndarray:
     """Gravity vector ``g(q) = rnea(q, 0, 0)``: the (n,) torques/forces that hold the robot
-    still at ``q`` (``q`` in ``nm.joint_names`` order)."""
+    still at ``q`` (``q`` (nq,) as :func:`rnea` takes it)."""
     zero = np.zeros(nm.n)
     return rnea(nm, q, zero, zero)
 
@@ -482,9 +272,10 @@ def gravity_torques(nm: NumericModel, q) -> np.ndarray:
 def M_rnea(nm: NumericModel, q) -> np.ndarray:
     """Joint-space mass matrix ``M(q)``, (n, n), rows and columns in ``nm.joint_names`` order.
 
-    Column ``i`` is ``rnea(q, 0, e_i) - rnea(q, 0, 0)`` (n + 1 RNEA calls, O(n²) overall).
+    Column ``i`` is ``rnea(q, 0, e_i) - rnea(q, 0, 0)`` (n + 1 RNEA calls, O(n²) overall);
+    ``q`` (nq,) as :func:`rnea` takes it.
     """
-    q = _check(nm, "q", q)
+    q = _check(nm, "q", q, nm.nq)
     zero = nm.numbers.zeros(nm.n)
     g = rnea(nm, q, zero, zero)
     M = nm.numbers.zeros((nm.n, nm.n))
@@ -495,12 +286,81 @@ def M_rnea(nm: NumericModel, q) -> np.ndarray:
     return M
 
 
+def _skew(numbers, v) -> np.ndarray:
+    zero = numbers.value(0)
+    return np.array([[zero, -v[2], v[1]], [v[2], zero, -v[0]], [-v[1], v[0], zero]],
+                    dtype=numbers.dtype)
+
+
+def M_crba(nm: NumericModel, q) -> np.ndarray:
+    """Joint-space mass matrix ``M(q)`` by the composite-rigid-body algorithm, (n, n), the
+    same matrix as :func:`M_rnea` in one inward pass and one walk up from each joint.
+
+    Spatial quantities in body coordinates, angular part first: body ``i``'s inertia about
+    its origin ``[[I_ci − m [c]×², m [c]×], [−m [c]×, m 1]]``; the composite inertia ``I^c_i``
+    (the body and everything below it) gathers each child's through ``ᶜX_iᵀ I^c_c ᶜX_i``,
+    ``ᶜX_i = [[Rᵀ, 0], [−Rᵀ [p]×, Rᵀ]]`` taking motions from body ``i`` to its child
+    (pose ``(R, p)`` in ``i``). With ``S_i`` the joint's motion (``(z, 0)`` revolute, ``(0, z)``
+    prismatic), ``M[k_i, k_j] = S_jᵀ (ʲX_iᵀ I^c_i S_i)`` for every joint ``j`` on the path from
+    ``i`` to the root. ``q`` (nq,) as :func:`rnea` takes it; with couplings ``Tᵀ M_tree T``.
+    """
+    x, placed = _configuration(nm, q)
+    R, p = _parent_transforms(nm, x, placed)
+    numbers, nb = nm.numbers, nm.nb
+    zeros = numbers.zeros
+    X = zeros((nb, 6, 6))  # motion transform parent -> body i
+    Ic = zeros((nb, 6, 6))
+    S = zeros((nb, 6))
+    for i in range(1, nb):
+        Rt = R[i].T
+        X[i, :3, :3] = Rt
+        X[i, 3:, 3:] = Rt
+        X[i, 3:, :3] = -Rt @ _skew(numbers, p[i])
+        c, m = nm.com[i], nm.mass[i]
+        C = _skew(numbers, c)
+        Ic[i, :3, :3] = nm.inertia[i] - m * (C @ C)
+        Ic[i, :3, 3:] = m * C
+        Ic[i, 3:, :3] = -m * C
+        Ic[i, 3:, 3:] = m * numbers.eye(3)
+        half = 0 if nm.joint_type[i] == REVOLUTE else 3
+        S[i, half:half + 3] = nm.axis[i]
+    for i in range(nb - 1, 1, -1):
+        j = nm.parent[i]
+        if j > 0:
+            Ic[j] = Ic[j] + X[i].T @ Ic[i] @ X[i]
+    M = zeros((nm.n_tree, nm.n_tree))
+    for i in range(1, nb):
+        k = nm.q_index[i]
+        if k < 0:
+            continue
+        F = Ic[i] @ S[i]
+        M[k, k] = S[i] @ F
+        j = i
+        while nm.parent[j] > 0:
+            F = X[j].T @ F
+            j = nm.parent[j]
+            col = nm.q_index[j]
+            if col >= 0:
+                M[k, col] = M[col, k] = S[j] @ F
+    return M if nm.coupling is None else nm.coupling.T @ M @ nm.coupling
+
+
 def coriolis_times_qd(nm: NumericModel, q, qd) -> np.ndarray:
     """Velocity product ``C(q, q̇) q̇ = rnea(q, q̇, 0) - rnea(q, 0, 0)``, shape (n,), in
-    ``nm.joint_names`` order (centrifugal and Coriolis torques/forces)."""
-    q = _check(nm, "q", q)
+    ``nm.joint_names`` order (centrifugal and Coriolis torques/forces); ``q`` (nq,) as
+    :func:`rnea` takes it."""
+    q = _check(nm, "q", q, nm.nq)
     zero = np.zeros(nm.n)
     return rnea(nm, q, qd, zero) - rnea(nm, q, zero, zero)
+
+
+def forward_dynamics(nm: NumericModel, q, qd, tau) -> np.ndarray:
+    """Joint accelerations ``q̈ = M(q)⁻¹ (τ − C(q, q̇) q̇ − g(q))``, shape (n,), from
+    :func:`M_crba` and :func:`rnea` (a float64 model; ``q`` (nq,) as :func:`rnea` takes it, with
+    quaternion joints ``q̈`` is ``v̇``). Raises ``numpy.linalg.LinAlgError`` for a singular M."""
+    zero = nm.numbers.zeros(nm.n)
+    h = rnea(nm, q, qd, zero)
+    return np.linalg.solve(M_crba(nm, q), _check(nm, "tau", tau) - h)
 
 
 def kinetic_energy(nm: NumericModel, q, qd) -> float:
@@ -508,20 +368,23 @@ def kinetic_energy(nm: NumericModel, q, qd) -> float:
 
     Parameters
     ----------
-    q, qd : (n,) array_like
-        Joint positions and velocities in ``nm.joint_names`` order.
+    q : (nq,) array_like
+        Joint positions in ``nm.joint_names`` order (the configuration, as :func:`rnea`).
+    qd : (n,) array_like
+        Joint velocities in ``nm.joint_names`` order.
     """
-    q = _check(nm, "q", q)
-    qd = _check(nm, "qd", qd)
-    R, p = _parent_transforms(nm, q)
+    q, placed = _configuration(nm, q)
+    qd = _tangent(nm, "qd", qd)
+    R, p = _parent_transforms(nm, q, placed)
     w, v = _velocities(nm, R, p, qd)
     vc = v + np.cross(w, nm.com)
     Iw = np.einsum("ijk,ik->ij", nm.inertia, w)
     return float(0.5 * (nm.mass @ np.einsum("ij,ij->i", vc, vc)) + 0.5 * np.sum(w * Iw))
 
 
-def _world_poses(nm: NumericModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    R, p = _parent_transforms(nm, q)
+def _world_poses(nm: NumericModel, q: np.ndarray, placed: dict
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    R, p = _parent_transforms(nm, q, placed)
     Rw = np.empty_like(R)
     pw = np.empty_like(p)
     Rw[0] = nm.numbers.eye(3)
@@ -533,6 +396,41 @@ def _world_poses(nm: NumericModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return Rw, pw
 
 
+def world_state(nm: NumericModel, q, qd) -> tuple[np.ndarray, ...]:
+    """Every body's motion in world (root) axes at ``q̈ = 0``, for the frame kinematics
+    (:mod:`eomgen.numeric.frames`, whose docstring has the recursion): ``(R, p, z, ω, v, ω̇,
+    a, q̇_tree)``, ``R`` (nb, 3, 3) and ``p`` (nb, 3) the body poses, ``z`` (nb, 3) the joint
+    axes, ``ω``, ``v`` the angular velocity and the origin's velocity, ``ω̇``, ``a`` their
+    classical accelerations (a quaternion joint's chain at the chart accelerations ``−n(v)``),
+    and the tree's joint velocities."""
+    x, placed = _configuration(nm, q)
+    qd = _tangent(nm, "qd", qd)
+    zeros = nm.numbers.zeros
+    qdd = zeros(nm.n_tree)
+    if nm.quaternion_joints:
+        qdd = -chart_offset(nm.quaternion_joints, qd, nm.numbers)
+    Rw, pw = _world_poses(nm, x, placed)
+    z = np.einsum("ijk,ik->ij", Rw, nm.axis)
+    w, v, wd, a = (zeros((nm.nb, 3)) for _ in range(4))
+    for i in range(1, nm.nb):
+        j = nm.parent[i]
+        r = pw[i] - pw[j]
+        w[i], wd[i] = w[j], wd[j]
+        v[i] = v[j] + np.cross(w[j], r)
+        a[i] = a[j] + np.cross(wd[j], r) + np.cross(w[j], np.cross(w[j], r))
+        k = nm.q_index[i]
+        if k < 0:
+            continue
+        motion = z[i] * qd[k]
+        if nm.joint_type[i] == REVOLUTE:
+            wd[i] = wd[i] + np.cross(w[j], motion) + z[i] * qdd[k]
+            w[i] = w[i] + motion
+        else:
+            v[i] = v[i] + motion
+            a[i] = a[i] + 2.0 * np.cross(w[j], motion) + z[i] * qdd[k]
+    return Rw, pw, z, w, v, wd, a, qd
+
+
 def potential_energy(nm: NumericModel, q) -> float:
     """Gravitational potential energy [J]: ``P = -Σ_i m_i gravityᵀ p_ci``, with ``p_ci`` the
     centre of mass of body ``i`` in the root frame (zero when every centre of mass is at the
@@ -540,11 +438,10 @@ def potential_energy(nm: NumericModel, q) -> float:
 
     Parameters
     ----------
-    q : (n,) array_like
-        Joint positions in ``nm.joint_names`` order.
+    q : (nq,) array_like
+        Joint positions in ``nm.joint_names`` order (the configuration, as :func:`rnea`).
     """
-    q = _check(nm, "q", q)
-    Rw, pw = _world_poses(nm, q)
+    Rw, pw = _world_poses(nm, *_configuration(nm, q))
     pc = pw + np.einsum("ijk,ik->ij", Rw, nm.com)
     return float(-(nm.mass @ (pc @ nm.gravity)))
 
@@ -554,8 +451,11 @@ def link_poses(nm: NumericModel, q) -> dict[str, tuple[np.ndarray, np.ndarray]]:
 
     Parameters
     ----------
-    q : (n,) array_like
-        Joint positions in ``nm.joint_names`` order.
+    q : (nq,) or (n,) array_like
+        Joint positions in ``nm.joint_names`` order (the configuration, as :func:`rnea`). With
+        quaternion joints, (n,) values are taken as the coordinates of their virtual joints
+        (the chain of one-axis joints the model holds, :mod:`eomgen.model.quaternion`), with
+        no pose placed from a quaternion: how the chain draws.
 
     Returns
     -------
@@ -564,8 +464,10 @@ def link_poses(nm: NumericModel, q) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         coordinates and ``p`` (3,) the link origin [m] in the root frame; the root maps to
         ``(I, 0)``. Every link is present, massless and fixed-joint links included.
     """
-    q = _check(nm, "q", q)
-    Rw, pw = _world_poses(nm, q)
+    if nm.quaternion_joints and np.shape(q) == (nm.n,):
+        Rw, pw = _world_poses(nm, _check(nm, "q", q), {})
+    else:
+        Rw, pw = _world_poses(nm, *_configuration(nm, q))
     return {name: (Rw[i], pw[i]) for i, name in enumerate(nm.body_names)}
 
 
@@ -577,7 +479,9 @@ __all__ = [
     "rnea",
     "gravity_torques",
     "M_rnea",
+    "M_crba",
     "coriolis_times_qd",
+    "forward_dynamics",
     "kinetic_energy",
     "potential_energy",
     "link_poses",

@@ -22,6 +22,10 @@ joint stays one coordinate (Pinocchio's URDF reader gives it two: cos and sin).
   contiguous range); :class:`PinocchioModel` maps coordinates to eomgen's ``JOINT_NAMES`` order
   (``perm``, and ``qperm`` for the configuration when NQ ≠ NV).
 * Gravity is the model's, in the root frame; parameters take their values.
+* Coupled joints (a URDF ``<mimic>``, :mod:`eomgen.model.coupling`): the Pinocchio model is the
+  whole tree's (every movable joint, followers included), and :class:`PinocchioModel` maps the
+  independent coordinates to it (``q_tree = T q + c``, ``v_tree = T v``) and projects
+  (``Tᵀ τ``, ``Tᵀ M T``), as eomgen's reduced model does.
 """
 
 from __future__ import annotations
@@ -30,8 +34,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model import RobotModel
+from ..model import RobotModel, coupling_map, uncoupled
 from .floating_base import dynamics_from_free_flyer, to_free_flyer
+from .model import configuration_map
 
 __all__ = ["PinocchioModel", "to_pinocchio", "plain_calls", "PinocchioFreeFlyer"]
 
@@ -56,18 +61,23 @@ class PinocchioModel:
         (n,) ints: Pinocchio's coordinate k is eomgen's ``perm[k]`` (``q_pin = q[perm]``).
     qperm:
         (nq,) ints, the same for the configuration (``q_pin = q[qperm]``); None: ``perm``.
+    coupling:
+        ``(T, P, c_q)`` of the model's coupled joints (float arrays: ``v_tree = T v``,
+        ``q_tree = P q + c_q``, :func:`eomgen.numeric.model.configuration_map`), in whose
+        whole-tree coordinates ``perm`` is given; None without couplings.
     """
 
     model: object
     data: object
     perm: np.ndarray
     qperm: np.ndarray | None = None
+    coupling: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
     @property
     def identity(self) -> bool:
         """True when Pinocchio's arrays are eomgen's (same order)."""
         q = self.perm if self.qperm is None else self.qperm
-        return (np.array_equal(self.perm, np.arange(len(self.perm)))
+        return (self.coupling is None and np.array_equal(self.perm, np.arange(len(self.perm)))
                 and np.array_equal(q, np.arange(len(q))))
 
     def rnea(self, q, qd, qdd) -> np.ndarray:
@@ -75,22 +85,29 @@ class PinocchioModel:
         import pinocchio as pin  # optional dependency: imported when used
 
         p = self.perm
+        q, qd, qdd = (np.asarray(x, float) for x in (q, qd, qdd))
+        if self.coupling is not None:
+            T, P, c = self.coupling
+            q, qd, qdd = P @ q + c, T @ qd, T @ qdd
         tau = np.empty(len(p))
         qp = p if self.qperm is None else self.qperm
-        tau[p] = pin.rnea(self.model, self.data, np.asarray(q, float)[qp],
-                          np.asarray(qd, float)[p], np.asarray(qdd, float)[p])
-        return tau
+        tau[p] = pin.rnea(self.model, self.data, q[qp], qd[p], qdd[p])
+        return tau if self.coupling is None else self.coupling[0].T @ tau
 
     def crba(self, q) -> np.ndarray:
         """M (n, n) in eomgen's order, by ``pinocchio.crba`` (upper triangle mirrored)."""
         import pinocchio as pin  # optional dependency: imported when used
 
         p = self.perm
+        q = np.asarray(q, float)
+        if self.coupling is not None:
+            q = self.coupling[1] @ q + self.coupling[2]
         qp = p if self.qperm is None else self.qperm
-        upper = np.triu(pin.crba(self.model, self.data, np.asarray(q, float)[qp]))
+        upper = np.triu(pin.crba(self.model, self.data, q[qp]))
         M_pin = upper + np.triu(upper, 1).T
         inverse = np.argsort(p)
-        return M_pin[np.ix_(inverse, inverse)]
+        M = M_pin[np.ix_(inverse, inverse)]
+        return M if self.coupling is None else self.coupling[0].T @ M @ self.coupling[0]
 
 
 def to_pinocchio(model: RobotModel) -> PinocchioModel:
@@ -105,6 +122,10 @@ def to_pinocchio(model: RobotModel) -> PinocchioModel:
 
     if model.free_symbols:
         model = model.with_numeric_parameters()
+    coupling = None
+    if model.couplings:
+        coupling = (_matrix(coupling_map(model)[0].tolist()), *configuration_map(model))
+        model = uncoupled(model)
     pmodel = pin.Model()
     pmodel.name = model.name
     anchor = {model.root: (0, pin.SE3.Identity())}  # link -> (joint id, placement in it)
@@ -153,7 +174,7 @@ def to_pinocchio(model: RobotModel) -> PinocchioModel:
         perm[pj.idx_v:pj.idx_v + pj.nv] = np.arange(v0, v0 + pj.nv)
         qperm[pj.idx_q:pj.idx_q + pj.nq] = np.arange(q0, q0 + pj.nq)
     return PinocchioModel(pmodel, pmodel.createData(), perm,
-                          None if np.array_equal(perm, qperm) else qperm)
+                          None if np.array_equal(perm, qperm) else qperm, coupling)
 
 
 def _configuration_indices(model: RobotModel) -> list[int]:
@@ -182,6 +203,10 @@ def plain_calls(pm: PinocchioModel, n: int):
         return (lambda q, qd, qdd: pin.rnea(model, data, q, qd, qdd),
                 lambda q: pin.crba(model, data, q),
                 f"pinocchio {pin.__version__}: plain pin.rnea and pin.crba calls")
+    if pm.coupling is not None:
+        return (pm.rnea, pm.crba,
+                f"pinocchio {pin.__version__}: pin.rnea and pin.crba on the whole tree at "
+                "q = T q_r + c, projected by Tᵀ (the coupling map a user of this model needs)")
     return (pm.rnea, pm.crba,
             f"pinocchio {pin.__version__}: pin.rnea and pin.crba with the joints "
             "reordered to eomgen's order (a conversion a user of this model needs)")

@@ -120,15 +120,17 @@ def load(path, strict: bool = False, defer_notices: bool = False,
 
 
 def independent_followers(model: RobotModel, strict: bool = False,
-                          defer_notices: bool = False) -> RobotModel:
+                          defer_notices: bool = False, how: str = "couplings=False"
+                          ) -> RobotModel:
     """``model`` with its followers read as independent joints, one
     :attr:`~eomgen.model.NoticeKind.MIMIC` notice per follower (warned, refused under
-    ``strict``, or kept in ``model.notices`` with ``defer_notices``)."""
+    ``strict``, or kept in ``model.notices`` with ``defer_notices``); ``how`` names what asked
+    for it in the notices."""
     found = tuple(
         Notice(NoticeKind.MIMIC, model.source, c.where,
                f"the coupling to joint{'s' if len(c.leaders) > 1 else ''} "
                + ", ".join(f"'{name}'" for name, _ in c.leaders) + " is not modelled",
-               "read as an independent joint (couplings=False)",
+               f"read as an independent joint ({how})",
                joints=(c.follower,) + tuple(name for name, _ in c.leaders))
         for c in model.couplings)
     if not defer_notices:

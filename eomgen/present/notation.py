@@ -115,9 +115,10 @@ def expanded_size(book: TextbookDerivation) -> int:
 def teaching_sized(dynamics: Dynamics, config: LatexConfig = LatexConfig()) -> bool:
     """Whether the textbook derivation of ``dynamics``' model is worth computing: few joints
     and a small program (:class:`LatexConfig`). Costs nothing next to the derivation: it
-    looks at the straight-line program only. Never for coupled joints (the textbook form
-    takes every joint as a coordinate)."""
-    return (not dynamics.model.couplings and dynamics.model.dof <= config.textbook_max_dof
+    looks at the straight-line program only. Never for coupled joints nor quaternion joints
+    (the textbook form takes every joint as a coordinate)."""
+    return (not dynamics.model.couplings and not dynamics.model.quaternion_joints
+            and dynamics.model.dof <= config.textbook_max_dof
             and dynamics.operation_count(["M", "C", "g"]) <= config.textbook_max_operations)
 
 

@@ -65,6 +65,13 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
         a payload on an unknown link, unknown parameters.
     """
     scene = scene or Scene()
+    own = tuple(loop for loop in model.loops if loop not in scene.loops)
+    if own:  # the description's own loops (MJCF connect, weld): as if the scene said them
+        taken = {loop.name for loop in own} & {loop.name for loop in scene.loops}
+        if taken:
+            raise scene.error("loops", f"the description ({model.source}) has a loop named "
+                              f"'{sorted(taken)[0]}' already (an MJCF equality)")
+        scene = replace(scene, loops=own + scene.loops)
     if scene.robot is not None and scene.robot != model.name:
         raise scene.error("robot", f"the scene is for robot '{scene.robot}', not "
                           f"'{model.name}' ({model.source})")

@@ -74,7 +74,8 @@ def identify(reg: Regressor, base, q, qd, qdd, tau, values: Mapping | None = Non
         A :class:`BaseParameters` or :class:`SymbolicBase` (its ``base`` columns are used).
     q, qd, qdd, tau:
         (N, n) arrays of joint positions, velocities, accelerations and measured efforts, in
-        JOINT_NAMES order (SI units).
+        JOINT_NAMES order (SI units); with quaternion joints q is (N, NQ), in
+        CONFIGURATION_NAMES order, and qd, qdd are v and v̇.
     values:
         Geometry parameter values overriding the model's defaults.
 
@@ -84,10 +85,13 @@ def identify(reg: Regressor, base, q, qd, qdd, tau, values: Mapping | None = Non
         When the arrays are not (N, n) or there are fewer rows N n than base parameters.
     """
     arrays = [np.atleast_2d(np.asarray(x, dtype=float)) for x in (q, qd, qdd, tau)]
-    if any(a.shape != arrays[0].shape or a.shape[1] != reg.n for a in arrays):
-        raise ValueError(f"q, qd, qdd and tau must all have shape (N, {reg.n})")
+    nq = len(reg.q)
+    if (arrays[0].shape != (arrays[1].shape[0], nq)
+            or any(a.shape != arrays[1].shape or a.shape[1] != reg.n for a in arrays[1:])):
+        shape = f"(N, {reg.n})" if nq == reg.n else f"(N, {nq}) and qd, qdd, tau (N, {reg.n})"
+        raise ValueError(f"q, qd, qdd and tau must have shape {shape}")
     columns = list(base.base)
-    if arrays[0].size < len(columns):
+    if arrays[1].size < len(columns):
         raise ValueError(f"{arrays[0].size} equations for {len(columns)} base parameters")
     W = observation_matrix(reg, columns, *arrays[:3], values=values)
     y = arrays[3].reshape(-1)

@@ -94,15 +94,18 @@ def sample_regressor(reg: Regressor, samples: int | None = None, seed: int = 0,
     standard normal (prismatic joints too). A quaternion's four entries drawn so are a
     non-unit quaternion, which the program normalises: a random rotation. The columns of the
     massless links inside a quaternion joint's chain (:attr:`QuaternionJoint.virtual
-    <eomgen.model.QuaternionJoint.virtual>`, parameters zero by construction) are zero, so
-    that no base parameter stands for them."""
+    <eomgen.model.QuaternionJoint.virtual>`, parameters zero by construction) are zero, and so
+    are the actuator columns of a quaternion joint's velocity coordinates (a quaternion joint
+    takes no drive), so that no base parameter stands for them."""
     f = reg.compiled(values)
     n, p = reg.n, reg.p
     samples = samples or max(20, 3 * p // max(n, 1) + 10)
     rng = np.random.default_rng(seed)
     rows = []
-    virtual = [10 * k + c for joint in reg.model.quaternion_joints for k in joint.virtual
-               for c in range(10)]
+    joints = reg.model.quaternion_joints
+    virtual = [10 * k + c for joint in joints for k in joint.virtual for c in range(10)]
+    virtual += [10 * n + g * n + k for g in range(len(reg.actuators)) for joint in joints
+                for k in range(joint.v_index, joint.v_index + joint.nv)]
     for _ in range(samples):
         q = rng.uniform(-np.pi, np.pi, len(reg.q))
         Y = np.array(f(q, rng.standard_normal(n), rng.standard_normal(n))["Y"], dtype=float)

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..model import coupling_map, uncoupled
+from ..model.coupling import coupling_map, full_configuration, uncoupled
 from ..outputs import BY_SYMBOL, splits
 
 #: Per output symbol: ``(rows, columns)``, whether its rows are joint efforts (× Tᵀ) and its
@@ -38,6 +38,7 @@ PROJECTIONS: dict[str, tuple[bool, bool]] = {
     "p_f": (False, False), "R_f": (False, False), "J_f": (False, True),
     "Jb_f": (False, True), "dJqd_f": (False, False), "dJbqd_f": (False, False),
     "J_c": (False, True), "dJqd_c": (False, False), "tau_c": (True, False),
+    "Phi_l": (False, False), "J_l": (False, True), "dJqd_l": (False, False),
     "cone_c": (False, False), "pyramid_c": (False, False),
     "c_G": (False, False), "J_G": (False, True), "A_G": (False, True), "dAGv": (False, False),
     "I_G": (False, False),
@@ -61,10 +62,16 @@ def refused(symbols) -> list[str]:
 
 def coupled_inputs(model, q, qd):
     """``(full model, T, q_full, qd_full)`` of a model with couplings and the symbols of its
-    independent ``q`` and ``qd``: the model the algorithms walk (every movable joint a
-    coordinate) and the full coordinates and velocities."""
-    T, c = coupling_map(model)
-    q_full = tuple(T * sp.Matrix(q) + c)
+    independent ``q`` (NQ) and ``qd`` (NV): the model the algorithms walk (every movable
+    joint a coordinate), the full configuration (the whole tree's NQ entries,
+    :func:`eomgen.model.coupling.full_configuration`: a quaternion joint's block copied, a
+    follower's entry ``Σ k q_leader + c``) and the full velocities ``T q̇``.
+
+    ``T`` (NV_full × NV) acts on velocities: a quaternion joint's velocity coordinates are
+    never coupled, so their rows are unit rows and the map is exact on the joint's tangent
+    space as well."""
+    T, _ = coupling_map(model)
+    q_full = full_configuration(model, tuple(q))
     qd_full = tuple(T * sp.Matrix(qd))
     return uncoupled(model), T, q_full, qd_full
 

@@ -91,7 +91,7 @@ class Derivation:
         joints, independent accelerations (``len(qdd)`` the ``qdd`` input's) become the full
         ``T q̈``."""
         if self.coupling is not None and len(qdd) == self.coupling.cols:
-            return tuple(self.coupling * sp.Matrix(qdd))
+            qdd = tuple(self.coupling * sp.Matrix(qdd))
         if not self.model.quaternion_joints:
             return tuple(qdd)
         return chart_accelerations(self.model.quaternion_joints, self.qd, qdd)
@@ -178,25 +178,28 @@ def new_derivation(model: RobotModel, inputs: Iterable[str] | None = None) -> De
     for name in ("q", "qd", "qdd"):
         symbols.setdefault(name, vector_symbols(name, input_size(name, model)))
     ordered = {name: symbols[name] for name in INPUTS if name in symbols}
-    if model.couplings:
-        if model.quaternion_joints:
-            raise UnsupportedError(model.source, "couplings", "coupled joints on a model "
-                                   "with a quaternion free flyer or ball joint are not derived "
-                                   "yet")
+    builder = ProgramBuilder(reserved)
+    if model.couplings:  # the whole tree in full coordinates (eomgen.symbolic.couplings)
         full, T, q_full, qd_full = coupled_inputs(model, ordered["q"], ordered["qd"])
-        return Derivation(full, body_tree(full), ordered, ProgramBuilder(reserved),
-                          coordinates=q_full, coupling=T, velocities=qd_full)
-    builder, tree = ProgramBuilder(reserved), body_tree(model)
-    joints = model.quaternion_joints
+        tree, coords = _placed(full, q_full, builder)
+        return Derivation(full, tree, ordered, builder, coordinates=coords, coupling=T,
+                          velocities=qd_full)
+    tree, coords = _placed(model, ordered["q"], builder)
+    return Derivation(model, tree, ordered, builder,
+                      coordinates=coords if model.quaternion_joints else None)
+
+
+def _placed(model: RobotModel, q, builder: ProgramBuilder) -> tuple[BodyTree, tuple]:
+    """The body tree of ``model`` with each quaternion joint's pose placed from ``q`` (NQ
+    entries) before its chain, and the joint coordinates the algorithms index (NV)."""
+    tree, joints = body_tree(model), model.quaternion_joints
     if not joints:
-        return Derivation(model, tree, ordered, builder)
-    q = ordered["q"]
+        return tree, tuple(q)
     placed = placements(joints, q, builder)
     tree = replace(tree, bodies=tuple(
         replace(body, placement=body.placement @ placed[body.q_index])
         if body.q_index in placed else body for body in tree.bodies))
-    return Derivation(model, tree, ordered, builder,
-                      coordinates=coordinates(joints, q, model.dof))
+    return tree, coordinates(joints, q, model.dof)
 
 
 __all__ = ["Derivation", "joint_symbols", "new_derivation", "vector_symbols"]

@@ -16,6 +16,11 @@ generated functions. The equations and conventions are those of :mod:`eomgen.act
   joints, ``S_R`` selecting the rigid joints and ``τ`` one vector: joint torque of a rigid joint,
   motor torque of a flexible one.
 
+On a model with quaternion joints (a free flyer, ball joints: :mod:`eomgen.model.quaternion`)
+every vector is NV long, in ``JOINT_NAMES`` order (velocity coordinates); drives sit on the
+real one-DOF joints only (a quaternion joint's entries have no armature, friction or spring:
+0 there), and ``q`` of ``τ_K`` is the flexible joint's own angle.
+
 Units: N m (N for prismatic joints), kg m², rad, rad/s. The friction law itself is
 :func:`friction_torque_expr`, shared with :mod:`eomgen.actuators` and :mod:`eomgen.symbolic.flat`.
 """
@@ -68,7 +73,10 @@ def build_drives(derivation, wanted) -> dict:
     actuators = joint_actuators(model)
     flexible = flexible_indices(model)
     require_flexible(model, FLEXIBLE & set(wanted))
-    q, qd, qdd = derivation.q, derivation.qd, derivation.qdd
+    q, qd = derivation.q, derivation.qd
+    # the true accelerations v̇ (T q̈ with coupled joints): a quaternion joint's chart takes
+    # others (derivation.qdd), but no quaternion joint has a drive
+    qdd = derivation.tangent(derivation.inputs["qdd"])
     armature = [a.armature for a in actuators]
     out = {}
     if "M_a" in wanted:

@@ -25,6 +25,15 @@ flexible one) in ``JOINT_NAMES`` order.
 (:func:`define_time_derivatives`): every intermediate ``x = f(s₁, …)`` of ``τ_L`` gets
 ``ẋ = Σ ∂f/∂s_k ṡ_k`` and ``ẍ = d/dt ẋ``, each defined as a new intermediate, so the program
 stays linear in the size of the Newton–Euler program (nothing is expanded).
+
+On a model with quaternion joints (a free flyer, ball joints: :mod:`eomgen.model.quaternion`)
+the trajectory is ``q(t)`` in the configuration space (NQ entries) with velocity ``v(t)``
+(NV): ``q̇``, ``q̈``, ``q⁽³⁾``, ``q⁽⁴⁾`` above read ``v``, ``v̇``, ``v̈``, ``v⁽³⁾``, and the
+configuration moves at ``q̇ = configuration_rate(q, v)`` (:func:`configuration_rates`), not
+at ``v``. The flexible joints are real one-DOF joints; in the outputs a quaternion joint's
+entries are those of a rigid joint without a drive: ``θ`` holds 0 there (the chart's
+coordinate: a quaternion joint has no angle), ``θ̇`` its velocity ``v``, ``τ`` its entries of
+``τ_L`` (the root wrench of a free flyer).
 """
 
 from __future__ import annotations
@@ -36,6 +45,7 @@ import sympy as sp
 from ..model import flexible_indices, joint_actuators
 from .drives import friction_torque_expr, require_flexible
 from .program import ProgramBuilder
+from .quaternion_joints import quaternion_rotation
 from .transforms import time_derivative
 
 #: The symbols :func:`build_flat` makes (all need flexible joints).
@@ -128,6 +138,36 @@ def define_time_derivatives(builder: ProgramBuilder, exprs: Sequence[sp.Expr],
     return out[1:]
 
 
+def configuration_rates(model, q, v) -> dict:
+    """``q̇`` of every configuration symbol ``q`` (NQ) at the velocity ``v`` (NV), by symbol:
+    ``v`` for a one-DOF joint; for a quaternion joint (:mod:`eomgen.model.quaternion`) the
+    quaternion's ``½ (x, y, z, w) ⊗ (ω, 0)`` and, for the free flyer, the origin's ``R v_lin``
+    (R of the normalised quaternion, as the program places it). Along these rates the
+    quaternion's norm is constant, so the forward-mode derivatives of the program, which
+    normalises it, are exact."""
+    rates, starts = {}, {j.v_index: j for j in model.quaternion_joints}
+    k = iq = 0
+    while k < len(v):
+        joint = starts.get(k)
+        if joint is None:
+            rates[q[iq]] = v[k]
+            k, iq = k + 1, iq + 1
+            continue
+        x, y, z, w = quat = q[joint.quaternion:joint.quaternion + 4]
+        wx, wy, wz = omega = v[k + joint.nv - 3:k + joint.nv]
+        vector = (x, y, z)
+        cross = (y * wz - z * wy, z * wx - x * wz, x * wy - y * wx)
+        for i in range(3):
+            rates[vector[i]] = (w * omega[i] + cross[i]) / 2
+        rates[w] = -(x * wx + y * wy + z * wz) / 2
+        if joint.nv == 6:
+            R = quaternion_rotation(*quat)
+            for i in range(3):
+                rates[q[iq + i]] = sum((R[i][c] * v[k + c] for c in range(3)), sp.Integer(0))
+        k, iq = k + joint.nv, iq + joint.nq
+    return rates
+
+
 def build_flat(derivation, wanted) -> dict:
     """The builder of ``theta_flat``, ``thetad_flat``, ``tau_flat`` and ``tau_flat_smooth`` in
     :mod:`eomgen.outputs` (``motor_angles``, ``motor_velocities``, ``flat_motor_torque``,
@@ -144,12 +184,14 @@ def build_flat(derivation, wanted) -> dict:
     actuators = joint_actuators(model)
     flexible = flexible_indices(model)
     inputs = derivation.inputs
-    q, qd, qdd = derivation.q, derivation.qd, derivation.qdd
+    # the true accelerations (a quaternion joint's chart takes others, derivation.qdd)
+    q, qd, qdd = derivation.q, derivation.qd, derivation.tangent(inputs["qdd"])
     qddd, qdddd = inputs["qddd"], inputs["qdddd"]
     n, b = len(q), derivation.builder
     tau_L = derivation.output("tau")
     orders = 2 if wanted & {"tau_flat", "tau_flat_smooth"} else 1 if "thetad_flat" in wanted else 0
-    rates = dict(zip(q, qd)) | dict(zip(qd, qdd)) | dict(zip(qdd, qddd)) | dict(zip(qddd, qdddd))
+    rates = (configuration_rates(model, inputs["q"], qd) | dict(zip(qd, qdd))
+             | dict(zip(qdd, qddd)) | dict(zip(qddd, qdddd)))
     rows = [tau_L[k, 0] for k in flexible]
     derivatives = define_time_derivatives(b, rows, rates, orders) if orders else []
     # τ_L,F and its derivatives, named per flexible joint

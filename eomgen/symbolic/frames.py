@@ -85,7 +85,8 @@ class FrameKinematics:
     frames:
         The frame (link) names, in the order of the outputs' index ``k``.
     q, qd:
-        Joint position and velocity symbols, ``JOINT_NAMES`` order.
+        Joint position and velocity symbols, ``JOINT_NAMES`` order (with quaternion joints
+        ``q`` is the configuration's, NQ symbols).
     program:
         Outputs ``p_k``, ``R_k``, ``J_k``, ``Jb_k``, ``dJqd_k``, ``dJbqd_k`` per frame k.
     """
@@ -117,9 +118,9 @@ class FrameKinematics:
         defaults to zero."""
         import numpy as np  # here: derive imports this module (F_c's size), not NumPy
 
-        n = len(self.q)
-        q = np.asarray(q, dtype=float).reshape(n)
-        qd = np.zeros(n) if qd is None else np.asarray(qd, dtype=float).reshape(n)
+        nq, nv = len(self.q), len(self.qd)  # NQ ≠ NV with quaternion joints
+        q = np.asarray(q, dtype=float).reshape(nq)
+        qd = np.zeros(nv) if qd is None else np.asarray(qd, dtype=float).reshape(nv)
         raw = self._compiled(q, qd)
         out = {}
         for k, name in enumerate(self.frames):
@@ -142,7 +143,7 @@ def derive_frames(model: RobotModel, frames: Iterable[str] | None = None) -> Fra
     kinematics = frame_kinematics(model, d.tree, d.q, d.qd, d.builder, frames)
     outputs = [(f"{kind}_{k}", values[kind]) for k, values in enumerate(kinematics)
                for kind in FRAME_OUTPUTS]
-    return FrameKinematics(model, frames, d.q, d.qd, d.program(outputs))
+    return FrameKinematics(model, frames, d.inputs["q"], d.qd, d.program(outputs))
 
 
 def frame_kinematics(model: RobotModel, tree, q, qd, b: ProgramBuilder,

@@ -98,6 +98,14 @@ def drive_equations(spong: SpongDynamics, book: TextbookDerivation | None, corio
     return links, motors
 
 
+def _velocities(model, tex: str) -> str:
+    """eomgen's own equation ``tex`` with ``q̈``, ``q̇`` read as ``v̇``, ``v`` for a model with
+    quaternion joints (its velocity is not the rate of q: :mod:`eomgen.teach.quaternion`)."""
+    if not model.quaternion_joints:
+        return tex
+    return tex.replace(r"\ddot{q}", r"\dot{v}").replace(r"\dot{q}", "v")
+
+
 def drives_section(spong: SpongDynamics, book: TextbookDerivation | None, coriolis,
                     w: Writer) -> Section:
     model = spong.dynamics.model
@@ -128,7 +136,8 @@ def drives_section(spong: SpongDynamics, book: TextbookDerivation | None, coriol
             "the gear, kg m$^{2}$) times $\\dot{\\theta}_{i}^{2}$; the part of the rotor's "
             "angular velocity due to the links that carry it is neglected (the rotor's mass "
             "belongs to the link that carries it)." + friction_text)))
-        rows = tuple(((code(names[k]),), prose(f"$q_{{{k + 1}}}$"),
+        position = {name: k for k, name in enumerate(model.configuration_names)}
+        rows = tuple(((code(names[k]),), prose(f"$q_{{{position[names[k]] + 1}}}$"),
                       (math(w.tex(spong.theta[c])),), (math(w.tex(stiffness[c])),),
                       (math(w.tex(inertia[c])),))
                      for c, k in enumerate(spong.flexible))
@@ -141,7 +150,7 @@ def drives_section(spong: SpongDynamics, book: TextbookDerivation | None, coriol
             "The Euler–Lagrange equations of the links and of the motors, the link equations "
             "and the motor equations, are")))
         blocks.append(Equations((
-            Equation(r"M(q)\, \ddot{q} + C(q, \dot{q})\, \dot{q} + g(q)",
+            Equation(_velocities(model, r"M(q)\, \ddot{q} + C(q, \dot{q})\, \dot{q} + g(q)"),
                      (r"K (\theta - q),",)),
             Equation(r"B\, \ddot{\theta} + K (\theta - q)", (r"\tau_{m},",)))))
         blocks.append(Paragraph(prose(
@@ -162,9 +171,9 @@ def drives_section(spong: SpongDynamics, book: TextbookDerivation | None, coriol
             "its reflected rotor inertia, the armature $a_{i} = r_{i}^{2} I_{\\mathrm{rotor},i}$ "
             "(kg m$^{2}$), to the diagonal of the mass matrix." + friction_text
             + " The equations of motion become")))
-        blocks.append(Equations((Equation(
-            r"\bigl(M(q) + \operatorname{diag}(a)\bigr)\, \ddot{q} + C(q, \dot{q})\, \dot{q} "
-            r"+ g(q) + \tau_{f}(\dot{q})", (r"\tau,",)),)))
+        blocks.append(Equations((Equation(_velocities(
+            model, r"\bigl(M(q) + \operatorname{diag}(a)\bigr)\, \ddot{q} + C(q, \dot{q})\, "
+            r"\dot{q} + g(q) + \tau_{f}(\dot{q})"), (r"\tau,",)),)))
         blocks.append(Paragraph(prose(
             "with $a = " + nt.vector(w.p, armature) + "$ and the friction torques "
             "$\\tau_{f} = " + nt.vector(w.p, [sp.Add(*_friction_terms(a, v)) for a, v in

@@ -182,8 +182,8 @@ def test_outputs_not_derived_for_the_chart_are_refused():
     from eomgen import derive
     from eomgen.errors import UnsupportedError
     with pytest.raises(UnsupportedError,
-                       match="Y_SL not derived for a quaternion free flyer"):
-        derive(add_free_flyer(floating_tree(5, 2)), outputs=("M", "Y_SL"))
+                       match="Phi_l not derived for a quaternion free flyer"):
+        derive(add_free_flyer(floating_tree(5, 2)), outputs=("M", "Phi_l"))
 
 
 @pytest.fixture(scope="module")

@@ -128,7 +128,7 @@ def test_contacts_and_loops_in_one_kkt_system(tmp_path):
 def test_generated_parallel_inverse_dynamics(tmp_path):
     """The NumPy and fast modules' parallel_inverse_dynamics on the Delta: the efforts that
     produced a constrained motion (zero on the passive joints) and its loop forces, one state
-    and a batch; the other backends leave it out (NumPy and C only)."""
+    and a batch (the other backends: test_parallel_outputs.py)."""
     from support.generated import generated
 
     model = _model("delta")

@@ -21,7 +21,7 @@ import pytest
 import eomgen
 from eomgen.errors import UnknownFormatError, UnsupportedError, UnsupportedFeatureWarning
 from eomgen.model import joint_actuators
-from support import relative, run_cli
+from support import model_states, relative, run_cli
 
 mujoco = pytest.importorskip("mujoco", reason="MJCF is read by MuJoCo's compiler")
 
@@ -55,14 +55,7 @@ def derived():
     return out
 
 
-def states(model, count=3, seed=0):
-    rng = np.random.default_rng(seed)
-    for _ in range(count):
-        q = rng.uniform(-1, 1, model.nq)
-        for joint in model.quaternion_joints:  # unit quaternions: MuJoCo takes them as given
-            k = joint.quaternion
-            q[k:k + 4] /= np.linalg.norm(q[k:k + 4])
-        yield q, rng.normal(size=model.dof)
+states = model_states
 
 
 @pytest.mark.parametrize("name", ["arm.xml", "floating.xml", "ball.xml",
@@ -203,11 +196,14 @@ def test_refused_by_name(tmp_path, case):
 
 
 WARNED = {
-    "connect": ("<connect name='loop' body1='a' body2='c' anchor='0 0 0'/>",
-                "equality 'loop' (connect): loop closures are not read yet"),
-    "weld": ("<weld body1='a' body2='c'/>", "equality 'eq0' (weld): loop closures are not"),
-    "joint": ("<joint name='mimic' joint1='j3' joint2='j2' polycoef='0 2 0 0 0'/>",
-              "equality 'mimic' (joint): joint couplings are not read yet"),
+    "connect": ("<connect name='loop' body1='a' body2='c' anchor='0 0 0' active='false'/>",
+                "equality 'loop' (connect, inactive): an inactive equality is not modelled"),
+    "weld": ("<weld body1='a' body2='c' active='false'/>",
+             "equality 'eq0' (weld, inactive): an inactive equality"),
+    "tendon": ("<tendon name='te' tendon1='t'/>", "equality 'te' (tendon): this equality is "
+               "not modelled"),
+    "joint": ("<joint name='mimic' joint1='j3' joint2='j2' polycoef='0 2 0 0 0' active='false'/>",
+              "equality 'mimic' (joint, inactive): an inactive equality is not modelled"),
 }
 
 
@@ -215,8 +211,10 @@ WARNED = {
 def test_equalities_are_warned_by_name_and_dropped(tmp_path, case):
     element, message = WARNED[case]
     path = tmp_path / "e.xml"
-    path.write_text(WORLD.format(extra_bodies="", extra=f"<equality>{element}</equality>"),
-                    encoding="utf-8")
+    tendon = ("<tendon><fixed name='t'><joint joint='j1' coef='1'/></fixed></tendon>"
+              if case == "tendon" else "")
+    path.write_text(WORLD.format(extra_bodies="", extra=f"{tendon}<equality>{element}"
+                                 "</equality>"), encoding="utf-8")
     with pytest.warns(UnsupportedFeatureWarning, match=message.replace("(", r"\(")
                       .replace(")", r"\)")):
         model = eomgen.load(path)

@@ -180,6 +180,20 @@ def load_quietly(path):
         return eomgen.load(path)
 
 
+def model_states(model, count: int = 3, seed: int = 0):
+    """``count`` random states ``(q, v)`` of ``model``: ``q`` uniform in [−1, 1] with each
+    quaternion joint's quaternion made unit (MuJoCo takes them as given), ``v`` normal."""
+    import numpy as np
+
+    rng = np.random.default_rng(seed)
+    for _ in range(count):
+        q = rng.uniform(-1, 1, model.nq)
+        for joint in model.quaternion_joints:
+            k = joint.quaternion
+            q[k:k + 4] /= np.linalg.norm(q[k:k + 4])
+        yield q, rng.normal(size=model.dof)
+
+
 def write(path: Path, text: str) -> Path:
     """Write ``text`` (UTF-8) to ``path`` and return the path."""
     path.write_text(text, encoding="utf-8")

@@ -40,19 +40,36 @@ What is read
 * ``<option gravity>`` (zero when the ``gravity`` flag is disabled).
 * ``<motor>`` actuators on hinge and slide joints: the joint torque is ``gear · ctrl``;
   ``model.info["mujoco_motors"]`` lists ``(actuator, joint, gear)``.
+* First-order ``joint`` equalities (``polycoef`` ``c0 c1 0 0 0``): MuJoCo's ``q1 − ref1 = c0
+  + c1 (q2 − ref2)`` is the coupling ``q1 = c1 q2 + (ref1 + c0 − c1 ref2)``
+  (:mod:`eomgen.model.coupling`; ``q`` is ``qpos``, so the refs enter the offset): ``joint1``
+  follows and leaves ``JOINT_NAMES``. A chain of them is written in the independent joints; a
+  ``joint`` equality without ``joint2`` (or with ``c1 = 0``) locks ``joint1`` at ``ref1 + c0``
+  (``model.info["mujoco_locks"]``). MuJoCo's equalities are soft (``solref``, ``solimp``);
+  eomgen's hold exactly.
+* ``connect`` and ``weld`` equalities: loops (:attr:`~eomgen.model.RobotModel.loops`,
+  docs/loops.md), named after the equality (``eq<i>`` unnamed): a ``connect`` is a point loop
+  whose frame b is the anchor on ``body1`` and frame a the same point on ``body2`` (where
+  MuJoCo's compiler put it at ``qpos0``), so that ``Φ = p_1 − p_2`` and ``J_l`` are MuJoCo's
+  rows and λ is the force on ``body1``; a ``weld`` is a weld loop, frame b on ``body1`` with
+  the axes of ``relpose``, frame a on ``body2`` at the ``anchor`` (a point loop with
+  ``torquescale="0"``); between sites, the two site frames. Every command applies them as if
+  a scene declared them (a scene's own loops come after).
 
 Unnamed bodies and joints are named ``body<i>`` and ``joint<i>`` with MuJoCo's id ``i``;
 a name that is taken gets ``_2``, ``_3``, … appended.
 
 Warned about (:class:`~eomgen.errors.UnsupportedFeatureWarning`, refused under ``strict``),
 by name: joint springs (``stiffness``, ``springref``: not modelled), tendons, actuators other
-than motors on hinge and slide joints, equality constraints (``connect``, ``weld``, first-order
-``joint``, ``tendon``: not read yet, the model is the tree without them), fluid forces
+than motors on hinge and slide joints, equalities that are inactive (``active="false"``),
+``tendon`` and flex equalities, an equality joining a dropped free body, fluid forces
 (``density``, ``viscosity``), gravity compensation (``gravcomp``). Refused
 (:class:`~eomgen.errors.UnsupportedError`), by name: ``joint`` equalities of order above
-one. ``ball`` joints are ball joints (:mod:`eomgen.model.quaternion`): MuJoCo's ``(qw, qx, qy,
-qz)`` is eomgen's ``(qx, qy, qz, qw)``; the velocity is the same (the child's angular velocity
-in the child frame); their armature, damping and frictionloss are warned about and left out.
+one; two ``joint`` equalities on one joint or a cycle of them
+(:class:`~eomgen.errors.KinematicTreeError`). ``ball`` joints are ball joints
+(:mod:`eomgen.model.quaternion`): MuJoCo's ``(qw, qx, qy, qz)`` is eomgen's ``(qx, qy, qz,
+qw)``; the velocity is the same (the child's angular velocity in the child frame); their
+armature, damping and frictionloss are warned about and left out.
 
 Contacts, joint limits, geoms, sites, sensors and the rendering options do not enter the
 equations of motion and are ignored.
@@ -68,7 +85,7 @@ from pathlib import Path
 from ...errors import DescriptionError, UnknownFormatError, UnreadableFileError, UnsupportedError
 from ...model import RobotModel, emit_notices
 from .. import register
-from .extras import model_notices, motors
+from .extras import model_notices, motors, with_equalities
 from .tree import build_tree
 
 #: The optional extra that installs MuJoCo.
@@ -166,7 +183,7 @@ def model_from_mujoco(m, source: str = "<mujoco>", strict: bool = False,
                       defer_notices: bool = False) -> RobotModel:
     """eomgen's model of the compiled MuJoCo model ``m`` (``mujoco.MjModel``); see the module
     docstring. ``source`` names it in messages."""
-    model = build_tree(m, source)
+    model = with_equalities(build_tree(m, source), m, source)
     present = {joint.name for joint in model.joints}
     # what concerns only the joints of a dropped free body goes with it
     notices = tuple(n for n in model_notices(m, source)

@@ -29,37 +29,51 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...model import RobotModel
+from ...model import RobotModel, coupling_map, uncoupled
 from .tree import joint_names, rotation_of_quaternion
 
 
 @dataclass(frozen=True)
 class Layout:
-    """Where each entry of eomgen's ``q`` (NQ) and ``v`` (NV) sits in MuJoCo's ``qpos`` and
-    ``qvel``: ``qpos[qpos_index]`` gives ``q`` (the quaternion reordered), ``T`` the velocity
-    map at a configuration. ``free`` is MuJoCo's qpos and dof address of the free joint (None
-    without one); ``nq``, ``nv`` are MuJoCo's sizes."""
+    """Where each entry of the whole tree's ``q`` and ``v`` (every movable joint, followers
+    of couplings included: NQ_full, NV_full) sits in MuJoCo's ``qpos`` and ``qvel``:
+    ``qpos[qpos_index]`` gives it (the quaternion reordered), ``T`` the velocity map at a
+    configuration. ``free`` is MuJoCo's qpos and dof address of the free joint (None without
+    one); ``nq``, ``nv`` are MuJoCo's sizes.
+
+    With couplings (MuJoCo's ``joint`` equalities, :mod:`eomgen.parsers.mjcf.extras`), the
+    model's own ``q`` (NQ) and ``v`` (NV) are the entries ``q_keep`` and ``v_keep`` of the
+    whole tree's; ``coupling`` is ``T_c`` (NV_full × NV, ``v_full = T_c v``) and
+    ``followers`` says how each follower's entry is made: ``(index, ((leader index, gain),
+    …), offset)`` in the whole tree's ``q``. ``locked`` holds MuJoCo's qpos address and value
+    of each joint a ``joint`` equality locks."""
 
     qpos_index: np.ndarray
     dof_index: np.ndarray
     free: tuple[int, int] | None
     nq: int
     nv: int
+    q_keep: np.ndarray | None = None
+    v_keep: np.ndarray | None = None
+    coupling: np.ndarray | None = None
+    followers: tuple = ()
+    locked: tuple[tuple[int, float], ...] = ()
 
 
 def layout(m, model: RobotModel) -> Layout:
     """The :class:`Layout` of ``model`` (read from the compiled MuJoCo model ``m``)."""
     by_name = {name: j for j, name in enumerate(joint_names(m))}
+    full = uncoupled(model)
     qpos, dofs, free = [], [], None
-    if model.free_flyer:
-        j = by_name[dict(model.info)["mujoco_free_joint"]]
+    if full.free_flyer:
+        j = by_name[dict(full.info)["mujoco_free_joint"]]
         qa, da = int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])
         free = (qa, da)
         qpos += [qa, qa + 1, qa + 2, qa + 4, qa + 5, qa + 6, qa + 3]
         dofs += list(range(da, da + 6))
-    balls = {f"{name}_wx": name for name in model.ball_joints}
-    virtual = {f"{name}_{axis}" for name in model.ball_joints for axis in ("wy", "wz")}
-    for joint in model.movable_joints[6 if model.free_flyer else 0:]:
+    balls = {f"{name}_wx": name for name in full.ball_joints}
+    virtual = {f"{name}_{axis}" for name in full.ball_joints for axis in ("wy", "wz")}
+    for joint in full.movable_joints[6 if full.free_flyer else 0:]:
         if joint.name in virtual:  # taken with the ball joint's first entry
             continue
         j = by_name[balls.get(joint.name, joint.name)]
@@ -70,30 +84,69 @@ def layout(m, model: RobotModel) -> Layout:
         else:
             qpos.append(qa)
             dofs.append(da)
+    locked = tuple((int(m.jnt_qposadr[by_name[name]]), float(value))
+                   for name, value in dict(model.info).get("mujoco_locks", ()))
+    coupled = {}
+    if model.couplings:
+        names = full.configuration_names
+        T, _ = coupling_map(model)
+        coupled = dict(
+            q_keep=np.array([names.index(n) for n in model.configuration_names], dtype=int),
+            v_keep=np.array([full.joint_names.index(n) for n in model.joint_names], dtype=int),
+            coupling=np.array(T.evalf(), dtype=float),
+            followers=tuple((names.index(c.follower),
+                             tuple((names.index(n), float(k)) for n, k in c.leaders),
+                             float(c.offset)) for c in model.couplings))
     return Layout(np.array(qpos, dtype=int), np.array(dofs, dtype=int), free, int(m.nq),
-                  int(m.nv))
+                  int(m.nv), locked=locked, **coupled)
 
 
 def to_eomgen(lay: Layout, qpos, qvel=None):
-    """eomgen's ``q`` (and ``v`` when ``qvel`` is given) from MuJoCo's ``qpos`` (``qvel``)."""
+    """eomgen's ``q`` (and ``v`` when ``qvel`` is given) from MuJoCo's ``qpos`` (``qvel``);
+    with couplings, the independent joints' entries (``qpos`` and ``qvel`` are taken to
+    satisfy the couplings)."""
     qpos = np.asarray(qpos, dtype=float)
     q = qpos[lay.qpos_index]
+    if lay.q_keep is not None:
+        q = q[lay.q_keep]
     if qvel is None:
         return q
-    v = velocity_map(lay, qpos).T @ np.asarray(qvel, dtype=float)  # T orthogonal: T⁻¹ = Tᵀ
-    return q, v
+    v = _tree_velocity_map(lay, qpos).T @ np.asarray(qvel, dtype=float)  # orthogonal: T⁻¹ = Tᵀ
+    return q, (v if lay.v_keep is None else v[lay.v_keep])
 
 
 def to_mujoco(lay: Layout, q, v):
-    """MuJoCo's ``(qpos, qvel)`` from eomgen's ``q`` and ``v``; entries of joints eomgen does
-    not have (a dropped free body's) stay zero."""
+    """MuJoCo's ``(qpos, qvel)`` from eomgen's ``q`` and ``v`` (followers where their
+    couplings put them, locked joints at their positions); entries of joints eomgen does not
+    have (a dropped free body's) stay zero."""
     qpos = np.zeros(lay.nq)
-    qpos[lay.qpos_index] = np.asarray(q, dtype=float)
+    qpos[lay.qpos_index] = full_q(lay, q)
+    for index, value in lay.locked:
+        qpos[index] = value
     return qpos, velocity_map(lay, qpos) @ np.asarray(v, dtype=float)
 
 
+def full_q(lay: Layout, q) -> np.ndarray:
+    """The whole tree's ``q`` (every movable joint) of eomgen's ``q``: ``q`` itself without
+    couplings."""
+    q = np.asarray(q, dtype=float)
+    if lay.q_keep is None:
+        return q
+    out = np.zeros(len(lay.qpos_index))
+    out[lay.q_keep] = q
+    for index, leaders, offset in lay.followers:
+        out[index] = sum(gain * out[leader] for leader, gain in leaders) + offset
+    return out
+
+
 def velocity_map(lay: Layout, qpos) -> np.ndarray:
-    """``T`` (MuJoCo's nv × NV): ``qvel = T v``."""
+    """``T`` (MuJoCo's nv × NV): ``qvel = T v`` (with couplings, ``T_mj T_c``)."""
+    T = _tree_velocity_map(lay, qpos)
+    return T if lay.coupling is None else T @ lay.coupling
+
+
+def _tree_velocity_map(lay: Layout, qpos) -> np.ndarray:
+    """MuJoCo's ``qvel`` of the whole tree's ``v`` (nv × NV_full)."""
     T = np.zeros((lay.nv, len(lay.dof_index)))
     T[lay.dof_index, np.arange(len(lay.dof_index))] = 1.0
     if lay.free is not None:
@@ -139,4 +192,5 @@ def _absent(m, lay: Layout) -> np.ndarray:
     """MuJoCo qpos entries eomgen has no coordinate for."""
     mask = np.ones(m.nq, dtype=bool)
     mask[lay.qpos_index] = False
+    mask[[index for index, _ in lay.locked]] = False
     return mask

@@ -2,18 +2,36 @@
 and the findings warned about (or refused) by name: joint springs, tendons, other actuators,
 equality constraints, fluid forces, gravity compensation (:mod:`eomgen.parsers.mjcf`).
 
-Each equality kind has its reader in :data:`EQUALITY_READERS` (``connect`` and ``weld`` will
-be loops, first-order ``joint`` equalities couplings); today each returns the notice that it is
-not read yet, and a ``joint`` equality of higher order is refused.
+Each equality kind has its reader in :data:`EQUALITY_READERS`: a first-order ``joint``
+equality is a coupling (:class:`~eomgen.model.Coupling`) or, without a second joint, a locked
+joint (:class:`JointLock`); ``connect`` is a point loop and ``weld`` a weld loop
+(:class:`~eomgen.model.Loop`); a ``joint`` equality of higher order is refused; an inactive
+equality, a ``tendon`` or flex one is a notice.
 """
 
 from __future__ import annotations
 
-from typing import Callable
+from dataclasses import replace
+from typing import Callable, NamedTuple, Union
 
 from ...errors import UnsupportedError
-from ...model import Notice, NoticeKind
-from .tree import FREE, HINGE, SLIDE, disabled, joint_names
+from ...model import (
+    POINT_LOOP,
+    WELD as WELD_LOOP,
+    Coupling,
+    Loop,
+    LoopFrame,
+    Notice,
+    NoticeKind,
+    RobotModel,
+    Transform,
+    lock_joints,
+    make_coupling,
+    scalar,
+    vec3,
+    with_couplings,
+)
+from .tree import FREE, HINGE, SLIDE, body_names, disabled, joint_names, rotation_of_quaternion
 
 #: MuJoCo's transmission, dynamics, gain and bias types of a plain motor (``mjTRN_JOINT``,
 #: ``mjDYN_NONE``, ``mjGAIN_FIXED``, ``mjBIAS_NONE``) and of ``mjTRN_JOINTINPARENT``.
@@ -24,6 +42,8 @@ _GAIN_MUSCLE, _BIAS_AFFINE = 2, 1
 #: MuJoCo's equality types (``mjtEq``) and wrap type of a joint in a fixed tendon.
 CONNECT, WELD, JOINT, TENDON = 0, 1, 2, 3
 _WRAP_JOINT = 1
+#: MuJoCo's object type of a site (``mjOBJ_SITE``): an equality between two sites.
+_OBJ_SITE = 6
 
 _NOT_READ = "not read yet: the model is the tree without it"
 
@@ -110,9 +130,7 @@ def model_notices(m, source: str) -> tuple[Notice, ...]:
                                    "eomgen's input is the joint torque",
                                    joints=(jnames[int(m.actuator_trnid[i, 0])],) if on_joint
                                    else ()))
-    for e in range(m.neq):
-        reader = EQUALITY_READERS.get(int(m.eq_type[e]), other_equality)
-        notices.append(reader(m, e, source))
+    notices += [found for found in equalities(m, source) if isinstance(found, Notice)]
     if m.opt.density or m.opt.viscosity:
         notices.append(_notice(source, "option density, viscosity",
                                "fluid forces are not modelled", "left out"))
@@ -133,26 +151,85 @@ def _equality_bodies(m, e: int) -> tuple[str, ...]:
                  + m.eq_obj2id[e:e + 1].tolist() if int(b) > 0)
 
 
-def equality_connect(m, e: int, source: str) -> Notice:
-    """A ``connect`` equality (a ball-and-socket loop closure): not read yet."""
-    return _notice(source, _equality_where(m, e, "connect"), "loop closures are " + _NOT_READ,
-                   links=_equality_bodies(m, e))
+def equality_connect(m, e: int, source: str) -> Union[Loop, Notice]:
+    """A ``connect`` equality: the point loop ``<name>`` (3 rows, world axes) holding the
+    anchor on ``body1`` (frame b, ``eq_data[0:3]`` in body1's frame) on the same point of
+    ``body2`` (frame a, ``eq_data[3:6]``, where the compiler put it at ``qpos0``): ``Φ = p_1 −
+    p_2``, MuJoCo's own residual and rows, and λ the force on body1 (MuJoCo's
+    ``efc_force``). Between sites, the two sites' origins."""
+    where = _equality_where(m, e, "connect")
+    if not bool(m.eq_active0[e]):
+        return _inactive(m, e, source, where)
+    data = m.eq_data[e]
+    one, two = (_site_frame(m, e, k) if int(m.eq_objtype[e]) == _OBJ_SITE
+                else _body_frame(m, e, k, data[3 * k:3 * k + 3]) for k in (0, 1))
+    return Loop(_name(m, "eq", e), POINT_LOOP, two, one)
 
 
-def equality_weld(m, e: int, source: str) -> Notice:
-    """A ``weld`` equality (a rigid loop closure): not read yet."""
-    return _notice(source, _equality_where(m, e, "weld"), "loop closures are " + _NOT_READ,
-                   links=_equality_bodies(m, e))
+def equality_weld(m, e: int, source: str) -> Union[Loop, Notice]:
+    """A ``weld`` equality: the weld loop ``<name>`` (6 rows, world axes) holding frame b on
+    ``body1`` (origin ``eq_data[3:6]``, axes ``relpose``, ``eq_data[6:10]``) on frame a on
+    ``body2`` (origin the ``anchor``, ``eq_data[0:3]``): MuJoCo's ``R_1 · relpose = R_2`` and
+    its anchor; λ acts on body1. ``torquescale="0"`` leaves the rotation free: a point loop.
+    Between sites, the two site frames."""
+    where = _equality_where(m, e, "weld")
+    if not bool(m.eq_active0[e]):
+        return _inactive(m, e, source, where)
+    data = m.eq_data[e]
+    if int(m.eq_objtype[e]) == _OBJ_SITE:
+        one, two = _site_frame(m, e, 0), _site_frame(m, e, 1)
+    else:
+        one = _body_frame(m, e, 0, data[3:6], rotation_of_quaternion(data[6:10]))
+        two = _body_frame(m, e, 1, data[0:3])
+    kind = WELD_LOOP if float(data[10]) else POINT_LOOP
+    return Loop(_name(m, "eq", e), kind, two, one)
 
 
-def equality_joint(m, e: int, source: str) -> Notice:
-    """A ``joint`` equality ``q1 = c0 + c1 q2 (+ c2 q2² + …)``: a coupling when first-order
-    (not read yet), refused above.
+def _inactive(m, e: int, source: str, where: str) -> Notice:
+    return _notice(source, where, "an inactive equality is not modelled (MuJoCo enforces it "
+                   "only once switched on)", "left out", links=_equality_bodies(m, e))
+
+
+def _body_frame(m, e: int, k: int, anchor, rotation=None) -> LoopFrame:
+    """Equality ``e``'s frame on its body ``k`` (0: body1, 1: body2) at ``anchor`` [m] in
+    the body frame, with axes ``rotation`` (the body's when None)."""
+    body = int((m.eq_obj1id if k == 0 else m.eq_obj2id)[e])
+    return LoopFrame(body_names(m)[body], _pose(anchor, rotation))
+
+
+def _site_frame(m, e: int, k: int) -> LoopFrame:
+    site = int((m.eq_obj1id if k == 0 else m.eq_obj2id)[e])
+    return LoopFrame(body_names(m)[int(m.site_bodyid[site])],
+                     _pose(m.site_pos[site], rotation_of_quaternion(m.site_quat[site])))
+
+
+def _pose(anchor, rotation) -> Transform:
+    if rotation is None:
+        return Transform(translation=vec3(float(v) for v in anchor))
+    return Transform(tuple(tuple(scalar(float(v)) for v in row) for row in rotation),
+                     vec3(float(v) for v in anchor))
+
+
+class JointLock(NamedTuple):
+    """A joint held at ``position`` [rad or m] by a ``joint`` equality without a second
+    joint (``element`` names it)."""
+
+    joint: str
+    position: float
+    element: str
+
+
+def equality_joint(m, e: int, source: str) -> Union[Coupling, JointLock, Notice]:
+    """A ``joint`` equality, MuJoCo's ``q1 − ref1 = c0 + c1 (q2 − ref2)`` (``polycoef``
+    ``c0 … c4``, the refs the joints' ``ref``, MuJoCo's ``qpos0``): first-order, the coupling
+    ``q1 = c1 q2 + (ref1 + c0 − c1 ref2)`` (eomgen's ``q`` is MuJoCo's ``qpos``); without
+    ``joint2`` (or with ``c1 = 0``) the lock ``q1 = ref1 + c0``; inactive (``active="false"``),
+    a notice (MuJoCo does not enforce it unless it is switched on).
 
     Raises
     ------
     UnsupportedError
-        A polynomial of order above one.
+        A polynomial of order above one; a joint that is not a hinge or a slide.
     """
     jnames = joint_names(m)
     where = _equality_where(m, e, "joint")
@@ -162,9 +239,19 @@ def equality_joint(m, e: int, source: str) -> Notice:
         raise UnsupportedError(source, where, f"a joint equality of order {order} (polycoef "
                                f"{' '.join(f'{c:g}' for c in coefficients)}): only first-order "
                                "couplings q1 = c0 + c1 q2 are read")
-    joints = (jnames[int(m.eq_obj1id[e])],) + (
-        (jnames[int(m.eq_obj2id[e])],) if int(m.eq_obj2id[e]) >= 0 else ())
-    return _notice(source, where, "joint couplings are " + _NOT_READ, joints=joints)
+    ids = [int(m.eq_obj1id[e])] + ([int(m.eq_obj2id[e])] if int(m.eq_obj2id[e]) >= 0 else [])
+    for j in ids:
+        if int(m.jnt_type[j]) not in (HINGE, SLIDE):
+            raise UnsupportedError(source, where, f"joint '{jnames[j]}' is not a hinge or a "
+                                   "slide: only one-axis joints are coupled")
+    joints = tuple(jnames[j] for j in ids)
+    if not bool(m.eq_active0[e]):
+        return replace(_inactive(m, e, source, where), links=(), joints=joints)
+    ref = [float(m.qpos0[int(m.jnt_qposadr[j])]) for j in ids]
+    c0, c1 = coefficients[:2]
+    if len(ids) == 1 or c1 == 0:
+        return JointLock(joints[0], ref[0] + c0, where)
+    return make_coupling(joints[0], {joints[1]: c1}, ref[0] + c0 - c1 * ref[1], where)
 
 
 def other_equality(m, e: int, source: str) -> Notice:
@@ -174,7 +261,85 @@ def other_equality(m, e: int, source: str) -> Notice:
                    "this equality is not modelled: the model is the tree without it")
 
 
-#: The reader of each equality kind (MuJoCo's ``mjtEq`` code): a notice today; the loop and
-#: coupling readers when those exist.
-EQUALITY_READERS: dict[int, Callable[..., Notice]] = {
+#: The reader of each equality kind (MuJoCo's ``mjtEq`` code): what the equality is in
+#: eomgen's model (a coupling, a locked joint), or the notice that it is not modelled.
+EQUALITY_READERS: dict[int, Callable[..., Union[Coupling, JointLock, Notice]]] = {
     CONNECT: equality_connect, WELD: equality_weld, JOINT: equality_joint}
+
+
+def equalities(m, source: str) -> list:
+    """What each equality of ``m`` is (:data:`EQUALITY_READERS`), in MuJoCo's order."""
+    return [EQUALITY_READERS.get(int(m.eq_type[e]), other_equality)(m, e, source)
+            for e in range(m.neq)]
+
+
+def with_equalities(model: RobotModel, m, source: str) -> RobotModel:
+    """``model`` (the tree of ``m``) with its equalities: the couplings of ``joint``
+    equalities (a chain of them, ``q3`` following ``q2`` following ``q1``, written in the
+    independent joints), the locked joints (``model.info["mujoco_locks"]``: ``(joint,
+    position)`` pairs, for :func:`eomgen.parsers.mjcf.convert.layout`) and the loops of
+    ``connect`` and ``weld`` (:attr:`~eomgen.model.RobotModel.loops`, in MuJoCo's order). An
+    equality on a dropped free body's joints or bodies is left out with that body; one
+    joining such a joint or body to a kept one is a notice.
+
+    Raises
+    ------
+    KinematicTreeError
+        Two equalities on one follower, a cycle of them (:func:`eomgen.model.check_couplings`),
+        a joint locked against its coupling.
+    """
+    present = {joint.name for joint in model.joints} | {link.name for link in model.links}
+    couplings, locks, loops, notices = [], {}, [], []
+    for found in equalities(m, source):
+        if isinstance(found, Notice):
+            continue  # in model_notices
+        if isinstance(found, Loop):
+            names, element = (found.a.link, found.b.link), f"equality '{found.name}'"
+        elif isinstance(found, JointLock):
+            names, element = (found.joint,), found.element
+        else:
+            names = (found.follower,) + tuple(name for name, _ in found.leaders)
+            element = found.where
+        if not any(name in present for name in names):
+            continue
+        if not all(name in present for name in names):
+            kept = tuple(n for n in names if n in present)
+            notices.append(_notice(source, element, "it joins a dropped free body", "left out",
+                                   **({"links": kept} if isinstance(found, Loop)
+                                      else {"joints": kept})))
+        elif isinstance(found, Loop):
+            loops.append(found)
+        elif isinstance(found, JointLock):
+            locks[found.joint] = found.position
+        else:
+            couplings.append(found)
+    model = with_couplings(model, _resolved(couplings)) if couplings else model
+    if locks:
+        model = replace(lock_joints(model, locks), info=model.info + (
+            ("mujoco_locks", tuple(locks.items())),))
+    return replace(model, loops=tuple(loops), notices=tuple(model.notices) + tuple(notices))
+
+
+def _resolved(couplings: list[Coupling]) -> list[Coupling]:
+    """``couplings`` with each leader that follows another coupling replaced by its own
+    leaders (MuJoCo allows chains of joint equalities, eomgen's couplings name independent
+    joints); a cycle is left for :func:`eomgen.model.check_couplings` to refuse."""
+    by_follower = {c.follower: c for c in couplings}
+    out = []
+    for coupling in couplings:
+        seen = {coupling.follower}
+        while any(name in by_follower and name not in seen for name, _ in coupling.leaders):
+            leaders: dict = {}
+            offset = coupling.offset
+            for name, gain in coupling.leaders:
+                inner = by_follower.get(name)
+                if inner is None or name in seen:
+                    leaders[name] = leaders.get(name, 0) + gain
+                    continue
+                seen.add(name)
+                offset += gain * inner.offset
+                for leader, k in inner.leaders:
+                    leaders[leader] = leaders.get(leader, 0) + gain * k
+            coupling = replace(coupling, leaders=tuple(leaders.items()), offset=offset)
+        out.append(coupling)
+    return out
