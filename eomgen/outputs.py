@@ -564,7 +564,7 @@ DRIVE_FORWARD_DERIVATIVES = register_output(Output(
 CONSTRAINED_PARTIALS = register_output(Output(
     "constrained_dynamics_partials", "dKKT", "[[dr/dq, dr/dqd], [da/dq, da/dqd]] (nv + m, 2 nv) "
     "of r = tau_c(q, qd, qdd, F_c) and the contact accelerations a = J_c qdd + J_c-dot qd.",
-    ("q", "qd", "qdd", "F_c"), False, "mixed", ("dKKT",), default=False,
+    ("q", "qd", "qdd", "F_c"), False, "mixed", ("dKKT",), default=False, constants=_CONTACT_NAMES,
     build="eomgen.symbolic.contact_derivatives:build_constrained_partials"))
 CONSTRAINED_DERIVATIVES = register_output(Output(
     "constrained_forward_dynamics_derivatives", None, "d(qdd, F_c)/d(q, qd, tau) of "
