@@ -42,13 +42,17 @@ DEFAULT_OUTPUTS = ("M", "C", "g")
 #: them; Y_SL against M, ``computeCoriolisMatrix`` and g; Y_K, Y_P against Pinocchio's energies;
 #: the drive outputs against ``model.armature`` and the friction law; the flat outputs against
 #: finite differences along a trajectory integrated on the configuration space). The others
-#: (derivatives by q, loop closures) are refused in one line.
+#: (loop closures, the drive derivatives) are refused in one line; the derivatives are taken
+#: along the tangent (eomgen.symbolic.tangent).
 FREE_FLYER_OUTPUTS = ("M", "C", "g", "P", "tau", "h", "qdd_aba", "MCg", "Mh", "p_f", "R_f",
                       "J_f", "Jb_f", "dJqd_f", "dJbqd_f", "J_c", "dJqd_c", "tau_c", "cone_c",
                       "pyramid_c", "c_G", "J_G", "A_G", "dAGv", "I_G", "Y", "pi", "Y_base", "beta",
                       "Y_SL", "Y_SL_base", "Y_K", "Y_P", "M_a", "tau_f", "tau_f_smooth", "tau_a",
                       "M_l", "tau_K", "thetadd_m", "theta_flat", "thetad_flat", "tau_flat",
-                      "tau_flat_smooth")
+                      "tau_flat_smooth",
+                      # issue 25: derivatives along the tangent (eomgen.symbolic.tangent)
+                      "dtau_dq", "dtau_dqd", "dtau", "dg_dq", "dqdd_dq", "dqdd_dqd", "Minv",
+                      "dqdd", "A_lin", "B_lin", "AB", "dKKT")
 
 #: ``derive(model, simplify=True)`` refuses models with more movable joints: trigonometric
 #: simplification of the expanded expressions grows exponentially with the number of joints

@@ -481,8 +481,8 @@ SLOTINE_LI_BASE_REGRESSOR = register_output(Output(
     _PER_PARAMETER, ("Y_SL_base",), build=_SLOTINE_LI, default=False, constants=_BASE_NAMES))
 
 
-# --- issue 25: exact derivatives of the dynamics (eomgen.symbolic.derivatives), fixed bases;
-# derivatives with respect to q are in the velocity (tangent) coordinates (nv columns).
+# --- issue 25: exact derivatives of the dynamics (eomgen.symbolic.derivatives); derivatives
+# with respect to q are along the tangent (nv columns: eomgen.symbolic.tangent).
 _DERIVATIVES = "eomgen.symbolic.derivatives:build_derivatives"
 _PER_Q = "of the joint efforts per rad (revolute columns) or m (prismatic)"
 DTAU_DQ = register_output(Output(
@@ -520,7 +520,8 @@ FORWARD_DERIVATIVES = register_output(Output(
     build=_DERIVATIVES, default=False, returns=("dqdd_dq", "dqdd_dqd", "Minv")))
 STATE_MATRIX = register_output(Output(
     "state_matrix", "A_lin", "A = df/dx (2 nv, 2 nv) of xdot = f(x, tau), x = (q, qd): "
-    "[[0, I], [dqdd/dq, dqdd/dqd]].", ("q", "qd", "tau"), False, "1, 1/s, 1/s^2",
+    "[[T, I], [dqdd/dq, dqdd/dqd]], T = 0 (quaternion joints: -ad_v / 2, the tangent chart's).",
+    ("q", "qd", "tau"), False, "1, 1/s, 1/s^2",
     ("A_lin",), build=_DERIVATIVES, default=False, width=2))
 INPUT_MATRIX = register_output(Output(
     "input_matrix", "B_lin", "B = df/dtau (2 nv, nv) of xdot = f(x, tau): [[0], [M^-1]].",
@@ -560,6 +561,18 @@ DRIVE_FORWARD_DERIVATIVES = register_output(Output(
     ("dqdd_a",), build=_DERIVATIVES, default=False,
     returns=("dqdd_a_dq", "dqdd_a_dqd", "Minv_a")))
 
+CONSTRAINED_PARTIALS = register_output(Output(
+    "constrained_dynamics_partials", "dKKT", "[[dr/dq, dr/dqd], [da/dq, da/dqd]] (nv + m, 2 nv) "
+    "of r = tau_c(q, qd, qdd, F_c) and the contact accelerations a = J_c qdd + J_c-dot qd.",
+    ("q", "qd", "qdd", "F_c"), False, "mixed", ("dKKT",), default=False, constants=_CONTACT_NAMES,
+    build="eomgen.symbolic.contact_derivatives:build_constrained_partials"))
+CONSTRAINED_DERIVATIVES = register_output(Output(
+    "constrained_forward_dynamics_derivatives", None, "d(qdd, F_c)/d(q, qd, tau) of "
+    "constrained_forward_dynamics: K^-1 (-dKKT, [1; 0]), K its KKT matrix.", ("q", "qd", "tau"),
+    False, "those of the forward dynamics derivatives; N per unit", ("M", "tau", "J_c", "dJqd_c",
+    "dKKT"), composed_from=(*CONSTRAINED_FORWARD.composed_from, CONSTRAINED_FORWARD.function,
+    CONSTRAINED_PARTIALS.function), default=False, constants=_CONTACT_NAMES,
+    backends=("numpy", "fast", "jax", "torch")))
 
 # --- issue 27: task-space quantities, composed from M, J_f, J_f-dot qd and tau (templates) --
 #: The backends whose templates compose the task-space functions.

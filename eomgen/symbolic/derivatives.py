@@ -1,4 +1,4 @@
-"""Exact derivatives of the dynamics as straight-line programs (issue 25, fixed bases).
+"""Exact derivatives of the dynamics as straight-line programs (issue 25).
 
 The derivatives are the dynamics' own programs differentiated once in forward mode
 (:func:`forward_mode`): each assignment ``x = f(a, b, …)`` of the Newton–Euler (or ABA) program
@@ -11,8 +11,10 @@ derivative is defined in the derivation's builder, so it reuses the dynamics' in
 direction has no derivative along it (nothing is computed), which is where the structure of the
 tree shows: ∂/∂q_j of a body's velocity exists only below joint j.
 
-Outputs (symbols of :mod:`eomgen.outputs`), n joints, ``JOINT_NAMES`` order; derivatives with
-respect to q are in the velocity (tangent) coordinates, n_v columns (= n for fixed bases):
+Outputs (symbols of :mod:`eomgen.outputs`), n = NV joints, ``JOINT_NAMES`` order; derivatives
+with respect to q are along the tangent, NV columns (:mod:`eomgen.symbolic.tangent`: for a
+quaternion free flyer or ball joints, ``d/dε f(q ⊕ ε eᵢ)`` with v held fixed, as Pinocchio's;
+each q entry's own direction otherwise):
 
 * ``dtau_dq``, ``dtau_dqd`` (n × n): ∂τ/∂q and ∂τ/∂q̇ of τ(q, q̇, q̈) (Newton–Euler); ∂τ/∂q̈ = M.
 * ``dg_dq`` (n × n): ∂g/∂q of g(q) = τ(q, 0, 0).
@@ -23,7 +25,8 @@ respect to q are in the velocity (tangent) coordinates, n_v columns (= n for fix
   Newton–Euler derivatives taken at q̈ = ABA(q, q̇, τ) held fixed (the implicit function
   theorem on τ(q, q̇, q̈(q, q̇, τ)) = τ; what Pinocchio's ``computeABADerivatives`` does).
 * ``A_lin`` (2n × 2n) and ``B_lin`` (2n × n): ẋ = f(x, τ), x = (q, q̇), linearized:
-  A = [[0, I], [∂q̈/∂q, ∂q̈/∂q̇]], B = [[0], [M⁻¹]].
+  A = [[T, I], [∂q̈/∂q, ∂q̈/∂q̇]], B = [[0], [M⁻¹]], T = 0 but for quaternion joints
+  (:func:`eomgen.symbolic.tangent.velocity_transport`).
 * ``dtau_a_dqd`` (n × n): ∂τ_a/∂q̇ = ∂τ/∂q̇ + diag(d) of the drive torques
   τ_a = τ + a q̈ + d q̇ + f sign(q̇) (∂τ_a/∂q = ∂τ/∂q; the Coulomb sign's derivative is 0 for
   q̇_i ≠ 0).
@@ -40,10 +43,11 @@ import sympy as sp
 
 from ..model import joint_actuators
 from ..outputs import BY_SYMBOL
-from .aba import forward_dynamics_program
+from .aba import forward_dynamics_program, true_accelerations
 from .drives import friction_torque_expr
 from .newton_euler import inverse_dynamics_program
 from .program import ProgramBuilder, name_expr
+from .tangent import tangent_seeds, velocity_transport
 
 #: the key of this module's work in ``Derivation.shared``
 _SHARED = __name__
@@ -117,7 +121,9 @@ def forward_mode(b: ProgramBuilder, outputs, seeds: dict, frozen=frozenset()) ->
     outputs:
         Expressions to differentiate.
     seeds:
-        ``{input symbol: direction}``: the input is the direction's variable (derivative 1).
+        ``{input symbol: direction}``: the input is the direction's variable (derivative 1);
+        or ``{input symbol: {direction: derivative}}``: the input's derivative along each
+        direction (an expression; a tangent direction of a quaternion, :func:`tangent_seeds`).
     frozen:
         Intermediates held constant (their derivative is zero, their definition not followed).
 
@@ -136,7 +142,8 @@ def forward_mode(b: ProgramBuilder, outputs, seeds: dict, frozen=frozenset()) ->
     >>> b.assignments[1:]
     [(ps, y*cos(x)), (ps_, sin(x)), (p, 2*s), (d_x1, p*ps), (d_y1, p*ps_)]
     """
-    D: dict = {s: {d: sp.Integer(1)} for s, d in seeds.items()}
+    D: dict = {s: dict(d) if isinstance(d, dict) else {d: sp.Integer(1)}
+               for s, d in seeds.items()}
     outputs = [sp.sympify(e) for e in outputs]
     partials: dict = {}
     for symbol, expr, free in _relevant(list(b.assignments), outputs, seeds, frozen):
@@ -177,7 +184,7 @@ def inverse_dynamics_jacobians(derivation) -> tuple[sp.Matrix, sp.Matrix]:
     if "dtau" not in work:
         tau = derivation.output("tau")
         n = len(derivation.q)
-        seeds = {**_seeds(derivation.q, "q"), **_seeds(derivation.qd, "qd")}
+        seeds = {**tangent_seeds(derivation), **_seeds(derivation.qd, "qd")}
         rows = forward_mode(derivation.builder, list(tau), seeds)
         work["dtau"] = (_jacobian(rows, "q", n), _jacobian(rows, "qd", n))
     return work["dtau"]
@@ -189,7 +196,7 @@ def gravity_jacobian(derivation) -> sp.Matrix:
     zero = (sp.Integer(0),) * n
     g = inverse_dynamics_program(derivation.tree, derivation.q, zero, zero,
                                  derivation.model.gravity, derivation.builder, hint="g")
-    rows = forward_mode(derivation.builder, list(g), _seeds(derivation.q, "q"))
+    rows = forward_mode(derivation.builder, list(g), tangent_seeds(derivation))
     return _jacobian(rows, "q", n)
 
 
@@ -211,24 +218,26 @@ def _aba(derivation) -> sp.Matrix:
         b = derivation.builder
         qdd = forward_dynamics_program(derivation.tree, derivation.q, derivation.qd,
                                        derivation.tau, derivation.model.gravity, b)
+        qdd = true_accelerations(derivation, qdd)  # v̇ of quaternion joints, not the chart's
         work["qdd"] = sp.Matrix([b.define(e, f"qdd_a{k + 1}") for k, e in enumerate(qdd)])
     return work["qdd"]
 
 
 def _efforts_at(derivation, qdd, hint: str) -> tuple[sp.Matrix, sp.Matrix]:
     """(∂τ/∂q, ∂τ/∂q̇) of the Newton–Euler τ(q, q̇, q̈) at the named accelerations ``qdd``
-    held fixed (the implicit function theorem's half of ∂q̈)."""
+    held fixed (the implicit function theorem's half of ∂q̈; ∂/∂q in tangent coordinates)."""
     b, n = derivation.builder, len(derivation.q)
-    inputs = set(derivation.q) | set(derivation.qd)
+    inputs = set(derivation.inputs["q"]) | set(derivation.qd)
     frozen = set()
     for e in qdd:  # a named intermediate (±), or free of q and q̇ (e.g. τ_1 / m of a lone body)
         named = e.is_Symbol or (e.is_Mul and e.args[0] == -1 and e.args[1].is_Symbol)
         if not named and e.free_symbols & inputs:
             raise ValueError(f"forward-dynamics acceleration {e} is not a named intermediate")
         frozen |= e.free_symbols - inputs
-    tau = inverse_dynamics_program(derivation.tree, derivation.q, derivation.qd, tuple(qdd),
+    tau = inverse_dynamics_program(derivation.tree, derivation.q, derivation.qd,
+                                   derivation.accelerations(tuple(qdd)),
                                    derivation.model.gravity, b, hint=hint)
-    seeds = {**_seeds(derivation.q, "q"), **_seeds(derivation.qd, "qd")}
+    seeds = {**tangent_seeds(derivation), **_seeds(derivation.qd, "qd")}
     rows = forward_mode(b, list(tau), seeds, frozenset(frozen))
     return _jacobian(rows, "q", n), _jacobian(rows, "qd", n)
 
@@ -285,10 +294,12 @@ def drive_forward_dynamics_jacobians(derivation) -> tuple[sp.Matrix, sp.Matrix, 
 
 
 def linearization(derivation) -> tuple[sp.Matrix, sp.Matrix]:
-    """A (2n × 2n) and B (2n × n) of ẋ = f(x, τ), x = (q, q̇)."""
+    """A (2n × 2n) and B (2n × n) of ẋ = f(x, τ), x = (q, q̇), n = NV: with quaternion
+    joints x = (δ, v) in the chart δ ↦ q ⊕ δ at δ = 0, whose position rows are
+    δ̇ = J_r(δ)⁻¹ v (:func:`eomgen.symbolic.tangent.velocity_transport`)."""
     n = len(derivation.q)
     dq, dqd, Minv = forward_dynamics_jacobians(derivation)
-    A = sp.Matrix.vstack(sp.Matrix.hstack(sp.zeros(n, n), sp.eye(n)),
+    A = sp.Matrix.vstack(sp.Matrix.hstack(velocity_transport(derivation), sp.eye(n)),
                          sp.Matrix.hstack(dq, dqd))
     B = sp.Matrix.vstack(sp.zeros(n, n), Minv)
     return A, B

@@ -11,7 +11,8 @@ from typing import Callable
 import sympy as sp
 
 from .. import Job, Loaded
-from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, INPUTS, PARALLEL_INVERSE,
+from ...outputs import (CONSTRAINED_DERIVATIVES, CONSTRAINED_FORWARD, CONSTRAINED_PARTIALS,
+                       FORWARD, INPUT_SIZES, INPUTS, PARALLEL_INVERSE,
                        TASK_SPACE, composition_names, constrained_names, exported,
                        parallel_names, task_space_names)
 from ..functions import FunctionSpec
@@ -204,6 +205,9 @@ def python_module_context(job: Job, printer, template: str, extra_exports=(),
         fd=composition_names(FORWARD),
         constrained_forward_dynamics=CONSTRAINED_FORWARD.function in functions,
         cfd=constrained_names(),
+        # issue 25: its derivatives, composed from it and the KKT partials (NumPy only)
+        constrained_derivatives=CONSTRAINED_DERIVATIVES.function in functions,
+        cfdd={"name": CONSTRAINED_DERIVATIVES.function, "partials": CONSTRAINED_PARTIALS.function},
         parallel_inverse=PARALLEL_INVERSE.function in functions,
         pid=parallel_names(),
         **parallel_indices(job.model),

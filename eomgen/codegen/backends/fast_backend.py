@@ -28,7 +28,8 @@ from sympy.printing.precedence import PRECEDENCE
 
 from ...compiler import c_compiler, shared_library
 from .. import GeneratedFile, Job, Loaded, register
-from ...outputs import (CONSTRAINED_FORWARD, FORWARD, INPUT_SIZES, PARALLEL_INVERSE,
+from ...outputs import (CONSTRAINED_DERIVATIVES, CONSTRAINED_FORWARD, CONSTRAINED_PARTIALS,
+                       FORWARD, INPUT_SIZES, PARALLEL_INVERSE,
                        TASK_SPACE, composition_names, constrained_names, exported,
                        parallel_names, task_space_names)
 from ...symbolic.printing import FloatLiteralMixin
@@ -194,6 +195,14 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
         "<= 1e-10 of A's largest diagonal entry: dependent contact rows, use damping > 0); "
         "FloatingPointError when M, C qd + g, tau, J_c or J_c-dot qd is not finite; "
         "ValueError for a damping not finite or < 0.")
+    # issue 25: its derivatives (templates/fast/constrained_derivatives.c.jinja)
+    derivatives = CONSTRAINED_DERIVATIVES.function in exported(job.functions, "fast")
+    derivatives_doc = c_string_literal(
+        f"{CONSTRAINED_DERIVATIVES.function}({', '.join(CONSTRAINED_DERIVATIVES.inputs)}, "
+        f"*{signature}, damping=0.0)\n--\n\n{CONSTRAINED_DERIVATIVES.summary}\n\nReturns "
+        f"(dqdd_dq, dqdd_dqd, dqdd_dtau) of shape (NV, NV) and (dF_dq, dF_dqd, dF_dtau) of "
+        f"shape ({nc}, NV) (a leading N for a batch): {cfd['name']}'s solve, then its Cholesky "
+        "factors on -constrained_dynamics_partials and [1; 0]; its errors.")
     task = _task_space_context(job, functions, signature)
     pid = parallel_names()
     parallel = PARALLEL_INVERSE.function in exported(job.functions, "fast")
@@ -239,6 +248,9 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
         cfd=cfd,
         nc=nc,
         constrained_doc=constrained_doc,
+        constrained_derivatives=derivatives,
+        cfdd={"name": CONSTRAINED_DERIVATIVES.function, "partials": CONSTRAINED_PARTIALS.function},
+        constrained_derivatives_doc=derivatives_doc,
         parallel_inverse=parallel,
         pid=pid,
         nl=nl,

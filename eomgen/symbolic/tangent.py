@@ -1,0 +1,104 @@
+"""Derivatives with respect to the configuration in tangent coordinates (issue 25).
+
+A model's configuration ``q`` has NQ entries, its velocity ``v`` NV: a quaternion free flyer or
+ball joint (:mod:`eomgen.model.quaternion`) holds four quaternion entries for three rotational
+velocities. A derivative "with respect to q" is then, as in Pinocchio, the derivative along the
+tangent: column ``i`` of ∂f/∂q is ``d/dε f(q ⊕ ε eᵢ)`` at ``ε = 0``, with
+``q ⊕ δ`` :func:`eomgen.quaternion_joints.integrate` (the joint's pose times the exponential of
+``δ`` in its own frame: ``M exp(δ)``), ``v`` and the other arguments held fixed (``v`` is the
+body twist of the free flyer, the child-frame angular velocity of a ball joint).
+
+The derivation's programs are functions of the configuration entries themselves (the chart of
+:mod:`eomgen.symbolic.quaternion_joints` is re-centred at each ``q``), so the tangent
+derivative is the chain rule through ``∂(q ⊕ δ)/∂δ`` at ``δ = 0`` (:func:`tangent_seeds`):
+
+* a one-axis joint's entry: 1 along its own direction;
+* the free flyer's origin ``p``: ``R`` along the linear directions (``p ⊕ δ = p + R V(ω) v``,
+  and ``V = 1`` to first order), 0 along the angular ones;
+* a quaternion ``(x, y, z, w)``: ``½ (w eₖ + (x, y, z) × eₖ)`` and ``−½ (x, y, z)ₖ`` along
+  the angular direction ``k`` (``q ⊗ (ω/2, 1)`` to first order). These directions are
+  tangent to the sphere of the quaternion's norm, so they hold for a quaternion of any norm
+  (the rotation is that of the normalised quaternion).
+
+In the same chart ``δ ↦ q ⊕ δ`` the state equation's position rows are
+``δ̇ = J_r(δ)⁻¹ v`` (``J_r`` the right Jacobian of the joint's group), whose derivative at
+``δ = 0`` is :func:`velocity_transport`: ``−½ ad_v`` for the free flyer (SE(3)),
+``−½ [ω]×`` for a ball joint (SO(3)), 0 for one-axis joints.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from .quaternion_joints import placements
+
+_HALF = sp.Rational(1, 2)
+
+
+def tangent_seeds(derivation, prefix: str = "q") -> dict:
+    """``{configuration symbol: {(prefix, i): ∂q/∂δᵢ}}`` at ``δ = 0`` (module docstring), for
+    :func:`eomgen.symbolic.derivatives.forward_mode`: the seeds of a derivative with respect
+    to q in tangent coordinates (NV directions). For a model without quaternion joints each
+    ``q`` entry is its own direction."""
+    q = derivation.inputs["q"]
+    joints = derivation.model.quaternion_joints
+    if not joints:
+        return {s: {(prefix, k): sp.Integer(1)} for k, s in enumerate(q)}
+    placed = placements(joints, q, derivation.builder)  # the derivation's own names again
+    starts = {j.v_index: j for j in joints}
+    seeds: dict = {}
+    k, iq, nv = 0, 0, derivation.model.dof
+    while k < nv:
+        joint = starts.get(k)
+        if joint is None:
+            seeds[q[iq]] = {(prefix, k): sp.Integer(1)}
+            k, iq = k + 1, iq + 1
+            continue
+        if joint.nv == 6:  # the origin moves along R's columns
+            R = placed[joint.v_index].rotation
+            for row in range(3):
+                seeds[q[iq + row]] = {(prefix, k + col): R[row][col] for col in range(3)}
+        x, y, z, w = q[joint.quaternion:joint.quaternion + 4]
+        first = k + joint.nv - 3
+        vector = (x, y, z)
+        for c in range(3):  # d(x, y, z)/dω_c = ½ (w e_c + (x, y, z) × e_c)
+            column = _cross_unit(vector, c)
+            for row, entry in enumerate(vector):
+                d = _HALF * ((w if row == c else 0) + column[row])
+                if d != 0:
+                    seeds.setdefault(entry, {})[(prefix, first + c)] = d
+        seeds[w] = {(prefix, first + c): -_HALF * vector[c] for c in range(3)}
+        k, iq = k + joint.nv, iq + joint.nq
+    return seeds
+
+
+def _cross_unit(a, c: int) -> tuple:
+    """``a × e_c``."""
+    e = [0, 0, 0]
+    e[c] = 1
+    return (a[1] * e[2] - a[2] * e[1], a[2] * e[0] - a[0] * e[2], a[0] * e[1] - a[1] * e[0])
+
+
+def _skew(a) -> sp.Matrix:
+    return sp.Matrix([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+
+
+def velocity_transport(derivation) -> sp.Matrix:
+    """∂δ̇/∂δ at ``δ = 0`` of ``δ̇ = J_r(δ)⁻¹ v`` (NV × NV, module docstring): the block of the
+    state matrix A that the positions' rows take in tangent coordinates; zero without
+    quaternion joints."""
+    nv, v = derivation.model.dof, derivation.inputs["qd"]
+    out = sp.zeros(nv, nv)
+    for joint in derivation.model.quaternion_joints:
+        k = joint.v_index
+        if joint.nv == 6:
+            linear, omega = v[k:k + 3], v[k + 3:k + 6]
+            out[k:k + 3, k:k + 3] = -_HALF * _skew(omega)
+            out[k:k + 3, k + 3:k + 6] = -_HALF * _skew(linear)
+            out[k + 3:k + 6, k + 3:k + 6] = -_HALF * _skew(omega)
+        else:
+            out[k:k + 3, k:k + 3] = -_HALF * _skew(v[k:k + 3])
+    return out
+
+
+__all__ = ["tangent_seeds", "velocity_transport"]
