@@ -55,3 +55,64 @@ def _module_cache_dir(_session_cache_dir, tmp_path_factory):
     with pytest.MonkeyPatch.context() as patch:
         patch.setenv("EOMGEN_CACHE_DIR", str(tmp_path_factory.mktemp("eomgen_cache")))
         yield
+
+
+# ----------------------------------------------------------------------------------------------
+# One worker per module that derives something once for its tests. A module-scoped fixture
+# (a robot derived, its modules generated and compiled) is computed once per worker process
+# that runs one of its tests (and so is a function of the module cached with functools);
+# `pytest -n auto` hands the tests out one by one (the first quarter of the collection
+# round-robin), so both workers paid for most of them. With `--dist loadgroup` (chosen below
+# when -n is given without a --dist of the caller's), the tests of a module that defines such a
+# fixture go to one worker together, largest groups first; the other tests are still handed out
+# one by one. Without xdist the mark is inert.
+# ----------------------------------------------------------------------------------------------
+
+
+def _module_fixture_here(item) -> bool:
+    """Whether ``item`` uses a module- or session-scoped fixture its own module defines, or
+    its module keeps results in a cached function (``functools.cache``, ``lru_cache``)."""
+    module = item.nodeid.split("::")[0]
+    namespace = getattr(getattr(item, "module", None), "__dict__", {})
+    if any(hasattr(value, "cache_info") and value.__module__ == namespace["__name__"]
+           for value in namespace.values()):
+        return True
+    info = getattr(item, "_fixtureinfo", None)
+    if info is None:
+        return False
+    for definitions in info.name2fixturedefs.values():
+        definition = definitions[-1]
+        if definition.scope in ("module", "session") and definition.baseid == module:
+            return True
+    return False
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config, items):
+    grouped = {item.nodeid.split("::")[0] for item in items if _module_fixture_here(item)}
+    for item in items:
+        module = item.nodeid.split("::")[0]
+        if module in grouped:
+            item.add_marker(pytest.mark.xdist_group(module))
+
+
+
+def pytest_configure(config):
+    """``-n`` without a ``--dist`` of the caller's: xdist's default ``load`` becomes
+    ``loadgroup`` (above), and each worker is told so (a worker reads the command line again,
+    where no ``--dist`` stands). Set here rather than in addopts, so that pytest without
+    pytest-xdist still runs."""
+    workerinput = getattr(config, "workerinput", None)
+    if workerinput is not None:
+        if workerinput.get("eomgen_loadgroup"):
+            config.option.loadgroup = True
+        return
+    chosen = [*config.invocation_params.args, *os.environ.get("PYTEST_ADDOPTS", "").split()]
+    if getattr(config.option, "dist", "no") == "load" and not any(
+            str(a).startswith(("--dist", "-d")) for a in chosen):
+        config.option.dist = "loadgroup"
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_configure_node(node):
+    node.workerinput["eomgen_loadgroup"] = node.config.getvalue("dist") == "loadgroup"

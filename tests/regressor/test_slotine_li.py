@@ -81,15 +81,12 @@ def test_random_robots_match_pinocchio(tmp_path, n, tree, seed):
     check_against_pinocchio(model, calls["numpy"], base=n <= 3)
 
 
+# The realistic arm. (A random 7-joint tree was checked here too, left out for the suite's
+# time budget: the 3-joint chain and 4-joint tree above test the same identities at random.)
 @pytest.mark.slow
-def test_a_random_seven_joint_tree_and_the_ur5_match_pinocchio(tmp_path):
-    model = random_robot(rng_of(7), 7, tree=True)
-    (tmp_path / "random").mkdir()
-    calls, _ = generated(model, FUNCTIONS[:4], tmp_path / "random", ("numpy",))
-    check_against_pinocchio(model, calls["numpy"], count=3, base=False)
+def test_the_ur5_matches_pinocchio(tmp_path):
     model = ur5()
-    (tmp_path / "ur5").mkdir()
-    calls, modules = generated(model, FUNCTIONS, tmp_path / "ur5", ("numpy",))
+    calls, modules = generated(model, FUNCTIONS, tmp_path, ("numpy",))
     assert len(modules["numpy"]["BASE_PARAMETER_NAMES"]) == 36
     check_against_pinocchio(model, calls["numpy"], count=3)
 

@@ -36,6 +36,9 @@ RTOL = 1e-10
 
 #: (seed, joints, tree): chains and trees with prismatic joints, random axes and fixed links.
 RANDOM = [(1, 4, False), (3, 6, False), (4, 7, True), (9, 7, False), (10, 3, True)]
+#: The ABA and CRBA programs' random cases: the 7-joint chain left out (it cost as much as the
+#: others together); the Panda, a 7-joint chain, is checked against Pinocchio's aba and crba.
+RANDOM_SHORTER = [case for case in RANDOM if case != (9, 7, False)]
 
 
 
@@ -113,7 +116,7 @@ def test_tau_program_is_exactly_the_lagrangian_with_symbolic_parameters():
 # Articulated-Body Algorithm
 # ----------------------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("case", RANDOM, ids=str)
+@pytest.mark.parametrize("case", RANDOM_SHORTER, ids=str)
 def test_aba_program_solves_the_numeric_equations_of_motion(case):
     model = random_model(case)
     nm = numeric_model(model)
@@ -169,7 +172,7 @@ def test_aba_program_keeps_symbolic_parameters():
 # Composite-Rigid-Body Algorithm in body frames, and the Cholesky route
 # ----------------------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("case", RANDOM, ids=str)
+@pytest.mark.parametrize("case", RANDOM_SHORTER, ids=str)
 def test_crba_program_equals_the_numeric_mass_matrix(case):
     model = random_model(case)
     nm = numeric_model(model)

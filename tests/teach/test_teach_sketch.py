@@ -231,14 +231,13 @@ for name in ("planar_2link", "puma560_dh"):
 def test_render_is_deterministic_in_process_and_across_interpreters(planar, puma):
     first = digests([planar, puma])
     assert digests([planar, puma]) == first
-    runs = []
-    for seed in ("0", "12345"):
-        env = dict(os.environ, PYTHONHASHSEED=seed)
-        out = subprocess.run([sys.executable, "-c", SUBPROCESS], env=env, check=True,
-                             capture_output=True, text=True).stdout.split()
-        runs.append(out)
-    assert runs[0] == runs[1]
-    assert runs[0] == first
+    # One other interpreter, its hash seed other than this one's (which is random unless the
+    # caller fixed it): the same bytes (a second interpreter tested no more than the first).
+    seed = "12345" if os.environ.get("PYTHONHASHSEED") != "12345" else "0"
+    env = dict(os.environ, PYTHONHASHSEED=seed)
+    out = subprocess.run([sys.executable, "-c", SUBPROCESS], env=env, check=True,
+                         capture_output=True, text=True).stdout.split()
+    assert out == first
 
 
 def test_render_formats_have_their_signatures(planar):
