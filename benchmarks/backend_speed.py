@@ -174,7 +174,7 @@ def main(argv=None) -> int:
 
     print(f"Panda ({n} joints), {args.states} states, {args.repeat} repeats; time per state "
           "(median, min-max), ratio of medians to NumPy's in this run\n")
-    print(f"| output | route | per state | spread | / numpy | note |")
+    print("| output | route | per state | spread | / numpy | note |")
     print("| --- | --- | ---: | ---: | ---: | --- |")
     ok = True
     for label, route, t, base, note in rows:

@@ -18,7 +18,6 @@ import math
 from dataclasses import replace
 from xml.sax.saxutils import quoteattr
 
-import pytest
 
 import eomgen
 from eomgen.floating import PinocchioFreeFlyer as FreeFlyerReference  # noqa: F401  (re-export)
