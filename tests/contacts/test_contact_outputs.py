@@ -19,6 +19,7 @@ import pytest
 import eomgen
 from eomgen.codegen import loadable_backends
 from support import ROOT, erd_robots_dir, floating_states, run_in_process
+from support.reference import pinocchio_contacts
 from eomgen import floating
 from eomgen.codegen.functions import select_functions
 from eomgen.codegen.generate import render_files
@@ -215,13 +216,7 @@ def test_solo_constrained_dynamics_matches_pinocchio_and_the_numeric_kkt(solo):
     cd = ContactDynamics(model, model.contacts)
     ref = floating.PinocchioFreeFlyer(path, model.joint_names)
     pm, pd, idx = ref.model, ref.data, ref.idx
-    models = pin.StdVec_RigidConstraintModel()
-    for c in model.contacts:
-        fr = pm.frames[pm.getFrameId(c.frame)]
-        models.append(pin.RigidConstraintModel(pin.ContactType.CONTACT_3D, pm, fr.parentJoint,
-                                               fr.placement, pin.LOCAL_WORLD_ALIGNED))
-    datas = pin.StdVec_RigidConstraintData([c.createData() for c in models])
-    pin.initConstraintDynamics(pm, pd, models, datas)
+    models, datas = pinocchio_contacts(pm, pd, [c.frame for c in model.contacts])
     for q, qd, tau in _states(3, 8):
         q_pin, v = ref.state(q, qd)
         T = floating.velocity_map(q)

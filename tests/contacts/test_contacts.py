@@ -25,6 +25,7 @@ from eomgen.model import Inertial, Joint, JointType, Link, Transform, build_mode
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support.robots import SOLO, FreeFlyerReference
+from support.reference import pinocchio_contacts
 
 FEET = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
 
@@ -44,14 +45,7 @@ def test_constrained_dynamics_matches_pinocchio(solo, kind, feet):
     cd = ContactDynamics(model, tuple(Contact(f, kind) for f in feet))
     ref = FreeFlyerReference(path, model.joint_names)
     pm, pd, idx = ref.model, ref.data, ref.idx
-    ctype, frame = ((pin.ContactType.CONTACT_3D, pin.LOCAL_WORLD_ALIGNED) if kind == "point"
-                    else (pin.ContactType.CONTACT_6D, pin.LOCAL))
-    models = pin.StdVec_RigidConstraintModel()
-    for f in feet:
-        fr = pm.frames[pm.getFrameId(f)]
-        models.append(pin.RigidConstraintModel(ctype, pm, fr.parentJoint, fr.placement, frame))
-    datas = pin.StdVec_RigidConstraintData([c.createData() for c in models])
-    pin.initConstraintDynamics(pm, pd, models, datas)
+    models, datas = pinocchio_contacts(pm, pd, feet, kind)
     rng = np.random.default_rng(20)
     for q, qd in floating_states(18, 2, seed=21):
         tau = rng.uniform(-2, 2, 18)

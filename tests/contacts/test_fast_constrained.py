@@ -18,6 +18,7 @@ import pytest
 
 import eomgen
 from support import ROOT, erd_robots_dir, load_module
+from support.reference import pinocchio_contacts
 from eomgen import floating
 from eomgen.codegen.functions import select_functions
 from eomgen.codegen.generate import render_files
@@ -49,15 +50,6 @@ def _modules(model, tmp_path):
         module = load_module(path, name)
         loaded.append(module)
     return loaded
-
-
-def _pinocchio_contacts(pin, pm, frames):
-    models = pin.StdVec_RigidConstraintModel()
-    for name in frames:
-        fr = pm.frames[pm.getFrameId(name)]
-        models.append(pin.RigidConstraintModel(pin.ContactType.CONTACT_3D, pm, fr.parentJoint,
-                                               fr.placement, pin.LOCAL_WORLD_ALIGNED))
-    return models, pin.StdVec_RigidConstraintData([c.createData() for c in models])
 
 
 # --- the planar arm on a wall -----------------------------------------------------------------
@@ -122,8 +114,7 @@ def test_wall_statics_and_pinocchio(wall, tmp_path):
     pm = pin.buildModelFromUrdf(str(path))
     pm.gravity.linear = np.array([0.0, -g0, 0.0])  # the arm's gravity (0, -g, 0)
     pd = pm.createData()
-    models, datas = _pinocchio_contacts(pin, pm, ["tip"])
-    pin.initConstraintDynamics(pm, pd, models, datas)
+    models, datas = pinocchio_contacts(pm, pd, ["tip"])
     rng = np.random.default_rng(11)
     for _ in range(3):
         q, qd, tau = rng.uniform(-2, 2, (3, 2))
@@ -170,8 +161,7 @@ def test_solo_fast_equals_numpy_and_pinocchio(tmp_path):
     assert len(fast.CONTACT_ROWS) == 12
     ref = floating.PinocchioFreeFlyer(path, model.joint_names)
     pm, pd, idx = ref.model, ref.data, ref.idx
-    models, datas = _pinocchio_contacts(pin, pm, [c.frame for c in model.contacts])
-    pin.initConstraintDynamics(pm, pd, models, datas)
+    models, datas = pinocchio_contacts(pm, pd, [c.frame for c in model.contacts])
     rng = np.random.default_rng(8)
     batch = []
     for _ in range(3):

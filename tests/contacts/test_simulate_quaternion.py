@@ -19,6 +19,7 @@ from eomgen.contacts import Contact, ContactDynamics
 from eomgen.free_flyer import add_free_flyer
 from eomgen.numeric.frames import frame_function
 from support import ROOT, erd_robots_or_skip, load_quietly, relative, run_cli, write
+from support.reference import pinocchio_contacts
 
 pin = pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
 
@@ -52,15 +53,9 @@ def test_contact_dynamics_equal_pinocchio(solo, kind, feet, frames):
     kinematics = frame_function(model, feet) if frames == "numeric" else None
     cd = ContactDynamics(model, tuple(Contact(f, kind) for f in feet),
                          frame_kinematics=kinematics)
-    ctype, frame = ((pin.ContactType.CONTACT_3D, pin.LOCAL_WORLD_ALIGNED) if kind == "point"
-                    else (pin.ContactType.CONTACT_6D, pin.LOCAL))
-    models = pin.StdVec_RigidConstraintModel()
-    for f in feet:
-        fr = pm.frames[pm.getFrameId(f)]
-        models.append(pin.RigidConstraintModel(ctype, pm, fr.parentJoint, fr.placement, frame))
-    datas = pin.StdVec_RigidConstraintData([c.createData() for c in models])
-    pin.initConstraintDynamics(pm, pd, models, datas)
+    models, datas = pinocchio_contacts(pm, pd, feet, kind)
     rows = slice(0, 3) if kind == "point" else slice(0, 6)
+    frame = pin.LOCAL_WORLD_ALIGNED if kind == "point" else pin.LOCAL  # the contacts' axes
     # a point's acceleration (classical), a surface frame's spatial acceleration (body twist)
     acceleration = (pin.getFrameClassicalAcceleration if kind == "point"
                     else pin.getFrameAcceleration)

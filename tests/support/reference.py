@@ -390,3 +390,22 @@ def planar_2link_by_hand():
         "ZZ2": (qdd1 + qdd2, qdd1 + qdd2),
     }
     return columns, (q1, q2), l1
+
+
+def pinocchio_contacts(pm, pd, frames, kind: str = "point"):
+    """Pinocchio's ``(RigidConstraintModel list, RigidConstraintData list)`` holding each of
+    ``frames`` of ``pm``: a point contact (CONTACT_3D, world-aligned axes) or a surface contact
+    (CONTACT_6D, the frame's own axes), eomgen's conventions (docs/contact.md); its
+    constraint dynamics initialised on ``pd``."""
+    import pinocchio as pin
+
+    ctype, reference = ((pin.ContactType.CONTACT_3D, pin.LOCAL_WORLD_ALIGNED) if kind == "point"
+                        else (pin.ContactType.CONTACT_6D, pin.LOCAL))
+    models = pin.StdVec_RigidConstraintModel()
+    for name in frames:
+        frame = pm.frames[pm.getFrameId(name)]
+        models.append(pin.RigidConstraintModel(ctype, pm, frame.parentJoint, frame.placement,
+                                               reference))
+    datas = pin.StdVec_RigidConstraintData([c.createData() for c in models])
+    pin.initConstraintDynamics(pm, pd, models, datas)
+    return models, datas
