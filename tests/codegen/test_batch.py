@@ -69,3 +69,24 @@ def test_dask_map_rejects_mismatched_inputs(planar):
         dask_map(module.gravity_vector, q, m2=np.ones(3))
     with pytest.raises(ValueError, match="at least one state"):
         dask_map(module.gravity_vector)
+
+
+def test_a_statistic_is_reduced_chunk_by_chunk_block_by_block(planar):
+    """With ``statistic``, each chunk gives one row (its statistic, computed ``block`` states at
+    a time), and reducing the rows gives the statistic of the whole batch's results."""
+    _, module = planar
+    q, qd, qdd = batch(1001, seed=3)
+    masses = np.linspace(0.5, 1.5, len(q))
+    whole = module.inverse_dynamics(q, qd, qdd, m2=masses)  # (1001, 2)
+    peak = dask_map(module.inverse_dynamics, q, qd, qdd, chunks=300, block=64, m2=masses,
+                    statistic=lambda r: abs(r).max(axis=0))
+    assert peak.shape == (4, 2) and peak.chunks[0] == (1, 1, 1, 1)
+    rows = peak.compute(scheduler="synchronous")
+    np.testing.assert_array_equal(rows[1], abs(whole[300:600]).max(axis=0))
+    np.testing.assert_array_equal(rows.max(axis=0), abs(whole).max(axis=0))
+    total = dask_map(module.mass_matrix, q, chunks=250, block=7,
+                     statistic=lambda r: r.sum(axis=0)).sum(axis=0)
+    np.testing.assert_allclose(total.compute(scheduler="synchronous"),
+                               module.mass_matrix(q).sum(axis=0), rtol=1e-13)
+    with pytest.raises(ValueError, match="block must be a positive number of states, got 0"):
+        dask_map(module.gravity_vector, q, statistic=np.sum, block=0)
