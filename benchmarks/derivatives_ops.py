@@ -4,7 +4,8 @@ and PUMA 560.
 For each robot, each derivative function of the generated CasADi module is counted as
 ``casadi.Function.n_instructions()`` (SX instructions, what CasADi executes), beside the same
 count of CasADi's own automatic differentiation of the generated τ
-(``casadi.jacobian(inverse_dynamics(q, qd, qdd), [q; qd])``), and eomgen's own operation count of
+(``casadi.jacobian(inverse_dynamics(q, qd, qdd), [q; qd])``; also in reverse mode, one
+adjoint sweep per joint, and of ∂τ/∂q alone), and eomgen's own operation count of
 each program (:meth:`eomgen.Dynamics.operation_count`, SymPy ``count_ops``). Issue 25's target:
 Panda ∂τ/∂(q, q̇) ≤ 0.6 × CasADi's AD of the generated τ.
 
@@ -48,8 +49,12 @@ def casadi_counts(model, folder: Path) -> dict[str, int]:
     n = model.dof
     q, qd, qdd = (ca.SX.sym(s, n) for s in ("q", "qd", "qdd"))
     tau = module["inverse_dynamics"](q, qd, qdd)  # parameters at their defaults
-    counts["AD"] = ca.Function("J", [q, qd, qdd],
-                               [ca.jacobian(tau, ca.vertcat(q, qd))]).n_instructions()
+    x = ca.vertcat(q, qd)
+    counts["AD"] = ca.Function("J", [q, qd, qdd], [ca.jacobian(tau, x)]).n_instructions()
+    # the same Jacobian in reverse mode: one adjoint sweep per row of τ (a row each)
+    rows = [ca.jtimes(tau, x, ca.DM.eye(n)[:, i], True).T for i in range(n)]
+    counts["AD reverse"] = ca.Function("R", [q, qd, qdd], [ca.vertcat(*rows)]).n_instructions()
+    counts["AD q"] = ca.Function("Jq", [q, qd, qdd], [ca.jacobian(tau, q)]).n_instructions()
     return counts
 
 
@@ -57,9 +62,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--markdown", type=Path, help="also write the table to this file")
     args = parser.parse_args()
-    lines = ["| robot | n | τ | ∂τ/∂(q, q̇) | CasADi AD of τ | ours / AD | ∂g/∂q | q̈ (ABA) | "
+    lines = ["| robot | n | τ | ∂τ/∂(q, q̇) | CasADi AD of τ | ours / AD | AD, reverse mode | "
+             "AD of ∂τ/∂q alone | ∂g/∂q | q̈ (ABA) | "
              "∂q̈/∂(q, q̇, τ) | linearize (A, B) | ops ∂τ (SymPy) | ops ∂q̈ (SymPy) | derive s |",
-             "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+             "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     print(lines[0], flush=True)
     for robot in robots():
         model = robot.load()
@@ -73,6 +79,7 @@ def main() -> None:
         ratio = c["inverse_dynamics_derivatives"] / c["AD"]
         line = (f"| {robot.label} | {model.dof} | {c['inverse_dynamics']:,} | "
                 f"{c['inverse_dynamics_derivatives']:,} | {c['AD']:,} | {ratio:.2f} | "
+                f"{c['AD reverse']:,} | {c['AD q']:,} | "
                 f"{c['gravity_derivative']:,} | {c['forward_dynamics_aba']:,} | "
                 f"{c['forward_dynamics_derivatives']:,} | {c['linearize']:,} | "
                 f"{dyn.operation_count(['dtau']):,} | {dyn.operation_count(['dqdd']):,} | "
