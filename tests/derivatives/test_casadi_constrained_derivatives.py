@@ -23,7 +23,8 @@ pytest.importorskip("casadi", reason="the CasADi backend")
 NAMES = ("dqdd_dq", "dqdd_dqd", "dqdd_dtau", "dF_dq", "dF_dqd", "dF_dtau")
 
 
-@pytest.fixture(scope="module", params=["fixed", "floating"])
+# the free flyer with CasADi's C library compiled (~5 s) is slow
+@pytest.fixture(scope="module", params=["fixed", pytest.param("floating", marks=pytest.mark.slow)])
 def case(request, tmp_path_factory):
     folder = tmp_path_factory.mktemp(request.param)
     floating = request.param == "floating"

@@ -8,12 +8,10 @@ convention, :func:`support.reference.pinocchio_contacts`) on models Pinocchio re
 same URDF: the UR5 holding its ``tool0`` (six joints, six rows) and the one-joint leg of
 tests/derivatives/test_constrained_derivatives.py on a quaternion free flyer holding its foot;
 central differences of the generated ``constrained_forward_dynamics`` along eomgen's
-``integrate``; the CasADi module's composition against the NumPy module's.
+``integrate``; (slow) the CasADi module's composition against the NumPy module's.
 """
 
 from __future__ import annotations
-
-from importlib.util import find_spec
 
 import numpy as np
 import pytest
@@ -34,10 +32,13 @@ def case(request, tmp_path_factory):
     if request.param == "ur5":
         path = erd_robots_or_skip() / "ur_description" / "urdf" / "ur5_robot.urdf"
         return held_robot(path, ["tool0"], False, [DERIVATIVES], folder, kind="surface")
+    return floating_leg(folder, ("numpy",))
+
+
+def floating_leg(folder, backends):
+    """The one-joint leg on a quaternion free flyer holding its foot (surface contact)."""
     path = folder / "leg.urdf"
     path.write_text(leg(1), encoding="utf-8")
-    # the CasADi module on the leg only (six rows in its Schur complement; one is enough)
-    backends = ("numpy", "casadi") if find_spec("casadi") else ("numpy",)
     return held_robot(path, ["foot"], True, [DERIVATIVES], folder, backends, "surface")
 
 
@@ -78,11 +79,10 @@ def test_surface_contact_derivatives_are_central_differences(case):
                                            atol=1e-6, err_msg=NAMES[3 * part + k])
 
 
-@pytest.mark.parametrize("case", ["floating_leg"], indirect=True)
-def test_casadi_composes_the_surface_contact_derivatives(case):
-    _, modules, pm, _ = case
-    if "casadi" not in modules:
-        pytest.skip("needs casadi")
+@pytest.mark.slow  # the leg derived again, with the CasADi module (~4 s)
+def test_casadi_composes_the_surface_contact_derivatives(tmp_path):
+    pytest.importorskip("casadi")
+    _, modules, pm, _ = floating_leg(tmp_path, ("numpy", "casadi"))
     function = modules["casadi"][DERIVATIVES]
     for q, v, tau in states(pm, 1, seed=8):
         out = function.call({"q": q, "qd": v, "tau": tau})
