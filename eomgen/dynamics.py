@@ -42,7 +42,7 @@ DEFAULT_OUTPUTS = ("M", "C", "g")
 #: them; Y_SL against M, ``computeCoriolisMatrix`` and g; Y_K, Y_P against Pinocchio's energies;
 #: the drive outputs against ``model.armature`` and the friction law; the flat outputs against
 #: finite differences along a trajectory integrated on the configuration space). The others
-#: (loop closures, the drive derivatives) are refused in one line; the derivatives are taken
+#: (loop closures) are refused in one line; the derivatives, the drives' too, are taken
 #: along the tangent (eomgen.symbolic.tangent).
 FREE_FLYER_OUTPUTS = ("M", "C", "g", "P", "tau", "h", "qdd_aba", "MCg", "Mh", "p_f", "R_f",
                       "J_f", "Jb_f", "dJqd_f", "dJbqd_f", "J_c", "dJqd_c", "tau_c", "cone_c",
@@ -52,7 +52,8 @@ FREE_FLYER_OUTPUTS = ("M", "C", "g", "P", "tau", "h", "qdd_aba", "MCg", "Mh", "p
                       "tau_flat_smooth",
                       # issue 25: derivatives along the tangent (eomgen.symbolic.tangent)
                       "dtau_dq", "dtau_dqd", "dtau", "dg_dq", "dqdd_dq", "dqdd_dqd", "Minv",
-                      "dqdd", "A_lin", "B_lin", "AB", "dKKT")
+                      "dqdd", "A_lin", "B_lin", "AB", "dKKT", "dtau_a_dqd", "dtau_a",
+                      "dqdd_a_dq", "dqdd_a_dqd", "Minv_a", "dqdd_a")
 
 #: ``derive(model, simplify=True)`` refuses models with more movable joints: trigonometric
 #: simplification of the expanded expressions grows exponentially with the number of joints

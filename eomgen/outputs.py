@@ -572,7 +572,7 @@ CONSTRAINED_DERIVATIVES = register_output(Output(
     False, "those of the forward dynamics derivatives; N per unit", ("M", "tau", "J_c", "dJqd_c",
     "dKKT"), composed_from=(*CONSTRAINED_FORWARD.composed_from, CONSTRAINED_FORWARD.function,
     CONSTRAINED_PARTIALS.function), default=False, constants=_CONTACT_NAMES,
-    backends=("numpy", "fast", "jax", "torch")))
+    backends=("numpy", "fast", "casadi", "c", "jax", "torch")))
 
 # --- issue 27: task-space quantities, composed from M, J_f, J_f-dot qd and tau (templates) --
 #: The backends whose templates compose the task-space functions.

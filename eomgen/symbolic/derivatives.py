@@ -32,7 +32,8 @@ each q entry's own direction otherwise):
   q̇_i ≠ 0).
 * ``dqdd_a_dq``, ``dqdd_a_dqd``, ``Minv_a`` (n × n): the drives' forward dynamics
   q̈ = (M + diag(a))⁻¹ (τ − C q̇ − g − d q̇ − f tanh(q̇ / w)) differentiated
-  (:func:`drive_forward_dynamics_jacobians`).
+  (:func:`drive_forward_dynamics_jacobians`); with quaternion joints q̈ is v̇ and ∂/∂q is along
+  the tangent, as for the plain derivatives (the drives sit on the one-DOF joints).
 * ``dtau``, ``dqdd``, ``AB``, ``dtau_a``, ``dqdd_a``: the several-result functions, side by
   side.
 """
@@ -281,6 +282,7 @@ def drive_forward_dynamics_jacobians(derivation) -> tuple[sp.Matrix, sp.Matrix, 
         qdd = forward_dynamics_program(derivation.tree, derivation.q, qd, effort,
                                        derivation.model.gravity, b,
                                        armature=[a.armature for a in actuators])
+        qdd = true_accelerations(derivation, qdd)  # v̇ of quaternion joints, not the chart's
         qdd = sp.Matrix([b.define(e, f"qdd_d{k + 1}") for k, e in enumerate(qdd)])
         rows = forward_mode(b, list(qdd), _seeds(derivation.tau, "tau"))
         full = _jacobian(rows, "tau", n)

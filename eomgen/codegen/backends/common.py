@@ -205,7 +205,7 @@ def python_module_context(job: Job, printer, template: str, extra_exports=(),
         fd=composition_names(FORWARD),
         constrained_forward_dynamics=CONSTRAINED_FORWARD.function in functions,
         cfd=constrained_names(),
-        # issue 25: its derivatives, composed from it and the KKT partials (NumPy only)
+        # issue 25: its derivatives, composed from it and the KKT partials
         constrained_derivatives=CONSTRAINED_DERIVATIVES.function in functions,
         cfdd={"name": CONSTRAINED_DERIVATIVES.function, "partials": CONSTRAINED_PARTIALS.function},
         parallel_inverse=PARALLEL_INVERSE.function in functions,
