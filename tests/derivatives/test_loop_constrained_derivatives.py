@@ -9,8 +9,9 @@ configurations with velocities along the loop: ``computeConstraintDynamicsDeriva
 derivatives by v and τ, and, for those by q, central differences of ``constraintDynamics``
 itself. Pinocchio 4.1's ``ddq_dq`` and ``dlambda_dq`` of a constraint between two moving joints
 do not agree with the central differences of its own ``constraintDynamics`` (0.6–2.3 relative
-here, in LOCAL and LOCAL_WORLD_ALIGNED axes alike; ours agree with them to ~5e-10):
-:func:`test_pinocchios_dq_derivatives_of_a_loop_disagree_with_its_own_differences` records it.
+here, in LOCAL and LOCAL_WORLD_ALIGNED axes alike, measured 2026-11-27; ours agree with the
+differences to ~5e-10), so they are not the reference here; compare with them directly once
+Pinocchio mends them.
 """
 
 from __future__ import annotations
@@ -124,14 +125,3 @@ def test_loop_derivatives_agree_with_pinocchio(closed):
         dqdd, dlam = differences(forward, q[p], v[p], tau[p])  # by q: its forward dynamics
         assert relative(ours[0], dqdd) <= 1e-7 and relative(ours[3], dlam) <= 1e-7
 
-
-def test_pinocchios_dq_derivatives_of_a_loop_disagree_with_its_own_differences(closed):
-    """Why the derivatives by q are checked against differences: Pinocchio 4.1's own are off
-    for a constraint between two moving joints (LOCAL axes too). If this fails, Pinocchio has
-    mended them: compare ours with its ``ddq_dq`` directly."""
-    m, pm, p, world_aligned, local = closed
-    q, v, tau = next(closed_states(m, 1, seed=2))
-    for held in (world_aligned, local):
-        _, refs = pinocchio_constrained_derivatives(pm, held, q[p], v[p], tau[p])
-        dqdd, _ = differences(pinocchio_forward(pm, held), q[p], v[p], tau[p])
-        assert relative(refs[0], dqdd) > 0.1
