@@ -23,12 +23,15 @@ import numpy as np
 import pytest
 
 import eomgen
+from eomgen.codegen.backends.casadi_backend import c_compiler
+from eomgen.codegen.generate import render_files
 from eomgen.model import joint_actuators, uncoupled
 from eomgen.model.coupling import coupling_map, full_configuration
 from eomgen.outputs import OUTPUTS
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import TESTS
+from support.derivatives import results
 from support.generated import BACKENDS, generated
 
 pin = pytest.importorskip("pinocchio", reason="checked against Pinocchio's derivatives")
@@ -207,16 +210,6 @@ def arguments(function, q, v, u) -> tuple:
     return tuple({"q": q, "qd": v, "qdd": u, "tau": u}[x] for x in OUTPUTS[function].inputs)
 
 
-def results(backend, module, function, *inputs, **parameters) -> tuple:
-    """Every result of ``function`` as float arrays (a CasADi function called by name, a JAX
-    or PyTorch one through NumPy)."""
-    declared = OUTPUTS[function]
-    if backend == "casadi":
-        out = module[function].call({**dict(zip(declared.inputs, inputs)), **parameters})
-        return tuple(np.array(out[s], dtype=float) for s in declared.returns)
-    return tuple(np.asarray(x, dtype=float) for x in module[function](*inputs, **parameters))
-
-
 def test_casadi_gives_the_numpy_modules_derivatives(arm):
     model, calls, module, *_ = arm
     if calls["casadi_module"] is None:
@@ -233,15 +226,28 @@ def test_casadi_gives_the_numpy_modules_derivatives(arm):
 
 @pytest.mark.slow
 def test_every_backend_gives_the_numpy_modules_derivatives(tmp_path):
+    """NumPy, CasADi, the fast module, JAX, PyTorch and CasADi's C library
+    (``casadi.external``)."""
     _, model = coupled_arm(tmp_path)
     _, modules = generated(model, DERIVATIVES, tmp_path)
     assert set(modules) == set(BACKENDS)
+    if "casadi" in modules and c_compiler() is not None:
+        import casadi
+
+        for f in render_files(model, ["c"], functions=DERIVATIVES):
+            path = tmp_path / f.name
+            path.write_bytes(f.content) if isinstance(f.content, bytes) else path.write_text(
+                f.content, encoding="utf-8")
+        library = next(p for p in tmp_path.iterdir() if p.name.startswith("geared_casadi.")
+                       and p.suffix in (".so", ".dylib", ".dll"))
+        modules["c"] = {f: casadi.external(f, str(library)) for f in DERIVATIVES}
     for q, v, u in states(model.dof, 2, seed=10):
         for function in DERIVATIVES:
             args = arguments(function, q, v, u)
             theirs = results("numpy", modules["numpy"], function, *args, m_load=0.9)
             for backend, module in modules.items():
-                ours = results(backend, module, function, *args, m_load=0.9)
+                ours = results("casadi" if backend == "c" else backend, module, function,
+                               *args, m_load=0.9)
                 assert len(ours) == len(theirs)
                 for part, expected in zip(ours, theirs):
                     assert relative(part, expected) <= 1e-12, (backend, function)
