@@ -227,7 +227,8 @@ def symmetric_inverse(b: ProgramBuilder, M: sp.Matrix, hint: str) -> sp.Matrix:
     Z = sp.eye(n)
     for j in range(n):
         for i in range(j + 1, n):
-            total = -sp.Add(*[L[i, k] * Z[k, j] for k in range(j, i) if L[i, k] != 0 and Z[k, j] != 0])
+            total = -sp.Add(*[L[i, k] * Z[k, j] for k in range(j, i)
+                              if L[i, k] != 0 and Z[k, j] != 0])
             if total != 0:
                 Z[i, j] = name_expr(b, total, f"{hint}_Z{i + 1}_{j + 1}")
     out = sp.zeros(n, n)
@@ -256,8 +257,8 @@ def _coupled_dynamics(derivation, armature=None, friction=None, hint: str = "c")
     if friction is not None:
         bias = bias + friction
     rhs = [t - e for t, e in zip(derivation.tau, _efforts(derivation, bias))]
-    qdd = [b.define(sp.Add(*[Minv[i, k] * rhs[k] for k in range(T.cols)]), f"qdd_{hint}{i + 1}")
-           for i in range(T.cols)]
+    qdd = [b.define(sp.Add(*[Minv[i, k] * rhs[k] for k in range(T.cols)]),
+                    f"qdd_{hint}{i + 1}") for i in range(T.cols)]
     return Minv, sp.Matrix(qdd)
 
 
@@ -283,7 +284,8 @@ def gravity_jacobian(derivation) -> sp.Matrix:
 
 
 def inverse_mass_matrix(derivation) -> sp.Matrix:
-    """M(q)⁻¹ as ∂q̈/∂τ of the ABA program (n × n, upper triangle computed, mirrored)."""
+    """M(q)⁻¹ as ∂q̈/∂τ of the ABA program (n × n, upper triangle computed, mirrored); with
+    coupled joints ``(Tᵀ M T)⁻¹`` from its LDLᵀ factors (:func:`symmetric_inverse`)."""
     work = _work(derivation)
     if "Minv" not in work and derivation.coupling is not None:  # no ABA: M_r's factors
         work["Minv"], work["qdd"] = _coupled_dynamics(derivation)
@@ -406,8 +408,8 @@ def linearization(derivation) -> tuple[sp.Matrix, sp.Matrix]:
     δ̇ = J_r(δ)⁻¹ v (:func:`eomgen.symbolic.tangent.velocity_transport`)."""
     n = _nv(derivation)
     dq, dqd, Minv = forward_dynamics_jacobians(derivation)
-    A = sp.Matrix.vstack(sp.Matrix.hstack(velocity_transport(independent(derivation)), sp.eye(n)),
-                         sp.Matrix.hstack(dq, dqd))
+    transport = velocity_transport(independent(derivation))
+    A = sp.Matrix.vstack(sp.Matrix.hstack(transport, sp.eye(n)), sp.Matrix.hstack(dq, dqd))
     B = sp.Matrix.vstack(sp.zeros(n, n), Minv)
     return A, B
 

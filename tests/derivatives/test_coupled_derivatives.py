@@ -30,7 +30,7 @@ from eomgen.model.coupling import coupling_map, full_configuration
 from eomgen.outputs import OUTPUTS
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
-from support import TESTS
+from support import TESTS, erd_robots_or_skip
 from support.derivatives import results
 from support.generated import BACKENDS, generated
 
@@ -292,3 +292,29 @@ def test_floating_coupled_derivatives_equal_pinocchios_along_the_tangent():
                                                        [omega[2], 0, -omega[0]],
                                                        [-omega[1], omega[0], 0]])) <= 1e-12
         np.testing.assert_array_equal(A[9:n, 9:n], np.zeros((n - 9, n - 9)))
+
+
+@pytest.mark.slow
+def test_panda_with_a_mimic_finger_equals_pinocchios_projected():
+    """The Panda, ``panda_finger_joint2`` following ``panda_finger_joint1`` (URDF <mimic>, 8
+    coordinates): every derivative against Pinocchio's whole tree (9 joints), projected."""
+    import warnings
+
+    path = erd_robots_or_skip() / "panda_description" / "urdf" / "panda.urdf"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = eomgen.load(path)
+    assert model.dof == 8 and len(model.couplings) == 1
+    module = eomgen.derive(model, ("dtau", "dqdd", "dg_dq")).lambdify().module
+    pm = pin.buildModelFromUrdf(str(path))
+    T, c = (np.array(x, dtype=float) for x in coupling_map(model))
+    rng = np.random.default_rng(12)
+    for _ in range(3):
+        q = np.append(rng.uniform(-1.5, 1.5, 7), rng.uniform(0, 0.04))
+        v, u = rng.normal(size=(2, 8))
+        dtau, dg, forward = reference(pm, T, c.ravel(), q, v, u)
+        for ours, theirs in zip(module.inverse_dynamics_derivatives(q, v, u), dtau):
+            assert relative(ours, theirs) <= 1e-10
+        assert relative(module.gravity_derivative(q), dg) <= 1e-10
+        for ours, theirs in zip(module.forward_dynamics_derivatives(q, v, u), forward):
+            assert relative(ours, theirs) <= 1e-10
