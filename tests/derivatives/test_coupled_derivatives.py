@@ -2,7 +2,8 @@
 26): ``inverse_dynamics_derivatives``, ``forward_dynamics_derivatives``, ``gravity_derivative``,
 ``linearize`` and the drive derivatives in the independent coordinates.
 
-Model: a fixed-base five-joint spatial arm (MJCF, a drive on every joint) with a scene coupling
+Model: a fixed-base five-joint spatial arm (MJCF, a drive on every joint; axes along the link
+frames but l2 turned by a general rotation, which keeps the program small) with a scene coupling
 ``j3 = -0.7 j2 + 0.3`` and a differential ``j5 = 0.05 j1 - 0.02 j4 + 0.01`` (a slide), and a
 payload whose mass ``m_load`` stays symbolic: independent ``q = (j1, j2, j4)``,
 ``q_full = T q + c``. (slow) The free-flying MJCF model of tests/data/mjcf/coupled_floating.xml
@@ -41,13 +42,13 @@ DRIVE = 'armature="{a}" damping="{d}" frictionloss="{f}"'
 ARM = f"""<mujoco model="geared"><option gravity="0.3 -0.2 -9.81"/><worldbody>
 <body name="l1" pos="0 0 0.1"><joint name="j1" axis="0 0 1" {DRIVE.format(a=0.05, d=0.3, f=0.2)}/>
 <inertial pos="0.01 0.02 0.1" mass="2" fullinertia="0.02 0.03 0.025 0.001 0.002 -0.001"/>
-<body name="l2" pos="0 0.05 0.2" quat="0.9 0.1 0.3 0.2"><joint name="j2" axis="0 1 0.2" {DRIVE.format(a=0.08, d=0.2, f=0.1)}/>
+<body name="l2" pos="0 0.05 0.2" quat="0.9 0.1 0.3 0.2"><joint name="j2" axis="0 1 0" {DRIVE.format(a=0.08, d=0.2, f=0.1)}/>
 <inertial pos="0.2 0.01 -0.02" mass="1.5" fullinertia="0.015 0.025 0.02 0.001 0 0.002"/>
-<body name="l3" pos="0.4 0 0" quat="0.95 0.2 -0.1 0.1"><joint name="j3" axis="0 0.6 0.8" {DRIVE.format(a=0.03, d=0.15, f=0.05)}/>
+<body name="l3" pos="0.4 0 0"><joint name="j3" axis="0 0 1" {DRIVE.format(a=0.03, d=0.15, f=0.05)}/>
 <inertial pos="0.1 -0.02 0.01" mass="1" diaginertia="0.008 0.012 0.01"/>
-<body name="l4" pos="0.3 0 0.05"><joint name="j4" axis="1 0 0.3" {DRIVE.format(a=0.02, d=0.1, f=0.08)}/>
+<body name="l4" pos="0.3 0 0.05"><joint name="j4" axis="1 0 0" {DRIVE.format(a=0.02, d=0.1, f=0.08)}/>
 <inertial pos="0.02 0.05 0" mass="0.5" diaginertia="0.003 0.002 0.004"/>
-<body name="l5" pos="0.1 0.02 0"><joint name="j5" type="slide" axis="0 0.3 1" {DRIVE.format(a=0.4, d=2, f=0.3)}/>
+<body name="l5" pos="0.1 0.02 0"><joint name="j5" type="slide" axis="0 0 1" {DRIVE.format(a=0.4, d=2, f=0.3)}/>
 <inertial pos="0 0.01 0.03" mass="0.3" diaginertia="0.001 0.002 0.0015"/>
 </body></body></body></body></body></worldbody></mujoco>"""
 SCENE = """version: 1
