@@ -227,8 +227,8 @@ def test_casadi_gives_the_numpy_modules_derivatives(arm):
 
 @pytest.mark.slow
 def test_every_backend_gives_the_numpy_modules_derivatives(tmp_path):
-    """NumPy, CasADi, the fast module, JAX, PyTorch and CasADi's C library
-    (``casadi.external``)."""
+    """NumPy, CasADi, the fast module, JAX, PyTorch, CasADi's C library (``casadi.external``)
+    and the plain C ``kernels`` (ctypes)."""
     _, model = coupled_arm(tmp_path)
     _, modules = generated(model, DERIVATIVES, tmp_path)
     assert set(modules) == set(BACKENDS)
@@ -242,6 +242,7 @@ def test_every_backend_gives_the_numpy_modules_derivatives(tmp_path):
         library = next(p for p in tmp_path.iterdir() if p.name.startswith("geared_casadi.")
                        and p.suffix in (".so", ".dylib", ".dll"))
         modules["c"] = {f: casadi.external(f, str(library)) for f in DERIVATIVES}
+    kernels = c_kernels(model, tmp_path) if c_compiler() is not None else None
     for q, v, u in states(model.dof, 2, seed=10):
         for function in DERIVATIVES:
             args = arguments(function, q, v, u)
@@ -252,6 +253,34 @@ def test_every_backend_gives_the_numpy_modules_derivatives(tmp_path):
                 assert len(ours) == len(theirs)
                 for part, expected in zip(ours, theirs):
                     assert relative(part, expected) <= 1e-12, (backend, function)
+            if kernels is not None:  # the results side by side, row-major
+                expected = np.hstack(theirs)
+                out = np.zeros(expected.shape)
+                kernels[function](*(np.ascontiguousarray(x) for x in args),
+                                  np.array([0.9]), out)
+                assert relative(out, expected) <= 1e-12, ("kernels", function)
+
+
+def c_kernels(model, folder) -> dict:
+    """The ``kernels`` backend's C functions of DERIVATIVES, compiled into a shared library and
+    called through ctypes: ``{function: f(*vectors, parameters, out)}``."""
+    import ctypes
+    import subprocess
+
+    for f in render_files(model, ["kernels"], functions=DERIVATIVES):
+        (folder / f.name).write_text(f.content, encoding="utf-8")
+    library = folder / "libgeared_kernels.so"
+    subprocess.run([c_compiler(), "-O1", "-std=c99", "-shared", "-fPIC",
+                    str(folder / "geared_kernels.c"), "-o", str(library), "-lm"], check=True)
+    loaded = ctypes.CDLL(str(library))
+    pointer = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
+    out = {}
+    for function in DERIVATIVES:
+        kernel = getattr(loaded, f"geared_{function}")
+        kernel.restype = None
+        kernel.argtypes = [pointer] * (len(OUTPUTS[function].inputs) + 2)
+        out[function] = kernel
+    return out
 
 
 @pytest.mark.slow
