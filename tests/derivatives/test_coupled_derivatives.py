@@ -6,8 +6,9 @@ Model: a fixed-base five-joint spatial arm (MJCF, a drive on every joint; axes a
 frames but l2 turned by a general rotation, which keeps the program small) with a scene coupling
 ``j3 = -0.7 j2 + 0.3`` and a differential ``j5 = 0.05 j1 - 0.02 j4 + 0.01`` (a slide), and a
 payload whose mass ``m_load`` stays symbolic: independent ``q = (j1, j2, j4)``,
-``q_full = T q + c``. (slow) The free-flying MJCF model of tests/data/mjcf/coupled_floating.xml
-(a free joint, a ball joint, a coupling below them), ∂/∂q along the tangent.
+``q_full = T q + c``. Along the tangent (∂/∂q of quaternion joints): a ball joint after a
+follower, and (slow) the free-flying MJCF model of tests/data/mjcf/coupled_floating.xml (a
+free joint, a ball joint, a coupling below them); (slow) the Panda with its mimic finger.
 
 References: Pinocchio 4.1 on the whole tree (its derivative algorithms refuse mimic joints):
 ``computeRNEADerivatives`` and ``computeGeneralizedGravityDerivatives`` at
@@ -59,6 +60,19 @@ couplings:
   - {joint: j3, to: j2, ratio: -0.7, offset: 0.3}
   - {joint: j5, to: {j1: 0.05, j4: -0.02}, offset: 0.01}
 """
+#: a hinge, a hinge following it, a ball joint, a hinge (Pinocchio's q: ja, jb, quaternion, jd)
+BALL_AFTER = """<mujoco model="ball_after"><option gravity="0.3 -0.2 -9.81"/><worldbody>
+<body name="a" pos="0 0 0.1"><joint name="ja" axis="0 0 1"/>
+<inertial pos="0.01 0.02 0.1" mass="2" fullinertia="0.02 0.03 0.025 0.001 0.002 -0.001"/>
+<body name="b" pos="0 0.05 0.2" quat="0.9 0.1 0.3 0.2"><joint name="jb" axis="0 1 0"/>
+<inertial pos="0.2 0.01 -0.02" mass="1.5" fullinertia="0.015 0.025 0.02 0.001 0 0.002"/>
+<body name="c" pos="0.3 0 0.05"><joint name="ball" type="ball"/>
+<inertial pos="0.02 0.05 0.1" mass="0.5" fullinertia="0.003 0.002 0.004 0.0002 0 0.0001"/>
+<body name="d" pos="0.1 0.02 0.2"><joint name="jd" axis="1 0 0"/>
+<inertial pos="0 0.01 0.03" mass="0.3" diaginertia="0.001 0.002 0.0015"/>
+</body></body></body></body></worldbody>
+<equality><joint name="gear" joint1="jb" joint2="ja" polycoef="0.1 -0.6 0 0 0"/></equality>
+</mujoco>"""
 LOAD, LOAD_COM = 0.4, np.array([0.05, 0, 0.02])
 DERIVATIVES = ["inverse_dynamics_derivatives", "forward_dynamics_derivatives",
                "gravity_derivative", "linearize", "drive_inverse_dynamics_derivatives",
@@ -110,16 +124,17 @@ def states(n, count, seed):
     return [tuple(rng.uniform(-1.2, 1.2, n) for _ in range(3)) for _ in range(count)]
 
 
-def reference(pm, T, c, q, v, u, drives=None):
-    """Pinocchio's whole tree projected: (∂τ_r/∂q, ∂τ_r/∂q̇, ∂g_r/∂q) at q̈_r = u and the
-    forward dynamics' (∂q̈/∂q, ∂q̈/∂q̇, M_r⁻¹) at τ_r = u; with ``drives`` (a, d, f, w) the
-    drives' ∂τ_a/∂q̇ and their forward dynamics'."""
+def reference(pm, T, qf, v, u, drives=None):
+    """Pinocchio's whole tree at the full configuration ``qf``, ``T v``, projected:
+    (∂τ_r/∂q, ∂τ_r/∂q̇), ∂g_r/∂q at q̈_r = u and the forward dynamics' (∂q̈/∂q, ∂q̈/∂q̇,
+    M_r⁻¹) at τ_r = u; with ``drives`` (a, d, f, w) the drives' ∂τ_a/∂q̇ and their forward
+    dynamics'."""
     data = pm.createData()
-    qf, vf = T @ q + c, T @ v
+    vf = T @ v
     M = pin.crba(pm, data, qf)
     M = np.triu(M) + np.triu(M, 1).T
     h = pin.nonLinearEffects(pm, data, qf, vf)
-    extra, slope, friction = np.zeros_like(M), np.zeros(len(qf)), np.zeros(len(qf))
+    extra, slope, friction = np.zeros_like(M), np.zeros(len(vf)), np.zeros(len(vf))
     if drives is not None:
         a, d, f, w = drives
         extra, friction = np.diag(a), d * vf + f * np.tanh(vf / w)
@@ -139,7 +154,7 @@ def test_derivatives_equal_pinocchios_projected(arm):
     model, _, call, pm, T, c, drives = arm
     n = model.dof
     for q, v, u in states(n, 3, seed=5):
-        dtau, dg, forward = reference(pm, T, c, q, v, u)
+        dtau, dg, forward = reference(pm, T, T @ q + c, v, u)
         got = call["inverse_dynamics_derivatives"](q, v, u)
         for name, ours, theirs in zip(("dtau_dq", "dtau_dqd"), got, dtau):
             assert ours.shape == (n, n)
@@ -159,7 +174,7 @@ def test_drive_derivatives_equal_pinocchios_projected(arm):
     model, _, call, pm, T, c, drives = arm
     a, d, f, w = drives
     for q, v, u in states(model.dof, 2, seed=6):
-        (dq, dv), _, forward = reference(pm, T, c, q, v, u, drives)
+        (dq, dv), _, forward = reference(pm, T, T @ q + c, v, u, drives)
         got = call["drive_inverse_dynamics_derivatives"](q, v, u)
         assert relative(got[0], dq) <= 1e-10
         assert relative(got[1], dv + T.T @ np.diag(d) @ T) <= 1e-10
@@ -283,45 +298,60 @@ def c_kernels(model, folder) -> dict:
     return out
 
 
-@pytest.mark.slow
-def test_floating_coupled_derivatives_equal_pinocchios_along_the_tangent():
-    """A free joint, a ball joint and ankle = −0.6 knee + 0.1 below them: ∂/∂q along the
-    tangent of the independent configuration (Pinocchio's on the whole tree, projected)."""
-    path = TESTS / "data" / "mjcf" / "coupled_floating.xml"
+def skew(w):
+    return np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
+
+
+def assert_tangent_derivatives(path, independent, seed):
+    """The derivatives of the MJCF model at ``path`` (quaternion joints and a coupling) equal
+    Pinocchio's on the whole tree read from the same file, projected, ∂/∂q along the tangent
+    of the independent configuration (``independent``: its entries' indices in Pinocchio's q);
+    ``linearize``'s position rows those of the tangent chart (docs/derivatives.md), 0 on the
+    one-axis joints."""
     model = eomgen.load(path)
     module = eomgen.derive(model, ("dtau", "dqdd", "dg_dq", "AB")).lambdify().module
     pm = pin.buildModelFromMJCF(str(path))
     pm.gravity = pin.Motion(GRAVITY, np.zeros(3))
-    T, _ = coupling_map(model)
-    T = np.array(T, dtype=float)
-    n, rng = model.dof, np.random.default_rng(11)
+    pm.armature = np.zeros(pm.nv)
+    T = np.array(coupling_map(model)[0], dtype=float)
+    n, rng = model.dof, np.random.default_rng(seed)
     for _ in range(2):
         full = pin.randomConfiguration(pm, -np.ones(pm.nq), np.ones(pm.nq))
-        q = np.concatenate([full[:12], full[13:]])   # base, hip, knee, shoulder (not ankle)
+        q = full[independent]
         qf = np.array(full_configuration(model, q), dtype=float)
         v, u = rng.normal(size=(2, n))
-        data = pm.createData()
-        pin.computeRNEADerivatives(pm, data, qf, T @ v, T @ u)
-        dq, dv = module.inverse_dynamics_derivatives(q, v, u)
-        assert relative(dq, T.T @ data.dtau_dq @ T) <= 1e-10
-        assert relative(dv, T.T @ data.dtau_dv @ T) <= 1e-10
-        G = pin.computeGeneralizedGravityDerivatives(pm, data, qf)
-        assert relative(module.gravity_derivative(q), T.T @ G @ T) <= 1e-10
-        M = pin.crba(pm, data, qf)
-        M_r = T.T @ (np.triu(M) + np.triu(M, 1).T) @ T
-        qdd = np.linalg.solve(M_r, u - T.T @ pin.nonLinearEffects(pm, data, qf, T @ v))
-        pin.computeRNEADerivatives(pm, data, qf, T @ v, T @ qdd)
-        Minv = np.linalg.inv(M_r)
-        expected = (-Minv @ T.T @ data.dtau_dq @ T, -Minv @ T.T @ data.dtau_dv @ T, Minv)
+        dtau, dg, forward = reference(pm, T, qf, v, u)
+        for ours, theirs in zip(module.inverse_dynamics_derivatives(q, v, u), dtau):
+            assert relative(ours, theirs) <= 1e-10
+        assert relative(module.gravity_derivative(q), dg) <= 1e-10
         for name, ours, theirs in zip(("dq", "dv", "Minv"),
-                                      module.forward_dynamics_derivatives(q, v, u), expected):
+                                      module.forward_dynamics_derivatives(q, v, u), forward):
             assert relative(ours, theirs) <= 1e-9, name
         A, _ = module.linearize(q, v, u)
-        omega = v[3:6]
-        assert relative(A[3:6, 3:6], -0.5 * np.array([[0, -omega[2], omega[1]],
-                                                       [omega[2], 0, -omega[0]],
-                                                       [-omega[1], omega[0], 0]])) <= 1e-12
-        np.testing.assert_array_equal(A[9:n, 9:n], np.zeros((n - 9, n - 9)))
+        transport = np.zeros((n, n))   # −½ ad_v of SE(3), −½ [ω]× of SO(3)
+        for joint in model.quaternion_joints:
+            k = joint.v_index + joint.nv - 3
+            transport[k:k + 3, k:k + 3] = -0.5 * skew(v[k:k + 3])
+            if joint.nv == 6:
+                transport[k - 3:k, k - 3:k] = -0.5 * skew(v[k:k + 3])
+                transport[k - 3:k, k:k + 3] = -0.5 * skew(v[k - 3:k])
+        assert relative(A[:n, :n], transport) <= 1e-12
+        np.testing.assert_array_equal(A[:n, n:], np.eye(n))
+
+
+def test_a_ball_joint_after_a_follower_along_the_tangent(tmp_path):
+    """``jb = −0.6 ja + 0.1`` before a ball joint: the ball's velocity and configuration
+    entries sit one place earlier in the independent coordinates than in the whole tree."""
+    path = tmp_path / "ball_after.xml"
+    path.write_text(BALL_AFTER, encoding="utf-8")
+    assert_tangent_derivatives(path, [0, 2, 3, 4, 5, 6], seed=13)
+
+
+@pytest.mark.slow
+def test_floating_coupled_derivatives_equal_pinocchios_along_the_tangent():
+    """A free joint, a ball joint and ankle = −0.6 knee + 0.1 below them."""
+    assert_tangent_derivatives(TESTS / "data" / "mjcf" / "coupled_floating.xml",
+                               list(range(12)) + [13], seed=11)   # all but the ankle
 
 
 @pytest.mark.slow
@@ -342,7 +372,7 @@ def test_panda_with_a_mimic_finger_equals_pinocchios_projected():
     for _ in range(3):
         q = np.append(rng.uniform(-1.5, 1.5, 7), rng.uniform(0, 0.04))
         v, u = rng.normal(size=(2, 8))
-        dtau, dg, forward = reference(pm, T, c.ravel(), q, v, u)
+        dtau, dg, forward = reference(pm, T, T @ q + c.ravel(), v, u)
         for ours, theirs in zip(module.inverse_dynamics_derivatives(q, v, u), dtau):
             assert relative(ours, theirs) <= 1e-10
         assert relative(module.gravity_derivative(q), dg) <= 1e-10
