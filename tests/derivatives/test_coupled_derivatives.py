@@ -60,15 +60,16 @@ couplings:
   - {joint: j3, to: j2, ratio: -0.7, offset: 0.3}
   - {joint: j5, to: {j1: 0.05, j4: -0.02}, offset: 0.01}
 """
-#: a hinge, a hinge following it, a ball joint, a hinge (Pinocchio's q: ja, jb, quaternion, jd)
-BALL_AFTER = """<mujoco model="ball_after"><option gravity="0.3 -0.2 -9.81"/><worldbody>
-<body name="a" pos="0 0 0.1"><joint name="ja" axis="0 0 1"/>
+#: a hinge, a hinge following it, a ball joint, a hinge (Pinocchio's q: ja, jb, quaternion,
+#: jd), a drive on every hinge
+BALL_AFTER = f"""<mujoco model="ball_after"><option gravity="0.3 -0.2 -9.81"/><worldbody>
+<body name="a" pos="0 0 0.1"><joint name="ja" axis="0 0 1" {DRIVE.format(a=0.05, d=0.3, f=0.2)}/>
 <inertial pos="0.01 0.02 0.1" mass="2" fullinertia="0.02 0.03 0.025 0.001 0.002 -0.001"/>
-<body name="b" pos="0 0.05 0.2" quat="0.9 0.1 0.3 0.2"><joint name="jb" axis="0 1 0"/>
+<body name="b" pos="0 0.05 0.2" quat="0.9 0.1 0.3 0.2"><joint name="jb" axis="0 1 0" {DRIVE.format(a=0.08, d=0.2, f=0.1)}/>
 <inertial pos="0.2 0.01 -0.02" mass="1.5" fullinertia="0.015 0.025 0.02 0.001 0 0.002"/>
 <body name="c" pos="0.3 0 0.05"><joint name="ball" type="ball"/>
 <inertial pos="0.02 0.05 0.1" mass="0.5" fullinertia="0.003 0.002 0.004 0.0002 0 0.0001"/>
-<body name="d" pos="0.1 0.02 0.2"><joint name="jd" axis="1 0 0"/>
+<body name="d" pos="0.1 0.02 0.2"><joint name="jd" axis="1 0 0" {DRIVE.format(a=0.02, d=0.1, f=0.08)}/>
 <inertial pos="0 0.01 0.03" mass="0.3" diaginertia="0.001 0.002 0.0015"/>
 </body></body></body></body></worldbody>
 <equality><joint name="gear" joint1="jb" joint2="ja" polycoef="0.1 -0.6 0 0 0"/></equality>
@@ -305,11 +306,16 @@ def skew(w):
 def assert_tangent_derivatives(path, independent, seed):
     """The derivatives of the MJCF model at ``path`` (quaternion joints and a coupling) equal
     Pinocchio's on the whole tree read from the same file, projected, ∂/∂q along the tangent
-    of the independent configuration (``independent``: its entries' indices in Pinocchio's q);
+    of the independent configuration (``independent``: its entries' indices in Pinocchio's q),
+    the drive derivatives too;
     ``linearize``'s position rows those of the tangent chart (docs/derivatives.md), 0 on the
     one-axis joints."""
     model = eomgen.load(path)
-    module = eomgen.derive(model, ("dtau", "dqdd", "dg_dq", "AB")).lambdify().module
+    module = eomgen.derive(model, ("dtau", "dqdd", "dg_dq", "AB", "dtau_a", "dqdd_a")
+                           ).lambdify().module
+    drives = joint_actuators(uncoupled(model))   # per velocity of the tree (0 on quaternions)
+    drives = tuple(np.array([float(getattr(x, k)) for x in drives])
+                   for k in ("armature", "damping", "friction", "friction_width"))
     pm = pin.buildModelFromMJCF(str(path))
     pm.gravity = pin.Motion(GRAVITY, np.zeros(3))
     pm.armature = np.zeros(pm.nv)
@@ -327,6 +333,12 @@ def assert_tangent_derivatives(path, independent, seed):
         for name, ours, theirs in zip(("dq", "dv", "Minv"),
                                       module.forward_dynamics_derivatives(q, v, u), forward):
             assert relative(ours, theirs) <= 1e-9, name
+        (dq, dv), _, forward = reference(pm, T, qf, v, u, drives)
+        ours = module.drive_inverse_dynamics_derivatives(q, v, u)
+        assert relative(ours[0], dq) <= 1e-10
+        assert relative(ours[1], dv + T.T @ np.diag(drives[1]) @ T) <= 1e-10
+        for ours, theirs in zip(module.drive_forward_dynamics_derivatives(q, v, u), forward):
+            assert relative(ours, theirs) <= 1e-9
         A, _ = module.linearize(q, v, u)
         transport = np.zeros((n, n))   # −½ ad_v of SE(3), −½ [ω]× of SO(3)
         for joint in model.quaternion_joints:
