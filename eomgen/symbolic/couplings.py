@@ -14,13 +14,23 @@ full-coordinate result into the independent coordinates, by what its rows and co
 So ``M_r = Tᵀ M T``, ``C_r = Tᵀ C(T q + c, T q̇) T`` (exactly the Christoffel C of the reduced
 Lagrangian: the symbols ``c_ijk`` are multilinear in the directions, and ``T`` is constant),
 ``g_r = Tᵀ g``, ``τ_r = Tᵀ τ(T q + c, T q̇, T q̈)``, ``Y_r = Tᵀ Y``, ``J_r = J T``. Outputs
-absent from the table are refused under couplings (:func:`refused`): the ABA and its
-derivatives solve the unconstrained tree, the base regressor's columns are those of the
-uncoupled tree, the flexible joints' motor states are per joint. (Y_SL: its ``q̇_r``, ``q̈_r`` enter as
-``T q̇_r``, ``T q̈_r``, :meth:`~eomgen.symbolic.derivation.Derivation.tangent`.)
+absent from the table are refused under couplings (:func:`refused`): the ABA solves the
+unconstrained tree, the base regressor's columns are those of the uncoupled tree, the flexible
+joints' motor states are per joint. (Y_SL: its ``q̇_r``, ``q̈_r`` enter as ``T q̇_r``,
+``T q̈_r``, :meth:`~eomgen.symbolic.derivation.Derivation.tangent`.)
+
+The derivatives of the dynamics (:mod:`eomgen.symbolic.derivatives`) are built in the
+independent coordinates already, so they pass unprojected: ``τ_r``'s program is differentiated
+in forward mode along the independent ``q``, ``q̇`` (a follower's entry ``Σ k q_leader + c``
+carries its gains, so ``∂τ_r/∂q_r = Tᵀ ∂τ/∂q T`` exactly), and ``M_r⁻¹`` (no ABA) comes from
+the straight-line LDLᵀ factors of ``M_r = Tᵀ M T`` (:func:`independent` gives the tangent
+directions of the independent coordinates).
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
+from types import SimpleNamespace
 
 import sympy as sp
 
@@ -42,10 +52,15 @@ PROJECTIONS: dict[str, tuple[bool, bool]] = {
     "cone_c": (False, False), "pyramid_c": (False, False),
     "c_G": (False, False), "J_G": (False, True), "A_G": (False, True), "dAGv": (False, False),
     "I_G": (False, False),
+    # the derivatives, built in the independent coordinates (eomgen.symbolic.derivatives)
+    "dtau_dq": (False, False), "dtau_dqd": (False, False), "dg_dq": (False, False),
+    "dqdd_dq": (False, False), "dqdd_dqd": (False, False), "Minv": (False, False),
+    "A_lin": (False, False), "B_lin": (False, False), "dtau_a_dqd": (False, False),
+    "dqdd_a_dq": (False, False), "dqdd_a_dqd": (False, False), "Minv_a": (False, False),
 }
 
 #: Several-result outputs (:attr:`eomgen.outputs.Output.returns`) projected block by block.
-COMBINED = ("MCg", "Mh")
+COMBINED = ("MCg", "Mh", "dtau", "dqdd", "AB", "dtau_a", "dqdd_a")
 
 
 def supported(symbol: str) -> bool:
@@ -87,6 +102,8 @@ def project(symbol: str, matrix: sp.Matrix, T: sp.Matrix) -> sp.Matrix:
     """
     if symbol in COMBINED:
         output = BY_SYMBOL[symbol]
+        if not any(any(PROJECTIONS[part]) for part in output.returns):
+            return matrix  # built in the independent coordinates (the derivatives)
         blocks = []
         for part, start, end in splits(output, T.rows):
             block = matrix[:, start:start + 1] if end is None else matrix[:, start:end]
@@ -100,4 +117,24 @@ def project(symbol: str, matrix: sp.Matrix, T: sp.Matrix) -> sp.Matrix:
     return matrix
 
 
-__all__ = ["COMBINED", "PROJECTIONS", "coupled_inputs", "project", "refused", "supported"]
+def independent(derivation):
+    """What :func:`eomgen.symbolic.tangent.tangent_seeds` and
+    :func:`~eomgen.symbolic.tangent.velocity_transport` read of ``derivation`` (its ``inputs``,
+    ``builder``, ``model.quaternion_joints`` and ``model.dof``), in the independent
+    coordinates: ``derivation`` itself without couplings; with couplings a view whose
+    quaternion joints are numbered in the independent ``q`` and ``v`` (a quaternion joint is
+    never coupled: its velocity rows of ``T`` are unit rows, and every follower before it is a
+    one-entry coordinate in both ``q`` and ``v``)."""
+    T = derivation.coupling
+    if T is None:
+        return derivation
+    joints = []
+    for joint in derivation.model.quaternion_joints:
+        v = next(k for k in range(T.cols) if T[joint.v_index, k] != 0)
+        joints.append(replace(joint, v_index=v, q_index=joint.q_index - joint.v_index + v))
+    return SimpleNamespace(inputs=derivation.inputs, builder=derivation.builder,
+                           model=SimpleNamespace(quaternion_joints=tuple(joints), dof=T.cols))
+
+
+__all__ = ["COMBINED", "PROJECTIONS", "coupled_inputs", "independent", "project", "refused",
+           "supported"]

@@ -36,6 +36,17 @@ each q entry's own direction otherwise):
   the tangent, as for the plain derivatives (the drives sit on the one-DOF joints).
 * ``dtau``, ``dqdd``, ``AB``, ``dtau_a``, ``dqdd_a``: the several-result functions, side by
   side.
+
+With coupled joints (:mod:`eomgen.symbolic.couplings`: the whole tree at ``q = T q_r + c``,
+``q̇ = T q̇_r``) every output is in the independent coordinates, n = NV_r: the efforts' rows
+``Tᵀ τ`` are differentiated along the independent ``q_r`` (tangent) and ``q̇_r``, so
+``∂τ_r/∂q_r = Tᵀ ∂τ/∂q T`` and ``∂g_r/∂q_r = Tᵀ ∂g/∂q T`` exactly; the ABA does not apply
+(it solves the unconstrained tree), so ``M_r⁻¹`` is the inverse of ``M_r = Tᵀ M T``
+(``+ Tᵀ diag(a) T`` with the drives) from its straight-line LDLᵀ factors
+(:func:`symmetric_inverse`), ``q̈_r = M_r⁻¹ (τ_r − Tᵀ h)`` (``h = τ(q, q̇, 0)``, plus the
+smoothed friction with the drives), and ``∂q̈_r/∂x_r = −M_r⁻¹ Tᵀ ∂τ/∂x T`` at ``T q̈_r`` held
+fixed, as without couplings; the drives' ``diag(d)`` and ``diag(τ_f′)`` enter as
+``Tᵀ diag(·) T``.
 """
 
 from __future__ import annotations
@@ -45,6 +56,7 @@ import sympy as sp
 from ..model import joint_actuators
 from ..outputs import BY_SYMBOL
 from .aba import forward_dynamics_program, true_accelerations
+from .couplings import independent
 from .drives import friction_torque_expr
 from .newton_euler import inverse_dynamics_program
 from .program import ProgramBuilder, name_expr
@@ -179,31 +191,104 @@ def _work(derivation) -> dict:
     return derivation.shared.setdefault(_SHARED, {})
 
 
+def _nv(derivation) -> int:
+    """The number of derivative columns: the model's NV (the independent ones with couplings)."""
+    return len(derivation.inputs["qd"])
+
+
+def _efforts(derivation, tau) -> list:
+    """The derivation's joint efforts ``tau`` in the model's coordinates: ``Tᵀ τ`` with coupled
+    joints (virtual work), ``τ`` itself otherwise."""
+    T = derivation.coupling
+    return list(tau) if T is None else list(T.T * sp.Matrix(tau))
+
+
+def _tangent_seeds(derivation) -> dict:
+    """The q seeds of :func:`forward_mode`: along the tangent of the model's own ``q`` (the
+    independent one with couplings) and the velocity seeds along ``q̇``."""
+    return {**tangent_seeds(independent(derivation)), **_seeds(derivation.inputs["qd"], "qd")}
+
+
+def symmetric_inverse(b: ProgramBuilder, M: sp.Matrix, hint: str) -> sp.Matrix:
+    """The inverse of the symmetric positive definite ``M`` (n × n) as a straight-line program
+    in ``b``: ``M = L D Lᵀ`` (L unit lower triangular, no square roots), ``Z = L⁻¹``, then
+    ``M⁻¹ = Zᵀ D⁻¹ Z``, upper triangle computed and mirrored; structural zeros skipped, each
+    nonzero named ``<hint>…``. Exact (rational operations only), O(n³)."""
+    n = M.rows
+    L, W, inv_D = sp.eye(n), sp.zeros(n, n), [sp.Integer(0)] * n
+    for j in range(n):
+        D = M[j, j] - sp.Add(*[L[j, k] * W[j, k] for k in range(j)])
+        inv_D[j] = name_expr(b, 1 / name_expr(b, D, f"{hint}_D{j + 1}"), f"{hint}_iD{j + 1}")
+        for i in range(j + 1, n):
+            total = M[i, j] - sp.Add(*[L[i, k] * W[j, k] for k in range(j)])
+            if total != 0:
+                W[i, j] = name_expr(b, total, f"{hint}_W{i + 1}_{j + 1}")   # L[i, j] D_j
+                L[i, j] = name_expr(b, W[i, j] * inv_D[j], f"{hint}_L{i + 1}_{j + 1}")
+    Z = sp.eye(n)
+    for j in range(n):
+        for i in range(j + 1, n):
+            total = -sp.Add(*[L[i, k] * Z[k, j] for k in range(j, i)
+                              if L[i, k] != 0 and Z[k, j] != 0])
+            if total != 0:
+                Z[i, j] = name_expr(b, total, f"{hint}_Z{i + 1}_{j + 1}")
+    out = sp.zeros(n, n)
+    for i in range(n):
+        for j in range(i, n):
+            total = sp.Add(*[Z[k, i] * Z[k, j] * inv_D[k] for k in range(j, n)
+                             if Z[k, i] != 0 and Z[k, j] != 0])
+            if total != 0:
+                out[i, j] = out[j, i] = name_expr(b, total, f"{hint}{i + 1}_{j + 1}")
+    return out
+
+
+def _coupled_dynamics(derivation, armature=None, friction=None, hint: str = "c"):
+    """``(M_r⁻¹, q̈_r)`` of a model with coupled joints: ``M_r = Tᵀ (M + diag(armature)) T``
+    inverted by :func:`symmetric_inverse`, ``q̈_r = M_r⁻¹ (τ_r − Tᵀ (τ(q, q̇, 0) + friction))``,
+    each acceleration named."""
+    b, T = derivation.builder, derivation.coupling
+    M = derivation.output("M")
+    if armature is not None:
+        M = M + sp.diag(*armature)
+    Minv = symmetric_inverse(b, T.T * M * T, f"Minv_{hint}")
+    zero = (sp.Integer(0),) * T.cols
+    bias = inverse_dynamics_program(derivation.tree, derivation.q, derivation.qd,
+                                    derivation.accelerations(zero),
+                                    derivation.model.gravity, b, hint=f"h_{hint}")
+    if friction is not None:
+        bias = bias + friction
+    rhs = [t - e for t, e in zip(derivation.tau, _efforts(derivation, bias))]
+    qdd = [b.define(sp.Add(*[Minv[i, k] * rhs[k] for k in range(T.cols)]),
+                    f"qdd_{hint}{i + 1}") for i in range(T.cols)]
+    return Minv, sp.Matrix(qdd)
+
+
 def inverse_dynamics_jacobians(derivation) -> tuple[sp.Matrix, sp.Matrix]:
     """(∂τ/∂q, ∂τ/∂q̇) of the derivation's τ output (both n × n)."""
     work = _work(derivation)
     if "dtau" not in work:
-        tau = derivation.output("tau")
-        n = len(derivation.q)
-        seeds = {**tangent_seeds(derivation), **_seeds(derivation.qd, "qd")}
-        rows = forward_mode(derivation.builder, list(tau), seeds)
+        tau = _efforts(derivation, derivation.output("tau"))
+        n = _nv(derivation)
+        rows = forward_mode(derivation.builder, tau, _tangent_seeds(derivation))
         work["dtau"] = (_jacobian(rows, "q", n), _jacobian(rows, "qd", n))
     return work["dtau"]
 
 
 def gravity_jacobian(derivation) -> sp.Matrix:
     """∂g/∂q of g(q) = τ(q, 0, 0) (Newton–Euler), n × n."""
-    n = len(derivation.q)
-    zero = (sp.Integer(0),) * n
+    zero = (sp.Integer(0),) * len(derivation.q)
     g = inverse_dynamics_program(derivation.tree, derivation.q, zero, zero,
                                  derivation.model.gravity, derivation.builder, hint="g")
-    rows = forward_mode(derivation.builder, list(g), tangent_seeds(derivation))
-    return _jacobian(rows, "q", n)
+    rows = forward_mode(derivation.builder, _efforts(derivation, g),
+                        tangent_seeds(independent(derivation)))
+    return _jacobian(rows, "q", _nv(derivation))
 
 
 def inverse_mass_matrix(derivation) -> sp.Matrix:
-    """M(q)⁻¹ as ∂q̈/∂τ of the ABA program (n × n, upper triangle computed, mirrored)."""
+    """M(q)⁻¹ as ∂q̈/∂τ of the ABA program (n × n, upper triangle computed, mirrored); with
+    coupled joints ``(Tᵀ M T)⁻¹`` from its LDLᵀ factors (:func:`symmetric_inverse`)."""
     work = _work(derivation)
+    if "Minv" not in work and derivation.coupling is not None:  # no ABA: M_r's factors
+        work["Minv"], work["qdd"] = _coupled_dynamics(derivation)
     if "Minv" not in work:
         qdd = _aba(derivation)
         n = len(derivation.q)
@@ -215,6 +300,8 @@ def inverse_mass_matrix(derivation) -> sp.Matrix:
 
 def _aba(derivation) -> sp.Matrix:
     work = _work(derivation)
+    if "qdd" not in work and derivation.coupling is not None:
+        work["Minv"], work["qdd"] = _coupled_dynamics(derivation)
     if "qdd" not in work:
         b = derivation.builder
         qdd = forward_dynamics_program(derivation.tree, derivation.q, derivation.qd,
@@ -227,8 +314,8 @@ def _aba(derivation) -> sp.Matrix:
 def _efforts_at(derivation, qdd, hint: str) -> tuple[sp.Matrix, sp.Matrix]:
     """(∂τ/∂q, ∂τ/∂q̇) of the Newton–Euler τ(q, q̇, q̈) at the named accelerations ``qdd``
     held fixed (the implicit function theorem's half of ∂q̈; ∂/∂q in tangent coordinates)."""
-    b, n = derivation.builder, len(derivation.q)
-    inputs = set(derivation.inputs["q"]) | set(derivation.qd)
+    b, n = derivation.builder, _nv(derivation)
+    inputs = set(derivation.inputs["q"]) | set(derivation.inputs["qd"])
     frozen = set()
     for e in qdd:  # a named intermediate (±), or free of q and q̇ (e.g. τ_1 / m of a lone body)
         named = e.is_Symbol or (e.is_Mul and e.args[0] == -1 and e.args[1].is_Symbol)
@@ -238,8 +325,8 @@ def _efforts_at(derivation, qdd, hint: str) -> tuple[sp.Matrix, sp.Matrix]:
     tau = inverse_dynamics_program(derivation.tree, derivation.q, derivation.qd,
                                    derivation.accelerations(tuple(qdd)),
                                    derivation.model.gravity, b, hint=hint)
-    seeds = {**tangent_seeds(derivation), **_seeds(derivation.qd, "qd")}
-    rows = forward_mode(b, list(tau), seeds, frozenset(frozen))
+    rows = forward_mode(b, _efforts(derivation, tau), _tangent_seeds(derivation),
+                        frozenset(frozen))
     return _jacobian(rows, "q", n), _jacobian(rows, "qd", n)
 
 
@@ -259,8 +346,9 @@ def drive_inverse_dynamics_jacobians(derivation) -> tuple[sp.Matrix, sp.Matrix]:
     """(∂τ_a/∂q, ∂τ_a/∂q̇) of the drive torques τ_a = τ + a q̈ + d q̇ + f sign(q̇): ∂τ/∂q, and
     ∂τ/∂q̇ + diag(d) (the exact Coulomb sign has derivative 0 wherever q̇_i ≠ 0)."""
     dq, dqd = inverse_dynamics_jacobians(derivation)
-    damping = [a.damping for a in joint_actuators(derivation.model)]
-    return dq, dqd + sp.diag(*damping)
+    damping = sp.diag(*[a.damping for a in joint_actuators(derivation.model)])
+    T = derivation.coupling
+    return dq, dqd + (damping if T is None else T.T * damping * T)
 
 
 def drive_forward_dynamics_jacobians(derivation) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
@@ -274,6 +362,8 @@ def drive_forward_dynamics_jacobians(derivation) -> tuple[sp.Matrix, sp.Matrix, 
       τ(q, q̇, q̈) + a q̈ + τ_f(q̇) = τ).
     """
     work = _work(derivation)
+    if "dqdd_a" not in work and derivation.coupling is not None:
+        work["dqdd_a"] = _coupled_drive_jacobians(derivation)
     if "dqdd_a" not in work:
         b, n, qd = derivation.builder, len(derivation.q), derivation.qd
         actuators = joint_actuators(derivation.model)
@@ -295,14 +385,31 @@ def drive_forward_dynamics_jacobians(derivation) -> tuple[sp.Matrix, sp.Matrix, 
     return work["dqdd_a"]
 
 
+def _coupled_drive_jacobians(derivation) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
+    """:func:`drive_forward_dynamics_jacobians` of a model with coupled joints: the drives sit
+    on the whole tree's joints (at ``T q̇_r``), ``M_a,r = Tᵀ (M + diag(a)) T`` inverted by
+    :func:`symmetric_inverse` and ``diag(τ_f′)`` projected as ``Tᵀ diag(τ_f′) T``."""
+    b, T, qd = derivation.builder, derivation.coupling, derivation.qd
+    actuators = joint_actuators(derivation.model)
+    friction = friction_torque_expr(actuators, qd, smooth=True)
+    Minv, qdd = _coupled_dynamics(derivation, [a.armature for a in actuators], friction, "d")
+    dq, dqd = _efforts_at(derivation, qdd, "tau_d")
+    x = [sp.Dummy(f"x{k}") for k in range(len(qd))]  # the friction law's slope at each T q̇_r
+    law = friction_torque_expr(actuators, x, smooth=True)
+    slope = [sp.diff(law[k, 0], x[k]).subs(x[k], v) for k, v in enumerate(qd)]
+    slope = sp.diag(*[name_expr(b, s, f"dtau_f{k + 1}") for k, s in enumerate(slope)])
+    dqd = dqd + T.T * slope * T
+    return (_product(b, Minv, dq, "dqdd_a_dq"), _product(b, Minv, dqd, "dqdd_a_dqd"), Minv)
+
+
 def linearization(derivation) -> tuple[sp.Matrix, sp.Matrix]:
     """A (2n × 2n) and B (2n × n) of ẋ = f(x, τ), x = (q, q̇), n = NV: with quaternion
     joints x = (δ, v) in the chart δ ↦ q ⊕ δ at δ = 0, whose position rows are
     δ̇ = J_r(δ)⁻¹ v (:func:`eomgen.symbolic.tangent.velocity_transport`)."""
-    n = len(derivation.q)
+    n = _nv(derivation)
     dq, dqd, Minv = forward_dynamics_jacobians(derivation)
-    A = sp.Matrix.vstack(sp.Matrix.hstack(velocity_transport(derivation), sp.eye(n)),
-                         sp.Matrix.hstack(dq, dqd))
+    transport = velocity_transport(independent(derivation))
+    A = sp.Matrix.vstack(sp.Matrix.hstack(transport, sp.eye(n)), sp.Matrix.hstack(dq, dqd))
     B = sp.Matrix.vstack(sp.zeros(n, n), Minv)
     return A, B
 
@@ -335,4 +442,4 @@ def build_derivatives(derivation, wanted) -> dict:
 __all__ = ["build_derivatives", "drive_forward_dynamics_jacobians",
            "drive_inverse_dynamics_jacobians", "forward_dynamics_jacobians", "forward_mode",
            "gravity_jacobian", "inverse_dynamics_jacobians", "inverse_mass_matrix",
-           "linearization"]
+           "linearization", "symmetric_inverse"]
