@@ -108,7 +108,10 @@ def case(request, tmp_path_factory):
 
 
 def states(pm, count, seed):
+    """``count`` states (q, v, τ) of Pinocchio's model ``pm``, the same for a seed whatever ran
+    before (``randomConfiguration`` draws from Pinocchio's global generator, seeded here)."""
     rng = np.random.default_rng(seed)
+    pin.seed(seed)
     for _ in range(count):
         q = pin.randomConfiguration(pm, -np.ones(pm.nq), np.ones(pm.nq))
         yield q, rng.normal(size=pm.nv), rng.normal(size=pm.nv)
