@@ -25,8 +25,6 @@ import numpy as np
 import pytest
 
 import eomgen
-from eomgen.codegen.backends.casadi_backend import c_compiler
-from eomgen.codegen.generate import render_files
 from eomgen.model import joint_actuators, uncoupled
 from eomgen.model.coupling import coupling_map, full_configuration
 from eomgen.outputs import OUTPUTS
@@ -243,60 +241,22 @@ def test_casadi_gives_the_numpy_modules_derivatives(arm):
 
 @pytest.mark.slow
 def test_every_backend_gives_the_numpy_modules_derivatives(tmp_path):
-    """NumPy, CasADi, the fast module, JAX, PyTorch, CasADi's C library (``casadi.external``)
-    and the plain C ``kernels`` (ctypes)."""
+    """NumPy, CasADi, the fast module, JAX and PyTorch print the same coupled programs.
+    (CasADi's C library and the plain C kernels print CasADi's functions and the same
+    straight-line program: their printers are checked on the uncoupled derivatives,
+    tests/derivatives/test_c_kernels.py.)"""
     _, model = coupled_arm(tmp_path)
     _, modules = generated(model, DERIVATIVES, tmp_path)
     assert set(modules) == set(BACKENDS)
-    if "casadi" in modules and c_compiler() is not None:
-        import casadi
-
-        for f in render_files(model, ["c"], functions=DERIVATIVES):
-            path = tmp_path / f.name
-            path.write_bytes(f.content) if isinstance(f.content, bytes) else path.write_text(
-                f.content, encoding="utf-8")
-        library = next(p for p in tmp_path.iterdir() if p.name.startswith("geared_casadi.")
-                       and p.suffix in (".so", ".dylib", ".dll"))
-        modules["c"] = {f: casadi.external(f, str(library)) for f in DERIVATIVES}
-    kernels = c_kernels(model, tmp_path) if c_compiler() is not None else None
-    for q, v, u in states(model.dof, 2, seed=10):
+    for q, v, u in states(model.dof, 1, seed=10):
         for function in DERIVATIVES:
             args = arguments(function, q, v, u)
             theirs = results("numpy", modules["numpy"], function, *args, m_load=0.9)
             for backend, module in modules.items():
-                ours = results("casadi" if backend == "c" else backend, module, function,
-                               *args, m_load=0.9)
+                ours = results(backend, module, function, *args, m_load=0.9)
                 assert len(ours) == len(theirs)
                 for part, expected in zip(ours, theirs):
                     assert relative(part, expected) <= 1e-12, (backend, function)
-            if kernels is not None:  # the results side by side, row-major
-                expected = np.hstack(theirs)
-                out = np.zeros(expected.shape)
-                kernels[function](*(np.ascontiguousarray(x) for x in args),
-                                  np.array([0.9]), out)
-                assert relative(out, expected) <= 1e-12, ("kernels", function)
-
-
-def c_kernels(model, folder) -> dict:
-    """The ``kernels`` backend's C functions of DERIVATIVES, compiled into a shared library and
-    called through ctypes: ``{function: f(*vectors, parameters, out)}``."""
-    import ctypes
-    import subprocess
-
-    for f in render_files(model, ["kernels"], functions=DERIVATIVES):
-        (folder / f.name).write_text(f.content, encoding="utf-8")
-    library = folder / "libgeared_kernels.so"
-    subprocess.run([c_compiler(), "-O1", "-std=c99", "-shared", "-fPIC",
-                    str(folder / "geared_kernels.c"), "-o", str(library), "-lm"], check=True)
-    loaded = ctypes.CDLL(str(library))
-    pointer = np.ctypeslib.ndpointer(dtype=np.float64, flags="C_CONTIGUOUS")
-    out = {}
-    for function in DERIVATIVES:
-        kernel = getattr(loaded, f"geared_{function}")
-        kernel.restype = None
-        kernel.argtypes = [pointer] * (len(OUTPUTS[function].inputs) + 2)
-        out[function] = kernel
-    return out
 
 
 def skew(w):
