@@ -7,6 +7,7 @@ example-robot-data is not installed) and a plain function in :mod:`support` (ret
 from __future__ import annotations
 
 import os
+import sys
 
 # One BLAS thread per test process: `pytest -n auto` already runs a worker per core, and
 # OpenBLAS's own threads on top of that oversubscribe the cores (a least-squares fit of the
@@ -41,6 +42,25 @@ def pytest_addoption(parser):
 # before the module's own fixtures run, so that `eomgen generate` processes they start inherit
 # it), and the whole session one besides; nothing is ever written to ~/.cache/eomgen.
 # ----------------------------------------------------------------------------------------------
+
+
+def _seed_pinocchio():
+    pinocchio = sys.modules.get("pinocchio")
+    if pinocchio is not None:
+        pinocchio.seed(0)
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _pinocchio_seeded_per_module():
+    """Pinocchio's global generator (``randomConfiguration``, ``SE3.Random``) seeded before a
+    module's fixtures and before every test, so that a test draws the same states whatever
+    ran before it on its worker."""
+    _seed_pinocchio()
+
+
+@pytest.fixture(autouse=True)
+def _pinocchio_seeded(_pinocchio_seeded_per_module):
+    _seed_pinocchio()
 
 
 @pytest.fixture(autouse=True, scope="session")
