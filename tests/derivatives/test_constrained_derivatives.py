@@ -13,18 +13,15 @@ central differences of the generated ``constrained_forward_dynamics`` (along eom
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pytest
 
 import eomgen
-from eomgen.errors import UnsupportedFeatureWarning
-from eomgen.quaternion_joints import integrate
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import erd_robots_or_skip
 from support.generated import BACKENDS, generated
+from support.held import constrained_central_differences, held_model
 from support.robots import SOLO
 
 pin = pytest.importorskip("pinocchio", reason="checked against Pinocchio's derivatives")
@@ -65,25 +62,10 @@ def leg(joints: int) -> str:
 
 
 def held(path, feet, floating: bool, functions, folder, backends=("numpy",)):
-    """(eomgen model, generated modules, Pinocchio model, constraint models and datas) of the
+    """(eomgen model, (calls, generated modules), Pinocchio model, constraint models) of the
     URDF at ``path`` with ``feet`` held (and a quaternion free flyer when ``floating``)."""
-    scene = "version: 1\n" + ("floating_base: quaternion\n" if floating else "") + \
-        "contacts:\n" + "".join(f"  - {{frame: {f}}}\n" for f in feet)
-    with warnings.catch_warnings():  # the solo12's URDF root "looks like a floating base"
-        warnings.simplefilter("ignore", UnsupportedFeatureWarning)
-        model = apply_scene(eomgen.load(path), load_scene("s.yaml", text=scene)).model
-    pm = (pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer()) if floating
-          else pin.buildModelFromUrdf(str(path)))
-    pm.gravity = pin.Motion(np.array([float(x) for x in model.gravity]), np.zeros(3))
-    assert list(pm.names[2 if floating else 1:]) == list(model.joint_names[6 if floating else 0:])
-    constraints = pin.StdVec_RigidConstraintModel()
-    for foot in feet:
-        frame = pm.frames[pm.getFrameId(foot)]
-        constraints.append(pin.RigidConstraintModel(pin.ContactType.CONTACT_3D, pm,
-                                                    frame.parentJoint, frame.placement,
-                                                    pin.LOCAL_WORLD_ALIGNED))
-    calls, modules = generated(model, functions, folder, backends=backends)
-    return model, (calls, modules), pm, constraints
+    model, pm, constraints = held_model(path, feet, floating)
+    return model, generated(model, functions, folder, backends=backends), pm, constraints
 
 
 def pinocchio_derivatives(pm, constraints, q, v, tau):
@@ -141,18 +123,8 @@ def test_constrained_derivatives_are_central_differences(case):
     cfd = m["constrained_forward_dynamics"]
     for q, v, tau in states(pm, 1, seed=1):
         exact = m[DERIVATIVES](q, v, tau)
-        for k, (f, x, along) in enumerate([
-                (lambda x: cfd(x, v, tau), q, model.quaternion_joints),
-                (lambda x: cfd(q, x, tau), v, None), (lambda x: cfd(q, v, x), tau, None)]):
-            steps = np.eye(model.dof) * h
-            if along:
-                plus = [f(integrate(x, e, model=model)) for e in steps]
-                minus = [f(integrate(x, -e, model=model)) for e in steps]
-            else:
-                plus, minus = [f(x + e) for e in steps], [f(x - e) for e in steps]
-            for part in range(2):  # qdd, then F_c
-                fd = np.stack([(p[part] - n[part]) / (2 * h) for p, n in zip(plus, minus)], -1)
-                np.testing.assert_allclose(exact[3 * part + k], fd, rtol=1e-6, atol=1e-6)
+        for got, fd in zip(exact, constrained_central_differences(model, cfd, q, v, tau, h)):
+            np.testing.assert_allclose(got, fd, rtol=1e-6, atol=1e-6)
 
 
 @pytest.mark.slow  # a C compile and three array libraries (~20 s)

@@ -16,9 +16,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from eomgen.quaternion_joints import integrate
 from support import erd_robots_or_skip
-from support.held import held_robot, pinocchio_constrained_derivatives
+from support.held import (constrained_central_differences, held_robot,
+                          pinocchio_constrained_derivatives)
 from test_constrained_derivatives import DERIVATIVES, leg, states
 
 pin = pytest.importorskip("pinocchio", reason="checked against Pinocchio's derivatives")
@@ -64,20 +64,10 @@ def test_surface_contact_derivatives_are_central_differences(case):
     cfd = m["constrained_forward_dynamics"]
     for q, v, tau in states(pm, 1, seed=7):
         exact = m[DERIVATIVES](q, v, tau)
-        for k, (f, x, along) in enumerate([
-                (lambda x: cfd(x, v, tau), q, model.quaternion_joints),
-                (lambda x: cfd(q, x, tau), v, None), (lambda x: cfd(q, v, x), tau, None)]):
-            steps = np.eye(model.dof) * h
-            if along:
-                pairs = [(f(integrate(x, e, model=model)), f(integrate(x, -e, model=model)))
-                         for e in steps]
-            else:
-                pairs = [(f(x + e), f(x - e)) for e in steps]
-            for part in range(2):  # qdd, then F_c
-                fd = np.stack([(p[part] - n[part]) / (2 * h) for p, n in pairs], -1)
-                scale = max(1.0, np.abs(fd).max())
-                np.testing.assert_allclose(exact[3 * part + k] / scale, fd / scale, rtol=0,
-                                           atol=1e-6, err_msg=NAMES[3 * part + k])
+        differences = constrained_central_differences(model, cfd, q, v, tau, h)
+        for name, got, fd in zip(NAMES, exact, differences):
+            scale = max(1.0, np.abs(fd).max())
+            np.testing.assert_allclose(got / scale, fd / scale, rtol=0, atol=1e-6, err_msg=name)
 
 
 @pytest.mark.slow  # the leg derived again, with the CasADi module (~4 s)

@@ -23,14 +23,11 @@ from eomgen.scene import load_scene
 from .reference import pinocchio_contacts
 
 
-def held_robot(path: Path, feet, floating: bool, functions, folder: Path,
-               backends=("numpy",), kind: str = "point"):
-    """``(model, modules, pm, constraints)``: eomgen's model of the URDF at ``path`` holding
-    each of ``feet`` with a ``kind`` ("point" or "surface") contact (and a quaternion free flyer
-    when ``floating``); its modules exporting ``functions`` for ``backends``, derived once
-    (``modules[backend]`` the namespace; ``"c"``: the CasADi C library's functions loaded with
-    ``casadi.external``); Pinocchio's model read from the same file and its
-    ``RigidConstraintModel`` list (eomgen's conventions, :func:`pinocchio_contacts`)."""
+def held_model(path: Path, feet, floating: bool, kind: str = "point"):
+    """``(model, pm, constraints)``: eomgen's model of the URDF at ``path`` holding each of
+    ``feet`` with a ``kind`` ("point" or "surface") contact (and a quaternion free flyer when
+    ``floating``), Pinocchio's model read from the same file (same gravity, same joint order)
+    and its ``RigidConstraintModel`` list (eomgen's conventions, :func:`pinocchio_contacts`)."""
     import pinocchio as pin
 
     scene = ("version: 1\n" + ("floating_base: quaternion\n" if floating else "")
@@ -43,6 +40,15 @@ def held_robot(path: Path, feet, floating: bool, functions, folder: Path,
     pm.gravity = pin.Motion(np.array([float(x) for x in model.gravity]), np.zeros(3))
     assert list(pm.names[2 if floating else 1:]) == list(model.joint_names[6 if floating else 0:])
     constraints, _ = pinocchio_contacts(pm, pm.createData(), feet, kind)
+    return model, pm, constraints
+
+
+def held_robot(path: Path, feet, floating: bool, functions, folder: Path,
+               backends=("numpy",), kind: str = "point"):
+    """``(model, modules, pm, constraints)``: :func:`held_model` and the model's modules
+    exporting ``functions`` for ``backends``, derived once (``modules[backend]`` the namespace;
+    ``"c"``: the CasADi C library's functions loaded with ``casadi.external``)."""
+    model, pm, constraints = held_model(path, feet, floating, kind)
     stem = module_name(model.name)
     for f in render_files(model, list(backends), functions=select_functions(functions)):
         target = folder / f.name
@@ -77,3 +83,24 @@ def pinocchio_constrained_derivatives(pm, constraints, q, v, tau):
     return (ddq, data.lambda_c.copy()), (data.ddq_dq.copy(), data.ddq_dv.copy(),
                                          data.ddq_dtau.copy(), data.dlambda_dq.copy(),
                                          data.dlambda_dv.copy(), data.dlambda_dtau.copy())
+
+
+def constrained_central_differences(model, forward, q, v, tau, h: float = 1e-6) -> list:
+    """Central differences of ``forward(q, v, tau) -> (q̈, F_c)`` (a generated
+    ``constrained_forward_dynamics``) in the order of ``constrained_forward_dynamics_derivatives``:
+    q̈ then F_c, each by q (along eomgen's ``integrate`` for quaternion joints), v and τ."""
+    from eomgen.quaternion_joints import integrate
+
+    steps = np.eye(model.dof) * h
+    columns = []
+    for f, x, along in [(lambda x: forward(x, v, tau), q, model.quaternion_joints),
+                        (lambda x: forward(q, x, tau), v, None),
+                        (lambda x: forward(q, v, x), tau, None)]:
+        if along:
+            pairs = [(f(integrate(x, e, model=model)), f(integrate(x, -e, model=model)))
+                     for e in steps]
+        else:
+            pairs = [(f(x + e), f(x - e)) for e in steps]
+        columns.append([np.stack([(p[part] - n[part]) / (2 * h) for p, n in pairs], -1)
+                        for part in range(2)])
+    return [columns[k][part] for part in range(2) for k in range(3)]
