@@ -21,7 +21,8 @@ from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import erd_robots_or_skip
 from support.generated import BACKENDS, generated
-from support.held import constrained_central_differences, held_model
+from support.held import (constrained_central_differences, held_model,
+                          pinocchio_constrained_derivatives)
 from support.robots import SOLO
 
 pin = pytest.importorskip("pinocchio", reason="checked against Pinocchio's derivatives")
@@ -68,18 +69,6 @@ def held(path, feet, floating: bool, functions, folder, backends=("numpy",)):
     return model, generated(model, functions, folder, backends=backends), pm, constraints
 
 
-def pinocchio_derivatives(pm, constraints, q, v, tau):
-    """Pinocchio's (ddq, λ) and its six derivatives (ddq, λ by q, v, τ)."""
-    data = pm.createData()
-    datas = pin.StdVec_RigidConstraintData([c.createData() for c in constraints])
-    pin.initConstraintDynamics(pm, data, constraints, datas)
-    ddq = pin.constraintDynamics(pm, data, q, v, tau, constraints, datas,
-                                 pin.ProximalSettings(1e-14, 1e-12, 1))
-    pin.computeConstraintDynamicsDerivatives(pm, data, constraints, datas)
-    return (ddq, data.lambda_c.copy()), (data.ddq_dq, data.ddq_dv, data.ddq_dtau,
-                                         data.dlambda_dq, data.dlambda_dv, data.dlambda_dtau)
-
-
 @pytest.fixture(scope="module", params=["fixed", "floating"])
 def case(request, tmp_path_factory):
     folder = tmp_path_factory.mktemp(request.param)
@@ -101,7 +90,7 @@ def states(pm, count, seed):
 
 def check_against_pinocchio(m, pm, constraints, count=2, seed=0, tol=1e-8):
     for q, v, tau in states(pm, count, seed):
-        (ddq, lam), refs = pinocchio_derivatives(pm, constraints, q, v, tau)
+        (ddq, lam), refs = pinocchio_constrained_derivatives(pm, constraints, q, v, tau)
         qdd, F = m["constrained_forward_dynamics"](q, v, tau)
         np.testing.assert_allclose(qdd, ddq, rtol=tol, atol=tol)
         np.testing.assert_allclose(F, lam, rtol=tol, atol=tol)
