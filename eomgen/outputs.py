@@ -503,15 +503,15 @@ GRAVITY_DERIVATIVE = register_output(Output(
     _PER_Q, ("dg_dq",), build=_DERIVATIVES, default=False))
 DQDD_DQ = register_output(Output(
     "forward_dynamics_derivative_q", "dqdd_dq", "dqdd/dq (nv, nv) of qdd(q, qd, tau) = -M^-1 "
-    "dtau/dq at qdd (ABA).", ("q", "qd", "tau"), False, "1/s^2", ("dqdd_dq",),
+    "dtau/dq at qdd(q, qd, tau).", ("q", "qd", "tau"), False, "1/s^2", ("dqdd_dq",),
     build=_DERIVATIVES, default=False))
 DQDD_DQD = register_output(Output(
     "forward_dynamics_derivative_qd", "dqdd_dqd", "dqdd/dqd (nv, nv) of qdd(q, qd, tau) = "
-    "-M^-1 dtau/dqd at qdd (ABA).", ("q", "qd", "tau"), False, "1/s", ("dqdd_dqd",),
+    "-M^-1 dtau/dqd at qdd(q, qd, tau).", ("q", "qd", "tau"), False, "1/s", ("dqdd_dqd",),
     build=_DERIVATIVES, default=False))
 INVERSE_MASS = register_output(Output(
-    "inverse_mass_matrix", "Minv", "M(q)^-1 = dqdd/dtau (nv, nv), the ABA program "
-    "differentiated along tau.", ("q",), False, "1/(kg m^2) (revolute), 1/kg (prismatic)",
+    "inverse_mass_matrix", "Minv", "M(q)^-1 = dqdd/dtau (nv, nv), from the "
+    "straight-line L^T D L factors of M.", ("q",), False, "1/(kg m^2) (revolute), 1/kg (prismatic)",
     ("Minv",), build=_DERIVATIVES, default=False))
 FORWARD_DERIVATIVES = register_output(Output(
     "forward_dynamics_derivatives", "dqdd", "(dqdd/dq, dqdd/dqd, M^-1 = dqdd/dtau) of "
@@ -552,7 +552,7 @@ DRIVE_DQDD_DQD = register_output(Output(
     ("dqdd_a_dqd",), build=_DERIVATIVES, default=False))
 DRIVE_INVERSE_MASS = register_output(Output(
     "drive_inverse_mass_matrix", "Minv_a", "(M(q) + diag(a))^-1 = dqdd/dtau (nv, nv) of the "
-    "drives' forward dynamics (ABA with the armature).", ("q",), False,
+    "drives' forward dynamics (the factors of M + diag(a)).", ("q",), False,
     "1/(kg m^2) (revolute), 1/kg (prismatic)", ("Minv_a",), build=_DERIVATIVES, default=False))
 DRIVE_FORWARD_DERIVATIVES = register_output(Output(
     "drive_forward_dynamics_derivatives", "dqdd_a", "(dqdd/dq, dqdd/dqd, (M + diag(a))^-1) of "
