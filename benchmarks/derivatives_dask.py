@@ -58,6 +58,16 @@ from fair_speed import LOCKED, spread  # noqa: E402
 
 FUNCTION = "inverse_dynamics_derivative_q"
 
+# What a compute-bound cluster does not need, set in this process and passed by the nannies to
+# the workers: the statistical profiler (it samples a working thread's stack every 10 ms) and
+# the event loops' 20 ms tick and 100 ms / 500 ms monitors. Measured on this 2-core machine, an
+# idle 2-worker cluster took 11.5 % of a core with dask's defaults and 1.8 % with these; one
+# worker's throughput of this study rose from 1.06 to 1.12 million states/s.
+QUIET = {"distributed.worker.profile.enabled": False,
+         "distributed.admin.tick.interval": "500ms",
+         "distributed.admin.system-monitor.interval": "2s",
+         "distributed.worker.memory.monitor-interval": "1s"}
+
 
 def build_module(folder: Path) -> None:
     """Write and compile the Panda's fast module with ∂τ/∂q into ``folder``."""
@@ -90,6 +100,8 @@ def main() -> None:
     parser.add_argument("--states", type=int, default=10_000_000)
     parser.add_argument("--chunks", type=int, default=500_000, help="states per chunk")
     parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--dask-defaults", action="store_true",
+                        help="keep dask's profiler and its 20 ms / 100 ms monitors in the workers")
     parser.add_argument("--markdown", type=Path, help="also write the table to this file")
     args = parser.parse_args()
     import dask
@@ -119,6 +131,8 @@ def main() -> None:
         environment = dict(dask.config.get("distributed.nanny.pre-spawn-environ"))
         environment.pop("MALLOC_TRIM_THRESHOLD_", None)
         dask.config.set({"distributed.nanny.pre-spawn-environ": environment})
+        if not args.dask_defaults:
+            dask.config.set(QUIET)
         clusters = {n: LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                     host="127.0.0.1", dashboard_address="127.0.0.1:0")
                     for n in (1, 2)}
