@@ -212,40 +212,52 @@ def _tangent_seeds(derivation) -> dict:
 
 def symmetric_inverse(b: ProgramBuilder, M: sp.Matrix, hint: str) -> sp.Matrix:
     """The inverse of the symmetric positive definite ``M`` (n × n) as a straight-line program
-    in ``b``: ``M = L D Lᵀ`` (L unit lower triangular, no square roots), ``Z = L⁻¹``, then
-    ``M⁻¹ = Zᵀ D⁻¹ Z``, upper triangle computed and mirrored; structural zeros skipped, each
-    nonzero named ``<hint>…``. Exact (rational operations only), O(n³)."""
+    in ``b``, factored from its last row and column up: ``M = Lᵀ D L`` (L unit lower
+    triangular, no square roots), ``Z = L⁻¹``, then ``M⁻¹ = Z D⁻¹ Zᵀ``, upper triangle computed
+    and mirrored; structural zeros skipped, each nonzero named ``<hint>…`` (indices of M).
+    Exact (rational operations only), O(n³) at most.
+
+    With the joints of a tree in the model's order (parents before children), eliminating the
+    leaves first creates no fill-in: ``L[i, j]`` is nonzero only when joint j is an ancestor of
+    joint i, as in Featherstone's factorization of a tree's mass matrix (*Rigid Body Dynamics
+    Algorithms*, §6.5), so a branched tree keeps its zeros."""
     n = M.rows
+    last = list(reversed(range(n)))  # work on the reversed matrix, leaves first
+    R = M.extract(last, last)
+
+    def label(i: int, j: int) -> str:  # the indices of M, 1-based
+        return f"{n - i}_{n - j}"
+
     L, W, inv_D = sp.eye(n), sp.zeros(n, n), [sp.Integer(0)] * n
     for j in range(n):
-        D = M[j, j] - sp.Add(*[L[j, k] * W[j, k] for k in range(j)])
-        inv_D[j] = name_expr(b, 1 / name_expr(b, D, f"{hint}_D{j + 1}"), f"{hint}_iD{j + 1}")
+        D = R[j, j] - sp.Add(*[L[j, k] * W[j, k] for k in range(j)])
+        inv_D[j] = name_expr(b, 1 / name_expr(b, D, f"{hint}_D{n - j}"), f"{hint}_iD{n - j}")
         for i in range(j + 1, n):
-            total = M[i, j] - sp.Add(*[L[i, k] * W[j, k] for k in range(j)])
+            total = R[i, j] - sp.Add(*[L[i, k] * W[j, k] for k in range(j)])
             if total != 0:
-                W[i, j] = name_expr(b, total, f"{hint}_W{i + 1}_{j + 1}")   # L[i, j] D_j
-                L[i, j] = name_expr(b, W[i, j] * inv_D[j], f"{hint}_L{i + 1}_{j + 1}")
+                W[i, j] = name_expr(b, total, f"{hint}_W{label(i, j)}")   # L[i, j] D_j
+                L[i, j] = name_expr(b, W[i, j] * inv_D[j], f"{hint}_L{label(i, j)}")
     Z = sp.eye(n)
     for j in range(n):
         for i in range(j + 1, n):
             total = -sp.Add(*[L[i, k] * Z[k, j] for k in range(j, i)
                               if L[i, k] != 0 and Z[k, j] != 0])
             if total != 0:
-                Z[i, j] = name_expr(b, total, f"{hint}_Z{i + 1}_{j + 1}")
+                Z[i, j] = name_expr(b, total, f"{hint}_Z{label(i, j)}")
     out = sp.zeros(n, n)
     for i in range(n):
         for j in range(i, n):
             total = sp.Add(*[Z[k, i] * Z[k, j] * inv_D[k] for k in range(j, n)
                              if Z[k, i] != 0 and Z[k, j] != 0])
             if total != 0:
-                out[i, j] = out[j, i] = name_expr(b, total, f"{hint}{i + 1}_{j + 1}")
-    return out
+                out[i, j] = out[j, i] = name_expr(b, total, f"{hint}{label(j, i)}")
+    return out.extract(last, last)
 
 
 def _solved_dynamics(derivation, armature=None, friction=None, hint: str = "s"):
     """``(M⁻¹, q̈)`` of the model in its own coordinates: ``M_r = Tᵀ (M + diag(armature)) T``
-    (``M + diag(armature)`` without couplings) inverted by :func:`symmetric_inverse` with the
-    joints taken leaves first (no fill-in on a branched tree), and
+    (``M + diag(armature)`` without couplings) inverted by :func:`symmetric_inverse` (leaves
+    first: no fill-in on a branched tree), and
     ``q̈ = M_r⁻¹ (τ_r − Tᵀ (τ(q, q̇, 0) + friction))``, each acceleration named."""
     b, T, n = derivation.builder, derivation.coupling, _nv(derivation)
     M = derivation.output("M")
@@ -253,9 +265,7 @@ def _solved_dynamics(derivation, armature=None, friction=None, hint: str = "s"):
         M = M + sp.diag(*armature)
     if T is not None:
         M = T.T * M * T
-    leaves_first = list(reversed(range(n)))  # parents come before children in the model
-    Minv = symmetric_inverse(b, M.extract(leaves_first, leaves_first), f"Minv_{hint}")
-    Minv = Minv.extract(leaves_first, leaves_first)
+    Minv = symmetric_inverse(b, M, f"Minv_{hint}")
     zero = (sp.Integer(0),) * n
     bias = inverse_dynamics_program(derivation.tree, derivation.q, derivation.qd,
                                     derivation.accelerations(zero),

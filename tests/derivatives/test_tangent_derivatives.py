@@ -30,14 +30,17 @@ BALL_ARM = """<mujoco model="ball_arm"><option gravity="0.3 -0.2 -9.81"/><worldb
 <body name="fore" pos="0 0.05 -0.4"><joint name="elbow" type="hinge" axis="0.3 1 0"/>
 <inertial pos="0.01 0 -0.2" mass="0.8" diaginertia="0.01 0.012 0.004"/></body></body>
 </worldbody></mujoco>"""
-#: a free-flying trunk with one leg on a hinge (NQ 8, NV 7)
+#: a free-flying trunk with two legs on hinges, a branched tree (NQ 9, NV 8)
 HOPPER = """<mujoco model="hopper"><option gravity="0.3 -0.2 -9.81"/><worldbody>
 <body name="torso" pos="0 0 1"><freejoint name="root"/>
 <inertial pos="0.01 -0.02 0.03" mass="4" fullinertia="0.2 0.3 0.25 0.01 -0.02 0.015"/>
 <body name="leg" pos="0.1 0.15 -0.1" quat="0.9 0.1 0.3 0.2">
 <joint name="hip" type="hinge" axis="0 1 0.2"/>
 <inertial pos="0 0.01 -0.2" mass="1.2" fullinertia="0.02 0.025 0.01 0.001 0.002 -0.001"/>
-</body></body></worldbody></mujoco>"""
+</body>
+<body name="other_leg" pos="-0.1 -0.12 -0.1"><joint name="other_hip" type="hinge" axis="1 0 0"/>
+<inertial pos="0 0 -0.15" mass="0.9" diaginertia="0.015 0.012 0.003"/></body>
+</body></worldbody></mujoco>"""
 FUNCTIONS = ["inverse_dynamics_derivatives", "forward_dynamics_derivatives",
              "gravity_derivative", "linearize", "inverse_dynamics", "forward_dynamics_aba",
              "gravity_vector"]
