@@ -151,6 +151,7 @@ def function_specs(dynamics: "Dynamics", functions=None,
     header, in-memory modules do not)."""
     vectors = dynamics.input_symbols
     chosen = select_functions(functions)
+    count = shared_operation_count() if count_operations else None
     specs = []
     for name in chosen:
         declared = OUTPUTS[name]
@@ -169,11 +170,33 @@ def function_specs(dynamics: "Dynamics", functions=None,
             output=program.output(output),
             is_vector=is_vector,
             program=program,
-            operation_count=program.operation_count() if count_operations else 0,
+            operation_count=count(program) if count_operations else 0,
             units=units,
             returns=splits(declared, dynamics.model.dof),
         ))
     return tuple(specs)
+
+
+def shared_operation_count():
+    """``count(program)``: :meth:`~eomgen.symbolic.program.Program.operation_count` of
+    ``program`` (SymPy's ``count_ops`` of its assignments and output entries, summed), each
+    expression *object* counted once over the calls: the pruned programs of one module share
+    most of their assignments, and counting costs as much as printing."""
+    counted: dict[int, tuple[sp.Expr, int]] = {}
+
+    def count_ops(expr) -> int:
+        found = counted.get(id(expr))
+        if found is None:
+            found = counted[id(expr)] = (expr, sp.count_ops(expr))
+        return found[1]
+
+    def count(program) -> int:
+        total = sum(count_ops(expr) for _, expr in program.assignments)
+        for _, matrix in program.outputs:
+            total += sum(count_ops(e) for e in matrix)
+        return int(total)
+
+    return count
 
 
 def module_constants(dynamics: "Dynamics", functions) -> tuple[tuple[str, tuple[str, ...]], ...]:

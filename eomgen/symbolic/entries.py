@@ -18,6 +18,7 @@ from typing import Sequence
 
 import sympy as sp
 from sympy.core.function import AppliedUndef, UndefinedFunction
+from sympy.printing.numpy import NumPyPrinter
 from mpmath.libmp import prec_to_dps
 
 
@@ -75,6 +76,7 @@ class EntryProgram:
         if self._compiled is None:  # compiled on first use: most entries are never evaluated
             subexpressions = list(self.pruned)
             self._compiled = sp.lambdify(self.inputs, self.value, "numpy",
+                                         printer=_lambdify_printer(self.value),
                                          cse=lambda exprs: (subexpressions, exprs))
         return self._compiled(*args)
 
@@ -85,6 +87,46 @@ class EntryProgram:
         for symbol, expr in self.pruned:
             rule[symbol] = expr.xreplace(rule)
         return self.value.xreplace(rule)
+
+
+class _PrintedOnce(NumPyPrinter):
+    """The printer ``sympy.lambdify(..., "numpy")`` makes, remembering the text of each
+    expression *object* it printed: the entries of one matrix share most of their definitions
+    (the same objects), and each entry's ``lambdify`` would print them again. Keyed by
+    identity (the object kept alive with its text), so the text is what SymPy prints."""
+
+    #: Texts kept before the memory is emptied (it holds the expressions it printed).
+    KEPT = 20_000
+
+    def __init__(self, settings):
+        super().__init__(settings)
+        self._texts: dict[int, tuple[sp.Basic, str]] = {}
+
+    def doprint(self, expr, assign_to=None):
+        if assign_to is not None:
+            return super().doprint(expr, assign_to)
+        found = self._texts.get(id(expr))
+        if found is None or found[0] is not expr:
+            if len(self._texts) >= self.KEPT:
+                self._texts.clear()
+            found = self._texts[id(expr)] = (expr, super().doprint(expr))
+        return found[1]
+
+
+_PRINTERS: dict[frozenset, _PrintedOnce] = {}
+
+
+def _lambdify_printer(value: sp.Expr) -> _PrintedOnce:
+    """The printer ``sympy.lambdify(inputs, value, "numpy")`` would make (its settings, with
+    the implemented functions of ``value`` as user functions), shared by the entries."""
+    implemented = frozenset(f.func.__name__ for f in value.atoms(sp.Function)
+                            if getattr(f.func, "_imp_", None) is not None)
+    printer = _PRINTERS.get(implemented)
+    if printer is None:
+        printer = _PRINTERS[implemented] = _PrintedOnce({
+            "fully_qualified_modules": False, "inline": True, "allow_unknown_functions": True,
+            "user_functions": {name: name for name in implemented}})
+    return printer
 
 
 class ProgramEntry(AppliedUndef):

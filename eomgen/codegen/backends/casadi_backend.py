@@ -23,13 +23,13 @@ from ...compiler import c_compiler, shared_library
 from .. import GeneratedFile, Job, Loaded, register
 from ...symbolic.printing import FloatLiteralMixin, exec_source
 from ...templating import render
-from .common import python_module_context
+from .common import TermOrderShared, python_module_context
 
 _FUNCTIONS = ("sin", "cos", "tan", "sqrt", "exp", "log", "asin", "acos", "atan", "atan2",
               "tanh", "sign")
 
 
-class CasADiPrinter(FloatLiteralMixin, PythonCodePrinter):
+class CasADiPrinter(TermOrderShared, FloatLiteralMixin, PythonCodePrinter):
     """Python code over CasADi SX symbols: ``ca.sin(x)``, exact float literals."""
 
     def _print_Function(self, expr):

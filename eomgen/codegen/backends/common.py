@@ -68,6 +68,44 @@ def input_sizes(arguments, model) -> dict:
     return sizes
 
 
+class TermOrderShared:
+    """A printer mixin (put it first): the order of a sum's terms, which the printer's classes
+    after it choose (SymPy's canonical order, then :class:`~eomgen.symbolic.printing.
+    FloatLiteralMixin`'s leading plus), remembered for each sum *object* and shared by every
+    printer whose ordering is the same function: the NumPy, JAX, PyTorch and CasADi modules of
+    one model print the same sums, and SymPy's ordering is a third of printing. The memory is
+    emptied past :attr:`KEPT` sums (it keeps the sums it ordered alive)."""
+
+    KEPT = 50_000
+    _orders: dict[tuple, tuple[sp.Expr, tuple]] = {}
+
+    def _as_ordered_terms(self, expr, order=None):
+        ordering = super()._as_ordered_terms
+        key = (id(expr), order or self.order, ordering.__func__)
+        found = TermOrderShared._orders.get(key)
+        if found is None or found[0] is not expr:
+            if len(TermOrderShared._orders) >= self.KEPT:
+                TermOrderShared._orders.clear()
+            found = TermOrderShared._orders[key] = (expr, tuple(ordering(expr, order=order)))
+        return list(found[1])
+
+
+def printed_once(doprint: Callable[[sp.Expr], str]) -> Callable[[sp.Expr], str]:
+    """``doprint`` remembering its text for each expression *object* it printed: the functions
+    of a module share most of their intermediates (the pruned programs of M, C, g, ... hold the
+    same assignment objects), each printed once. Keyed by identity, not equality, so that the
+    text is exactly what ``doprint`` gives that object (the object is kept alive with it)."""
+    texts: dict[int, tuple[sp.Expr, str]] = {}
+
+    def once(expr: sp.Expr) -> str:
+        found = texts.get(id(expr))
+        if found is None:
+            found = texts[id(expr)] = (expr, doprint(expr))
+        return found[1]
+
+    return once
+
+
 def print_function(spec: FunctionSpec, job: Job, doprint, element_name) -> PrintedFunction:
     """Print ``spec`` with ``doprint(expr) -> str``; ``element_name(vector, index) -> str`` names
     the scalar unpacked from an input vector."""
@@ -178,8 +216,10 @@ def python_module_context(job: Job, printer, template: str, extra_exports=(),
     functions = exported(job.functions, backend) if backend else job.functions
     renames = parameter_renames(job)
 
-    def doprint(expr: sp.Expr) -> str:
+    def text(expr: sp.Expr) -> str:
         return printer.doprint(expr.xreplace(renames) if renames else expr)
+
+    doprint = printed_once(text)
 
     return dict(
         header=job.header_lines(template),

@@ -21,6 +21,7 @@ import warnings
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
+from typing import Callable
 
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
@@ -34,7 +35,8 @@ from ...outputs import (CONSTRAINED_DERIVATIVES, CONSTRAINED_FORWARD, CONSTRAINE
                        parallel_names, task_space_names)
 from ...symbolic.printing import FloatLiteralMixin
 from ...templating import TEMPLATES_DIR, render
-from .common import import_file, parallel_indices, positional, warning_exports
+from .common import (import_file, parallel_indices, positional, printed_once,
+                     warning_exports)
 
 #: The fixed C runtime every generated module includes parts of: real C files (compiled and
 #: warning-checked on their own by tests/backends/test_fast_runtime_c.py), by the name the template
@@ -125,17 +127,23 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
     # at least q, qd, tau of the composed forward dynamics
     max_inputs = max([3] + [len(spec.arguments) for spec in job.specs])
     functions = []
+    # one printer per layout of the vector inputs (the locals and parameters are named alike
+    # in every function): the intermediates the functions share are printed once
+    printers: dict[tuple, Callable[[sp.Expr], str]] = {}
+    # intermediates become C locals named t_<name> (never a C keyword nor q, p, out)
+    local = {symbol: sp.Symbol("t_" + symbol.name, real=True)
+             for spec in job.specs for symbol, _ in spec.program.assignments}
     for spec in job.specs:
-        # intermediates become C locals named t_<name> (never a C keyword nor q, p, out)
-        local = {symbol: sp.Symbol("t_" + symbol.name, real=True)
-                 for symbol, _ in spec.program.assignments}
         # the j-th vector input is the kernel's pointer x[j], bound to a local of its name
         vectors = {symbol: sp.Symbol(f"{argument.name}[{k}]", real=True)
                    for argument in spec.arguments for k, symbol in enumerate(argument.symbols)}
         rename = {**names, **vectors, **local}
 
-        def doprint(expr: sp.Expr) -> str:
+        def text(expr: sp.Expr, rename=rename) -> str:
             return printer.doprint(expr.xreplace(rename))
+
+        layout = tuple((a.name, tuple(a.symbols)) for a in spec.arguments)
+        doprint = printers.setdefault(layout, printed_once(text))
 
         rows, cols = spec.output.shape
         entries = [(r * cols + c, doprint(spec.output[r, c]))

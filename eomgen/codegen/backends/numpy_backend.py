@@ -15,7 +15,7 @@ from ...symbolic.printing import NumPyModulePrinter
 from ...templating import render
 from ...runtime.cholesky import included_source
 from ...runtime import task_space
-from .common import python_loader, python_module_context, warning_exports
+from .common import TermOrderShared, python_loader, python_module_context, warning_exports
 
 
 @dataclass(frozen=True)
@@ -26,7 +26,7 @@ class NumPyConfig:
     suffix: str = "_numpy.py"
 
 
-class ArrayModulePrinter(NumPyModulePrinter):
+class ArrayModulePrinter(TermOrderShared, NumPyModulePrinter):
     """NumPy-style code whose ``numpy.<name>`` calls go to another array module, ``alias``
     (``jnp`` for ``jax.numpy``, ``torch``): the same expressions, the same float literals."""
 
@@ -41,7 +41,7 @@ class ArrayModulePrinter(NumPyModulePrinter):
           config=NumPyConfig, order=10, reserved=("np",), printer=NumPyModulePrinter,
           load=python_loader(NumPyConfig.suffix), requires=("numpy",))
 def generate_numpy(job: Job, config: NumPyConfig = NumPyConfig()) -> list[GeneratedFile]:
-    printer = NumPyModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
+    printer = ArrayModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
     return [GeneratedFile(job.stem + config.suffix, numpy_source(job, printer, config))]
 
 
