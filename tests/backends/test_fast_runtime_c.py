@@ -30,6 +30,7 @@ MODULE_CONSTANTS = """\
 #define NV 2
 #define NP 1
 #define MAX_IN 3
+#define MAX_LEN 2
 static const char *const parameter_names[NP + 1] = {"m2", NULL};
 static const double parameter_defaults[NP + 1] = {1.5, 0.0};
 static const int parameter_has_default[NP + 1] = {1, 0};

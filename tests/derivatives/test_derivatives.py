@@ -235,8 +235,9 @@ def test_a_structural_zero_is_not_computed():
 def test_fma_clones_of_the_fast_kernels_give_the_numpy_modules_derivatives(planar, tmp_path,
                                                                           monkeypatch):
     """Every kernel compiled in two versions (with and without fused multiply-add, the loader
-    picking one; here forced on for the planar arm's small kernels) gives the NumPy module's
-    derivatives, for one state and for a batch."""
+    picking one; here forced on for the planar arm's small kernels), and its lanes kernel (a
+    batch four states at a time), gives the NumPy module's derivatives, for one state and for
+    a batch, with parameters other than the description's."""
     from eomgen.codegen.backends import fast_backend
 
     model, _, modules = planar
@@ -245,15 +246,21 @@ def test_fma_clones_of_the_fast_kernels_give_the_numpy_modules_derivatives(plana
     monkeypatch.setattr(fast_backend, "FMA_CLONE_OPERATIONS", 0)
     _, cloned = generated(model, FUNCTIONS, tmp_path, backends=("fast",))
     source = (tmp_path / "planar_2link_fast.c").read_text(encoding="utf-8")
-    assert source.count("FMA_CLONES static void") == len(FUNCTIONS)
+    for function in FUNCTIONS:  # the one-state kernel, and the batch's lanes kernel
+        assert f"FMA_CLONES static void {function}_one(" in source
+        assert f"FMA_CLONES static void {function}_lanes(" in source
     rng = np.random.default_rng(7)
-    Q, QD, U = (rng.uniform(-1.5, 1.5, (4, model.dof)) for _ in range(3))
+    # 6 states: the batch's first 4 through the lanes kernel, the last 2 one by one
+    Q, QD, U = (rng.uniform(-1.5, 1.5, (6, model.dof)) for _ in range(3))
+    changed = {"m1": 2.5, "l1": 0.7}  # parameters broadcast to the lanes
     for function in FUNCTIONS:
         args = (Q,) if function == "gravity_derivative" else (Q, QD, U)
-        batch = results("fast", cloned["fast"], function, *args)
+        batch = results("fast", cloned["fast"], function, *args, **changed)
         for k in range(len(Q)):
-            expected = results("numpy", modules["numpy"], function, *(a[k] for a in args))
-            single = results("fast", cloned["fast"], function, *(a[k] for a in args))
+            expected = results("numpy", modules["numpy"], function, *(a[k] for a in args),
+                               **changed)
+            single = results("fast", cloned["fast"], function, *(a[k] for a in args),
+                             **changed)
             for a, s, b in zip(batch, single, expected):
                 np.testing.assert_allclose(s, b, rtol=1e-12, atol=1e-12, err_msg=function)
                 np.testing.assert_allclose(a[k], b, rtol=1e-12, atol=1e-12, err_msg=function)
