@@ -188,6 +188,7 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
         doprint = printers.setdefault(layout, printed_once(text))
 
         rows, cols = spec.output.shape
+        lanes = spec.operation_count >= FMA_CLONE_OPERATIONS and in_lanes(spec)
         entries = [(r * cols + c, doprint(spec.output[r, c]))
                    for r in range(rows) for c in range(cols) if spec.output[r, c] != 0]
         functions.append(dict(
@@ -202,8 +203,7 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
             assignments=[(local[s].name, doprint(e)) for s, e in spec.program.assignments],
             entries=entries, operation_count=spec.operation_count, units=spec.units,
             fma_clone=spec.operation_count >= FMA_CLONE_OPERATIONS,
-            lanes=spec.operation_count >= FMA_CLONE_OPERATIONS and in_lanes(spec),
-            broadcast=broadcast(spec, local),
+            lanes=lanes, broadcast=broadcast(spec, local) if lanes else frozenset(),
             returns=spec.returns))
     # the docstrings open with a text signature (inspect.signature reads it)
     signature = "".join(", " + p.identifier
