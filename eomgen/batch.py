@@ -20,6 +20,7 @@ import numpy as np
 __all__ = ["dask_map"]
 
 _AXES = "abcdefgh"  # names of the output's per-state axes in dask's blockwise notation
+_JOINT_AXES = "zyx"  # the state arrays' joint axes, one letter per width (NQ, NV)
 
 
 def dask_map(function: Callable, *states, chunks: int = 100_000,
@@ -39,7 +40,9 @@ def dask_map(function: Callable, *states, chunks: int = 100_000,
         The function's state arguments (q, qd, ...), in CONFIGURATION_NAMES and JOINT_NAMES
         order. NumPy arrays are
         split into chunks of ``chunks`` states; dask arrays are rechunked to the first one's
-        chunks of states, with all joints of a state in one chunk.
+        chunks of states, with all joints of a state in one chunk. Dask arrays made blockwise
+        (``dask.array.map_blocks`` of a function drawing or reading a chunk) are fused into
+        their chunk's evaluation: one task per chunk, whose states are never stored apart.
     chunks : int
         States per chunk when the first state argument is not a dask array already.
     statistic : callable, optional
@@ -99,7 +102,6 @@ def dask_map(function: Callable, *states, chunks: int = 100_000,
     first = function(*(np.asarray(x[:1]) for x in arrays), **fixed,
                      **{name: np.asarray(c[:1]) for name, c in zip(per_state, columns)})
     shape = np.shape(first)[1:]
-    axes = _AXES[:len(shape)]
     names = list(per_state)
 
     def evaluate(*blocks):
@@ -107,19 +109,37 @@ def dask_map(function: Callable, *states, chunks: int = 100_000,
         return np.asarray(function(*block_states, **fixed,
                                    **dict(zip(names, block_parameters))), dtype=float)
 
-    pairs = [item for x in arrays for item in (x, "iz")]
+    # Each state array's joint axis (one chunk) gets a letter of its own width and is KEPT in
+    # the output, cut to length 1 and indexed away afterwards: a contracted index would stop
+    # dask from fusing the chunk task with the tasks that make its states (a blockwise draw of
+    # random states, a load), and each chunk's states would be separate tasks, stored and
+    # possibly moved between workers before the evaluation.
+    widths = list(dict.fromkeys(x.shape[1] for x in arrays))
+    joint_axes = _JOINT_AXES[:len(widths)]
+    pairs = [item for x in arrays for item in (x, "i" + joint_axes[widths.index(x.shape[1])])]
     pairs += [item for c in columns for item in (c, "i")]
+    kept = {axis: 1 for axis in joint_axes}
+    cut = (slice(None),) + (0,) * len(joint_axes)
+
+    def lazy(chunk_function, result_shape, states_per_chunk):
+        axes = _AXES[:len(result_shape)]
+
+        def with_joint_axes(*blocks):
+            result = chunk_function(*blocks)
+            return result.reshape(result.shape[:1] + (1,) * len(joint_axes) + result.shape[1:])
+
+        adjust = {"i": states_per_chunk, **kept} if states_per_chunk else kept
+        result = da.blockwise(with_joint_axes, "i" + joint_axes + axes, *pairs, dtype=float,
+                              new_axes=dict(zip(axes, result_shape)), adjust_chunks=adjust,
+                              meta=np.empty((0,) * (1 + len(joint_axes) + len(result_shape))))
+        return result[cut]
+
     if statistic is None:
-        return da.blockwise(evaluate, "i" + axes, *pairs, dtype=float, concatenate=True,
-                            new_axes=dict(zip(axes, shape)),
-                            meta=np.empty((0,) * (1 + len(shape))))
+        return lazy(evaluate, shape, None)
 
     def reduce_chunk(*chunk):
         parts = [np.asarray(statistic(evaluate(*(x[start:start + block] for x in chunk))))
                  for start in range(0, len(chunk[0]), block)]
         return np.asarray(statistic(np.stack(parts)), dtype=float)[np.newaxis]
 
-    reduced = np.shape(statistic(first))
-    return da.blockwise(reduce_chunk, "i" + _AXES[:len(reduced)], *pairs, dtype=float,
-                        concatenate=True, new_axes=dict(zip(_AXES, reduced)),
-                        adjust_chunks={"i": 1}, meta=np.empty((0,) * (1 + len(reduced))))
+    return lazy(reduce_chunk, np.shape(statistic(first)), 1)

@@ -90,3 +90,46 @@ def test_a_statistic_is_reduced_chunk_by_chunk_block_by_block(planar):
                                module.mass_matrix(q).sum(axis=0), rtol=1e-13)
     with pytest.raises(ValueError, match="block must be a positive number of states, got 0"):
         dask_map(module.gravity_vector, q, statistic=np.sum, block=0)
+
+
+def draw(stream, block_id=None, block_info=None):
+    """A chunk of 2-joint states from a generator seeded by (stream, chunk), made blockwise."""
+    rng = np.random.default_rng([stream, block_id[0]])
+    return rng.uniform(-np.pi, np.pi, (block_info[None]["chunk-shape"][0], 2))
+
+
+def test_states_made_blockwise_are_fused_into_the_chunk_evaluation(planar):
+    """dask fuses a chunk's evaluation with the blockwise tasks that make its states (here drawn
+    chunk by chunk): one task per chunk (and a view of its result), so a cluster never stores or moves a chunk's states
+    apart from its evaluation; the results are those of the whole batch."""
+    import dask
+
+    _, module = planar
+    sizes = ((300, 300, 300, 101), (2,))
+    q, qd = (da.map_blocks(draw, k, chunks=sizes, dtype=float, meta=np.empty((0, 2)))
+             for k in range(2))
+    whole = module.coriolis_matrix(q.compute(), qd.compute())
+    lazy = dask_map(module.coriolis_matrix, q, qd)
+    peak = dask_map(module.coriolis_matrix, q, qd, statistic=lambda r: abs(r).max(axis=0))
+    for result in (lazy, peak):
+        (optimized,) = dask.optimize(result)
+        graph = optimized.__dask_graph__()
+        assert not [key for key in graph if key[0].startswith("draw-")]  # drawn inside
+        assert len(graph) == 2 * 4  # per chunk, the evaluation and a view of its result
+    np.testing.assert_array_equal(lazy.compute(scheduler="synchronous"), whole)
+    np.testing.assert_array_equal(peak.compute(scheduler="synchronous").max(axis=0),
+                                  abs(whole).max(axis=0))
+
+
+def test_configuration_and_velocity_of_different_sizes():
+    """q of NQ columns beside velocities of NV ≠ NQ columns (a quaternion base): each keeps its
+    width, split into chunks of states only."""
+    q = np.arange(30.0).reshape(10, 3)
+    v = np.arange(20.0).reshape(10, 2) / 7
+
+    def function(q, v):
+        return q[:, :2] * v + q[:, 2:]
+
+    lazy = dask_map(function, da.from_array(q, chunks=(4, 1)), v, chunks=4)
+    assert lazy.chunks == ((4, 4, 2), (2,))
+    np.testing.assert_array_equal(lazy.compute(scheduler="synchronous"), function(q, v))
