@@ -1,8 +1,8 @@
 """A workspace study with the generated derivatives on a dask cluster (issue 25; Franka Panda,
 fingers locked).
 
-The statistic: over N random states (q, q̇, q̈ uniform in [−1.5, 1.5] per joint, drawn lazily by
-dask chunk by chunk), the largest |∂τ_i/∂q_j| of each entry, a 7 × 7 table of the arm's
+The statistic: over N random states (q, q̇, q̈ uniform in [−1.5, 1.5] per joint, drawn lazily
+chunk by chunk where the chunk is evaluated), the largest |∂τ_i/∂q_j| of each entry, a 7 × 7 table of the arm's
 worst-case torque sensitivity to its joint angles (N m/rad). ∂τ/∂q comes from the Panda's fast
 module (``inverse_dynamics_derivative_q``, the loop over a block of states in C) through
 ``eomgen.batch.dask_map`` with ``statistic=``: each chunk is evaluated 4,096 states at a time
@@ -84,10 +84,19 @@ def statistic(function, states: int, chunks: int):
     """The lazy 7 × 7 table max |∂τ/∂q| over ``states`` random states."""
     import dask.array as da
 
-    rng = da.random.default_rng(0)
-    Q, QD, QDD = (rng.uniform(-1.5, 1.5, size=(states, 7), chunks=(chunks, 7))
-                  for _ in range(3))
+    sizes = (chunks,) * (states // chunks) + ((states % chunks,) if states % chunks else ())
+    Q, QD, QDD = (da.map_blocks(draw, stream, chunks=(sizes, (7,)), dtype=float,
+                                meta=np.empty((0, 7))) for stream in range(3))
     return dask_map(function, Q, QD, QDD, statistic=largest).max(axis=0)
+
+
+def draw(stream: int, block_id=None, block_info=None) -> np.ndarray:
+    """One chunk of states uniform in [−1.5, 1.5], from a generator seeded by (stream, chunk):
+    the same numbers whichever process draws them. Drawn blockwise (``map_blocks``), so that
+    dask fuses the drawing into the chunk's evaluation: one task per chunk, no state array
+    stored or moved between workers (``dask.array.random`` arrays would be separate tasks)."""
+    rng = np.random.default_rng([0, stream, block_id[0]])
+    return rng.uniform(-1.5, 1.5, size=(block_info[None]["chunk-shape"][0], 7))
 
 
 def largest(results: np.ndarray) -> np.ndarray:
