@@ -20,7 +20,7 @@ import numpy as np
 __all__ = ["dask_map"]
 
 _AXES = "abcdefgh"  # names of the output's per-state axes in dask's blockwise notation
-_JOINT_AXES = "zyx"  # the state arrays' joint axes, one letter per width (NQ, NV)
+_JOINT_AXES = "zyxwvu"  # the state arrays' joint axes, one letter per width (NQ, NV, ...)
 
 
 def dask_map(function: Callable, *states, chunks: int = 100_000,
