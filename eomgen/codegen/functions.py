@@ -22,7 +22,7 @@ import sympy as sp
 
 from ..output import module_name  # noqa: F401  (re-exported: its earlier home)
 from ..outputs import BY_SYMBOL, INPUTS, OUTPUTS, resolve, select, splits
-from ..symbolic.program import Program
+from ..symbolic.program import Program, count_ops as count_ops_of
 
 # ``dynamics`` arguments are eomgen.dynamics.Dynamics, named in strings only: eomgen.dynamics
 # imports eomgen.lambdify, which prints through this module (no import back up).
@@ -179,7 +179,8 @@ def function_specs(dynamics: "Dynamics", functions=None,
 
 def shared_operation_count():
     """``count(program)``: :meth:`~eomgen.symbolic.program.Program.operation_count` of
-    ``program`` (SymPy's ``count_ops`` of its assignments and output entries, summed), each
+    ``program`` (SymPy's ``count_ops`` of its assignments and output entries, summed, as
+    :func:`eomgen.symbolic.program.count_ops` counts it), each
     expression *object* counted once over the calls: the pruned programs of one module share
     most of their assignments, and counting costs as much as printing."""
     counted: dict[int, tuple[sp.Expr, int]] = {}
@@ -187,7 +188,7 @@ def shared_operation_count():
     def count_ops(expr) -> int:
         found = counted.get(id(expr))
         if found is None:
-            found = counted[id(expr)] = (expr, sp.count_ops(expr))
+            found = counted[id(expr)] = (expr, count_ops_of(expr))
         return found[1]
 
     def count(program) -> int:

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from typing import Iterable, Mapping, NamedTuple, Sequence
 
 import sympy as sp
+from sympy.core.operations import LatticeOp
 
 
 class Tag(NamedTuple):
@@ -255,6 +256,81 @@ def rough_operation_count(exprs: Iterable[sp.Expr]) -> int:
     return total
 
 
+def count_ops(expr: sp.Expr) -> int:
+    """SymPy's ``count_ops(expr)`` (``visual=False``), the same number, without the new
+    expressions SymPy makes on the way (it negates every negative term and rebuilds every
+    product to split it into a fraction): sums, products, powers with a positive exponent,
+    numbers, symbols and functions are counted here; anything else (a division, a symbolic
+    exponent, ``exp``, a piecewise) is handed to ``sp.count_ops`` whole.
+
+    >>> x, y = sp.symbols("x y")
+    >>> [count_ops(e) for e in (x - 2.5*y, -x*y, sp.sin(x)**2 - 1, x/y)]
+    [2, 2, 3, 1]
+    """
+    if expr.is_Symbol:
+        return 0
+    if expr.is_Rational:
+        return 0 if expr is sp.S.One else int(expr.p < 0) + int(expr.q != 1)
+    if expr.is_Float:
+        return 0
+    if expr.is_Add:
+        terms = expr.args
+        total, negative = len(terms) - 1, 0
+        for term in terms:
+            if _negative_coefficient(term):
+                negative += 1
+                total += _count_negated(term)
+            else:
+                total += count_ops(term)
+        return total + (negative == len(terms))
+    if expr.is_Mul:
+        args = expr.args
+        if not all(_plain_factor(f) for f in args) or (
+                args[0] is sp.S.NegativeOne and len(args) == 2 and args[1].is_Add):
+            return int(sp.count_ops(expr))  # SymPy leaves −(x + y)'s own sum uncounted
+        if _negative_coefficient(expr):
+            return 1 + _count_negated(expr)
+        return len(expr.args) - 1 + sum(count_ops(f) for f in expr.args)
+    if expr.is_Pow:
+        if expr.exp.is_Number and expr.exp > 0 and expr.base is not sp.S.Exp1:
+            return 1 + count_ops(expr.base) + count_ops(expr.exp)
+        return int(sp.count_ops(expr))
+    if (isinstance(expr, sp.Function) and not isinstance(expr, (sp.exp, LatticeOp))
+            and all(isinstance(a, sp.Expr) for a in expr.args)):
+        return 1 + sum(count_ops(a) for a in expr.args)
+    return int(sp.count_ops(expr))
+
+
+def _negative_coefficient(expr: sp.Expr) -> bool:
+    """SymPy's ``_coeff_isneg``: a negative number, or a product that leads with one."""
+    c = expr.args[0] if expr.is_Mul else expr
+    return c.is_Number and bool(c.is_extended_negative)
+
+
+def _plain_factor(factor: sp.Expr) -> bool:
+    """A factor that puts nothing in a product's denominator (SymPy's ``fraction``)."""
+    if factor.is_Pow:
+        return factor.exp.is_Number and factor.exp > 0
+    if factor.is_Rational:
+        return factor.q == 1
+    return not isinstance(factor, sp.exp)
+
+
+def _count_negated(expr: sp.Expr) -> int:
+    """``count_ops(-expr)`` of a negative number or a product with a negative leading number
+    whose factors are all plain (:func:`_plain_factor`), else SymPy's count of ``-expr``."""
+    if expr.is_Float:
+        return 0
+    if expr.is_Rational:
+        return int(expr.q != 1)
+    if expr.is_Mul and all(_plain_factor(f) for f in expr.args):
+        c, rest = expr.args[0], expr.args[1:]
+        if c is sp.S.NegativeOne:  # −1·x·y → x·y
+            return len(rest) - 1 + sum(count_ops(f) for f in rest)
+        return len(expr.args) - 1 + _count_negated(c) + sum(count_ops(f) for f in rest)
+    return int(sp.count_ops(-expr))
+
+
 @dataclass(frozen=True)
 class Program:
     """An immutable straight-line program with named outputs.
@@ -329,7 +405,7 @@ class Program:
         """Arithmetic operations (SymPy ``count_ops``) of the assignments and outputs needed for
         the named outputs (all by default)."""
         program = self if names is None else self.pruned(names)
-        total = sum(sp.count_ops(expr) for _, expr in program.assignments)
+        total = sum(count_ops(expr) for _, expr in program.assignments)
         for _, matrix in program.outputs:
-            total += sum(sp.count_ops(e) for e in matrix)
+            total += sum(count_ops(e) for e in matrix)
         return int(total)
