@@ -34,9 +34,82 @@ from __future__ import annotations
 from typing import Callable, Mapping, Sequence
 
 import sympy as sp
+from sympy.core.function import Function
 from sympy.printing.numpy import NumPyPrinter
+from sympy.printing.precedence import PRECEDENCE, precedence
 
 from .program import Program
+
+_MUL, _ADD = PRECEDENCE["Mul"], PRECEDENCE["Add"]
+#: the precedence of a product whose leading factor is a negative number (``-x`` binds looser
+#: than a product, tighter than a power: SymPy's weight for a unary minus)
+_NEGATED = 0.5 * (PRECEDENCE["Pow"] + PRECEDENCE["Mul"])
+
+
+def leads_with_negative_number(product: sp.Expr) -> bool:
+    """``product.could_extract_minus_sign()`` of a finite product, without building
+    ``-product`` as SymPy does to rule out ``zoo``: its leading factor is a negative number."""
+    c = product.args[0]
+    return c.is_Number and c.is_finite is not False and bool(c.is_extended_negative)
+
+
+def ordered_terms(expr: sp.Expr) -> list:
+    """``expr.as_ordered_terms()`` (SymPy's canonical order of a sum's terms, which the code
+    printers print), the same list, read off the terms of a sum of real numbers times products
+    of integer powers of functions, symbols and other expressions in symbols, without SymPy's
+    detour through complex coefficients; any other sum is ordered by SymPy itself."""
+    args = expr.args
+    if not expr.is_Add:
+        return expr.as_ordered_terms()
+    if len(args) == 2:  # SymPy's special case: a positive number, then −k·x
+        numbers = sorted(args, key=lambda a: not isinstance(a, (sp.Number, sp.NumberSymbol)))
+        if isinstance(numbers[0], (sp.Number, sp.NumberSymbol)) and numbers[1].is_Mul:
+            factors = sorted(numbers[1].args, key=lambda a: not isinstance(a, sp.Number))
+            if (len(factors) == 2 and isinstance(factors[0], sp.Number)
+                    and numbers[0].is_positive and factors[0].is_negative):
+                return numbers
+    gens, terms = {}, []
+    for term in args:
+        if term.is_Number:
+            coefficient, factors = term, ()
+        elif term.is_Mul and term.args[0].is_Number:
+            coefficient, factors = term.args[0], term.args[1:]
+        elif term.is_Mul:
+            coefficient, factors = sp.S.One, term.args
+        else:
+            coefficient, factors = sp.S.One, (term,)
+        if not (coefficient.is_Rational or coefficient.is_Float):
+            return expr.as_ordered_terms()
+        powers = {}
+        for factor in factors:
+            base, exponent = (factor.base, factor.exp) if factor.is_Pow else (factor, sp.S.One)
+            if (not exponent.is_Integer or isinstance(base, sp.exp) or not base.free_symbols
+                    or not factor.is_commutative):
+                return expr.as_ordered_terms()
+            powers[base] = int(exponent)
+            gens[base] = None
+        terms.append((term, float(coefficient), powers))
+    index = {g: k for k, g in enumerate(sorted(gens, key=sp.default_sort_key))}
+
+    def key(entry):
+        monomial = [0] * len(index)
+        for base, exponent in entry[2].items():
+            monomial[index[base]] = -exponent
+        return tuple(monomial), entry[1]
+
+    return [term for term, _, _ in sorted(terms, key=key)]
+
+
+def fast_precedence(item) -> int:
+    """SymPy's :func:`~sympy.printing.precedence.precedence`, with a product's sign read off
+    its leading number (:func:`leads_with_negative_number`) rather than by negating it: the
+    same value, without making and querying a new expression at every product printed."""
+    if isinstance(item, sp.Mul) and not hasattr(item, "precedence"):
+        if any(isinstance(a, Function) and getattr(a, "precedence", _MUL) < _MUL
+               for a in item.args):
+            return _MUL
+        return _ADD if leads_with_negative_number(item) else _MUL
+    return precedence(item)
 
 
 class FloatLiteralMixin:
@@ -60,17 +133,92 @@ class FloatLiteralMixin:
     def _as_ordered_terms(self, expr, order=None):
         """SymPy's order of a sum's terms, but a term without a minus sign first when there
         is one: ``y - 2*x`` rather than ``-2*x + y``, which spends a negation."""
-        terms = super()._as_ordered_terms(expr, order=order)
-        if terms and terms[0].could_extract_minus_sign():
+        if (order or self.order) is None:
+            terms = ordered_terms(expr)
+        else:
+            terms = super()._as_ordered_terms(expr, order=order)
+        if terms and _minus(terms[0]):
             for k, term in enumerate(terms):
-                if not term.could_extract_minus_sign():
+                if not _minus(term):
                     return [term] + terms[:k] + terms[k + 1:]
         return terms
 
     def parenthesize(self, item, level, strict=False):
         if isinstance(item, sp.Rational) and not item.is_Integer and item.is_positive:
             return self._print(item)
-        return super().parenthesize(item, level, strict)
+        level_of_item = fast_precedence(item)
+        if level_of_item < level or (not strict and level_of_item <= level):
+            return "(%s)" % self._print(item)
+        return self._print(item)
+
+    # SymPy's code printers' sums and products (StrPrinter._print_Add, CodePrinter._print_Mul),
+    # the same text, but a product's sign read off its leading number and its negation's factors
+    # listed rather than built as a new product: SymPy's own versions make and query a new
+    # expression for most products they print, half the time of printing a program.
+
+    def _print_Add(self, expr, order=None):
+        terms = self._as_ordered_terms(expr, order=order)
+        level = fast_precedence(expr)
+        parts = []
+        for term in terms:
+            text = self._print(term)
+            if text.startswith("-") and not term.is_Add:
+                sign, text = "-", text[1:]
+            else:
+                sign = "+"
+            if term.is_Add or fast_precedence(term) < level:
+                text = "(%s)" % text
+            parts.extend([sign, text])
+        sign = parts.pop(0)
+        return ("" if sign == "+" else sign) + " ".join(parts)
+
+    def _print_Mul(self, expr):
+        if not expr.is_commutative or self.order in ("old", "none"):
+            return super()._print_Mul(expr)
+        level = fast_precedence(expr)
+        c = expr.args[0]
+        if c.is_Number and c.is_finite is not False and c.is_extended_negative:
+            sign, c = "-", -c
+            factors = list(expr.args[1:])
+            if any(f.is_Mul for f in factors) or (
+                    c is not sp.S.One and len(factors) == 1 and factors[0].is_Add):
+                return super()._print_Mul(expr)  # built unevaluated: -1·(x·y), c·(a + b)
+            if c is not sp.S.One:
+                factors.insert(0, c)
+            factors.sort(key=lambda f: f.sort_key(order=self.order))
+        else:
+            sign, factors = "", expr.as_ordered_factors()
+        numerator, denominator, grouped = [], [], []
+        for item in factors:
+            if item.is_Pow and item.exp.is_Rational and item.exp.is_negative:
+                if item.exp != -1:
+                    denominator.append(sp.Pow(item.base, -item.exp, evaluate=False))
+                else:
+                    if len(item.args[0].args) != 1 and isinstance(item.base, sp.Mul):
+                        grouped.append(item)
+                    denominator.append(sp.Pow(item.base, -item.exp))
+            else:
+                numerator.append(item)
+        numerator = numerator or [sp.S.One]
+        if len(numerator) == 1 and sign == "-":
+            texts = [self.parenthesize(numerator[0], _NEGATED)]
+        else:
+            texts = [self.parenthesize(x, level) for x in numerator]
+        below = [self.parenthesize(x, level) for x in denominator]
+        for item in grouped:
+            if item.base in denominator:
+                k = denominator.index(item.base)
+                below[k] = "(%s)" % below[k]
+        if not denominator:
+            return sign + "*".join(texts)
+        if len(denominator) == 1:
+            return sign + "*".join(texts) + "/" + below[0]
+        return sign + "*".join(texts) + "/(%s)" % "*".join(below)
+
+
+def _minus(term: sp.Expr) -> bool:
+    """``term.could_extract_minus_sign()``, a product's read off its leading number."""
+    return leads_with_negative_number(term) if term.is_Mul else term.could_extract_minus_sign()
 
 
 class NumPyModulePrinter(FloatLiteralMixin, NumPyPrinter):
@@ -81,6 +229,41 @@ class NumPyModulePrinter(FloatLiteralMixin, NumPyPrinter):
     def _module_format(self, fqn, register=True):
         text = super()._module_format(fqn, register)
         return "np." + text[len("numpy."):] if text.startswith("numpy.") else text
+
+
+def renamed(expr: sp.Expr, names: Mapping[sp.Symbol, sp.Symbol]) -> sp.Expr:
+    """``expr.xreplace(names)`` for a one-to-one renaming of symbols, printed alike when
+    ``expr`` is evaluated (as a derivation's expressions are): sums and products are rebuilt
+    from their new arguments as they stand (SymPy's ``_from_args``), not flattened and sorted
+    again as ``xreplace`` does, since a printer orders the terms and factors it prints itself
+    and renamed symbols never merge. Only what holds a renamed symbol is rebuilt.
+
+    >>> x, y, t = sp.symbols("x y t_x")
+    >>> renamed(2*x*y + sp.sin(x), {x: t})
+    2*t_x*y + sin(t_x)
+    """
+    if not names:
+        return expr
+    done: dict[sp.Expr, sp.Expr] = {}
+
+    def walk(e):
+        if e.is_Symbol:
+            return names.get(e, e)
+        if e.is_Atom:
+            return e
+        found = done.get(e)
+        if found is None:
+            args = tuple(walk(a) for a in e.args)
+            if all(a is b for a, b in zip(args, e.args)):
+                found = e
+            elif e.is_Add or e.is_Mul:
+                found = e.func._from_args(args, e.is_commutative)
+            else:
+                found = e.func(*args)
+            done[e] = found
+        return found
+
+    return walk(expr)
 
 
 def print_program(program: Program, inputs: Sequence[sp.Symbol], printer,

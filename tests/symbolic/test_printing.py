@@ -15,8 +15,9 @@ from eomgen.analysis.routes import _BatchPrinter, compile_batch, compile_scalar
 from eomgen.codegen import available_backends
 from eomgen.codegen.backends.fast_backend import FastCPrinter
 from eomgen.symbolic.evaluate import FloatPrinter, compile_program
-from eomgen.symbolic.printing import FloatLiteralMixin, print_program
+from eomgen.symbolic.printing import FloatLiteralMixin, ordered_terms, print_program, renamed
 from eomgen.symbolic.program import Program
+from support.expressions import X, Z, random_expressions
 
 #: Every code backend's registered printer (the registry: a new backend is tested too), and
 #: the printers of the numeric routes.
@@ -143,3 +144,58 @@ def test_print_program_prunes_renames_and_fixes():
     text = print_program(program, (q1, q2), FloatPrinter(), ["b"], fixed={m: 2}, flat=True)
     assert text.splitlines()[0] == "def _program(_a0, _a1):"
     assert text.splitlines()[1:] == ["    s = sin(_a0)*cos(_a1)", "    return ([2*s, _a1],)"]
+
+
+def _sympys_own(cls):
+    """``cls`` printing sums and products with SymPy's own methods (StrPrinter._print_Add,
+    CodePrinter._print_Mul, StrPrinter.parenthesize and SymPy's term order, then a term
+    without a minus sign first) and the mixin's literals: the reference of the mixin's faster
+    sums and products."""
+    from sympy.printing.codeprinter import CodePrinter
+    from sympy.printing.printer import Printer
+    from sympy.printing.str import StrPrinter
+
+    def parenthesize(self, item, level, strict=False):
+        if isinstance(item, sp.Rational) and not item.is_Integer and item.is_positive:
+            return self._print(item)
+        return StrPrinter.parenthesize(self, item, level, strict)
+
+    def ordered(self, expr, order=None):
+        terms = Printer._as_ordered_terms(self, expr, order=order)
+        if terms and terms[0].could_extract_minus_sign():
+            for k, term in enumerate(terms):
+                if not term.could_extract_minus_sign():
+                    return [term] + terms[:k] + terms[k + 1:]
+        return terms
+
+    return type("SymPys" + cls.__name__, (cls,), {
+        "_print_Add": StrPrinter._print_Add, "_print_Mul": CodePrinter._print_Mul,
+        "parenthesize": parenthesize, "_as_ordered_terms": ordered})
+
+
+@pytest.mark.parametrize("cls", PRINTERS, ids=lambda c: c.__name__)
+def test_sums_and_products_print_as_sympys_own_methods_print_them(cls):
+    """The mixin's sums and products (signs read off leading numbers, negations listed, not
+    built) give SymPy's text, character for character, on random expressions and their
+    renamed copies (``renamed``, what the backends print, against ``xreplace``)."""
+    make = (lambda c: c({"standard": "python3"})) if cls is not FastCPrinter else (lambda c: c())
+    ours, reference = make(cls), make(_sympys_own(cls))
+    names = {X: sp.Symbol("t_x", real=True), Z: sp.Symbol("q[2]", real=True)}
+    evaluated = 0
+    for expr in random_expressions(300, seed=3):
+        assert ours.doprint(expr) == reference.doprint(expr), expr
+        if expr.xreplace(names).xreplace({v: k for k, v in names.items()}) == expr:
+            # an evaluated expression (what a derivation makes; -(x + y) built unevaluated
+            # becomes -x - y in xreplace)
+            evaluated += 1
+            assert ours.doprint(renamed(expr, names)) == reference.doprint(
+                expr.xreplace(names)), expr
+    assert evaluated > 300
+
+
+def test_ordered_terms_are_sympys_order():
+    sums = [e for e in random_expressions(600, seed=7) if e.is_Add]
+    sums += [a for e in sums for a in e.args if a.is_Add]
+    assert len(sums) > 200
+    for expr in sums:
+        assert ordered_terms(expr) == expr.as_ordered_terms(), expr

@@ -16,6 +16,7 @@ from ...outputs import (CONSTRAINED_DERIVATIVES, CONSTRAINED_FORWARD, CONSTRAINE
                        TASK_SPACE, composition_names, constrained_names, exported,
                        parallel_names, task_space_names)
 from ..functions import FunctionSpec
+from ...symbolic.printing import renamed
 
 
 @dataclass(frozen=True)
@@ -217,7 +218,7 @@ def python_module_context(job: Job, printer, template: str, extra_exports=(),
     renames = parameter_renames(job)
 
     def text(expr: sp.Expr) -> str:
-        return printer.doprint(expr.xreplace(renames) if renames else expr)
+        return printer.doprint(renamed(expr, renames))
 
     doprint = printed_once(text)
 

@@ -34,7 +34,7 @@ from ...outputs import (CONSTRAINED_DERIVATIVES, CONSTRAINED_FORWARD, CONSTRAINE
                        FORWARD, INPUT_SIZES, PARALLEL_INVERSE,
                        TASK_SPACE, composition_names, constrained_names, exported,
                        parallel_names, task_space_names)
-from ...symbolic.printing import FloatLiteralMixin
+from ...symbolic.printing import FloatLiteralMixin, renamed
 from ...templating import TEMPLATES_DIR, render
 from .common import (import_file, parallel_indices, positional, printed_once,
                      warning_exports)
@@ -182,7 +182,7 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
         rename = {**names, **vectors, **local}
 
         def text(expr: sp.Expr, rename=rename) -> str:
-            return printer.doprint(expr.xreplace(rename))
+            return printer.doprint(renamed(expr, rename))
 
         layout = tuple((a.name, tuple(a.symbols)) for a in spec.arguments)
         doprint = printers.setdefault(layout, printed_once(text))
