@@ -84,6 +84,11 @@ def mul(x, y):
     if (type(y) is int or isinstance(y, sp.Integer)) and (y == 0 or y == 1) and _symbolic(x):
         return _ZERO if y == 0 else x
     if isinstance(x, sp.Basic) and isinstance(y, sp.Basic):
+        number, other = (x, y) if x.is_Number else (y, x)
+        if (other.is_Add and other.is_commutative and (number.is_Float or number.is_Rational)
+                and number and number is not sp.S.One):
+            # SymPy distributes a number over a sum: the sum of the scaled terms
+            return total([mul(number, term) for term in other.args])
         a, b = _monomial(x), _monomial(y)
         if a is not None and b is not None and (a[1] or b[1]):
             symbols = a[1] + b[1]
@@ -105,14 +110,19 @@ def mul(x, y):
 
 def total(terms) -> sp.Expr:
     """``sp.Add(*terms)``. A sum of monomials (see :func:`mul`) that no two share their symbols
-    (so that none combine), zeros aside, is made directly as the sum SymPy makes: the terms
-    sorted as SymPy sorts them."""
+    (so that none combine), zeros aside, and at most one non-zero number, is made directly as
+    the sum SymPy makes: the number first, then the terms sorted as SymPy sorts them."""
     kept = [t for t in terms if not (t is _ZERO or (type(t) is int and t == 0))]
-    if len(kept) > 1 and all(type(t) in (sp.Symbol, sp.Mul) for t in kept):
+    numbers = [t for t in kept if isinstance(t, (sp.Float, sp.Rational))]
+    if len(numbers) == 1 and numbers[0]:
+        kept = [t for t in kept if t is not numbers[0]]
+    elif numbers:
+        return sp.Add(*terms)
+    if len(kept) + len(numbers) > 1 and all(type(t) in (sp.Symbol, sp.Mul) for t in kept):
         monomials = [_monomial(t) for t in kept]
         if all(m is not None for m in monomials) and \
                 len({m[1] for m in monomials}) == len(monomials):
-            return sp.Add._from_args(tuple(sorted(kept, key=_SORT_KEY)), True)
+            return sp.Add._from_args(tuple(numbers) + tuple(sorted(kept, key=_SORT_KEY)), True)
     return sp.Add(*terms)
 
 
