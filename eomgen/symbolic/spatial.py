@@ -108,6 +108,38 @@ def mul(x, y):
     return x * y
 
 
+def negated(x):
+    """``-x``. A monomial (see :func:`mul`) is negated directly, as SymPy negates it: its
+    number's negative (dropped when it is 1) before the same symbols, or −1 before them; a sum
+    of monomials as the sum of its negated terms (:func:`total`), which is what SymPy makes of
+    −(a + b). SymPy builds each through its general product, whose new float it then asks
+    whether it is zero."""
+    if isinstance(x, sp.Basic):
+        if x.is_Add:
+            terms = [negated(t) for t in x.args]
+            if all(t is not None and not (isinstance(t, sp.Basic) and t.is_Add) for t in terms):
+                return total(terms)
+            return -x
+        m = _monomial(x)
+        if m is not None and m[1]:
+            coefficient, symbols = m
+            if coefficient is None:
+                return sp.Mul._from_args((sp.S.NegativeOne,) + symbols, True)
+            c = -coefficient
+            if c is sp.S.One:
+                return symbols[0] if len(symbols) == 1 else sp.Mul._from_args(symbols, True)
+            return sp.Mul._from_args((c,) + symbols, True)
+    return -x
+
+
+def difference(x, y):
+    """``x - y`` (:func:`total` of ``x`` and :func:`negated` ``y`` when both are SymPy
+    expressions)."""
+    if not (isinstance(x, sp.Basic) and isinstance(y, sp.Basic)):
+        return x - y
+    return total([x, negated(y)])
+
+
 def total(terms) -> sp.Expr:
     """``sp.Add(*terms)``. A sum of monomials (see :func:`mul`) that no two share their symbols
     (so that none combine), zeros aside, and at most one non-zero number, is made directly as
@@ -128,8 +160,9 @@ def total(terms) -> sp.Expr:
 
 def cross(a, b) -> tuple:
     """The cross product ``a × b`` of two 3-vectors (in the same axes)."""
-    return (mul(a[1], b[2]) - mul(a[2], b[1]), mul(a[2], b[0]) - mul(a[0], b[2]),
-            mul(a[0], b[1]) - mul(a[1], b[0]))
+    return (difference(mul(a[1], b[2]), mul(a[2], b[1])),
+            difference(mul(a[2], b[0]), mul(a[0], b[2])),
+            difference(mul(a[0], b[1]), mul(a[1], b[0])))
 
 
 def dot(a, b) -> sp.Expr:

@@ -9,7 +9,7 @@ import random
 
 import sympy as sp
 
-from eomgen.symbolic.spatial import mul, total
+from eomgen.symbolic.spatial import cross, mul, negated, total
 
 SYMBOLS = sp.symbols("a b c d e f", real=True)
 NUMBERS = [sp.Float(2.5), sp.Float(-0.5), sp.Float(1.0), sp.Float(-1.0), sp.Integer(3),
@@ -47,3 +47,29 @@ def test_a_number_times_a_sum_is_sympys_distributed_sum():
 def test_a_sum_of_monomials_is_sympys_sum():
     for terms, _ in _sums(2000, seed=2):
         assert _same(total(terms), sp.Add(*terms)), terms
+
+
+def _monomials(count: int, seed: int = 3):
+    rng = random.Random(seed)
+    for _ in range(count):
+        product = sp.Mul(*rng.sample(SYMBOLS, rng.randint(1, 3)))
+        number = rng.choice(NUMBERS + [None, None])
+        yield product if number is None else number * product
+
+
+def test_negations_and_cross_products_are_sympys():
+    for terms, number in _sums(1000, seed=4):
+        add = sp.Add(*terms)
+        assert _same(negated(add), -add), add
+    monomials = list(_monomials(3000))
+    for m in monomials:
+        assert _same(negated(m), -m), m
+    rng = random.Random(5)
+    for _ in range(1000):
+        a = [rng.choice(monomials + [sp.S.Zero, 0, 1]) for _ in range(3)]
+        b = [rng.choice(monomials + [sp.S.Zero, 0]) for _ in range(3)]
+        want_all = (mul(a[1], b[2]) - mul(a[2], b[1]), mul(a[2], b[0]) - mul(a[0], b[2]),
+                    mul(a[0], b[1]) - mul(a[1], b[0]))  # the former cross product
+        for got, want in zip(cross(a, b), want_all):
+            assert type(got) is type(want) and got == want and getattr(got, "args", ()) == \
+                getattr(want, "args", ()), (a, b)
