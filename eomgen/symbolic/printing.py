@@ -38,7 +38,7 @@ from sympy.core.function import Function
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.precedence import PRECEDENCE, precedence
 
-from .program import Program
+from .program import Program, substituted
 
 _MUL, _ADD = PRECEDENCE["Mul"], PRECEDENCE["Add"]
 #: the precedence of a product whose leading factor is a negative number (``-x`` binds looser
@@ -234,36 +234,15 @@ class NumPyModulePrinter(FloatLiteralMixin, NumPyPrinter):
 def renamed(expr: sp.Expr, names: Mapping[sp.Symbol, sp.Symbol]) -> sp.Expr:
     """``expr.xreplace(names)`` for a one-to-one renaming of symbols, printed alike when
     ``expr`` is evaluated (as a derivation's expressions are): sums and products are rebuilt
-    from their new arguments as they stand (SymPy's ``_from_args``), not flattened and sorted
-    again as ``xreplace`` does, since a printer orders the terms and factors it prints itself
-    and renamed symbols never merge. Only what holds a renamed symbol is rebuilt.
+    from their new arguments as they stand (:func:`~eomgen.symbolic.program.substituted`), not
+    flattened and sorted again as ``xreplace`` does, since a printer orders the terms and
+    factors it prints itself and renamed symbols never merge.
 
     >>> x, y, t = sp.symbols("x y t_x")
     >>> renamed(2*x*y + sp.sin(x), {x: t})
     2*t_x*y + sin(t_x)
     """
-    if not names:
-        return expr
-    done: dict[sp.Expr, sp.Expr] = {}
-
-    def walk(e):
-        if e.is_Symbol:
-            return names.get(e, e)
-        if e.is_Atom:
-            return e
-        found = done.get(e)
-        if found is None:
-            args = tuple(walk(a) for a in e.args)
-            if all(a is b for a, b in zip(args, e.args)):
-                found = e
-            elif e.is_Add or e.is_Mul:
-                found = e.func._from_args(args, e.is_commutative)
-            else:
-                found = e.func(*args)
-            done[e] = found
-        return found
-
-    return walk(expr)
+    return substituted(expr, names) if names else expr
 
 
 def print_program(program: Program, inputs: Sequence[sp.Symbol], printer,

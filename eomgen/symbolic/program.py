@@ -237,6 +237,40 @@ def name_matrix(b: ProgramBuilder, A, hint: str, tag=None) -> tuple:
                        for c in range(3)) for r in range(3))
 
 
+def substituted(expr: sp.Expr, replace: Mapping[sp.Symbol, sp.Expr],
+                done: dict | None = None) -> sp.Expr:
+    """``expr`` with the symbols of ``replace`` replaced and the rest of its structure kept as
+    it stands: sums, products and powers are rebuilt unevaluated from their new arguments (not
+    flattened, sorted or simplified again, so that this stays linear in the size of ``expr``),
+    other functions applied to theirs; what holds no replaced symbol is ``expr``'s own object.
+    ``done`` remembers rebuilt subexpressions across calls with the same (growing) ``replace``.
+
+    >>> x, y, t = sp.symbols("x y t")
+    >>> substituted(2*x*y + sp.sin(x), {x: t + 1})
+    2*y*(t + 1) + sin(t + 1)
+    """
+    done = {} if done is None else done
+
+    def walk(e):
+        if e.is_Symbol:
+            return replace.get(e, e)
+        if e.is_Atom:
+            return e
+        found = done.get(e)
+        if found is None:
+            args = tuple(walk(a) for a in e.args)
+            if all(a is b for a, b in zip(args, e.args)):
+                found = e
+            elif e.is_Add or e.is_Mul or e.is_Pow:
+                found = e.func(*args, evaluate=False)
+            else:
+                found = e.func(*args)
+            done[e] = found
+        return found
+
+    return walk(expr)
+
+
 def rough_operation_count(exprs: Iterable[sp.Expr]) -> int:
     """A fast estimate of the arithmetic operations of ``exprs``: one per argument of a sum or
     product beyond the first, per power and per function call (what :meth:`Program.operation_count`
@@ -379,21 +413,9 @@ class Program:
         what keeps this linear in the program size.
         """
         full: dict[sp.Symbol, sp.Expr] = {}
-
-        def rebuild(expr):
-            if expr.is_Symbol:
-                return full.get(expr, expr)
-            if expr.is_Atom:
-                return expr
-            args = tuple(rebuild(a) for a in expr.args)
-            if all(a is b for a, b in zip(args, expr.args)):
-                return expr
-            if expr.is_Add or expr.is_Mul or expr.is_Pow:
-                return expr.func(*args, evaluate=False)
-            return expr.func(*args)
-
+        done: dict[sp.Expr, sp.Expr] = {}
         for symbol, expr in self.assignments:
-            full[symbol] = rebuild(expr)
+            full[symbol] = substituted(expr, full, done)
         return full
 
     def expand(self, matrix: sp.Matrix, full: Mapping | None = None) -> sp.Matrix:
