@@ -38,19 +38,13 @@ from sympy.core.function import Function
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.precedence import PRECEDENCE, precedence
 
+from .monomials import leads_with_negative_number
 from .program import Program, substituted
 
 _MUL, _ADD = PRECEDENCE["Mul"], PRECEDENCE["Add"]
 #: the precedence of a product whose leading factor is a negative number (``-x`` binds looser
 #: than a product, tighter than a power: SymPy's weight for a unary minus)
 _NEGATED = 0.5 * (PRECEDENCE["Pow"] + PRECEDENCE["Mul"])
-
-
-def leads_with_negative_number(product: sp.Expr) -> bool:
-    """``product.could_extract_minus_sign()`` of a finite product, without building
-    ``-product`` as SymPy does to rule out ``zoo``: its leading factor is a negative number."""
-    c = product.args[0]
-    return c.is_Number and c.is_finite is not False and bool(c.is_extended_negative)
 
 
 def ordered_terms(expr: sp.Expr) -> list:

@@ -20,6 +20,8 @@ from typing import Iterable, Mapping, NamedTuple, Sequence
 import sympy as sp
 from sympy.core.operations import LatticeOp
 
+from .monomials import leads_with_negative_number, negated
+
 
 class Tag(NamedTuple):
     """What an intermediate is, set where it is defined (never read back from its name).
@@ -131,7 +133,7 @@ class ProgramBuilder:
             return known
         symbols = frozenset(expr.free_symbols)
         if symbols in self._symbol_sets:
-            neg = self._by_value.get(-expr)
+            neg = self._by_value.get(negated(expr))
             if neg is not None:
                 return -neg
         symbol = self._fresh(hint)
@@ -188,8 +190,9 @@ def _leads_negative(expr: sp.Expr) -> bool:
     """Whether ``expr`` prints with a leading minus sign (one more operation than its negation
     when that negation can be absorbed where it is used: a constant factor, a subtraction)."""
     if expr.is_Add:  # printers put a term without a minus sign first when there is one
-        return all(term.could_extract_minus_sign() for term in expr.args)
-    return expr.is_Mul and expr.could_extract_minus_sign()
+        return all(leads_with_negative_number(term) if term.is_Mul
+                   else term.could_extract_minus_sign() for term in expr.args)
+    return expr.is_Mul and leads_with_negative_number(expr)
 
 
 def name_expr(b: ProgramBuilder, expr, hint: str, tag=None, scaled: bool = False) -> sp.Expr:
@@ -206,8 +209,7 @@ def name_expr(b: ProgramBuilder, expr, hint: str, tag=None, scaled: bool = False
     """
     expr = sp.sympify(expr)
     if _leads_negative(expr):
-        negated = sp.Add(*[-t for t in expr.args]) if expr.is_Add else -expr
-        return -b.define(negated, hint, tag, scaled)
+        return negated(b.define(negated(expr), hint, tag, scaled))
     return b.define(expr, hint, tag, scaled)
 
 
