@@ -1,7 +1,7 @@
-"""The spatial algebra's products and sums (eomgen.symbolic.spatial.mul, total), which make the
-commonest products and sums of the recursions directly: each is SymPy's own result, argument
-for argument (the same expression object up to identity, so that programs and the generated
-code do not change)."""
+"""The scalar algebra under the spatial one (eomgen.symbolic.monomials: mul, total, negated) and
+the cross product built on it, which make the commonest products, sums and negations of the
+recursions directly: each is SymPy's own result, argument for argument (so that programs and
+the generated code do not change)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,8 @@ import random
 
 import sympy as sp
 
-from eomgen.symbolic.spatial import cross, mul, negated, total
+from eomgen.symbolic.monomials import mul, negated, total
+from eomgen.symbolic.spatial import cross
 
 SYMBOLS = sp.symbols("a b c d e f", real=True)
 NUMBERS = [sp.Float(2.5), sp.Float(-0.5), sp.Float(1.0), sp.Float(-1.0), sp.Integer(3),
