@@ -150,4 +150,11 @@ def leads_with_negative_number(product: sp.Expr) -> bool:
     return c.is_Number and c.is_finite is not False and bool(c.is_extended_negative)
 
 
-__all__ = ["difference", "leads_with_negative_number", "monomial", "mul", "negated", "total"]
+def leads_with_minus(expr: sp.Expr) -> bool:
+    """``expr.could_extract_minus_sign()``, a product's read off its leading number
+    (:func:`leads_with_negative_number`)."""
+    return leads_with_negative_number(expr) if expr.is_Mul else expr.could_extract_minus_sign()
+
+
+__all__ = ["difference", "leads_with_minus", "leads_with_negative_number", "monomial", "mul",
+           "negated", "total"]

@@ -38,7 +38,7 @@ from sympy.core.function import Function
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.precedence import PRECEDENCE, precedence
 
-from .monomials import leads_with_negative_number
+from .monomials import leads_with_minus, leads_with_negative_number
 from .program import Program, substituted
 
 _MUL, _ADD = PRECEDENCE["Mul"], PRECEDENCE["Add"]
@@ -131,9 +131,9 @@ class FloatLiteralMixin:
             terms = ordered_terms(expr)
         else:
             terms = super()._as_ordered_terms(expr, order=order)
-        if terms and _minus(terms[0]):
+        if terms and leads_with_minus(terms[0]):
             for k, term in enumerate(terms):
-                if not _minus(term):
+                if not leads_with_minus(term):
                     return [term] + terms[:k] + terms[k + 1:]
         return terms
 
@@ -170,9 +170,8 @@ class FloatLiteralMixin:
         if not expr.is_commutative or self.order in ("old", "none"):
             return super()._print_Mul(expr)
         level = fast_precedence(expr)
-        c = expr.args[0]
-        if c.is_Number and c.is_finite is not False and c.is_extended_negative:
-            sign, c = "-", -c
+        if leads_with_negative_number(expr):
+            sign, c = "-", -expr.args[0]
             factors = list(expr.args[1:])
             if any(f.is_Mul for f in factors) or (
                     c is not sp.S.One and len(factors) == 1 and factors[0].is_Add):
@@ -208,11 +207,6 @@ class FloatLiteralMixin:
         if len(denominator) == 1:
             return sign + "*".join(texts) + "/" + below[0]
         return sign + "*".join(texts) + "/(%s)" % "*".join(below)
-
-
-def _minus(term: sp.Expr) -> bool:
-    """``term.could_extract_minus_sign()``, a product's read off its leading number."""
-    return leads_with_negative_number(term) if term.is_Mul else term.could_extract_minus_sign()
 
 
 class NumPyModulePrinter(FloatLiteralMixin, NumPyPrinter):

@@ -20,7 +20,7 @@ from typing import Iterable, Mapping, NamedTuple, Sequence
 import sympy as sp
 from sympy.core.operations import LatticeOp
 
-from .monomials import leads_with_negative_number, negated
+from .monomials import leads_with_minus, leads_with_negative_number, negated
 
 
 class Tag(NamedTuple):
@@ -190,8 +190,7 @@ def _leads_negative(expr: sp.Expr) -> bool:
     """Whether ``expr`` prints with a leading minus sign (one more operation than its negation
     when that negation can be absorbed where it is used: a constant factor, a subtraction)."""
     if expr.is_Add:  # printers put a term without a minus sign first when there is one
-        return all(leads_with_negative_number(term) if term.is_Mul
-                   else term.could_extract_minus_sign() for term in expr.args)
+        return all(leads_with_minus(term) for term in expr.args)
     return expr.is_Mul and leads_with_negative_number(expr)
 
 

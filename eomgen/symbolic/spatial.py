@@ -291,8 +291,7 @@ class JointFrames:
         return A_p, B_p, C
 
 
-__all__ = ["JointFrames", "SpatialInertia", "add", "aligned_axis", "cross", "dot",
-           "difference", "force_cross", "matmul", "matvec", "motion_cross", "mul", "negated",
-           "rotate_aligned",
+__all__ = ["JointFrames", "SpatialInertia", "add", "aligned_axis", "cross", "difference", "dot",
+           "force_cross", "matmul", "matvec", "motion_cross", "mul", "negated", "rotate_aligned",
            "rotate_back", "rotation", "scale", "skew", "skew_times", "total", "transpose",
            "transpose_apply"]
