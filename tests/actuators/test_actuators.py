@@ -27,6 +27,7 @@ from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 
 from support import ROOT, erd_robots_dir
+from support.extras import need
 
 FLEXIBLE_2LINK = ROOT / "examples" / "robots" / "flexible_2link.yaml"
 
@@ -97,7 +98,7 @@ def test_bad_scene_actuators_are_one_line_naming_the_scene_and_the_joint(text, e
 def _mujoco_model(urdf: Path, armature: dict, damping: dict):
     """MuJoCo's model of the URDF (visual and collision geometry removed: MuJoCo would load
     the meshes) with the given armature and damping per joint."""
-    mujoco = pytest.importorskip("mujoco", reason="MuJoCo is the reference (test extra)")
+    mujoco = need("mujoco", reason="MuJoCo is the reference")
     text = re.sub(r"<(visual|collision)\b.*?</\1>", "", urdf.read_text(), flags=re.S)
     m = mujoco.MjSpec.from_string(text).compile()
     for name in armature:  # runtime model fields, read by mj_crb (qM) and mj_passive

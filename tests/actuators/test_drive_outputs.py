@@ -24,6 +24,7 @@ from eomgen.scene import load_scene
 from support import erd_robots_dir
 from support.generated import generated
 from support.robots import FLEXIBLE_2LINK, drive_arm as arm
+from support.extras import need
 
 RIGID = ("M_a", "tau_f", "tau_f_smooth", "tau_a")
 FLEXIBLE = ("M_l", "tau_K", "thetadd_m", "h", "M")
@@ -101,7 +102,7 @@ def test_flexible_outputs_of_a_rigid_robot_are_a_one_line_error(tmp_path):
 
 
 def test_drive_mass_matrix_and_friction_match_mujoco(tmp_path):
-    mujoco = pytest.importorskip("mujoco", reason="MuJoCo is the reference (test extra)")
+    mujoco = need("mujoco", reason="MuJoCo is the reference")
     robots = erd_robots_dir()
     if robots is None:
         pytest.skip("example-robot-data is not installed")

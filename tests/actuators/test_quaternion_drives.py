@@ -23,8 +23,9 @@ from eomgen.quaternion_joints import configuration_rate
 from support import relative
 from support.generated import generated
 from support.quaternion import pinocchio_states, quaternion_robot
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio", reason="quaternion joints are checked against Pinocchio")
+pin = need("pinocchio", reason="quaternion joints are checked against Pinocchio")
 
 SPEC = (("a_hip", "spherical", -1), ("b_knee", "revolute", 0), ("c_arm", "revolute", -1))
 KNEE = Actuator(armature=0.05, damping=0.1, friction=0.2, friction_width=0.5, stiffness=50.0)
@@ -94,7 +95,7 @@ def test_flexible_knee_outputs(case):
 
 
 def test_flat_outputs_follow_a_trajectory_on_the_configuration_space(case):
-    scipy = pytest.importorskip("scipy.integrate", reason="the trajectory is integrated by SciPy")
+    scipy = need("scipy.integrate", reason="the trajectory is integrated by SciPy")
     model, pm, call, index = case
     a, d, f, w = drive_vectors(pm, index)
     k = index["b_knee"]

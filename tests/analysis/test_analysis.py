@@ -20,9 +20,10 @@ from eomgen.analysis.precision import (Reference, high_precision_model, max_abs,
 from eomgen.cli import main
 from eomgen.numeric import kinetic_energy, numeric_model, potential_energy, rnea
 from support.reference import random_robot
+from support.extras import need
 
-pytest.importorskip("matplotlib")
-pytest.importorskip("scipy")
+need("matplotlib")
+need("scipy")
 
 EPS = float(np.finfo(float).eps)
 
@@ -117,7 +118,7 @@ def test_every_route_agrees_with_the_reference(planar, tmp_path):
 
 
 def test_pinocchio_bridge_matches_rnea_on_a_random_tree():
-    pytest.importorskip("pinocchio")
+    need("pinocchio")
     from eomgen.analysis.pinocchio_bridge import to_pinocchio
 
     model = random_robot(np.random.default_rng(4), 5, tree=True)

@@ -20,8 +20,9 @@ from eomgen.numeric import (M_crba, M_rnea, coriolis_times_qd, forward_dynamics,
                             kinetic_energy, link_poses, numeric_model, potential_energy, rnea)
 from support import erd_robots_or_skip, load_quietly, relative
 from support.reference import random_inertial, random_rotation
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio", reason="quaternion joints are checked against Pinocchio")
+pin = need("pinocchio", reason="quaternion joints are checked against Pinocchio")
 
 #: A tree with two ball joints and a branch: (name, type, parent index), on a free flyer.
 TREE = (("j0", JointType.REVOLUTE, -1), ("ball", JointType.SPHERICAL, 0),
@@ -152,7 +153,7 @@ def test_verify_checks_a_quaternion_model():
 def test_mpmath_references_agree_on_quaternion_joints():
     """The bench's two 40-digit references (the derived program, the mpmath Newton–Euler) on a
     free flyer with a ball joint, and the float64 recursion against them."""
-    pytest.importorskip("mpmath")
+    need("mpmath")
     from eomgen.analysis.bench import sample_states
     from eomgen.analysis.precision import Reference, relative_error
 
@@ -180,8 +181,8 @@ def test_bench_measures_a_ball_joint(tmp_path):
     """``eomgen bench`` of a pendulum on a ball joint (it refused quaternion joints): every
     float64 route within rounding of the 40-digit reference, which its two evaluations agree
     on."""
-    pytest.importorskip("matplotlib", reason="eomgen bench needs the analysis extra")
-    pytest.importorskip("mpmath", reason="eomgen bench needs the analysis extra")
+    need("matplotlib", reason="eomgen bench")
+    need("mpmath", reason="eomgen bench")
     import csv
 
     from support import run_in_process

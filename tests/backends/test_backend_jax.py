@@ -13,8 +13,9 @@ from support.array_backends import (
     ARGUMENTS, FUNCTIONS, ROBOTS, assert_relative, central_difference, hostile_modules,
     load_module, robot_modules, states,
 )
+from support.extras import need
 
-jax = pytest.importorskip("jax", reason="the JAX backend needs jax: pip install 'eomgen[jax]'")
+jax = need("jax", reason="the JAX backend")
 jax.config.update("jax_enable_x64", True)
 jnp = jax.numpy
 
@@ -216,7 +217,7 @@ def test_parameters_named_like_the_framework_do_not_shadow_it(tmp_path):
 def test_dask_map_takes_dask_inputs_and_jax_functions(robot):
     """eomgen.batch.dask_map over a JAX function (issue 12, item 7): chunks of a dask array,
     the joints of a state joined into one chunk, equal to the NumPy batch."""
-    da = pytest.importorskip("dask.array", reason="dask_map needs dask: pip install 'eomgen[dask]'")
+    da = need("dask.array", reason="dask_map runs on dask")
     from eomgen.batch import dask_map
 
     modules = robot("planar_2link")

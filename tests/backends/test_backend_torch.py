@@ -13,9 +13,9 @@ from support.array_backends import (
     ARGUMENTS, FUNCTIONS, ROBOTS, assert_relative, central_difference, hostile_modules,
     load_module, robot_modules, states,
 )
+from support.extras import need
 
-torch = pytest.importorskip("torch",
-                            reason="the PyTorch backend needs torch: pip install 'eomgen[torch]'")
+torch = need("torch", reason="the PyTorch backend")
 
 
 @pytest.fixture(scope="module")

@@ -23,6 +23,7 @@ from eomgen.codegen.backends.casadi_backend import c_compiler
 from eomgen.codegen.generate import render_files
 from eomgen.dynamics import derive
 from support import load_module
+from support.extras import need
 
 FUNCTIONS = {"mass_matrix": ("q",), "coriolis_matrix": ("q", "qd"), "gravity_vector": ("q",),
              "inverse_dynamics": ("q", "qd", "qdd"), "forward_dynamics": ("q", "qd", "tau")}
@@ -130,7 +131,7 @@ def test_forward_dynamics_solves_and_reports_the_condition(planar):
 def test_ur5_fast_module_agrees_with_pinocchio(erd_robots_dir, tmp_path):
     """Read without snapping (as Pinocchio reads it), the UR5's τ, M, C and g agree with
     Pinocchio to 1e-14 relative, and q̈ inverts τ."""
-    pin = pytest.importorskip("pinocchio", reason="Pinocchio is the independent reference")
+    pin = need("pinocchio", reason="Pinocchio is the independent reference")
     path = erd_robots_dir / "ur_description/urdf/ur5_robot.urdf"
     files = render_files(eomgen.load(path, snap=False), ["numpy", "fast"])
     _, fast = _load(tmp_path, files, "ur5")

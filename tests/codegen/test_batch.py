@@ -13,8 +13,9 @@ import pytest
 import eomgen
 from eomgen.batch import dask_map
 from eomgen.codegen.generate import generate
+from support.extras import need
 
-da = pytest.importorskip("dask.array", reason="dask_map needs dask: pip install 'eomgen[dask]'")
+da = need("dask.array", reason="dask_map runs on dask")
 
 
 @pytest.fixture(scope="module")
@@ -36,7 +37,7 @@ def batch(count: int, seed: int = 0):
 
 
 def test_dask_map_on_a_local_cluster_equals_the_numpy_batch(planar):
-    distributed = pytest.importorskip("distributed", reason="needs eomgen[dask] (distributed)")
+    distributed = need("distributed", reason="needs eomgen[dask] (distributed)")
     outdir, module = planar
     q, qd, qdd = batch(1001)
     masses = np.linspace(0.5, 1.5, len(q))

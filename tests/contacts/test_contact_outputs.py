@@ -29,6 +29,7 @@ from eomgen.outputs import CONSTRAINED_FORWARD, OUTPUTS
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from eomgen.symbolic.frames import output_frames
+from support.extras import need
 
 WALL = ROOT / "examples/contacts/planar_2link_wall.yaml"
 STANDING = ROOT / "examples/contacts/solo12_standing.yaml"
@@ -167,7 +168,7 @@ def _states(count, seed):
 
 @pytest.mark.slow
 def test_solo_frames_match_pinocchio_and_finite_differences(solo):
-    pin = pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
+    pin = need("pinocchio", reason="Pinocchio is the reference")
     path, model, np_module, ca_module = solo
     feet = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
     assert tuple(np_module["FRAME_NAMES"]) == feet  # the contact frames, by the rule
@@ -210,7 +211,7 @@ def test_solo_frames_match_pinocchio_and_finite_differences(solo):
 
 @pytest.mark.slow
 def test_solo_constrained_dynamics_matches_pinocchio_and_the_numeric_kkt(solo):
-    pin = pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
+    pin = need("pinocchio", reason="Pinocchio is the reference")
     path, model, np_module, ca_module = solo
     assert len(np_module["CONTACT_ROWS"]) == 12 and np_module["CONTACT_ROWS"][0] == "FL_FOOT.f_x"
     cd = ContactDynamics(model, model.contacts)
@@ -311,7 +312,7 @@ def test_fixed_base_frames_are_pinocchios_local_world_aligned_jacobians(tmp_path
     getFrameJacobian(LOCAL_WORLD_ALIGNED) as it stands ([v; ω], linear rows first). The
     tolerance is that of the two readers' rotations of the URDF's rounded rpy values
     (differences of 5e-12 observed)."""
-    pin = pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
+    pin = need("pinocchio", reason="Pinocchio is the reference")
     if erd_robots_dir() is None:
         pytest.skip("example-robot-data is not installed")
     import warnings

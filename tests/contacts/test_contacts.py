@@ -26,6 +26,7 @@ from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support.robots import SOLO, FreeFlyerReference
 from support.reference import pinocchio_contacts
+from support.extras import need
 
 FEET = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
 
@@ -40,7 +41,7 @@ def solo():
 
 @pytest.mark.parametrize("kind, feet", [("point", FEET), ("surface", FEET[:1])])
 def test_constrained_dynamics_matches_pinocchio(solo, kind, feet):
-    pin = pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
+    pin = need("pinocchio", reason="Pinocchio is the reference")
     path, model = solo
     cd = ContactDynamics(model, tuple(Contact(f, kind) for f in feet))
     ref = FreeFlyerReference(path, model.joint_names)
@@ -88,7 +89,7 @@ def _standing(model):
 
 
 def test_solo12_standing_statics(solo):
-    pin = pytest.importorskip("pinocchio", reason="Pinocchio gives mass and centre of mass")
+    pin = need("pinocchio", reason="Pinocchio gives mass and centre of mass")
     path, model = solo
     cd = ContactDynamics(model, tuple(Contact(f, mu=0.7) for f in FEET))
     q = _standing(model)

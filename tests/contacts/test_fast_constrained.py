@@ -24,6 +24,7 @@ from eomgen.codegen.functions import select_functions
 from eomgen.codegen.generate import render_files
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
+from support.extras import need
 
 WALL = ROOT / "examples/contacts/planar_2link_wall.yaml"
 STANDING = ROOT / "examples/contacts/solo12_standing.yaml"
@@ -106,7 +107,7 @@ def test_wall_statics_and_pinocchio(wall, tmp_path):
     qdd, F = fast.constrained_forward_dynamics(q, np.zeros(2), tau, damping=1e-12)
     assert np.abs(qdd).max() < 1e-9 and np.allclose(F, [-f, 0, 0], atol=1e-8)
 
-    pin = pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
+    pin = need("pinocchio", reason="Pinocchio is the reference")
     from support.reference import to_urdf
 
     path = tmp_path / "planar_2link.urdf"
@@ -149,7 +150,7 @@ def test_redundant_contacts_need_damping(tmp_path):
 
 @pytest.mark.slow
 def test_solo_fast_equals_numpy_and_pinocchio(tmp_path):
-    pin = pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
+    pin = need("pinocchio", reason="Pinocchio is the reference")
     if erd_robots_dir() is None:
         pytest.skip("example-robot-data is not installed")
     path = erd_robots_dir() / "solo_description/robots/solo12.urdf"

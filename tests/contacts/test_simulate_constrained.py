@@ -18,6 +18,7 @@ from click.testing import CliRunner
 
 import eomgen
 from support import ROOT
+from support.extras import need
 from eomgen import actuators as A
 from eomgen import numeric
 from eomgen.cli import _load_reduced, main
@@ -25,8 +26,8 @@ from eomgen.contacts import Contact, ContactDynamics, derived_mass_and_bias, rot
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 
-pytest.importorskip("matplotlib", reason="eomgen simulate needs the analysis extra")
-pytest.importorskip("scipy", reason="eomgen simulate needs the analysis extra")
+need("matplotlib", reason="eomgen simulate")
+need("scipy", reason="eomgen simulate")
 from scipy.integrate import solve_ivp  # noqa: E402
 from scipy.spatial.transform import Rotation  # noqa: E402
 

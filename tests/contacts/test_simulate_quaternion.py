@@ -20,8 +20,9 @@ from eomgen.free_flyer import add_free_flyer
 from eomgen.numeric.frames import frame_function
 from support import ROOT, erd_robots_or_skip, load_quietly, relative, run_cli, write
 from support.reference import pinocchio_contacts
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
+pin = need("pinocchio", reason="Pinocchio is the reference")
 
 FEET = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
 
@@ -83,8 +84,8 @@ def test_simulate_holds_a_spinning_top_on_its_tip_with_a_quaternion_base(tmp_pat
     0.2 rad and spun at 20 rad/s: the tip stays put (RK4 at 1 ms), the energy from
     eomgen.numeric stays (no Baumgarte: the held contact does no work), and the quaternion norm
     drift (the quaternion is integrated as a vector) is reported, small and not zero."""
-    pytest.importorskip("scipy", reason="eomgen simulate needs the analysis extra")
-    pytest.importorskip("matplotlib", reason="eomgen simulate needs the analysis extra")
+    need("scipy", reason="eomgen simulate")
+    need("matplotlib", reason="eomgen simulate")
     scene = (ROOT / "examples" / "contacts" / "top_on_a_point.yaml").read_text("utf-8")
     assert "floating_base: true" in scene
     scene = write(tmp_path / "top.yaml", scene.replace("floating_base: true",

@@ -19,8 +19,9 @@ import pytest
 import eomgen
 from eomgen.control import (ComputedTorque, PDGravity, SlotineLi, estimated_mass_matrix,
                             fourier_reference, simulate)
+from support.extras import need
 
-scipy = pytest.importorskip("scipy")
+scipy = need("scipy")
 
 
 @pytest.fixture(scope="module")

@@ -24,9 +24,10 @@ from eomgen.control.configuration import module_layout, position_error
 from eomgen.identification import FourierTrajectory
 from support import relative
 from support.quaternion import quaternion_robot
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio", reason="the laws are checked against Pinocchio")
-pytest.importorskip("scipy", reason="closed loops are integrated by SciPy")
+pin = need("pinocchio", reason="the laws are checked against Pinocchio")
+need("scipy", reason="closed loops are integrated by SciPy")
 
 SPEC = (("ball", "spherical", -1), ("j2", "revolute", 0))  # a ball joint, then a revolute one
 

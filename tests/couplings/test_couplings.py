@@ -17,6 +17,7 @@ from eomgen.errors import KinematicTreeError, UnsupportedError
 from eomgen.model import couple, coupling_map, lock_joints, uncoupled
 from eomgen.numeric.newton_euler import M_rnea, numeric_model, rnea
 from support import erd_robots_dir, load_module
+from support.extras import need
 
 BACKENDS = ("numpy", "fast", "casadi", "jax", "torch")
 
@@ -43,7 +44,7 @@ def panda():
 
 
 def test_panda_mimic_matches_pinocchio(panda):
-    pin = pytest.importorskip("pinocchio")
+    pin = need("pinocchio")
     path, model, f = panda
     assert model.dof == 8 and "panda_finger_joint2" not in model.joint_names
     pmodel = pin.buildModelFromUrdf(str(path), mimic=True)

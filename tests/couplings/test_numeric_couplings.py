@@ -20,6 +20,7 @@ from eomgen.model import couple
 from eomgen.numeric import (M_crba, M_rnea, coriolis_times_qd, gravity_torques, kinetic_energy,
                             numeric_model, potential_energy, rnea)
 from support import erd_robots_or_skip, relative, run_cli
+from support.extras import need
 
 
 @pytest.fixture(scope="module")
@@ -31,7 +32,7 @@ def panda():
 
 
 def test_panda_mimic_equals_pinocchio(panda):
-    pin = pytest.importorskip("pinocchio", reason="Pinocchio's mimic joints are the reference")
+    pin = need("pinocchio", reason="Pinocchio's mimic joints are the reference")
     path, model = panda
     nm = numeric_model(model)
     assert (nm.n, nm.nq, nm.n_tree) == (8, 8, 9)
@@ -73,7 +74,7 @@ def test_differential_equals_the_symbolic_reduced_model():
         assert relative(M_rnea(nm, q), f.M(q)) < 1e-12
         assert relative(coriolis_times_qd(nm, q, v), f.C(q, v) @ v) < 1e-12
         assert relative(gravity_torques(nm, q), f.g(q).ravel()) < 1e-12
-    pytest.importorskip("mpmath")
+    need("mpmath")
     from eomgen.analysis.precision import Reference, relative_error
 
     reference = Reference(model)
@@ -84,8 +85,8 @@ def test_differential_equals_the_symbolic_reduced_model():
 def test_verify_and_simulate_a_coupled_model(tmp_path):
     """eomgen verify on the differential, and eomgen simulate's study on it (it refused coupled
     models: its energy comes from eomgen.numeric): DOP853 keeps that energy."""
-    pytest.importorskip("scipy", reason="eomgen simulate needs the analysis extra")
-    pytest.importorskip("matplotlib", reason="eomgen simulate needs the analysis extra")
+    need("scipy", reason="eomgen simulate")
+    need("matplotlib", reason="eomgen simulate")
     arm = eomgen.load(eomgen.example_path("elbow_rrr"))
     model = couple(arm, "elbow", {"waist": 0.5, "shoulder": -0.3}, offset=0.1)
     report = eomgen.verify(eomgen.derive(model, ("M", "C", "g")), samples=3)
@@ -102,8 +103,8 @@ def test_bench_runs_the_panda_with_its_mimic_fingers(panda, tmp_path):
     """``eomgen bench`` refused the Panda (eomgen.numeric had no coupling map): every route
     within rounding of the 40-digit reference, Pinocchio's through the whole tree (T q + c,
     projected by Tᵀ). simulate: test_verify_and_simulate_a_coupled_model."""
-    pytest.importorskip("matplotlib", reason="eomgen bench needs the analysis extra")
-    pytest.importorskip("mpmath", reason="eomgen bench needs the analysis extra")
+    need("matplotlib", reason="eomgen bench")
+    need("mpmath", reason="eomgen bench")
     path, _ = panda
     result = run_cli("bench", str(path), "--samples", "2", "--repeats", "1", "--batch-size",
                      "2", "--quiet", "-o", str(tmp_path / "bench"))
@@ -140,7 +141,7 @@ def test_panda_with_a_free_flyer_and_mimic_fingers_equals_pinocchio(panda):
     """Couplings on a quaternion model: q (NQ = 15) maps to the whole tree's configuration
     (NQ = 16) with the free flyer's seven entries copied; against Pinocchio's free flyer with
     mimic joints, arrays unchanged."""
-    pin = pytest.importorskip("pinocchio", reason="Pinocchio's mimic joints are the reference")
+    pin = need("pinocchio", reason="Pinocchio's mimic joints are the reference")
     from eomgen.free_flyer import add_free_flyer
     from eomgen.numeric.frames import frame_kinematics
 

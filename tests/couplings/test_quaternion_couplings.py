@@ -15,8 +15,9 @@ from eomgen.free_flyer import add_free_flyer
 from eomgen.model import couple, uncoupled
 from eomgen.model.coupling import full_configuration
 from support import relative
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio", reason="checked against Pinocchio's mimic joints")
+pin = need("pinocchio", reason="checked against Pinocchio's mimic joints")
 
 LINK = """  <link name="{name}"><inertial><origin xyz="{com}" rpy="0.1 0.2 0.3"/>
     <mass value="{mass}"/><inertia ixx="0.02" ixy="0.001" ixz="0.002" iyy="0.03" iyz="-0.001"

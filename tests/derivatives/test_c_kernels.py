@@ -13,6 +13,7 @@ import eomgen
 from eomgen.codegen.backends.casadi_backend import c_compiler
 from eomgen.codegen.generate import render_files
 from support import load_module
+from support.extras import need
 
 FUNCTIONS = ["inverse_dynamics", "inverse_dynamics_derivatives", "forward_dynamics_aba"]
 
@@ -73,7 +74,7 @@ def test_kernels_called_from_c_and_cpp_equal_the_numpy_module(tmp_path):
 
 @pytest.mark.skipif(c_compiler() is None, reason="needs a C compiler")
 def test_casadi_c_library_linearize_equals_the_numpy_module(tmp_path):
-    casadi = pytest.importorskip("casadi")
+    casadi = need("casadi")
     model = eomgen.load(eomgen.example_path("planar_2link"))
     for f in render_files(model, ["c", "numpy"], functions=["linearize"]):
         path = tmp_path / f.name

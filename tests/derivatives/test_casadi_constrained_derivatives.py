@@ -16,9 +16,10 @@ import pytest
 from eomgen.compiler import c_compiler
 from support.held import held_robot, pinocchio_constrained_derivatives
 from test_constrained_derivatives import DERIVATIVES, leg, states
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio", reason="checked against Pinocchio's derivatives")
-pytest.importorskip("casadi", reason="the CasADi backend")
+pin = need("pinocchio", reason="checked against Pinocchio's derivatives")
+need("casadi", reason="the CasADi backend")
 
 NAMES = ("dqdd_dq", "dqdd_dqd", "dqdd_dtau", "dF_dq", "dF_dqd", "dF_dtau")
 

@@ -24,8 +24,9 @@ from support.generated import BACKENDS, generated
 from support.held import (constrained_central_differences, held_model,
                           pinocchio_constrained_derivatives)
 from support.robots import SOLO
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio", reason="checked against Pinocchio's derivatives")
+pin = need("pinocchio", reason="checked against Pinocchio's derivatives")
 
 DERIVATIVES = "constrained_forward_dynamics_derivatives"
 PARTIALS = "constrained_dynamics_partials"

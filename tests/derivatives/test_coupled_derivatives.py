@@ -33,8 +33,9 @@ from eomgen.scene import load_scene
 from support import TESTS, erd_robots_or_skip
 from support.derivatives import results
 from support.generated import BACKENDS, generated
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio", reason="checked against Pinocchio's derivatives")
+pin = need("pinocchio", reason="checked against Pinocchio's derivatives")
 
 GRAVITY = np.array([0.3, -0.2, -9.81])
 DRIVE = 'armature="{a}" damping="{d}" frictionloss="{f}"'
@@ -81,6 +82,7 @@ FUNCTIONS = DERIVATIVES + ["inverse_dynamics", "forward_dynamics", "gravity_vect
 
 
 def coupled_arm(folder):
+    need("mujoco", reason="the model is MJCF, read by MuJoCo's compiler")
     path = folder / "geared.xml"
     path.write_text(ARM, encoding="utf-8")
     scene = load_scene(folder / "scene.yaml", text=SCENE)
@@ -270,6 +272,7 @@ def assert_tangent_derivatives(path, independent, seed):
     the drive derivatives too;
     ``linearize``'s position rows those of the tangent chart (docs/derivatives.md), 0 on the
     one-axis joints."""
+    need("mujoco", reason="the model is MJCF, read by MuJoCo's compiler")
     model = eomgen.load(path)
     module = eomgen.derive(model, ("dtau", "dqdd", "dg_dq", "AB", "dtau_a", "dqdd_a")
                            ).lambdify().module
@@ -314,6 +317,7 @@ def assert_tangent_derivatives(path, independent, seed):
 def test_a_ball_joint_after_a_follower_along_the_tangent(tmp_path):
     """``jb = −0.6 ja + 0.1`` before a ball joint: the ball's velocity and configuration
     entries sit one place earlier in the independent coordinates than in the whole tree."""
+    need("mujoco", reason="the model is MJCF, read by MuJoCo's compiler")
     path = tmp_path / "ball_after.xml"
     path.write_text(BALL_AFTER, encoding="utf-8")
     assert_tangent_derivatives(path, [0, 2, 3, 4, 5, 6], seed=13)

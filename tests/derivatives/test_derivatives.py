@@ -20,6 +20,7 @@ from eomgen.outputs import OUTPUTS
 from support import robots
 from support.generated import generated
 from support.reference import pin_q_order, to_pinocchio
+from support.extras import need
 
 FUNCTIONS = ["inverse_dynamics_derivatives", "forward_dynamics_derivatives",
              "gravity_derivative", "linearize"]
@@ -137,7 +138,7 @@ def test_derivatives_are_central_differences_of_the_generated_dynamics(planar, p
 
 
 def test_derivatives_are_jax_jacfwd_of_the_generated_jax_dynamics(planar):
-    jax = pytest.importorskip("jax")
+    jax = need("jax")
     jax.config.update("jax_enable_x64", True)
     model, calls, modules = planar
     if "jax" not in modules:
@@ -203,7 +204,7 @@ def _bundled(name):
                                   robots.puma, robots.ur5],
                          ids=["planar_2link", "stanford_rrp (prismatic)", "puma560", "ur5"])
 def test_derivatives_agree_with_pinocchio(make, tmp_path):
-    pytest.importorskip("pinocchio")
+    need("pinocchio")
     worst = _pinocchio_agreement(make(), tmp_path)
     assert len(worst) == 9 and max(worst.values()) <= 1e-10, worst
 
@@ -215,7 +216,7 @@ def test_panda_derivatives_agree_with_pinocchio_in_numpy_and_the_fast_module(tmp
     the clones are the same code, checked against NumPy below on the planar arm)."""
     from eomgen.codegen.backends import fast_backend
 
-    pytest.importorskip("pinocchio")
+    need("pinocchio")
     monkeypatch.setattr(fast_backend, "FMA_CLONE_OPERATIONS", float("inf"))
     worst = _pinocchio_agreement(robots.panda(), tmp_path, backends=("numpy", "fast"))
     assert len(worst) == 18 and max(worst.values()) <= 1e-10, worst

@@ -20,6 +20,7 @@ from eomgen.model import Actuator
 from support import robots
 from support.generated import generated
 from support.reference import pin_q_order, to_pinocchio
+from support.extras import need
 
 FUNCTIONS = ["drive_inverse_dynamics_derivatives", "drive_forward_dynamics_derivatives",
              "drive_inverse_dynamics"]
@@ -29,7 +30,7 @@ FUNCTIONS = ["drive_inverse_dynamics_derivatives", "drive_forward_dynamics_deriv
 def driven(tmp_path_factory):
     """The PUMA 560 with armature, viscous and Coulomb friction on every joint, its NumPy
     module, the drive values and Pinocchio's model with the same armature."""
-    pytest.importorskip("pinocchio")
+    need("pinocchio")
     model = robots.puma()
     n = model.dof
     a, d = 0.1 + 0.1 * np.arange(n), 0.2 + 0.05 * np.arange(n)

@@ -22,8 +22,10 @@ import eomgen
 from eomgen.model import joint_actuators
 from eomgen.quaternion_joints import integrate
 from support.generated import BACKENDS, generated
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio", reason="checked against Pinocchio's derivatives")
+pin = need("pinocchio", reason="checked against Pinocchio's derivatives")
+need("mujoco", reason="the models are MJCF, read by MuJoCo's compiler")
 
 GRAVITY = np.array([0.3, -0.2, -9.81])
 DRIVE = 'armature="{a}" damping="{d}" frictionloss="{f}"'

@@ -26,8 +26,10 @@ from eomgen.numeric.loops import pinocchio_loops
 from eomgen.numeric.pinocchio import to_pinocchio
 from support.generated import generated
 from support.held import pinocchio_constrained_derivatives
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio", reason="checked against Pinocchio's constraint dynamics")
+pin = need("pinocchio", reason="checked against Pinocchio's constraint dynamics")
+need("mujoco", reason="the models are MJCF, read by MuJoCo's compiler")
 
 DERIVATIVES = "constrained_forward_dynamics_derivatives"
 #: a crank and rod (c1 about z, c2 about y) pinned to a rocker (r1 about z, r2 about x)

@@ -20,8 +20,9 @@ from support import erd_robots_or_skip
 from support.held import (constrained_central_differences, held_robot,
                           pinocchio_constrained_derivatives)
 from test_constrained_derivatives import DERIVATIVES, leg, states
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio", reason="checked against Pinocchio's derivatives")
+pin = need("pinocchio", reason="checked against Pinocchio's derivatives")
 
 NAMES = ("dqdd_dq", "dqdd_dqd", "dqdd_dtau", "dF_dq", "dF_dqd", "dF_dtau")
 
@@ -72,7 +73,7 @@ def test_surface_contact_derivatives_are_central_differences(case):
 
 @pytest.mark.slow  # the leg derived again, with the CasADi module (~4 s)
 def test_casadi_composes_the_surface_contact_derivatives(tmp_path):
-    pytest.importorskip("casadi")
+    need("casadi")
     _, modules, pm, _ = floating_leg(tmp_path, ("numpy", "casadi"))
     function = modules["casadi"][DERIVATIVES]
     for q, v, tau in states(pm, 1, seed=8):

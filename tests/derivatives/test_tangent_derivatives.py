@@ -18,8 +18,10 @@ import pytest
 import eomgen
 from eomgen.quaternion_joints import integrate
 from support.generated import generated
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio", reason="checked against Pinocchio's derivatives")
+pin = need("pinocchio", reason="checked against Pinocchio's derivatives")
+need("mujoco", reason="the models are MJCF, read by MuJoCo's compiler")
 
 GRAVITY = np.array([0.3, -0.2, -9.81])
 #: a ball shoulder off its body's origin, a hinge elbow about a general axis (NQ 5, NV 4)

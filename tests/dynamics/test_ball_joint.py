@@ -20,8 +20,9 @@ from eomgen.quaternion_joints import difference, integrate, neutral
 from support import relative
 from support.generated import generated
 from support.reference import pinocchio_free_motion, random_inertial, random_rotation
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio", reason="ball joints are checked against Pinocchio")
+pin = need("pinocchio", reason="ball joints are checked against Pinocchio")
 
 #: A chain with two ball joints mid-chain and a branch: (name, type, parent joint index).
 CHAIN = (("j0", "revolute", -1), ("ball", "spherical", 0), ("j2", "prismatic", 1),
@@ -380,7 +381,7 @@ def test_simulate_a_ball_joint_keeps_energy_and_follows_pinocchio():
     """eomgen.analysis.simulate integrates a ball joint's quaternion (q̇ from
     configuration_rate): RK4 keeps the energy, and the final state is Pinocchio's (aba and
     integrate, integrated by SciPy's DOP853)."""
-    pytest.importorskip("scipy", reason="the reference trajectory is SciPy's DOP853")
+    need("scipy", reason="the reference trajectory is SciPy's DOP853")
     from eomgen.analysis.simulate import RK4, System, energies, simulate
     model, pm = robots(CHAIN[:2], seed=29)
     system = System(model)

@@ -33,6 +33,7 @@ from eomgen.robots import example_path
 from eomgen.symbolic.evaluate import compile_program
 from support import assert_close, erd_robots_dir
 from support.reference import random_robot, to_pinocchio
+from support.extras import need
 
 RTOL = 1e-10
 _COMPILED: dict = {}
@@ -253,7 +254,7 @@ def erd_dynamics(name: str, locked: tuple = ()) -> Dynamics:
 
 @pytest.mark.parametrize("name", sorted(ARMS))
 def test_arm_matches_pinocchio(name):
-    pin = pytest.importorskip("pinocchio")
+    pin = need("pinocchio")
     dyn = erd_dynamics(name)
     pmodel = pin.buildModelFromUrdf(str(erd_path(name)))
     assert dyn.joint_names == tuple(pmodel.names[1:])  # chains: the same order
@@ -262,7 +263,7 @@ def test_arm_matches_pinocchio(name):
 
 @pytest.mark.parametrize("fingers", [(0.0, 0.0), (0.01, 0.035)], ids=["closed", "open"])
 def test_panda_with_locked_fingers_matches_reduced_pinocchio(fingers):
-    pin = pytest.importorskip("pinocchio")
+    pin = need("pinocchio")
     dyn = erd_dynamics("panda", tuple(zip(FINGERS, fingers)))
     assert dyn.joint_names == tuple(f"panda_joint{k}" for k in range(1, 8))
     full = pin.buildModelFromUrdf(str(erd_path("panda")))
@@ -329,7 +330,7 @@ def test_random_robots_cover_the_features():
 
 @pytest.mark.parametrize("case", RANDOM, ids=random_id)
 def test_random_robot_matches_pinocchio(case):
-    pytest.importorskip("pinocchio")
+    need("pinocchio")
     dyn = random_dynamics(case)
     compare_with_pinocchio(dyn, PinocchioReference(dyn.model, to_pinocchio(dyn.model)),
                            seed=case[0] + 100)

@@ -19,6 +19,7 @@ from eomgen.model import Inertial, Joint, JointType, Link, build_model, vec3
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support.robots import SOLO, FreeFlyerReference
+from support.extras import need
 
 TALOS = "talos_data/robots/talos_reduced.urdf"
 LEGS = ("leg_left_6_link", "leg_right_6_link")
@@ -26,7 +27,7 @@ LEGS = ("leg_left_6_link", "leg_right_6_link")
 
 @pytest.fixture(scope="module")
 def solo():
-    pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
+    need("pinocchio", reason="Pinocchio is the reference")
     robots = erd_robots_dir()
     if robots is None:
         pytest.skip("example-robot-data is not installed")
@@ -70,7 +71,7 @@ def test_solo12_symbolic_derivation_matches_pinocchio(solo):
 
 
 def test_talos_legs_scene_matches_pinocchio():
-    pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
+    need("pinocchio", reason="Pinocchio is the reference")
     if erd_robots_dir() is None:
         pytest.skip("example-robot-data is not installed")
     path = erd_robots_dir() / TALOS

@@ -18,8 +18,9 @@ from eomgen.free_flyer import add_free_flyer, difference, integrate, neutral
 from support import relative
 from support.generated import generated
 from support.reference import massive_tree as floating_tree, pinocchio_free_motion, to_urdf
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio", reason="the free flyer is checked against Pinocchio")
+pin = need("pinocchio", reason="the free flyer is checked against Pinocchio")
 
 FUNCTIONS = ("M", "C", "g", "tau", "h", "qdd_aba", "forward_dynamics")
 

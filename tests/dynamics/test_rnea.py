@@ -42,8 +42,9 @@ from support.reference import (
     to_urdf,
 )
 from support import uniform_states
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio")
+pin = need("pinocchio")
 
 RTOL = 1e-10
 
@@ -484,7 +485,7 @@ def test_one_rnea_in_float64_and_mpmath(robot, erd_robots_dir):
     numbers at 50 digits (eomgen.analysis.precision.MPMATH) it gives the float64 result to
     rounding (~1e-14 relative), and the mpmath values really carry more than double
     precision (the float64 run is not what the mpmath run computes)."""
-    mpmath = pytest.importorskip("mpmath", reason="the mpmath number type needs mpmath")
+    mpmath = need("mpmath", reason="the mpmath number type needs mpmath")
     import eomgen
     from eomgen.analysis.precision import MPMATH
     from eomgen.errors import UnsupportedFeatureWarning

@@ -16,8 +16,9 @@ from support import relative
 from support.generated import generated
 from support.reference import massive_tree as floating_tree, to_urdf
 from support.robots import ur5
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio", reason="task-space quantities are checked against "
+pin = need("pinocchio", reason="task-space quantities are checked against "
                           "Pinocchio")
 
 FUNCTIONS = ("operational_space_inertia", "operational_space_bias",

@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 
 from support import run_in_process, write
+from support.extras import need
 
-pytest.importorskip("scipy", reason="identification needs scipy (pip install 'eomgen[identify]')")
+need("scipy", reason="identification needs scipy")
 
 #: ``<dynamics damping friction>`` of the arm's joints: FV, FC per joint.
 DAMPING = {"FV1": 0.8, "FV2": 0.3}

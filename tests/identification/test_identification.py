@@ -24,8 +24,9 @@ from eomgen.parsers.urdf import JointLimit, joint_limits
 from eomgen.regressor import base_parameters, derive_regressor
 
 from support import ROOT, erd_robots_dir, run_in_process
+from support.extras import need
 
-pytest.importorskip("scipy", reason="identification needs scipy (pip install 'eomgen[identify]')")
+need("scipy", reason="identification needs scipy")
 
 PUMA = eomgen.example_path("puma560_dh")
 PLANAR = eomgen.example_path("planar_2link")
@@ -305,8 +306,7 @@ def test_pseudo_inertia_is_psd_exactly_for_physical_bodies():
 
 
 def test_physical_fit_returns_psd_pseudo_inertias():
-    pytest.importorskip("cvxpy", reason="the physically consistent fit needs cvxpy "
-                                        "(pip install 'eomgen[identify]')")
+    need("cvxpy", reason="the physically consistent fit is an SDP")
     model, reg, base, _ = setup("puma560_dh")
     data, W, beta = simulated("puma560_dh", 200, noise=0.01, seed=1)
     est = weighted_least_squares(W, data.tau)
@@ -332,8 +332,7 @@ def test_physical_fit_returns_psd_pseudo_inertias():
 def test_physical_fit_of_a_physical_robot_keeps_the_estimate():
     """τ = W β(π) for a random π whose pseudo-inertias are positive definite, 1 % noise: the
     constrained fit lands within 3 std of the truth, as the unconstrained one does."""
-    pytest.importorskip("cvxpy", reason="the physically consistent fit needs cvxpy "
-                                        "(pip install 'eomgen[identify]')")
+    need("cvxpy", reason="the physically consistent fit is an SDP")
     model, reg, base, _ = setup("puma560_dh")
     _, W, _ = simulated("puma560_dh", 200)
     rng = np.random.default_rng(3)
@@ -360,7 +359,7 @@ def test_physical_fit_of_a_physical_robot_keeps_the_estimate():
 
 @pytest.mark.slow
 def test_excite_then_identify_puma(tmp_path):
-    pytest.importorskip("cvxpy", reason="--physical needs cvxpy (pip install 'eomgen[identify]')")
+    need("cvxpy", reason="--physical needs cvxpy")
     data = tmp_path / "puma.csv"
     result = run_in_process("excite", PUMA, "-o", data, "--samples", 150, "--noise", 0.01,
                          "--quiet")

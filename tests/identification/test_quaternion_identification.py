@@ -25,9 +25,10 @@ from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import relative, run_cli, write
 from support.quaternion import HOPPER, HOPPER_SCENE as SCENE
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio", reason="the data come from Pinocchio")
-pytest.importorskip("scipy", reason="identification needs scipy (pip install 'eomgen[identify]')")
+pin = need("pinocchio", reason="the data come from Pinocchio")
+need("scipy", reason="identification needs scipy")
 
 ARMATURE, DAMPING, FRICTION = 0.05, 0.3, 0.4
 

@@ -21,6 +21,7 @@ from eomgen.loops import LoopDynamics
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import ROOT, relative, run_cli
+from support.extras import need
 
 ROBOT = ROOT / "examples/robots/fivebar.yaml"
 SCENE = ROOT / "examples/loops/fivebar_elbow_held.yaml"
@@ -35,7 +36,7 @@ def model():
 def _pinocchio_dynamics(model, q0):
     """``(q, v) -> (q̈, lambda_c)`` of Pinocchio holding the loop and the elbow at its place at
     ``q0`` (eomgen's joint order), with Pinocchio's order of the constraint rows."""
-    pin = pytest.importorskip("pinocchio")
+    pin = need("pinocchio")
     from eomgen.numeric.loops import pinocchio_loops
     from eomgen.numeric.pinocchio import to_pinocchio
 
@@ -61,7 +62,7 @@ def _pinocchio_dynamics(model, q0):
 
 
 def test_simulation_matches_pinocchio(model):
-    pytest.importorskip("scipy")
+    need("scipy")
     from eomgen.analysis.simulate import integrators_named, simulate
     from eomgen.analysis.simulate_loops import (HeldContacts, LoopSystem, consistent_start,
                                                 dependent)
@@ -117,7 +118,7 @@ def test_baumgarte_pulls_the_contact_back_critically_damped(model, surface):
     contact (position and angle), 2.5 mm and 0.024 rad away. With kp = 100, kd = 20 each error
     follows ë + kd ė + kp e = 0 from rest, e0 (1 + ωt) e^{−ωt} with ω = 10 rad/s; without
     Baumgarte it stays (the contact holds the frame where it is)."""
-    pytest.importorskip("scipy")
+    need("scipy")
     from eomgen.analysis.simulate import integrators_named, simulate
     from eomgen.analysis.simulate_loops import HeldContacts, LoopSystem, consistent_start
 
@@ -142,8 +143,8 @@ def test_baumgarte_pulls_the_contact_back_critically_damped(model, surface):
 
 
 def test_simulate_command_reports_loop_and_contact_drift(tmp_path):
-    pytest.importorskip("scipy")
-    pytest.importorskip("matplotlib")
+    need("scipy")
+    need("matplotlib")
     result = run_cli("simulate", ROBOT, "--scene", SCENE, "--q0", ",".join(map(str, Q0)),
                      "--qd0", ",".join(map(str, QD0)), "--duration", "0.3", "--integrators",
                      "rk4", "--dt", "0.002", "--quiet", "-o", tmp_path)

@@ -6,13 +6,13 @@ Its soft, iteratively solved constraint forces are not compared (docs/loops.md).
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 import eomgen
 from eomgen.loops import LoopDynamics
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import ROOT
+from support.extras import need
 
 FOURBAR_MJCF = """<mujoco><option gravity="0 -9.81 0" jacobian="dense"><flag contact="disable"/></option><worldbody>
 <body name="crank"><joint name="crank_joint" type="hinge" axis="0 0 1"/>
@@ -26,7 +26,7 @@ FOURBAR_MJCF = """<mujoco><option gravity="0 -9.81 0" jacobian="dense"><flag con
 
 
 def test_loop_jacobian_is_mujoco_connect_efc_J():
-    mujoco = pytest.importorskip("mujoco")
+    mujoco = need("mujoco")
     m = mujoco.MjModel.from_xml_string(FOURBAR_MJCF)
     d = mujoco.MjData(m)
     text = (ROOT / "examples/loops/fourbar_loop.yaml").read_text().replace(

@@ -15,6 +15,7 @@ from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import ROOT, relative
 from support.generated import generated
+from support.extras import need
 
 ROBOT = ROOT / "examples/robots/fivebar.yaml"
 SCENE = ROOT / "examples/loops/fivebar_loop.yaml"
@@ -33,7 +34,7 @@ def _motions(model, count=3, seed=4):
     """Closed states near the five-bar's working pose (velocities on the loop), motor efforts
     alone (the passive joints' zero), and the q̈ and loop force Pinocchio's constraintDynamics
     gives them (λ on frame b in world axes: −R_a λ_pin, in the plane)."""
-    pin = pytest.importorskip("pinocchio")
+    pin = need("pinocchio")
     from eomgen.numeric.loops import pinocchio_loops
     from eomgen.numeric.pinocchio import to_pinocchio
 
@@ -106,7 +107,7 @@ def test_every_python_backend_against_pinocchio_and_numpy(fivebar):
 
 def test_casadi_c_library(fivebar, tmp_path):
     """The C backend's shared library (CasADi's code generator) exports it too."""
-    casadi = pytest.importorskip("casadi")
+    casadi = need("casadi")
     from eomgen.codegen.functions import select_functions
     from eomgen.codegen.generate import render_files
     from eomgen.compiler import c_compiler

@@ -21,6 +21,7 @@ from eomgen.loops import LoopDynamics
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import ROOT, relative
+from support.extras import need
 
 ROBOTS = {"fivebar": ("fivebar_loop", [1.2, 1.0, 1.9, -1.0]),
           "delta": ("delta_loops", [0.3, 2.13, 0.0] * 3 + [0.0, 0.0, -0.35])}
@@ -55,7 +56,7 @@ def _states(dyn, q0, count=2, seed=0):
 
 
 def test_against_pinocchio_constraint_dynamics(robot):
-    pin = pytest.importorskip("pinocchio")
+    pin = need("pinocchio")
     from eomgen.numeric.loops import pinocchio_loops
     from eomgen.numeric.pinocchio import to_pinocchio
 
@@ -154,7 +155,7 @@ def test_planar_weld_against_pinocchio_6d():
     """The five-bar's distal links welded in the plane (rows u, v, rn: 3 of 4 joints held):
     against Pinocchio's CONTACT_6D between them, whose 3 out-of-plane rows are dependent (a
     proximal mu), q̈ and the in-plane force and moment."""
-    pin = pytest.importorskip("pinocchio")
+    pin = need("pinocchio")
     from eomgen.model import WELD, Loop, LoopFrame, Transform, mat3, vec3
     from eomgen.numeric.loops import pinocchio_loops
     from eomgen.numeric.pinocchio import to_pinocchio

@@ -17,6 +17,7 @@ from eomgen.loops import LoopDynamics
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import ROOT, relative
+from support.extras import need
 
 ROBOT = ROOT / "examples/robots/fourbar.yaml"
 SCENE = ROOT / "examples/loops/fourbar_loop.yaml"
@@ -62,7 +63,7 @@ def test_damped_kkt_of_the_redundant_hinge_is_the_planar_loop(loops, tmp_path):
 
 
 def test_simulate_solves_the_redundant_loop_damped(loops):
-    pytest.importorskip("scipy")
+    need("scipy")
     from eomgen.analysis.simulate import integrators_named, simulate
     from eomgen.analysis.simulate_contacts import DEPENDENT_DAMPING
     from eomgen.analysis.simulate_loops import LoopSystem, run_loop_study

@@ -6,19 +6,19 @@ report."""
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 import eomgen
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import ROOT, run_cli
+from support.extras import need
 
 ROBOT = ROOT / "examples/robots/fourbar.yaml"
 SCENE = ROOT / "examples/loops/fourbar_loop.yaml"
 
 
 def test_energy_is_conserved_and_the_loop_held():
-    pytest.importorskip("scipy")
+    need("scipy")
     from eomgen.analysis.simulate import integrators_named
     from eomgen.analysis.simulate_loops import run_loop_study
 
@@ -34,8 +34,8 @@ def test_energy_is_conserved_and_the_loop_held():
 
 
 def test_simulate_command_reports_loop_drift(tmp_path):
-    pytest.importorskip("scipy")
-    pytest.importorskip("matplotlib")
+    need("scipy")
+    need("matplotlib")
     result = run_cli("simulate", ROBOT, "--scene", SCENE, "--duration", "0.1", "--integrators",
                      "rk4", "--dt", "0.005", "--quiet", "-o", tmp_path)
     assert result.exit_code == 0, result.output

@@ -18,6 +18,7 @@ from eomgen.loops import LoopDynamics
 from eomgen.model import HINGE, WELD, Loop, LoopFrame, Transform, mat3, vec3
 from eomgen.symbolic.frames import derive_frames
 from eomgen.symbolic.loops import plane_axes
+from support.extras import need
 
 ARMS = """name: two_arms
 gravity: [0, 0, -9.81]
@@ -88,7 +89,7 @@ def test_the_chain_is_closed_at_q_star(chains):
 
 
 def test_weld_against_pinocchio_6d(chains):
-    pin = pytest.importorskip("pinocchio")
+    pin = need("pinocchio")
     from eomgen.numeric.loops import pinocchio_loops
     from eomgen.numeric.pinocchio import to_pinocchio
 

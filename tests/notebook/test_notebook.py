@@ -14,6 +14,7 @@ from support import run_cli as run
 from eomgen.display import dynamics_latex, expression_latex, grouped_matrices
 from eomgen.symbolic.textbook import textbook_derivation
 from eomgen.notebook import build_notebook
+from support.extras import need
 
 
 @pytest.fixture(scope="module")
@@ -80,8 +81,8 @@ def test_scara_base_parameters_keep_the_description_symbols():
 def test_cli_notebook_runs_without_errors(tmp_path, example):
     """The notebooks of the bundled examples execute without a cell error (the 6-joint PUMA
     takes the large-model path: no textbook cells, summaries instead)."""
-    nbclient = pytest.importorskip("nbclient")
-    pytest.importorskip("ipykernel")
+    nbclient = need("nbclient")
+    need("ipykernel")
     path = tmp_path / "arm.ipynb"
     result = run("notebook", eomgen.example_path(example), "-o", path)
     assert result.exit_code == 0, result.output

@@ -9,6 +9,7 @@ import pytest
 
 import eomgen
 from eomgen.notebook import build_notebook
+from support.extras import need
 
 CHECK = "largest |Y_SL beta - (M qdd_r + C qd_r + g)|:"
 
@@ -26,8 +27,8 @@ def test_the_section_is_there_for_the_two_link_arm(notebook):
 
 @pytest.mark.slow
 def test_the_section_runs_and_its_check_holds(notebook, tmp_path):
-    nbclient = pytest.importorskip("nbclient")
-    pytest.importorskip("ipykernel")
+    nbclient = need("nbclient")
+    need("ipykernel")
     nb = nbformat.from_dict(notebook)
     nbclient.NotebookClient(nb, timeout=120, kernel_name="python3",
                             resources={"metadata": {"path": str(tmp_path)}}).execute()

@@ -13,6 +13,7 @@ import pytest
 import eomgen
 from eomgen.notebook import build_notebook
 from support import run_cli, write
+from support.extras import need
 
 PENDULUM = """name: pendulum
 links:
@@ -49,9 +50,9 @@ def test_notebook_states_the_chart_and_leaves_out_the_textbook(pendulum):
 
 @pytest.mark.slow
 def test_notebook_runs_and_agrees_with_pinocchio(pendulum, tmp_path):
-    nbclient = pytest.importorskip("nbclient")
-    pytest.importorskip("ipykernel")
-    pytest.importorskip("pinocchio")
+    nbclient = need("nbclient")
+    need("ipykernel")
+    need("pinocchio")
     out = tmp_path / "pendulum.ipynb"
     result = run_cli("notebook", pendulum[0], "-o", out)
     assert result.exit_code == 0, result.output

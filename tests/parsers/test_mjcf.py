@@ -22,8 +22,9 @@ import eomgen
 from eomgen.errors import UnknownFormatError, UnsupportedError, UnsupportedFeatureWarning
 from eomgen.model import joint_actuators
 from support import model_states, relative, run_cli
+from support.extras import need
 
-mujoco = pytest.importorskip("mujoco", reason="MJCF is read by MuJoCo's compiler")
+mujoco = need("mujoco", reason="MJCF is read by MuJoCo's compiler")
 
 from eomgen.numeric.newton_euler import link_poses, numeric_model  # noqa: E402
 from eomgen.parsers.mjcf import MujocoCompileError, compile_mjcf, is_mjcf  # noqa: E402

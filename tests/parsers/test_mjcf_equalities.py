@@ -21,8 +21,9 @@ import pytest
 import eomgen
 from eomgen.errors import KinematicTreeError
 from support import load_quietly, model_states, relative
+from support.extras import need
 
-mujoco = pytest.importorskip("mujoco", reason="MJCF is read by MuJoCo's compiler")
+mujoco = need("mujoco", reason="MJCF is read by MuJoCo's compiler")
 
 from eomgen.parsers.mjcf import compile_mjcf  # noqa: E402
 from eomgen.parsers.mjcf.convert import (  # noqa: E402

@@ -22,8 +22,9 @@ from eomgen.loops import kkt_solve
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import relative, run_cli
+from support.extras import need
 
-mujoco = pytest.importorskip("mujoco", reason="MJCF is read by MuJoCo's compiler")
+mujoco = need("mujoco", reason="MJCF is read by MuJoCo's compiler")
 
 from eomgen.parsers.mjcf import compile_mjcf  # noqa: E402
 from eomgen.parsers.mjcf.convert import (  # noqa: E402

@@ -16,6 +16,7 @@ from eomgen.analysis.routes import compile_batch
 from eomgen.dynamics import derive
 from eomgen.model import SNAP_TOLERANCE, snap_summary
 from support import run_in_process
+from support.extras import need
 
 ANGLE = 1.57079632679  # π/2 to 11 decimals: cos is 4.9e-12, snapped to 0
 
@@ -72,7 +73,7 @@ def test_no_snap_keeps_the_floats_exactly(bent):
 
 
 def test_ur5_without_snapping_agrees_with_pinocchio_to_1e_14(erd_robots_dir):
-    pin = pytest.importorskip("pinocchio", reason="Pinocchio is the independent reference")
+    pin = need("pinocchio", reason="Pinocchio is the independent reference")
     path = erd_robots_dir / "ur_description/urdf/ur5_robot.urdf"
     model = pin.buildModelFromUrdf(str(path))
     data = model.createData()

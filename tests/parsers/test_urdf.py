@@ -32,6 +32,7 @@ from eomgen.model import JointType, Notice, NoticeKind, RobotModel, Transform, e
 from eomgen.parsers.urdf import LEG_REACH, load_urdf, parse_urdf_string, rotate_inertia
 from eomgen.reduction import load_for_scene
 from eomgen.scene import Scene
+from support.extras import need
 
 #: Arms of example-robot-data (paths below its robots/ folder) and whether they use <mimic>.
 ARMS = [
@@ -58,7 +59,7 @@ TOL = 1e-10
 
 @pytest.fixture(scope="module")
 def pin():
-    return pytest.importorskip("pinocchio")
+    return need("pinocchio")
 
 
 # ----------------------------------------------------------------------------------------------

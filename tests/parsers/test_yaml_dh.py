@@ -28,6 +28,7 @@ from eomgen.errors import (
 from eomgen.model import JointType, RobotModel, parameter_symbol
 from eomgen.parsers import _yaml, dh, yaml_format
 from eomgen.robots import DEFAULT, EXAMPLES, example_path
+from support.extras import need
 
 DOCS = ROOT / "docs" / "formats.md"
 
@@ -127,7 +128,7 @@ def num(x: float) -> str:
 
 
 def pinocchio_model(model: RobotModel):
-    pin = pytest.importorskip("pinocchio")
+    pin = need("pinocchio")
     model = model.with_numeric_parameters() if model.free_symbols else model
     pm = pin.Model()
     pm.gravity.linear = np.array(model.gravity, dtype=float)

@@ -21,8 +21,9 @@ from support import relative
 from support.generated import generated
 from support.quaternion import (body_columns, pinocchio_parameters, pinocchio_states,
                                 quaternion_robot)
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio", reason="quaternion joints are checked against Pinocchio")
+pin = need("pinocchio", reason="quaternion joints are checked against Pinocchio")
 
 FUNCTIONS = ("Y_SL", "Y_SL_base", "Y", "pi", "beta", "Y_K", "Y_P")
 KNEE = Actuator(armature=0.3, damping=0.4, friction=0.2, friction_width=0.5)

@@ -21,6 +21,7 @@ from eomgen.regressor import (base_parameters, derive_regressor, identify, regre
                               symbolic_base_parameters)
 from eomgen.symbolic.textbook import fourier_form
 from support.reference import pin_q_order, planar_2link_by_hand, random_robot, to_pinocchio
+from support.extras import need
 
 URDF = {
     "ur5": "ur_description/urdf/ur5_robot.urdf",
@@ -114,7 +115,7 @@ def test_unknown_actuator_term_is_refused():
 
 @pytest.mark.parametrize("name", ["ur5", "panda", "random_tree"])
 def test_Y_equals_pinocchio_column_by_column(name):
-    pin = pytest.importorskip("pinocchio")
+    pin = need("pinocchio")
     reg = regressor(name)
     if name in URDF:
         pmodel = pin.buildModelFromUrdf(str(erd_robots_dir() / URDF[name]))

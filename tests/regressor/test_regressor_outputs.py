@@ -19,6 +19,7 @@ from eomgen.errors import UnsupportedFeatureWarning
 from eomgen.numeric import kinetic_energy, numeric_model, potential_energy, rnea
 from support.generated import BACKENDS, generated as generate_all
 from support.reference import pin_q_order
+from support.extras import need
 
 FUNCTIONS = ("regressor", "inertial_parameters", "base_regressor", "base_parameters",
              "kinetic_energy_regressor", "potential_energy_regressor", "inverse_dynamics")
@@ -132,7 +133,7 @@ def load_urdf(relative: str):
 
 
 def test_ur5_regressor_is_pinocchios_column_by_column(tmp_path):
-    pin = pytest.importorskip("pinocchio")
+    pin = need("pinocchio")
     model, path = load_urdf("ur_description/urdf/ur5_robot.urdf")
     calls, modules = generated(model, ("numpy", "casadi"), tmp_path)
     pmodel = pin.buildModelFromUrdf(str(path))

@@ -15,8 +15,9 @@ from support import random_states, rng_of
 from support.generated import BACKENDS, generated
 from support.reference import pin_q_order, random_robot, to_pinocchio
 from support.robots import ur5
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio")
+pin = need("pinocchio")
 
 FUNCTIONS = ("slotine_li_regressor", "slotine_li_base_regressor", "regressor",
              "inertial_parameters", "base_parameters")

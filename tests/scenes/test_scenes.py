@@ -33,6 +33,7 @@ from eomgen.scene import PLANNED_KEYS, SCENE_KEYS, Scene, load_scene
 from eomgen.symbolic.evaluate import compile_program
 from support import ROOT, assert_close, erd_robots_dir, run_process
 from support.reference import random_robot, to_pinocchio
+from support.extras import need
 
 SCENES = ROOT / "examples" / "scenes"
 RTOL = 1e-10
@@ -146,7 +147,7 @@ class Compared:
 
 
 def compare_example(name: str, seed: int) -> Reduction:
-    pin = pytest.importorskip("pinocchio")
+    pin = need("pinocchio")
     model = erd_model(EXAMPLES[name])
     scene = load_scene(SCENES / f"{name}.yaml")
     reduction = apply_scene(model, scene)
@@ -284,7 +285,7 @@ def with_payload(text: str, model: RobotModel, rng: np.random.Generator) -> str:
 
 @pytest.mark.parametrize("seed", range(6))
 def test_random_trees_with_random_locks_equal_pinocchio(seed):
-    pytest.importorskip("pinocchio")
+    need("pinocchio")
     rng = np.random.default_rng(100 + seed)
     model = random_robot(rng, int(rng.integers(3, 7)), tree=True)
     try:
@@ -300,7 +301,7 @@ def test_random_trees_with_random_locks_equal_pinocchio(seed):
 
 
 def test_random_chain_with_base_and_tip_in_the_middle():
-    pytest.importorskip("pinocchio")
+    need("pinocchio")
     model = random_robot(np.random.default_rng(7), 6, tree=False, fixed_links=True)
     chain = [j for j in model.topological_joints if j.type.is_movable]
     base, tip = chain[1].child, chain[4].child

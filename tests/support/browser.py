@@ -27,6 +27,8 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from .extras import install_hint
+
 CHROMIUM = Path("/usr/bin/chromium")
 CHROMEDRIVER = Path("/usr/bin/chromedriver")
 
@@ -65,11 +67,11 @@ def chromium_available() -> str | None:
         if not os.access(path, os.X_OK):
             return (f"{path} not found (install the Debian package {package}: "
                     f"apt-get install --no-install-recommends chromium chromium-driver)")
-    for module, requirement in (("selenium", "selenium>=4.10"), ("PIL", "pillow")):
+    for module in ("selenium", "PIL"):
         try:
             __import__(module)
         except ImportError:
-            return f"Python package {requirement} not installed (pip install -e '.[test]')"
+            return f"{module} is not installed ({install_hint(module)})"
     return None
 
 

@@ -13,13 +13,13 @@ from __future__ import annotations
 
 
 import numpy as np
-import pytest
 
 import eomgen
 from eomgen.codegen.functions import select_functions
 from eomgen.numeric import M_rnea, numeric_model, rnea
 from support.generated import generated
 from support.reference import pin_q_order, random_robot, to_pinocchio
+from support.extras import need
 
 FUNCTIONS = select_functions(["qdd_aba", "h", "forward_dynamics"])
 
@@ -33,7 +33,7 @@ def load_modules(model, folder):
 
 
 def test_aba_and_nonlinear_effects_agree_with_pinocchio_in_every_backend(tmp_path):
-    pin = pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
+    pin = need("pinocchio", reason="Pinocchio is the reference")
     model = random_robot(np.random.default_rng(4), 5, tree=True)
     pmodel = to_pinocchio(model)
     data = pmodel.createData()

@@ -16,6 +16,7 @@ from eomgen.errors import KinematicTreeError
 from eomgen.symbolic.frames import derive_frames, frame_site
 from support import floating_states, load_quietly
 from support.robots import SOLO, FreeFlyerReference
+from support.extras import need
 
 FEET = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
 
@@ -61,7 +62,7 @@ def test_jacobians_are_finite_differences_of_the_poses(solo):
 
 
 def test_frames_match_pinocchio(solo):
-    pin = pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
+    pin = need("pinocchio", reason="Pinocchio is the reference")
     path, model, fk = solo
     ref = FreeFlyerReference(path, model.joint_names)
     pm, pd, idx = ref.model, ref.data, ref.idx
@@ -122,7 +123,7 @@ def test_frame_positions_of_a_tree_whose_first_joint_is_offset():
     """A fixed-base tree whose first moving joint sits away from the root origin: the frame
     origins are world positions (Pinocchio's ``oMf``), not positions from that joint (the
     world-frame kinematics' reference point; a bug until the free flyer's frames showed it)."""
-    pin = pytest.importorskip("pinocchio", reason="Pinocchio is the reference")
+    pin = need("pinocchio", reason="Pinocchio is the reference")
     from support.reference import pin_q_order, random_robot, to_pinocchio
     model = random_robot(np.random.default_rng(5), 3, tree=True)
     assert any(v != 0 for v in model.joints[0].origin.translation)

@@ -18,6 +18,7 @@ from eomgen.symbolic.evaluate import FloatPrinter, compile_program
 from eomgen.symbolic.printing import FloatLiteralMixin, ordered_terms, print_program, renamed
 from eomgen.symbolic.program import Program
 from support.expressions import X, Z, random_expressions
+from support.extras import need
 
 #: Every code backend's registered printer (the registry: a new backend is tested too), and
 #: the printers of the numeric routes.
@@ -117,7 +118,7 @@ def test_every_evaluator_of_a_program_agrees_with_sympy():
     """compile_program (NumPy scalars), compile_scalar (math, flat), compile_batch (arrays)
     and the mpmath reference all print the program with print_program; each equals SymPy's
     evaluation of the expanded outputs."""
-    mpmath = pytest.importorskip("mpmath", reason="the mpmath reference needs mpmath")
+    mpmath = need("mpmath", reason="the mpmath reference needs mpmath")
     from eomgen.analysis.precision import compile_program_mp
 
     program, inputs, exact = _small_program()

@@ -31,6 +31,7 @@ from eomgen.symbolic.opcount import count_node, module_operation_counts, program
 from support import ROOT, assert_close
 from support.reference import pin_q_order, random_robot, to_pinocchio
 from support.robots import panda, puma
+from support.extras import need
 
 RTOL = 1e-10
 
@@ -138,7 +139,7 @@ def test_aba_program_solves_the_numeric_equations_of_motion(case):
 
 
 def test_aba_program_matches_pinocchio_aba_on_the_panda():
-    pin = pytest.importorskip("pinocchio")
+    pin = need("pinocchio")
     model = panda()
     pmodel = to_pinocchio(model)
     data = pmodel.createData()
@@ -198,7 +199,7 @@ def test_crba_program_is_exactly_the_lagrangian_mass_matrix():
 
 
 def test_crba_program_matches_pinocchio_crba_on_the_panda():
-    pin = pytest.importorskip("pinocchio")
+    pin = need("pinocchio")
     model = panda()
     pmodel = to_pinocchio(model)
     data = pmodel.createData()

@@ -16,8 +16,9 @@ import eomgen
 from eomgen.present import notation as nt
 from eomgen.teach.content import HANDOUT_CONFIG, named_coriolis
 from eomgen.teach.control import slotine_li_equations
+from support.extras import need
 
-pin = pytest.importorskip("pinocchio")
+pin = need("pinocchio")
 
 TITLE = "Adaptive control: the Slotine–Li regressor"
 

@@ -22,8 +22,9 @@ import eomgen
 from eomgen.teach.sketch import (
     SketchGeometry, render_sketch, sketch_figure, sketch_geometry, sketch_pose,
 )
+from support.extras import need
 
-pytest.importorskip("matplotlib")
+need("matplotlib")
 
 FORMATS = ("svg", "png", "pdf")
 TOL = 1e-12
@@ -114,7 +115,7 @@ def test_puma_is_not_planar(puma):
 
 
 def test_ur5_matches_pinocchio_frame_placements(erd_robots_dir):
-    pin = pytest.importorskip("pinocchio")
+    pin = need("pinocchio")
     path = erd_robots_dir / "ur_description" / "urdf" / "ur5_robot.urdf"
     model = load_quietly(path)
     pmodel = pin.buildModelFromUrdf(str(path))
@@ -250,7 +251,7 @@ def test_render_formats_have_their_signatures(planar):
 
 @pytest.mark.parametrize("which", ["planar", "puma"])
 def test_png_decodes_and_is_not_blank(which, request):
-    PIL = pytest.importorskip("PIL.Image")
+    PIL = need("PIL.Image")
     model = request.getfixturevalue(which)
     image = PIL.open(io.BytesIO(render_sketch(model, "png")))
     width, height = image.size
