@@ -141,16 +141,40 @@ def pytest_configure_node(node):
 # ----------------------------------------------------------------------------------------------
 # What skipped, for CI: `.ci/run` first runs the README's test command as a newcomer would (only
 # the `test` extra), then installs the other extras and system packages and runs what skipped.
-# With EOMGEN_SKIPPED_LOG set, the controller (not an xdist worker) writes the node ids of the
-# skipped tests and modules there, one a line, sorted.
+# With EOMGEN_SKIPPED_LOG set, every process (each xdist worker, and the controller) notes the
+# node ids of the tests and modules that skipped in it, and the controller writes them all there
+# at the end, one a line, sorted. (Each process keeps its own list: xdist forwards only one of the
+# module skips whose reasons read alike.)
 # ----------------------------------------------------------------------------------------------
+
+_SKIPPED: set[str] = set()
+
+
+def _note_skipped(report) -> None:
+    if os.environ.get("EOMGEN_SKIPPED_LOG") and report.skipped and report.nodeid \
+            and not hasattr(report, "wasxfail"):
+        _SKIPPED.add(report.nodeid)
+
+
+def pytest_collectreport(report):
+    _note_skipped(report)
+
+
+def pytest_runtest_logreport(report):
+    _note_skipped(report)
 
 
 def pytest_sessionfinish(session):
     path = os.environ.get("EOMGEN_SKIPPED_LOG")
-    if not path or hasattr(session.config, "workerinput"):
+    if not path:
         return
-    reporter = session.config.pluginmanager.get_plugin("terminalreporter")
-    reports = reporter.stats.get("skipped", []) if reporter is not None else []
-    skipped = sorted({r.nodeid for r in reports if r.nodeid and not hasattr(r, "wasxfail")})
-    Path(path).write_text("".join(f"{nodeid}\n" for nodeid in skipped), encoding="utf-8")
+    workerinput = getattr(session.config, "workerinput", None)
+    if workerinput is not None:   # a worker: its part, for the controller to gather
+        part = Path(f"{path}.{workerinput['workerid']}")
+        part.write_text("".join(f"{n}\n" for n in sorted(_SKIPPED)), encoding="utf-8")
+        return
+    for part in sorted(Path(path).parent.glob(Path(path).name + ".*")):
+        _SKIPPED.update(part.read_text(encoding="utf-8").split("\n"))
+        part.unlink()
+    _SKIPPED.discard("")
+    Path(path).write_text("".join(f"{n}\n" for n in sorted(_SKIPPED)), encoding="utf-8")

@@ -20,7 +20,7 @@ from eomgen.quaternion_joints import difference, integrate, neutral
 from support import relative
 from support.generated import generated
 from support.reference import pinocchio_free_motion, random_inertial, random_rotation
-from support.extras import need
+from support.extras import need, skip_backend
 
 pin = need("pinocchio", reason="ball joints are checked against Pinocchio")
 
@@ -192,7 +192,7 @@ def test_every_backend_equals_pinocchio(chain_backends, backend):
     """M, C, g, τ, h and both forward dynamics of a ball joint in every code backend."""
     _, pm, calls, _ = chain_backends
     if backend not in calls:
-        pytest.skip(f"the {backend} backend cannot be loaded here")
+        skip_backend(backend)
     call = calls[backend]
     for q, v, a in states(pm, count=1, seed=3):
         for function, inputs, value in expected(pm, q, v, a)[:7]:

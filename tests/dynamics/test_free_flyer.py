@@ -18,7 +18,7 @@ from eomgen.free_flyer import add_free_flyer, difference, integrate, neutral
 from support import relative
 from support.generated import generated
 from support.reference import massive_tree as floating_tree, pinocchio_free_motion, to_urdf
-from support.extras import need
+from support.extras import need, skip_backend
 
 pin = need("pinocchio", reason="the free flyer is checked against Pinocchio")
 
@@ -63,7 +63,7 @@ def test_layout_is_pinocchios(case):
 def test_dynamics_equal_pinocchio(case, backend):
     model, pm, calls, _ = case
     if backend not in calls:
-        pytest.skip(f"the {backend} backend cannot be loaded here")
+        skip_backend(backend)
     call, data = calls[backend], pm.createData()
     for q, v, a in states(pm):
         M = pin.crba(pm, data, q)

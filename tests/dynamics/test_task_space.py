@@ -16,7 +16,7 @@ from support import relative
 from support.generated import generated
 from support.reference import massive_tree as floating_tree, to_urdf
 from support.robots import ur5
-from support.extras import need
+from support.extras import need, skip_backend
 
 pin = need("pinocchio", reason="task-space quantities are checked against "
                           "Pinocchio")
@@ -55,7 +55,7 @@ def flyer(tmp_path_factory):
 def module_of(modules, backend):
     """``backend``'s module, its task-space functions returning NumPy arrays."""
     if backend not in modules:
-        pytest.skip(f"the {backend} module cannot be loaded here")
+        skip_backend(backend, "module")
     namespace = modules[backend]
 
     def as_numpy(function):

@@ -59,3 +59,15 @@ def need(module: str, reason: str | None = None) -> ModuleType:
     hint = install_hint(module)
     why = f"{reason} " if reason else ""
     return pytest.importorskip(module, reason=f"{why}(needs {module}: {hint})")
+
+
+#: Code backends whose generated modules import an optional module.
+BACKEND_MODULES = {"jax": "jax", "torch": "torch", "casadi": "casadi"}
+
+
+def skip_backend(backend: str, what: str = "backend") -> None:
+    """Skip the calling test because ``backend``'s module could not be loaded, saying why it
+    may not have: its extra (JAX, PyTorch) or, for the compiled ones, a C compiler."""
+    module = BACKEND_MODULES.get(backend)
+    why = install_hint(module) if module else "it needs a C compiler and Python's C headers"
+    pytest.skip(f"the {backend} {what} cannot be loaded here ({why})")
