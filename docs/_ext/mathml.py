@@ -8,6 +8,9 @@ line (an error under ``-W``), not a formula silently shown as source.
 
 from __future__ import annotations
 
+import html
+import re
+
 from docutils import nodes
 from sphinx.util import logging
 
@@ -18,12 +21,24 @@ logger = logging.getLogger(__name__)
 FORMAT = HtmlFormat()
 
 
+#: What latex2mathml writes, without an error, for LaTeX it does not know: an unknown command
+#: as an identifier (``<mi>\\foo</mi>``), the ``&`` of an alignment outside ``array`` or a
+#: matrix (``aligned`` is not supported) as a letter.
+UNREAD = re.compile(r"<mi>(\\[A-Za-z]+|&amp;|&)</mi>")
+
+
 def _render(translator, node, convert) -> None:
+    tex = node.astext()
     try:
-        translator.body.append(convert(node.astext()))
+        out = convert(tex)
+        unread = UNREAD.search(out)
+        if unread:
+            raise GenerationError(f"cannot convert {tex!r} to MathML: {html.unescape(unread.group(1))!r} "
+                                  "is not understood (an alignment needs \\begin{array})")
+        translator.body.append(out)
     except GenerationError as error:
         logger.warning("%s", error, location=node)
-        translator.body.append(translator.encode(node.astext()))
+        translator.body.append(translator.encode(tex))
     raise nodes.SkipNode
 
 

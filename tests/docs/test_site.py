@@ -82,9 +82,12 @@ def test_the_sidebar_names_each_page_once(site):
 def test_a_broken_link_or_formula_fails_the_build(tmp_path):
     """The build with warnings as errors is not a formality: the same configuration
     (``-c docs``) on a page with a link to a page that does not exist, or a formula the
-    converter cannot read, fails and names the page."""
+    converter cannot read (a syntax error, an alignment it does not know, an unknown command,
+    the last two of which latex2mathml itself lets through), fails and names the page."""
     for name, text in (("link", "See [the missing page](missing.md).\n"),
-                       ("formula", "The mass matrix $M(q) = \\frac{1}{$.\n")):
+                       ("formula", "The mass matrix $M(q) = \\frac{1}{$.\n"),
+                       ("alignment", "$$\n\\begin{aligned} a &= b \\end{aligned}\n$$\n"),
+                       ("command", "The mass matrix $\\Mass(q)$.\n")):
         source = tmp_path / name
         source.mkdir()
         (source / "index.md").write_text(f"# Home\n\n{text}", encoding="utf-8")
