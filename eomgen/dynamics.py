@@ -104,8 +104,9 @@ class Dynamics:
 
     @property
     def input_symbols(self) -> dict[str, tuple[sp.Symbol, ...]]:
-        """The symbols of each input vector of :data:`eomgen.outputs.INPUTS` (``q``: ``q1 …
-        qn``; ``tau``: ``tau1 … taun``, the joint efforts, for outputs taking them; ...)."""
+        """The symbols of each input vector of :data:`eomgen.outputs.INPUTS` by its name
+        (``q`` → ``q1 … qn``, ``tau`` → ``tau1 … taun`` the joint efforts for outputs taking
+        them, ...)."""
         return {"q": self.q, "qd": self.qd, "qdd": self.qdd, **dict(self.vectors)}
 
     @property

@@ -6,16 +6,16 @@ and the root link, so that the Lagrangian derivation (:func:`eomgen.derive`), th
 Newton–Euler reference (:mod:`eomgen.numeric`) and code generation work unchanged on true
 generalised coordinates (the approach of FROST):
 
-=========  ===========  =========================================================
- q index    joint        motion
-=========  ===========  =========================================================
- 0, 1, 2    base_x/y/z   prismatic along the world x, y, z axes: the root link origin
-                         ``p`` [m] in the world frame
- 3          base_yaw     revolute about z: yaw ψ [rad]
- 4          base_pitch   revolute about the new y: pitch θ [rad]
- 5          base_roll    revolute about the new x: roll φ [rad]
- 6 …        the robot's  in the description's order
-=========  ===========  =========================================================
+=========  ============  =========================================================
+ q index    joint         motion
+=========  ============  =========================================================
+ 0, 1, 2    base_x/y/z    prismatic along the world x, y, z axes: the root link origin
+                          ``p`` [m] in the world frame
+ 3          base_yaw      revolute about z: yaw ψ [rad]
+ 4          base_pitch    revolute about the new y: pitch θ [rad]
+ 5          base_roll     revolute about the new x: roll φ [rad]
+ 6 …        the robot's   in the description's order
+=========  ============  =========================================================
 
 so the root link's pose in the world is ``p`` and ``R = Rz(ψ) Ry(θ) Rx(φ)`` (ZYX Euler angles,
 intrinsic yaw–pitch–roll; the same R as URDF's ``rpy="φ θ ψ"``). The world frame is the old

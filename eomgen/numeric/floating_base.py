@@ -58,7 +58,7 @@ def base_rotation(yaw: float, pitch: float, roll: float) -> np.ndarray:
 
 def euler_angles(R) -> np.ndarray:
     """``(yaw, pitch, roll)`` [rad] with ``R = Rz(yaw) Ry(pitch) Rx(roll)``, pitch in
-    [−π/2, π/2], yaw and roll in (−π, π]; at the singularity (|cos pitch| = 0) roll is 0."""
+    [−π/2, π/2], yaw and roll in (−π, π]; at the singularity (``|cos pitch| = 0``) roll is 0."""
     R = np.asarray(R, dtype=float)
     pitch = np.arctan2(-R[2, 0], np.hypot(R[0, 0], R[1, 0]))
     if np.hypot(R[0, 0], R[1, 0]) < 1e-15:

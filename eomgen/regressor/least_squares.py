@@ -45,7 +45,7 @@ class Identification:
     beta:
         Estimated β, (b,), in the order of the base used.
     std:
-        Standard deviations of β from the residual (σ² (WᵀW)⁻¹, σ² = |τ − W β|² / (rows − b)).
+        Standard deviations of β from the residual (σ² (WᵀW)⁻¹, σ² = ‖τ − W β‖² / (rows − b)).
     rms:
         Root mean square of the residual τ − W β [N m or N].
     condition:

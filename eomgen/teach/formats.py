@@ -239,6 +239,10 @@ class HtmlFormat(_Format):
     def math(self, tex):
         return self._wrap(self._mathml(tex), tex, "inline")
 
+    def displayed(self, tex: str) -> str:
+        """One displayed formula (the documentation site's ``$$…$$``, docs/_ext/mathml.py)."""
+        return self._wrap(self._mathml(tex), tex, "block")
+
     def code(self, value):
         return "<code>" + html.escape(value, quote=False) + "</code>"
 
