@@ -298,7 +298,10 @@ def test_states_round_trip_and_a_last_free_body_is_left_at_rest(tmp_path, derive
     qpos, qvel = to_mujoco(lay, q, v)
     assert (qpos.shape, qvel.shape) == ((m.nq,), (m.nv,))
     q2, v2 = to_eomgen(lay, qpos, qvel)
-    assert np.allclose(q2, q, rtol=0, atol=1e-15) and np.allclose(v2, v, rtol=0, atol=1e-15)
+    # at round-off: v goes through the rotation of the quaternion and back (T then Tᵀ)
+    eps = np.finfo(float).eps
+    assert np.max(np.abs(q2 - q)) <= 4 * eps * max(1.0, np.max(np.abs(q)))
+    assert np.max(np.abs(v2 - v)) <= 8 * eps * max(1.0, np.max(np.abs(v)))
     path = tmp_path / "last.xml"  # the dropped ball's coordinates after every other one
     path.write_text("<mujoco><worldbody><body name='box'><freejoint name='root'/>"
                     "<geom type='box' size='.1 .2 .3'/><body name='arm' pos='.1 0 0'>"
