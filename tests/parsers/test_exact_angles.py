@@ -160,3 +160,16 @@ def test_generated_modules_with_sqrt3_agree_with_pinocchio(files):
         torch_module = load_module(out / "turned_2r_torch.py", "turned_2r_torch_angles")
         M_torch = torch_module.mass_matrix(torch.tensor(q, dtype=torch.float64)).numpy()
         assert np.abs(M_torch - M_pin).max() < 1e-13
+
+
+def test_among_floats_the_snapped_angle_costs_no_operation(tmp_path):
+    """With a float mass the model is derived in floats (``float_constants``): the snapped
+    π/6 folds into the floats, and the program is as long as the one of the floats kept."""
+    from eomgen.symbolic.opcount import program_operation_count
+
+    path = write(tmp_path / "r.urdf", turned_arm_urdf(repr(PI_6)).replace(
+        '<mass value="2"/>', '<mass value="2.5"/>'))
+    snapped, kept = (derive(eomgen.load(path, snap=snap), outputs=("M", "g"), simplify=False)
+                     for snap in (True, False))
+    assert dict(snapped.model.info)["snapped"] and not snapped.M.has(sp.sqrt(3))
+    assert program_operation_count(snapped.program) == program_operation_count(kept.program)
