@@ -170,7 +170,8 @@ def answer_from_cache(request, outdir: Path, quiet: bool, cache_dir: Path | None
                    "identifier; default: from the robot's name in the description).")
 @click.option("--no-snap", is_flag=True,
               help="Keep rotation and axis entries exactly as the description's floats give "
-                   "them (default: entries within 1e-11 of 0 or ±1 are made exact).")
+                   "them (default: entries within 1e-11 of 0 or ±1, and angles within 1e-12 "
+                   "of a multiple of pi/12, are made exact).")
 @click.option("--outputs", default=None,
               help="Comma-separated functions to export, by name or symbol (default: M, C, g, "
                    "tau and forward dynamics; docs/outputs.md lists the others, e.g. Y). "

@@ -5,12 +5,13 @@
 
 from __future__ import annotations
 
+import contextlib
 import shutil
 from pathlib import Path
 
 import click
 
-from ..errors import GenerationError
+from ..errors import EomgenError, GenerationError
 from ..output import check_output_file, check_output_folder
 from ..progress import Progress
 from .handling import handle_errors
@@ -19,14 +20,37 @@ from .options import (description_argument, output_file_option, output_folder_op
                       quiet_option, scene_option, strict_option)
 
 
+@contextlib.contextmanager
+def unexpected_errors(what: str):
+    """Within the block, an exception that is not an :class:`~eomgen.errors.EomgenError` (a
+    defect of eomgen, not of the description) becomes a :class:`GenerationError` naming
+    ``what`` and the exception in one line, so that the command ends on the CLI's error line
+    (exit 2) rather than a traceback; ``--debug`` shows the traceback (the original is
+    chained)."""
+    try:
+        yield
+    except EomgenError:
+        raise
+    except OSError as exc:  # the machine's (a full disk), not eomgen's
+        raise GenerationError(f"{what} failed: {exc}") from exc
+    except Exception as exc:  # noqa: BLE001 (reported, never hidden: see the docstring)
+        raise GenerationError(
+            f"{what} failed unexpectedly ({type(exc).__name__}: {exc}); this is a defect of "
+            "eomgen: please report it with the description (--debug shows the traceback)"
+        ) from exc
+
+
 @click.command()
 @description_argument()
 @output_file_option("Notebook file to write (default: <robot>_derivation.ipynb).")
 @scene_option()
+@click.option("--no-check", is_flag=True,
+              help="Leave out the checks (eomgen.verify, Mdot - 2C skew-symmetric, the "
+                   "asserted comparisons); the notebook says so.")
 @quiet_option()
 @strict_option
 @handle_errors
-def notebook(description, output, scene_path, quiet, strict):
+def notebook(description, output, scene_path, no_check, quiet, strict):
     """Write a Jupyter notebook deriving DESCRIPTION's equations of motion step by step.
 
     The notebook (saved without outputs) loads the robot, derives positions, Jacobians,
@@ -49,7 +73,8 @@ def notebook(description, output, scene_path, quiet, strict):
     if output is None:
         check_output_file(path)
     progress(f"building the notebook of {model.name}")
-    nb = build_notebook(model, description, scene=scene_path)
+    with unexpected_errors(f"building the notebook of {model.name}"):
+        nb = build_notebook(model, description, scene=scene_path, check=not no_check)
     progress.clear()
     click.echo(str(write_notebook(nb, path)))
 
@@ -63,7 +88,8 @@ def notebook(description, output, scene_path, quiet, strict):
 @scene_option("Scene file (YAML, docs/scenes.md): derive only what it moves, e.g. two "
               "joints of a real arm (examples/scenes/panda_two_joints.yaml).")
 @click.option("--no-check", is_flag=True,
-              help="Leave out the numeric verification (the handout says so).")
+              help="Leave out the checks: the numeric verification (the handout says "
+                   "so) and those of what it writes with named factors.")
 @quiet_option()
 @strict_option
 @handle_errors
@@ -100,7 +126,9 @@ def teach(description, formats, outdir, scene_path, no_check, quiet, strict):
                                   "Live: apt install texlive-latex-base); choose html, md or tex")
     check_output_folder(outdir)
     model, report = load_reduced(description, scene_path, strict)
-    paths = write_handout(model, outdir, chosen, progress, check=not no_check, scene=report)
+    with unexpected_errors(f"writing the handout of {model.name}"):
+        paths = write_handout(model, outdir, chosen, progress, check=not no_check,
+                              scene=report)
     progress.clear()
     for path in paths:
         click.echo(str(path))

@@ -58,22 +58,23 @@ from .robot import (
     RobotModel,
     configuration_size,
     all_scalars,
+    float_constants,
     flexible_indices,
     joint_actuators,
     joint_motion,
     lock_joints,
 )
 from .scalars import IDENTITY3, ZERO3, Mat3, Scalar, Vec3, mat3, parameter_symbol, scalar, vec3
-from .snapping import SNAP_TOLERANCE, Snap, snap, snap_summary, snapping
+from .snapping import ANGLE_SNAP_TOLERANCE, SNAP_TOLERANCE, Snap, snap, snap_summary, snapping
 from .transforms import Transform, rotation_about_axis, rotation_from_rpy
 
 __all__ = [
     "HINGE", "LOOP_KINDS", "POINT_LOOP", "WELD", "Loop", "LoopFrame",
-    "DEFAULT_FRICTION_WIDTH", "FREE_FLYER_CONFIGURATION", "FREE_FLYER_VELOCITY", "IDENTITY3", "MAX_JOINTS", "POINT", "SNAP_TOLERANCE", "SURFACE",
+    "ANGLE_SNAP_TOLERANCE", "DEFAULT_FRICTION_WIDTH", "FREE_FLYER_CONFIGURATION", "FREE_FLYER_VELOCITY", "IDENTITY3", "MAX_JOINTS", "POINT", "SNAP_TOLERANCE", "SURFACE",
     "ZERO3", "Actuator", "Contact", "Coupling", "couple", "coupling_map", "uncoupled",
     "make_coupling", "with_couplings", "Inertial", "Joint", "JointType", "Link", "Mat3", "Notice",
     "NoticeKind", "Parameter", "QuaternionJoint", "RobotModel", "Scalar", "Snap", "Transform", "Vec3",
-    "all_scalars", "build_model", "check_actuator", "check_axis", "check_inertial",
+    "all_scalars", "build_model", "check_actuator", "float_constants", "check_axis", "check_inertial",
     "check_size", "check_tree", "configuration_size", "emit_notices", "expand_ball_joints", "flexible_indices", "joint_actuators",
     "joint_motion", "lock_joints", "mat3", "parameter_symbol", "quaternion_layout", "rotation_about_axis",
     "rotation_from_rpy", "scalar", "snap", "snap_summary", "snapping", "vec3",

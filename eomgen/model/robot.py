@@ -237,6 +237,41 @@ def all_scalars(model: RobotModel) -> Iterable[sp.Expr]:
             yield from joint.actuator.scalars()
 
 
+def float_constants(model: RobotModel) -> RobotModel:
+    """``model`` with its exact irrational constants (√2/2 of an angle snapped to π/4, √3/2 of
+    ``pi/6``) as doubles when its numbers hold a float, else ``model`` itself.
+
+    SymPy folds a float with a rational (``0.5 * 1/3`` is one float) but not with an
+    irrational number (``0.0075*sqrt(2)`` stays a product), so exact rotations among float
+    inertias would cost the generated code an operation per such product; derived in floats
+    they cost what the description's floats cost. A model with exact numbers only (symbols,
+    integers, rationals, √3) is returned unchanged and derived exactly. The inertial data and
+    the joints' geometry are converted (where rotations and inertias meet); gravity and
+    actuators are kept.
+    """
+    if not any(value.has(sp.Float) for value in all_scalars(model)):
+        return model
+
+    def floated(x):
+        if not isinstance(x, sp.Basic) or x.is_Rational or x.is_Float:
+            return x
+        return scalar(x.replace(lambda e: e.is_number and not e.is_Rational and not e.is_Float
+                                and e.is_real, lambda e: sp.Float(float(e.evalf(30)), 17)))
+
+    def vector(v):
+        return tuple(floated(x) for x in v)
+
+    links = tuple(
+        replace(link, inertial=Inertial(floated(link.inertial.mass), vector(link.inertial.com),
+                                        tuple(vector(r) for r in link.inertial.inertia)))
+        if link.inertial is not None else link for link in model.links)
+    joints = tuple(
+        replace(j, origin=Transform(tuple(vector(r) for r in j.origin.rotation),
+                                    vector(j.origin.translation)), axis=vector(j.axis))
+        for j in model.joints)
+    return replace(model, links=links, joints=joints)
+
+
 def joint_actuators(model: RobotModel) -> tuple[Actuator, ...]:
     """The actuator of every movable joint, in ``model.joint_names`` order (a joint without
     one gets ``Actuator()``: no armature, no friction, rigid)."""

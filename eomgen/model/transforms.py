@@ -9,7 +9,7 @@ from typing import Iterable
 import sympy as sp
 
 from .scalars import IDENTITY3, ZERO3, Mat3, Vec3, mat3, vec3
-from .snapping import snap
+from .snapping import exact_angle, snap
 
 def _matmul3(a: Mat3, b: Mat3) -> Mat3:
     return tuple(
@@ -21,13 +21,30 @@ def _matvec3(a: Mat3, v: Vec3) -> Vec3:
     return tuple(sp.Add(*[a[i][k] * v[k] for k in range(3)]) for i in range(3))  # type: ignore
 
 
-def rotation_about_axis(axis: Vec3, angle) -> Mat3:
-    """Rotation matrix of ``angle`` (rad, right hand rule) about the unit vector ``axis``."""
+def cos_sin(angle) -> tuple[sp.Expr, sp.Expr]:
+    """``(cos, sin)`` of ``angle`` (rad) as the model's scalars.
+
+    Symbolic for an angle in parameters; exact for an exact angle whose cosine and sine SymPy
+    writes without trigonometric functions (every multiple of π/12, π/8, π/10: ``pi/6`` gives
+    √3/2 and 1/2), and for a float snapped to a multiple of π/12 (:func:`exact_angle`); else
+    the floats, each snapped to 0 or ±1 when within :data:`~eomgen.model.SNAP_TOLERANCE` of one
+    (:func:`snap`).
+    """
     if isinstance(angle, sp.Basic) and not angle.is_number:
-        c, s = sp.cos(angle), sp.sin(angle)
-    else:
-        c = snap(math.cos(float(angle)), f"cos({float(angle)!r})")
-        s = snap(math.sin(float(angle)), f"sin({float(angle)!r})")
+        return sp.cos(angle), sp.sin(angle)
+    exact = exact_angle(angle)
+    if exact is not None:
+        c, s = sp.cos(exact), sp.sin(exact)
+        if not (c.has(sp.cos, sp.sin) or s.has(sp.cos, sp.sin)):
+            return c, s
+    value = float(angle)
+    return snap(math.cos(value), f"cos({value!r})"), snap(math.sin(value), f"sin({value!r})")
+
+
+def rotation_about_axis(axis: Vec3, angle) -> Mat3:
+    """Rotation matrix of ``angle`` (rad, right hand rule) about the unit vector ``axis``
+    (its cosine and sine from :func:`cos_sin`)."""
+    c, s = cos_sin(angle)
     x, y, z = axis
     t = 1 - c
     return mat3(

@@ -23,7 +23,7 @@ from typing import Iterable
 import sympy as sp
 
 from ..bodies import BodyTree, body_tree
-from ..model import RobotModel
+from ..model import RobotModel, float_constants
 from ..errors import UnsupportedError
 from ..outputs import BY_SYMBOL, INPUTS, input_size
 from .couplings import coupled_inputs, project, refused
@@ -191,8 +191,10 @@ def new_derivation(model: RobotModel, inputs: Iterable[str] | None = None) -> De
 
 def _placed(model: RobotModel, q, builder: ProgramBuilder) -> tuple[BodyTree, tuple]:
     """The body tree of ``model`` with each quaternion joint's pose placed from ``q`` (NQ
-    entries) before its chain, and the joint coordinates the algorithms index (NV)."""
-    tree, joints = body_tree(model), model.quaternion_joints
+    entries) before its chain, and the joint coordinates the algorithms index (NV). A model
+    with floats is placed with its irrational constants as floats (:func:`~eomgen.model.
+    float_constants`), so that they fold with the floats."""
+    tree, joints = body_tree(float_constants(model)), model.quaternion_joints
     if not joints:
         return tree, tuple(q)
     placed = placements(joints, q, builder)

@@ -6,7 +6,9 @@ Two things every printer of eomgen shares:
   ``Float`` is printed as the shortest decimal that reads back as the same double
   (``repr(float(x))``, 17 significant digits at most), and an exact ``Rational`` ``p/q`` as
   the literal of the double nearest to ``p/q``: the value Python's ``p/q`` computes (integer
-  true division is correctly rounded), so no generated code spends a division on a constant.
+  true division is correctly rounded), so no generated code spends a division on a constant;
+  an exact irrational constant such as ``sqrt(3)`` (from an angle of ``pi/6``) is the literal
+  of its correctly rounded double too (``torch.sqrt`` takes no number).
   Backends whose literals look different (C needs ``1.0`` rather than ``1``; the float32
   batches wrap each literal in their dtype) override only :meth:`FloatLiteralMixin._literal`.
 * :class:`NumPyModulePrinter`: the NumPy backend's printer (SymPy's ``NumPyPrinter`` with
@@ -111,7 +113,8 @@ class FloatLiteralMixin:
 
     ``Float`` → ``repr(float(x))``; non-integer ``Rational`` ``p/q`` → the literal of the
     double ``p/q`` (correctly rounded), printed without parentheses when positive (a positive
-    literal is an atom in Python and C). Integers keep the printer's own form.
+    literal is an atom in Python and C); a real power of numbers (``sqrt(3)``) → the literal of
+    its double, evaluated to 30 digits and rounded. Integers keep the printer's own form.
     """
 
     def _literal(self, value: float) -> str:
@@ -123,6 +126,11 @@ class FloatLiteralMixin:
 
     def _print_Rational(self, expr):
         return self._literal(int(expr.p) / int(expr.q))
+
+    def _print_Pow(self, expr, *args, **kwargs):
+        if expr.is_number and expr.is_real:  # sqrt(3), from an angle of pi/6
+            return self._literal(float(expr.evalf(30)))
+        return super()._print_Pow(expr, *args, **kwargs)
 
     def _as_ordered_terms(self, expr, order=None):
         """SymPy's order of a sum's terms, but a term without a minus sign first when there

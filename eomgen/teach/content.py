@@ -48,8 +48,8 @@ from ..symbolic.textbook import TextbookDerivation
 from ..verify import VerificationReport, verify
 from .loops import loop_section, loop_symbol_names
 from .quaternion import chart_method_section, velocity_names
-from .control import (control_section, control_symbol_names, has_control_section,
-                      slotine_li_equations)
+from .control import (control_section, control_symbol_names, handout_check,
+                      has_control_section, slotine_li_equations)
 from .contacts import (contact_equations, contact_forces,  # noqa: F401  (re-exported)
                        contact_section, contact_symbol_names)
 from .document import (Equation, Equations, Figure, Handout, Paragraph, Section, Table, code,
@@ -307,11 +307,11 @@ def _quadratic_terms(M: sp.Matrix, qd, masses) -> list[sp.Expr]:
     return terms
 
 
-def named_coriolis(dyn: Dynamics, book: TextbookDerivation):
+def named_coriolis(dyn: Dynamics, book: TextbookDerivation, check: bool = True):
     """The names of the common factors of the Christoffel symbols (see
     :func:`~eomgen.teach.readability.common_christoffel_factors`; none when a parameter is
     already called ``h``…), the Christoffel symbols written with them, and C written with them
-    (checked equal to the derived C)."""
+    (checked equal to the derived C unless ``check`` is false: :func:`handout_check`)."""
     n = dyn.model.dof
     taken = {p.name for p in dyn.model.parameters}
     names = [] if taken & {"h", "h1", "h2", "h3", "h4"} else rd.common_christoffel_factors(
@@ -324,8 +324,9 @@ def named_coriolis(dyn: Dynamics, book: TextbookDerivation):
             C[i, k] += value * dyn.qd[j]
     C = C.applyfunc(sp.factor_terms)
     values = {nf.symbol: nf.value for nf in names}
-    if (C.subs(values) - book.C).applyfunc(sp.expand) != sp.zeros(n, n):
-        raise AssertionError("C written with named factors differs from the derived C")
+    if check:
+        handout_check(dyn, "C written with named factors equals the derived C",
+                      (C.subs(values) - book.C).applyfunc(sp.expand), book.C)
     return names, christoffel, C
 
 
@@ -499,7 +500,9 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
     """The handout deriving ``model``'s equations of motion (see the module docstring).
 
     ``progress`` receives one line per stage (deriving, checking…); ``check=False`` leaves out
-    the numeric verification (the section then says so); ``scene`` is the
+    the numeric verification (the section then says so) and the checks of what the handout
+    writes with named factors (C, and Ṁ − 2C skew-symmetric: :func:`handout_check`, which
+    raises :class:`~eomgen.errors.VerificationError` when one fails); ``scene`` is the
     :class:`~eomgen.reduction.ReductionReport` when ``model`` comes from a scene (a paragraph
     says what was locked, and its contacts get a section).
 
@@ -539,7 +542,7 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
         caption += prose(" Drawn with 1 for the parameters without a value: ",
                          *code_names(geometry.placeholder_parameters), ".")
     sections = [_robot_section(model, w, caption, scene), _method_section(model, book is not None)]
-    coriolis = named_coriolis(dyn, book) if book is not None else None
+    coriolis = named_coriolis(dyn, book, check) if book is not None else None
     if book is not None:
         sections += _textbook_sections(dyn, book, coriolis, w)
     else:
@@ -552,7 +555,8 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
         sections.append(loop_section(dyn, book, coriolis, w))
     if control:
         progress("deriving the Slotine-Li regressor")
-        sections.append(control_section(slotine_li_equations(dyn, book, coriolis), book, dyn, w))
+        sections.append(control_section(slotine_li_equations(dyn, book, coriolis, check),
+                                        book, dyn, w))
     report, missing, hint = None, "the check was switched off", None
     if check:
         progress("checking the derivation against Newton-Euler")

@@ -17,9 +17,11 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..dynamics import Dynamics, derive
+from ..errors import VerificationError
 from ..present import readability as rd
 from ..regressor.generated import generated_base
 from ..regressor.notation import parameter_latex
+from ..symbolic.identities import ZeroCheck, check_zero
 from ..symbolic.textbook import TextbookDerivation, fourier_form, simplify_trig
 from .document import Equation, Equations, Paragraph, Section, prose
 from .writer import Writer
@@ -49,6 +51,9 @@ class ControlEquations:
         ``M q̈_r + C(q, q̇) q̇_r + g = Y β``.
     M_dot, N:
         Ṁ = Σ_k ∂M/∂q_k q̇_k and N = Ṁ − 2C, written with step 6's named factors.
+    skew:
+        The check that N + Nᵀ = 0 (exactly, or to a tolerance when the model has floats);
+        None when the handout is made without checks.
     """
 
     qd_r: tuple
@@ -58,11 +63,25 @@ class ControlEquations:
     Y: sp.Matrix
     M_dot: sp.Matrix
     N: sp.Matrix
+    skew: ZeroCheck | None = None
 
 
-def slotine_li_equations(dyn: Dynamics, book: TextbookDerivation, coriolis) -> ControlEquations:
+def handout_check(dyn: Dynamics, statement: str, residual, scale) -> ZeroCheck:
+    """:func:`~eomgen.symbolic.identities.check_zero` of an identity the handout states;
+    raises :class:`~eomgen.errors.VerificationError` (one line naming the description) when
+    it fails."""
+    result = check_zero(statement, residual, scale)
+    if not result.holds:
+        raise VerificationError(f"{dyn.model.source}: a check of the handout failed: {result}; "
+                                "--no-check writes the handout without its checks")
+    return result
+
+
+def slotine_li_equations(dyn: Dynamics, book: TextbookDerivation, coriolis,
+                         check: bool = True) -> ControlEquations:
     """Derive the section's equations (``coriolis``: :func:`~eomgen.teach.content.
-    named_coriolis`'s names, Christoffel symbols and C)."""
+    named_coriolis`'s names, Christoffel symbols and C); ``check``: check that Ṁ − 2C is
+    skew-symmetric (:func:`handout_check`)."""
     model = dyn.model
     sl = derive(model, outputs=("Y_SL_base", "beta"), simplify=False)
     q = list(sl.q)
@@ -99,12 +118,13 @@ def slotine_li_equations(dyn: Dynamics, book: TextbookDerivation, coriolis) -> C
             N[i, j] = (with_names if not with_names.has(sp.sin, sp.cos)
                        else in_names(raw[i, j]))
     values = {nf.symbol: nf.value for nf in names_h}
-    if (N + N.T).subs(values).applyfunc(lambda e: sp.expand(simplify_trig(e, dyn.q))) != \
-            sp.zeros(model.dof, model.dof):
-        raise AssertionError("Mdot - 2C written with named factors is not skew-symmetric")
+    skew = handout_check(
+        dyn, "Mdot - 2C written with named factors is skew-symmetric",
+        (N + N.T).subs(values).applyfunc(lambda e: sp.expand(simplify_trig(e, dyn.q))),
+        raw) if check else None
     vectors = sl.input_symbols
     return ControlEquations(tuple(vectors["qd_r"]), tuple(vectors["qdd_r"]), names, beta, Y,
-                            M_dot, N)
+                            M_dot, N, skew)
 
 
 def control_symbol_names(dyn: Dynamics) -> dict:
@@ -189,6 +209,7 @@ def control_section(eqs: ControlEquations, book: TextbookDerivation, dyn: Dynami
             "$\\dot{M} = \\sum_{k} \\partial M / \\partial q_{k}\\, \\dot{q}_{k}$, and with "
             "$C$ of step 6:")),
         Equations(w.matrix(r"\dot{M}", eqs.M_dot) + w.matrix(r"\dot{M} - 2C", eqs.N)),
+        *_float_note(eqs.skew),
         Paragraph(prose(
             "$(\\dot{M} - 2C)^{T} = -(\\dot{M} - 2C)$, so $s^{T} (\\dot{M} - 2C)\\, s = 0$ for "
             "every $s$ and $\\dot{V} = -s^{T} K_{D}\\, s \\le 0$: $s$ and the tracking error "
@@ -200,5 +221,16 @@ def control_section(eqs: ControlEquations, book: TextbookDerivation, dyn: Dynami
     return Section("Adaptive control: the Slotine–Li regressor", tuple(blocks))
 
 
-__all__ = ["ControlEquations", "control_section", "control_symbol_names",
+def _float_note(skew: ZeroCheck | None) -> tuple:
+    """A paragraph saying to what tolerance the skew symmetry was checked when the model has
+    floating-point numbers (none when it was checked exactly, or not at all)."""
+    if skew is None or skew.exact:
+        return ()
+    return (Paragraph(prose(
+        "The model has floating-point numbers, so the entries above carry rounding errors: "
+        f"eomgen checked the skew symmetry to {skew.tolerance:g} relative (largest residual "
+        f"{skew.residual:.1e}), not exactly.")),)
+
+
+__all__ = ["ControlEquations", "control_section", "control_symbol_names", "handout_check",
            "has_control_section", "slotine_li_equations"]

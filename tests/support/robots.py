@@ -6,7 +6,9 @@
   solo12 path (:data:`SOLO`) and Pinocchio's free flyer as its reference;
 * the hostile-names robot (:func:`hostile_star`): names that try to break out of the string
   literals, docstrings and comments they end up in;
-* the flexible 2-link arm with drives (:func:`drive_arm`).
+* the flexible 2-link arm with drives (:func:`drive_arm`);
+* the planar two-link arm whose second joint is turned about z (:func:`turned_arm_yaml`,
+  :func:`turned_arm_urdf`): exact and float rotation angles.
 
 Each function builds a fresh model (models are frozen data, but tests that cache a derivation
 do so in their own module).
@@ -156,3 +158,55 @@ def drive_arm() -> RobotModel:
         j.actuator, damping=0.05, friction=0.1, friction_width=0.5)) if j.actuator else j.actuator)
         for j in model.joints)
     return replace(model, joints=joints)
+
+
+# ----------------------------------------------------------------------------------------------
+# A joint with a turned origin
+# ----------------------------------------------------------------------------------------------
+
+
+def turned_arm_yaml(angle: str = "pi/6") -> str:
+    """The planar two-link arm (joints about z) in eomgen's YAML, its second joint's origin
+    turned by ``angle`` (text, e.g. ``pi/6``) about z; parameters with integer values, so that
+    :func:`turned_arm_urdf` is the same model at those values. M₁₁ = m₁ l_c1² + m₂ (l₁² +
+    l_c2² + 2 l₁ l_c2 cos(q₂ + angle)) + I₁ + I₂."""
+    return f"""name: turned_2r
+gravity: [0, -g, 0]
+parameters:
+  m1: 1
+  m2: 2
+  l1: 2
+  lc1: 1
+  lc2: 1
+  I1: 1
+  I2: 1
+  g: 9.81
+links:
+  - name: base
+  - {{name: link1, mass: m1, com: [lc1, 0, 0], inertia: {{ixx: I1, iyy: I1, izz: I1}}}}
+  - {{name: link2, mass: m2, com: [lc2, 0, 0], inertia: {{ixx: I2, iyy: I2, izz: I2}}}}
+joints:
+  - {{name: joint1, type: revolute, parent: base, child: link1}}
+  - name: joint2
+    type: revolute
+    parent: link1
+    child: link2
+    origin: {{xyz: [l1, 0, 0], rpy: [0, 0, {angle}]}}
+"""
+
+
+def turned_arm_urdf(angle: str) -> str:
+    """:func:`turned_arm_yaml`'s arm at its parameter values, as a URDF (``angle``: the
+    ``rpy`` yaw text, e.g. ``0.5235987755982988``); gravity is URDF's (-z)."""
+    return robot(
+        '<link name="base"/>',
+        f'<link name="link1"><inertial><mass value="1"/><origin xyz="1 0 0"/>{INERTIA}'
+        '</inertial></link>',
+        f'<link name="link2"><inertial><mass value="2"/><origin xyz="1 0 0"/>{INERTIA}'
+        '</inertial></link>',
+        '<joint name="joint1" type="revolute"><parent link="base"/><child link="link1"/>'
+        '<axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>',
+        '<joint name="joint2" type="revolute"><parent link="link1"/><child link="link2"/>'
+        f'<origin xyz="2 0 0" rpy="0 0 {angle}"/><axis xyz="0 0 1"/>'
+        '<limit lower="-3" upper="3" effort="1" velocity="1"/></joint>',
+        name="turned_2r")
