@@ -13,6 +13,7 @@ import pytest
 
 import eomgen.notebook
 from support import run_in_process, write
+from support.extras import need
 from support.robots import turned_arm_yaml
 
 SKEW = "Mdot - 2C is skew-symmetric"
@@ -32,8 +33,8 @@ def _source(nb) -> str:
 
 def _run(nb, tmp_path) -> str:
     """Execute ``nb`` in a kernel; no cell may fail; the printed text."""
-    nbclient = pytest.importorskip("nbclient")
-    pytest.importorskip("ipykernel")
+    nbclient = need("nbclient", reason="the notebook is run")
+    need("ipykernel", reason="the notebook is run")
     nbclient.NotebookClient(nb, timeout=300, kernel_name="python3",
                             resources={"metadata": {"path": str(tmp_path)}}).execute()
     outputs = [o for cell in nb.cells if cell.cell_type == "code" for o in cell.outputs]

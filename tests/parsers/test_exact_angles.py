@@ -10,6 +10,8 @@ URDF, and Pinocchio's CRBA on the URDF (its own parser, floats) are the referenc
 
 from __future__ import annotations
 
+import importlib.util
+
 import math
 
 import numpy as np
@@ -22,6 +24,7 @@ from eomgen.model import ANGLE_SNAP_TOLERANCE, snap_summary
 from eomgen.symbolic.identities import check_zero
 from support import load_module, run_in_process, write
 from support.robots import turned_arm_urdf, turned_arm_yaml
+from support.extras import need
 
 PI_6 = 0.5235987755982988  # the double nearest π/6
 
@@ -126,7 +129,7 @@ def test_an_angle_without_a_radical_cosine_is_read_as_floats(tmp_path):
 
 def test_snapped_M_equals_pinocchios_crba(files, snapped):
     """Pinocchio reads the URDF itself (floats, its own parser): the snapped exact M agrees."""
-    pin = pytest.importorskip("pinocchio", reason="Pinocchio is the independent reference")
+    pin = need("pinocchio", reason="Pinocchio is the independent reference")
     model = pin.buildModelFromUrdf(str(files["urdf"]))
     data = model.createData()
     M_of = sp.lambdify(snapped.q, snapped.M, "numpy")
@@ -139,8 +142,8 @@ def test_snapped_M_equals_pinocchios_crba(files, snapped):
 def test_generated_modules_with_sqrt3_agree_with_pinocchio(files):
     """`eomgen generate` prints √3 as a literal: the NumPy and PyTorch modules (torch.sqrt
     takes no number) give Pinocchio's M on the URDF."""
-    pin = pytest.importorskip("pinocchio", reason="Pinocchio is the independent reference")
-    torch_available = pytest.importorskip("importlib.util").find_spec("torch") is not None
+    pin = need("pinocchio", reason="Pinocchio is the independent reference")
+    torch_available = importlib.util.find_spec("torch") is not None
     backends = "numpy,torch" if torch_available else "numpy"
     out = files["folder"] / "generated"
     result = run_in_process("generate", files["yaml"], "--backend", backends, "--no-cache",
