@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Callable
 
 from ..errors import TooLargeError, UnknownFormatError, UnreadableFileError
-from ..model import Notice, NoticeKind, RobotModel, emit_notices, snapping, uncoupled
+from ..model import Notice, NoticeKind, RobotModel, emit_notices, settled, snapping, uncoupled
 
 #: ``load(path, strict, defer_notices=False)``.
 Loader = Callable[..., RobotModel]
@@ -111,11 +111,14 @@ def load(path, strict: bool = False, defer_notices: bool = False,
                 + "): a DH table needs a top-level 'dh' list, an eomgen robot 'links' and 'joints'")
         candidates = sniffed
     with snapping(snap) as snaps:
-        model = candidates[0].load(path, strict, defer_notices=defer_notices)
+        model = candidates[0].load(path, strict, defer_notices=True)
     if snaps:
         model = replace(model, info=model.info + (("snapped", tuple(snaps)),))
     if not couplings and model.couplings:
-        model = independent_followers(model, strict, defer_notices)
+        model = independent_followers(model, strict, defer_notices=True)
+    model = settled(model)  # the whole model known: what its masses leave to say
+    if not defer_notices:
+        emit_notices(model.notices, strict)
     return model
 
 
