@@ -152,6 +152,44 @@ def test_debug_shows_a_traceback(tmp_path):
 # ----------------------------------------------------------------------------------------------
 
 
+@pytest.mark.parametrize("command", ["verify", "generate", "teach", "bench"])
+def test_a_near_miss_of_a_bundled_name_is_suggested(command, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # no file of that name here
+    result = run(command, "elbow_rr", "--quiet")
+    assert result.exit_code == 2, result.output
+    assert result.stderr.splitlines() == [
+        f"{ERROR}elbow_rr: no such file; did you mean 'elbow_rrr'?"]
+
+
+def test_a_bundled_name_is_a_description_in_python_too():
+    assert eomgen.load("elbow_rrr") == eomgen.load(example_path("elbow_rrr"))
+
+
+def test_a_near_miss_of_a_file_is_suggested_with_its_folder(tmp_path):
+    write(tmp_path / "arm.urdf", "<robot/>")
+    result = run("verify", tmp_path / "arms.urdf", "--quiet")
+    assert result.exit_code == 2, result.output
+    assert result.stderr.splitlines() == [
+        f"{ERROR}{tmp_path / 'arms.urdf'}: no such file; did you mean '{tmp_path / 'arm.urdf'}'?"]
+    far = run("verify", tmp_path / "nothing_alike.yaml", "--quiet")
+    assert far.stderr.splitlines() == [f"{ERROR}{tmp_path / 'nothing_alike.yaml'}: no such file"]
+
+
+def test_a_misspelled_output_is_one_short_line(tmp_path):
+    """The suggestions first, then where the list is: not the list of every output."""
+    from eomgen.outputs import OUTPUTS
+
+    result = run("generate", "--outputs", "M,regresor", "-o", tmp_path / "out", "--no-cache")
+    assert result.exit_code == 2, result.output
+    (line,) = result.stderr.splitlines()
+    assert line == (f"{ERROR}--outputs: unknown output 'regresor'; did you mean 'regressor' or "
+                    "'base_regressor'? (docs/outputs.md lists them all; in Python, "
+                    "eomgen.outputs.OUTPUTS)")
+    assert sum(name in line for name in OUTPUTS) <= 3 and len(line) < 200
+    assert "`regressor`" in (support.ROOT / "docs/outputs.md").read_text(encoding="utf-8")
+    assert not (tmp_path / "out").exists()
+
+
 def test_puma560_passes_silently_even_under_strict():
     """Its published links 1 and 3 break the triangle inequality, but its dynamics are a
     physical robot's (tests/parsers/test_yaml_dh.py): nothing to warn about or refuse."""
