@@ -32,9 +32,11 @@ from .notices import Notice, NoticeKind
 from .parts import Inertial, Joint, JointType
 from .robot import RobotModel
 
-#: Relative tolerance of "no mass", "no inertia about the axis" and "Σ ⪰ 0" (as the triangle
+#: Relative tolerance of "Σ ⪰ 0" and of an axis being parallel to another (as the triangle
 #: inequality of :func:`eomgen.model.check_inertial`).
 TOLERANCE = 1e-9
+#: Relative size below which a moment about an axis is roundoff of zero (a rotated axis).
+ROUNDOFF = 1e-12
 
 
 def _float(x) -> float | None:
@@ -98,7 +100,7 @@ def _carries_nothing(inertial: Inertial | None, joint: Joint, path: list[Joint])
         return False
     scale = max(1.0, max(abs(v) for row in inertia for v in row))
     moment = sum(axis[i] * inertia[i][k] * axis[k] for i in range(3) for k in range(3))
-    return abs(moment) <= TOLERANCE * scale * 1e-3
+    return abs(moment) <= ROUNDOFF * scale
 
 
 def _cross(a, b):
@@ -156,7 +158,8 @@ def massless_notices(model: RobotModel) -> tuple[Notice, ...]:
 
 def physical_bodies(model: RobotModel) -> set[str] | None:
     """The links whose bodies can be made physical without changing the dynamics (module
-    docstring); None when a symbolic inertia or pose leaves it undecided."""
+    docstring); None when a symbolic inertia or pose anywhere leaves it undecided (then every
+    finding stays)."""
     import numpy as np  # here: loading a description without such a finding needs no NumPy
 
     children = _children(model)
@@ -215,20 +218,20 @@ def physical_bodies(model: RobotModel) -> set[str] | None:
         if rotation is None or None in axis:
             return None
         to_parent = R @ np.array(rotation)
+        scale = max(1.0, float(np.abs(S).max()))
         if joint.type is JointType.PRISMATIC:  # any rotational inertia crosses
             eig, vec = np.linalg.eigh(S)
             need = -(vec * np.minimum(eig, 0)) @ vec.T
         else:
             a = np.array(axis) / np.linalg.norm(axis)
             beta = _least_beta(S, a)
-            scale = max(1.0, float(np.abs(S).max()))
             if beta is None or np.linalg.eigvalsh(
                     S + beta * np.outer(a, a))[0] < -TOLERANCE * scale:
                 ok[lead], took[lead] = False, False
                 continue
             need = beta * np.outer(a, a)
         ok[lead] = True
-        took[lead] = bool(np.abs(need).max() > 0)
+        took[lead] = bool(np.abs(need).max() > TOLERANCE * scale)
         sigma[parent] = sigma[parent] - to_parent @ need @ to_parent.T
     good: dict[str, bool] = {}
     for lead in order:  # parents first: what a body took, its parent must have had to give
