@@ -333,7 +333,8 @@ def test_a_bundled_example_name_is_a_description_in_every_command(tmp_path, monk
     assert refused.exit_code == 2
     assert refused.stderr.startswith(f"{ERROR}scara_rrp: unknown file type ''")
     missing = run("verify", "scara")
-    assert missing.exit_code == 2 and missing.stderr == f"{ERROR}scara: no such file\n"
+    assert missing.exit_code == 2 and missing.stderr == (
+        f"{ERROR}scara: no such file; did you mean 'scara_rrp'?\n")
 
 
 def click_context(command):
