@@ -255,6 +255,16 @@ class Dynamics:
 
         return lambdify(self)
 
+    def __repr__(self) -> str:
+        """One line: the robot, the sizes, the outputs derived, the parameters (the matrices
+        themselves: ``dyn.M``, ``dyn.C``, ...)."""
+        model = self.model
+        params = (f"{len(model.parameters)} parameters ({reprs.names(model.parameter_names)})"
+                  if model.parameters else "no parameters")
+        return (f"<Dynamics of {model.name!r}: nq={model.nq}, nv={model.dof}; outputs "
+                f"{reprs.names(self.outputs, most=8)}; {params}"
+                + ("; simplified" if self.simplified else "") + ">")
+
     def _repr_latex_(self) -> str | None:  # rich display in notebooks: registered by eomgen.display
         return reprs.render("dynamics", self, "text/latex")
 

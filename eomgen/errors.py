@@ -49,7 +49,22 @@ from __future__ import annotations
 
 import contextlib
 import warnings
-from typing import Callable, Iterator
+from typing import Callable, Iterable, Iterator
+
+
+def closest_name(name: str, known: Iterable[str]) -> str | None:
+    """The closest of ``known`` to ``name`` (:func:`difflib.get_close_matches`), or None."""
+    import difflib  # here: only when an error is being written
+
+    hint = difflib.get_close_matches(name, list(known), n=1)
+    return hint[0] if hint else None
+
+
+def did_you_mean(name: str, known: Iterable[str]) -> str:
+    """``"; did you mean 'x'?"`` for the closest of ``known``, or an empty string: the tail of
+    a one-line error about an unknown name."""
+    hint = closest_name(name, known)
+    return f"; did you mean '{hint}'?" if hint else ""
 
 
 def one_line(text: str) -> str:

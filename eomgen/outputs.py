@@ -647,6 +647,10 @@ def function_names(default_only: bool = False) -> tuple[str, ...]:
     return tuple(f for f, o in OUTPUTS.items() if o.default or not default_only)
 
 
+#: Where an unknown output's error sends the reader for the list of names.
+UNKNOWN_OUTPUT_HELP = "docs/outputs.md lists them all; in Python, eomgen.outputs.OUTPUTS"
+
+
 def select(names=None) -> tuple[str, ...]:
     """The functions to generate for the requested ``names``, in module order.
 
@@ -675,10 +679,11 @@ def select(names=None) -> tuple[str, ...]:
     for name in names:
         function = aliases.get(name, name)
         if function not in OUTPUTS:
-            known = list(aliases) + list(OUTPUTS)
-            hint = difflib.get_close_matches(str(name), known, n=1)
-            raise ValueError(f"unknown output {name!r} (known: {', '.join(known)})"
-                             + (f"; did you mean '{hint[0]}'?" if hint else ""))
+            hints = difflib.get_close_matches(str(name), list(aliases) + list(OUTPUTS), n=3)
+            said = " or ".join(f"'{h}'" for h in hints)
+            raise ValueError(f"unknown output {name!r}" + (f"; did you mean {said}?" if hints
+                                                           else "")
+                             + f" ({UNKNOWN_OUTPUT_HELP})")
         wanted.add(function)
         wanted.update(OUTPUTS[function].composed_from)
     if not wanted:

@@ -69,15 +69,13 @@ Examples
 
 from __future__ import annotations
 
-import difflib
 import functools
 import warnings
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Iterable
 
 from .model import HINGE, LOOP_KINDS, POINT, SURFACE, Contact, Loop, LoopFrame, Transform
-from .errors import DescriptionError, SceneError
+from .errors import DescriptionError, SceneError, did_you_mean  # noqa: F401  (re-export)
 from .model import Coupling, Inertial, Parameter, Vec3, check_inertial, make_coupling, mat3, vec3
 from .outputs import select
 from .parsers._yaml import Reader, read_document
@@ -227,12 +225,6 @@ class _SceneReader(Reader):
 
     def error(self, where: str, problem: str, *args, **kwargs) -> SceneError:
         return _as_scene_error(super().error(where, problem, *args, **kwargs))
-
-
-def did_you_mean(name: str, known: Iterable[str]) -> str:
-    """``"; did you mean 'x'?"`` for the closest of ``known``, or an empty string."""
-    hint = difflib.get_close_matches(name, list(known), n=1)
-    return f"; did you mean '{hint[0]}'?" if hint else ""
 
 
 def load_scene(path, text: str | None = None, strict: bool = False) -> Scene:

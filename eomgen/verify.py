@@ -33,7 +33,8 @@ import sympy as sp
 
 from .dynamics import Dynamics
 from .errors import ParameterError
-from .model import all_scalars
+from .model import all_scalars, massless_joints
+from .model.moving_mass import massless_problem
 from .numeric import numeric_model
 from .numeric import rnea as numeric_rnea
 from .quaternion_joints import configuration_rate
@@ -57,6 +58,9 @@ class CheckResult:
 class VerificationReport:
     robot: str
     checks: tuple[CheckResult, ...]
+    #: What explains a failed check, one sentence each: the joints that move no mass
+    #: (:func:`eomgen.model.massless_joints`), naming the links they carry.
+    notes: tuple[str, ...] = ()
 
     @property
     def passed(self) -> bool:
@@ -69,6 +73,7 @@ class VerificationReport:
             status = "ok  " if c.passed else "FAIL"
             lines.append(f"  {status} {c.name:<{width}}  max abs {c.max_abs_error:9.2e}  "
                          f"max rel {c.max_rel_error:9.2e}  ({c.how})")
+        lines += [f"  {note}" for note in self.notes]
         lines.append("all checks passed" if self.passed else "SOME CHECKS FAILED")
         return "\n".join(lines)
 
@@ -268,4 +273,6 @@ def verify(dynamics: Dynamics, samples: int = 20, seed: int = 0,
         record("symbolic Newton-Euler tau = M qdd + C qd + g",
                [(r["tau"][:, 0], r["M"] @ qdd + r["C"] @ qd + r["g"][:, 0])
                 for (q, qd, qdd), r in zip(states, results)])
-    return VerificationReport(model.name, tuple(checks))
+    notes = tuple(f"M is singular: joint '{joint}' {massless_problem(links)}"
+                  for joint, links in massless_joints(model))
+    return VerificationReport(model.name, tuple(checks), notes)

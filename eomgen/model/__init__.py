@@ -25,8 +25,10 @@ The package holds one concept per module, bottom up: :mod:`~eomgen.model.scalars
 :mod:`~eomgen.model.parts` (joint types, links, joints, parameters),
 :mod:`~eomgen.model.notices`, :mod:`~eomgen.model.coupling` (coupled joints),
 :mod:`~eomgen.model.quaternion` (free flyer and ball joints: the layout of q and v),
-:mod:`~eomgen.model.robot` (:class:`RobotModel`) and
-:mod:`~eomgen.model.checks` (validation, :func:`build_model`). Import every name from
+:mod:`~eomgen.model.robot` (:class:`RobotModel`),
+:mod:`~eomgen.model.checks` (validation, :func:`build_model`) and
+:mod:`~eomgen.model.moving_mass` (what the dynamics see of the masses: joints that move no
+mass, inertias whose findings do not matter). Import every name from
 ``eomgen.model``.
 """
 
@@ -46,6 +48,7 @@ from .contact import POINT, SURFACE, Contact
 from .coupling import Coupling, couple, coupling_map, make_coupling, uncoupled, with_couplings
 from .loop import HINGE, LOOP_KINDS, POINT_LOOP, WELD, Loop, LoopFrame
 from .notices import Notice, NoticeKind, emit_notices
+from .moving_mass import massless_joints, massless_notices, settled
 from .parts import Inertial, Joint, JointType, Link, Parameter
 from .quaternion import (
     FREE_FLYER_CONFIGURATION,
@@ -76,6 +79,6 @@ __all__ = [
     "NoticeKind", "Parameter", "QuaternionJoint", "RobotModel", "Scalar", "Snap", "Transform", "Vec3",
     "all_scalars", "build_model", "check_actuator", "float_constants", "check_axis", "check_inertial",
     "check_size", "check_tree", "configuration_size", "emit_notices", "expand_ball_joints", "flexible_indices", "joint_actuators",
-    "joint_motion", "lock_joints", "mat3", "parameter_symbol", "quaternion_layout", "rotation_about_axis",
+    "joint_motion", "lock_joints", "massless_joints", "massless_notices", "settled", "mat3", "parameter_symbol", "quaternion_layout", "rotation_about_axis",
     "rotation_from_rpy", "scalar", "snap", "snap_summary", "snapping", "vec3",
 ]

@@ -7,6 +7,7 @@ from typing import Mapping
 
 import sympy as sp
 
+from .. import reprs
 from .scalars import Scalar, scalar
 
 #: Coulomb friction is smoothed as ``friction · tanh(q̇ / friction_width)`` for simulation; this
@@ -46,6 +47,8 @@ class Actuator:
         The rotor inertia [kg m²] and gear ratio when the description gives them (None
         otherwise); ``armature`` holds their product ``r² I_rotor``.
     """
+
+    __repr__ = reprs.field_repr  # its numbers as short as they read back
 
     armature: Scalar = sp.Integer(0)
     damping: Scalar = sp.Integer(0)

@@ -18,6 +18,7 @@ from ..errors import (
     ParameterError,
     TooLargeError,
 )
+from .moving_mass import settled
 from .notices import Notice, NoticeKind, emit_notices
 from .parts import Inertial, Joint, Link, Parameter
 from .quaternion import expand_ball_joints
@@ -335,5 +336,6 @@ def build_model(
     if undeclared:
         model = replace(model, parameters=params + tuple(Parameter(s) for s in undeclared))
     if not defer_notices:
+        model = settled(model)
         emit_notices(model.notices, strict)
     return model

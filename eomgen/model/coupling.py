@@ -28,6 +28,7 @@ from typing import Mapping, Sequence
 
 import sympy as sp
 
+from .. import reprs
 from ..errors import KinematicTreeError, UnsupportedError
 from .scalars import scalar
 
@@ -49,6 +50,8 @@ class Coupling:
         Where the coupling was declared (``"joint 'x' <mimic>"``, ``"couplings[0]"``), for
         error messages; no part of comparing couplings.
     """
+
+    __repr__ = reprs.field_repr  # its numbers as short as they read back
 
     follower: str
     leaders: tuple[tuple[str, sp.Expr], ...]

@@ -20,9 +20,13 @@ class NoticeKind(enum.Enum):
     """What a :class:`Notice` is about."""
 
     TRIANGLE_INEQUALITY = "triangle inequality"  # a link inertia that is not physical
+    NO_MASS = "moves no mass"                    # a joint whose row of M(q) is zero
     MIMIC = "mimic"                              # a URDF <mimic> coupling read as independent
     FLOATING_BASE = "floating base"              # a root that looks free, read as fixed
     NOT_MODELLED = "not modelled"                # a feature left out (MJCF tendons, springs)
+
+#: The kinds about masses and inertias (:class:`~eomgen.errors.PhysicalConsistencyWarning`).
+_INERTIAL = (NoticeKind.TRIANGLE_INEQUALITY, NoticeKind.NO_MASS)
 
 
 @dataclass(frozen=True)
@@ -59,14 +63,14 @@ class Notice:
     @property
     def category(self) -> type[Warning]:
         """The warning class issued without ``strict``."""
-        if self.kind is NoticeKind.TRIANGLE_INEQUALITY:
+        if self.kind in _INERTIAL:
             return PhysicalConsistencyWarning
         return UnsupportedFeatureWarning
 
     @property
     def error(self) -> type[DescriptionError]:
         """The error class raised under ``strict``."""
-        if self.kind is NoticeKind.TRIANGLE_INEQUALITY:
+        if self.kind in _INERTIAL:
             return InvalidInertiaError
         return UnsupportedError
 

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
+from .. import reprs
 from .actuator import Actuator
 from .scalars import ZERO3, Mat3, Scalar, Vec3, mat3, scalar, vec3
 from .transforms import Transform
@@ -39,6 +40,8 @@ class Inertial:
     """Mass [kg], centre of mass [m] in the link frame, inertia [kg m²] about the centre of mass
     in the link frame axes."""
 
+    __repr__ = reprs.field_repr  # its numbers as short as they read back
+
     mass: Scalar
     com: Vec3 = ZERO3
     inertia: Mat3 = field(default_factory=lambda: mat3([[0, 0, 0], [0, 0, 0], [0, 0, 0]]))
@@ -53,6 +56,8 @@ class Inertial:
 class Link:
     """A rigid body. ``inertial`` is None for a massless link (valid: frames, sensors)."""
 
+    __repr__ = reprs.field_repr  # its numbers as short as they read back
+
     name: str
     inertial: Inertial | None = None
 
@@ -60,6 +65,8 @@ class Link:
 @dataclass(frozen=True)
 class Joint:
     """A joint from ``parent`` link to ``child`` link; see the module docstring for frames."""
+
+    __repr__ = reprs.field_repr  # its numbers as short as they read back
 
     name: str
     type: JointType
@@ -78,6 +85,8 @@ class Joint:
 class Parameter:
     """A symbol the model keeps symbolic, with the numeric value used where numbers are needed
     (verification, defaults of generated keyword arguments). ``value`` is None when unknown."""
+
+    __repr__ = reprs.field_repr  # its numbers as short as they read back
 
     symbol: sp.Symbol
     value: float | None = None

@@ -145,6 +145,19 @@ class RobotModel:
             stack.extend(reversed(children.get(joint.child, [])))
         return tuple(order)
 
+    def __repr__(self) -> str:
+        """One line: the name, the sizes, the joints and parameters by name, the source (the
+        parts: ``model.links``, ``model.joints``)."""
+        params = (f"{len(self.parameters)} parameters ({reprs.names(self.parameter_names)})"
+                  if self.parameters else "no parameters")
+        sizes = f"nq={self.nq}, nv={self.dof}" + (" (free flyer)" if self.free_flyer else "")
+        return (f"<RobotModel {self.name!r}: {sizes}, joints {reprs.names(self.joint_names)}; "
+                f"{len(self.links)} links; {params}; from {self.source}>")
+
+    @property
+    def parameter_names(self) -> tuple[str, ...]:
+        return tuple(p.name for p in self.parameters)
+
     def _repr_html_(self) -> str | None:  # rich display in notebooks: registered by eomgen.display
         return reprs.render("model", self, "text/html")
 

@@ -8,6 +8,7 @@ from typing import Iterable
 
 import sympy as sp
 
+from .. import reprs
 from .scalars import IDENTITY3, ZERO3, Mat3, Vec3, mat3, vec3
 from .snapping import exact_angle, snap
 
@@ -68,6 +69,8 @@ def rotation_from_rpy(rpy: Vec3) -> Mat3:
 @dataclass(frozen=True)
 class Transform:
     """A rigid transform: ``p_parent = rotation · p_child + translation``."""
+
+    __repr__ = reprs.field_repr  # its numbers as short as they read back
 
     rotation: Mat3 = IDENTITY3
     translation: Vec3 = ZERO3

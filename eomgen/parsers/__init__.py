@@ -12,8 +12,9 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Callable
 
-from ..errors import TooLargeError, UnknownFormatError, UnreadableFileError
-from ..model import Notice, NoticeKind, RobotModel, emit_notices, snapping, uncoupled
+from ..errors import TooLargeError, UnknownFormatError, UnreadableFileError, closest_name
+from ..model import Notice, NoticeKind, RobotModel, emit_notices, settled, snapping, uncoupled
+from ..robots import EXAMPLES
 
 #: ``load(path, strict, defer_notices=False)``.
 Loader = Callable[..., RobotModel]
@@ -53,9 +54,12 @@ def load(path, strict: bool = False, defer_notices: bool = False,
     Parameters
     ----------
     path:
-        The description file.
+        The description file, or the name of a bundled example (:data:`eomgen.robots.EXAMPLES`,
+        e.g. ``"elbow_rrr"``; a file of that name wins), as the commands take it. A missing
+        file's error suggests a close name (:func:`near_miss`).
     strict:
-        Refuse (rather than warn about) inertias that break the triangle inequality and
+        Refuse (rather than warn about) inertias that break the triangle inequality, joints
+        that move no mass (:mod:`eomgen.model.moving_mass`) and
         features read in a simpler way than described (a URDF root that looks like a floating
         base; followers read as independent joints with ``couplings=False``).
     defer_notices:
@@ -86,8 +90,10 @@ def load(path, strict: bool = False, defer_notices: bool = False,
     from . import dh, mjcf, urdf, yaml_format  # noqa: F401
 
     path = Path(path)
+    if not path.exists() and str(path) in EXAMPLES:
+        path = EXAMPLES[str(path)]
     if not path.is_file():
-        raise UnreadableFileError(str(path), "", "no such file")
+        raise UnreadableFileError(str(path), "", "no such file" + near_miss(path))
     if path.stat().st_size > MAX_FILE_BYTES:
         raise TooLargeError(str(path), "", f"file larger than {MAX_FILE_BYTES} bytes")
     suffix = path.suffix.lower()
@@ -111,12 +117,36 @@ def load(path, strict: bool = False, defer_notices: bool = False,
                 + "): a DH table needs a top-level 'dh' list, an eomgen robot 'links' and 'joints'")
         candidates = sniffed
     with snapping(snap) as snaps:
-        model = candidates[0].load(path, strict, defer_notices=defer_notices)
+        model = candidates[0].load(path, strict, defer_notices=True)
     if snaps:
         model = replace(model, info=model.info + (("snapped", tuple(snaps)),))
     if not couplings and model.couplings:
-        model = independent_followers(model, strict, defer_notices)
+        model = independent_followers(model, strict, defer_notices=True)
+    model = settled(model)  # the whole model known: what its masses leave to say
+    if not defer_notices:
+        emit_notices(model.notices, strict)
     return model
+
+
+#: At most this many names of a folder are compared with a missing file's (:func:`near_miss`).
+NEAR_MISS_SCAN = 2000
+
+
+def near_miss(path: Path) -> str:
+    """``"; did you mean 'x'?"`` for a missing description ``path``: the closest name among the
+    files beside it and, for a bare name, the bundled examples (:data:`eomgen.robots.EXAMPLES`,
+    which commands take by name); empty when none is close."""
+    known: dict[str, str] = {}  # the name compared → what to suggest
+    try:
+        for _, entry in zip(range(NEAR_MISS_SCAN), (path.parent or Path(".")).iterdir()):
+            if entry.is_file():
+                known[entry.name] = str(path.with_name(entry.name))
+    except OSError:
+        pass
+    if path.parent == Path("."):
+        known.update({name: name for name in EXAMPLES})
+    hint = closest_name(path.name, known)
+    return f"; did you mean '{known[hint]}'?" if hint else ""
 
 
 def independent_followers(model: RobotModel, strict: bool = False,

@@ -116,6 +116,7 @@ from ..model import (
     with_couplings,
     emit_notices,
     mat3,
+    settled,
     rotation_from_rpy,
     scalar,
     vec3,
@@ -232,6 +233,7 @@ def _read_robot(data: str | bytes, source: str, strict: bool, defer_notices: boo
     notices = ([floating] if floating is not None else []) + list(model.notices)
     model = replace(model, notices=tuple(notices))
     if not defer_notices:
+        model = settled(model)
         emit_notices(model.notices, strict)
     return model
 

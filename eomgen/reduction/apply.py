@@ -24,16 +24,18 @@ from ..model import (
     check_actuator,
     emit_notices,
     lock_joints,
+    massless_joints,
     scalar,
     vec3,
     with_couplings,
 )
 from ..model.coupling import locked_couplings
+from ..model.moving_mass import massless_problem
 from ..outputs import select
 from ..parsers import load
 from ..scene import Payload, Scene, did_you_mean, scene_error
 from ..symbolic.frames import frame_site
-from .inertia import (clean_transform, combined_inertial, inertial_scalars, is_zero_inertial,
+from .inertia import (clean_transform, combined_inertial, inertial_scalars,
                       substituted_inertial, tidy)
 from .planar import in_plane, planar_motion
 from .loops import with_loops
@@ -532,17 +534,7 @@ def _reroot(model: RobotModel) -> tuple[RobotModel, str]:
 
 
 def _massless_notes(model: RobotModel) -> list[str]:
-    """A note for each moving body whose subtree carries no mass at all (M is then singular)."""
-    children: dict[str, list[str]] = {}
-    for j in model.joints:
-        children.setdefault(j.parent, []).append(j.child)
-    links = model.link_by_name
-
-    def massless(name: str) -> bool:
-        inertial = links[name].inertial
-        if inertial is not None and not is_zero_inertial(inertial):
-            return False
-        return all(massless(c) for c in children.get(name, []))
-
-    return [f"joint '{j.name}' moves nothing with mass: the mass matrix is singular"
-            for j in model.movable_joints if massless(j.child)]
+    """A note for each joint that moves no mass (M is then singular,
+    :func:`eomgen.model.massless_joints`)."""
+    return [f"joint '{joint}' {massless_problem(links)}"
+            for joint, links in massless_joints(model)]

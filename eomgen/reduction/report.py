@@ -7,6 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import NamedTuple
 
+from .. import reprs
 from ..model import RobotModel
 from .inertia import is_zero_inertial
 from .planar import PlanarMotion
@@ -97,6 +98,12 @@ class ReductionReport:
     #: The six virtual joints a scene's ``floating_base`` put above the root (moving, but not
     #: the description's); empty without a floating base.
     virtual_joints: tuple[str, ...] = ()
+
+    def __repr__(self) -> str:
+        """One line: the robot, the scene, what moves (the whole report: :meth:`markdown`)."""
+        return (f"<ReductionReport of {self.robot!r} by scene {self.scene!r}: "
+                f"{self.moving_summary()} ({reprs.names(self.moving)}); outputs "
+                f"{reprs.names(self.outputs, most=8)}; {len(self.notes)} notes>")
 
     @property
     def locked_by_default(self) -> tuple[str, ...]:

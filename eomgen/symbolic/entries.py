@@ -59,6 +59,12 @@ class EntryProgram:
     def __hash__(self):
         return self._hash
 
+    def __getstate__(self):
+        # the compiled function is SymPy lambdify's (defined in a namespace of its own, not
+        # importable): a cache, left out so that an entry, and the Dynamics holding it, pickle
+        # after being evaluated; compiled again on first use
+        return {**self.__dict__, "_compiled": None}
+
     @property
     def pruned(self) -> tuple:
         """The definitions the entry needs, in order."""

@@ -152,26 +152,98 @@ def test_debug_shows_a_traceback(tmp_path):
 # ----------------------------------------------------------------------------------------------
 
 
-def test_puma560_warns_about_link1_and_passes():
-    path = example_path("puma560_dh")
-    result = run("verify", path, "--samples", "3", "--quiet")  # warnings even when quiet
+@pytest.mark.parametrize("command", ["verify", "generate", "teach", "bench"])
+def test_a_near_miss_of_a_bundled_name_is_suggested(command, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # no file of that name here
+    result = run(command, "elbow_rr", "--quiet")
+    assert result.exit_code == 2, result.output
+    assert result.stderr.splitlines() == [
+        f"{ERROR}elbow_rr: no such file; did you mean 'elbow_rrr'?"]
+
+
+def test_a_bundled_name_is_a_description_in_python_too():
+    assert eomgen.load("elbow_rrr") == eomgen.load(example_path("elbow_rrr"))
+
+
+def test_a_near_miss_of_a_file_is_suggested_with_its_folder(tmp_path):
+    write(tmp_path / "arm.urdf", "<robot/>")
+    result = run("verify", tmp_path / "arms.urdf", "--quiet")
+    assert result.exit_code == 2, result.output
+    assert result.stderr.splitlines() == [
+        f"{ERROR}{tmp_path / 'arms.urdf'}: no such file; did you mean '{tmp_path / 'arm.urdf'}'?"]
+    far = run("verify", tmp_path / "nothing_alike.yaml", "--quiet")
+    assert far.stderr.splitlines() == [f"{ERROR}{tmp_path / 'nothing_alike.yaml'}: no such file"]
+
+
+def test_a_misspelled_output_is_one_short_line(tmp_path):
+    """The suggestions first, then where the list is: not the list of every output."""
+    from eomgen.outputs import OUTPUTS
+
+    result = run("generate", "--outputs", "M,regresor", "-o", tmp_path / "out", "--no-cache")
+    assert result.exit_code == 2, result.output
+    (line,) = result.stderr.splitlines()
+    assert line == (f"{ERROR}--outputs: unknown output 'regresor'; did you mean 'regressor' or "
+                    "'base_regressor'? (docs/outputs.md lists them all; in Python, "
+                    "eomgen.outputs.OUTPUTS)")
+    assert sum(name in line for name in OUTPUTS) <= 3 and len(line) < 200
+    assert "`regressor`" in (support.ROOT / "docs/outputs.md").read_text(encoding="utf-8")
+    assert not (tmp_path / "out").exists()
+
+
+def test_puma560_passes_silently_even_under_strict():
+    """Its published links 1 and 3 break the triangle inequality, but its dynamics are a
+    physical robot's (tests/parsers/test_yaml_dh.py): nothing to warn about or refuse."""
+    result = run("verify", example_path("puma560_dh"), "--samples", "3", "--quiet", "--strict")
     assert result.exit_code == 0, result.output
-    warnings = result.stderr.splitlines()
-    assert warnings and all(line.startswith(f"{WARNING}{path}: link '") for line in warnings)
-    assert any(line.startswith(f"{WARNING}{path}: link 'link1'") for line in warnings)
-    assert all("triangle inequality" in line for line in warnings)
+    assert result.stderr == ""
     assert result.stdout.splitlines()[-1] == "all checks passed"
 
 
-def test_puma560_is_refused_under_strict():
-    path = example_path("puma560_dh")
-    result = run("verify", path, "--strict")
+#: A two-joint arm whose tip link has no <inertial>: joint 'wrist' moves no mass.
+MASSLESS_TIP = """<robot name="arm">
+  <link name="base"/>
+  <link name="upper"><inertial><origin xyz="0.5 0 0"/><mass value="1"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+  <link name="tip"/>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/>
+    <axis xyz="0 0 1"/></joint>
+  <joint name="wrist" type="revolute"><parent link="upper"/><child link="tip"/>
+    <origin xyz="1 0 0"/><axis xyz="0 0 1"/></joint>
+</robot>
+"""
+MASSLESS = ("joint 'wrist': moves no mass: link 'tip' after it carries no mass (nor inertia "
+            "about its axis), so its row of M(q) is zero and forward dynamics fail; give it an "
+            "inertial or make the joint fixed")
+
+
+def test_verify_names_the_joint_that_moves_no_mass(tmp_path):
+    path = write(tmp_path / "tip.urdf", MASSLESS_TIP)
+    result = run("verify", path, "--samples", "3", "--quiet")
+    assert result.exit_code == 1, result.output
+    assert result.stderr.splitlines() == [f"{WARNING}{path}: {MASSLESS}"]
+    lines = result.stdout.splitlines()
+    assert any(line.startswith("  FAIL M positive definite") for line in lines)
+    assert f"  M is singular: {MASSLESS.replace(':', '', 1)}" in lines
+    assert lines[-1] == "SOME CHECKS FAILED"
+
+
+def test_generate_warns_about_the_joint_that_moves_no_mass(tmp_path):
+    path = write(tmp_path / "tip.urdf", MASSLESS_TIP)
+    result = run("generate", path, "--backend", "numpy", "-o", tmp_path / "out", "--quiet",
+                 "--no-cache")
+    assert result.exit_code == 0, result.output
+    assert result.stderr.splitlines() == [f"{WARNING}{path}: {MASSLESS}"]
+    assert (tmp_path / "out" / "arm_numpy.py").is_file()
+
+
+def test_generate_strict_refuses_the_joint_that_moves_no_mass_and_writes_nothing(tmp_path):
+    path = write(tmp_path / "tip.urdf", MASSLESS_TIP)
+    result = run("generate", path, "--backend", "numpy", "-o", tmp_path / "out", "--quiet",
+                 "--no-cache", "--strict")
     assert result.exit_code == 2, result.output
-    lines = result.stderr.splitlines()
-    assert len(lines) == 1, result.stderr
-    assert lines[0].startswith(f"{ERROR}{path}: link 'link1'")
-    assert "triangle inequality" in lines[0] and "--strict" in lines[0]
-    assert result.stdout == ""
+    assert result.stderr.splitlines() == [
+        f"{ERROR}{path}: {MASSLESS} (refused under --strict)"]
+    assert result.stdout == "" and not (tmp_path / "out").exists()
 
 
 def test_mimic_joint_is_honoured_under_strict():
@@ -261,7 +333,8 @@ def test_a_bundled_example_name_is_a_description_in_every_command(tmp_path, monk
     assert refused.exit_code == 2
     assert refused.stderr.startswith(f"{ERROR}scara_rrp: unknown file type ''")
     missing = run("verify", "scara")
-    assert missing.exit_code == 2 and missing.stderr == f"{ERROR}scara: no such file\n"
+    assert missing.exit_code == 2 and missing.stderr == (
+        f"{ERROR}scara: no such file; did you mean 'scara_rrp'?\n")
 
 
 def click_context(command):

@@ -175,3 +175,21 @@ def test_expand_program_keeps_exact_numbers_and_parameters():
                                     sp.sin(q2) ** 2: 1 - sp.cos(q2) ** 2}))
     assert out == direct and not out.atoms(sp.Float)  # the same canonical SymPy expression
     assert out.args == direct.args
+
+
+@pytest.mark.parametrize("which", ["planar_2link", pytest.param("spatial5",
+                                                                 marks=pytest.mark.slow)])
+def test_dynamics_pickle_after_sympy_lambdify_and_evaluation(which):
+    """``sympy.lambdify`` of M, then a call: a named entry compiles its program on first use
+    (a function of lambdify's own namespace, which pickle cannot name), yet the Dynamics
+    still pickles, and the copy's M is the original's, evaluating to the same numbers."""
+    import pickle
+
+    dyn = (eomgen.derive(eomgen.load(eomgen.example_path("planar_2link")))
+           if which == "planar_2link" else spatial5())
+    inputs = list(dyn.q) + sorted(dyn.M.free_symbols - set(dyn.q), key=str)
+    point = [0.1 * (k + 1) for k in range(len(inputs))]
+    before = np.asarray(sp.lambdify(inputs, dyn.M)(*point), float)
+    copy = pickle.loads(pickle.dumps(dyn))
+    assert sp.Matrix(copy.M) == sp.Matrix(dyn.M)  # entry by entry (named: the same programs)
+    close(np.asarray(sp.lambdify(inputs, copy.M)(*point), float), before)

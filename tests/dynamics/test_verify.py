@@ -23,7 +23,7 @@ import sympy as sp
 
 import eomgen
 from eomgen.dynamics import ALL_OUTPUTS, Dynamics, derive
-from eomgen.errors import DescriptionError, PhysicalConsistencyWarning
+from eomgen.errors import DescriptionError
 from eomgen.model import (
     Inertial,
     Joint,
@@ -65,8 +65,7 @@ def planar() -> Dynamics:
 
 @functools.cache
 def puma() -> Dynamics:
-    with pytest.warns(PhysicalConsistencyWarning):  # link 1's published inertia
-        return derive(eomgen.load(example_path("puma560_dh")))
+    return derive(eomgen.load(example_path("puma560_dh")))
 
 
 def massive_random_robot(seed: int, n: int, tree: bool):
@@ -257,3 +256,67 @@ def test_verify_does_not_warn():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         verify(planar(), samples=3)
+
+
+# ----------------------------------------------------------------------------------------------
+# Joints that move no mass: named by the model check, against the rows of M from Newton–Euler
+# ----------------------------------------------------------------------------------------------
+
+_ARM = ('<link name="base"/><link name="upper"><inertial><origin xyz="0.5 0 0"/>'
+        '<mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/>'
+        '</inertial></link>'
+        '<joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/>'
+        '<axis xyz="0 0 1"/></joint>')
+
+
+def _tip(mass="0", inertia=(0, 0, 0)) -> str:
+    ixx, iyy, izz = inertia
+    return (f'<link name="tip"><inertial><mass value="{mass}"/><inertia ixx="{ixx}" ixy="0" '
+            f'ixz="0" iyy="{iyy}" iyz="0" izz="{izz}"/></inertial></link>')
+
+
+def _wrist(kind="revolute", axis="0 0 1") -> str:
+    return (f'<joint name="wrist" type="{kind}"><parent link="upper"/><child link="tip"/>'
+            f'<origin xyz="1 0 0" rpy="0.3 0 0"/><axis xyz="{axis}"/></joint>')
+
+
+_HAND = ('<link name="hand"><inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" '
+         'iyz="0" izz="0.2"/></inertial></link>')
+
+
+@pytest.mark.parametrize("parts, expected", [
+    ([_tip(), _wrist()], [("wrist", ("tip",))]),  # no mass, no inertia
+    (['<link name="tip"/>', _wrist()], [("wrist", ("tip",))]),  # no <inertial>
+    ([_tip(inertia=(0.2, 0, 0)), _wrist()], [("wrist", ("tip",))]),  # inertia across the axis
+    ([_tip(inertia=(0, 0, 0.2)), _wrist()], []),  # inertia about the axis
+    ([_tip(inertia=(0.2, 0.2, 0.2)), _wrist("prismatic")], [("wrist", ("tip",))]),
+    ([_tip(mass="0.1"), _wrist("prismatic")], []),
+    # a link fixed to the tip carries mass: merged, the wrist moves it
+    ([_tip(), _wrist(), '<link name="sensor"><inertial><mass value="0.1"/><inertia ixx="0" '
+      'ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link><joint name="bolt" '
+      'type="fixed"><parent link="tip"/><child link="sensor"/><origin xyz="0 0.1 0"/></joint>'],
+     []),
+    # inertia about z of a hand turned about x (roll): the wrist moves it, the roll does not
+    ([_tip(), _wrist(), _HAND, '<joint name="roll" type="revolute"><parent link="tip"/>'
+      '<child link="hand"/><axis xyz="1 0 0"/></joint>'], [("roll", ("hand",))]),
+    # the hand turns about the wrist's own axis: its moment about z stays; x-only would not
+    ([_tip(), _wrist(), _HAND.replace('izz="0.2"', 'izz="0"').replace('ixx="0"', 'ixx="0.2"'),
+      '<joint name="yaw" type="revolute"><parent link="tip"/><child link="hand"/>'
+      '<axis xyz="0 0 1"/></joint>'], [("wrist", ("tip", "hand")), ("yaw", ("hand",))]),
+])
+def test_joints_that_move_no_mass_are_the_zero_rows_of_M(parts, expected):
+    from eomgen.model import massless_joints
+    from eomgen.parsers.urdf import parse_urdf_string
+    from eomgen.verify import reference_rnea
+
+    model = parse_urdf_string("<robot name='r'>" + _ARM + "".join(parts) + "</robot>",
+                              defer_notices=True)
+    assert list(massless_joints(model)) == expected
+    rnea, n = reference_rnea(model), model.dof
+    rng = np.random.default_rng(1)
+    zero_rows = set(range(n))
+    for _ in range(3):
+        q, zeros = rng.uniform(-np.pi, np.pi, n), np.zeros(n)
+        M = np.column_stack([rnea(q, zeros, e) - rnea(q, zeros, zeros) for e in np.eye(n)])
+        zero_rows &= {i for i in range(n) if np.abs(M[i]).max() < 1e-12}
+    assert sorted(zero_rows) == sorted(model.joint_names.index(j) for j, _ in expected)

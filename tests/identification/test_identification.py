@@ -35,7 +35,7 @@ PLANAR = eomgen.example_path("planar_2link")
 @lru_cache(maxsize=None)
 def setup(name: str):
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # the PUMA's links 1 and 3 break the triangle inequality
+        warnings.simplefilter("ignore")
         model = eomgen.load(eomgen.example_path(name))
     reg = derive_regressor(model)
     base = base_parameters(reg)

@@ -602,8 +602,10 @@ def test_unreadable_file_is_a_description_error(tmp_path):
         load_urdf(tmp_path, False)  # a directory
 
 
+#: Principal moments 3, 1, 1 with the excess across the joint's axis (z): no rotational
+#: inertia about that axis moved from the world makes the body physical, so it warns.
 TRIANGLE = with_mass('<mass value="1"/>',
-                     '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="3"/>')
+                     '<inertia ixx="3" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/>')
 
 
 def test_triangle_inequality_warns_by_default(tmp_path):
@@ -611,7 +613,7 @@ def test_triangle_inequality_warns_by_default(tmp_path):
     path.write_text(TRIANGLE, encoding="utf-8")
     with pytest.warns(PhysicalConsistencyWarning) as record:
         model = eomgen.load(path)
-    assert model.link_by_name["arm"].inertial.inertia[2][2] == 3
+    assert model.link_by_name["arm"].inertial.inertia[0][0] == 3
     message = str(record[0].message)
     assert message.startswith(f"{path}: link 'arm'") and "triangle inequality" in message
 
@@ -793,3 +795,42 @@ def test_documented_floating_base_warning_is_what_eomgen_prints(erd_robots_dir):
     path = erd_robots_dir / "solo_description/robots/solo12.urdf"
     model = parse_urdf_string(path.read_bytes(), source="solo12.urdf", defer_notices=True)
     assert documented == [n.message for n in floating_notices(model)]
+
+
+# ----------------------------------------------------------------------------------------------
+# Inertias that do not matter: the Go1's placeholder root
+# ----------------------------------------------------------------------------------------------
+
+
+def _go1_text(robots) -> str:
+    return (robots / "go1_description/urdf/go1.urdf").read_text(encoding="utf-8")
+
+
+def _inertia_warnings(path) -> list[str]:
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        eomgen.load(path)
+    return [str(w.message) for w in caught if issubclass(w.category, PhysicalConsistencyWarning)]
+
+
+def test_go1_placeholder_root_inertia_does_not_warn(erd_robots_dir):
+    """The Go1's root link 'base' carries a placeholder (1e-6 in every entry: moments 0, 0,
+    3e-6) and is fixed to the world with the trunk: it never moves, nothing to warn about."""
+    text = _go1_text(erd_robots_dir)
+    assert '<inertia ixx="1e-6" ixy="1e-6" ixz="1e-6" iyy="1e-6" iyz="1e-6" izz="1e-6"/>' in text
+    assert _inertia_warnings(erd_robots_dir / "go1_description/urdf/go1.urdf") == []
+
+
+def test_go1_with_a_bad_leg_inertia_still_warns(erd_robots_dir, tmp_path):
+    """A thigh whose largest moment lies across its joint axis (y): no inertia moved across the
+    joint makes it physical, so it warns, naming the link."""
+    text = _go1_text(erd_robots_dir)
+    head, tail = text.split('<link name="FR_thigh">', 1)
+    start, end = tail.index("<inertia "), tail.index("/>", tail.index("<inertia ")) + 2
+    bad = '<inertia ixx="3" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/>'
+    path = tmp_path / "go1.urdf"
+    path.write_text(head + '<link name="FR_thigh">' + tail[:start] + bad + tail[end:],
+                    encoding="utf-8")
+    (message,) = _inertia_warnings(path)
+    assert message.startswith(f"{path}: link 'FR_thigh' inertial: principal moments 1, 1, 3 "
+                              "break the triangle inequality")

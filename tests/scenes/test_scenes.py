@@ -695,8 +695,9 @@ def test_cli_warns_and_refuses_only_about_what_the_scene_keeps(tmp_path):
     common = ("--backend", "numpy", "--quiet")
     whole = run_process("generate", description, "-o", tmp_path / "a", *common)
     assert whole.returncode == 0, whole.stderr
-    assert len(warning_lines(whole.stderr)) == 3  # without a scene: everything (the mimic
-    # finger follows: no warning)
+    assert [line.split(": ")[3] for line in warning_lines(whole.stderr)] == [
+        "link 'other' inertial", "link 'sensor' inertial"]  # without a scene: everything but
+    # the plate, which never moves (fixed to the world), and the mimic finger, which follows
     locked = run_process("generate", description, "--scene", fingers, "-o", tmp_path / "b",
                          *common)
     assert locked.returncode == 0, locked.stderr

@@ -83,7 +83,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from ...errors import DescriptionError, UnknownFormatError, UnreadableFileError, UnsupportedError
-from ...model import RobotModel, emit_notices
+from ...model import RobotModel, emit_notices, settled
 from .. import register
 from .extras import model_notices, motors, with_equalities
 from .tree import build_tree
@@ -192,6 +192,7 @@ def model_from_mujoco(m, source: str = "<mujoco>", strict: bool = False,
                     info=model.info + (("mujoco_motors", tuple(
                         motor for motor in motors(m) if motor[1] in present)),))
     if not defer_notices:
+        model = settled(model)
         emit_notices(model.notices, strict)
     return model
 
