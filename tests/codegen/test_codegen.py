@@ -40,7 +40,7 @@ import sympy as sp
 
 import eomgen
 from eomgen.codegen import BACKENDS, Backend, GeneratedFile, available_backends
-from eomgen.codegen.backends.casadi_backend import FUNCTION_NAMES, c_compiler
+from eomgen.codegen.backends.casadi_backend import FUNCTION_NAMES, c_compiler, library_name
 from eomgen.codegen.generate import generate, keep_symbolic, render_files, write_atomically
 from eomgen.model import (Inertial, Joint, JointType, Link, Parameter, RobotModel, Transform,
                           build_model, vec3)
@@ -138,7 +138,7 @@ def build_example(name: str, model: RobotModel, outdir: Path, backends="numpy,ca
     paths = generate(model, outdir, backends)
     by_name = {p.name: p for p in paths}
     stem = next(p.name[:-len("_numpy.py")] for p in paths if p.name.endswith("_numpy.py"))
-    library = by_name.get(stem + "_casadi.so")
+    library = by_name.get(library_name(stem))
     compiled = None
     if library is not None:
         compiled = {f: ca.external(f, str(library)) for f in FUNCTION_NAMES}
@@ -536,7 +536,7 @@ def load_interfaces(files: list[GeneratedFile], outdir: Path, model: RobotModel,
     stem = next(n[:-len("_numpy.py")] for n in paths if n.endswith("_numpy.py"))
     numpy_module = load_module(paths[stem + "_numpy.py"], f"{name}_numpy")
     functions = tuple(f for f in FUNCTION_NAMES if hasattr(numpy_module, f))
-    library = paths.get(stem + "_casadi.so")
+    library = paths.get(library_name(stem))
     if library is None:
         assert c_compiler() is None, "a C compiler exists but no shared library was built"
     compiled = None if library is None else {f: ca.external(f, str(library)) for f in functions}
@@ -700,7 +700,7 @@ def test_no_c_compiler_is_one_warning_line(tmp_path):
     command = [sys.executable, "-m", "eomgen.cli", "generate", "--backend", "numpy,c",
                "--cache-dir", str(tmp_path / "cache"), "-o", str(tmp_path / "out")]
     expected = ("eomgen: warning: no C compiler found ($CC, cc, gcc, clang): wrote "
-                "planar_2link_casadi.c/.h without the .so")
+                "planar_2link_casadi.c/.h without libplanar_2link_casadi.so")
     for run in ("derived", "cached"):
         result = subprocess.run(command + ["--quiet"], env=env, capture_output=True, text=True,
                                 timeout=120)
@@ -718,7 +718,7 @@ def test_no_c_compiler_warns_library_callers(build, tmp_path, monkeypatch):
     monkeypatch.setenv("PATH", str(tmp_path))
     assert c_compiler() is None
     model = build("planar_2link").model
-    match = r"^no C compiler found .*: wrote planar_2link_casadi\.c/\.h without the \.so$"
+    match = r"^no C compiler found .*: wrote planar_2link_casadi\.c/\.h without libplanar_2link_casadi\.so$"
     with pytest.warns(NoCompilerWarning, match=match):
         paths = generate(model, tmp_path / "a", "c", cache_dir=tmp_path / "cache")
     assert [p.name for p in paths] == ["planar_2link_casadi.c", "planar_2link_casadi.h"]
@@ -830,7 +830,7 @@ def test_c_backend_accepts_names_with_repeated_underscores(tmp_path):
     paths = generate(model, tmp_path, "c")
     assert [p.name for p in paths][:2] == ["arm__2_casadi.c", "arm__2_casadi.h"]
     if c_compiler() is not None:
-        f = ca.external("gravity_vector", str(tmp_path / "arm__2_casadi.so"))
+        f = ca.external("gravity_vector", str(tmp_path / library_name("arm__2")))
         assert_close(ca_call(f, {}, [0.3]), rnea(numeric_model(model), [0.3], [0.0], [0.0]), "g")
 
 
@@ -1142,9 +1142,9 @@ def cli(tmp_path_factory) -> dict[str, CliRun]:
 
 def _expected_default_files() -> set[str]:
     suffixes = {"numpy": ["_numpy.py"], "casadi": ["_casadi.py"],
-                "c": ["_casadi.c", "_casadi.h"] + (["_casadi.so"] if c_compiler() else []),
-                "latex": [".tex"]}
-    return {"planar_2link" + s for b in available_backends() for s in suffixes.get(b, [])}
+                "c": ["_casadi.c", "_casadi.h"], "latex": [".tex"]}
+    library = {library_name("planar_2link")} if c_compiler() else set()
+    return {"planar_2link" + s for b in available_backends() for s in suffixes.get(b, [])} | library
 
 
 @pytest.mark.slow
