@@ -61,7 +61,7 @@ class CasADiConfig:
 def _render_module(job: Job, config: CasADiConfig) -> str:
     printer = CasADiPrinter({"standard": "python3"})
     # Parameters without a value have no default: the module refuses calls that leave them out.
-    required = [p.identifier for p in job.parameters if p.default is None]
+    required = [p.keyword for p in job.parameters if p.default is None]
     return render(config.template, required=required,
                   **python_module_context(job, printer, config.template, backend="casadi"))
 
