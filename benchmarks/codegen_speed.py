@@ -64,6 +64,7 @@ import casadi as ca  # noqa: E402
 
 import eomgen  # noqa: E402
 from eomgen.codegen import Job, available_backends, make_job  # noqa: E402
+from eomgen.codegen.backends.casadi_backend import library_name  # noqa: E402
 from eomgen.codegen.generate import write_atomically  # noqa: E402
 from eomgen.dynamics import ALL_OUTPUTS  # noqa: E402
 from eomgen.model import lock_joints  # noqa: E402
@@ -412,7 +413,7 @@ class Generated:
     job: Job
     numpy_module: object         # the loaded <robot>_numpy.py
     casadi_module: object        # the loaded <robot>_casadi.py
-    library: Path                # the compiled <robot>_casadi.so
+    library: Path                # the compiled lib<robot>_casadi.so
 
 
 def generate_code(robot: Robot, model: eomgen.RobotModel, tmp: Path, report: Report) -> Generated:
@@ -434,7 +435,7 @@ def generate_code(robot: Robot, model: eomgen.RobotModel, tmp: Path, report: Rep
         f"{k} {v:.2f} s" for k, v in stages.items()) + f"; total {sum(stages.values()):.2f} s")
     return Generated(dyn, job, load_module(outdir / f"{job.stem}_numpy.py"),
                      load_module(outdir / f"{job.stem}_casadi.py"),
-                     outdir / f"{job.stem}_casadi.so")
+                     outdir / library_name(job.stem))
 
 
 def measure_size(robot: Robot, code: Generated, report: Report) -> None:

@@ -67,10 +67,12 @@ def lambdify(dynamics: "eomgen.dynamics.Dynamics") -> NumericDynamics:  # noqa: 
     >>> import numpy as np, eomgen
     >>> dyn = eomgen.derive(eomgen.load(eomgen.example_path("planar_2link")))
     >>> f = dyn.lambdify()
-    >>> f.parameters[:3]  # sorted by name; g_ because g is the gravity vector's name
-    ('I1', 'I2', 'g_')
+    >>> f.parameters[:3]  # sorted by name: the description's names
+    ('I1', 'I2', 'g')
     >>> np.round(f.g(np.zeros(2), m2=2.0), 4)
     array([34.335,  9.81 ])
+    >>> np.round(f.g(np.zeros(2), g=1.62), 4)  # on the Moon
+    array([3.24, 0.81])
     """
     # Imported on first use (start-up time): code generation loads Jinja and the backends,
     # which `import eomgen` and derive never need.
@@ -94,7 +96,7 @@ def lambdify(dynamics: "eomgen.dynamics.Dynamics") -> NumericDynamics:  # noqa: 
         return getattr(module, name, None) if name in functions else None
 
     return NumericDynamics(
-        dynamics.joint_names, tuple(p.identifier for p in job.parameters),
+        dynamics.joint_names, tuple(p.keyword for p in job.parameters),
         tuple(p.symbol for p in job.parameters),
         get(BY_SYMBOL["M"].function), get(BY_SYMBOL["C"].function),
         get(BY_SYMBOL["g"].function), get(BY_SYMBOL["tau"].function), get(FORWARD.function),

@@ -21,6 +21,7 @@ import shutil
 import signal
 import tempfile
 from dataclasses import dataclass
+from importlib.machinery import EXTENSION_SUFFIXES, SOURCE_SUFFIXES
 from keyword import iskeyword
 from pathlib import Path
 from typing import Sequence
@@ -52,6 +53,53 @@ class GeneratedFile:
     name: str
     content: str | bytes
     golden: bool = True
+
+
+def import_name(file_name: str) -> str | None:
+    """The module name under which Python's import system finds the file ``file_name`` in a
+    folder on ``sys.path`` (an extension suffix such as ``.cpython-311-x86_64-linux-gnu.so`` or
+    a plain ``.so``, or ``.py``), or None for a file it never imports (``.c``, ``.tex``).
+    Extension modules come first in the import order: a ``.py`` file and a ``.so`` of one
+    import name leave the ``.py`` file unimportable.
+
+    >>> import_name("arm_numpy.py"), import_name("libarm_casadi.so"), import_name("arm.tex")
+    ('arm_numpy', 'libarm_casadi', None)
+    """
+    for suffix in (*EXTENSION_SUFFIXES, *SOURCE_SUFFIXES):
+        if file_name.endswith(suffix) and "." not in file_name[:-len(suffix)]:
+            return file_name[:-len(suffix)]
+    return None
+
+
+def python_module_name(file_name: str) -> str | None:
+    """The module that ``import`` loads from ``file_name``: a ``.py`` file's or an extension
+    module's built for this interpreter (its tagged suffix, e.g.
+    ``.cpython-311-x86_64-linux-gnu.so``); None for anything else, such as a C library
+    (``libarm_casadi.so``), which the import system finds but cannot load.
+
+    >>> python_module_name("arm_numpy.py"), python_module_name("libarm_casadi.so")
+    ('arm_numpy', None)
+    """
+    for suffix in (EXTENSION_SUFFIXES[0], *SOURCE_SUFFIXES):
+        if file_name.endswith(suffix) and "." not in file_name[:-len(suffix)]:
+            return file_name[:-len(suffix)]
+    return None
+
+
+def import_collisions(file_names: Sequence[str]) -> list[list[str]]:
+    """The groups of ``file_names`` that Python would import under one name
+    (:func:`import_name`), each sorted: files of one output folder must have none, or the
+    second of each group cannot be imported.
+
+    >>> import_collisions(["arm_casadi.py", "arm_casadi.so", "arm_numpy.py", "arm_casadi.c"])
+    [['arm_casadi.py', 'arm_casadi.so']]
+    """
+    groups: dict[str, list[str]] = {}
+    for name in file_names:
+        module = import_name(name)
+        if module is not None:
+            groups.setdefault(module, []).append(name)
+    return [sorted(group) for _, group in sorted(groups.items()) if len(group) > 1]
 
 
 def checked_stem(stem: str | None) -> str | None:

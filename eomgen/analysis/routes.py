@@ -16,7 +16,7 @@ Python floats, one state   float64  the program printed over Python floats with 
                                     (:func:`compile_scalar`; what ``eomgen simulate`` uses)
 CasADi SX, one state       float64  ``<robot>_casadi.py``'s ``casadi.Function``
 CasADi SX, map             float64  the same, ``Function.map(N)`` over the batch
-C (CasADi), one state      float64  the compiled ``<robot>_casadi.so`` via ``casadi.external``
+C (CasADi), one state      float64  the compiled ``lib<robot>_casadi.so`` via ``casadi.external``
 C (CasADi), map            float64  the same, mapped over the batch
 C (ctypes), one state      float64  the same library's C functions called through ctypes
                                     (no CasADi call layer: the speed of the C code itself
@@ -55,6 +55,7 @@ from ..progress import plural
 from ..numeric import M_crba, numeric_model, rnea
 from ..numeric.pinocchio import plain_calls, to_pinocchio
 from ..outputs import INVERSE, MASS
+from ..codegen.backends.casadi_backend import library_name
 from ..codegen.backends.numpy_backend import NumPyModulePrinter
 from ..symbolic.evaluate import FloatPrinter
 from ..symbolic.printing import program_function
@@ -235,20 +236,20 @@ def build_routes(model: RobotModel, workdir: Path, dynamics: Dynamics | None = N
     routes += _casadi_routes("CasADi SX", getattr(casadi_module, tau_name),
                              getattr(casadi_module, M_name), n,
                              "casadi.Function (SX virtual machine)")
-    library = paths.get(casadi_stem + ".so")
+    library = paths.get(library_name(job.stem))
     if library is not None:
         import casadi as ca  # optional dependency: only where a CasADi library was built
 
         routes += _casadi_routes("C (CasADi)", ca.external(tau_name, str(library)),
                                  ca.external(M_name, str(library)), n,
-                                 "compiled <robot>_casadi.so via casadi.external")
+                                 "compiled lib<robot>_casadi.so via casadi.external")
         shared = ctypes.CDLL(str(library))
         tau_c = CFunction(shared, tau_name)
         M_c = CFunction(shared, M_name)
         routes.append(Route("C (ctypes), one state", "float64", False,
                             _per_state(tau_c, (n,)),
                             _per_state(lambda q: M_c(q).reshape(n, n), (n, n)),
-                            "compiled <robot>_casadi.so called through ctypes"))
+                            "compiled lib<robot>_casadi.so called through ctypes"))
 
     fast_stem = job.stem + suffix("fast")
     fast = [p for name, p in paths.items() if name.startswith(fast_stem + ".")

@@ -10,13 +10,12 @@ from __future__ import annotations
 import dataclasses
 import sys
 import time
-from importlib.machinery import EXTENSION_SUFFIXES
 from pathlib import Path
 
 import click
 
 from ..errors import GenerationError, VerificationError
-from ..output import check_output_folder, checked_stem, write_atomically
+from ..output import check_output_folder, checked_stem, python_module_name, write_atomically
 from ..progress import Progress, plural
 from .handling import handle_errors, recorded_warnings
 from .loading import command_params, default_description, load, load_reduced
@@ -111,12 +110,9 @@ def functions_option(text: str | None) -> tuple[str, ...] | None:
 
 def import_hint(paths: list[Path], outdir: Path, stem_given: bool) -> str | None:
     """The line saying how to import the Python modules among ``paths`` (None when there are
-    none: LaTeX or C only): the ``.py`` files and extension modules, not a ``.py`` file that a
-    shared library of the same name (the C backend's ``<stem>_casadi.so``) would shadow."""
-    names = {p.name for p in paths}
-    modules = {n[:-3] for n in names if n.endswith(".py") and n[:-3] + ".so" not in names}
-    modules |= {n[:-len(EXTENSION_SUFFIXES[0])] for n in names
-                if n.endswith(EXTENSION_SUFFIXES[0])}
+    none: LaTeX or C only): every ``.py`` file and extension module
+    (:func:`eomgen.output.python_module_name`; no C library)."""
+    modules = {python_module_name(p.name) for p in paths} - {None}
     modules = sorted(modules, key=lambda m: (not m.endswith("_numpy"), m))
     if not modules:
         return None

@@ -39,12 +39,25 @@ class Argument:
 
 @dataclass(frozen=True)
 class ParameterArgument:
-    """A parameter kept symbolic: a keyword argument with the description's value as default."""
+    """A parameter kept symbolic: a keyword argument with the description's value as default.
 
+    ``keyword`` is what a caller passes: the description's ``name`` itself, unless no keyword
+    can be that (see :func:`parameter_arguments`). ``identifier`` names the parameter inside
+    the generated bodies, apart from the names they use themselves (``g_`` for ``g``, the
+    gravity vector's name); where it differs from the keyword, a function binds it first.
+    """
+
+    keyword: str
     identifier: str
     symbol: sp.Symbol
     default: float | None
     doc: str
+    name: str = ""
+
+    @property
+    def renamed(self) -> bool:
+        """Whether the keyword is not the description's name (a Python keyword, ...)."""
+        return self.keyword != self.name
 
 
 @dataclass(frozen=True)
@@ -63,31 +76,51 @@ class FunctionSpec:
     returns: tuple[tuple[str, int, int | None], ...] = ()
 
 
-#: Identifiers every generated module uses itself, whatever its backend; parameters avoid them,
-#: and the names each backend's modules import (``register(..., reserved=("np",))``), see
-#: :func:`reserved_identifiers`.
-RESERVED_IDENTIFIERS = frozenset(
-    {"math", *INPUTS, "out", "single", "batch", "n",
-     "JOINT_NAMES", "CONFIGURATION_NAMES", "NQ", "NV", "PARAMETERS", *OUTPUTS, *BY_SYMBOL,
-     "self", "cls", "L", "x", "y", "d",
-     "rhs", "bias", "args", "names", "vectors", "functions", "parameters", "q_columns",
-     "qd_columns", "qdd_columns", "k", "finite", "condition", "return_condition",
-     "close", "eigenvalues", "IllConditionedWarning",
+#: Names no parameter's keyword can take, whatever the backend: the other arguments of the
+#: generated functions (their inputs, ``return_condition``, ``damping``, ...), the names their
+#: bodies read from the module (its functions, constants and runtime helpers; Python's
+#: keywords and builtins), which a keyword argument of that name would hide. With the names
+#: each backend's modules import (``register(..., reserved=("np",))``), see
+#: :func:`reserved_keywords`.
+RESERVED_KEYWORDS = frozenset(
+    {"math", *INPUTS, "return_condition", "damping", "linear", "frames", "who",
+     "JOINT_NAMES", "CONFIGURATION_NAMES", "NQ", "NV", "PARAMETERS", *OUTPUTS,
+     "IllConditionedWarning",
      # the Cholesky runtime NumPy modules include (eomgen.runtime.cholesky)
      "_CONDITION_LIMIT", "_EXACT_FROM", "_condition_estimate", "_condition_number",
      "_ill_conditioned_message", "_cholesky_solve", "_at", "_not_positive_definite"}
-) | frozenset(keyword.kwlist) | frozenset(keyword.softkwlist) | frozenset(dir(builtins))
+) | frozenset(keyword.kwlist) | frozenset(dir(builtins))
+
+#: Identifiers every generated module uses itself, whatever its backend: the reserved keywords
+#: and the local names of the functions' bodies (``out``, ``M``, ``g``, ...). A parameter's
+#: identifier inside a body avoids them (its keyword need not), and the names each backend's
+#: modules import, see :func:`reserved_identifiers`.
+RESERVED_IDENTIFIERS = RESERVED_KEYWORDS | frozenset(
+    {"out", "single", "batch", "n", *BY_SYMBOL,
+     "self", "cls", "L", "x", "y", "d",
+     "rhs", "bias", "args", "names", "vectors", "functions", "parameters", "q_columns",
+     "qd_columns", "qdd_columns", "k", "finite", "condition",
+     "close", "eigenvalues"}) | frozenset(keyword.softkwlist)
 
 
-def reserved_identifiers() -> frozenset[str]:
-    """:data:`RESERVED_IDENTIFIERS` and the names every registered backend reserves: the same
-    parameter names in every backend's module."""
+def _backends_reserved() -> tuple[tuple[str, ...], ...]:
     # The package's registry: complete only once eomgen.codegen has imported every backend,
     # which happens after this module (imported by eomgen.codegen) is loaded.
     from . import available_backends
 
-    return RESERVED_IDENTIFIERS.union(OUTPUTS, BY_SYMBOL,
-                                      *(b.reserved for b in available_backends().values()))
+    return tuple(b.reserved for b in available_backends().values())
+
+
+def reserved_identifiers() -> frozenset[str]:
+    """:data:`RESERVED_IDENTIFIERS` and the names every registered backend reserves: the same
+    parameter identifiers in every backend's module."""
+    return RESERVED_IDENTIFIERS.union(OUTPUTS, BY_SYMBOL, *_backends_reserved())
+
+
+def reserved_keywords() -> frozenset[str]:
+    """:data:`RESERVED_KEYWORDS` and the names every registered backend's modules import: the
+    same parameter keywords in every backend's module."""
+    return RESERVED_KEYWORDS.union(OUTPUTS, *_backends_reserved())
 
 
 _IDENTIFIER = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
@@ -108,14 +141,32 @@ def safe_identifier(name: str, taken: set[str], reserved: frozenset[str] | None 
 
 
 def parameter_arguments(dynamics: "Dynamics") -> tuple[ParameterArgument, ...]:
-    """Keyword arguments for the parameters the model keeps symbolic, sorted by name."""
-    taken: set[str] = set()
+    """Keyword arguments for the parameters the model keeps symbolic, sorted by name.
+
+    A parameter's keyword is its name in the description (``g``), unless no keyword can be:
+    a name that is not an ASCII identifier, a Python keyword or builtin, or a name the module
+    needs (:func:`reserved_keywords`: ``q``, ``np``, ``mass_matrix``, ...) gets a keyword of
+    :func:`safe_identifier` (``lambda_``). Its identifier inside the bodies avoids their own
+    names as well (:func:`reserved_identifiers`: ``g_`` for ``g``) and every keyword.
+
+    >>> import eomgen
+    >>> dynamics = eomgen.derive(eomgen.load(eomgen.example_path("planar_2link")), outputs=["g"])
+    >>> [(p.keyword, p.identifier) for p in parameter_arguments(dynamics)][2:4]
+    [('g', 'g_'), ('l1', 'l1')]
+    """
+    declared = sorted(dynamics.parameters, key=lambda p: p.name)
+    keywords_taken: set[str] = set()
+    reserved = reserved_keywords()
+    keywords = [safe_identifier(p.name, keywords_taken, reserved) for p in declared]
+    taken = set(keywords)
     reserved = reserved_identifiers()
     out = []
-    for p in sorted(dynamics.parameters, key=lambda p: p.name):
+    for p, keyword_ in zip(declared, keywords):
         doc = p.description or "model parameter"
-        out.append(ParameterArgument(safe_identifier(p.name, taken, reserved), p.symbol, p.value,
-                                     doc))
+        taken.discard(keyword_)  # its own keyword may be its identifier
+        identifier = safe_identifier(p.name, taken, reserved)
+        taken.add(keyword_)
+        out.append(ParameterArgument(keyword_, identifier, p.symbol, p.value, doc, p.name))
     return tuple(out)
 
 

@@ -15,7 +15,7 @@ from ..dynamics import derive
 from ..cache import CacheRequest, render_cached
 from ..errors import GenerationError
 from ..model import RobotModel, snap_summary
-from ..output import checked_stem, write_atomically  # noqa: F401  (re-exported)
+from ..output import checked_stem, import_collisions, write_atomically  # noqa: F401
 from ..progress import plural
 from ..outputs import OUTPUTS
 from . import GeneratedFile, available_backends, make_job
@@ -139,6 +139,10 @@ def render_job(job, backends: Sequence[str], progress: Progress = lambda _: None
     duplicates = {n for n in names if names.count(n) > 1}
     if duplicates:  # pragma: no cover - backends use distinct suffixes
         raise GenerationError(f"backends produced the same file twice: {sorted(duplicates)}")
+    collisions = import_collisions(names)
+    if collisions:  # pragma: no cover - backends name their files apart (a test checks it)
+        raise GenerationError("files Python would import under one name: "
+                              + "; ".join(", ".join(group) for group in collisions))
     return files
 
 

@@ -75,7 +75,7 @@ static const casadi_int casadi_s0[3] = {2, 1, 1};
 static const casadi_int casadi_s1[3] = {1, 1, 1};
 static const casadi_int casadi_s2[3] = {2, 2, 1};
 
-/* mass_matrix:(q[2],I1,I2,g_,l1,l2,lc1,lc2,m1,m2)->(M[2x2]) */
+/* mass_matrix:(q[2],I1,I2,g,l1,l2,lc1,lc2,m1,m2)->(M[2x2]) */
 static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real a0, a1, a2, a3, a4, a5, a6;
   a0=arg[7]? arg[7][0] : 0;
@@ -153,7 +153,7 @@ CASADI_SYMBOL_EXPORT const char* mass_matrix_name_in(casadi_int i) {
     case 0: return "q";
     case 1: return "I1";
     case 2: return "I2";
-    case 3: return "g_";
+    case 3: return "g";
     case 4: return "l1";
     case 5: return "l2";
     case 6: return "lc1";
@@ -210,7 +210,7 @@ CASADI_SYMBOL_EXPORT int mass_matrix_work_bytes(casadi_int *sz_arg, casadi_int* 
   return 0;
 }
 
-/* coriolis_matrix:(q[2],qd[2],I1,I2,g_,l1,l2,lc1,lc2,m1,m2)->(C[2x2]) */
+/* coriolis_matrix:(q[2],qd[2],I1,I2,g,l1,l2,lc1,lc2,m1,m2)->(C[2x2]) */
 static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10;
   a00=5.0000000000000000e-01;
@@ -308,7 +308,7 @@ CASADI_SYMBOL_EXPORT const char* coriolis_matrix_name_in(casadi_int i) {
     case 1: return "qd";
     case 2: return "I1";
     case 3: return "I2";
-    case 4: return "g_";
+    case 4: return "g";
     case 5: return "l1";
     case 6: return "l2";
     case 7: return "lc1";
@@ -366,7 +366,7 @@ CASADI_SYMBOL_EXPORT int coriolis_matrix_work_bytes(casadi_int *sz_arg, casadi_i
   return 0;
 }
 
-/* gravity_vector:(q[2],I1,I2,g_,l1,l2,lc1,lc2,m1,m2)->(g[2]) */
+/* gravity_vector:(q[2],I1,I2,g,l1,l2,lc1,lc2,m1,m2)->(g[2]) */
 static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real a0, a1, a2, a3, a4, a5, a6;
   a0=arg[0]? arg[0][0] : 0;
@@ -439,7 +439,7 @@ CASADI_SYMBOL_EXPORT const char* gravity_vector_name_in(casadi_int i) {
     case 0: return "q";
     case 1: return "I1";
     case 2: return "I2";
-    case 3: return "g_";
+    case 3: return "g";
     case 4: return "l1";
     case 5: return "l2";
     case 6: return "lc1";
@@ -496,7 +496,7 @@ CASADI_SYMBOL_EXPORT int gravity_vector_work_bytes(casadi_int *sz_arg, casadi_in
   return 0;
 }
 
-/* inverse_dynamics:(q[2],qd[2],qdd[2],I1,I2,g_,l1,l2,lc1,lc2,m1,m2)->(tau[2]) */
+/* inverse_dynamics:(q[2],qd[2],qdd[2],I1,I2,g,l1,l2,lc1,lc2,m1,m2)->(tau[2]) */
 static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16;
@@ -608,7 +608,7 @@ CASADI_SYMBOL_EXPORT const char* inverse_dynamics_name_in(casadi_int i) {
     case 2: return "qdd";
     case 3: return "I1";
     case 4: return "I2";
-    case 5: return "g_";
+    case 5: return "g";
     case 6: return "l1";
     case 7: return "l2";
     case 8: return "lc1";
@@ -667,7 +667,7 @@ CASADI_SYMBOL_EXPORT int inverse_dynamics_work_bytes(casadi_int *sz_arg, casadi_
   return 0;
 }
 
-/* forward_dynamics:(q[2],qd[2],tau[2],I1,I2,g_,l1,l2,lc1,lc2,m1,m2)->(qdd[2]) */
+/* forward_dynamics:(q[2],qd[2],tau[2],I1,I2,g,l1,l2,lc1,lc2,m1,m2)->(qdd[2]) */
 static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13;
@@ -793,7 +793,7 @@ CASADI_SYMBOL_EXPORT const char* forward_dynamics_name_in(casadi_int i) {
     case 2: return "tau";
     case 3: return "I1";
     case 4: return "I2";
-    case 5: return "g_";
+    case 5: return "g";
     case 6: return "l1";
     case 7: return "l2";
     case 8: return "lc1";

@@ -5,10 +5,10 @@
 functions (SX graphs).
 
 Joint order: JOINT_NAMES. Each function has named inputs, vectors among q, qd, qdd and tau, then
-the parameters kept symbolic (PARAMETERS: I1, I2, g_, l1, l2, lc1, lc2, m1, m2), and one named output.
+the parameters kept symbolic (PARAMETERS: I1, I2, g, l1, l2, lc1, lc2, m1, m2), and one named output.
 Call it with every input in order, or by name:
 
-    mass_matrix(q, I1, I2, g_, l1, l2, lc1, lc2, m1, m2)
+    mass_matrix(q, I1, I2, g, l1, l2, lc1, lc2, m1, m2)
     mass_matrix(q=q)["M"]
     mass_matrix(q=q, I1=...)["M"]
 
@@ -37,7 +37,7 @@ NV = 2
 PARAMETERS = {
     "I1": 0.08333333333333333,  # 'inertia of link 1 about z through its centre of mass [kg m^2]'
     "I2": 0.08333333333333333,  # 'inertia of link 2 about z through its centre of mass [kg m^2]'
-    "g_": 9.81,  # 'gravitational acceleration [m/s^2]'
+    "g": 9.81,  # 'gravitational acceleration [m/s^2]'
     "l1": 1.0,  # 'length of link 1 [m]'
     "l2": 1.0,  # 'length of link 2 [m]'
     "lc1": 0.5,  # 'distance from joint 1 to the centre of mass of link 1 [m]'
@@ -171,9 +171,10 @@ def _cholesky_solve(M, b):
 def _function(name, inputs, outputs, input_names, output_names):
     """casadi.Function ``name`` of ``inputs`` (vectors, then parameters) with ``outputs`` (one,
     or several results of one program). By name, a parameter left out takes its PARAMETERS
-    value, a vector left out is zero."""
+    value, a vector left out is zero. An input may have an output's name (a parameter
+    g, and the gravity vector g): CasADi allows it when told."""
     vectors = len(inputs) - len(_PARAMETER_DEFAULTS)
-    options = {"default_in": [0.0] * vectors + _PARAMETER_DEFAULTS}
+    options = {"default_in": [0.0] * vectors + _PARAMETER_DEFAULTS, "allow_duplicate_io_names": True}
     return ca.Function(name, inputs, outputs, input_names, output_names, options)
 
 
@@ -184,7 +185,7 @@ def _build():
     tau = ca.SX.sym("tau", NV)
     I1 = ca.SX.sym("I1")
     I2 = ca.SX.sym("I2")
-    g_ = ca.SX.sym("g_")
+    g_ = ca.SX.sym("g")
     l1 = ca.SX.sym("l1")
     l2 = ca.SX.sym("l2")
     lc1 = ca.SX.sym("lc1")
@@ -192,7 +193,7 @@ def _build():
     m1 = ca.SX.sym("m1")
     m2 = ca.SX.sym("m2")
     parameters = [I1, I2, g_, l1, l2, lc1, lc2, m1, m2]
-    names = ["I1", "I2", "g_", "l1", "l2", "lc1", "lc2", "m1", "m2"]
+    names = ["I1", "I2", "g", "l1", "l2", "lc1", "lc2", "m1", "m2"]
     vectors = {"q": q, "qd": qd, "qdd": qdd, "tau": tau}
     functions = {}
     args = [vectors["q"]]

@@ -39,7 +39,7 @@ static const char *const configuration_names[NQ + 1] = {
 static const char *const parameter_names[NP + 1] = {
     "I1",  /* inertia of link 1 about z through its centre of mass [kg m^2] */
     "I2",  /* inertia of link 2 about z through its centre of mass [kg m^2] */
-    "g_",  /* gravitational acceleration [m/s^2] */
+    "g",  /* gravitational acceleration [m/s^2] */
     "l1",  /* length of link 1 [m] */
     "l2",  /* length of link 2 [m] */
     "lc1",  /* distance from joint 1 to the centre of mass of link 1 [m] */
@@ -69,6 +69,9 @@ static const int parameter_has_default[NP + 1] = {
     1,
     1,
     0};
+/* The parameters whose keyword is not their name in the description: {name, keyword}. */
+static const char *const renamed_parameters[][2] = {
+    {NULL, NULL}};
 
 /* ---------------------------------------------------------------------------------------- */
 /* The functions of one state: inputs x[j] (NV,) each (F_c: the contact rows), parameters p
@@ -438,6 +441,16 @@ static int parse(const function_t *f, PyObject *const *args, Py_ssize_t nargs,
             found = 1;
         }
         if (!found) {
+            const char *text = PyUnicode_AsUTF8(key);
+            if (text == NULL)
+                return -1;
+            for (j = 0; renamed_parameters[j][0] != NULL; ++j)
+                if (strcmp(text, renamed_parameters[j][0]) == 0) {
+                    PyErr_Format(PyExc_TypeError, "%s() got an unexpected keyword argument %R: "
+                                 "parameter %R of the description is the keyword '%s'",
+                                 f->name, key, key, renamed_parameters[j][1]);
+                    return -1;
+                }
             PyErr_Format(PyExc_TypeError, "%s() got an unexpected keyword argument %R",
                          f->name, key);
             return -1;
@@ -657,16 +670,16 @@ static PyObject *forward_dynamics(PyObject *self, PyObject *const *args, Py_ssiz
 
 static PyMethodDef methods[] = {
     {"mass_matrix", (PyCFunction)(void (*)(void))mass_matrix, METH_FASTCALL | METH_KEYWORDS,
-     "mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0)\012--\012\012Mass matrix M(q), symmetric positive definite.\012\012Inputs of shape (NV,) or (N, NV) in JOINT_NAMES order, q of shape (NQ,) or (N, NQ); returns shape (2, 2) or (N,) + that, in kg m^2 (revolute rows/columns), kg (prismatic). 19 arithmetic operations per state."},
+     "mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0)\012--\012\012Mass matrix M(q), symmetric positive definite.\012\012Inputs of shape (NV,) or (N, NV) in JOINT_NAMES order, q of shape (NQ,) or (N, NQ); returns shape (2, 2) or (N,) + that, in kg m^2 (revolute rows/columns), kg (prismatic). 19 arithmetic operations per state."},
     {"coriolis_matrix", (PyCFunction)(void (*)(void))coriolis_matrix, METH_FASTCALL | METH_KEYWORDS,
-     "coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0)\012--\012\012Coriolis matrix C(q, qd) from the Christoffel symbols of the first kind, so that Mdot - 2 C is skew-symmetric.\012\012Inputs of shape (NV,) or (N, NV) in JOINT_NAMES order, q of shape (NQ,) or (N, NQ); returns shape (2, 2) or (N,) + that, in kg m^2/s (revolute). 43 arithmetic operations per state."},
+     "coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0)\012--\012\012Coriolis matrix C(q, qd) from the Christoffel symbols of the first kind, so that Mdot - 2 C is skew-symmetric.\012\012Inputs of shape (NV,) or (N, NV) in JOINT_NAMES order, q of shape (NQ,) or (N, NQ); returns shape (2, 2) or (N,) + that, in kg m^2/s (revolute). 43 arithmetic operations per state."},
     {"gravity_vector", (PyCFunction)(void (*)(void))gravity_vector, METH_FASTCALL | METH_KEYWORDS,
-     "gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0)\012--\012\012Gravity vector g(q) = dP/dq.\012\012Inputs of shape (NV,) or (N, NV) in JOINT_NAMES order, q of shape (NQ,) or (N, NQ); returns shape (2,) or (N,) + that, in N m (revolute), N (prismatic). 16 arithmetic operations per state."},
+     "gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0)\012--\012\012Gravity vector g(q) = dP/dq.\012\012Inputs of shape (NV,) or (N, NV) in JOINT_NAMES order, q of shape (NQ,) or (N, NQ); returns shape (2,) or (N,) + that, in N m (revolute), N (prismatic). 16 arithmetic operations per state."},
     {"inverse_dynamics", (PyCFunction)(void (*)(void))inverse_dynamics, METH_FASTCALL | METH_KEYWORDS,
-     "inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0)\012--\012\012Joint efforts tau = M(q) qdd + C(q, qd) qd + g(q) (recursive Newton-Euler, straight-line).\012\012Inputs of shape (NV,) or (N, NV) in JOINT_NAMES order, q of shape (NQ,) or (N, NQ); returns shape (2,) or (N,) + that, in N m (revolute), N (prismatic). 46 arithmetic operations per state."},
+     "inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0)\012--\012\012Joint efforts tau = M(q) qdd + C(q, qd) qd + g(q) (recursive Newton-Euler, straight-line).\012\012Inputs of shape (NV,) or (N, NV) in JOINT_NAMES order, q of shape (NQ,) or (N, NQ); returns shape (2,) or (N,) + that, in N m (revolute), N (prismatic). 46 arithmetic operations per state."},
     {"forward_dynamics", (PyCFunction)(void (*)(void))forward_dynamics,
      METH_FASTCALL | METH_KEYWORDS,
-     "forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0, return_condition=False)\012--\012\012Joint accelerations qdd solving M(q) qdd = tau - (C(q, qd) qd + g(q)) by Cholesky.\012\012Warns IllConditionedWarning when (max L_ii / min L_ii)^2, a lower bound of cond(M), exceeds 1e-6 / eps; return_condition=True also returns that estimate. Raises numpy.linalg.LinAlgError when M is not positive definite and FloatingPointError when M, C qd + g or tau is not finite."},
+     "forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0, return_condition=False)\012--\012\012Joint accelerations qdd solving M(q) qdd = tau - (C(q, qd) qd + g(q)) by Cholesky.\012\012Warns IllConditionedWarning when (max L_ii / min L_ii)^2, a lower bound of cond(M), exceeds 1e-6 / eps; return_condition=True also returns that estimate. Raises numpy.linalg.LinAlgError when M is not positive definite and FloatingPointError when M, C qd + g or tau is not finite."},
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module_definition = {

@@ -36,7 +36,7 @@ NV = 2
 PARAMETERS = {
     "I1": 0.08333333333333333,  # 'inertia of link 1 about z through its centre of mass [kg m^2]'
     "I2": 0.08333333333333333,  # 'inertia of link 2 about z through its centre of mass [kg m^2]'
-    "g_": 9.81,  # 'gravitational acceleration [m/s^2]'
+    "g": 9.81,  # 'gravitational acceleration [m/s^2]'
     "l1": 1.0,  # 'length of link 1 [m]'
     "l2": 1.0,  # 'length of link 2 [m]'
     "lc1": 0.5,  # 'distance from joint 1 to the centre of mass of link 1 [m]'
@@ -83,7 +83,7 @@ def _stack(x, shape, entries):
     return jnp.stack(columns, axis=-1).reshape((x.shape[0],) + shape)
 
 
-def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
+def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
     """Mass matrix M(q), symmetric positive definite.
 
     Parameters
@@ -98,6 +98,7 @@ def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l
 
     19 arithmetic operations per state.
     """
+    g_ = g
     q, single = _states((q, "q"))
     q2 = q[:, 1]
     c2 = _kept(jnp.cos(q2), q2)
@@ -114,7 +115,7 @@ def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l
     return out[0] if single else out
 
 
-def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
+def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
     """Coriolis matrix C(q, qd) from the Christoffel symbols of the first kind, so that Mdot - 2 C is skew-symmetric.
 
     Parameters
@@ -131,6 +132,7 @@ def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_
 
     43 arithmetic operations per state.
     """
+    g_ = g
     q, qd, single = _states((q, "q"), (qd, "qd"))
     q1 = q[:, 0]
     q2 = q[:, 1]
@@ -162,7 +164,7 @@ def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_
     return out[0] if single else out
 
 
-def gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
+def gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
     """Gravity vector g(q) = dP/dq.
 
     Parameters
@@ -177,6 +179,7 @@ def gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81
 
     16 arithmetic operations per state.
     """
+    g_ = g
     q, single = _states((q, "q"))
     q1 = q[:, 0]
     q2 = q[:, 1]
@@ -195,7 +198,7 @@ def gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81
     return out[0] if single else out
 
 
-def inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
+def inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
     """Joint efforts tau = M(q) qdd + C(q, qd) qd + g(q) (recursive Newton-Euler, straight-line).
 
     Parameters
@@ -214,6 +217,7 @@ def inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.083333333333333
 
     46 arithmetic operations per state.
     """
+    g_ = g
     q, qd, qdd, single = _states((q, "q"), (qd, "qd"), (qdd, "qdd"))
     q1 = q[:, 0]
     q2 = q[:, 1]
@@ -245,7 +249,7 @@ def inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.083333333333333
     return out[0] if single else out
 
 
-def forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0, return_condition=False):
+def forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0, return_condition=False):
     """Joint accelerations qdd solving M(q) qdd = tau - (C(q, qd) qd + g(q)).
 
     Solved with a batched Cholesky factorisation M = L L^T (never an explicit inverse); the
@@ -273,9 +277,10 @@ def forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.083333333333333
         diagonal, a lower bound of the 2-norm condition number of M (typically within a factor
         of ten). The NumPy module warns above 1e-6 / eps (about 4.5e9 in float64).
     """
+    g_ = g
     q, qd, tau, single = _states((q, "q", NQ), (qd, "qd"), (tau, "tau"))
-    M = mass_matrix(q, I1=I1, I2=I2, g_=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
-    bias = inverse_dynamics(q, qd, jnp.zeros_like(qd), I1=I1, I2=I2, g_=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
+    M = mass_matrix(q, I1=I1, I2=I2, g=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
+    bias = inverse_dynamics(q, qd, jnp.zeros_like(qd), I1=I1, I2=I2, g=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
     L = jnp.linalg.cholesky(M)
     x = _cho_solve((L, True), (tau - bias)[:, :, jnp.newaxis])[:, :, 0]
     if return_condition:

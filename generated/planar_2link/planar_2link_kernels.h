@@ -23,7 +23,7 @@ extern "C" {
 #define PLANAR_2LINK_NV 2
 #define PLANAR_2LINK_NP 9
 #define PLANAR_2LINK_JOINT_NAMES {"joint1", "joint2"}
-#define PLANAR_2LINK_PARAMETER_NAMES {"I1", "I2", "g_", "l1", "l2", "lc1", "lc2", "m1", "m2"}
+#define PLANAR_2LINK_PARAMETER_NAMES {"I1", "I2", "g", "l1", "l2", "lc1", "lc2", "m1", "m2"}
 
 extern const double planar_2link_parameter_defaults[9 + 1];
 

@@ -32,7 +32,7 @@ NV = 2
 PARAMETERS = {
     "I1": 0.08333333333333333,  # 'inertia of link 1 about z through its centre of mass [kg m^2]'
     "I2": 0.08333333333333333,  # 'inertia of link 2 about z through its centre of mass [kg m^2]'
-    "g_": 9.81,  # 'gravitational acceleration [m/s^2]'
+    "g": 9.81,  # 'gravitational acceleration [m/s^2]'
     "l1": 1.0,  # 'length of link 1 [m]'
     "l2": 1.0,  # 'length of link 2 [m]'
     "lc1": 0.5,  # 'distance from joint 1 to the centre of mass of link 1 [m]'
@@ -66,7 +66,7 @@ def _states(*named):
     return (*arrays, all(singles))
 
 
-def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
+def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
     """Mass matrix M(q), symmetric positive definite.
 
     Parameters
@@ -81,6 +81,7 @@ def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l
 
     19 arithmetic operations per state.
     """
+    g_ = g
     q, single = _states((q, "q"))
     batch = q.shape[0]
     q_columns = np.ascontiguousarray(q.T)
@@ -103,7 +104,7 @@ def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l
     return out[0] if single else out
 
 
-def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
+def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
     """Coriolis matrix C(q, qd) from the Christoffel symbols of the first kind, so that Mdot - 2 C is skew-symmetric.
 
     Parameters
@@ -120,6 +121,7 @@ def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_
 
     43 arithmetic operations per state.
     """
+    g_ = g
     q, qd, single = _states((q, "q"), (qd, "qd"))
     batch = q.shape[0]
     q_columns = np.ascontiguousarray(q.T)
@@ -163,7 +165,7 @@ def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_
     return out[0] if single else out
 
 
-def gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
+def gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
     """Gravity vector g(q) = dP/dq.
 
     Parameters
@@ -178,6 +180,7 @@ def gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81
 
     16 arithmetic operations per state.
     """
+    g_ = g
     q, single = _states((q, "q"))
     batch = q.shape[0]
     q_columns = np.ascontiguousarray(q.T)
@@ -203,7 +206,7 @@ def gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81
     return out[0] if single else out
 
 
-def inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
+def inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
     """Joint efforts tau = M(q) qdd + C(q, qd) qd + g(q) (recursive Newton-Euler, straight-line).
 
     Parameters
@@ -222,6 +225,7 @@ def inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.083333333333333
 
     46 arithmetic operations per state.
     """
+    g_ = g
     q, qd, qdd, single = _states((q, "q"), (qd, "qd"), (qdd, "qdd"))
     batch = q.shape[0]
     q_columns = np.ascontiguousarray(q.T)
@@ -358,7 +362,7 @@ def _not_positive_definite(M):
     return 0
 
 
-def forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0, return_condition=False):
+def forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0, return_condition=False):
     """Joint accelerations qdd solving M(q) qdd = tau - (C(q, qd) qd + g(q)).
 
     Solved with a Cholesky factorisation M = L L^T (never an explicit inverse). The relative
@@ -399,9 +403,10 @@ def forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.083333333333333
     FloatingPointError
         When M, C qd + g or tau is not finite at some state (overflow, non-finite input).
     """
+    g_ = g
     q_batch, qd_batch, tau_batch, single = _states((q, "q", NQ), (qd, "qd"), (tau, "tau"))
-    M = mass_matrix(q_batch, I1=I1, I2=I2, g_=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
-    bias = inverse_dynamics(q_batch, qd_batch, np.zeros_like(qd_batch), I1=I1, I2=I2, g_=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
+    M = mass_matrix(q_batch, I1=I1, I2=I2, g=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
+    bias = inverse_dynamics(q_batch, qd_batch, np.zeros_like(qd_batch), I1=I1, I2=I2, g=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
     rhs = tau_batch - bias
     qdd, condition = _cholesky_solve(M[0] if single else M, rhs[0] if single else rhs,
                                      who="forward_dynamics: ", stacklevel=2)

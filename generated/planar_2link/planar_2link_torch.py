@@ -36,7 +36,7 @@ NV = 2
 PARAMETERS = {
     "I1": 0.08333333333333333,  # 'inertia of link 1 about z through its centre of mass [kg m^2]'
     "I2": 0.08333333333333333,  # 'inertia of link 2 about z through its centre of mass [kg m^2]'
-    "g_": 9.81,  # 'gravitational acceleration [m/s^2]'
+    "g": 9.81,  # 'gravitational acceleration [m/s^2]'
     "l1": 1.0,  # 'length of link 1 [m]'
     "l2": 1.0,  # 'length of link 2 [m]'
     "lc1": 0.5,  # 'distance from joint 1 to the centre of mass of link 1 [m]'
@@ -73,7 +73,7 @@ def _parameter(value, like):
     return torch.as_tensor(value, dtype=like.dtype, device=like.device)
 
 
-def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
+def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
     """Mass matrix M(q), symmetric positive definite.
 
     Parameters
@@ -91,7 +91,7 @@ def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l
     q, single = _states((q, "q"))
     I1 = _parameter(I1, q)
     I2 = _parameter(I2, q)
-    g_ = _parameter(g_, q)
+    g_ = _parameter(g, q)
     l1 = _parameter(l1, q)
     l2 = _parameter(l2, q)
     lc1 = _parameter(lc1, q)
@@ -118,7 +118,7 @@ def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l
     return out[0] if single else out
 
 
-def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
+def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
     """Coriolis matrix C(q, qd) from the Christoffel symbols of the first kind, so that Mdot - 2 C is skew-symmetric.
 
     Parameters
@@ -138,7 +138,7 @@ def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_
     q, qd, single = _states((q, "q"), (qd, "qd"))
     I1 = _parameter(I1, q)
     I2 = _parameter(I2, q)
-    g_ = _parameter(g_, q)
+    g_ = _parameter(g, q)
     l1 = _parameter(l1, q)
     l2 = _parameter(l2, q)
     lc1 = _parameter(lc1, q)
@@ -186,7 +186,7 @@ def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_
     return out[0] if single else out
 
 
-def gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
+def gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
     """Gravity vector g(q) = dP/dq.
 
     Parameters
@@ -204,7 +204,7 @@ def gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81
     q, single = _states((q, "q"))
     I1 = _parameter(I1, q)
     I2 = _parameter(I2, q)
-    g_ = _parameter(g_, q)
+    g_ = _parameter(g, q)
     l1 = _parameter(l1, q)
     l2 = _parameter(l2, q)
     lc1 = _parameter(lc1, q)
@@ -234,7 +234,7 @@ def gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81
     return out[0] if single else out
 
 
-def inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
+def inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0):
     """Joint efforts tau = M(q) qdd + C(q, qd) qd + g(q) (recursive Newton-Euler, straight-line).
 
     Parameters
@@ -256,7 +256,7 @@ def inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.083333333333333
     q, qd, qdd, single = _states((q, "q"), (qd, "qd"), (qdd, "qdd"))
     I1 = _parameter(I1, q)
     I2 = _parameter(I2, q)
-    g_ = _parameter(g_, q)
+    g_ = _parameter(g, q)
     l1 = _parameter(l1, q)
     l2 = _parameter(l2, q)
     lc1 = _parameter(lc1, q)
@@ -310,7 +310,7 @@ class IllConditionedWarning(RuntimeWarning):
     relative error up to about cond(M) * eps."""
 
 
-def forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.08333333333333333, g_=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0, return_condition=False):
+def forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1=1.0, l2=1.0, lc1=0.5, lc2=0.5, m1=1.0, m2=1.0, return_condition=False):
     """Joint accelerations qdd solving M(q) qdd = tau - (C(q, qd) qd + g(q)).
 
     Solved with a batched Cholesky factorisation M = L L^T (torch.linalg.cholesky_ex, then
@@ -351,9 +351,10 @@ def forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.083333333333333
     FloatingPointError
         When M, C qd + g or tau is not finite at some state (overflow, non-finite input).
     """
+    g_ = g
     q, qd, tau, single = _states((q, "q", NQ), (qd, "qd"), (tau, "tau"))
-    M = mass_matrix(q, I1=I1, I2=I2, g_=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
-    bias = inverse_dynamics(q, qd, torch.zeros_like(qd), I1=I1, I2=I2, g_=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
+    M = mass_matrix(q, I1=I1, I2=I2, g=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
+    bias = inverse_dynamics(q, qd, torch.zeros_like(qd), I1=I1, I2=I2, g=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
     rhs = tau - bias
     finite = torch.isfinite(M).flatten(1).all(dim=1) & torch.isfinite(rhs).all(dim=1)
     if not bool(finite.all()):

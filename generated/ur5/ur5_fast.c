@@ -50,6 +50,9 @@ static const double parameter_defaults[NP + 1] = {
     0.0};
 static const int parameter_has_default[NP + 1] = {
     0};
+/* The parameters whose keyword is not their name in the description: {name, keyword}. */
+static const char *const renamed_parameters[][2] = {
+    {NULL, NULL}};
 
 /* ---------------------------------------------------------------------------------------- */
 /* The functions of one state: inputs x[j] (NV,) each (F_c: the contact rows), parameters p
@@ -966,6 +969,16 @@ static int parse(const function_t *f, PyObject *const *args, Py_ssize_t nargs,
             found = 1;
         }
         if (!found) {
+            const char *text = PyUnicode_AsUTF8(key);
+            if (text == NULL)
+                return -1;
+            for (j = 0; renamed_parameters[j][0] != NULL; ++j)
+                if (strcmp(text, renamed_parameters[j][0]) == 0) {
+                    PyErr_Format(PyExc_TypeError, "%s() got an unexpected keyword argument %R: "
+                                 "parameter %R of the description is the keyword '%s'",
+                                 f->name, key, key, renamed_parameters[j][1]);
+                    return -1;
+                }
             PyErr_Format(PyExc_TypeError, "%s() got an unexpected keyword argument %R",
                          f->name, key);
             return -1;

@@ -116,14 +116,14 @@ def test_parameters_left_out_take_the_descriptions_values(robot):
     modules = robot("planar_2link")
     q, qd, qdd = states(2, seed=4)
     values = dict(modules.numpy.PARAMETERS)
-    assert values["g_"] == 9.81 and values["m2"] == 1.0
+    assert values["g"] == 9.81 and values["m2"] == 1.0
     module = modules.jax
     default = module.inverse_dynamics(q, qd, qdd)
     explicit = module.inverse_dynamics(q, qd, qdd, **values)
     assert_relative(default, np.asarray(explicit), tol=0.0)
     # a left-out parameter is the description's value, not zero: gravity is there
     assert np.max(np.abs(np.asarray(module.gravity_vector(q)))) > 1.0
-    assert np.max(np.abs(np.asarray(module.gravity_vector(q, g_=0.0)))) == 0.0
+    assert np.max(np.abs(np.asarray(module.gravity_vector(q, g=0.0)))) == 0.0
     # per-state parameter arrays, as in the NumPy module
     masses = np.linspace(0.5, 2.0, len(q))
     assert_relative(module.gravity_vector(q, m2=masses),

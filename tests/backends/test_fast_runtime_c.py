@@ -34,6 +34,7 @@ MODULE_CONSTANTS = """\
 static const char *const parameter_names[NP + 1] = {"m2", NULL};
 static const double parameter_defaults[NP + 1] = {1.5, 0.0};
 static const int parameter_has_default[NP + 1] = {1, 0};
+static const char *const renamed_parameters[][2] = {{NULL, NULL}};
 """
 
 #: What each runtime file needs defined before it.

@@ -49,9 +49,9 @@ def test_dask_map_on_a_local_cluster_equals_the_numpy_batch(planar):
                                (module.gravity_vector, (q,)),
                                (module.inverse_dynamics, (q, qd, qdd)),
                                (module.forward_dynamics, (q, qd, qdd))):
-            lazy = dask_map(function, *args, chunks=300, m2=masses, g_=3.7)
+            lazy = dask_map(function, *args, chunks=300, m2=masses, g=3.7)
             assert lazy.chunks[0] == (300, 300, 300, 101)
-            expected = function(*args, m2=masses, g_=3.7)
+            expected = function(*args, m2=masses, g=3.7)
             assert lazy.shape == expected.shape
             with distributed.get_task_stream(client) as stream:
                 np.testing.assert_array_equal(lazy.compute(), expected)

@@ -40,7 +40,7 @@ import sympy as sp
 
 import eomgen
 from eomgen.codegen import BACKENDS, Backend, GeneratedFile, available_backends
-from eomgen.codegen.backends.casadi_backend import FUNCTION_NAMES, c_compiler
+from eomgen.codegen.backends.casadi_backend import FUNCTION_NAMES, c_compiler, library_name
 from eomgen.codegen.generate import generate, keep_symbolic, render_files, write_atomically
 from eomgen.model import (Inertial, Joint, JointType, Link, Parameter, RobotModel, Transform,
                           build_model, vec3)
@@ -138,7 +138,7 @@ def build_example(name: str, model: RobotModel, outdir: Path, backends="numpy,ca
     paths = generate(model, outdir, backends)
     by_name = {p.name: p for p in paths}
     stem = next(p.name[:-len("_numpy.py")] for p in paths if p.name.endswith("_numpy.py"))
-    library = by_name.get(stem + "_casadi.so")
+    library = by_name.get(library_name(stem))
     compiled = None
     if library is not None:
         compiled = {f: ca.external(f, str(library)) for f in FUNCTION_NAMES}
@@ -452,7 +452,7 @@ def _parameter_identifiers_are_sound(module: ModuleType) -> None:
     module_names = set(vars(module))
     for identifier in names:
         assert identifier.isidentifier() and identifier.isascii(), identifier
-        assert not keyword.iskeyword(identifier) and not keyword.issoftkeyword(identifier)
+        assert not keyword.iskeyword(identifier)
         assert identifier not in dir(builtins), identifier
         assert identifier not in module_names, f"{identifier} shadows a module-level name"
 
@@ -461,7 +461,7 @@ def test_keyword_parameters_equal_substituted_models(build, tmp_path):
     """m2 = 2.5 in the call equals the model with m2 = 2.5: through RNEA and regenerated."""
     ex = build("planar_2link")
     module, model = ex.numpy, ex.model
-    assert module.PARAMETERS == {"I1": 1 / 12, "I2": 1 / 12, "g_": 9.81, "l1": 1.0, "l2": 1.0,
+    assert module.PARAMETERS == {"I1": 1 / 12, "I2": 1 / 12, "g": 9.81, "l1": 1.0, "l2": 1.0,
                                  "lc1": 0.5, "lc2": 0.5, "m1": 1.0, "m2": 1.0}
     _parameter_identifiers_are_sound(module)
     m2 = sp.Symbol("m2", real=True)
@@ -469,7 +469,7 @@ def test_keyword_parameters_equal_substituted_models(build, tmp_path):
     generate(model.substitute({m2: 2.5}), tmp_path, "numpy")
     regenerated = load_module(tmp_path / "planar_2link_numpy.py", "planar_m2_fixed")
     assert "m2" not in regenerated.PARAMETERS
-    changed = {"m2": 2.5, "g_": 3.7, "lc1": 0.8}  # g is a reserved name: its keyword is g_
+    changed = {"m2": 2.5, "g": 3.7, "lc1": 0.8}  # the description's names are the keywords
     nm = numeric_model(model, {"m2": 2.5, "g": 3.7, "lc1": 0.8})
     for q, qd, qdd in random_states(np.random.default_rng(9), 2):
         tau = module.inverse_dynamics(q, qd, qdd, **changed)
@@ -497,9 +497,9 @@ def test_parameters_may_be_arrays_over_the_batch(build):
     rng = np.random.default_rng(10)
     Q, QD = rng.uniform(-3, 3, (4, 2)), rng.normal(size=(4, 2))
     m2 = np.array([0.5, 1.0, 2.0, 4.0])
-    batched = module.coriolis_matrix(Q, QD, m2=m2, g_=2.0)
+    batched = module.coriolis_matrix(Q, QD, m2=m2, g=2.0)
     for k in range(4):
-        assert_close(batched[k], module.coriolis_matrix(Q[k], QD[k], m2=m2[k], g_=2.0), "C")
+        assert_close(batched[k], module.coriolis_matrix(Q[k], QD[k], m2=m2[k], g=2.0), "C")
 
 
 def test_symbolic_subset_fixes_the_other_parameters(build, tmp_path):
@@ -536,7 +536,7 @@ def load_interfaces(files: list[GeneratedFile], outdir: Path, model: RobotModel,
     stem = next(n[:-len("_numpy.py")] for n in paths if n.endswith("_numpy.py"))
     numpy_module = load_module(paths[stem + "_numpy.py"], f"{name}_numpy")
     functions = tuple(f for f in FUNCTION_NAMES if hasattr(numpy_module, f))
-    library = paths.get(stem + "_casadi.so")
+    library = paths.get(library_name(stem))
     if library is None:
         assert c_compiler() is None, "a C compiler exists but no shared library was built"
     compiled = None if library is None else {f: ca.external(f, str(library)) for f in functions}
@@ -611,7 +611,7 @@ def test_left_out_parameters_take_the_description_values(build, tmp_path, symbol
     files = render_files(keep_symbolic(model, symbolic), ["numpy", "casadi", "c"])
     ex = load_interfaces(files, tmp_path, model, "planar_defaults")
     if symbolic is not None:
-        assert sorted(ex.casadi.PARAMETERS) == sorted({"g": "g_"}.get(s, s) for s in symbolic)
+        assert sorted(ex.casadi.PARAMETERS) == sorted(symbolic)
     q = np.array([0.3, -0.7])
     g = rnea_reference(ex.nm, "gravity_vector", q, None, None)
     assert np.all(np.abs(g) > 1.0)  # so that zeros would show
@@ -700,7 +700,7 @@ def test_no_c_compiler_is_one_warning_line(tmp_path):
     command = [sys.executable, "-m", "eomgen.cli", "generate", "--backend", "numpy,c",
                "--cache-dir", str(tmp_path / "cache"), "-o", str(tmp_path / "out")]
     expected = ("eomgen: warning: no C compiler found ($CC, cc, gcc, clang): wrote "
-                "planar_2link_casadi.c/.h without the .so")
+                "planar_2link_casadi.c/.h without libplanar_2link_casadi.so")
     for run in ("derived", "cached"):
         result = subprocess.run(command + ["--quiet"], env=env, capture_output=True, text=True,
                                 timeout=120)
@@ -718,7 +718,7 @@ def test_no_c_compiler_warns_library_callers(build, tmp_path, monkeypatch):
     monkeypatch.setenv("PATH", str(tmp_path))
     assert c_compiler() is None
     model = build("planar_2link").model
-    match = r"^no C compiler found .*: wrote planar_2link_casadi\.c/\.h without the \.so$"
+    match = r"^no C compiler found .*: wrote planar_2link_casadi\.c/\.h without libplanar_2link_casadi\.so$"
     with pytest.warns(NoCompilerWarning, match=match):
         paths = generate(model, tmp_path / "a", "c", cache_dir=tmp_path / "cache")
     assert [p.name for p in paths] == ["planar_2link_casadi.c", "planar_2link_casadi.h"]
@@ -733,13 +733,15 @@ def test_no_c_compiler_warns_library_callers(build, tmp_path, monkeypatch):
 NUMPY_CALLS = {"_batch", "_states", "mass_matrix", "inverse_dynamics", "ValueError", "len", "range",
                "reversed", "zip", "all", "int", "_at", "_not_positive_definite",
                "FloatingPointError",
+               # the wrapper naming a renamed parameter's keyword (templates/common/renamed.py.jinja)
+               "_renamed_keywords", "function", "TypeError",
                # the Cholesky runtime (eomgen/runtime/cholesky.py), included verbatim
                "_cholesky_solve", "_condition_number", "_condition_estimate",
                "_ill_conditioned_message"}
 NUMPY_LOCAL_OBJECTS = {"arrays", "singles", "_warnings"}
 CASADI_LOCAL_OBJECTS = {"PARAMETERS"}  # the module's dict literal: PARAMETERS.values()
 CASADI_CALLS = {"_build", "_function", "_cholesky_solve", "sum", "range", "reversed", "len",
-                "float"} | {
+                "float", "_Function", "TypeError", "isinstance"} | {
     f"_{f}_expression" for f in FUNCTION_NAMES}
 #: Tokens holding literal text (Python 3.12 splits f-strings into several tokens).
 _LITERAL_TOKENS = {tokenize.STRING, tokenize.COMMENT} | (
@@ -830,7 +832,7 @@ def test_c_backend_accepts_names_with_repeated_underscores(tmp_path):
     paths = generate(model, tmp_path, "c")
     assert [p.name for p in paths][:2] == ["arm__2_casadi.c", "arm__2_casadi.h"]
     if c_compiler() is not None:
-        f = ca.external("gravity_vector", str(tmp_path / "arm__2_casadi.so"))
+        f = ca.external("gravity_vector", str(tmp_path / library_name("arm__2")))
         assert_close(ca_call(f, {}, [0.3]), rnea(numeric_model(model), [0.3], [0.0], [0.0]), "g")
 
 
@@ -1142,9 +1144,9 @@ def cli(tmp_path_factory) -> dict[str, CliRun]:
 
 def _expected_default_files() -> set[str]:
     suffixes = {"numpy": ["_numpy.py"], "casadi": ["_casadi.py"],
-                "c": ["_casadi.c", "_casadi.h"] + (["_casadi.so"] if c_compiler() else []),
-                "latex": [".tex"]}
-    return {"planar_2link" + s for b in available_backends() for s in suffixes.get(b, [])}
+                "c": ["_casadi.c", "_casadi.h"], "latex": [".tex"]}
+    library = {library_name("planar_2link")} if c_compiler() else set()
+    return {"planar_2link" + s for b in available_backends() for s in suffixes.get(b, [])} | library
 
 
 @pytest.mark.slow

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import eomgen
-from eomgen.codegen.backends.casadi_backend import c_compiler
+from eomgen.codegen.backends.casadi_backend import c_compiler, library_name
 from eomgen.codegen.generate import render_files
 from support import load_module
 from support.extras import need
@@ -81,8 +81,7 @@ def test_casadi_c_library_linearize_equals_the_numpy_module(tmp_path):
         path.write_bytes(f.content) if isinstance(f.content, bytes) else path.write_text(
             f.content, encoding="utf-8")
     numpy_module = load_module(tmp_path / "planar_2link_numpy.py", "planar_2link_numpy_c")
-    library = next(p for p in tmp_path.iterdir() if p.name.startswith("planar_2link_casadi.")
-                   and p.suffix in (".so", ".dylib", ".dll"))
+    library = tmp_path / library_name("planar_2link")
     linearize = casadi.external("linearize", str(library))
     q, qd, tau = np.array([0.3, -0.8]), np.array([0.5, 0.2]), np.array([1.0, -2.0])
     out = linearize.call({"q": q, "qd": qd, "tau": tau, "m2": 1.7})

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import eomgen
+from eomgen.codegen.backends.casadi_backend import library_name
 from eomgen.loops import LoopDynamics
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
@@ -119,8 +120,7 @@ def test_casadi_c_library(fivebar, tmp_path):
         path = tmp_path / f.name
         path.write_bytes(f.content) if isinstance(f.content, bytes) else path.write_text(
             f.content, encoding="utf-8")
-    library = next(p for p in tmp_path.iterdir() if p.name.startswith("fivebar_casadi.")
-                   and p.suffix in (".so", ".dylib", ".dll"))
+    library = tmp_path / library_name("fivebar")
     f = casadi.external(NAME, str(library))
     (q, qd, qdd, tau, lam), = _motions(model, count=1, seed=5)
     t, l = _call("casadi", f, q, qd, qdd)

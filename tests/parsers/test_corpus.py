@@ -166,7 +166,7 @@ def test_hostile_but_valid_files_generate_with_every_backend(name, tmp_path, cap
             stem = file_name.split(".")[0]
             fast = load_module(file, stem)
             assert fast.JOINT_NAMES == model.joint_names and fast.NQ == n
-            assert set(fast.PARAMETERS) == {p.identifier for p in parameter_arguments(
+            assert set(fast.PARAMETERS) == {p.keyword for p in parameter_arguments(
                 derive(model, outputs=("g",), simplify=False))}
             M = fast.mass_matrix(np.linspace(-1, 1, n))
             assert M.shape == (n, n) and np.all(np.isfinite(M)) and np.allclose(M, M.T)

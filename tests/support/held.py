@@ -14,6 +14,7 @@ import numpy as np
 
 import eomgen
 from eomgen.codegen import loadable_backends
+from eomgen.codegen.backends.casadi_backend import library_name
 from eomgen.codegen.functions import module_name, select_functions
 from eomgen.codegen.generate import render_files
 from eomgen.errors import UnsupportedFeatureWarning
@@ -59,8 +60,7 @@ def held_robot(path: Path, feet, floating: bool, functions, folder: Path,
     if "c" in backends:
         import casadi
 
-        library = next(p for p in folder.iterdir() if p.name.startswith(stem + "_casadi.")
-                       and p.suffix in (".so", ".dylib", ".dll"))
+        library = folder / library_name(stem)
         modules["c"] = {name: casadi.external(name, str(library)) for name in
                         select_functions(functions) if name in modules.get("casadi", {})}
     return model, modules, pm, constraints

@@ -61,7 +61,7 @@ class CasADiConfig:
 def _render_module(job: Job, config: CasADiConfig) -> str:
     printer = CasADiPrinter({"standard": "python3"})
     # Parameters without a value have no default: the module refuses calls that leave them out.
-    required = [p.identifier for p in job.parameters if p.default is None]
+    required = [p.keyword for p in job.parameters if p.default is None]
     return render(config.template, required=required,
                   **python_module_context(job, printer, config.template, backend="casadi"))
 
@@ -142,20 +142,34 @@ def emit_c(job: Job, config: CasADiConfig = CasADiConfig()) -> list[GeneratedFil
             GeneratedFile(stem + ".h", header + h_source)]
 
 
+def library_name(stem: str) -> str:
+    """The file name of the C backend's shared library for modules named ``stem``:
+    ``lib<stem>_casadi.so``, which ``casadi.external(function, path)`` loads. Not
+    ``<stem>_casadi.so``: Python's import system finds a ``.so`` before a ``.py`` file of the
+    same name, so that name would hide the CasADi module ``<stem>_casadi.py`` from ``import``.
+
+    >>> library_name("planar_2link")
+    'libplanar_2link_casadi.so'
+    """
+    return f"lib{stem}_casadi.so"
+
+
 def build_c(job: Job, emitted: list[GeneratedFile], config: CasADiConfig = CasADiConfig()
             ) -> list[GeneratedFile]:
-    """The shared library compiled from the emitted C source (``casadi.external`` loads it),
-    or nothing, with a :class:`NoCompilerWarning`, when no C compiler is found."""
+    """The shared library :func:`library_name` compiled from the emitted C source
+    (``casadi.external`` loads it), or nothing, with a :class:`NoCompilerWarning`, when no C
+    compiler is found."""
     stem = job.stem + "_casadi"
     (source,) = [f.content for f in emitted if f.name == stem + ".c"]
     compiler = c_compiler()
     if compiler is None:
         warnings.warn(f"no C compiler found ($CC, cc, gcc, clang): wrote {stem}.c/.h "
-                      "without the .so", NoCompilerWarning, stacklevel=3)
+                      f"without {library_name(job.stem)}", NoCompilerWarning,
+                      stacklevel=3)
         return []
-    return [GeneratedFile(stem + ".so", shared_library(compiler, source, stem,
-                                                       ("-O3", "-fPIC", "-shared"),
-                                                       message_limit=500), golden=False)]
+    return [GeneratedFile(library_name(job.stem),
+                          shared_library(compiler, source, stem, ("-O3", "-fPIC", "-shared"),
+                                         message_limit=500), golden=False)]
 
 
 @register("c", "C source through CasADi's code generator, and a shared library when a C compiler is found",

@@ -157,6 +157,12 @@ def parameter_renames(job: Job) -> dict[sp.Symbol, sp.Symbol]:
             if p.identifier != p.symbol.name}
 
 
+def parameter_bindings(job: Job) -> list[tuple[str, str]]:
+    """``(identifier, keyword)`` of the parameters whose identifier inside the bodies is not
+    their keyword (``("g_", "g")``): a function's first lines bind them."""
+    return [(p.identifier, p.keyword) for p in job.parameters if p.identifier != p.keyword]
+
+
 def python_literal(text: str) -> str:
     """A Python string literal for ``text`` that cannot break out of its quotes."""
     return repr(str(text))
@@ -229,8 +235,14 @@ def python_module_context(job: Job, printer, template: str, extra_exports=(),
         nq=job.model.nq,
         nv=job.model.dof,
         configuration_names=[python_literal(n) for n in job.model.configuration_names],
-        parameters=[(p.identifier, repr(float(p.default)) if p.default is not None else None,
+        # (keyword, identifier inside the bodies, default, doc); the identifiers a function
+        # binds from the keywords first; the description's names that are not the keywords
+        parameters=[(p.keyword, p.identifier,
+                     repr(float(p.default)) if p.default is not None else None,
                      python_literal(p.doc)) for p in job.parameters],
+        bindings=parameter_bindings(job),
+        renamed=[(python_literal(p.name), python_literal(p.keyword)) for p in job.parameters
+                 if p.renamed],
         functions=[print_function(spec, job, doprint, None) for spec in job.specs],
         constants=[(name, [python_literal(v) for v in values]) for name, values in job.constants],
         # q, qd, qdd and tau (forward dynamics takes tau), then any other input a function takes

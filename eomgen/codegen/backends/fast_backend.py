@@ -206,7 +206,7 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
             lanes=lanes, broadcast=broadcast(spec, local) if lanes else frozenset(),
             returns=spec.returns))
     # the docstrings open with a text signature (inspect.signature reads it)
-    signature = "".join(", " + p.identifier
+    signature = "".join(", " + p.keyword
                         + ("" if p.default is None else f"={float(p.default)!r}")
                         for p in job.parameters)
     for f in functions:
@@ -268,7 +268,7 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
         "J_a^T lambda. Raises numpy.linalg.LinAlgError at damping 0 when J_p J_p^T is "
         "numerically singular (a singularity of the parallel robot), FloatingPointError when t "
         "or J_l is not finite.")
-    parameters = [dict(name=c_string_literal(p.identifier),
+    parameters = [dict(name=c_string_literal(p.keyword),
                        default=("NAN" if p.default is None
                                 else printer.doprint(sp.Float(p.default))),
                        has_default=int(p.default is not None),
@@ -288,6 +288,8 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
         joint_names=[c_string_literal(name) for name in job.dynamics.joint_names],
         configuration_names=[c_string_literal(name) for name in job.model.configuration_names],
         parameters=parameters,
+        renamed=[(c_string_literal(p.name), c_string_literal(p.keyword))
+                 for p in job.parameters if p.renamed],
         functions=functions,
         fma_clones=any(f["fma_clone"] for f in functions),
         constants=[(name, [c_string_literal(v) for v in values])

@@ -4,7 +4,8 @@
  *
  * The generated module defines, before this text: NQ (entries of q), NV (joints), NP (parameters kept symbolic),
  * MAX_IN (most vector inputs of a function), MAX_LEN (the longest of them), parameter_names[NP + 1] (NULL-terminated),
- * parameter_defaults[NP + 1] and parameter_has_default[NP + 1]; and includes Python.h, NumPy's
+ * parameter_defaults[NP + 1], parameter_has_default[NP + 1] and renamed_parameters[][2] ({name,
+ * keyword} pairs ending with {NULL, NULL}); and includes Python.h, NumPy's
  * arrayobject.h, <math.h> and <string.h>, as this file does.
  *
  * Real C source, not a template: eomgen copies the text below the marker line into the module
@@ -195,6 +196,16 @@ static int parse(const function_t *f, PyObject *const *args, Py_ssize_t nargs,
             found = 1;
         }
         if (!found) {
+            const char *text = PyUnicode_AsUTF8(key);
+            if (text == NULL)
+                return -1;
+            for (j = 0; renamed_parameters[j][0] != NULL; ++j)
+                if (strcmp(text, renamed_parameters[j][0]) == 0) {
+                    PyErr_Format(PyExc_TypeError, "%s() got an unexpected keyword argument %R: "
+                                 "parameter %R of the description is the keyword '%s'",
+                                 f->name, key, key, renamed_parameters[j][1]);
+                    return -1;
+                }
             PyErr_Format(PyExc_TypeError, "%s() got an unexpected keyword argument %R",
                          f->name, key);
             return -1;
