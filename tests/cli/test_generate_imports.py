@@ -16,6 +16,7 @@ from eomgen.codegen import available_backends
 from eomgen.compiler import c_compiler
 from eomgen.output import import_collisions, python_module_name
 from support import run_in_process
+from support.extras import need
 
 STEM = "planar_2link"
 
@@ -37,7 +38,7 @@ print(json.dumps({"files": files,
 
 @pytest.mark.slow
 def test_every_module_of_the_default_output_imports_as_the_hint_says(tmp_path):
-    pytest.importorskip("casadi")
+    need("casadi", reason="the CasADi module is imported")
     folder = tmp_path / "out"
     done = run_in_process("generate", eomgen.example_path("planar_2link"), "-o", folder,
                           "--cache-dir", tmp_path / "cache")

@@ -20,6 +20,7 @@ from eomgen.codegen.generate import generate
 from eomgen.compiler import c_compiler
 from eomgen.model import Parameter
 from support import load_module
+from support.extras import need
 
 STEM = "planar_2link"
 MOON = 1.62
@@ -69,7 +70,7 @@ PYTHON_BACKENDS = {"numpy": "numpy", "fast": "numpy", "jax": "jax", "torch": "to
 
 @pytest.mark.parametrize("backend", PYTHON_BACKENDS)
 def test_gravity_is_the_keyword_g_in_each_python_module(folder, backend):
-    pytest.importorskip(PYTHON_BACKENDS[backend], reason=f"the {backend} extra is not installed")
+    need(PYTHON_BACKENDS[backend], reason=f"the {backend} backend")
     module = module_of(folder, backend)
     if backend == "jax":
         import jax
@@ -90,7 +91,7 @@ def test_gravity_is_the_keyword_g_in_each_python_module(folder, backend):
 
 
 def test_gravity_is_the_input_g_of_the_casadi_functions_and_their_c_library(folder):
-    casadi = pytest.importorskip("casadi", reason="the casadi extra is not installed")
+    casadi = need("casadi", reason="the CasADi backend")
     module = module_of(folder, "casadi")
     functions = [module.gravity_vector]
     if c_compiler() is not None:
@@ -142,7 +143,7 @@ def keyworded(arm, tmp_path_factory):
 
 @pytest.mark.parametrize("backend", PYTHON_BACKENDS)
 def test_a_python_keyword_parameter_is_renamed_and_its_old_name_says_so(keyworded, backend):
-    pytest.importorskip(PYTHON_BACKENDS[backend], reason=f"the {backend} extra is not installed")
+    need(PYTHON_BACKENDS[backend], reason=f"the {backend} backend")
     model, out = keyworded
     module = module_of(out, backend)
     assert "lambda_" in module.PARAMETERS and "lambda" not in module.PARAMETERS
@@ -157,7 +158,7 @@ def test_a_python_keyword_parameter_is_renamed_and_its_old_name_says_so(keyworde
 
 
 def test_a_python_keyword_parameter_is_renamed_in_casadi_and_its_old_name_says_so(keyworded):
-    pytest.importorskip("casadi", reason="the casadi extra is not installed")
+    need("casadi", reason="the CasADi backend")
     model, out = keyworded
     module = module_of(out, "casadi")
     f = module.gravity_vector
