@@ -29,9 +29,12 @@ from .options import (description_argument, output_file_option, output_folder_op
 def notebook(description, output, scene_path, quiet, strict):
     """Write a Jupyter notebook deriving DESCRIPTION's equations of motion step by step.
 
-    The notebook (saved without outputs) loads the robot, derives positions, Jacobians,
-    energies, M, the Christoffel symbols, C and g (textbook form for at most 3 joints), checks
-    them, compares them with Newton–Euler and simulates the robot.
+    The notebook (saved without outputs) holds the description's text, so it runs wherever
+    it is copied; it loads the robot, derives positions, Jacobians, energies, M, the
+    Christoffel symbols, C and g (textbook form for at most 3 joints), checks them, compares
+    them with Newton–Euler and simulates the robot. Run it with the notebook extra (pip
+    install 'eomgen[notebook]'): jupyter lab FILE, or headless jupyter nbconvert --to notebook
+    --execute FILE.
 
     \b
     Examples:
@@ -49,7 +52,7 @@ def notebook(description, output, scene_path, quiet, strict):
     if output is None:
         check_output_file(path)
     progress(f"building the notebook of {model.name}")
-    nb = build_notebook(model, description, scene=scene_path)
+    nb = build_notebook(model, description, scene=scene_path, at=path)
     progress.clear()
     click.echo(str(write_notebook(nb, path)))
 
