@@ -348,10 +348,17 @@ n = model.dof
 sl = eomgen.derive(model, outputs=("Y_SL_base", "beta"))
 Y_SL = sl.named("Y_SL_base").expand()
 beta = sl.named("beta").expand()
-for k, value in enumerate(beta):
-    show(f"\\\\beta_{{{k + 1}}}", value)
-for k in range(Y_SL.cols):
-    show(f"Y_{{:,{k + 1}}}", Y_SL[:, k])
+# the base parameters, named as in the handout (MX1R: MX1 with others grouped into it); those
+# that are zero for every value of this robot's parameters are listed, their columns left out
+from eomgen.regressor.generated import generated_base
+
+names = generated_base(model).names
+print("zero for every parameter value:", ", ".join(
+    name for name, value in zip(names, beta) if value == 0) or "none")
+for k, (name, value) in enumerate(zip(names, beta)):
+    if value != 0:  # Y's column in the trigonometric form of the cells above (s2 c2, c12)
+        show(parameter_latex(name), value)
+        show(f"Y_{{:,\\,{parameter_latex(name)}}}", book.trig_form(Y_SL[:, k]))
 # Mdot - 2C is skew-symmetric
 M_dot = sum((dyn.M.diff(qk) * qdk for qk, qdk in zip(dyn.q, dyn.qd)), sp.zeros(n, n))
 N = M_dot - 2 * dyn.C
