@@ -376,8 +376,12 @@ def coriolis_terms(christoffel, qd, masses) -> dict[tuple[int, int], list[sp.Exp
         terms = []
         for k, value in sorted(entries[i, j].items()):
             grouped = rd.mass_grouped(value, masses)
-            terms.append(sp.Mul(qd[k], grouped, evaluate=False) if grouped.is_Add
-                         else qd[k] * grouped)
+            if grouped.is_Add:  # q̇_k (the sum)
+                terms.append(sp.Mul(qd[k], grouped, evaluate=False))
+                continue
+            negative = grouped.could_extract_minus_sign()  # Γ's product as above, then q̇_k
+            term = sp.Mul(-grouped if negative else grouped, qd[k], evaluate=False)
+            terms.append(sp.Mul(-1, term, evaluate=False) if negative else term)
         out[i, j] = terms
     return out
 
