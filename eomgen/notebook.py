@@ -17,6 +17,7 @@ same file, byte for byte.
 
 from __future__ import annotations
 
+import ast
 import contextlib
 import os
 import tempfile
@@ -32,15 +33,94 @@ from .present.notation import teaching_sized
 from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS
 
 
-def _load_code(description: Path | None, scene: Path | None = None) -> str:
-    if description is None:
-        code = 'model = eomgen.load(eomgen.example_path("planar_2link"))'
+def text_literal(text: str) -> str:
+    r'''A Python literal of ``text`` to read in a cell: a triple-quoted string, one line of the
+    cell per line of ``text``, when that reads back as ``text`` (a description's usual case);
+    else :func:`repr` (one long line, but exact).
+
+    >>> print(text_literal('robot: "arm"\nlinks: []\n'))
+    """\
+    robot: "arm"
+    links: []
+    """
+    '''
+    body = text.replace("\\", "\\\\").replace('"""', '\\"""')
+    if body.endswith('"'):
+        body = body[:-1] + '\\"'
+    literal = '"""\\\n' + body + '"""'
+    try:
+        if ast.literal_eval(literal) == text:
+            return literal
+    except (SyntaxError, ValueError):  # a character a string literal cannot hold as it is
+        pass
+    return repr(text)
+
+
+def _external_files(path: Path, text: str) -> bool:
+    """Whether the description names other files that its parser reads (an MJCF ``<include>``,
+    mesh or height field: MuJoCo's compiler opens them). A URDF's meshes are not read (the
+    dynamics need none), and eomgen's YAML and DH files name no files."""
+    from .parsers.mjcf import is_mjcf  # the MJCF sniffer: no MuJoCo import
+
+    if path.suffix.lower() != ".xml" or not is_mjcf(text):
+        return False
+    from defusedxml import ElementTree  # the parsers' XML reader, as for a URDF
+
+    try:
+        root = ElementTree.fromstring(text)
+    except ElementTree.ParseError:
+        return True  # let the compiler read it from its folder, where it compiled
+    return any(element.get("file") for element in root.iter())
+
+
+def _read_text(path: Path) -> str | None:
+    try:
+        return path.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        return None
+
+
+def _load_cells(description: Path | None, scene: Path | None, notebook: Path | None):
+    """The cells that make ``model``: the description's text (and the scene's) written into
+    the notebook, so that it runs wherever it is copied; or, for a description that names
+    files of its own (MJCF meshes, includes) or is not UTF-8 text, its path relative to the
+    notebook (``notebook``: where it will be written; None: the current folder).
+
+    Returns ``(markdown, [code cells])``."""
+    path = Path(description) if description is not None else None
+    if path is None:  # the bundled planar arm
+        from .robots import example_path
+
+        path = example_path("planar_2link")
+    text = _read_text(path)
+    embed = text is not None and not _external_files(path, text)
+    cells = []
+    if embed:
+        markdown = (f"The description `{path.name}` is written into this notebook, so that the "
+                    "notebook runs wherever it is copied: edit it and run the notebook again "
+                    "to change the robot. It is written to a temporary folder under its own name "
+                    "(the suffix tells the format) and loaded from there.")
+        cells.append(f"DESCRIPTION = {text_literal(text)}")
+        load = ("with tempfile.TemporaryDirectory() as folder:\n"
+                f"    path = Path(folder) / {path.name!r}\n"
+                "    path.write_text(DESCRIPTION, encoding=\"utf-8\")\n"
+                "    model = eomgen.load(path)")
     else:
-        code = f"model = eomgen.load({str(Path(description).resolve())!r})"
+        where = Path(notebook).resolve().parent if notebook is not None else Path.cwd()
+        relative = Path(os.path.relpath(path.resolve(), where)).as_posix()
+        markdown = (f"The description `{path.name}` names files of its own (meshes, "
+                    "includes), so it is loaded from its folder: keep it at "
+                    f"`{relative}`, relative to this notebook (Jupyter runs a notebook in "
+                    "its own folder).")
+        load = f"model = eomgen.load({relative!r})"
     if scene is not None:
-        code += ("\nfrom eomgen.reduction import apply_scene\nfrom eomgen.scene import load_scene"
-                 f"\nmodel = apply_scene(model, load_scene({str(Path(scene).resolve())!r})).model")
-    return code
+        scene = Path(scene)
+        markdown += (f" The scene `{scene.name}` (which joints move, what is locked) is "
+                     "written in as well, and applied to the model.")
+        cells.append(f"SCENE = {text_literal(scene.read_text(encoding='utf-8'))}")
+        load += ("\nmodel = eomgen.apply_scene(model, eomgen.load_scene("
+                 f"{scene.name!r}, text=SCENE)).model")
+    return markdown, cells, load
 
 
 def _teaching_sized(model: RobotModel) -> bool:
@@ -50,7 +130,8 @@ def _teaching_sized(model: RobotModel) -> bool:
 
 
 def build_notebook(model: RobotModel, description: Path | None = None,
-                   scene: Path | None = None, check: bool = True) -> nbformat.NotebookNode:
+                   scene: Path | None = None, check: bool = True,
+                   at: Path | None = None) -> nbformat.NotebookNode:
     """The derivation notebook of ``model``, loaded from ``description`` (None: the bundled
     planar 2-link arm) and reduced by the scene file ``scene`` when given (``model`` is then the
     reduced model, see :func:`eomgen.reduction.apply_scene`). ``check=False`` (``--no-check``)
@@ -60,6 +141,11 @@ def build_notebook(model: RobotModel, description: Path | None = None,
     The symbolic check of Ṁ − 2C is exact for a model with exact numbers and holds to
     :data:`~eomgen.symbolic.identities.FLOAT_TOLERANCE` when the model has floating-point
     numbers (:func:`~eomgen.symbolic.identities.check_zero`); the cell prints which.
+
+    The description's text (and the scene's) is written into the notebook, which therefore
+    runs wherever it is copied; a description naming files of its own (an MJCF's meshes or
+    includes) is loaded by its path relative to ``at``, where the notebook will be written
+    (None: the current folder).
 
     Raises
     ------
@@ -97,9 +183,15 @@ of the robot with the Lagrangian method, step by step, with eomgen, then checks 
 simulates the robot.
 Compact notation: $s_{{1}} = \\sin q_1$, $c_{{12}} = \\cos(q_1 + q_2)$.
 """)
-    md("## The robot\n\nThe description is loaded into a `RobotModel`: links, joints, "
-       "gravity and parameters.")
+    about, texts, load = _load_cells(description, scene, at)
+    md("## The robot\n\n" + about + " `eomgen.load` makes a `RobotModel` of it: links, "
+       "joints, gravity and parameters.")
+    for text in texts:
+        code(text)
     code(f"""
+import tempfile
+from pathlib import Path
+
 import numpy as np
 import sympy as sp
 from IPython.display import Math, display
@@ -107,7 +199,7 @@ from IPython.display import Math, display
 import eomgen
 from eomgen.display import expression_latex
 
-{_load_code(description, scene)}
+{load}
 dyn = eomgen.derive(model)
 
 
@@ -263,10 +355,17 @@ n = model.dof
 sl = eomgen.derive(model, outputs=("Y_SL_base", "beta"))
 Y_SL = sl.named("Y_SL_base").expand()
 beta = sl.named("beta").expand()
-for k, value in enumerate(beta):
-    show(f"\\\\beta_{{{k + 1}}}", value)
-for k in range(Y_SL.cols):
-    show(f"Y_{{:,{k + 1}}}", Y_SL[:, k])
+# the base parameters, named as in the handout (MX1R: MX1 with others grouped into it); those
+# that are zero for every value of this robot's parameters are listed, their columns left out
+from eomgen.regressor.generated import generated_base
+
+names = generated_base(model).names
+print("zero for every parameter value:", ", ".join(
+    name for name, value in zip(names, beta) if value == 0) or "none")
+for k, (name, value) in enumerate(zip(names, beta)):
+    if value != 0:  # Y's column in the trigonometric form of the cells above (s2 c2, c12)
+        show(parameter_latex(name), value)
+        show(f"Y_{{:,\\,{parameter_latex(name)}}}", book.trig_form(Y_SL[:, k]))
 # Mdot - 2C is skew-symmetric
 M_dot = sum((dyn.M.diff(qk) * qdk for qk, qdk in zip(dyn.q, dyn.qd)), sp.zeros(n, n))
 N = M_dot - 2 * dyn.C

@@ -53,9 +53,12 @@ def unexpected_errors(what: str):
 def notebook(description, output, scene_path, no_check, quiet, strict):
     """Write a Jupyter notebook deriving DESCRIPTION's equations of motion step by step.
 
-    The notebook (saved without outputs) loads the robot, derives positions, Jacobians,
-    energies, M, the Christoffel symbols, C and g (textbook form for at most 3 joints), checks
-    them, compares them with Newton–Euler and simulates the robot.
+    The notebook (saved without outputs) holds the description's text, so it runs wherever
+    it is copied; it loads the robot, derives positions, Jacobians, energies, M, the
+    Christoffel symbols, C and g (textbook form for at most 3 joints), checks them, compares
+    them with Newton–Euler and simulates the robot. Run it with the notebook extra (pip
+    install 'eomgen[notebook]'): jupyter lab FILE, or headless jupyter nbconvert --to notebook
+    --execute FILE.
 
     \b
     Examples:
@@ -74,7 +77,8 @@ def notebook(description, output, scene_path, no_check, quiet, strict):
         check_output_file(path)
     progress(f"building the notebook of {model.name}")
     with unexpected_errors(f"building the notebook of {model.name}"):
-        nb = build_notebook(model, description, scene=scene_path, check=not no_check)
+        nb = build_notebook(model, description, scene=scene_path, check=not no_check,
+                            at=path)
     progress.clear()
     click.echo(str(write_notebook(nb, path)))
 

@@ -133,14 +133,28 @@ def textbook_for(dynamics: Dynamics,
     return book if expanded_size(book) <= config.textbook_max_size else None
 
 
+#: LaTeX of entry ``k`` (1-based) of the input vectors written with a subscript of their own:
+#: the Slotine–Li reference velocity and acceleration, ``\dot{q}_{r,2}`` (the handout's and
+#: docs/control.md's notation; SymPy alone would print ``qd_r2`` as ``\textrm{qd\_r2}``).
+VECTOR_ENTRIES = {
+    "qd_r": r"\dot{{q}}_{{r,{k}}}",
+    "qdd_r": r"\ddot{{q}}_{{r,{k}}}",
+}
+
+
 def symbol_names(dyn: Dynamics) -> dict[sp.Symbol, str]:
-    """Explicit LaTeX for the joint symbols, and for parameters whose name would print like one
-    of the document's own quantities."""
+    """Explicit LaTeX for the joint symbols and the entries of :data:`VECTOR_ENTRIES`' input
+    vectors, and for parameters whose name would print like one of the document's own
+    quantities."""
     names: dict[sp.Symbol, str] = {}
     for k, (q, qd, qdd) in enumerate(zip(dyn.q, dyn.qd, dyn.qdd), start=1):
         names[q] = f"q_{{{k}}}"
         names[qd] = rf"\dot{{q}}_{{{k}}}"
         names[qdd] = rf"\ddot{{q}}_{{{k}}}"
+    vectors = dyn.input_symbols
+    for vector, tex in VECTOR_ENTRIES.items():
+        for k, symbol in enumerate(vectors.get(vector, ()), start=1):
+            names[symbol] = tex.format(k=k)
     for p in dyn.model.parameters:
         if _NOTATION_NAMES.match(p.name):
             names[p.symbol] = r"\textrm{" + latex_escape(p.name) + "}"

@@ -72,6 +72,8 @@ def group_by_factor(expr: sp.Expr, key: Callable[[sp.Expr], sp.Expr | None],
         inner = -inner if negative else inner
         if inner == 1:
             term = k
+        elif factor and inner.is_Mul and inner.as_coeff_Mul()[0] != 1:
+            term = k * inner  # a monomial with a number: 2 a_2 q̇_1 s_2^2, not s_2^2 · 2 a_2 q̇_1
         elif inner.is_Add or factor:
             term = sp.Mul(k, inner, evaluate=False)
         else:

@@ -277,6 +277,42 @@ class TextbookDerivation:
     christoffel: tuple[tuple[tuple[int, int, int], sp.Expr], ...]
     C: sp.Matrix
     g: sp.Matrix
+    #: ``(k, p)``: joint k's axis is parallel to that of joint p just before it (0-based), so
+    #: results may be written in the absolute angle ``q_p + q_k`` (see :meth:`trig_form`).
+    parallel: tuple[tuple[int, int], ...] = ()
+    #: The description's floats, printed with all their digits (:func:`description_floats`).
+    written: frozenset[float] = frozenset()
+
+    def trig_form(self, matrix) -> sp.Matrix:
+        """``matrix`` (entries: polynomials in sines and cosines of the joint angles, in any
+        form: ``sin(2 q_2)``, ``cos(q_2 + q_3)``, products) written as this derivation writes
+        M, the Christoffel symbols and g: products of ``s_k``, ``c_k`` (and ``s_{23}``,
+        ``c_{23}`` of parallel joints where shorter), reduced with ``s² + c² = 1``, float
+        noise dropped, common factors pulled out. Never a double angle: one form in every
+        section of a document. Other symbols (velocities, a controller's q̇_r) are kept as
+        they are.
+
+        >>> import eomgen
+        >>> book = textbook_derivation(eomgen.load(eomgen.example_path("planar_2link")))
+        >>> q1, q2 = book.q
+        >>> book.trig_form(sp.Matrix([sp.sin(2 * q2), sp.cos(q1) * sp.cos(q2) - sp.sin(q1) * sp.sin(q2)]))
+        Matrix([
+        [2*sin(q2)*cos(q2)],
+        [     cos(q1 + q2)]])
+        """
+        matrix = sp.Matrix(matrix)
+        # sin(2 q2) → 2 s2 c2, cos(q2 + q3) → c2 c3 − s2 s3: products of the joints' own sines
+        # and cosines, which the algebra reduces and rewrites in the absolute angles
+        entries = [sp.expand_trig(sp.sympify(e)) for e in matrix]
+        A = _TrigAlgebra(entries, self.q, self.qd)
+        A.written = self.written
+        A.absolute_angles(dict(self.parallel))
+        rows = [[A(e) for e in entries[r * matrix.cols:(r + 1) * matrix.cols]]
+                for r in range(matrix.rows)]
+        if not rows or not rows[0]:
+            return matrix
+        reference = A.largest(rows)
+        return sp.Matrix([[A.expr(f, reference, by_factor=True) for f in row] for row in rows])
 
 
 def textbook_derivation(model: RobotModel, max_dof: int = TEXTBOOK_MAX_DOF) -> TextbookDerivation:
@@ -344,11 +380,12 @@ def textbook_derivation(model: RobotModel, max_dof: int = TEXTBOOK_MAX_DOF) -> T
                      for r in range(3)] if body.joint.type.is_revolute else [zero] * 3)
     # Chains of parallel revolute joints (the elbow arm's shoulder and elbow): write results in
     # the absolute angles q2 + q3 where that is shorter.
-    A.absolute_angles({body.q_index: tree.bodies[body.parent].q_index
-                       for i, body in enumerate(tree.bodies)
-                       if body.parent >= 0 and body.joint.type.is_revolute
-                       and tree.bodies[body.parent].joint.type.is_revolute
-                       and any(axes[i]) and axes[i] == axes[body.parent]})
+    parallel = {body.q_index: tree.bodies[body.parent].q_index
+                for i, body in enumerate(tree.bodies)
+                if body.parent >= 0 and body.joint.type.is_revolute
+                and tree.bodies[body.parent].joint.type.is_revolute
+                and any(axes[i]) and axes[i] == axes[body.parent]}
+    A.absolute_angles(parallel)
     bodies = []
     shares = []
     potentials = []
@@ -398,7 +435,7 @@ def textbook_derivation(model: RobotModel, max_dof: int = TEXTBOOK_MAX_DOF) -> T
     return TextbookDerivation(
         q, qd, tuple(model.gravity), tuple(bodies), quadratic_form(M_expr, qd), A.expr(P),
         M_expr, christoffel, A.matrix(C, reference=scale),
-        A.matrix(g, reference=A.largest([[P]])))
+        A.matrix(g, reference=A.largest([[P]])), tuple(sorted(parallel.items())), A.written)
 
 
 class _TrigAlgebra:
@@ -507,6 +544,32 @@ class _TrigAlgebra:
                         [(width + 2 * j, width + 2 * j + 1) for j in range(len(parent))]
                         + [self._pair_index[k] for k in range(len(self.q)) if k not in parent])
 
+    def readable_by_factor(self, f):
+        """:meth:`readable` chosen for each product of the other factors (velocities,
+        parameters) on its own: ``g c_{12} + l_1 q̇_1 q̇_{r,1} s_2`` where :meth:`readable`
+        takes the relative or the absolute angles for the whole of ``f``. Exact: rewriting the
+        sines and cosines keeps each product's coefficient apart."""
+        if self._angles is None:
+            return self.readable(f)
+        ring, rewrite, pythagoras, pairs = self._angles
+        relative = self._pair_index
+        trig_index = {k for pair in relative for k in pair}
+        groups: dict[tuple, dict] = {}
+        for monomial, coefficient in f.terms():
+            rest = tuple(0 if k in trig_index else e for k, e in enumerate(monomial))
+            groups.setdefault(rest, {})[monomial] = coefficient
+        out = ring.zero
+        for terms in groups.values():
+            part = self.ring(terms)
+            best = self._lift(self._shortest_squares(part, relative), ring)
+            other = self._lift(part, ring).compose(rewrite).rem(pythagoras)
+            if len(other) < len(best):
+                other = self._shortest_squares(other, pairs)
+                if len(other) < len(best):
+                    best = other
+            out += best
+        return out
+
     @staticmethod
     def _lift(f, ring):
         """``f`` in ``ring``, which has the generators of ``f.ring`` first and more after."""
@@ -561,12 +624,13 @@ class _TrigAlgebra:
         return max((abs(float(v)) for row in matrix for f in row for v in f.coeffs()),
                    default=0.0)
 
-    def expr(self, f, reference: float = 0.0) -> sp.Expr:
+    def expr(self, f, reference: float = 0.0, by_factor: bool = False) -> sp.Expr:
         """``f`` as a SymPy expression in the form of :meth:`readable`: float rounding noise
         dropped (:func:`drop_float_noise`), computed floats written with 15 significant digits
         (:func:`round_floats`: ``0.009``, not ``0.0090000000000000018``) while the description's
         own floats keep all theirs, common factors pulled out."""
-        value = self.readable(self._denoise(self.reduce(f), reference)).as_expr()
+        readable = self.readable_by_factor if by_factor else self.readable
+        value = readable(self._denoise(self.reduce(f), reference)).as_expr()
         return sp.factor_terms(round_floats(value, keep=self.written))
 
     def _denoise(self, f, reference: float = 0.0, rtol: float = FLOAT_NOISE_RTOL):

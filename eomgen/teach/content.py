@@ -48,8 +48,8 @@ from ..symbolic.textbook import TextbookDerivation
 from ..verify import VerificationReport, verify
 from .loops import loop_section, loop_symbol_names
 from .quaternion import chart_method_section, velocity_names
-from .control import (control_section, control_symbol_names, handout_check,
-                      has_control_section, slotine_li_equations)
+from .control import (control_section, handout_check, has_control_section,
+                      slotine_li_equations)
 from .contacts import (contact_equations, contact_forces,  # noqa: F401  (re-exported)
                        contact_section, contact_symbol_names)
 from .document import (Equation, Equations, Figure, Handout, Paragraph, Section, Table, code,
@@ -344,19 +344,48 @@ def _coriolis_section(book: TextbookDerivation, coriolis, w: Writer) -> Section:
         masses = body_masses(book)
         blocks.append(Equations(tuple(w.terms(w.tex(nf.symbol), rd.by_mass(nf.value, masses))
                                       for nf in names)))
+    masses = body_masses(book)
     equations = []
-    for (i, j, k), value in christoffel:
+    for (i, j, k), value in christoffel:  # grouped by body mass, as M and the names are
         lhs = rf"\Gamma_{{{i + 1},{j + 1},{k + 1}}}"
         if j != k:
             lhs += rf" = \Gamma_{{{i + 1},{k + 1},{j + 1}}}"
-        equations.append(w.eq(lhs, value))
+        equations.append(w.terms(lhs, rd.by_mass(value, masses)))
     blocks.append(Equations(tuple(equations)) if equations else
                   Paragraph(prose("All Christoffel symbols are zero.")))
     blocks.append(Paragraph(prose(
         "The Coriolis matrix is $C_{i,j} = \\sum_{k} \\Gamma_{i,j,k}\\, \\dot{q}_{k}$ "
         "(with this choice, $\\dot{M} - 2C$ is skew-symmetric):")))
-    blocks.append(Equations(w.matrix("C", C)))
+    if names or not equations:
+        blocks.append(Equations(w.matrix("C", C)))
+    else:  # entry by entry, each Γ as printed above (grouped by mass) times its velocity
+        blocks.append(Equations(tuple(
+            w.terms(f"C_{{{i + 1},{j + 1}}}", terms)
+            for (i, j), terms in coriolis_terms(christoffel, book.qd, masses).items())))
     return Section("Step 6: Christoffel symbols and the Coriolis matrix", tuple(blocks))
+
+
+def coriolis_terms(christoffel, qd, masses) -> dict[tuple[int, int], list[sp.Expr]]:
+    """The non-zero entries of ``C_{i,j} = Σ_k Γ_{i,j,k} q̇_k`` as lists of terms
+    ``q̇_k (Γ_{i,j,k} grouped by body mass)``, in the order of ``christoffel`` (``Γ_{i,j,k}``
+    with ``j ≤ k``, 0-based), for the handout to print with the Christoffel symbols' form."""
+    entries: dict[tuple[int, int], dict[int, sp.Expr]] = {}
+    for (i, j, k), value in christoffel:
+        for a, b in ((j, k), (k, j)) if j != k else ((j, k),):
+            entries.setdefault((i, a), {})[b] = value
+    out = {}
+    for (i, j) in sorted(entries):
+        terms = []
+        for k, value in sorted(entries[i, j].items()):
+            grouped = rd.mass_grouped(value, masses)
+            if grouped.is_Add:  # q̇_k (the sum)
+                terms.append(sp.Mul(qd[k], grouped, evaluate=False))
+                continue
+            negative = grouped.could_extract_minus_sign()  # Γ's product as above, then q̇_k
+            term = sp.Mul(-grouped if negative else grouped, qd[k], evaluate=False)
+            terms.append(sp.Mul(-1, term, evaluate=False) if negative else term)
+        out[i, j] = terms
+    return out
 
 
 def _equations_section(dyn: Dynamics, book: TextbookDerivation, coriolis,
@@ -527,8 +556,6 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
     if spong is not None:  # the drives' own symbols, printed by the document's printer
         extra_names.update(drive_symbol_names(spong, w.tex))
     control = has_control_section(book, spong is not None, contacts or model.loops)
-    if control:
-        extra_names.update(control_symbol_names(dyn))
     w = Writer(nt.printing(dyn, HANDOUT_CONFIG, compact_trig=book is not None,
                             extra_names=extra_names))
     geometry = sketch_geometry(model)

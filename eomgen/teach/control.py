@@ -22,7 +22,7 @@ from ..present import readability as rd
 from ..regressor.generated import generated_base
 from ..regressor.notation import parameter_latex
 from ..symbolic.identities import ZeroCheck, check_zero
-from ..symbolic.textbook import TextbookDerivation, fourier_form, simplify_trig
+from ..symbolic.textbook import TextbookDerivation, simplify_trig
 from .document import Equation, Equations, Paragraph, Section, prose
 from .writer import Writer
 
@@ -43,12 +43,19 @@ class ControlEquations:
     qd_r, qdd_r:
         The symbols of q̇_r and q̈_r (``qd_r1``, ``qdd_r1``, … of :attr:`Dynamics.input_symbols`).
     names:
-        The base parameters' names (``MX1R``, …), in the columns' order.
+        The base parameters' names (``MX1R``, …), in the columns' order, without those in
+        ``zero``.
     beta:
-        β as expressions of the description's parameters (the ``beta`` output).
+        β as expressions of the description's parameters (the ``beta`` output), without those
+        in ``zero``.
     Y:
-        The base Slotine–Li regressor, n × b, each entry in compact trigonometric form:
-        ``M q̈_r + C(q, q̇) q̇_r + g = Y β``.
+        The base Slotine–Li regressor, n × b, each entry in the textbook's trigonometric form
+        (:meth:`~eomgen.symbolic.textbook.TextbookDerivation.trig_form`), without the columns
+        of ``zero``: ``M q̈_r + C(q, q̇) q̇_r + g = Y β``.
+    zero:
+        The names of the base parameters that are zero for every value of the description's
+        parameters (``MY1`` of an arm whose centres of mass lie on the links' x axes): left
+        out, with their columns.
     M_dot, N:
         Ṁ = Σ_k ∂M/∂q_k q̇_k and N = Ṁ − 2C, written with step 6's named factors.
     skew:
@@ -63,6 +70,7 @@ class ControlEquations:
     Y: sp.Matrix
     M_dot: sp.Matrix
     N: sp.Matrix
+    zero: tuple[str, ...] = ()
     skew: ZeroCheck | None = None
 
 
@@ -84,57 +92,48 @@ def slotine_li_equations(dyn: Dynamics, book: TextbookDerivation, coriolis,
     skew-symmetric (:func:`handout_check`)."""
     model = dyn.model
     sl = derive(model, outputs=("Y_SL_base", "beta"), simplify=False)
-    q = list(sl.q)
-    Y = sl.named("Y_SL_base").expand().applyfunc(
-        lambda e: sp.factor_terms(fourier_form(e, q), sign=False))
+    # in the trigonometric form of steps 1-7 (products s_2 c_2, never sin 2q_2)
+    Y = book.trig_form(sl.named("Y_SL_base").expand())
     beta = tuple(sp.factor_terms(sp.expand(b)) for b in sl.named("beta").expand())
     names = tuple(generated_base(model).names)
+    kept = [k for k, b in enumerate(beta) if b != 0]  # β_k = 0 for every parameter value
+    zero = tuple(name for k, name in enumerate(names) if k not in kept)
+    Y = Y.extract(list(range(Y.rows)), kept)
+    beta, names = tuple(beta[k] for k in kept), tuple(names[k] for k in kept)
     names_h, _, C = coriolis
-    M_dot = sp.zeros(model.dof, model.dof)
-    for k, qk in enumerate(dyn.q):
-        M_dot += book.M.diff(qk) * dyn.qd[k]
-    named = {nf.value: nf.symbol for nf in names_h}
-
-    def in_names(e):
-        """``e`` in compact trigonometric form, written with step 6's named factors when
-        that leaves no sine or cosine (``-2 h q̇_2``), else as it is (an entry of Ṁ that
-        no factor covers)."""
-        e = simplify_trig(e, dyn.q)
-        if e == 0:
-            return e
-        short = e
-        for value, symbol in named.items():
-            short = short.subs(value, symbol)
-        return sp.factor(short) if not short.has(sp.sin, sp.cos) else e
-
-    raw = M_dot - 2 * book.C
-    M_dot = M_dot.applyfunc(in_names)
-    N = sp.zeros(model.dof, model.dof)
-    for i in range(model.dof):
-        for j in range(model.dof):
-            if simplify_trig(raw[i, j], dyn.q) == 0:
-                continue
-            with_names = sp.factor(sp.expand(M_dot[i, j] - 2 * C[i, j]))
-            N[i, j] = (with_names if not with_names.has(sp.sin, sp.cos)
-                       else in_names(raw[i, j]))
-    values = {nf.symbol: nf.value for nf in names_h}
-    skew = handout_check(
-        dyn, "Mdot - 2C written with named factors is skew-symmetric",
-        (N + N.T).subs(values).applyfunc(lambda e: sp.expand(simplify_trig(e, dyn.q))),
-        raw) if check else None
+    # Ṁ = Σ_k ∂M/∂q_k q̇_k = C + Cᵀ, since ∂M_ij/∂q_k = Γ_ijk + Γ_jik: in step 6's names
+    # when it has them (every Γ is then a multiple of one), else in the textbook's form
+    if names_h:
+        M_dot = (C + C.T).applyfunc(sp.factor)
+        N = (C.T - C).applyfunc(sp.factor)
+    else:
+        M_dot = book.trig_form(C + C.T)
+        N = book.trig_form(C.T - C)
+    skew = None
+    if check:   # Ṁ = C + Cᵀ against M differentiated: then Ṁ − 2C = Cᵀ − C is skew-symmetric
+        values = {nf.symbol: nf.value for nf in names_h}
+        derivative = sp.zeros(model.dof, model.dof)
+        for k, qk in enumerate(dyn.q):
+            derivative += book.M.diff(qk) * dyn.qd[k]
+        skew = handout_check(
+            dyn, "Mdot written as C + C^T is dM/dt, so Mdot - 2C = C^T - C is skew-symmetric",
+            (M_dot.subs(values) - derivative).applyfunc(
+                lambda e: sp.expand(simplify_trig(e, dyn.q))), derivative)
     vectors = sl.input_symbols
     return ControlEquations(tuple(vectors["qd_r"]), tuple(vectors["qdd_r"]), names, beta, Y,
-                            M_dot, N, skew)
+                            M_dot, N, zero, skew)
 
 
-def control_symbol_names(dyn: Dynamics) -> dict:
-    """LaTeX of q̇_r and q̈_r (``\\dot{q}_{r,1}``) and of the base parameters' symbols."""
-    vectors = dyn.input_symbols
-    names = {}
-    for k, (v, a) in enumerate(zip(vectors["qd_r"], vectors["qdd_r"]), start=1):
-        names[v] = rf"\dot{{q}}_{{r,{k}}}"
-        names[a] = rf"\ddot{{q}}_{{r,{k}}}"
-    return names
+def _zero_clause(zero: tuple[str, ...]) -> str:
+    """What the section says of the base parameters that are identically zero."""
+    if not zero:
+        return ""
+    names = [f"${parameter_latex(name)}$" for name in zero]
+    listed = names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
+    one = len(zero) == 1
+    return (f", of which {listed} {'is' if one else 'are'} zero for every value of this "
+            f"robot's parameters and {'is' if one else 'are'} left out with "
+            f"{'its column' if one else 'their columns'} of $Y$")
 
 
 def control_section(eqs: ControlEquations, book: TextbookDerivation, dyn: Dynamics,
@@ -158,8 +157,9 @@ def control_section(eqs: ControlEquations, book: TextbookDerivation, dyn: Dynami
             "The equations of motion are linear in the inertial parameters, and so is "
             "$M(q)\\, \\ddot{q}_{r} + C(q, \\dot{q})\\, \\dot{q}_{r} + g(q)$, with $C$ the "
             "Coriolis matrix of step 6 multiplied by $\\dot{q}_{r}$ and not by "
-            f"$\\dot{{q}}$. In the {b} base parameters (the combinations that the motion can "
-            "reveal; the superscript $R$ marks a parameter with others grouped into it):")),
+            f"$\\dot{{q}}$. In the {b + len(eqs.zero)} base parameters (the combinations that "
+            "the motion can reveal; the superscript $R$ marks a parameter with others grouped "
+            "into it)" + _zero_clause(eqs.zero) + ":")),
         Equations(tuple(Equation(tex, (w.tex(value) + ("," if k < b - 1 else "."),))
                         for k, (tex, value) in enumerate(zip(beta_tex, eqs.beta)))),
         Paragraph(prose(
@@ -232,5 +232,5 @@ def _float_note(skew: ZeroCheck | None) -> tuple:
         f"{skew.residual:.1e}), not exactly.")),)
 
 
-__all__ = ["ControlEquations", "control_section", "control_symbol_names", "handout_check",
-           "has_control_section", "slotine_li_equations"]
+__all__ = ["ControlEquations", "control_section", "handout_check", "has_control_section",
+           "slotine_li_equations"]

@@ -322,7 +322,8 @@ joints:
 
 def test_verify_and_notebook_take_a_scene(tmp_path):
     """The Panda reduced to its shoulder and elbow: verify checks the reduced model against
-    Newton-Euler; the notebook's first cell loads the same reduced model."""
+    Newton-Euler; the notebook's first cells (the description and the scene written in) load
+    the same reduced model."""
     urdf, scene = panda(), SCENES / "panda_two_joints.yaml"
     done = run_in_process("verify", urdf, "--scene", scene, "--samples", "3", "--quiet")
     assert done.returncode == 0, done.stderr
@@ -337,12 +338,10 @@ def test_verify_and_notebook_take_a_scene(tmp_path):
     from eomgen.reduction import apply_scene
     from eomgen.scene import load_scene
 
-    cell = next(c for c in nbformat.read(notebook, as_version=4).cells
-                if c.cell_type == "code" and "eomgen.load(" in c.source)
-    load = "\n".join(line for line in cell.source.splitlines()
-                     if "eomgen.load(" in line or "scene" in line)
-    namespace = {"eomgen": eomgen}
-    exec(load, namespace)  # the notebook's own loading lines
+    namespace: dict = {}
+    for cell in nbformat.read(notebook, as_version=4).cells:  # the notebook's own cells, up
+        if cell.cell_type == "code" and "model" not in namespace:  # to the one making model
+            exec(cell.source, namespace)
     expected = apply_scene(eomgen.load(urdf), load_scene(scene)).model
     assert namespace["model"].joint_names == expected.joint_names == ("panda_joint2",
                                                                        "panda_joint4")

@@ -111,6 +111,9 @@ def test_cli_notebook_runs_without_errors(tmp_path, example):
         latex = [o.data["text/latex"] for o in outputs if "text/latex" in o.get("data", {})]
         assert any(tex in text for text in latex)
         assert any(r"\mathrm{ZZ}_{1}^{R} = " in text for text in latex)  # a grouped β
+        # the Slotine–Li cell in the handout's notation: q̇_{r,1}, not \textrm{qd\_r1}
+        assert any(r"\dot{q}_{r,1}" in text for text in latex)
+        assert not any("qd\\_r" in text or "qdd\\_r" in text for text in latex)
 
 
 def test_cli_notebook_bad_description(tmp_path):
