@@ -85,7 +85,6 @@ CYCLES_TODAY: frozenset[tuple[str, ...]] = frozenset({
 
 #: Modules over MAX_LINES lines today.
 LONG_TODAY: frozenset[str] = frozenset({
-    'eomgen.analysis.simulate',
     'eomgen.outputs',
     'eomgen.parsers.urdf',
     'eomgen.symbolic.named',
