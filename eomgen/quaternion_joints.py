@@ -38,6 +38,7 @@ import numpy as np
 from .model import QuaternionJoint, RobotModel
 from .model.quaternion import FREE_FLYER
 from .numeric.floating_base import matrix_quaternion, quaternion_matrix
+from .numeric.so3 import left_jacobian, skew, so3_exp, so3_log  # all four kept importable here
 
 
 def layout(model, nv: int | None = None) -> tuple[QuaternionJoint, ...]:
@@ -48,46 +49,6 @@ def layout(model, nv: int | None = None) -> tuple[QuaternionJoint, ...]:
     if isinstance(model, RobotModel):
         return model.quaternion_joints
     return tuple(model)
-
-
-def skew(w) -> np.ndarray:
-    """``[w]×``: the 3×3 matrix of ``w ×``."""
-    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
-
-
-def so3_exp(w) -> np.ndarray:
-    """The rotation ``exp([w]×)`` (Rodrigues)."""
-    theta = np.linalg.norm(w)
-    K = skew(w)
-    if theta < 1e-8:
-        return np.eye(3) + K + K @ K / 2
-    return np.eye(3) + np.sin(theta) / theta * K + (1 - np.cos(theta)) / theta ** 2 * K @ K
-
-
-def left_jacobian(w) -> np.ndarray:
-    """V(ω) with exp([ν, ω]) = (exp(ω), V ν): the SE(3) exponential's translation part."""
-    theta = np.linalg.norm(w)
-    K = skew(w)
-    if theta < 1e-6:
-        return np.eye(3) + K / 2 + K @ K / 6
-    return (np.eye(3) + (1 - np.cos(theta)) / theta ** 2 * K
-            + (theta - np.sin(theta)) / theta ** 3 * K @ K)
-
-
-def so3_log(R) -> np.ndarray:
-    """The rotation vector ``w`` (|w| ≤ π) with ``exp([w]×) = R``."""
-    cos = np.clip((np.trace(R) - 1) / 2, -1.0, 1.0)
-    theta = np.arccos(cos)
-    vee = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
-    if theta < 1e-8:
-        return vee / 2
-    if np.pi - theta < 1e-6:  # near π: the axis from the symmetric part
-        axis = np.sqrt(np.maximum((np.diag(R) + 1) / 2, 0.0))
-        k = int(np.argmax(axis))
-        axis = (R[k] + np.eye(3)[k]) / (2 * axis[k]) if axis[k] > 0 else axis
-        axis /= np.linalg.norm(axis)
-        return theta * axis * (1.0 if axis @ vee >= 0 else -1.0)
-    return theta / (2 * np.sin(theta)) * vee
 
 
 def _pieces(joints, nv: int):

@@ -48,8 +48,9 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ..model import POINT, Contact, RobotModel
-from ..numeric.contacts import ContactDynamics, derived_mass_and_bias, rotation_log
+from ..numeric.contacts import ContactDynamics, derived_mass_and_bias
 from ..numeric import kinetic_energy, numeric_model, potential_energy
+from ..numeric.so3 import so3_log
 from ..progress import plural
 from ..quaternion_joints import configuration_rate
 from .report import csv_text, fmt, markdown_table, pyplot
@@ -174,7 +175,7 @@ class ContactSystem:
             position = max(position, float(np.linalg.norm(f["p"] - self.cd.anchors[c.frame])))
             if c.kind != POINT:
                 rotation = self.cd.orientations[c.frame].T @ f["R"]
-                orientation = max(orientation, float(np.linalg.norm(rotation_log(rotation))))
+                orientation = max(orientation, float(np.linalg.norm(so3_log(rotation))))
         J = self.cd.contact_jacobian(q)
         velocity = float(np.abs(J @ np.asarray(qd, float)).max()) if J.size else 0.0
         return position, orientation, velocity

@@ -40,8 +40,9 @@ import numpy as np
 
 from ..model import POINT, RobotModel
 from ..numeric import kinetic_energy, numeric_model, potential_energy
-from ..numeric.contacts import ContactDynamics, rotation_log
+from ..numeric.contacts import ContactDynamics
 from ..numeric.loops import RANK_TOLERANCE, LoopDynamics
+from ..numeric.so3 import so3_log
 from ..symbolic.frames import derive_frames
 from ..progress import plural
 from .report import csv_text, fmt, markdown_table
@@ -105,7 +106,7 @@ class HeldContacts:
             position = max(position, float(np.linalg.norm(f["p"] - self.held.anchors[c.frame])))
             if c.kind != POINT:
                 R = self.held.orientations[c.frame].T @ f["R"]
-                orientation = max(orientation, float(np.linalg.norm(rotation_log(R))))
+                orientation = max(orientation, float(np.linalg.norm(so3_log(R))))
         return position, orientation
 
 

@@ -3,6 +3,8 @@
 * :mod:`eomgen.numeric.newton_euler`: rigid-body dynamics by Newton–Euler recursions on a
   :class:`NumericModel` (the independent reference for the symbolic engine); its names are
   importable from ``eomgen.numeric`` itself (``eomgen.numeric.rnea``, ``numeric_model``, ...).
+* :mod:`eomgen.numeric.so3`: the skew matrix, exponential and logarithm of rotations, the
+  one numeric copy every module uses.
 * :mod:`eomgen.numeric.quaternion_chart`: quaternion joints (a free flyer, ball joints) in those
   recursions: ``q`` of NQ entries, ``qd``, ``qdd``, ``tau`` of NV (Pinocchio's layout).
 * :mod:`eomgen.numeric.frames`: pose, Jacobians and J̇ q̇ of named links by recursion (the

@@ -56,6 +56,7 @@ from ..model import POINT, Contact, RobotModel
 from ..symbolic.evaluate import compile_program
 from ..symbolic.frames import derive_frames
 from .newton_euler import M_crba, coriolis_times_qd, gravity_torques, numeric_model, rnea
+from .so3 import so3_log
 
 #: ``constrained_forward_dynamics`` without damping refuses a contact Jacobian whose smallest
 #: singular value is below this fraction of its largest.
@@ -77,29 +78,9 @@ def derived_mass_and_bias(model: RobotModel) -> Callable:
     return mass_and_bias
 
 
-def rotation_log(R) -> np.ndarray:
-    """The rotation vector ``θ u`` (3,) [rad] of a rotation matrix: ``R = exp([θ u]×)``,
-    ``θ ∈ [0, π]`` (the logarithm of SO(3)). Near ``θ = π`` the axis comes from the symmetric
-    part ``(R + Rᵀ)/2 = cos θ 1 + (1 − cos θ) u uᵀ``, whose sign the skew part fixes.
-
-    >>> np.round(rotation_log(np.array([[0., -1, 0], [1, 0, 0], [0, 0, 1]])), 6)
-    array([0.      , 0.      , 1.570796])
-    """
-    R = np.asarray(R, dtype=float)
-    w = 0.5 * np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])  # sin θ u
-    c = min(1.0, max(-1.0, 0.5 * (np.trace(R) - 1.0)))
-    s = float(np.linalg.norm(w))
-    theta = float(np.arctan2(s, c))
-    if theta < 1e-6:
-        return w * (1.0 + theta * theta / 6.0)  # θ / sin θ to second order
-    if theta < np.pi - 1e-6 and s > 1e-6:
-        return w * (theta / s)
-    B = 0.5 * (R + R.T) - c * np.eye(3)  # (1 − cos θ) u uᵀ
-    k = int(np.argmax(np.diag(B)))
-    u = B[k] / np.sqrt(B[k, k] * (1.0 - c))
-    if u @ w < 0:
-        u = -u
-    return theta * u
+#: The logarithm of SO(3) (:func:`eomgen.numeric.so3.so3_log`) under the name the contact
+#: error and its callers use.
+rotation_log = so3_log
 
 
 @dataclass(frozen=True)

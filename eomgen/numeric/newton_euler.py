@@ -59,6 +59,7 @@ import numpy as np
 from .model import (FIXED, FLOAT64, PRISMATIC, REVOLUTE, Numbers, NumericModel,
                     numeric_model)
 from .quaternion_chart import chart_coordinates, chart_offset, placements
+from .so3 import rotation_about, skew
 
 # ----------------------------------------------------------------------------------------------
 # Kinematics shared by the algorithms
@@ -100,13 +101,6 @@ def _tangent(nm: NumericModel, name: str, x) -> np.ndarray:
     return x if nm.coupling is None else nm.coupling @ x
 
 
-def _rotation(numbers: Numbers, axis: np.ndarray, angle) -> np.ndarray:
-    """Rodrigues: rotation by ``angle`` [rad] about the unit vector ``axis``."""
-    x, y, z = axis
-    K = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]], dtype=numbers.dtype)
-    return numbers.eye(3) + numbers.sin(angle) * K + (1.0 - numbers.cos(angle)) * (K @ K)
-
-
 def _parent_transforms(nm: NumericModel, q: np.ndarray, placed: dict | None = None
                        ) -> tuple[np.ndarray, np.ndarray]:
     """Pose of every body frame in its parent's frame at the coordinates ``q`` (n,), the
@@ -131,7 +125,7 @@ def _parent_transforms(nm: NumericModel, q: np.ndarray, placed: dict | None = No
             p[i] = p[i] + R[i] @ pq
             R[i] = R[i] @ Rq
         if nm.joint_type[i] == REVOLUTE:
-            R[i] = R[i] @ _rotation(nm.numbers, nm.axis[i], q[k])
+            R[i] = R[i] @ rotation_about(nm.axis[i], q[k], nm.numbers)
         else:  # prismatic: the child frame moves along the axis, without rotating
             p[i] = p[i] + R[i] @ (nm.axis[i] * q[k])
     return R, p
@@ -286,12 +280,6 @@ def M_rnea(nm: NumericModel, q) -> np.ndarray:
     return M
 
 
-def _skew(numbers, v) -> np.ndarray:
-    zero = numbers.value(0)
-    return np.array([[zero, -v[2], v[1]], [v[2], zero, -v[0]], [-v[1], v[0], zero]],
-                    dtype=numbers.dtype)
-
-
 def M_crba(nm: NumericModel, q) -> np.ndarray:
     """Joint-space mass matrix ``M(q)`` by the composite-rigid-body algorithm, (n, n), the
     same matrix as :func:`M_rnea` in one inward pass and one walk up from each joint.
@@ -315,9 +303,9 @@ def M_crba(nm: NumericModel, q) -> np.ndarray:
         Rt = R[i].T
         X[i, :3, :3] = Rt
         X[i, 3:, 3:] = Rt
-        X[i, 3:, :3] = -Rt @ _skew(numbers, p[i])
+        X[i, 3:, :3] = -Rt @ skew(p[i], numbers)
         c, m = nm.com[i], nm.mass[i]
-        C = _skew(numbers, c)
+        C = skew(c, numbers)
         Ic[i, :3, :3] = nm.inertia[i] - m * (C @ C)
         Ic[i, :3, 3:] = m * C
         Ic[i, 3:, :3] = -m * C

@@ -51,7 +51,7 @@ from mpmath.libmp import prec_to_dps
 from ..bodies import BodyTree, InertialParameters
 from ..model import Transform, Vec3
 from .program import ProgramBuilder, name_expr, name_exprs
-from .spatial import JointFrames, aligned_axis, cross, dot, matvec, mul, rotation
+from .spatial import JointFrames, aligned_axis, cross, dot, matvec, mul, rotation, skew
 
 
 def _invariant_part(axis: Vec3, revolute: bool, par: InertialParameters) -> InertialParameters:
@@ -228,7 +228,7 @@ def _renamed_terms(expr, w, ww) -> sp.Expr:
 def _khalil_U(ww, dw, b: ProgramBuilder, tag) -> tuple:
     """U = [ω̇]× + [ω]×[ω]× = [ω̇]× + ω ωᵀ − |ω|² 1 from the products ``ww`` of
     :func:`_omega_products`, entries named (only those used survive)."""
-    skew = ((0, -dw[2], dw[1]), (dw[2], 0, -dw[0]), (-dw[1], dw[0], 0))
+    W = skew(dw)
     U = []
     for r in range(3):
         row = []
@@ -237,7 +237,7 @@ def _khalil_U(ww, dw, b: ProgramBuilder, tag) -> tuple:
                 e = -b.define(sum((ww[x][x] for x in range(3) if x != r), sp.Integer(0)),
                               f"U{tag}_{r}{c}", ("U", tag, r, c))
             else:
-                e = name_expr(b, ww[r][c] + skew[r][c], f"U{tag}_{r}{c}", ("U", tag, r, c))
+                e = name_expr(b, ww[r][c] + W[r][c], f"U{tag}_{r}{c}", ("U", tag, r, c))
             row.append(e)
         U.append(tuple(row))
     return tuple(U)

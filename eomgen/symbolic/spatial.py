@@ -80,7 +80,8 @@ def scale(a, s) -> tuple:
 
 
 def skew(h) -> tuple:
-    """``[h]×``, the 3×3 with ``[h]× v = h × v``."""
+    """``[h]×``, the 3×3 with ``[h]× v = h × v`` (of expressions; the numeric one is
+    :func:`eomgen.numeric.so3.skew`)."""
     zero = sp.Integer(0)
     return ((zero, -h[2], h[1]), (h[2], zero, -h[0]), (-h[1], h[0], zero))
 

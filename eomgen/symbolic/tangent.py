@@ -31,6 +31,7 @@ from __future__ import annotations
 import sympy as sp
 
 from .quaternion_joints import placements
+from .spatial import skew
 
 _HALF = sp.Rational(1, 2)
 
@@ -79,10 +80,6 @@ def _cross_unit(a, c: int) -> tuple:
     return (a[1] * e[2] - a[2] * e[1], a[2] * e[0] - a[0] * e[2], a[0] * e[1] - a[1] * e[0])
 
 
-def _skew(a) -> sp.Matrix:
-    return sp.Matrix([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
-
-
 def velocity_transport(derivation) -> sp.Matrix:
     """∂δ̇/∂δ at ``δ = 0`` of ``δ̇ = J_r(δ)⁻¹ v`` (NV × NV, module docstring): the block of the
     state matrix A that the positions' rows take in tangent coordinates; zero without
@@ -93,11 +90,11 @@ def velocity_transport(derivation) -> sp.Matrix:
         k = joint.v_index
         if joint.nv == 6:
             linear, omega = v[k:k + 3], v[k + 3:k + 6]
-            out[k:k + 3, k:k + 3] = -_HALF * _skew(omega)
-            out[k:k + 3, k + 3:k + 6] = -_HALF * _skew(linear)
-            out[k + 3:k + 6, k + 3:k + 6] = -_HALF * _skew(omega)
+            out[k:k + 3, k:k + 3] = -_HALF * sp.Matrix(skew(omega))
+            out[k:k + 3, k + 3:k + 6] = -_HALF * sp.Matrix(skew(linear))
+            out[k + 3:k + 6, k + 3:k + 6] = -_HALF * sp.Matrix(skew(omega))
         else:
-            out[k:k + 3, k:k + 3] = -_HALF * _skew(v[k:k + 3])
+            out[k:k + 3, k:k + 3] = -_HALF * sp.Matrix(skew(v[k:k + 3]))
     return out
 
 

@@ -141,7 +141,7 @@ def test_options_the_cache_cannot_replay_turn_it_off(tmp_path):
 
 
 def test_a_cached_cli_run_imports_neither_sympy_nor_the_parsers(tmp_path, folder):
-    cache._code_fingerprint.cache_clear()  # the code as the other process will read it
+    cache.keys._code_fingerprint.cache_clear()  # the code as the other process will read it
     assert run("generate", ARM, "--backend", "numpy", "-o", tmp_path / "a").exit_code == 0
     script = ("import sys\nfrom eomgen.cli import main\n"
               "try:\n    main(sys.argv[1:])\nexcept SystemExit as exc:\n    code = exc.code\n"
@@ -217,7 +217,7 @@ def test_toolchain_is_the_c_backends_compiler():
 def test_code_version_changes_with_the_code(monkeypatch):
     version = cache.code_version()
     assert version.startswith(eomgen.__version__ + "+")
-    monkeypatch.setattr(cache, "_code_fingerprint", lambda: "f" * 64)
+    monkeypatch.setattr(cache.keys, "_code_fingerprint", lambda: "f" * 64)
     assert cache.code_version() != version
 
 
@@ -292,7 +292,7 @@ def test_stale_entry_is_rebuilt(arm, tmp_path, folder, capsys, monkeypatch):
     between writing and reading) is not used."""
     entry, expected = _stored(arm, tmp_path, folder)
     key = entry.stem
-    monkeypatch.setattr(cache, "code_version", lambda: "0.0.0+other")
+    monkeypatch.setattr(cache.store, "code_version", lambda: "0.0.0+other")  # what get reads
     assert Cache(folder).get(key) is None
     notice = capsys.readouterr().err
     assert "stale (written by eomgen 0.1.0+" in notice and not entry.exists()
@@ -383,7 +383,7 @@ def test_an_unusable_cache_folder_does_not_fail_generation(arm, tmp_path, capsys
 
 
 def test_least_recently_used_entries_are_pruned(folder, monkeypatch):
-    monkeypatch.setattr(cache, "MAX_ENTRIES", 2)
+    monkeypatch.setattr(cache.store, "MAX_ENTRIES", 2)
     store = Cache(folder)
     keys = [cache_key(bytes([i]), {}) for i in range(3)]
     for i, key in enumerate(keys):
@@ -415,9 +415,12 @@ def test_the_suite_never_uses_the_users_cache():
 # ----------------------------------------------------------------------------------------------
 
 def test_cache_module_imports_no_deserializer_of_code():
-    tree = ast.parse(Path(cache.__file__).read_text(encoding="utf-8"))
+    """Every module of the cache package."""
     imported = set()
-    for node in ast.walk(tree):
+    sources = sorted(Path(cache.__file__).parent.glob("*.py"))
+    assert {p.stem for p in sources} >= {"__init__", "keys", "store", "generation"}
+    nodes = [n for p in sources for n in ast.walk(ast.parse(p.read_text(encoding="utf-8")))]
+    for node in nodes:
         if isinstance(node, ast.Import):
             imported |= {alias.name.split(".")[0] for alias in node.names}
         elif isinstance(node, ast.ImportFrom) and node.module:

@@ -1,30 +1,5 @@
-"""The derivation cache: the files of an earlier identical generation request, reused.
+"""The store of the derivation cache: one signed file per entry, in a private folder.
 
-Deriving a robot and rendering its code takes seconds to minutes; a request answered before is
-answered again from the cache in a fraction of that, with the same bytes.
-
-Keys
-----
-:func:`cache_key` is the SHA-256 of a canonical JSON text of
-
-* the description file's bytes, and a scene file's bytes when one is given;
-* the code version (:func:`code_version`): eomgen's ``__version__`` and a fingerprint of its
-  sources and templates, so that an edited checkout never serves what older code produced;
-* the options: everything else the files depend on (backends, parameters kept symbolic,
-  ``strict``, the C compiler found, ...).
-
-Two callers build keys:
-
-* ``eomgen generate`` (:mod:`eomgen.cli`) keys the description *file* (bytes and name) and the
-  command's options (:func:`command_request`) before the file is read, so that a hit needs
-  neither parsing nor SymPy: the cached run takes a fraction of a second.
-* :func:`eomgen.codegen.generate.generate` keys the *model* it is given (a canonical text of
-  every name and number, :func:`model_fingerprint`), the backends with the functions
-  implementing them, and the description file's bytes (every file's header quotes their hash):
-  library callers pass models no file describes (locked joints, substituted parameters).
-
-Storage
--------
 One file per entry, ``<folder>/entries/<key>.entry``: one line of JSON,
 ``{"format": 1, "length": n, "sha256": "...", "hmac": "..."}``, then the payload: n bytes of
 JSON holding the key, the code version, the files (text, or base64 for bytes, each with its
@@ -43,16 +18,11 @@ read-only folder, a full disk) never fail a generation: a notice, and the result
 
 The folder is ``--cache-dir``, else ``$EOMGEN_CACHE_DIR``, else ``$XDG_CACHE_HOME/eomgen``, else
 ``~/.cache/eomgen`` (:func:`default_cache_dir`).
-
-Only the standard library and eomgen's light modules (output, compiler) are imported at the top
-(no SymPy, NumPy or CasADi); the backend registry is imported by :func:`generation_key` alone.
 """
 
 from __future__ import annotations
 
 import base64
-import dataclasses
-import enum
 import hashlib
 import hmac
 import json
@@ -61,35 +31,19 @@ import re
 import secrets
 import stat
 import sys
-import warnings
-import sysconfig
 from dataclasses import dataclass
-from functools import lru_cache
 from pathlib import Path
-from typing import Callable, Mapping, Sequence
+from typing import Callable, Sequence
 
-from .compiler import c_compiler_path
-from .errors import recorded_warnings
-from .output import GeneratedFile
+from ..output import GeneratedFile
+from .keys import FORMAT, code_version
 
-#: Version of the entry layout; entries of another format are stale.
-FORMAT = 1
 #: Entries kept; the least recently used beyond are deleted when a new one is stored.
 MAX_ENTRIES = 64
-#: Description and scene files larger than this are not keyed (the parsers refuse them).
-MAX_KEYED_BYTES = 50 * 1024 * 1024
 
-_PACKAGE = Path(__file__).resolve().parent
 _KEY = re.compile(r"^[0-9a-f]{64}$")
 #: Names a cached file may have: plain file names, no folders, not hidden.
 _FILE_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.\-]*$")
-#: ``eomgen generate`` parameters that do not change what is written.
-COMMAND_IGNORED = frozenset({"description", "outdir", "quiet", "debug", "no_cache", "cache_dir"})
-#: ``eomgen generate`` parameters that enter the key (and ``scene_path``, keyed by the scene
-#: file's bytes and name). A parameter in none of these, given with a value other than None or
-#: False (``--explain``), turns the command-level cache off for that run: it may print more
-#: than the files, which a cached run would not repeat.
-COMMAND_KEYED = frozenset({"backends", "symbolic", "strict", "no_snap", "outputs", "name"})
 
 Notify = Callable[[str], None]
 
@@ -97,10 +51,6 @@ Notify = Callable[[str], None]
 def _stderr_notice(text: str) -> None:
     print(f"eomgen: notice: {text}", file=sys.stderr, flush=True)
 
-
-# ----------------------------------------------------------------------------------------------
-# Keys
-# ----------------------------------------------------------------------------------------------
 
 def default_cache_dir() -> Path:
     """``$EOMGEN_CACHE_DIR``, else ``$XDG_CACHE_HOME/eomgen``, else ``~/.cache/eomgen``."""
@@ -112,185 +62,6 @@ def default_cache_dir() -> Path:
         return Path(xdg) / "eomgen"
     return Path.home() / ".cache" / "eomgen"
 
-
-@lru_cache(maxsize=1)
-def _code_fingerprint() -> str:
-    """SHA-256 over eomgen's Python sources and templates (paths and bytes)."""
-    digest = hashlib.sha256()
-    roots = [_PACKAGE] + [t for t in (_PACKAGE / "templates", _PACKAGE.parent / "templates")
-                          if t.is_dir()]
-    for root in roots:
-        pattern = "*.py" if root == _PACKAGE else "*"
-        for path in sorted(root.rglob(pattern)):
-            if path.is_file() and "__pycache__" not in path.parts:
-                digest.update(str(path.relative_to(root)).encode() + b"\0")
-                digest.update(path.read_bytes() + b"\0")
-    return digest.hexdigest()
-
-
-def code_version() -> str:
-    """eomgen's ``__version__`` and a fingerprint of its code: ``"0.1.0+3f2a…"``.
-
-    The version alone would serve stale results to anyone editing a checkout (or its
-    templates) without bumping it.
-    """
-    from . import __version__  # read at each call: tests change it
-
-    return f"{__version__}+{_code_fingerprint()[:16]}"
-
-
-def toolchain() -> dict[str, str | bool | None]:
-    """What outside the inputs changes the files: the C compiler the C backends would use
-    (:func:`eomgen.compiler.c_compiler_path`), and for the fast backend's compiled extension
-    the Python it is built for (its ``EXT_SUFFIX`` names the ABI) and whether Python's headers are there. (NumPy's C API is backward compatible: an
-    extension built against NumPy 2 headers targets the oldest supported NumPy by default.)"""
-    compiler = c_compiler_path()
-    include = sysconfig.get_paths().get("include")
-    return {"cc": compiler, "ext_suffix": sysconfig.get_config_var("EXT_SUFFIX"),
-            "python_headers": bool(include) and Path(include, "Python.h").is_file()}
-
-
-def canonical(value) -> object:
-    """A JSON-able, deterministic rendering of ``value`` for keys: dataclasses field by field,
-    enums by value, SymPy objects by ``srepr``, mappings with sorted keys, paths as text.
-
-    Values of other types are rendered with ``repr``; when that holds a memory address the key
-    never matches again, which costs a derivation but never serves a wrong result.
-    """
-    if value is None or isinstance(value, (bool, int, str)):
-        return value
-    if isinstance(value, float):
-        return repr(value)
-    if isinstance(value, bytes):
-        return {"sha256": hashlib.sha256(value).hexdigest()}
-    if isinstance(value, enum.Enum):
-        return [type(value).__name__, canonical(value.value)]
-    if isinstance(value, Path):
-        return str(value)
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return [type(value).__name__] + [[f.name, canonical(getattr(value, f.name))]
-                                         for f in dataclasses.fields(value)]
-    if isinstance(value, Mapping):
-        return sorted([[canonical(k), canonical(v)] for k, v in value.items()], key=json.dumps)
-    if isinstance(value, (list, tuple)):
-        return [canonical(v) for v in value]
-    if isinstance(value, (set, frozenset)):
-        return sorted((canonical(v) for v in value), key=json.dumps)
-    if type(value).__module__.startswith("sympy"):
-        import sympy  # only for SymPy values, already imported by whoever made them: the
-        # cached ``eomgen generate`` path must not load SymPy (start-up time)
-
-        return ["sympy", sympy.srepr(value)]
-    return ["repr", repr(value)]
-
-
-def cache_key(description: bytes, options: Mapping[str, object], scene: bytes | None = None
-              ) -> str:
-    """The key of a request: SHA-256 (hex) of the description's bytes, the scene's bytes (if
-    any), :func:`code_version` and ``options`` (anything :func:`canonical` renders).
-
-    >>> key = cache_key(b"<robot/>", {"backends": ["numpy"]})
-    >>> len(key), key == cache_key(b"<robot/>", {"backends": ["numpy"]})
-    (64, True)
-    >>> key == cache_key(b"<robot/>", {"backends": ["numpy"]}, scene=b"lock: {}")
-    False
-    """
-    text = json.dumps({
-        "format": FORMAT,
-        "version": code_version(),
-        "description": hashlib.sha256(description).hexdigest(),
-        "scene": None if scene is None else hashlib.sha256(scene).hexdigest(),
-        "options": canonical(dict(options)),
-    }, sort_keys=True, ensure_ascii=True, separators=(",", ":"))
-    return hashlib.sha256(text.encode("ascii")).hexdigest()
-
-
-def model_fingerprint(model) -> str:
-    """SHA-256 of a canonical text of a :class:`~eomgen.model.RobotModel`: every field but
-    ``source`` (generated files name the source file only by its base name and hash)."""
-    fields = [[f.name, canonical(getattr(model, f.name))]
-              for f in dataclasses.fields(model) if f.name != "source"]
-    return hashlib.sha256(json.dumps(fields).encode("ascii")).hexdigest()
-
-
-def _read_limited(path: Path) -> bytes | None:
-    """The file's bytes, or None when it is not a readable file of at most MAX_KEYED_BYTES."""
-    try:
-        if not path.is_file() or path.stat().st_size > MAX_KEYED_BYTES:
-            return None
-        return path.read_bytes()
-    except (OSError, ValueError):
-        return None
-
-
-@dataclass(frozen=True)
-class CacheRequest:
-    """A key chosen by the caller, and the notices to store with the entry (read when the entry
-    is stored, so a list the caller keeps filling may be passed)."""
-
-    key: str
-    notices: Sequence[str] = ()
-
-
-def command_request(description: Path, params: Mapping[str, object]) -> CacheRequest | None:
-    """The cache request of an ``eomgen generate`` run, made before the description is read.
-
-    ``params`` are the command's parameters (click's ``ctx.params``). The key covers the
-    description file's bytes and name, the scene file's bytes and name (``--scene``; its
-    report and the files' headers name it), every parameter of :data:`COMMAND_KEYED`,
-    :func:`toolchain` and :func:`code_version`. Returns None (answer without the
-    command-level cache) when the description cannot be read or a parameter the cache does not
-    know is given.
-    """
-    description = Path(description)
-    data = _read_limited(description)
-    if data is None:
-        return None
-    options: dict[str, object] = {"request": "eomgen generate", "file": description.name,
-                                  "toolchain": toolchain()}
-    scene = None
-    if params.get("scene_path") is not None:
-        scene_path = Path(params["scene_path"])
-        scene = _read_limited(scene_path)
-        if scene is None:
-            return None
-        options["scene_file"] = scene_path.name
-    for name, value in sorted(params.items()):
-        if name in COMMAND_IGNORED or name == "scene_path":
-            continue
-        if name == "name" and value is None:  # keyed only when given: earlier keys stay valid
-            continue
-        if name not in COMMAND_KEYED:
-            if value is None or value is False:
-                continue
-            return None
-        options[name] = value
-    return CacheRequest(cache_key(data, options, scene=scene))
-
-
-def generation_key(model, backends: Sequence[str], options: Mapping[str, object]) -> str:
-    """The key of a library call ``render(model, backends, **options)`` (see the module
-    docstring): the model's fingerprint, the backends and the functions implementing them,
-    the options, the toolchain, and the description file's bytes."""
-    # imported here, not at the top: eomgen.codegen loads SymPy, which the cached
-    # ``eomgen generate`` path (command_request) must not (start-up time)
-    from .codegen import available_backends
-
-    registry = available_backends()
-    implementations = [[name, f"{registry[name].generate.__module__}."
-                              f"{registry[name].generate.__qualname__}"] for name in backends]
-    source = Path(model.source)
-    description = _read_limited(source) or b""
-    return cache_key(description, {
-        "request": "generate()", "file": source.name, "model": model_fingerprint(model),
-        "backends": implementations, "options": canonical(dict(options)),
-        "toolchain": toolchain(),
-    })
-
-
-# ----------------------------------------------------------------------------------------------
-# Storage
-# ----------------------------------------------------------------------------------------------
 
 @dataclass(frozen=True)
 class Entry:
@@ -567,41 +338,4 @@ def _decode_file(data: dict) -> GeneratedFile:
     raise ValueError("bad file entry")
 
 
-# ----------------------------------------------------------------------------------------------
-# Use from code generation
-# ----------------------------------------------------------------------------------------------
-
-class CachedNotice(UserWarning):
-    """A warning the run that filled a cache entry showed while rendering (e.g. that no C
-    compiler was found), shown again when a library call is answered from that entry."""
-
-
-def render_cached(render: Callable[..., list], model, backends: Sequence[str],
-                  progress: Callable[[str], None], *, cache: bool | CacheRequest = True,
-                  cache_dir: Path | None = None, **options) -> list[GeneratedFile]:
-    """``render(model, backends, progress, **options)``, or the files it returned for an
-    identical earlier call.
-
-    ``cache`` False calls ``render``; True keys the call with :func:`generation_key`; a
-    :class:`CacheRequest` gives the key (and the notices to store) itself. The warnings
-    ``render`` shows are stored with the entry too; a call answered from the cache shows them
-    again (as :class:`CachedNotice`; ``eomgen generate`` prints an entry's notices itself).
-    """
-    if cache is False:
-        return render(model, backends, progress, **options)
-    store = Cache(cache_dir)
-    if isinstance(cache, CacheRequest):
-        request = cache
-    else:
-        request = CacheRequest(generation_key(model, backends, options))
-    entry = store.get(request.key)
-    if entry is not None:
-        progress(f"using cached result (key {request.key[:16]}…)")
-        if not isinstance(cache, CacheRequest):  # the caller's own notices are not replayed
-            for notice in entry.notices:
-                warnings.warn(notice, CachedNotice, stacklevel=3)
-        return list(entry.files)
-    with recorded_warnings(tidy=lambda text: " ".join(text.split())) as shown:
-        files = render(model, backends, progress, **options)
-    store.put(request.key, files, (*request.notices, *shown))
-    return files
+__all__ = ["MAX_ENTRIES", "Cache", "Entry", "Notify", "default_cache_dir"]
