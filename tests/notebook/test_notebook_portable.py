@@ -16,6 +16,7 @@ import eomgen
 from eomgen.notebook import build_notebook, text_literal
 from eomgen.numeric import numeric_model, rnea
 from support import run_cli, write as write_file
+from support.extras import need
 
 #: The planar arm with a heavier second link: a notebook that loaded the bundled file instead
 #: of its own copy would print other torques.
@@ -93,7 +94,7 @@ def test_scene_is_written_in_as_well(description, tmp_path, monkeypatch):
 def test_mjcf_with_an_include_is_loaded_relative_to_the_notebook(tmp_path, monkeypatch):
     """MuJoCo's compiler reads an MJCF's includes and meshes from its folder: such a
     description stays a file, named relative to where the notebook is written."""
-    pytest.importorskip("mujoco")
+    need("mujoco", reason="the description is MJCF")
     write(tmp_path / "robots" / "link.xml", (
         '<mujoco><body name="link" pos="0 0 -0.1"><joint name="hinge" axis="0 1 0"/>'
         '<geom type="capsule" fromto="0 0 0 0 0 -0.4" size="0.02" mass="0.5"/></body>'
@@ -113,8 +114,8 @@ def test_moved_notebook_runs_in_a_kernel(description, tmp_path):
     """Made in one folder, moved to another, the description's folder deleted: the notebook
     runs in a real kernel without a cell error, with the description it holds (its torques
     are those of the heavier arm, from eomgen's numeric Newton–Euler here)."""
-    nbclient = pytest.importorskip("nbclient")
-    pytest.importorskip("ipykernel")
+    nbclient = need("nbclient", reason="the notebook is run")
+    need("ipykernel", reason="the notebook is run")
     made = tmp_path / "made" / "arm.ipynb"
     result = run_cli("notebook", description, "-o", made)
     assert result.exit_code == 0, result.output
