@@ -5,18 +5,17 @@ no longer exists, a formula that cannot become MathML all fail the build)."""
 
 from __future__ import annotations
 
-import importlib.util
 import re
 import subprocess
 import sys
 
 import pytest
 
-from support import DOCS, ROOT
+from support import DOCS
+from support.extras import missing
 
-needs_docs = pytest.mark.skipif(
-    any(importlib.util.find_spec(m) is None for m in ("sphinx", "myst_parser", "furo")),
-    reason="the docs extra is not installed (python3 -m pip install -e \".[docs]\")")
+_DOCS_MISSING = missing("sphinx", "myst_parser", "furo")
+needs_docs = pytest.mark.skipif(_DOCS_MISSING is not None, reason=f"the site build {_DOCS_MISSING}")
 
 #: A table of contents: MyST's ``:::{toctree}`` block (index.md) or reST's directive
 #: (api/index.rst), up to the closing ``:::`` or the end of the indented block.

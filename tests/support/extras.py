@@ -12,6 +12,7 @@ module through it (``tests/docs/test_extras.py`` checks that no test calls
 
 from __future__ import annotations
 
+import importlib.util
 from types import ModuleType
 
 import pytest
@@ -34,6 +35,10 @@ EXTRAS: dict[str, tuple[str, str]] = {
     "jax": ("jax", "jax"),
     "torch": ("torch", "torch"),
     "selenium": ("selenium", "browser"),
+    "sphinx": ("sphinx", "docs"),
+    "myst_parser": ("myst-parser", "docs"),
+    "furo": ("furo", "docs"),
+    "nbconvert": ("nbconvert", "notebook"),
     "casadi": ("casadi", "core"),
     "matplotlib": ("matplotlib", "core"),
     "PIL": ("pillow", "core"),
@@ -48,6 +53,15 @@ def install_hint(module: str) -> str:
     if extra == "core":
         return f"{distribution} is one of eomgen's own dependencies: pip install -e ."
     return f"pip install -e '.[{extra}]' brings {distribution}"
+
+
+def missing(*modules: str) -> str | None:
+    """Why a test needing ``modules`` cannot run here (the first one missing and the extra that
+    brings it), or None when they all import: for ``pytest.mark.skipif``."""
+    for module in modules:
+        if importlib.util.find_spec(module) is None:
+            return f"needs {module}: {install_hint(module)}"
+    return None
 
 
 def need(module: str, reason: str | None = None) -> ModuleType:
