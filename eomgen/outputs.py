@@ -37,11 +37,28 @@ from __future__ import annotations
 import difflib
 
 # The catalogue's data, re-exported under the public name (docs, backends, tests use it).
+from . import catalogue
 from .catalogue import (CATALOGUE, CONSTRAINED_DERIVATIVES, CONSTRAINED_FORWARD,  # noqa: F401
                         CONSTRAINED_PARTIALS, CORIOLIS, DYNAMICALLY_CONSISTENT_INVERSE, DYNAMICS,
-                        FORWARD, FRAME_JACOBIANS, FRAME_JACOBIANS_DOT_QD, GRAVITY, INPUT_SIZES,
-                        INPUTS, INVERSE, MASS, MASS_AND_BIAS, OPERATIONAL_SPACE_BIAS,
-                        OPERATIONAL_SPACE_INERTIA, PARALLEL_INVERSE, TASK_SPACE, Output)
+                        FORWARD, FRAME_JACOBIANS, FRAME_JACOBIANS_DOT_QD, GRAVITY, INVERSE, MASS,
+                        MASS_AND_BIAS, OPERATIONAL_SPACE_BIAS, OPERATIONAL_SPACE_INERTIA,
+                        PARALLEL_INVERSE, TASK_SPACE, Output)
+
+#: The vector inputs a generated function may take, by name, with their docstring line
+#: (:data:`eomgen.catalogue.INPUTS`).
+INPUTS = catalogue.INPUTS
+#: The inputs whose length is not the number of joints, with what their length is
+#: (:data:`eomgen.catalogue.INPUT_SIZES`; the function giving it is registered with
+#: :func:`eomgen.symbolic.builders.sizes`).
+INPUT_SIZES = catalogue.INPUT_SIZES
+
+
+def __getattr__(name: str):
+    """The catalogue's other entries under the public name (``eomgen.outputs.FRAME_POSITIONS``)."""
+    if name.isupper() and isinstance(getattr(catalogue, name, None), Output):
+        return getattr(catalogue, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 #: Every output, by function name, in module order (:data:`~eomgen.catalogue.CATALOGUE`, then
 #: any registered later).

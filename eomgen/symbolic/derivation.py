@@ -4,8 +4,8 @@ A :class:`Derivation` holds a model, its body tree (fixed links merged, :mod:`eo
 the symbols of each input vector in ``JOINT_NAMES`` order and the program builder the
 algorithms define their intermediates in. :func:`new_derivation` is the only function that
 builds one; :func:`eomgen.derive`, the algorithm entry points (CRBA, ABA, Newton–Euler, the
-regressor, frames, the combined programs) and the output builders of :mod:`eomgen.outputs` all
-start from it, so that the symbols, the reserved names and the sizes of the inputs are decided
+regressor, frames, the combined programs) and the output builders (registered in
+:mod:`eomgen.symbolic.builders`, each found by its symbol) all start from it, so that the symbols, the reserved names and the sizes of the inputs are decided
 once.
 
 Symbols: ``q1 … qn`` [rad or m] (``n`` = NQ, the configuration size: seven entries more
@@ -47,8 +47,8 @@ def joint_symbols(n: int) -> tuple[tuple[sp.Symbol, ...], tuple[sp.Symbol, ...],
 
 @dataclass(frozen=True)
 class Derivation:
-    """What an algorithm or an output's builder (:func:`eomgen.symbolic.builders.builds`) works
-    with: the model, its body tree (fixed links merged), the symbols of every input vector it
+    """What an algorithm or an output's builder (:func:`~eomgen.symbolic.builders.builds`)
+    works with: the model, its body tree (fixed links merged), the symbols of every input vector it
     was made with, in ``JOINT_NAMES`` order (``inputs["q"]`` is ``q1 … qn``; also as the
     attributes ``q``, ``qd``, ``qdd``, ``tau``), and the program builder to define
     intermediates in. ``shared`` lets builders keep what another builder may reuse (keyed by
