@@ -20,7 +20,7 @@ import sympy as sp
 from . import reprs
 from .errors import TooLargeError, UnsupportedError
 from .model import Parameter, RobotModel
-from .outputs import derived_symbols
+from .outputs import BY_SYMBOL, derived_symbols
 # Derivation, joint_symbols and vector_symbols live in eomgen.symbolic.derivation; re-exported here
 # because the docs and earlier code import them from eomgen.dynamics.
 from .symbolic.derivation import Derivation, joint_symbols, new_derivation, vector_symbols  # noqa: F401
@@ -28,32 +28,19 @@ from .symbolic.couplings import refused
 from .symbolic.program import Program
 from .symbolic.named import AUTO_EXPAND_WORK, ExpansionTooLargeError, ProgramMatrix
 from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS, textbook_derivation
+# Every module that registers the builder of an output (eomgen.symbolic.builders), imported for
+# its registrations: a derivation finds each output's builder by symbol, so all must be known
+# before derive() builds one (tests/architecture checks that every printed output has one).
+from . import regressor  # noqa: F401  (the regressor outputs: eomgen.regressor.generated)
+from .regressor import slotine_li  # noqa: F401
+from .symbolic import (aba, centroidal, combined, contact_derivatives, derivatives,  # noqa: F401
+                       drives, flat, frames, loops, newton_euler, routes)
 
 #: What generated modules export by default: the mass matrix, Coriolis matrix, gravity vector
 #: and the inverse dynamics τ(q, q̇, q̈) (by a symbolic Newton–Euler pass; cheaper to evaluate).
 #: :func:`derive` builds these and every further output of :mod:`eomgen.outputs`.
 ALL_OUTPUTS = derived_symbols(default_only=True)  # ("M", "C", "g", "tau")
 DEFAULT_OUTPUTS = ("M", "C", "g")
-
-#: The outputs derived for a model with a quaternion free flyer or ball joints
-#: (:mod:`eomgen.model.quaternion`), each checked against Pinocchio's free flyer and spherical
-#: joints (Y against ``computeJointTorqueRegressor``: a virtual joint's massless body has
-#: columns of its own, multiplied by zero parameters; Y_base by the numeric route, without
-#: them; Y_SL against M, ``computeCoriolisMatrix`` and g; Y_K, Y_P against Pinocchio's energies;
-#: the drive outputs against ``model.armature`` and the friction law; the flat outputs against
-#: finite differences along a trajectory integrated on the configuration space). The others
-#: (loop closures) are refused in one line; the derivatives, the drives' too, are taken
-#: along the tangent (eomgen.symbolic.tangent).
-FREE_FLYER_OUTPUTS = ("M", "C", "g", "P", "tau", "h", "qdd_aba", "MCg", "Mh", "p_f", "R_f",
-                      "J_f", "Jb_f", "dJqd_f", "dJbqd_f", "J_c", "dJqd_c", "tau_c", "cone_c",
-                      "pyramid_c", "c_G", "J_G", "A_G", "dAGv", "I_G", "Y", "pi", "Y_base", "beta",
-                      "Y_SL", "Y_SL_base", "Y_K", "Y_P", "M_a", "tau_f", "tau_f_smooth", "tau_a",
-                      "M_l", "tau_K", "thetadd_m", "theta_flat", "thetad_flat", "tau_flat",
-                      "tau_flat_smooth",
-                      # issue 25: derivatives along the tangent (eomgen.symbolic.tangent)
-                      "dtau_dq", "dtau_dqd", "dtau", "dg_dq", "dqdd_dq", "dqdd_dqd", "Minv",
-                      "dqdd", "A_lin", "B_lin", "AB", "dKKT", "dtau_a_dqd", "dtau_a",
-                      "dqdd_a_dq", "dqdd_a_dqd", "Minv_a", "dqdd_a")
 
 #: ``derive(model, simplify=True)`` refuses models with more movable joints: trigonometric
 #: simplification of the expanded expressions grows exponentially with the number of joints
@@ -149,11 +136,7 @@ class Dynamics:
         parameters as formulas of the standard ones, on first use. Meant for teaching-sized
         models (the LaTeX document and the notebook use it below the textbook bound). A façade
         for the README's API: the work is :func:`eomgen.regressor.regressor_form`."""
-        # Imported on first use (start-up time): eomgen.regressor loads NumPy (about 0.25 s),
-        # which deriving never needs.
-        from .regressor import regressor_form
-
-        return regressor_form(self.model)
+        return regressor.regressor_form(self.model)
 
     def named(self, name: str):
         """Output ``name`` (``"M"``, ``"C"``, ``"g"``, ``"P"``, ``"tau"``) in terms of the
@@ -318,14 +301,24 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     unknown = outputs - set(known)
     if unknown:
         raise ValueError(f"unknown outputs {sorted(unknown)}; choose from {known}")
-    if model.quaternion_joints and outputs - set(FREE_FLYER_OUTPUTS):
+    # With a quaternion free flyer or ball joints (eomgen.model.quaternion), the outputs the
+    # catalogue marks (Output.quaternion_joints), each checked against Pinocchio's free flyer
+    # and spherical joints (Y against computeJointTorqueRegressor: a virtual joint's massless
+    # body has columns of its own, multiplied by zero parameters; Y_base by the numeric route,
+    # without them; Y_SL against M, computeCoriolisMatrix and g; Y_K, Y_P against Pinocchio's
+    # energies; the drive outputs against model.armature and the friction law; the flat outputs
+    # against finite differences along a trajectory integrated on the configuration space). The
+    # others (loop closures) are refused in one line; the derivatives, the drives' too, are
+    # taken along the tangent (eomgen.symbolic.tangent).
+    refused_here = sorted(s for s in outputs if not BY_SYMBOL[s].quaternion_joints)
+    if model.quaternion_joints and refused_here:
         what, where, hint = (("a quaternion free flyer", "floating_base: quaternion",
                               "; use floating_base: euler") if model.free_flyer else
                              ("a ball joint", f"ball joint '{model.ball_joints[0]}'", ""))
+        derived = [s for s, o in BY_SYMBOL.items() if o.quaternion_joints]
         raise UnsupportedError(
-            model.source, where,
-            f"{', '.join(sorted(outputs - set(FREE_FLYER_OUTPUTS)))} not derived for "
-            f"{what} yet (it has {', '.join(FREE_FLYER_OUTPUTS)}){hint}")
+            model.source, where, f"{', '.join(refused_here)} not derived for {what} yet (it "
+            f"has {', '.join(derived)}){hint}")
     if model.couplings and refused(outputs):
         raise UnsupportedError(
             model.source, "couplings", f"{', '.join(refused(outputs))} not derived for a model "

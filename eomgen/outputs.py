@@ -23,142 +23,45 @@ Cholesky solve of ``M q̈ = τ − (C q̇ + g)``), whose names it receives from 
 Further outputs are derived and exported only when asked for (``default=False``: ``eomgen
 generate --outputs Y`` or a scene's ``outputs``), so that existing modules stay as they were.
 
-Adding an output is one module with the function that builds its symbol (``build``, see
-:class:`Output`) and one :func:`register_output` call here. :func:`eomgen.derive` calls the
-builders; the backends print what they return.
+The outputs are declared as data in :mod:`eomgen.catalogue` (re-exported here, the public
+name); this module indexes them (:data:`OUTPUTS`, :data:`BY_SYMBOL`) and answers what is asked
+of them. It names no function that builds an output and imports nothing of eomgen but the
+catalogue, so every layer may read it (docs/architecture.md: layer 0). Adding an output is one
+entry in the catalogue and, in the module that builds its symbol, a builder registered with
+:func:`@builds(symbol) <eomgen.symbolic.builders.builds>`: :func:`eomgen.derive` finds it by
+symbol, the backends print what it returns.
 """
 
 from __future__ import annotations
 
 import difflib
-import importlib
-from dataclasses import dataclass
-from typing import Callable
 
-#: The vector inputs a generated function may take, each of length n (the joints, in
-#: ``JOINT_NAMES`` order) unless :data:`INPUT_SIZES` gives another length, with their docstring line. Their symbols are ``<name>1 … <name>n``
-#: (:attr:`eomgen.symbolic.derivation.Derivation.inputs`); adding an input is one line here.
-INPUTS: dict[str, str] = {
-    "q": "joint positions [rad or m]",
-    "qd": "joint velocities [rad/s or m/s]",
-    "qdd": "joint accelerations [rad/s^2 or m/s^2]",
-    "tau": "joint efforts [N m or N]",
-    "theta_m": "motor angles of the flexible joints, link side of the gear [rad] (entries of "
-             "rigid joints are ignored)",
-    "thetad_m": "motor velocities of the flexible joints, link side of the gear [rad/s] "
-              "(entries of rigid joints are ignored)",
-    "qddd": "third time derivatives of the joint positions (jerk) [rad/s^3 or m/s^3]",
-    "qdddd": "fourth time derivatives of the joint positions (snap) [rad/s^4 or m/s^4]",
-    "F_c": "contact forces on the robot, rows CONTACT_ROWS (point contacts: force [N] in world "
-           "axes; surface contacts: force [N] and moment [N m] in the contact frame's axes; "
-           "then the loop forces on each loop's frame b, in its rows' axes)",
-    "qd_r": "reference joint velocities of the Slotine-Li controller [rad/s or m/s]",
-    "qdd_r": "reference joint accelerations of the Slotine-Li controller [rad/s^2 or m/s^2]",
-}
+# The catalogue's data, re-exported under the public name (docs, backends, tests use it).
+from . import catalogue
+from .catalogue import (CATALOGUE, CONSTRAINED_DERIVATIVES, CONSTRAINED_FORWARD,  # noqa: F401
+                        CONSTRAINED_PARTIALS, CORIOLIS, DYNAMICALLY_CONSISTENT_INVERSE, DYNAMICS,
+                        FORWARD, FRAME_JACOBIANS, FRAME_JACOBIANS_DOT_QD, GRAVITY, INVERSE, MASS,
+                        MASS_AND_BIAS, OPERATIONAL_SPACE_BIAS, OPERATIONAL_SPACE_INERTIA,
+                        PARALLEL_INVERSE, TASK_SPACE, Output)
 
-#: The inputs whose length is not the number of joints: ``"module:function"`` of
-#: ``function(model) -> int``, their length for a model (``F_c``: the contact rows).
-INPUT_SIZES: dict[str, str] = {
-    "q": "eomgen.model.robot:configuration_size",
-    "F_c": "eomgen.symbolic.loops:constraint_row_count",
-}
+#: The vector inputs a generated function may take, by name, with their docstring line
+#: (:data:`eomgen.catalogue.INPUTS`).
+INPUTS = catalogue.INPUTS
+#: The inputs whose length is not the number of joints, with what their length is
+#: (:data:`eomgen.catalogue.INPUT_SIZES`; the function giving it is registered with
+#: :func:`eomgen.symbolic.builders.sizes`).
+INPUT_SIZES = catalogue.INPUT_SIZES
 
 
-def input_size(name: str, model) -> int:
-    """The length of input ``name`` (:data:`INPUTS`) for ``model``: its number of joints unless
-    :data:`INPUT_SIZES` says otherwise."""
-    return resolve(INPUT_SIZES[name])(model) if name in INPUT_SIZES else model.dof
+def __getattr__(name: str):
+    """The catalogue's other entries under the public name (``eomgen.outputs.FRAME_POSITIONS``)."""
+    if name.isupper() and isinstance(getattr(catalogue, name, None), Output):
+        return getattr(catalogue, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-@dataclass(frozen=True)
-class Output:
-    """One function of a generated module.
-
-    Attributes
-    ----------
-    function:
-        Its name in the generated module (a Python and C identifier).
-    symbol:
-        The derived quantity it returns (``"M"``), the key of :attr:`Dynamics.outputs
-        <eomgen.dynamics.Dynamics.outputs>` and a short name callers may use; ``None`` for a
-        composed function.
-    summary:
-        The first line of its docstring.
-    inputs:
-        Names of its vector inputs, in call order (``"q"``, ``"qd"``, ``"qdd"``, ``"tau"``).
-    is_vector:
-        Whether it returns an (n,) vector rather than an (n, n) matrix.
-    units:
-        Units of the result's entries.
-    needs:
-        Symbols of the derived outputs it needs (its own symbol for a printed output).
-    composed_from:
-        Functions a composed output is built from (generated along with it); empty otherwise.
-    build:
-        ``"module:function"``, the builder of ``symbol``, imported when first needed:
-        ``function(derivation, wanted) -> dict`` takes a
-        :class:`~eomgen.symbolic.derivation.Derivation` (the model, its body tree, the joint symbols and
-        the program builder) and the set of symbols wanted of those it builds, and returns
-        ``{symbol: sympy.Matrix}`` in terms of the builder's intermediates. Outputs sharing a
-        builder are built in one call. A returned symbol no output declares (the potential
-        energy ``P`` of the Lagrangian builder) is kept in the program as well.
-    default:
-        Whether a generated module exports it when the caller names no outputs.
-    constants:
-        ``"module:function"`` or ``None``: ``function(dynamics) -> {NAME: (str, ...)}``, tuples
-        of names a module exporting this output also exports (e.g. ``PARAMETER_NAMES``, the
-        columns of the regressor).
-    backends:
-        For a composed output, the backends whose templates compose it (``None``: every one);
-        the others leave it out of their modules.
-    returns:
-        For a function returning several results from one program (sharing its intermediates):
-        the symbols of the printed outputs it returns, in order. Its own ``symbol`` is then the
-        side-by-side matrix of those results (each n rows; a vector is one column), which the
-        module splits into the tuple it returns. Empty for a function of one result.
-    width:
-        The columns of a matrix result in units of n (2 for the 2n × 2n state matrix of
-        ``linearize``), for :func:`splits`.
-    """
-
-    function: str
-    symbol: str | None
-    summary: str
-    inputs: tuple[str, ...]
-    is_vector: bool
-    units: str
-    needs: tuple[str, ...]
-    composed_from: tuple[str, ...] = ()
-    build: str | None = None
-    default: bool = True
-    constants: str | None = None
-    backends: tuple[str, ...] | None = None
-    returns: tuple[str, ...] = ()
-    width: int = 1
-
-    @property
-    def composed(self) -> bool:
-        """Whether backends compose it from other functions instead of printing a program."""
-        return bool(self.composed_from)
-
-    def shape(self, n: int) -> tuple[int, ...]:
-        """Its result's shape for ``n`` joints, for the outputs whose rows and columns are the
-        joints (the printed shape of any output is that of the matrix its builder returns)."""
-        return (n,) if self.is_vector else (n, n)
-
-    def builder(self) -> Callable:
-        """The function :attr:`build` names, imported."""
-        return resolve(self.build)
-
-
-def resolve(reference: str) -> Callable:
-    """The object ``"package.module:name"`` refers to (imported on demand, so that the registry
-    stays light to import)."""
-    module, _, name = reference.partition(":")
-    return getattr(importlib.import_module(module), name)
-
-
-#: Every output, by function name, in module order.
+#: Every output, by function name, in module order (:data:`~eomgen.catalogue.CATALOGUE`, then
+#: any registered later).
 OUTPUTS: dict[str, Output] = {}
 
 
@@ -176,8 +79,9 @@ def register_output(output: Output) -> Output:
     if output.symbol is not None and output.symbol in BY_SYMBOL:
         raise ValueError(f"output symbol {output.symbol!r} is already registered")
     missing = [f for f in output.composed_from if f not in OUTPUTS]
-    if output.symbol is not None and output.build is None:
-        raise ValueError(f"printed output {output.function!r} has no builder")
+    if isinstance(output.constants, str):
+        raise ValueError(f"{output.function!r}: constants are a tuple of names, not "
+                         f"{output.constants!r}")
     strangers = [s for s in output.returns if s not in BY_SYMBOL]
     if strangers:
         raise ValueError(f"{output.function!r} returns unregistered outputs {strangers}")
@@ -196,145 +100,9 @@ def register_output(output: Output) -> Output:
 #: Printed outputs by symbol (``BY_SYMBOL["M"].function``).
 BY_SYMBOL: dict[str, Output] = {}
 
-_REVOLUTE_EFFORT = "N m (revolute), N (prismatic)"
-#: M, C and g (and the potential energy P) come from one Lagrangian program.
-_LAGRANGIAN = "eomgen.symbolic.routes:build_lagrangian"
-
-MASS = register_output(Output(
-    "mass_matrix", "M", "Mass matrix M(q), symmetric positive definite.", ("q",), False,
-    "kg m^2 (revolute rows/columns), kg (prismatic)", ("M",), build=_LAGRANGIAN))
-CORIOLIS = register_output(Output(
-    "coriolis_matrix", "C", "Coriolis matrix C(q, qd) from the Christoffel symbols of the first "
-    "kind, so that Mdot - 2 C is skew-symmetric.", ("q", "qd"), False, "kg m^2/s (revolute)",
-    ("C",), build=_LAGRANGIAN))
-GRAVITY = register_output(Output(
-    "gravity_vector", "g", "Gravity vector g(q) = dP/dq.", ("q",), True, _REVOLUTE_EFFORT,
-    ("g",), build=_LAGRANGIAN))
-INVERSE = register_output(Output(
-    "inverse_dynamics", "tau", "Joint efforts tau = M(q) qdd + C(q, qd) qd + g(q) "
-    "(recursive Newton-Euler, straight-line).", ("q", "qd", "qdd"), True, _REVOLUTE_EFFORT,
-    ("tau",), build="eomgen.symbolic.newton_euler:build_inverse_dynamics"))
-FORWARD = register_output(Output(
-    "forward_dynamics", None, "Joint accelerations qdd solving M(q) qdd = tau - (C(q, qd) qd "
-    "+ g(q)) by Cholesky.", ("q", "qd", "tau"), True, "rad/s^2 (revolute), m/s^2 (prismatic)",
-    ("M", "tau"), composed_from=(MASS.function, INVERSE.function)))
-
-# Issue 18: O(n) algorithms, exported when asked for (``--outputs qdd_aba,h``).
-FORWARD_ABA = register_output(Output(
-    "forward_dynamics_aba", "qdd_aba", "Joint accelerations qdd of M(q) qdd + C(q, qd) qd + "
-    "g(q) = tau by the Articulated-Body Algorithm (O(n), straight-line, no factorisation).",
-    ("q", "qd", "tau"), True, "rad/s^2 (revolute), m/s^2 (prismatic)", ("qdd_aba",),
-    build="eomgen.symbolic.aba:build_forward_dynamics_aba", default=False))
-NONLINEAR = register_output(Output(
-    "nonlinear_effects", "h", "Nonlinear effects h(q, qd) = C(q, qd) qd + g(q) (Newton-Euler "
-    "with qdd = 0; C itself is not formed).", ("q", "qd"), True, _REVOLUTE_EFFORT, ("h",),
-    build="eomgen.symbolic.combined:build_nonlinear_effects", default=False))
-
-# Issue 17: drives and flexible joints (docs/actuators.md), exported when asked for.
-_DRIVES = "eomgen.symbolic.drives:build_drives"
-DRIVE_MASS = register_output(Output(
-    "drive_mass_matrix", "M_a", "Mass matrix with the drives' armature, M(q) + diag(a) (every "
-    "joint stiff).", ("q",), False, "kg m^2 (revolute rows/columns), kg (prismatic)", ("M_a",),
-    build=_DRIVES, default=False))
-FRICTION = register_output(Output(
-    "friction_torque", "tau_f", "Friction torque of the drives d qd + f sign(qd) (exact sign, "
-    "for inverse dynamics).", ("qd",), True, _REVOLUTE_EFFORT, ("tau_f",), build=_DRIVES,
-    default=False))
-FRICTION_SMOOTH = register_output(Output(
-    "friction_torque_smooth", "tau_f_smooth", "Friction torque of the drives d qd + f tanh(qd / "
-    "w) (Coulomb smoothed with the width w, for simulation).", ("qd",), True, _REVOLUTE_EFFORT,
-    ("tau_f_smooth",), build=_DRIVES, default=False))
-DRIVE_INVERSE = register_output(Output(
-    "drive_inverse_dynamics", "tau_a", "Drive torques (M(q) + diag(a)) qdd + C(q, qd) qd + g(q) "
-    "+ d qd + f sign(qd).", ("q", "qd", "qdd"), True, _REVOLUTE_EFFORT, ("tau_a",),
-    build=_DRIVES, default=False))
-LINK_MASS = register_output(Output(
-    "link_mass_matrix", "M_l", "Link mass matrix of the flexible-joint model, M(q) + diag(a) of "
-    "the rigid joints only.", ("q",), False, "kg m^2 (revolute rows/columns), kg (prismatic)",
-    ("M_l",), build=_DRIVES, default=False))
-SPRING = register_output(Output(
-    "spring_torque", "tau_K", "Torque the joint springs pass to the links, K (theta_m - q) on "
-    "flexible joints, 0 on rigid ones.", ("q", "theta_m"), True, _REVOLUTE_EFFORT, ("tau_K",),
-    build=_DRIVES, default=False))
-MOTOR_FORWARD = register_output(Output(
-    "motor_forward_dynamics", "thetadd_m", "Motor accelerations (tau - K (theta_m - q) - d "
-    "thetad_m - f tanh(thetad_m / w)) / B of flexible joints (0 for rigid ones); tau is the "
-    "motor torque.",
-    ("q", "theta_m", "thetad_m", "tau"), True, "rad/s^2", ("thetadd_m",), build=_DRIVES,
-    default=False))
-
-# Issue 15: the joint torque regressor tau = Y(q, qd, qdd) pi, the description's parameters pi,
-# the base regressor and base parameters (Y pi = Y_base beta), and the energy regressors; all
-# built in one call by eomgen.regressor:build_outputs (see docs/regressor.md).
-_REGRESSOR = "eomgen.regressor:build_outputs"
-_PER_PARAMETER = "N m (revolute rows), N (prismatic) per unit of each column's parameter"
-_NAMES, _BASE_NAMES = "eomgen.regressor:parameter_names", "eomgen.regressor:base_parameter_names"
-REGRESSOR = register_output(Output(
-    "regressor", "Y", "Joint torque regressor Y(q, qd, qdd), n x p: tau = Y pi, columns "
-    "PARAMETER_NAMES (per body m, m c, inertia about the body origin; then actuator terms).",
-    ("q", "qd", "qdd"), False, _PER_PARAMETER, ("Y",), build=_REGRESSOR, default=False,
-    constants=_NAMES))
-INERTIAL_PARAMETERS = register_output(Output(
-    "inertial_parameters", "pi", "The description's standard parameters pi, (p,), in "
-    "PARAMETER_NAMES order.", (), True,
-    "kg, kg m, kg m^2; armature kg m^2, viscous N m s/rad, Coulomb N m", ("pi",),
-    build=_REGRESSOR, default=False, constants=_NAMES))
-BASE_REGRESSOR = register_output(Output(
-    "base_regressor", "Y_base", "Base regressor Y_base(q, qd, qdd), n x b, full column rank: "
-    "tau = Y_base beta, columns BASE_PARAMETER_NAMES.", ("q", "qd", "qdd"), False,
-    _PER_PARAMETER, ("Y_base",), build=_REGRESSOR, default=False, constants=_BASE_NAMES))
-BASE_PARAMETERS = register_output(Output(
-    "base_parameters", "beta", "The description's base parameters beta, (b,), in "
-    "BASE_PARAMETER_NAMES order: the identifiable combinations of pi.", (), True,
-    "the units of the parameter each groups into", ("beta",), build=_REGRESSOR, default=False,
-    constants=_BASE_NAMES))
-KINETIC_REGRESSOR = register_output(Output(
-    "kinetic_energy_regressor", "Y_K", "Kinetic energy regressor Y_K(q, qd), (p,): K = Y_K . pi "
-    "(actuator columns 0).", ("q", "qd"), True, "J per unit of each column's parameter",
-    ("Y_K",), build=_REGRESSOR, default=False, constants=_NAMES))
-POTENTIAL_REGRESSOR = register_output(Output(
-    "potential_energy_regressor", "Y_P", "Potential energy regressor Y_P(q), (p,): P = Y_P . pi "
-    "= -sum m g_vec . c over the moving bodies (actuator columns 0).", ("q",), True,
-    "J per unit of each column's parameter", ("Y_P",), build=_REGRESSOR, default=False,
-    constants=_NAMES))
-
-# Issue 17: the flat inverse dynamics of Spong's flexible-joint model (docs/actuators.md): motor
-# states and torques that make the links follow q(t), from q and its derivatives up to order 4.
-_FLAT = "eomgen.symbolic.flat:build_flat"
-MOTOR_ANGLES = register_output(Output(
-    "motor_angles", "theta_flat", "Motor angles (link side of the gear) that make the links "
-    "follow q(t): q + K^-1 tau_L on flexible joints, q on rigid ones; tau_L = M qdd + C qd + g.",
-    ("q", "qd", "qdd"), True, "rad (revolute), m (prismatic)", ("theta_flat",), build=_FLAT,
-    default=False))
-MOTOR_VELOCITIES = register_output(Output(
-    "motor_velocities", "thetad_flat", "Motor velocities that make the links follow q(t): qd + "
-    "K^-1 d/dt tau_L on flexible joints, qd on rigid ones.", ("q", "qd", "qdd", "qddd"), True,
-    "rad/s (revolute), m/s (prismatic)", ("thetad_flat",), build=_FLAT, default=False))
-FLAT_TORQUE = register_output(Output(
-    "flat_motor_torque", "tau_flat", "Inputs tau that make the links follow q(t) (flatness): "
-    "B thetadd + K (theta - q) + d thetad + f sign(thetad) on flexible joints (motor torque), "
-    "tau_L + a qdd + d qd + f sign(qd) on rigid ones.", ("q", "qd", "qdd", "qddd", "qdddd"), True,
-    _REVOLUTE_EFFORT, ("tau_flat",), build=_FLAT, default=False))
-FLAT_TORQUE_SMOOTH = register_output(Output(
-    "flat_motor_torque_smooth", "tau_flat_smooth", "Inputs tau that make the links follow "
-    "q(t), as flat_motor_torque but with Coulomb friction f tanh(v / w) in place of f sign(v) "
-    "(the law of motor_forward_dynamics: a simulation fed with it follows q(t)).", ("q", "qd", "qdd", "qddd", "qdddd"), True, _REVOLUTE_EFFORT,
-    ("tau_flat_smooth",), build=_FLAT, default=False))
-
-
-# Issue 18: several results from one program, sharing its work (``--outputs dynamics``).
-_COMBINED = "eomgen.symbolic.combined:build_combined"
-DYNAMICS = register_output(Output(
-    "dynamics", "MCg", "M(q), C(q, qd) and g(q) in one call: one program shares their work "
-    "(sines, rotations, recursions).", ("q", "qd"), False,
-    "the units of mass_matrix, coriolis_matrix and gravity_vector", ("MCg",), build=_COMBINED,
-    default=False,
-    returns=(MASS.symbol, CORIOLIS.symbol, GRAVITY.symbol)))
-MASS_AND_BIAS = register_output(Output(
-    "mass_matrix_and_bias", "Mh", "M(q) and h(q, qd) = C(q, qd) qd + g(q) in one call (what "
-    "forward dynamics and computed-torque control need): one program shares their work.",
-    ("q", "qd"), False, "the units of mass_matrix and nonlinear_effects", ("Mh",),
-    build=_COMBINED, default=False, returns=(MASS.symbol, NONLINEAR.symbol)))
+for _output in CATALOGUE:
+    register_output(_output)
+del _output
 
 
 def splits(output: Output, n: int) -> tuple[tuple[str, int, int | None], ...]:
@@ -350,256 +118,6 @@ def splits(output: Output, n: int) -> tuple[tuple[str, int, int | None], ...]:
             out.append((symbol, column, column + width))
             column += width
     return tuple(out)
-
-
-# --- issue 27: centroidal quantities (eomgen.symbolic.centroidal) ----------------------------
-_CENTROIDAL = "eomgen.symbolic.centroidal:build_centroidal"
-CENTER_OF_MASS = register_output(Output(
-    "center_of_mass", "c_G", "Centre of mass c of the robot in world coordinates: (3,).",
-    ("q",), True, "m", ("c_G",), build=_CENTROIDAL, default=False))
-CENTER_OF_MASS_JACOBIAN = register_output(Output(
-    "center_of_mass_jacobian", "J_G", "Jacobian of the centre of mass, cdot = J_G qd: (3, n).",
-    ("q",), False, "m/rad or 1", ("J_G",), build=_CENTROIDAL, default=False))
-CENTROIDAL_MAP = register_output(Output(
-    "centroidal_momentum_matrix", "A_G", "Centroidal momentum matrix A_G, h_G = A_G qd = "
-    "[linear; angular momentum about the centre of mass], world axes: (6, n).", ("q",), False,
-    "kg m/rad or kg (linear rows), kg m^2/rad or kg m (angular rows)", ("A_G",),
-    build=_CENTROIDAL, default=False))
-CENTROIDAL_BIAS = register_output(Output(
-    "centroidal_momentum_bias", "dAGv", "Centroidal momentum bias A_G-dot qd: the rate of h_G "
-    "at qdd = 0, [linear; angular]: (6,).", ("q", "qd"), True, "N, N m", ("dAGv",),
-    build=_CENTROIDAL, default=False))
-CENTROIDAL_INERTIA = register_output(Output(
-    "centroidal_composite_inertia", "I_G", "Centroidal composite inertia [[m 1, 0], [0, I_c]], "
-    "I_c the rotational inertia about the centre of mass in world axes: (6, 6).", ("q",),
-    False, "kg (upper block), kg m^2 (lower block)", ("I_G",), build=_CENTROIDAL,
-    default=False))
-
-
-# --- issue 16: frame kinematics and contacts (eomgen.symbolic.frames) -----------------------
-_FRAMES = "eomgen.symbolic.frames:build_frames"
-_FRAME_NAMES = "eomgen.symbolic.frames:frame_constants"
-# the contact rows, then the loop rows (eomgen.symbolic.loops): J_c, F_c cover both
-_CONTACTS = "eomgen.symbolic.loops:build_constraints"
-_CONTACT_NAMES = "eomgen.symbolic.loops:constraint_constants"
-FRAME_POSITIONS = register_output(Output(
-    "frame_positions", "p_f", "Frame origins in world coordinates, one row per frame of "
-    "FRAME_NAMES: (nf, 3).", ("q",), False, "m", ("p_f",), build=_FRAMES, default=False,
-    constants=_FRAME_NAMES))
-FRAME_ROTATIONS = register_output(Output(
-    "frame_rotations", "R_f", "Frame rotations R (x_world = R x_frame + p), 3x3 blocks stacked "
-    "in FRAME_NAMES order: (3 nf, 3).", ("q",), False, "1", ("R_f",), build=_FRAMES,
-    default=False, constants=_FRAME_NAMES))
-FRAME_JACOBIANS = register_output(Output(
-    "frame_jacobians", "J_f", "World-aligned frame Jacobians at the frame origins, [linear; "
-    "angular]: [pdot; omega] = J qd, 6xn blocks in FRAME_NAMES order: (6 nf, n).", ("q",), False,
-    "m/rad (linear rows), 1 (angular rows)", ("J_f",), build=_FRAMES, default=False,
-    constants=_FRAME_NAMES))
-FRAME_BODY_JACOBIANS = register_output(Output(
-    "frame_body_jacobians", "Jb_f", "Body frame Jacobians, [linear; angular] in frame axes: "
-    "[R^T pdot; R^T omega] = Jb qd, 6xn blocks in FRAME_NAMES order: (6 nf, n).", ("q",), False,
-    "m/rad (linear rows), 1 (angular rows)", ("Jb_f",), build=_FRAMES, default=False,
-    constants=_FRAME_NAMES))
-FRAME_JACOBIANS_DOT_QD = register_output(Output(
-    "frame_jacobians_dot_qd", "dJqd_f", "Jdot qd of the world-aligned frame Jacobians: the "
-    "frame accelerations [pddot; omegadot] at qdd = 0, FRAME_NAMES order: (6 nf,).",
-    ("q", "qd"), True, "m/s^2, rad/s^2", ("dJqd_f",), build=_FRAMES, default=False,
-    constants=_FRAME_NAMES))
-CONTACT_JACOBIAN = register_output(Output(
-    "contact_jacobian", "J_c", "Contact Jacobian J_c (m, n): the rows of the scene's contacts "
-    "(point: world-aligned linear rows; surface: body rows), then of its loops (J_l), "
-    "CONTACT_ROWS order.", ("q",), False,
-    "m/rad (force rows), 1 (moment rows)", ("J_c",), build=_CONTACTS, default=False,
-    constants=_CONTACT_NAMES))
-LOOP_CONSTRAINT = register_output(Output(
-    "loop_constraint", "Phi_l", "Loop closure error Phi_l(q) (m_l,), zero on closed loops: "
-    "frame b less frame a, LOOP_ROWS order (eomgen.symbolic.loops).", ("q",), True,
-    "m (translational rows), 1 (rotational rows: sines)", ("Phi_l",), build=_CONTACTS,
-    default=False, constants="eomgen.symbolic.loops:loop_constants"))
-LOOP_JACOBIAN = register_output(Output(
-    "loop_jacobian", "J_l", "Loop Jacobian J_l(q) (m_l, n): the velocity of each loop's frame "
-    "b relative to its frame a in the rows' axes, J_l qd, LOOP_ROWS order.", ("q",), False,
-    "m/rad (translational rows), 1 (rotational rows)", ("J_l",), build=_CONTACTS,
-    default=False, constants="eomgen.symbolic.loops:loop_constants"))
-LOOP_BIAS = register_output(Output(
-    "loop_bias", "dJqd_l", "Loop bias J_l-dot qd (m_l,): the loops' relative accelerations at "
-    "qdd = 0, LOOP_ROWS order.", ("q", "qd"), True, "m/s^2, rad/s^2", ("dJqd_l",),
-    build=_CONTACTS, default=False, constants="eomgen.symbolic.loops:loop_constants"))
-CONTACT_BIAS = register_output(Output(
-    "contact_bias", "dJqd_c", "Contact bias J_c-dot qd (m,): the constraint accelerations at "
-    "qdd = 0, CONTACT_ROWS order.", ("q", "qd"), True, "m/s^2, rad/s^2", ("dJqd_c",),
-    build=_CONTACTS, default=False, constants=_CONTACT_NAMES))
-FRAME_BODY_JACOBIANS_DOT_QD = register_output(Output(
-    "frame_body_jacobians_dot_qd", "dJbqd_f", "Jdot qd of the body frame Jacobians: the time "
-    "derivative of the body twist [v_b; omega_b] at qdd = 0, [R^T pddot - omega_b x v_b; R^T "
-    "omegadot], FRAME_NAMES order: (6 nf,).", ("q", "qd"), True, "m/s^2, rad/s^2", ("dJbqd_f",),
-    build=_FRAMES, default=False, constants=_FRAME_NAMES))
-CONTACT_INVERSE = register_output(Output(
-    "contact_inverse_dynamics", "tau_c", "Joint efforts tau = M(q) qdd + C(q, qd) qd + g(q) - "
-    "J_c(q)^T F_c giving qdd while the contacts push on the robot with F_c (CONTACT_ROWS, the "
-    "axes of contact_jacobian's rows).", ("q", "qd", "qdd", "F_c"), True, _REVOLUTE_EFFORT,
-    ("tau_c",), build="eomgen.symbolic.frames:build_contact_inverse_dynamics", default=False,
-    constants=_CONTACT_NAMES))
-_CONES = "eomgen.symbolic.frames:build_friction_cones"
-FRICTION_CONE = register_output(Output(
-    "friction_cone_margin", "cone_c", "Exact friction-cone margins mu f_n - |f_t| of the "
-    "contact forces F_c, one per contact (CONTACT_NAMES): >= 0 inside the cone.", ("F_c",),
-    True, "N", ("cone_c",), build=_CONES, default=False,
-    constants="eomgen.symbolic.frames:pyramid_constants"))
-FRICTION_PYRAMID = register_output(Output(
-    "friction_pyramid_margins", "pyramid_c", "Margins of the inscribed four-sided friction "
-    "pyramid, mu/sqrt(2) f_n -/+ f_t1 and -/+ f_t2 per contact (PYRAMID_ROWS), linear in F_c: "
-    "all >= 0 inside.", ("F_c",), True, "N", ("pyramid_c",), build=_CONES, default=False,
-    constants="eomgen.symbolic.frames:pyramid_constants"))
-CONSTRAINED_FORWARD = register_output(Output(
-    "constrained_forward_dynamics", None, "(qdd, F_c) holding every contact: the KKT system "
-    "[[M, -J_c^T], [J_c, 0]] [qdd; F_c] = [tau - (C qd + g); -J_c-dot qd].",
-    ("q", "qd", "tau"), True, "rad/s^2, m/s^2; N, N m", ("M", "tau", "J_c", "dJqd_c"),
-    composed_from=(MASS.function, INVERSE.function, CONTACT_JACOBIAN.function,
-                   CONTACT_BIAS.function), default=False, constants=_CONTACT_NAMES))
-
-PARALLEL_INVERSE = register_output(Output(
-    "parallel_inverse_dynamics", None, "(tau, lambda) of a parallel robot: joint efforts zero "
-    "on the passive joints (ACTUATED_JOINTS carry them) and loop forces (LOOP_ROWS) with "
-    "M qdd + C qd + g = tau + J_l^T lambda, for a qdd consistent with the loops.",
-    ("q", "qd", "qdd"), True, "N m, N; N, N m", (INVERSE.symbol, "J_l"),
-    composed_from=(INVERSE.function, LOOP_JACOBIAN.function), default=False,
-    constants="eomgen.symbolic.loops:parallel_constants",
-    backends=("numpy", "fast", "casadi", "c", "jax", "torch")))
-
-# Issue 28: the Slotine-Li regressor Y_SL(q, qd, qd_r, qdd_r) pi = M qdd_r + C(q, qd) qd_r + g
-# (C Christoffel) and its base columns, for adaptive control (docs/control.md).
-_SLOTINE_LI = "eomgen.regressor.slotine_li:build_slotine_li"
-SLOTINE_LI_REGRESSOR = register_output(Output(
-    "slotine_li_regressor", "Y_SL", "Slotine-Li regressor Y_SL(q, qd, qd_r, qdd_r), n x p: "
-    "Y_SL pi = M qdd_r + C(q, qd) qd_r + g (Christoffel C), columns PARAMETER_NAMES.",
-    ("q", "qd", "qd_r", "qdd_r"), False, _PER_PARAMETER, ("Y_SL",), build=_SLOTINE_LI,
-    default=False, constants=_NAMES))
-SLOTINE_LI_BASE_REGRESSOR = register_output(Output(
-    "slotine_li_base_regressor", "Y_SL_base", "Base Slotine-Li regressor, n x b: Y_SL_base "
-    "beta = Y_SL pi, columns BASE_PARAMETER_NAMES.", ("q", "qd", "qd_r", "qdd_r"), False,
-    _PER_PARAMETER, ("Y_SL_base",), build=_SLOTINE_LI, default=False, constants=_BASE_NAMES))
-
-
-# --- issue 25: exact derivatives of the dynamics (eomgen.symbolic.derivatives); derivatives
-# with respect to q are along the tangent (nv columns: eomgen.symbolic.tangent).
-_DERIVATIVES = "eomgen.symbolic.derivatives:build_derivatives"
-_PER_Q = "of the joint efforts per rad (revolute columns) or m (prismatic)"
-DTAU_DQ = register_output(Output(
-    "inverse_dynamics_derivative_q", "dtau_dq", "dtau/dq (n, nv) of tau(q, qd, qdd) "
-    "(Newton-Euler differentiated in forward mode).", ("q", "qd", "qdd"), False, _PER_Q,
-    ("dtau_dq",), build=_DERIVATIVES, default=False))
-DTAU_DQD = register_output(Output(
-    "inverse_dynamics_derivative_qd", "dtau_dqd", "dtau/dqd (n, nv) of tau(q, qd, qdd).",
-    ("q", "qd", "qdd"), False, "of the joint efforts per rad/s or m/s", ("dtau_dqd",),
-    build=_DERIVATIVES, default=False))
-INVERSE_DERIVATIVES = register_output(Output(
-    "inverse_dynamics_derivatives", "dtau", "(dtau/dq, dtau/dqd) of tau(q, qd, qdd) in one "
-    "call (dtau/dqdd is M).", ("q", "qd", "qdd"), False,
-    "the units of inverse_dynamics_derivative_q and _qd", ("dtau",), build=_DERIVATIVES,
-    default=False, returns=("dtau_dq", "dtau_dqd")))
-GRAVITY_DERIVATIVE = register_output(Output(
-    "gravity_derivative", "dg_dq", "dg/dq (n, nv) of the gravity vector g(q).", ("q",), False,
-    _PER_Q, ("dg_dq",), build=_DERIVATIVES, default=False))
-DQDD_DQ = register_output(Output(
-    "forward_dynamics_derivative_q", "dqdd_dq", "dqdd/dq (nv, nv) of qdd(q, qd, tau) = -M^-1 "
-    "dtau/dq at qdd(q, qd, tau).", ("q", "qd", "tau"), False, "1/s^2", ("dqdd_dq",),
-    build=_DERIVATIVES, default=False))
-DQDD_DQD = register_output(Output(
-    "forward_dynamics_derivative_qd", "dqdd_dqd", "dqdd/dqd (nv, nv) of qdd(q, qd, tau) = "
-    "-M^-1 dtau/dqd at qdd(q, qd, tau).", ("q", "qd", "tau"), False, "1/s", ("dqdd_dqd",),
-    build=_DERIVATIVES, default=False))
-INVERSE_MASS = register_output(Output(
-    "inverse_mass_matrix", "Minv", "M(q)^-1 = dqdd/dtau (nv, nv), from the "
-    "straight-line L^T D L factors of M.", ("q",), False, "1/(kg m^2) (revolute), 1/kg (prismatic)",
-    ("Minv",), build=_DERIVATIVES, default=False))
-FORWARD_DERIVATIVES = register_output(Output(
-    "forward_dynamics_derivatives", "dqdd", "(dqdd/dq, dqdd/dqd, M^-1 = dqdd/dtau) of "
-    "qdd(q, qd, tau) in one call.", ("q", "qd", "tau"), False,
-    "the units of forward_dynamics_derivative_q, _qd and inverse_mass_matrix", ("dqdd",),
-    build=_DERIVATIVES, default=False, returns=("dqdd_dq", "dqdd_dqd", "Minv")))
-STATE_MATRIX = register_output(Output(
-    "state_matrix", "A_lin", "A = df/dx (2 nv, 2 nv) of xdot = f(x, tau), x = (q, qd): "
-    "[[T, I], [dqdd/dq, dqdd/dqd]], T = 0 (quaternion joints: -ad_v / 2, the tangent chart's).",
-    ("q", "qd", "tau"), False, "1, 1/s, 1/s^2",
-    ("A_lin",), build=_DERIVATIVES, default=False, width=2))
-INPUT_MATRIX = register_output(Output(
-    "input_matrix", "B_lin", "B = df/dtau (2 nv, nv) of xdot = f(x, tau): [[0], [M^-1]].",
-    ("q", "qd", "tau"), False, "1/(kg m^2) (revolute)", ("B_lin",), build=_DERIVATIVES,
-    default=False))
-LINEARIZE = register_output(Output(
-    "linearize", "AB", "(A, B) of xdot = f(x, tau) ~ A dx + B dtau, x = (q, qd), in one call.",
-    ("q", "qd", "tau"), False, "the units of state_matrix and input_matrix", ("AB",),
-    build=_DERIVATIVES, default=False, returns=("A_lin", "B_lin")))
-# with the drives of issue 17 (armature a, viscous d and Coulomb f friction; docs/actuators.md)
-DRIVE_DTAU_DQD = register_output(Output(
-    "drive_inverse_dynamics_derivative_qd", "dtau_a_dqd", "dtau_a/dqd (n, nv) of the drive "
-    "torques tau_a = tau + a qdd + d qd + f sign(qd): dtau/dqd + diag(d) (sign: 0 at qd != 0).",
-    ("q", "qd", "qdd"), False, "of the joint efforts per rad/s or m/s", ("dtau_a_dqd",),
-    build=_DERIVATIVES, default=False))
-DRIVE_INVERSE_DERIVATIVES = register_output(Output(
-    "drive_inverse_dynamics_derivatives", "dtau_a", "(dtau_a/dq, dtau_a/dqd) of the drive "
-    "torques in one call (dtau_a/dq is dtau/dq).", ("q", "qd", "qdd"), False,
-    "the units of inverse_dynamics_derivative_q and _qd", ("dtau_a",), build=_DERIVATIVES,
-    default=False, returns=("dtau_dq", "dtau_a_dqd")))
-DRIVE_DQDD_DQ = register_output(Output(
-    "drive_forward_dynamics_derivative_q", "dqdd_a_dq", "dqdd/dq (nv, nv) of the drives' "
-    "qdd = (M + diag(a))^-1 (tau - C qd - g - d qd - f tanh(qd / w)).", ("q", "qd", "tau"),
-    False, "1/s^2", ("dqdd_a_dq",), build=_DERIVATIVES, default=False))
-DRIVE_DQDD_DQD = register_output(Output(
-    "drive_forward_dynamics_derivative_qd", "dqdd_a_dqd", "dqdd/dqd (nv, nv) of the drives' "
-    "forward dynamics (friction included).", ("q", "qd", "tau"), False, "1/s",
-    ("dqdd_a_dqd",), build=_DERIVATIVES, default=False))
-DRIVE_INVERSE_MASS = register_output(Output(
-    "drive_inverse_mass_matrix", "Minv_a", "(M(q) + diag(a))^-1 = dqdd/dtau (nv, nv) of the "
-    "drives' forward dynamics (the factors of M + diag(a)).", ("q",), False,
-    "1/(kg m^2) (revolute), 1/kg (prismatic)", ("Minv_a",), build=_DERIVATIVES, default=False))
-DRIVE_FORWARD_DERIVATIVES = register_output(Output(
-    "drive_forward_dynamics_derivatives", "dqdd_a", "(dqdd/dq, dqdd/dqd, (M + diag(a))^-1) of "
-    "the drives' forward dynamics in one call.", ("q", "qd", "tau"), False,
-    "the units of drive_forward_dynamics_derivative_q, _qd and drive_inverse_mass_matrix",
-    ("dqdd_a",), build=_DERIVATIVES, default=False,
-    returns=("dqdd_a_dq", "dqdd_a_dqd", "Minv_a")))
-
-CONSTRAINED_PARTIALS = register_output(Output(
-    "constrained_dynamics_partials", "dKKT", "[[dr/dq, dr/dqd], [da/dq, da/dqd]] (nv + m, 2 nv) "
-    "of r = tau_c(q, qd, qdd, F_c) and the contact accelerations a = J_c qdd + J_c-dot qd.",
-    ("q", "qd", "qdd", "F_c"), False, "mixed", ("dKKT",), default=False, constants=_CONTACT_NAMES,
-    build="eomgen.symbolic.contact_derivatives:build_constrained_partials"))
-CONSTRAINED_DERIVATIVES = register_output(Output(
-    "constrained_forward_dynamics_derivatives", None, "d(qdd, F_c)/d(q, qd, tau) of "
-    "constrained_forward_dynamics: K^-1 (-dKKT, [1; 0]), K its KKT matrix.", ("q", "qd", "tau"),
-    False, "those of the forward dynamics derivatives; N per unit", ("M", "tau", "J_c", "dJqd_c",
-    "dKKT"), composed_from=(*CONSTRAINED_FORWARD.composed_from, CONSTRAINED_FORWARD.function,
-    CONSTRAINED_PARTIALS.function), default=False, constants=_CONTACT_NAMES,
-    backends=("numpy", "fast", "casadi", "c", "jax", "torch")))
-
-# --- issue 27: task-space quantities, composed from M, J_f, J_f-dot qd and tau (templates) --
-#: The backends whose templates compose the task-space functions.
-_TASK_BACKENDS = ("numpy", "fast", "jax", "torch")
-_TASK_NOTE = ("Per frame of FRAME_NAMES, from its world-aligned Jacobian J at the frame origin "
-              "(linear=True: its 3 linear rows)")
-OPERATIONAL_SPACE_INERTIA = register_output(Output(
-    "operational_space_inertia", None, "Operational-space inertia Lambda = (J M^-1 J^T + "
-    "damping 1)^-1. " + _TASK_NOTE + ": (nf, 6, 6) or (nf, 3, 3).", ("q",), False,
-    "kg (linear block), kg m (mixed), kg m^2 (angular block)", (MASS.symbol, "J_f"),
-    composed_from=(MASS.function, FRAME_JACOBIANS.function), default=False,
-    constants=_FRAME_NAMES, backends=_TASK_BACKENDS))
-OPERATIONAL_SPACE_BIAS = register_output(Output(
-    "operational_space_bias", None, "(mu, p) of the operational-space equations F = Lambda "
-    "xdd + mu + p: mu = Lambda J M^-1 C qd - Lambda Jdot qd, p = Lambda J M^-1 g. " + _TASK_NOTE
-    + ": (nf, 6) each, or (nf, 3).", ("q", "qd"), False, "N (linear rows), N m (angular rows)",
-    (MASS.symbol, INVERSE.symbol, "J_f", "dJqd_f"),
-    composed_from=(MASS.function, INVERSE.function, FRAME_JACOBIANS.function,
-                   FRAME_JACOBIANS_DOT_QD.function), default=False, constants=_FRAME_NAMES,
-    backends=_TASK_BACKENDS))
-DYNAMICALLY_CONSISTENT_INVERSE = register_output(Output(
-    "dynamically_consistent_inverse", None, "Dynamically consistent inverse Jbar = M^-1 J^T "
-    "Lambda (J Jbar = 1 at damping 0). " + _TASK_NOTE + ": (nf, n, 6) or (nf, n, 3).", ("q",),
-    False, "rad/m or 1 (linear columns), rad or m (angular columns)", (MASS.symbol, "J_f"),
-    composed_from=(MASS.function, FRAME_JACOBIANS.function), default=False,
-    constants=_FRAME_NAMES, backends=_TASK_BACKENDS))
-TASK_SPACE = (OPERATIONAL_SPACE_INERTIA, OPERATIONAL_SPACE_BIAS, DYNAMICALLY_CONSISTENT_INVERSE)
 
 
 def task_space_names() -> dict[str, str]:
@@ -698,8 +216,8 @@ def composition_names(output: Output = FORWARD) -> dict[str, str]:
     return {"name": output.function, "mass": mass, "bias": bias}
 
 
-__all__ = ["INPUTS", "splits", "DYNAMICS", "MASS_AND_BIAS", "INPUT_SIZES", "input_size", "Output", "OUTPUTS", "resolve", "BY_SYMBOL", "register_output", "derived_symbols",
-           "function_names", "select", "composition_names", "MASS", "CORIOLIS", "GRAVITY", "INVERSE",
-           "FORWARD", "exported", "constrained_names", "CONSTRAINED_FORWARD",
-           "PARALLEL_INVERSE", "parallel_names",
+__all__ = ["INPUTS", "splits", "DYNAMICS", "MASS_AND_BIAS", "INPUT_SIZES", "Output", "OUTPUTS",
+           "BY_SYMBOL", "register_output", "derived_symbols", "function_names", "select",
+           "composition_names", "MASS", "CORIOLIS", "GRAVITY", "INVERSE", "FORWARD", "exported",
+           "constrained_names", "CONSTRAINED_FORWARD", "PARALLEL_INVERSE", "parallel_names",
            "TASK_SPACE", "task_space_names"]

@@ -21,7 +21,8 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..output import module_name  # noqa: F401  (re-exported: its earlier home)
-from ..outputs import BY_SYMBOL, INPUTS, OUTPUTS, resolve, select, splits
+from ..outputs import BY_SYMBOL, INPUTS, OUTPUTS, select, splits
+from ..symbolic.builders import constants_provider
 from ..symbolic.program import Program, count_ops as count_ops_of
 
 # ``dynamics`` arguments are eomgen.dynamics.Dynamics, named in strings only: eomgen.dynamics
@@ -258,7 +259,7 @@ def module_constants(dynamics: "Dynamics", functions) -> tuple[tuple[str, tuple[
     found: dict[str, tuple[str, ...]] = {}
     for name in functions:
         declared = OUTPUTS[name]
-        if declared.constants is not None:
-            for key, values in resolve(declared.constants)(dynamics).items():
+        if declared.constants:
+            for key, values in constants_provider(declared.constants)(dynamics).items():
                 found.setdefault(key, tuple(str(v) for v in values))
     return tuple(found.items())

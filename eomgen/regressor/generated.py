@@ -14,6 +14,7 @@ import sympy as sp
 
 from ..errors import ParameterError, UnsupportedError
 from ..model import RobotModel
+from ..symbolic.builders import builds, provides
 from ..symbolic.program import Program
 from ..symbolic.regressor import ACTUATOR_NAMES, INERTIAL_NAMES, regressor_program
 from .derive import Regressor, derive_regressor
@@ -173,6 +174,7 @@ def generated_base(model: RobotModel) -> GeneratedBase:
     return GeneratedBase(tuple(names), tuple(columns), beta, route)
 
 
+@builds("Y", "pi", "Y_base", "beta", "Y_K", "Y_P")
 def build_outputs(derivation, wanted) -> dict:
     """The builder of the regressor outputs (:mod:`eomgen.outputs`): ``Y`` (n × p),
     ``Y_K`` and ``Y_P`` (p × 1, the energy regressors), ``pi`` (p × 1), ``Y_base`` (n × b) and
@@ -208,6 +210,7 @@ def build_outputs(derivation, wanted) -> dict:
     return out
 
 
+@provides("PARAMETER_NAMES")
 def parameter_names(dynamics) -> dict[str, tuple[str, ...]]:
     """``PARAMETER_NAMES``: the columns of the generated regressor (module constant)."""
     model = dynamics.model
@@ -219,6 +222,7 @@ def parameter_names(dynamics) -> dict[str, tuple[str, ...]]:
     return {"PARAMETER_NAMES": tuple(names)}
 
 
+@provides("PARAMETER_NAMES", "BASE_PARAMETER_NAMES")
 def base_parameter_names(dynamics) -> dict[str, tuple[str, ...]]:
     """``BASE_PARAMETER_NAMES`` (and ``PARAMETER_NAMES``): the columns of the generated base
     regressor (module constants)."""

@@ -21,11 +21,13 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ..symbolic.builders import builds
 from ..symbolic.quaternion_joints import coriolis_correction
 from ..symbolic.slotine_li import slotine_li_program
 from .generated import declared_actuator_terms, generated_base
 
 
+@builds("Y_SL", "Y_SL_base")
 def build_slotine_li(derivation, wanted) -> dict:
     """``Y_SL`` (n × p) and ``Y_SL_base`` (n × b), those in ``wanted``, built by
     :func:`eomgen.symbolic.slotine_li.slotine_li_program` into the derivation's program with

@@ -37,6 +37,7 @@ import sympy as sp
 
 from ..bodies import BodyTree
 from ..model import RobotModel, Vec3
+from .builders import builds
 from .derivation import new_derivation
 from .crba import M_program
 from .newton_euler import grouped_inertials, inverse_dynamics_program
@@ -276,6 +277,7 @@ def cholesky_program(model: RobotModel) -> ForwardDynamics:
     return ForwardDynamics(d.inputs["q"], qd, tau, d.program([("qdd", qdd)]))
 
 
+@builds("qdd_aba")
 def build_forward_dynamics_aba(derivation, wanted) -> dict:
     """The builder of ``qdd_aba`` in :mod:`eomgen.outputs` (``forward_dynamics_aba(q, qd,
     tau)``): :func:`forward_dynamics_program` on the derivation's body tree, q̈ [rad/s² or m/s²]

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from .builders import builds
 from .composite import world_composites
 from .quaternion_joints import chart_offset
 from .spatial import cross, force_cross, motion_cross
@@ -71,6 +72,7 @@ def free_flyer_momentum(derivation) -> tuple[list, sp.Matrix]:
     return com, A_G
 
 
+@builds("c_G", "J_G", "A_G", "dAGv", "I_G")
 def build_centroidal(derivation, wanted) -> dict:
     """The builder of ``c_G``, ``J_G``, ``A_G``, ``dAGv`` and ``I_G`` (module docstring)."""
     tree, b, n = derivation.tree, derivation.builder, derivation.model.dof

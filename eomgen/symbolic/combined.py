@@ -18,6 +18,7 @@ import sympy as sp
 
 from ..model import RobotModel
 from ..outputs import BY_SYMBOL
+from .builders import builds
 from .crba import M_program
 from .derivation import new_derivation
 from .newton_euler import inverse_dynamics_program
@@ -47,6 +48,7 @@ def dynamics_program(model: RobotModel) -> tuple[tuple, tuple, Program]:
     return q, qd, d.program(outputs)
 
 
+@builds("h")
 def build_nonlinear_effects(derivation, wanted) -> dict:
     """The builder of ``h`` in :mod:`eomgen.outputs` (``nonlinear_effects(q, qd)``):
     h = C(q, q̇) q̇ + g(q) = τ(q, q̇, 0), one Newton–Euler pass with q̈ = 0 [N m or N] (what
@@ -57,6 +59,7 @@ def build_nonlinear_effects(derivation, wanted) -> dict:
                                           derivation.model.gravity, derivation.builder)}
 
 
+@builds("MCg", "Mh")
 def build_combined(derivation, wanted) -> dict:
     """The builder of the several-result functions of :mod:`eomgen.outputs` (``returns``):
     ``MCg`` = [M | C | g] (n × (2n + 1)), returned as (M, C, g), and ``Mh`` = [M | h]

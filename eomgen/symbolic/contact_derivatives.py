@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from .builders import builds
 from .derivatives import forward_mode
 from .tangent import tangent_seeds
 
@@ -44,6 +45,7 @@ def constrained_partials(derivation) -> sp.Matrix:
         ("q", j) if j < nv else ("qd", j - nv), sp.Integer(0)))
 
 
+@builds("dKKT")
 def build_constrained_partials(derivation, wanted) -> dict:
     """The builder of ``dKKT`` in :mod:`eomgen.outputs`: :func:`constrained_partials`."""
     return {"dKKT": constrained_partials(derivation)}

@@ -4,15 +4,15 @@ A :class:`Derivation` holds a model, its body tree (fixed links merged, :mod:`eo
 the symbols of each input vector in ``JOINT_NAMES`` order and the program builder the
 algorithms define their intermediates in. :func:`new_derivation` is the only function that
 builds one; :func:`eomgen.derive`, the algorithm entry points (CRBA, ABA, Newton–Euler, the
-regressor, frames, the combined programs) and the output builders of :mod:`eomgen.outputs` all
-start from it, so that the symbols, the reserved names and the sizes of the inputs are decided
+regressor, frames, the combined programs) and the output builders (registered in
+:mod:`eomgen.symbolic.builders`, each found by its symbol) all start from it, so that the symbols, the reserved names and the sizes of the inputs are decided
 once.
 
 Symbols: ``q1 … qn`` [rad or m] (``n`` = NQ, the configuration size: seven entries more
 than the joints for a free flyer or ball joints, :mod:`eomgen.model.quaternion`), ``qd1 … qdn`` [rad/s or m/s], ``qdd1 … qddn`` [rad/s² or
 m/s²], ``tau1 … taun`` [N m or N]; an input of :data:`eomgen.outputs.INPUTS` is
-``<name>1 … <name>k`` with ``k`` its own size (:func:`eomgen.outputs.input_size`: the number of
-joints unless the registry says otherwise, e.g. the contact rows of ``F_c``).
+``<name>1 … <name>k`` with ``k`` its own size (:func:`eomgen.symbolic.builders.input_size`: the
+number of joints unless the catalogue says otherwise, e.g. the contact rows of ``F_c``).
 """
 
 from __future__ import annotations
@@ -23,12 +23,16 @@ from typing import Iterable
 import sympy as sp
 
 from ..bodies import BodyTree, body_tree
-from ..model import RobotModel, float_constants
+from ..model import RobotModel, configuration_size, float_constants
 from ..errors import UnsupportedError
-from ..outputs import BY_SYMBOL, INPUTS, input_size
+from ..outputs import BY_SYMBOL, INPUTS
+from .builders import builder_of, input_size, sizes
 from .couplings import coupled_inputs, project, refused
 from .quaternion_joints import chart_accelerations, coordinates, placements
 from .program import Program, ProgramBuilder
+
+# ``q`` is NQ long: the configuration, an entry more than the velocity per quaternion joint.
+sizes("q")(configuration_size)
 
 
 def vector_symbols(prefix: str, n: int) -> tuple[sp.Symbol, ...]:
@@ -43,8 +47,8 @@ def joint_symbols(n: int) -> tuple[tuple[sp.Symbol, ...], tuple[sp.Symbol, ...],
 
 @dataclass(frozen=True)
 class Derivation:
-    """What an algorithm or an output's builder (:attr:`eomgen.outputs.Output.build`) works
-    with: the model, its body tree (fixed links merged), the symbols of every input vector it
+    """What an algorithm or an output's builder (:func:`~eomgen.symbolic.builders.builds`)
+    works with: the model, its body tree (fixed links merged), the symbols of every input vector it
     was made with, in ``JOINT_NAMES`` order (``inputs["q"]`` is ``q1 … qn``; also as the
     attributes ``q``, ``qd``, ``qdd``, ``tau``), and the program builder to define
     intermediates in. ``shared`` lets builders keep what another builder may reuse (keyed by
@@ -124,16 +128,16 @@ class Derivation:
         return self.built[symbol]
 
     def build(self, symbols) -> None:
-        """Build the registered ``symbols`` not built yet, in registry order; outputs sharing a
-        builder are built in one call."""
+        """Build the registered ``symbols`` not built yet, in registry order, each by the
+        builder registered for it (:func:`eomgen.symbolic.builders.builder_of`); outputs sharing
+        a builder are built in one call."""
         symbols = set(symbols)
         for symbol in BY_SYMBOL:
             if symbol not in symbols or symbol in self.built:
                 continue
-            declared = BY_SYMBOL[symbol]
-            wanted = {s for s in symbols - set(self.built)
-                      if BY_SYMBOL[s].build == declared.build}
-            made = declared.builder()(self, wanted)
+            builder = builder_of(symbol)
+            wanted = {s for s in symbols - set(self.built) if builder_of(s) is builder}
+            made = builder(self, wanted)
             self.built.update({k: v for k, v in made.items() if k not in self.built})
 
     def program(self, outputs: Iterable[tuple[str, sp.Matrix]]) -> Program:

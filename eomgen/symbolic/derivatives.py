@@ -57,6 +57,7 @@ import sympy as sp
 
 from ..model import joint_actuators
 from ..outputs import BY_SYMBOL
+from .builders import builds
 from .couplings import independent
 from .drives import friction_torque_expr
 from .newton_euler import inverse_dynamics_program
@@ -393,6 +394,8 @@ def linearization(derivation) -> tuple[sp.Matrix, sp.Matrix]:
     return A, B
 
 
+@builds("dtau_dq", "dtau_dqd", "dtau", "dg_dq", "dqdd_dq", "dqdd_dqd", "Minv", "dqdd", "A_lin",
+        "B_lin", "AB", "dtau_a_dqd", "dtau_a", "dqdd_a_dq", "dqdd_a_dqd", "Minv_a", "dqdd_a")
 def build_derivatives(derivation, wanted) -> dict:
     """The builder of the derivative outputs of :mod:`eomgen.outputs` (see the module's
     docstring for each symbol)."""

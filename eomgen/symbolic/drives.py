@@ -33,6 +33,7 @@ from typing import Sequence
 
 from ..errors import GenerationError
 from ..model import Actuator, flexible_indices, joint_actuators
+from .builders import builds
 
 #: The symbols :func:`build_drives` makes that need flexible joints.
 FLEXIBLE = frozenset({"tau_K", "thetadd_m"})
@@ -59,6 +60,7 @@ def require_flexible(model, symbols) -> None:
             "but no joint has an actuator with a stiffness (docs/actuators.md)")
 
 
+@builds("M_a", "tau_f", "tau_f_smooth", "tau_a", "M_l", "tau_K", "thetadd_m")
 def build_drives(derivation, wanted) -> dict:
     """The builder of ``M_a``, ``tau_f``, ``tau_f_smooth``, ``tau_a``, ``M_l``, ``tau_K`` and
     ``thetadd_m`` in :mod:`eomgen.outputs` (see the module docstring).

@@ -43,6 +43,7 @@ from typing import Mapping, Sequence
 import sympy as sp
 
 from ..model import flexible_indices, joint_actuators
+from .builders import builds
 from .drives import friction_torque_expr, require_flexible
 from .program import ProgramBuilder
 from .quaternion_joints import quaternion_rotation
@@ -168,6 +169,7 @@ def configuration_rates(model, q, v) -> dict:
     return rates
 
 
+@builds("theta_flat", "thetad_flat", "tau_flat", "tau_flat_smooth")
 def build_flat(derivation, wanted) -> dict:
     """The builder of ``theta_flat``, ``thetad_flat``, ``tau_flat`` and ``tau_flat_smooth`` in
     :mod:`eomgen.outputs` (``motor_angles``, ``motor_velocities``, ``flat_motor_torque``,

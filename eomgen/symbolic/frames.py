@@ -35,6 +35,7 @@ import sympy as sp
 
 from ..errors import GenerationError, KinematicTreeError
 from ..model import IDENTITY3, POINT, RobotModel, Transform, ZERO3
+from .builders import builds, provides
 from .composite import forward_kinematics
 from .derivation import new_derivation
 from .evaluate import compile_program
@@ -267,6 +268,7 @@ FRAME_SYMBOLS = {"p_f": ("p", 3), "R_f": ("R", 3), "J_f": ("J", 6), "Jb_f": ("Jb
                  "dJqd_f": ("dJqd", 6), "dJbqd_f": ("dJbqd", 6)}
 
 
+@builds("p_f", "R_f", "J_f", "Jb_f", "dJqd_f", "dJbqd_f")
 def build_frames(derivation, wanted) -> dict:
     """The builder of the ``frame_*`` outputs (:mod:`eomgen.outputs`), stacked over the frames
     of :func:`output_frames` (``FRAME_NAMES`` order), frame k in rows ``k r … k r + r − 1``:
@@ -293,6 +295,7 @@ def build_frames(derivation, wanted) -> dict:
     return result
 
 
+@provides("FRAME_NAMES")
 def frame_constants(dynamics) -> dict[str, tuple[str, ...]]:
     """``FRAME_NAMES``: the frames of the ``frame_*`` outputs, in block order."""
     return {"FRAME_NAMES": output_frames(dynamics.model)}
@@ -356,6 +359,7 @@ def build_contacts(derivation, wanted) -> dict:
     return {k: v for k, v in result.items() if k in wanted}
 
 
+@builds("tau_c")
 def build_contact_inverse_dynamics(derivation, wanted) -> dict:
     """The builder of ``tau_c`` (n,): the joint efforts ``τ = M q̈ + C q̇ + g − J_cᵀ F_c`` that
     give the accelerations ``q̈`` while the contacts push on the robot with ``F_c`` (rows
@@ -408,6 +412,7 @@ def _exact(x: float):
     return sp.Integer(int(x)) if float(x).is_integer() else sp.Float(float(x))
 
 
+@builds("cone_c", "pyramid_c")
 def build_friction_cones(derivation, wanted) -> dict:
     """The builders of the friction-cone margins of the contact forces ``F_c`` (rows
     ``CONTACT_ROWS``), one friction coefficient μ per contact (the scene's ``mu``):
@@ -443,6 +448,7 @@ def build_friction_cones(derivation, wanted) -> dict:
     return {k: v for k, v in result.items() if k in wanted}
 
 
+@provides("CONTACT_NAMES", "PYRAMID_ROWS")
 def pyramid_constants(dynamics) -> dict[str, tuple[str, ...]]:
     """``CONTACT_NAMES`` and ``PYRAMID_ROWS``, the rows of ``friction_pyramid_margins``:
     ``<contact>.-t1``, ``<contact>.+t1``, ``<contact>.-t2``, ``<contact>.+t2``."""

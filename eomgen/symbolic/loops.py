@@ -32,6 +32,7 @@ import sympy as sp
 
 from ..errors import GenerationError
 from ..model import HINGE, WELD, RobotModel, Transform
+from .builders import builds, provides, sizes
 from .frames import build_contacts, contact_rows, frame_kinematics
 from .spatial import cross, matmul, matvec
 
@@ -73,11 +74,13 @@ def constraint_rows(model: RobotModel) -> tuple[str, ...]:
     return contact_rows(model) + loop_rows(model)
 
 
+@sizes("F_c")
 def constraint_row_count(model: RobotModel) -> int:
     """The length of ``F_c``: contact rows and loop rows."""
     return len(constraint_rows(model))
 
 
+@provides("LOOP_NAMES", "LOOP_ROWS")
 def loop_constants(dynamics) -> dict[str, tuple[str, ...]]:
     """``LOOP_NAMES`` and ``LOOP_ROWS`` (:func:`loop_rows`)."""
     model = dynamics.model
@@ -85,6 +88,7 @@ def loop_constants(dynamics) -> dict[str, tuple[str, ...]]:
             "LOOP_ROWS": loop_rows(model)}
 
 
+@provides("ACTUATED_JOINTS", "LOOP_ROWS")
 def parallel_constants(dynamics) -> dict[str, tuple[str, ...]]:
     """``ACTUATED_JOINTS`` (the scene's ``actuated:``, else every joint) and ``LOOP_ROWS``."""
     model = dynamics.model
@@ -92,6 +96,7 @@ def parallel_constants(dynamics) -> dict[str, tuple[str, ...]]:
             "LOOP_ROWS": loop_rows(model)}
 
 
+@provides("CONTACT_NAMES", "CONTACT_ROWS")
 def constraint_constants(dynamics) -> dict[str, tuple[str, ...]]:
     """``CONTACT_NAMES`` and ``CONTACT_ROWS`` (:func:`constraint_rows`): contacts, then
     loops."""
@@ -197,6 +202,7 @@ def loop_program(derivation) -> tuple[list, list, list]:
     return Phi, J, bias
 
 
+@builds("J_c", "Phi_l", "J_l", "dJqd_l", "dJqd_c")
 def build_constraints(derivation, wanted) -> dict:
     """The builder of the loop outputs and of the constrained rows (:mod:`eomgen.outputs`):
 

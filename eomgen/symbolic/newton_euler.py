@@ -50,6 +50,7 @@ from mpmath.libmp import prec_to_dps
 
 from ..bodies import BodyTree, InertialParameters
 from ..model import Transform, Vec3
+from .builders import builds
 from .program import ProgramBuilder, name_expr, name_exprs
 from .spatial import JointFrames, aligned_axis, cross, dot, matvec, mul, rotation, skew
 
@@ -362,6 +363,7 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
     return tau
 
 
+@builds("tau")
 def build_inverse_dynamics(derivation, wanted) -> dict:
     """The builder of ``tau`` in :mod:`eomgen.outputs`: :func:`inverse_dynamics_program`."""
     return {"tau": inverse_dynamics_program(derivation.tree, derivation.q, derivation.qd,

@@ -26,6 +26,7 @@ import sympy as sp
 
 from ..bodies import BodyTree
 from ..model import Vec3
+from .builders import builds
 from .composite import (christoffel_coriolis_program, composite_gravity_program,
                         composite_M_program, coriolis_program, forward_kinematics,
                         potential_energy)
@@ -128,6 +129,7 @@ def derive_program(tree: BodyTree, q, qd, gravity: Vec3, outputs: set[str], b: P
     return result
 
 
+@builds("M", "C", "g")
 def build_lagrangian(derivation, wanted) -> dict:
     """The builder of M, C and g in :mod:`eomgen.outputs`: :func:`derive_program` on the
     derivation's body tree for the ``wanted`` ones, with the potential energy ``P`` [J] when g is

@@ -26,6 +26,7 @@ from eomgen.codegen.functions import (RESERVED_IDENTIFIERS, derived_outputs,
 from eomgen.codegen.render import TEMPLATES_DIR
 from eomgen.dynamics import ALL_OUTPUTS, derive
 from eomgen.outputs import BY_SYMBOL, FORWARD, OUTPUTS, Output, register_output
+from eomgen.symbolic.builders import BUILDERS, CONSTANTS, builds, provides
 from support import load_module
 
 #: The function table of the generated modules as the README documented it before the registry.
@@ -186,7 +187,7 @@ def test_cli_help_lists_the_registered_backends(monkeypatch):
 
 
 # ----------------------------------------------------------------------------------------------
-# An output is one builder plus one registration: three made-up outputs (a 2×3 matrix of q, a
+# An output is one catalogue entry plus one registered builder: three made-up outputs (a 2×3 matrix of q, a
 # vector of q, qd and tau, a vector without inputs with module constants) go through every
 # backend and are compared with SymPy evaluating what the builders returned.
 # ----------------------------------------------------------------------------------------------
@@ -211,11 +212,11 @@ def _toy_constants(dynamics):
 
 _TOYS = (
     Output("toy_a", "TOY_A", "A 2x3 matrix of q.", ("q",), False, "1", ("TOY_A",),
-           build=f"{__name__}:_toy_builder", default=False),
+           default=False),
     Output("toy_b", "TOY_B", "A vector of q, qd and tau.", ("q", "qd", "tau"), True, "1",
-           ("TOY_B",), build=f"{__name__}:_toy_builder", default=False),
+           ("TOY_B",), default=False),
     Output("toy_c", "TOY_C", "A vector of the parameters only.", (), True, "kg", ("TOY_C",),
-           build=f"{__name__}:_toy_builder", default=False, constants=f"{__name__}:_toy_constants"),
+           default=False, constants=("TOY_NAMES",)),
 )
 
 
@@ -223,12 +224,16 @@ _TOYS = (
 def toys():
     for toy in _TOYS:
         register_output(toy)
+    builds("TOY_A", "TOY_B", "TOY_C")(_toy_builder)  # as a module registers its builder
+    provides("TOY_NAMES")(_toy_constants)
     try:
         yield _TOYS
     finally:
         for toy in _TOYS:
             OUTPUTS.pop(toy.function, None)
             BY_SYMBOL.pop(toy.symbol, None)
+            BUILDERS.pop(toy.symbol, None)
+        CONSTANTS.pop(("TOY_NAMES",), None)
 
 
 def test_a_registered_output_reaches_every_backend(toys, tmp_path):
