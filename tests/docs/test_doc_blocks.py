@@ -205,3 +205,7 @@ def test_the_set_up_commands_are_the_ones_ci_runs():
     venv = next(i for i, line in enumerate(ci) if line.startswith("python3 -m venv "))
     installs = [i for i, line in enumerate(ci) if "pip install" in line and i not in runs]
     assert len(runs) == 1 and venv < runs[0] < min(installs), "stage 1 is the README's command"
+    # the suite's size and time are stated once, in the README
+    stated = [p.name for p in FILES
+              if re.search(r"\d[\d,]* tests in", p.read_text(encoding="utf-8"))]
+    assert stated == ["README.md"]
