@@ -11,8 +11,10 @@ Y (τ = Y π, columns named) and the base parameters as expressions of the stand
 :func:`eomgen.verify`; a comparison with the numeric Newton–Euler algorithm at a sample state;
 and a short simulation (SciPy's ``solve_ivp``) with a plot.
 
-The notebook is saved without outputs and holds no timestamp: the same description gives the
-same file, byte for byte.
+The cells' texts are the blocks of ``templates/notebook/cells.jinja`` (:data:`CELLS_TEMPLATE`),
+one per cell; this module chooses which cells a model's notebook holds and fills in its names
+and numbers. The notebook is saved without outputs and holds no timestamp: the same description
+gives the same file, byte for byte.
 """
 
 from __future__ import annotations
@@ -74,11 +76,11 @@ def build_notebook(model: RobotModel, description: Path | None = None,
     source = embedded_source(description, scene, at)
     context = {
         "name": model.name, "nq": model.nq, "dof": model.dof, "chart": chart, "check": check,
-        "quaternion_joints": ", ".join(f"`{j.name}`" for j in model.quaternion_joints),
+        "quaternion_joints": [joint.name for joint in model.quaternion_joints],
         "textbook_max_dof": TEXTBOOK_MAX_DOF, "textbook_max_operations": TEXTBOOK_MAX_OPERATIONS,
         "source": source,
     }
-    cells = [_cell(block, context) for block in _blocks(source, chart, small, check)]
+    cells = [_cell(block, context) for block in cell_blocks(source, chart, small, check)]
     nb = v4.new_notebook(cells=cells, metadata={
         "kernelspec": {"display_name": "Python 3", "language": "python", "name": "python3"},
         "language_info": {"name": "python"},
@@ -97,7 +99,7 @@ _TEXTBOOK = ("jacobians", "energy", "mass_matrix", "christoffel", "coriolis", "g
 _REGRESSOR = ("regressor", "base_parameters", "slotine_li")
 
 
-def _blocks(source: EmbeddedSource, chart: bool, small: bool, check: bool) -> list[str]:
+def cell_blocks(source: EmbeddedSource, chart: bool, small: bool, check: bool) -> list[str]:
     """The notebook's cells, in order, as the names of their blocks in :data:`CELLS_TEMPLATE`:
     a ``<section>_text`` block is a markdown cell, a ``<section>_code`` block a code cell."""
     def section(*names: str) -> list[str]:
@@ -152,4 +154,4 @@ def write_notebook(nb: nbformat.NotebookNode, path: Path) -> Path:
     return path
 
 
-__all__ = ["CELLS_TEMPLATE", "build_notebook", "text_literal", "write_notebook"]
+__all__ = ["CELLS_TEMPLATE", "build_notebook", "cell_blocks", "text_literal", "write_notebook"]
