@@ -1,5 +1,5 @@
-"""The one Jinja environment of eomgen, and where the templates live (code generation and the
-teaching handouts both render through it).
+"""The one Jinja environment of eomgen, and where the templates live (code generation, the
+teaching handouts and the notebook's cells all render through it).
 
 Templates only loop over printed strings: every decision is made in Python before rendering.
 The templates sit in the top-level ``templates/`` folder of a source checkout and are shipped
@@ -45,3 +45,10 @@ def environment() -> jinja2.Environment:
 def render(template: str, **context) -> str:
     """Render ``template`` (a path below :data:`TEMPLATES_DIR`, e.g. ``numpy/module.py.jinja``)."""
     return environment().get_template(template).render(**context)
+
+
+def render_block(template: str, block: str, **context) -> str:
+    """Render one ``{% block %}`` of ``template`` on its own, with ``context`` (the notebook
+    renders each of its cells so: one block per cell, the order chosen in Python)."""
+    compiled = environment().get_template(template)
+    return "".join(compiled.blocks[block](compiled.new_context(context)))

@@ -1,13 +1,15 @@
 """A description's text written into a teaching document: the notebook holds the description
 (and the scene) it was made from, so that it runs wherever it is copied; a description that
 names files of its own (an MJCF's includes or meshes) is loaded by its path relative to the
-notebook instead."""
+notebook instead. This module says which, as data; the notebook's template prints the cells."""
 
 from __future__ import annotations
 
 import ast
 import os
+from dataclasses import dataclass, replace
 from pathlib import Path
+
 
 def text_literal(text: str) -> str:
     r'''A Python literal of ``text`` to read in a cell: a triple-quoted string, one line of the
@@ -56,47 +58,65 @@ def _read_text(path: Path) -> str | None:
         return None
 
 
-def load_cells(description: Path | None, scene: Path | None, notebook: Path | None):
-    """The cells that make ``model``: the description's text (and the scene's) written into
+@dataclass(frozen=True)
+class EmbeddedSource:
+    """Where the notebook's model comes from, as the cells that make it print it
+    (templates/notebook/cells.jinja, blocks ``robot_text``, ``description_code``,
+    ``scene_code`` and ``setup_code``).
+
+    ``name``: the description's file name; ``description``: its text as a Python literal
+    (:func:`text_literal`) when it is written in, else None and ``relative``: its path
+    relative to the notebook; ``scene``, ``scene_text``: the scene's file name and its text as
+    a literal, or None."""
+
+    name: str
+    description: str | None = None
+    relative: str | None = None
+    scene: str | None = None
+    scene_text: str | None = None
+
+    @property
+    def name_literal(self) -> str:
+        return repr(self.name)
+
+    @property
+    def relative_literal(self) -> str:
+        return repr(self.relative)
+
+    @property
+    def scene_literal(self) -> str:
+        return repr(self.scene)
+
+
+def embedded_source(description: Path | None, scene: Path | None,
+                    notebook: Path | None) -> EmbeddedSource:
+    """How the notebook makes ``model``: the description's text (and the scene's) written into
     the notebook, so that it runs wherever it is copied; or, for a description that names
     files of its own (MJCF meshes, includes) or is not UTF-8 text, its path relative to the
     notebook (``notebook``: where it will be written; None: the current folder).
 
-    Returns ``(markdown, [code cells])``."""
+    >>> from eomgen.robots import example_path
+    >>> source = embedded_source(example_path("planar_2link"), None, None)
+    >>> source.name, source.relative, source.description.splitlines()[1][:14]
+    ('planar_2link.yaml', None, '# The textbook')
+    """
     path = Path(description) if description is not None else None
     if path is None:  # the bundled planar arm
         from ..robots import example_path
 
         path = example_path("planar_2link")
     text = _read_text(path)
-    embed = text is not None and not _external_files(path, text)
-    cells = []
-    if embed:
-        markdown = (f"The description `{path.name}` is written into this notebook, so that the "
-                    "notebook runs wherever it is copied: edit it and run the notebook again "
-                    "to change the robot. It is written to a temporary folder under its own name "
-                    "(the suffix tells the format) and loaded from there.")
-        cells.append(f"DESCRIPTION = {text_literal(text)}")
-        load = ("with tempfile.TemporaryDirectory() as folder:\n"
-                f"    path = Path(folder) / {path.name!r}\n"
-                "    path.write_text(DESCRIPTION, encoding=\"utf-8\")\n"
-                "    model = eomgen.load(path)")
+    if text is not None and not _external_files(path, text):
+        source = EmbeddedSource(path.name, description=text_literal(text))
     else:
         where = Path(notebook).resolve().parent if notebook is not None else Path.cwd()
         relative = Path(os.path.relpath(path.resolve(), where)).as_posix()
-        markdown = (f"The description `{path.name}` names files of its own (meshes, "
-                    "includes), so it is loaded from its folder: keep it at "
-                    f"`{relative}`, relative to this notebook (Jupyter runs a notebook in "
-                    "its own folder).")
-        load = f"model = eomgen.load({relative!r})"
-    if scene is not None:
-        scene = Path(scene)
-        markdown += (f" The scene `{scene.name}` (which joints move, what is locked) is "
-                     "written in as well, and applied to the model.")
-        cells.append(f"SCENE = {text_literal(scene.read_text(encoding='utf-8'))}")
-        load += ("\nmodel = eomgen.apply_scene(model, eomgen.load_scene("
-                 f"{scene.name!r}, text=SCENE)).model")
-    return markdown, cells, load
+        source = EmbeddedSource(path.name, relative=relative)
+    if scene is None:
+        return source
+    scene = Path(scene)
+    return replace(source, scene=scene.name,
+                   scene_text=text_literal(scene.read_text(encoding="utf-8")))
 
 
-__all__ = ["load_cells", "text_literal"]
+__all__ = ["EmbeddedSource", "embedded_source", "text_literal"]

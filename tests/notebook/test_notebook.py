@@ -116,6 +116,35 @@ def test_cli_notebook_runs_without_errors(tmp_path, example):
         assert not any("qd\\_r" in text or "qdd\\_r" in text for text in latex)
 
 
+def test_every_block_of_the_cells_template_is_a_cell_of_some_notebook():
+    """templates/notebook/cells.jinja holds the notebook's cells, one block each, and nothing
+    else: the blocks the notebooks render, over every choice (description written in or named
+    by its path, with or without a scene, quaternion joints, teaching-sized, --no-check), are
+    exactly the template's blocks, each once per notebook, markdown blocks named ``*_text``."""
+    from itertools import product
+
+    from eomgen.notebook import CELLS_TEMPLATE, cell_blocks
+    from eomgen.teach.embedded import EmbeddedSource
+    from eomgen.templating import environment
+
+    sources = [EmbeddedSource("arm.yaml", description='"""..."""'),
+               EmbeddedSource("arm.xml", relative="robots/arm.xml"),
+               EmbeddedSource("arm.yaml", description='"""..."""', scene="s.yaml",
+                              scene_text='"""..."""')]
+    used = set()
+    for source, chart, small, check in product(sources, *[(False, True)] * 3):
+        if chart and small:
+            continue  # no textbook form with quaternion joints
+        blocks = cell_blocks(source, chart, small, check)
+        assert len(blocks) == len(set(blocks)), blocks
+        assert blocks[1] == "robot_text" and blocks[-2:] == ["simulation_text",
+                                                             "simulation_code"]
+        used.update(blocks)
+    template = set(environment().get_template(CELLS_TEMPLATE).blocks)
+    assert used == template
+    assert all(block.endswith(("_text", "_code")) for block in template)
+
+
 def test_cli_notebook_bad_description(tmp_path):
     bad = tmp_path / "bad.yaml"
     bad.write_text("robot: [unclosed\n")
