@@ -69,7 +69,7 @@ def generate_jax(job: Job, config: JaxConfig = JaxConfig()) -> list[GeneratedFil
                           for _, rhs in f.assignments)
     context["stacked"] = {f.name: stacked_rows(f) for f in context["functions"]
                           if len(f.output_shape) == 2}
-    text = render(config.template, **context)
+    text = render(config.template, xp=printer.alias, **context)
     return [GeneratedFile(job.stem + config.suffix, text)]
 
 

@@ -48,8 +48,10 @@ def generate_numpy(job: Job, config: NumPyConfig = NumPyConfig()) -> list[Genera
 def numpy_source(job: Job, printer, config: NumPyConfig = NumPyConfig()) -> str:
     """The NumPy module's text for ``job`` printed with ``printer`` (also what
     :func:`eomgen.lambdify` executes): the template, with the Cholesky runtime
-    (:mod:`eomgen.runtime.cholesky`) included where forward dynamics needs it."""
-    return render(config.template, cholesky_runtime=included_source(),
+    (:mod:`eomgen.runtime.cholesky`) included where forward dynamics needs it; ``xp``, the
+    array module's name that the composed functions call (common/composed.py.jinja)."""
+    return render(config.template, xp=ArrayModulePrinter.alias,
+                  cholesky_runtime=included_source(),
                   task_space_runtime=task_space.included_source(),
                   **python_module_context(job, printer, config.template, warning_exports(job),
                                           backend="numpy"))

@@ -38,6 +38,7 @@ class TorchConfig:
           load=python_loader(TorchConfig.suffix), requires=("torch",))
 def generate_torch(job: Job, config: TorchConfig = TorchConfig()) -> list[GeneratedFile]:
     printer = TorchModulePrinter({"fully_qualified_modules": True, "standard": "python3"})
-    text = render(config.template, **python_module_context(job, printer, config.template,
-                                                           warning_exports(job), backend="torch"))
+    context = python_module_context(job, printer, config.template, warning_exports(job),
+                                    backend="torch")
+    text = render(config.template, xp=printer.alias, **context)
     return [GeneratedFile(job.stem + config.suffix, text)]
