@@ -79,7 +79,6 @@ CYCLES_TODAY: frozenset[tuple[str, ...]] = frozenset({
 #: Modules over MAX_LINES lines today.
 LONG_TODAY: frozenset[str] = frozenset({
     'eomgen.parsers.urdf',
-    'eomgen.symbolic.textbook',
     'eomgen.teach.sketch',
 })
 
