@@ -78,7 +78,6 @@ CYCLES_TODAY: frozenset[tuple[str, ...]] = frozenset({
 
 #: Modules over MAX_LINES lines today.
 LONG_TODAY: frozenset[str] = frozenset({
-    'eomgen.parsers.urdf',
     'eomgen.teach.sketch',
 })
 
