@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..errors import UnsupportedError
-from ..symbolic.textbook import drop_float_noise, fourier_form
+from ..symbolic.trigonometry import drop_float_noise, fourier_form
 from .derive import Regressor, derive_regressor
 from .notation import by_coefficient, parameter_latex
 from .numeric_base import base_parameters
@@ -39,7 +39,7 @@ class RegressorForm:
     columns:
         Indices of the columns of Y that are not identically zero, increasing.
     Y:
-        Those columns, n × len(columns), each entry as :func:`eomgen.symbolic.textbook.
+        Those columns, n × len(columns), each entry as :func:`eomgen.symbolic.trigonometry.
         simplify_trig` writes it (``l1*cos(q2)``, ``g*cos(q1 + q2)``) except that a sum is not
         written as −(…).
     zero:
@@ -99,7 +99,7 @@ def regressor_form(model_or_regressor) -> RegressorForm:
     """Y and the base parameters of a small model written out (:class:`RegressorForm`).
 
     Y is expanded (:attr:`Regressor.Y`) and each entry put in the form eomgen prints for
-    small models (:func:`~eomgen.symbolic.textbook.simplify_trig`); β comes from the closed-form
+    small models (:func:`~eomgen.symbolic.trigonometry.simplify_trig`); β comes from the closed-form
     grouping (:func:`symbolic_base_parameters`), or, for axes it does not cover, from the
     numeric route with 15-digit coefficients. Expanding is exponential in the number of
     joints: meant for teaching-sized models (the bound of the textbook derivation,

@@ -87,7 +87,7 @@ def exact_regrouping(Y: sp.Matrix, dependent: int, support: Sequence[int], state
     ``c_k`` an expression of the geometry symbols (``2 a_2``), where least squares gives a
     float that is its roundoff (0.49999999999999994). ``Y`` must be in a form where distinct
     functions of the state are distinct terms (sines and cosines in
-    :func:`~eomgen.symbolic.textbook.fourier_form`). None when there is no unique exact
+    :func:`~eomgen.symbolic.trigonometry.fourier_form`). None when there is no unique exact
     solution or it differs from the numeric ``estimate`` at the geometry values ``at``.
 
     >>> a, q, x, y = sp.symbols("a q x y")
@@ -135,7 +135,7 @@ def symbolic_base_parameters(reg: Regressor, samples: int | None = None, seed: i
     dependent on earlier ones (special cases the rules do not cover) are reported as
     ``residual`` and regrouped into the others with numeric coefficients. Actuator columns are kept when not zero or dependent.
     Given ``Y``, the expanded regressor (n × p) in the form of
-    :func:`~eomgen.symbolic.textbook.fourier_form` (what :func:`~eomgen.regressor.
+    :func:`~eomgen.symbolic.trigonometry.fourier_form` (what :func:`~eomgen.regressor.
     regressor_form` prints), the residual coefficients are solved exactly in the geometry
     symbols instead (:func:`exact_regrouping`; numeric where that finds no exact solution).
 

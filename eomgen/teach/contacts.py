@@ -12,7 +12,8 @@ from ..dynamics import Dynamics
 from ..present import notation as nt
 from ..present import readability as rd
 from ..symbolic.frames import derive_frames
-from ..symbolic.textbook import TextbookDerivation, simplify_trig
+from ..symbolic.textbook import TextbookDerivation
+from ..symbolic.trigonometry import simplify_trig
 from .document import Equation, Equations, Paragraph, Section, code, prose
 from .writer import Writer, compact_terms
 

@@ -22,7 +22,8 @@ from ..present import readability as rd
 from ..regressor.generated import generated_base
 from ..regressor.notation import parameter_latex
 from ..symbolic.identities import ZeroCheck, check_zero
-from ..symbolic.textbook import TextbookDerivation, simplify_trig
+from ..symbolic.textbook import TextbookDerivation
+from ..symbolic.trigonometry import simplify_trig
 from .document import Equation, Equations, Paragraph, Section, prose
 from .writer import Writer
 

@@ -11,7 +11,8 @@ import sympy as sp
 from ..dynamics import Dynamics, derive
 from ..present import notation as nt
 from ..present import readability as rd
-from ..symbolic.textbook import TextbookDerivation, simplify_trig
+from ..symbolic.textbook import TextbookDerivation
+from ..symbolic.trigonometry import simplify_trig
 from .document import Equation, Equations, Paragraph, Section, code, prose
 from .writer import Writer, compact_terms
 

@@ -2,9 +2,11 @@
 
 Two stages, plain data between them:
 
-* :func:`sketch_geometry` runs the numeric forward kinematics (:func:`eomgen.numeric.link_poses`)
-  at one pose and returns a :class:`SketchGeometry`: joint origins, centres of mass, the link
-  segments and, when the robot moves in a plane, which plane.
+* :func:`~eomgen.teach.sketch_geometry.sketch_geometry` runs the numeric forward kinematics
+  (:func:`eomgen.numeric.link_poses`) at one pose and returns a
+  :class:`~eomgen.teach.sketch_geometry.SketchGeometry`: joint origins, centres of mass, the
+  link segments and, when the robot moves in a plane, which plane (:mod:`eomgen.teach.
+  sketch_geometry`).
 * :func:`sketch_figure` draws that geometry as a textbook figure with matplotlib (links as
   thick grey lines, revolute joints as circles, prismatic joints as squares, a hatched base,
   centres of mass as ⊕ markers labelled c₁, c₂…, joint labels q₁, q₂…, the gravity arrow g and
@@ -39,21 +41,14 @@ import io
 import math
 import textwrap
 import warnings
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..model import RobotModel
 from ..numeric import link_poses, numeric_model
-
-Point = tuple[float, float, float]
-
-#: Angle [rad] of every revolute or continuous joint in the default pose: 30°, so that the joint
-#: angles are visible in the figure (at 0 the links would line up).
-SKETCH_ANGLE = math.pi / 6
-
-#: Value given to a parameter that has none, so that the robot can still be drawn.
-PLACEHOLDER_VALUE = 1.0
+# What is drawn (plain data, NumPy alone); its names are also imported from here.
+from .sketch_geometry import (PLACEHOLDER_VALUE, SKETCH_ANGLE, TOL, SketchGeometry,
+                              sketch_geometry, sketch_pose)
 
 #: Figure size [in] and the fixed 3-D view (elevation, azimuth) [deg].
 FIGSIZE = (5.0, 4.0)
@@ -81,138 +76,7 @@ _METADATA = {
     "png": {},
 }
 
-_TOL = 1e-9
 _AXIS_NAMES = "xyz"
-
-
-@dataclass(frozen=True)
-class SketchGeometry:
-    """What the sketch shows: plain data, world (root link) frame, metres.
-
-    Attributes
-    ----------
-    q : tuple of float, (n,)
-        The pose drawn, in ``model.movable_joints`` order: radians for revolute and continuous
-        joints, metres for prismatic ones.
-    joints : tuple of (str, (x, y, z))
-        Every joint, fixed ones included, in description order, with the world origin of its
-        joint frame after the joint's motion, i.e. the origin of its child link frame (for a
-        revolute joint a point of its axis; for a prismatic joint it slides with ``q``).
-    coms : tuple of (str, (x, y, z))
-        Every link with mass > 0, in description order, with its centre of mass in the world.
-    segments : tuple of ((x, y, z), (x, y, z))
-        The links as drawn: for every joint, the line from the origin of its parent link frame
-        (the parent joint's origin, or the world origin for the root) to the joint's origin;
-        for every link with mass but no child joint, the line from its origin to its centre of
-        mass. Zero-length lines are left out.
-    plane : (int, int) or None
-        ``(i, j)``: the world axes spanning the motion plane when the robot is planar, drawn as
-        the horizontal and vertical axes of a 2-D view: (0, 1) for x-y, (0, 2) for x-z, (1, 2)
-        for y-z. Planar means every revolute joint turns about a world axis parallel to one
-        root axis (the plane normal; at least one such joint), and every prismatic joint slides
-        perpendicular to it: then every point moves in a plane parallel to ``(i, j)``. None
-        otherwise (a 3-D view).
-    placeholder_parameters : tuple of str
-        Parameters without a value, drawn with :data:`PLACEHOLDER_VALUE` (1.0).
-    """
-
-    q: tuple[float, ...]
-    joints: tuple[tuple[str, Point], ...]
-    coms: tuple[tuple[str, Point], ...]
-    segments: tuple[tuple[Point, Point], ...]
-    plane: tuple[int, int] | None
-    placeholder_parameters: tuple[str, ...]
-
-
-def sketch_pose(model: RobotModel) -> tuple[float, ...]:
-    """The default pose drawn: every revolute or continuous joint at π/6 rad (30°), so that
-    the joint angles can be seen, and every prismatic joint at 0 m.
-
-    Returns
-    -------
-    tuple of float, (n,)
-        In ``model.movable_joints`` order.
-
-    Examples
-    --------
-    >>> import eomgen
-    >>> sketch_pose(eomgen.load(eomgen.example_path("planar_2link")))  # doctest: +ELLIPSIS
-    (0.5235987755982..., 0.5235987755982...)
-    """
-    return tuple(SKETCH_ANGLE if j.type.is_revolute else 0.0 for j in model.movable_joints)
-
-
-def _point(v) -> Point:
-    return (float(v[0]), float(v[1]), float(v[2]))
-
-
-def sketch_geometry(model: RobotModel, q=None) -> SketchGeometry:
-    """Forward kinematics of ``model`` at ``q``, as the sketch draws it.
-
-    Parameters
-    ----------
-    model : RobotModel
-        The robot. Parameters without a value are set to :data:`PLACEHOLDER_VALUE` and
-        listed in ``placeholder_parameters``.
-    q : (n,) array_like, optional
-        Joint positions in ``model.movable_joints`` order [rad or m]; :func:`sketch_pose`
-        when omitted.
-
-    Returns
-    -------
-    SketchGeometry
-        Points in the world (root link) frame [m].
-
-    Raises
-    ------
-    ValueError
-        When ``q`` has the wrong length or a non-finite entry.
-    """
-    placeholders = tuple(p.name for p in model.parameters if p.value is None)
-    nm = numeric_model(model, values={name: PLACEHOLDER_VALUE for name in placeholders})
-    q = sketch_pose(model) if q is None else q
-    poses = link_poses(nm, q)  # checks the shape of q
-    q = tuple(float(x) for x in q)
-    body = {name: i for i, name in enumerate(nm.body_names)}
-
-    def origin(link: str) -> np.ndarray:
-        return poses[link][1]
-
-    def com(link: str) -> np.ndarray:
-        return poses[link][1] + poses[link][0] @ nm.com[body[link]]
-
-    joints = tuple((j.name, _point(origin(j.child))) for j in model.joints)
-    coms = tuple((link.name, _point(com(link.name))) for link in model.links
-                 if nm.mass[body[link.name]] > 0)
-    lines = [(origin(j.parent), origin(j.child)) for j in model.joints]
-    # A link ending the chain is drawn from its origin to its centre of mass.
-    parents = {j.parent for j in model.joints}
-    lines += [(origin(name), com(name)) for name, _ in coms if name not in parents]
-    segments = tuple((_point(a), _point(b)) for a, b in lines if np.linalg.norm(b - a) > _TOL)
-
-    return SketchGeometry(
-        q=q,
-        joints=joints,
-        coms=coms,
-        segments=segments,
-        plane=_motion_plane(model),
-        placeholder_parameters=placeholders,
-    )
-
-
-def _motion_plane(model: RobotModel) -> tuple[int, int] | None:
-    """The ``(i, j)`` root-frame plane of a planar robot: the plane of
-    :func:`eomgen.reduction.planar_motion` when its normal is a root axis (the view is drawn in
-    root coordinates), else None."""
-    from ..reduction import planar_motion  # start-up time: it imports SymPy; this needs NumPy
-
-    planar = planar_motion(model)
-    if planar is None:
-        return None
-    k = int(np.argmax(np.abs(planar.normal)))
-    if abs(abs(planar.normal[k]) - 1.0) > _TOL:
-        return None
-    return {0: (1, 2), 1: (0, 2), 2: (0, 1)}[k]
 
 
 # ----------------------------------------------------------------------------------------------
@@ -302,7 +166,7 @@ def _numeric_gravity(model: RobotModel) -> np.ndarray | None:
         g = np.array([float(x.subs(values)) for x in model.gravity])
     except TypeError:  # a parameter without a value: the direction is unknown
         return None
-    return g if np.all(np.isfinite(g)) and np.linalg.norm(g) > _TOL else None
+    return g if np.all(np.isfinite(g)) and np.linalg.norm(g) > TOL else None
 
 
 def _format_pose(model: RobotModel, q) -> str:
@@ -393,7 +257,7 @@ def _figure(model: RobotModel, geo: SketchGeometry):
     FigureCanvasAgg(fig)
     points = np.array([p for _, p in geo.joints] + [p for _, p in geo.coms] + [(0.0, 0.0, 0.0)])
     scale = float(np.max(np.linalg.norm(points, axis=1)))
-    scale = scale if scale > _TOL else 1.0
+    scale = scale if scale > TOL else 1.0
     if geo.plane is not None:
         _draw_planar(fig, model, geo, scale, _numeric_gravity(model))
     else:
@@ -439,7 +303,7 @@ def _draw_planar(fig, model: RobotModel, geo: SketchGeometry, scale: float, grav
     # The view is turned in its plane so that gravity points down the page, as a student would
     # draw it (a turn keeps the handedness, so the angle arcs keep their sense).
     turn_view = np.eye(2)
-    if gravity is not None and math.hypot(gravity[i], gravity[j]) > _TOL:
+    if gravity is not None and math.hypot(gravity[i], gravity[j]) > TOL:
         phi = -math.pi / 2 - math.atan2(gravity[j], gravity[i])
         if abs(phi) > 1e-12:
             turn_view = np.array([[math.cos(phi), -math.sin(phi)],
@@ -454,7 +318,7 @@ def _draw_planar(fig, model: RobotModel, geo: SketchGeometry, scale: float, grav
 
     # Base: a ground line under the root origin, hatched on the far side.
     down = np.array([0.0, -1.0]) if gravity is None else v(gravity)
-    down = down / np.linalg.norm(down) if np.linalg.norm(down) > _TOL else np.array([0.0, -1.0])
+    down = down / np.linalg.norm(down) if np.linalg.norm(down) > TOL else np.array([0.0, -1.0])
     side = np.array([-down[1], down[0]])
     w, h, top = 0.16 * scale, 0.06 * scale, down * 0.08 * scale
     ground = [top - side * w, top + side * w, top + side * w + down * h, top - side * w + down * h]
@@ -505,7 +369,7 @@ def _draw_planar(fig, model: RobotModel, geo: SketchGeometry, scale: float, grav
         d = xy - (joint_at[model.parent_joint[link].name] if link in model.parent_joint
                   else np.zeros(2))
         normal = np.array([-d[1], d[0]]) * turn.get(link, 1.0)
-        _label(ax, xy, f"${name}$", normal if np.linalg.norm(d) > _TOL else (1.0, -1.0))
+        _label(ax, xy, f"${name}$", normal if np.linalg.norm(d) > TOL else (1.0, -1.0))
 
     box = (FIGSIZE[0] * rect[2], FIGSIZE[1] * rect[3])
     _fit_limits(ax, np.array(pts), 0.12 * scale, box)

@@ -77,12 +77,7 @@ CYCLES_TODAY: frozenset[tuple[str, ...]] = frozenset({
 })
 
 #: Modules over MAX_LINES lines today.
-LONG_TODAY: frozenset[str] = frozenset({
-    'eomgen.parsers.urdf',
-    'eomgen.symbolic.named',
-    'eomgen.symbolic.textbook',
-    'eomgen.teach.sketch',
-})
+LONG_TODAY: frozenset[str] = frozenset()
 
 _REFERENCE = re.compile(r"^(eomgen(?:\.\w+)+):\w+$")
 

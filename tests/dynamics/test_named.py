@@ -16,7 +16,7 @@ import sympy as sp
 import eomgen
 from eomgen import numeric
 from eomgen.robots import example_path
-from eomgen.symbolic import named
+from eomgen.symbolic import expansion, named
 from eomgen.symbolic.named import ExpansionTooLargeError, ProgramMatrix
 from support.reference import random_robot
 from support import uniform_states
@@ -50,13 +50,13 @@ def test_large_model_gives_the_named_form_after_bounded_work(monkeypatch):
     """The 5-joint arm's M is not written out: derive's result tries the expansion within
     AUTO_EXPAND_WORK term operations, stops, and gives the named form."""
     spent = []
-    spend = named._Polynomials.spend
+    spend = expansion.Polynomials.spend
 
     def counting(self, work, size, what):
         spent.append(self.work + work)
         return spend(self, work, size, what)
 
-    monkeypatch.setattr(named._Polynomials, "spend", counting)
+    monkeypatch.setattr(expansion.Polynomials, "spend", counting)
     dyn = eomgen.derive(spatial5().model, outputs=("M",))
     M = dyn.M
     assert isinstance(M, ProgramMatrix) and M.shape == (5, 5) and M.rows == M.cols == 5
@@ -168,7 +168,7 @@ def test_expand_program_keeps_exact_numbers_and_parameters():
     x0, x1, q1, q2, a = sp.symbols("x0 x1 q1 q2 a", real=True)
     program = [(x0, sp.cos(q1) * a + sp.Rational(1, 3) * sp.sin(q2)),
                (x1, x0 ** 2 - sp.sin(q1) * x0)]
-    [out] = named.expand_program(program, [x1 * sp.cos(q2) + 2])
+    [out] = expansion.expand_program(program, [x1 * sp.cos(q2) + 2])
     direct = sp.expand(((sp.cos(q1) * a + sp.sin(q2) / 3) ** 2
                         - sp.sin(q1) * (sp.cos(q1) * a + sp.sin(q2) / 3)) * sp.cos(q2) + 2)
     direct = sp.expand(direct.subs({sp.sin(q1) ** 2: 1 - sp.cos(q1) ** 2,

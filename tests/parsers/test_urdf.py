@@ -29,7 +29,8 @@ from eomgen.errors import (
     UnsupportedFeatureWarning,
 )
 from eomgen.model import JointType, Notice, NoticeKind, RobotModel, Transform, emit_notices
-from eomgen.parsers.urdf import LEG_REACH, load_urdf, parse_urdf_string, rotate_inertia
+from eomgen.parsers.legged import LEG_REACH
+from eomgen.parsers.urdf import load_urdf, parse_urdf_string, rotate_inertia
 from eomgen.reduction import load_for_scene
 from eomgen.scene import Scene
 from support.extras import need

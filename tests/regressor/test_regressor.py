@@ -19,7 +19,7 @@ from eomgen.errors import UnsupportedError, UnsupportedFeatureWarning
 from eomgen.numeric import kinetic_energy, numeric_model, potential_energy, rnea
 from eomgen.regressor import (base_parameters, derive_regressor, identify, regressor_form,
                               symbolic_base_parameters)
-from eomgen.symbolic.textbook import fourier_form
+from eomgen.symbolic.trigonometry import fourier_form
 from support.reference import pin_q_order, planar_2link_by_hand, random_robot, to_pinocchio
 from support.extras import need
 
