@@ -36,9 +36,8 @@ LAYERS: tuple[tuple[int, tuple[str, ...]], ...] = (
     (4, ("symbolic",)),
     (5, ("dynamics", "regressor", "actuators")),
     (6, ("numeric", "verify", "quaternion_joints", "loops", "contacts")),
-    (7, ("codegen", "present", "lambdify")),
-    (8, ("analysis", "identification", "teach", "notebook", "display", "batch", "cache",
-         "control")),
+    (7, ("codegen", "cache", "present", "lambdify")),
+    (8, ("analysis", "identification", "teach", "notebook", "display", "batch", "control")),
     (9, ("cli",)),
     (10, ("",)),   # eomgen/__init__.py: the public API
 )
@@ -52,8 +51,6 @@ UPWARD_TODAY: frozenset[tuple[str, str]] = frozenset({
     ('eomgen.cache.keys', 'eomgen'),
     ('eomgen.cli', 'eomgen'),
     ('eomgen.codegen', 'eomgen'),
-    ('eomgen.codegen.generate', 'eomgen.cache'),
-    ('eomgen.codegen.scene_generate', 'eomgen.cache'),
     ('eomgen.dynamics', 'eomgen.lambdify'),
     ('eomgen.expressions', 'eomgen.model'),
     ('eomgen.floating', 'eomgen.numeric.floating_base'),
