@@ -312,9 +312,11 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     # taken along the tangent (eomgen.symbolic.tangent).
     refused_here = sorted(s for s in outputs if not BY_SYMBOL[s].quaternion_joints)
     if model.quaternion_joints and refused_here:
+        first = model.quaternion_joints[0]
         what, where, hint = (("a quaternion free flyer", "floating_base: quaternion",
                               "; use floating_base: euler") if model.free_flyer else
-                             ("a ball joint", f"ball joint '{model.ball_joints[0]}'", ""))
+                             (f"a {first.kind.describe()[0]} joint",
+                              f"{first.kind.describe()[0]} joint '{first.name}'", ""))
         derived = [s for s, o in BY_SYMBOL.items() if o.quaternion_joints]
         raise UnsupportedError(
             model.source, where, f"{', '.join(refused_here)} not derived for {what} yet (it "

@@ -36,14 +36,15 @@ from __future__ import annotations
 import numpy as np
 
 from .model import QuaternionJoint, RobotModel
-from .model.quaternion import FREE_FLYER
-from .numeric.floating_base import matrix_quaternion, quaternion_matrix
-from .numeric.so3 import left_jacobian, skew, so3_exp, so3_log  # all four kept importable here
+from .model.joints import FREE_FLYER
+# kept importable here: the rotations every kind uses (eomgen.model.joints.lie)
+from .model.joints.lie import left_jacobian, skew, so3_exp, so3_log
 
 
 def layout(model, nv: int | None = None) -> tuple[QuaternionJoint, ...]:
-    """The quaternion joints of ``model`` (a :class:`~eomgen.model.RobotModel` or its
-    ``quaternion_joints``); None: one free flyer at the start."""
+    """The joints of ``model`` whose configuration is not their coordinates (a
+    :class:`~eomgen.model.RobotModel`, or its ``quaternion_joints``); None: one free flyer at
+    the start."""
     if model is None:
         return (QuaternionJoint(FREE_FLYER, "base", 0, 0),)
     if isinstance(model, RobotModel):
@@ -63,74 +64,53 @@ def _pieces(joints, nv: int):
 
 
 def configuration_rate(q, v, model=None) -> np.ndarray:
-    """``q̇`` (NQ) at velocity ``v`` (NV): a free flyer's origin moves at ``R v_lin``, a
-    quaternion at ``½ (x, y, z, w) ⊗ (ω, 0)``, the other joints at ``v``."""
+    """``q̇`` (NQ) at velocity ``v`` (NV): each joint's kind's rate
+    (:meth:`~eomgen.model.joints.JointKind.configuration_rate`): a free flyer's origin moves at
+    ``R v_lin``, a quaternion at ``½ (x, y, z, w) ⊗ (ω, 0)``, the other joints at ``v``."""
     q, v = np.asarray(q, dtype=float), np.asarray(v, dtype=float)
     out = np.empty(len(q))
     for joint, sv, sq in _pieces(layout(model), len(v)):
-        if joint is None:
-            out[sq] = v[sv]
-            continue
-        quat, omega = q[joint.quaternion:joint.quaternion + 4], v[sv][-3:]
-        if joint.kind == FREE_FLYER:
-            out[sq.start:sq.start + 3] = quaternion_matrix(quat) @ v[sv][:3]
-        k = joint.quaternion
-        out[k:k + 3] = 0.5 * (quat[3] * omega + np.cross(quat[:3], omega))
-        out[k + 3] = -0.5 * (quat[:3] @ omega)
+        out[sq] = v[sv] if joint is None else joint.kind.configuration_rate(q[sq], v[sv])
     return out
 
 
 def integrate(q, v, dt: float = 1.0, model=None) -> np.ndarray:
     """The configuration reached from ``q`` (NQ) moving with the constant velocity ``v`` (NV)
-    for ``dt`` seconds (Pinocchio's ``integrate(model, q, v dt)``): a free flyer along the
-    SE(3) exponential of its twist (root frame), a ball joint ``R exp([ω dt]×)``, the other
-    joints by ``q + v dt``. The quaternions of the result are unit."""
+    for ``dt`` seconds (Pinocchio's ``integrate(model, q, v dt)``), each joint by its kind's
+    exponential: a free flyer along the SE(3) exponential of its twist (root frame), a ball
+    joint ``R exp([ω dt]×)``, a planar joint along SE(2)'s, the other joints by ``q + v dt``.
+    The quaternions of the result are unit."""
     q, v = np.asarray(q, dtype=float), np.asarray(v, dtype=float) * dt
     out = np.empty(len(q))
     for joint, sv, sq in _pieces(layout(model), len(v)):
-        if joint is None:
-            out[sq] = q[sq] + v[sv]
-            continue
-        k, step = joint.quaternion, v[sv]
-        R = quaternion_matrix(q[k:k + 4])
-        if joint.kind == FREE_FLYER:
-            out[sq.start:sq.start + 3] = q[sq.start:sq.start + 3] + R @ (
-                left_jacobian(step[3:]) @ step[:3])
-        out[k:k + 4] = matrix_quaternion(R @ so3_exp(step[-3:]))
+        out[sq] = q[sq] + v[sv] if joint is None else joint.kind.integrate(q[sq], v[sv])
     return out
 
 
 def difference(q0, q1, model=None) -> np.ndarray:
     """The velocity ``v`` (NV) with ``integrate(q0, v, 1) = q1`` (Pinocchio's
-    ``difference``): a free flyer's SE(3) logarithm of ``(R0, p0)⁻¹ (R1, p1)`` (root frame of
-    ``q0``), a ball joint's ``log(R0ᵀ R1)``, ``q1 − q0`` for the other joints."""
+    ``difference``), each joint by its kind's logarithm: a free flyer's SE(3) logarithm of
+    ``(R0, p0)⁻¹ (R1, p1)`` (root frame of ``q0``), a ball joint's ``log(R0ᵀ R1)``, ``q1 − q0``
+    for the one-axis joints."""
     q0, q1 = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
     joints = layout(model)
-    out = np.empty(len(q0) - len(joints))
+    out = np.empty(len(q0) - sum(j.nq - j.nv for j in joints))
     for joint, sv, sq in _pieces(joints, len(out)):
-        if joint is None:
-            out[sv] = q1[sq] - q0[sq]
-            continue
-        k = joint.quaternion
-        R0, R1 = quaternion_matrix(q0[k:k + 4]), quaternion_matrix(q1[k:k + 4])
-        w = so3_log(R0.T @ R1)
-        if joint.kind == FREE_FLYER:
-            p = slice(sq.start, sq.start + 3)
-            out[sv.start:sv.start + 3] = np.linalg.solve(left_jacobian(w), R0.T @ (q1[p] - q0[p]))
-        out[sv.stop - 3:sv.stop] = w
+        out[sv] = q1[sq] - q0[sq] if joint is None else joint.kind.difference(q0[sq], q1[sq])
     return out
 
 
 def neutral(model) -> np.ndarray:
-    """The neutral configuration (Pinocchio's ``neutral``): identity quaternions (0, 0, 0, 1),
-    everything else zero. ``model``: a :class:`~eomgen.model.RobotModel`, or the NQ of a model
-    whose only quaternion joint is a free flyer at the start."""
+    """The neutral configuration (Pinocchio's ``neutral``): each joint's kind's (identity
+    quaternions (0, 0, 0, 1), a planar joint's (0, 0, 1, 0)), everything else zero. ``model``:
+    a :class:`~eomgen.model.RobotModel`, or the NQ of a model whose only such joint is a free
+    flyer at the start."""
     if isinstance(model, RobotModel):
         q, joints = np.zeros(model.nq), model.quaternion_joints
     else:
         q, joints = np.zeros(int(model)), layout(None)
     for joint in joints:
-        q[joint.quaternion + 3] = 1.0
+        q[joint.q_slice] = joint.kind.neutral()
     return q
 
 

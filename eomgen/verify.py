@@ -146,10 +146,7 @@ def random_configuration(model, coordinates: np.ndarray, rng: np.random.Generato
             q[iq] = coordinates[k]
             k, iq = k + 1, iq + 1
             continue
-        if joint.nv == 6:
-            q[iq:iq + 3] = coordinates[k:k + 3]
-        quaternion = rng.normal(size=4)
-        q[joint.quaternion:joint.quaternion + 4] = quaternion / np.linalg.norm(quaternion)
+        q[joint.q_slice] = joint.kind.random_configuration(coordinates[joint.v_slice], rng)
         k, iq = k + joint.nv, iq + joint.nq
     return q
 

@@ -157,8 +157,8 @@ class ContactSystem:
     def quaternion_norm_error(self, q) -> float:
         """``max_j |‖quaternion_j‖ − 1|`` over the quaternion joints at ``q`` (0 without)."""
         q = np.asarray(q, float)
-        return max((abs(float(np.linalg.norm(q[j.quaternion:j.quaternion + 4])) - 1.0)
-                    for j in self.model.quaternion_joints), default=0.0)
+        return max((j.kind.norm_error(q[j.q_slice]) for j in self.model.quaternion_joints),
+                   default=0.0)
 
     def energy(self, q, qd) -> tuple[float, float]:
         """``(K, P)`` [J] from :mod:`eomgen.numeric`."""

@@ -214,9 +214,10 @@ def identify(description, data, outdir, physical, friction, cutoff, scene_path, 
     model, _ = load_reduced(description, scene_path, strict)
     terms = _terms(model, friction)
     progress(f"reading {data}")
-    quaternions = [j.quaternion for j in model.quaternion_joints]
+    quaternions = [j.quaternion for j in model.quaternion_joints if j.quaternion is not None]
     measured = read_measurements(data, model.joint_names, cutoff,
-                                 model.configuration_names if quaternions else None, quaternions)
+                                 model.configuration_names if model.quaternion_joints else None,
+                                 quaternions)
     reg, base = _regressor(model, terms, progress)
     progress(f"stacking the base regressor over {plural(measured.N, 'sample')}")
     W = observation_matrix(reg, base.base, measured.q, measured.qd, measured.qdd)

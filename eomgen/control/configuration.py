@@ -15,34 +15,34 @@ from __future__ import annotations
 import numpy as np
 
 from ..model import QuaternionJoint
-from ..model.quaternion import (BALL_CONFIGURATION, BALL_VELOCITY, FREE_FLYER,
-                                FREE_FLYER_CONFIGURATION, FREE_FLYER_VELOCITY, SPHERICAL)
+from ..model.joints import FREE_FLYER, KINDS, ChartKind
 from ..quaternion_joints import configuration_rate, difference
 
 
 def module_layout(module) -> tuple[QuaternionJoint, ...]:
-    """The quaternion joints of a generated module (or anything with ``JOINT_NAMES`` and,
-    for a model with quaternion joints, ``CONFIGURATION_NAMES``), from the names: a free
-    flyer's ``base_vx … base_wz`` over ``base_x … base_qw``, a ball joint's ``<name>_wx …
-    _wz`` over ``<name>_qx … _qw``; empty when the two lists are one."""
+    """The joints of a generated module whose configuration is not their coordinates (read
+    off anything with ``JOINT_NAMES`` and, for such a model, ``CONFIGURATION_NAMES``), from the
+    names each kind gives its entries (:mod:`eomgen.model.joints`): a free flyer's ``base_vx …
+    base_wz`` over ``base_x … base_qw``, a ball joint's ``<name>_wx … _wz`` over ``<name>_qx …
+    _qw``, a planar joint's ``<name>_vx, _vy, _wz`` over ``<name>_x, _y, _cos, _sin``; empty
+    when the two lists are one."""
     velocity = tuple(getattr(module, "JOINT_NAMES", ()))
     configuration = tuple(getattr(module, "CONFIGURATION_NAMES", velocity))
     if configuration == velocity:
         return ()
+    kinds = [kind for kind in KINDS.values() if isinstance(kind, ChartKind)]
     found, k, iq = [], 0, 0
     while k < len(velocity):
-        name = velocity[k]
-        if velocity[k:k + 6] == FREE_FLYER_VELOCITY \
-                and configuration[iq:iq + 7] == FREE_FLYER_CONFIGURATION:
-            found.append(QuaternionJoint(FREE_FLYER, "base", k, iq))
+        for kind in kinds:
+            name = velocity[k][:-len(kind.velocity_suffixes[0]) - 1]
+            if (velocity[k:k + kind.nv] == kind.velocity_names(name)
+                    and configuration[iq:iq + kind.nq] == kind.configuration_names(name)):
+                found.append(QuaternionJoint(kind, "base" if kind is FREE_FLYER else name,
+                                             k, iq))
+                k, iq = k + kind.nv, iq + kind.nq
+                break
         else:
-            ball = name[:-len(BALL_VELOCITY[0]) - 1]
-            if (velocity[k:k + 3] == tuple(f"{ball}_{s}" for s in BALL_VELOCITY)
-                    and configuration[iq:iq + 4] == tuple(f"{ball}_{s}"
-                                                          for s in BALL_CONFIGURATION)):
-                found.append(QuaternionJoint(SPHERICAL, ball, k, iq))
-        width = found[-1].nv if found and found[-1].v_index == k else 1
-        k, iq = k + width, iq + width + (width > 1)
+            k, iq = k + 1, iq + 1
     if iq != len(configuration):
         raise ValueError(f"CONFIGURATION_NAMES ({len(configuration)}) and JOINT_NAMES "
                          f"({len(velocity)}) do not describe one configuration space")

@@ -25,38 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..numeric.floating_base import matrix_quaternion
-
-_AXES = np.eye(3)
-
-
-def _rotation(axis: int, angle) -> np.ndarray:
-    """``R_axis(angle)`` for each of the angles ``angle`` (N,): (N, 3, 3)."""
-    angle = np.asarray(angle, dtype=float)
-    c, s = np.cos(angle), np.sin(angle)
-    i, j = (axis + 1) % 3, (axis + 2) % 3
-    R = np.zeros(angle.shape + (3, 3))
-    R[..., axis, axis] = 1.0
-    R[..., i, i], R[..., i, j], R[..., j, i], R[..., j, j] = c, -s, s, c
-    return R
-
-
-def rotation_rates(angles, rates, accelerations) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(R, ω, ω̇)`` of ``R = Rx(a) Ry(b) Rz(c)`` for the angles ``(a, b, c)`` [rad] and their
-    first and second time derivatives, each (N, 3) (or (3,)): ``ω`` and ``ω̇`` in the rotated
-    (body) frame (module docstring); R (N, 3, 3)."""
-    angles, rates, accelerations = (np.asarray(x, dtype=float)
-                                    for x in (angles, rates, accelerations))
-    omega, domega = np.zeros(angles.shape), np.zeros(angles.shape)
-    after = np.broadcast_to(np.eye(3), angles.shape[:-1] + (3, 3))  # A_k: factors after k
-    for k in (2, 1, 0):
-        axis = after[..., k, :]  # A_kᵀ e_k
-        term = axis * rates[..., k:k + 1]
-        domega = domega + axis * accelerations[..., k:k + 1] + np.cross(term, omega)
-        omega = omega + term  # so far: the terms after k
-        after = _rotation(k, angles[..., k]) @ after
-    return after, omega, domega
-
+from ..model.joints.lie import rotation_rates  # noqa: F401 (importable here)
 
 def chart_states(joints, xi, xid, xidd) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(q, v, v̇)`` of the chart states ``(ξ, ξ̇, ξ̈)`` (each (N, NV)) for the quaternion
@@ -66,7 +35,7 @@ def chart_states(joints, xi, xid, xidd) -> tuple[np.ndarray, np.ndarray, np.ndar
     if not joints:
         return xi, xid, xidd
     N, nv = xi.shape
-    q = np.empty((N, nv + len(joints)))
+    q = np.empty((N, nv + sum(j.nq - j.nv for j in joints)))
     v, vd = xid.copy(), xidd.copy()
     starts = {j.v_index: j for j in joints}
     k = iq = 0
@@ -76,15 +45,9 @@ def chart_states(joints, xi, xid, xidd) -> tuple[np.ndarray, np.ndarray, np.ndar
             q[:, iq] = xi[:, k]
             k, iq = k + 1, iq + 1
             continue
-        w = slice(k + joint.nv - 3, k + joint.nv)
-        R, v[:, w], vd[:, w] = rotation_rates(xi[:, w], xid[:, w], xidd[:, w])
-        q[:, joint.quaternion:joint.quaternion + 4] = [matrix_quaternion(r) for r in R]
-        if joint.nv == 6:
-            q[:, iq:iq + 3] = xi[:, k:k + 3]
-            linear = np.einsum("nji,nj->ni", R, xid[:, k:k + 3])  # Rᵀ ṗ
-            v[:, k:k + 3] = linear
-            vd[:, k:k + 3] = (np.einsum("nji,nj->ni", R, xidd[:, k:k + 3])
-                              - np.cross(v[:, w], linear))
+        q[:, joint.q_slice], v[:, joint.v_slice], vd[:, joint.v_slice] = \
+            joint.kind.chart_states(xi[:, joint.v_slice], xid[:, joint.v_slice],
+                                    xidd[:, joint.v_slice])
         k, iq = k + joint.nv, iq + joint.nq
     return q, v, vd
 

@@ -55,6 +55,7 @@ from .quaternion import (
     FREE_FLYER_VELOCITY,
     QuaternionJoint,
     expand_ball_joints,
+    expand_joints,
     quaternion_layout,
 )
 from .robot import (
@@ -78,7 +79,7 @@ __all__ = [
     "make_coupling", "with_couplings", "Inertial", "Joint", "JointType", "Link", "Mat3", "Notice",
     "NoticeKind", "Parameter", "QuaternionJoint", "RobotModel", "Scalar", "Snap", "Transform", "Vec3",
     "all_scalars", "build_model", "check_actuator", "float_constants", "check_axis", "check_inertial",
-    "check_size", "check_tree", "configuration_size", "emit_notices", "expand_ball_joints", "flexible_indices", "joint_actuators",
+    "check_size", "check_tree", "configuration_size", "emit_notices", "expand_ball_joints", "expand_joints", "flexible_indices", "joint_actuators",
     "joint_motion", "lock_joints", "massless_joints", "massless_notices", "settled", "mat3", "parameter_symbol", "quaternion_layout", "rotation_about_axis",
     "rotation_from_rpy", "scalar", "snap", "snap_summary", "snapping", "vec3",
 ]

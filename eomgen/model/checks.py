@@ -17,11 +17,12 @@ from ..errors import (
     KinematicTreeError,
     ParameterError,
     TooLargeError,
+    UnsupportedError,
 )
 from .moving_mass import settled
 from .notices import Notice, NoticeKind, emit_notices
-from .parts import Inertial, Joint, Link, Parameter
-from .quaternion import expand_ball_joints
+from .parts import Inertial, Joint, JointType, Link, Parameter
+from .quaternion import expand_joints
 from .robot import RobotModel
 from .scalars import Vec3, scalar, vec3
 from .snapping import snap
@@ -201,6 +202,21 @@ def check_axis(source: str, joint: str, axis: Vec3) -> Vec3:
     return vec3([snap(v / norm, f"joint '{joint}' axis") for v in values])
 
 
+def check_kind(source: str, joint: Joint) -> None:
+    """Refuse what a joint's kind cannot be: a planar joint whose axis (the plane's normal) is
+    not the joint frame's z axis, a helical joint whose pitch is not a finite number."""
+    if joint.type is JointType.PLANAR and tuple(joint.axis) != (0, 0, 1):
+        raise UnsupportedError(source, f"joint '{joint.name}' axis", "a planar joint moves in "
+                               "its joint frame's xy plane (Pinocchio's JointModelPlanar): its "
+                               "axis, the plane's normal, must be 0 0 1; turn the plane with "
+                               "the joint's origin")
+    if joint.type is JointType.HELICAL:
+        pitch = _number(joint.pitch)
+        if pitch is not None and not math.isfinite(pitch):
+            raise InvalidNumberError(source, f"joint '{joint.name}' pitch",
+                                     "the pitch is not finite")
+
+
 def _is_symbolic(inertial: Inertial) -> bool:
     return any(isinstance(v, sp.Basic) and v.free_symbols
                for v in (inertial.mass, *inertial.com, *sum(inertial.inertia, ())))
@@ -304,6 +320,8 @@ def build_model(
     joints = tuple(joints)
     check_size(source, len(links), len(joints))
     joints = tuple(replace(j, axis=check_axis(source, j.name, j.axis)) for j in joints)
+    for joint in joints:
+        check_kind(source, joint)
     root = check_tree(source, (l.name for l in links), joints)
     params = tuple(parameters)
     defaults = {p.symbol: scalar(p.value) for p in params if p.value is not None}
@@ -331,7 +349,7 @@ def build_model(
     model = RobotModel(name=name, links=links, joints=joints, root=root, gravity=gravity,
                        parameters=params, source=str(source),
                        info=tuple((info or {}).items()), notices=tuple(notices))
-    model = expand_ball_joints(model)  # a parser's SPHERICAL joints: eomgen.model.quaternion
+    model = expand_joints(model)  # a parser's ball, planar and helical joints: their chains
     undeclared = sorted((s for s in model.free_symbols if s.name not in names), key=str)
     if undeclared:
         model = replace(model, parameters=params + tuple(Parameter(s) for s in undeclared))

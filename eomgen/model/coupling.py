@@ -30,6 +30,7 @@ import sympy as sp
 
 from .. import reprs
 from ..errors import KinematicTreeError, UnsupportedError
+from .joints import KINDS
 from .scalars import scalar
 
 
@@ -90,7 +91,8 @@ def check_couplings(source: str, model, couplings: Sequence[Coupling]) -> None:
     joints = {j.name: j for j in model.joints}
     movable = {j.name for j in model.movable_joints}
     virtual = set(j.name for j in model.movable_joints[:6]) if model.free_flyer else set()
-    balls = {f"{ball}_{axis}": ball for ball in model.ball_joints for axis in ("wx", "wy", "wz")}
+    balls = {virtual: (KINDS[kind].describe()[0], name) for kind, name in model.compound_joints
+             for virtual in KINDS[kind].velocity_names(name)}
     followers: dict[str, Coupling] = {}
     for coupling in couplings:
         where = coupling.where
@@ -109,7 +111,7 @@ def check_couplings(source: str, model, couplings: Sequence[Coupling]) -> None:
                                        "the floating base: it cannot be coupled")
             if name in balls:
                 raise UnsupportedError(source, where, f"joint '{name}' is a virtual joint of "
-                                       f"ball joint '{balls[name]}': only one-axis joints "
+                                       f"{balls[name][0]} joint '{balls[name][1]}': only one-axis joints "
                                        "can be coupled")
         leaders = [name for name, _ in coupling.leaders]
         if len(set(leaders)) != len(leaders):

@@ -9,22 +9,30 @@ import sympy as sp
 
 from .. import reprs
 from .actuator import Actuator
+from .joints import KINDS, JointKind
 from .scalars import ZERO3, Mat3, Scalar, Vec3, mat3, scalar, vec3
 from .transforms import Transform
 
 class JointType(enum.Enum):
-    """Joint types eomgen models. Floating and planar joints are refused by the parsers; a URDF
-    ``<mimic>`` joint is a movable joint that a coupling makes follow another
-    (:mod:`eomgen.model.coupling`).
-    ``SPHERICAL`` (a ball joint, three rotational freedoms, its configuration a unit
-    quaternion) is what a parser writes; :func:`~eomgen.model.build_model` turns it into three
-    virtual joints (:func:`eomgen.model.expand_ball_joints`), so no model holds one."""
+    """The joint types a description writes, each naming its kind (:attr:`kind`, a type of
+    :mod:`eomgen.model.joints` that answers every question about it). A URDF ``<mimic>`` joint
+    is a movable joint that a coupling makes follow another (:mod:`eomgen.model.coupling`).
+    ``SPHERICAL`` (a ball joint), ``PLANAR`` and ``HELICAL`` are what a parser writes;
+    :func:`~eomgen.model.build_model` turns each into its chain of one-axis joints
+    (:func:`eomgen.model.expand_joints`), so no model holds one."""
 
     REVOLUTE = "revolute"
     CONTINUOUS = "continuous"
     PRISMATIC = "prismatic"
     FIXED = "fixed"
     SPHERICAL = "spherical"
+    PLANAR = "planar"
+    HELICAL = "helical"
+
+    @property
+    def kind(self) -> JointKind:
+        """The joint kind of this type (:data:`eomgen.model.joints.KINDS`)."""
+        return KINDS[self.value]
 
     @property
     def is_movable(self) -> bool:
@@ -76,9 +84,12 @@ class Joint:
     axis: Vec3 = vec3([0, 0, 1])
     #: The drive of a movable joint (armature, friction, elasticity); None for none.
     actuator: "Actuator | None" = None
+    #: A helical joint's pitch [m/rad]: its translation along ``axis`` per radian turned.
+    pitch: Scalar = 0
 
     def __post_init__(self):  # accept plain numbers from Python callers
         object.__setattr__(self, "axis", vec3(self.axis))
+        object.__setattr__(self, "pitch", scalar(self.pitch))
 
 
 @dataclass(frozen=True)

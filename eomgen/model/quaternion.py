@@ -28,64 +28,71 @@ rotation of the quaternion before them.
 
 A parser writes a ball joint as a :class:`~eomgen.model.Joint` of type
 :attr:`JointType.SPHERICAL <eomgen.model.JointType.SPHERICAL>` (its origin the joint frame,
-its axis unused); :func:`~eomgen.model.build_model` calls :func:`expand_ball_joints`, which
-replaces it by the chain.
+its axis unused), a planar joint as one of type ``PLANAR``, a screw as one of type
+``HELICAL``; :func:`~eomgen.model.build_model` calls :func:`expand_joints`, which replaces each
+by its chain. Every question about a joint's kind (sizes, names, configuration space, pose) is
+a method of its kind (:mod:`eomgen.model.joints`); this module only lays them out.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+
 from ..errors import KinematicTreeError, UnsupportedError
+from .coupling import make_coupling
+from .joints import FREE_FLYER, KINDS, SPHERICAL, ChartKind, JointKind
+from .joints.free_flyer import CONFIGURATION as FREE_FLYER_CONFIGURATION
+from .joints.free_flyer import VELOCITY as FREE_FLYER_VELOCITY
 from .parts import Joint, JointType, Link
 from .scalars import vec3
 from .transforms import Transform
 
-#: A free flyer's configuration entries (q[0:7]): the root link origin in the world [m], then
-#: the unit quaternion (x, y, z, w) of its orientation (Pinocchio's ``JointModelFreeFlyer``).
-FREE_FLYER_CONFIGURATION = ("base_x", "base_y", "base_z", "base_qx", "base_qy", "base_qz",
-                            "base_qw")
-#: A free flyer's velocity entries (v[0:6], its joints' names): the twist of the root link in
-#: its own frame, linear [m/s] then angular [rad/s].
-FREE_FLYER_VELOCITY = ("base_vx", "base_vy", "base_vz", "base_wx", "base_wy", "base_wz")
-
 #: Suffixes of a ball joint's velocity entries (its virtual joints ``<name>_wx …``) and of its
 #: configuration entries (``<name>_qx … <name>_qw``).
-BALL_VELOCITY = ("wx", "wy", "wz")
-BALL_CONFIGURATION = ("qx", "qy", "qz", "qw")
-
-FREE_FLYER = "free_flyer"
-SPHERICAL = "spherical"
+BALL_VELOCITY = SPHERICAL.velocity_suffixes
+BALL_CONFIGURATION = SPHERICAL.configuration_suffixes
 
 
 @dataclass(frozen=True)
 class QuaternionJoint:
-    """One quaternion joint of a model: ``kind`` (:data:`FREE_FLYER` or :data:`SPHERICAL`), its
-    name (``base`` for the free flyer), the index of its first velocity entry in ``v``
+    """One joint of a model whose configuration is not its coordinates (a free flyer, a ball
+    joint, a planar joint: a :class:`~eomgen.model.joints.ChartKind`): its ``kind``, its name
+    (``base`` for the free flyer), the index of its first velocity entry in ``v``
     (``v_index``) and of its first configuration entry in ``q`` (``q_index``)."""
 
-    kind: str
+    kind: ChartKind
     name: str
     v_index: int
     q_index: int
 
     @property
     def nv(self) -> int:
-        return 6 if self.kind == FREE_FLYER else 3
+        return self.kind.nv
 
     @property
     def nq(self) -> int:
-        return self.nv + 1
+        return self.kind.nq
 
     @property
-    def quaternion(self) -> int:
-        """The index in ``q`` of the quaternion's x (then y, z, w)."""
-        return self.q_index + self.nv - 3
+    def v_slice(self) -> slice:
+        return slice(self.v_index, self.v_index + self.kind.nv)
+
+    @property
+    def q_slice(self) -> slice:
+        return slice(self.q_index, self.q_index + self.kind.nq)
+
+    @property
+    def quaternion(self) -> int | None:
+        """The index in ``q`` of the quaternion's x (then y, z, w); None for a kind without
+        one (planar)."""
+        offset = self.kind.quaternion_offset
+        return None if offset is None else self.q_index + offset
 
     @property
     def motions(self) -> tuple[int, ...]:
         """The chart's unit motions in chain order, as indices into a spatial motion vector
-        (linear then angular): the free flyer's six, a ball joint's three rotations."""
-        return tuple(range(6)) if self.kind == FREE_FLYER else (3, 4, 5)
+        (linear then angular)."""
+        return self.kind.motions
 
     @property
     def virtual(self) -> range:
@@ -95,109 +102,149 @@ class QuaternionJoint:
 
     @property
     def velocity_names(self) -> tuple[str, ...]:
-        if self.kind == FREE_FLYER:
-            return FREE_FLYER_VELOCITY
-        return ball_velocity_names(self.name)
+        return self.kind.velocity_names(self.name)
 
     @property
     def configuration_names(self) -> tuple[str, ...]:
-        if self.kind == FREE_FLYER:
-            return FREE_FLYER_CONFIGURATION
-        return tuple(f"{self.name}_{s}" for s in BALL_CONFIGURATION)
+        return self.kind.configuration_names(self.name)
 
 
 def ball_velocity_names(name: str) -> tuple[str, str, str]:
     """The virtual joints of ball joint ``name``: ``<name>_wx``, ``<name>_wy``, ``<name>_wz``."""
-    return tuple(f"{name}_{s}" for s in BALL_VELOCITY)  # type: ignore[return-value]
+    return SPHERICAL.velocity_names(name)  # type: ignore[return-value]
 
 
-def expand_ball_joints(model: "RobotModel") -> "RobotModel":
-    """``model`` with each :attr:`~eomgen.model.JointType.SPHERICAL` joint replaced by its
-    chain (module docstring): joints ``<name>_wx``, ``<name>_wy``, ``<name>_wz`` (continuous,
-    about the x, y, z axes, the first at the ball joint's origin) through massless links
-    ``<child>_<name>_wx`` and ``<child>_<name>_wy``, in the ball joint's place in the joint
-    order; the names are recorded in :attr:`~eomgen.model.RobotModel.ball_joints`. The hook a
-    parser calls (:func:`~eomgen.model.build_model` does it for every parser).
+def _chart_chain(model, joint: Joint, kind: ChartKind, taken: set) -> tuple[list, list]:
+    """The virtual joints and massless links of ``joint``'s chart (its kind's chain)."""
+    where = f"{kind.describe()[0]} joint '{joint.name}'"
+    if joint.actuator is not None:
+        raise UnsupportedError(model.source, where, f"a {kind.describe()[0]} joint takes no "
+                               "actuator (armature, friction, stiffness) yet")
+    steps = kind.chain()
+    names = [f"{joint.name}_{suffix}" for suffix, _, _ in steps]
+    links = [f"{joint.child}_{name}" for name in names[:-1]]
+    for name in (*names, *links):
+        if name in taken:
+            raise KinematicTreeError(model.source, where, f"the name '{name}' of one of "
+                                     "its virtual joints or links is taken")
+        taken.add(name)
+    chain = [joint.parent, *links, joint.child]
+    joints = [Joint(names[k], JointType(step[1]), chain[k], chain[k + 1],
+                    joint.origin if k == 0 else Transform(), vec3(step[2]))
+              for k, step in enumerate(steps)]
+    return joints, [Link(name) for name in links]
+
+
+def _screw_chain(model, joint: Joint, taken: set) -> tuple[list, list, object]:
+    """A helical joint's continuous joint, massless link and coupled prismatic joint
+    (:mod:`eomgen.model.joints.helical`)."""
+    screw, link = KINDS["helical"].chain(joint.name, joint.child)
+    for name in (screw, link):
+        if name in taken:
+            raise KinematicTreeError(model.source, f"helical joint '{joint.name}'",
+                                     f"the name '{name}' of its virtual joint or link is taken")
+        taken.add(name)
+    turn = replace(joint, type=JointType.CONTINUOUS, child=link, pitch=0)
+    slide = Joint(screw, JointType.PRISMATIC, link, joint.child, Transform(), joint.axis)
+    coupling = make_coupling(screw, [(joint.name, joint.pitch)],
+                             element=f"helical joint '{joint.name}' pitch")
+    return [turn, slide], [Link(link)], coupling
+
+
+def expand_joints(model: "RobotModel") -> "RobotModel":
+    """``model`` with each joint of a kind that is a chain in the tree replaced by its chain, in
+    the joint's place in the joint order: a :attr:`~eomgen.model.JointType.SPHERICAL` or
+    ``PLANAR`` joint by its chart's virtual joints ``<name>_<suffix>`` (the kind's
+    :meth:`~eomgen.model.joints.ChartKind.chain`, the first at the joint's origin) through
+    massless links ``<child>_<name>_<suffix>``, recorded in
+    :attr:`~eomgen.model.RobotModel.compound_joints`; a ``HELICAL`` joint by a continuous
+    joint and a coupled prismatic one (:mod:`eomgen.model.joints.helical`). The hook a parser
+    calls (:func:`~eomgen.model.build_model` does it for every parser).
 
     Raises
     ------
     KinematicTreeError
         A name the chain needs is taken by a link or joint.
     UnsupportedError
-        The ball joint carries an actuator (armature, friction, stiffness): not modelled yet.
+        A ball or planar joint carries an actuator (armature, friction, stiffness): not
+        modelled yet.
     """
-    balls = [j for j in model.joints if j.type is JointType.SPHERICAL]
-    if not balls:
+    expanded = [j for j in model.joints if isinstance(j.type.kind, ChartKind)
+                or j.type is JointType.HELICAL]
+    if not expanded:
         return model
     taken = {link.name for link in model.links} | {j.name for j in model.joints}
-    chains: dict[str, list[str]] = {}
+    chains: dict[str, list[Link]] = {}
     joints: list[Joint] = []
+    couplings = list(model.couplings)
+    compound = list(model.compound_joints)
     for joint in model.joints:
-        if joint.type is not JointType.SPHERICAL:
+        kind = joint.type.kind
+        if isinstance(kind, ChartKind):
+            virtual, links = _chart_chain(model, joint, kind, taken)
+            compound.append((kind.name, joint.name))
+        elif joint.type is JointType.HELICAL:
+            virtual, links, coupling = _screw_chain(model, joint, taken)
+            couplings.append(coupling)
+        else:
             joints.append(joint)
             continue
-        where = f"ball joint '{joint.name}'"
-        if joint.actuator is not None:
-            raise UnsupportedError(model.source, where, "a ball joint takes no actuator "
-                                   "(armature, friction, stiffness) yet")
-        names = ball_velocity_names(joint.name)
-        links = [f"{joint.child}_{names[0]}", f"{joint.child}_{names[1]}"]
-        for name in (*names, *links):
-            if name in taken:
-                raise KinematicTreeError(model.source, where, f"the name '{name}' of one of "
-                                         "its virtual joints or links is taken")
-            taken.add(name)
-        chain = [joint.parent, *links, joint.child]
-        joints += [Joint(names[k], JointType.CONTINUOUS, chain[k], chain[k + 1],
-                         joint.origin if k == 0 else Transform(),
-                         vec3([1 if i == k else 0 for i in range(3)])) for k in range(3)]
+        joints += virtual
         chains[joint.child] = links
     links_out: list[Link] = []
     for link in model.links:
-        links_out += [Link(name) for name in chains.get(link.name, ())]
+        links_out += chains.get(link.name, ())
         links_out.append(link)
     return replace(model, links=tuple(links_out), joints=tuple(joints),
-                   ball_joints=model.ball_joints + tuple(j.name for j in balls))
+                   compound_joints=tuple(compound), couplings=tuple(couplings))
+
+
+_COUNT = {2: "two", 3: "three", 6: "six"}
+
+#: The name this hook had when ball joints were the only chains.
+expand_ball_joints = expand_joints
 
 
 def quaternion_layout(model: "RobotModel") -> tuple[QuaternionJoint, ...]:
-    """The quaternion joints of ``model`` in velocity order, with their places in ``q`` and
-    ``v`` (module docstring).
+    """The joints of ``model`` whose configuration is not their coordinates (the free flyer and
+    :attr:`~eomgen.model.RobotModel.compound_joints`) in velocity order, with their places in
+    ``q`` and ``v`` (module docstring).
 
     Raises
     ------
     KinematicTreeError
-        A ball joint's three virtual joints are no longer consecutive movable joints, one the
-        child of the other (a scene locked or reordered one of them).
+        A chart's virtual joints are no longer consecutive movable joints, one the child of the
+        other (a scene locked or reordered one of them).
     UnsupportedError
-        The model holds a :attr:`~eomgen.model.JointType.SPHERICAL` joint that was not
-        expanded (:func:`expand_ball_joints`).
+        The model holds a joint of a chain kind that was not expanded (:func:`expand_joints`).
     """
     for joint in model.joints:
-        if joint.type is JointType.SPHERICAL:
+        if isinstance(joint.type.kind, ChartKind) or joint.type is JointType.HELICAL:
             raise UnsupportedError(model.source, f"joint '{joint.name}'",
-                                   "a spherical joint must be expanded first "
-                                   "(eomgen.model.expand_ball_joints; build_model does it)")
+                                   f"a {joint.type.value} joint must be expanded first "
+                                   "(eomgen.model.expand_joints; build_model does it)")
     movable = model.coordinate_joints  # the followers of couplings are no coordinates
     index = {j.name: k for k, j in enumerate(movable)}
     found = [(0, FREE_FLYER, "base")] if model.free_flyer else []
-    for ball in model.ball_joints:
-        names = ball_velocity_names(ball)
+    for kind_name, name in model.compound_joints:
+        kind = KINDS[kind_name]
+        names = kind.velocity_names(name)
         k = index.get(names[0], -1)
-        chain = movable[k:k + 3] if k >= 0 else ()
+        chain = movable[k:k + kind.nv] if k >= 0 else ()
         if (tuple(j.name for j in chain) != names
-                or any(chain[i + 1].parent != chain[i].child for i in range(2))):
-            raise KinematicTreeError(model.source, f"ball joint '{ball}'",
-                                     f"its joints {', '.join(names)} are not three consecutive "
-                                     "movable joints in a chain (was one locked or removed?)")
-        found.append((k, SPHERICAL, ball))
+                or any(chain[i + 1].parent != chain[i].child for i in range(kind.nv - 1))):
+            raise KinematicTreeError(model.source, f"{kind.describe()[0]} joint '{name}'",
+                                     f"its joints {', '.join(names)} are not {_COUNT[kind.nv]} "
+                                     "consecutive movable joints in a chain (was one locked "
+                                     "or removed?)")
+        found.append((k, kind, name))
     layout, extra = [], 0
-    for k, kind, name in sorted(found):
+    for k, kind, name in sorted(found, key=lambda item: item[0]):
         layout.append(QuaternionJoint(kind, name, k, k + extra))
-        extra += 1
+        extra += kind.nq - kind.nv
     return tuple(layout)
 
 
 __all__ = ["BALL_CONFIGURATION", "BALL_VELOCITY", "FREE_FLYER", "FREE_FLYER_CONFIGURATION",
-           "FREE_FLYER_VELOCITY", "QuaternionJoint", "SPHERICAL", "ball_velocity_names",
-           "expand_ball_joints", "quaternion_layout"]
+           "FREE_FLYER_VELOCITY", "JointKind", "QuaternionJoint", "SPHERICAL",
+           "ball_velocity_names", "expand_ball_joints", "expand_joints", "quaternion_layout"]

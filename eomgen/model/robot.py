@@ -68,10 +68,11 @@ class RobotModel:
     #: coordinates (:mod:`eomgen.free_flyer`): the configuration ``q`` then has ``dof + 1``
     #: entries (root position, unit quaternion), the velocity ``v`` has ``dof``.
     free_flyer: bool = False
-    #: The names of the model's ball (spherical) joints, each three movable virtual joints
-    #: ``<name>_wx … <name>_wz`` whose configuration is a unit quaternion
-    #: (:mod:`eomgen.model.quaternion`, :func:`~eomgen.model.expand_ball_joints`).
-    ball_joints: tuple[str, ...] = ()
+    #: ``(kind, name)`` of each joint that is a chart of virtual joints in the tree (a ball
+    #: joint: three movable virtual joints ``<name>_wx … <name>_wz`` whose configuration is a
+    #: unit quaternion; a planar joint), :mod:`eomgen.model.quaternion`,
+    #: :func:`~eomgen.model.expand_joints`.
+    compound_joints: tuple[tuple[str, str], ...] = ()
     #: Coupled joints (:mod:`eomgen.model.coupling`): each follower's position is an affine
     #: function of its leaders'; followers are no coordinates (``joint_names``, ``dof``).
     couplings: tuple[Coupling, ...] = ()
@@ -107,6 +108,11 @@ class RobotModel:
         other (:attr:`couplings`)."""
         return len(self.coordinate_joints)
 
+    @property
+    def ball_joints(self) -> tuple[str, ...]:
+        """The names of the model's ball (spherical) joints (:attr:`compound_joints`)."""
+        return tuple(name for kind, name in self.compound_joints if kind == "spherical")
+
     @cached_property
     def quaternion_joints(self) -> tuple[QuaternionJoint, ...]:
         """The free flyer and the ball joints, with their places in ``q`` and ``v``
@@ -118,7 +124,7 @@ class RobotModel:
         """The number of configuration coordinates (NQ): :attr:`dof`, plus one for the
         quaternion of each quaternion joint (a free flyer: seven entries for its six
         velocities; a ball joint: four for three)."""
-        return self.dof + len(self.quaternion_joints)
+        return self.dof + sum(j.nq - j.nv for j in self.quaternion_joints)
 
     @property
     def configuration_names(self) -> tuple[str, ...]:

@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model.joints.lie import matrix_quaternion, quaternion_matrix  # importable here too
+
 __all__ = [
     "SINGULARITY_TOLERANCE", "EulerSingularityError", "base_rotation", "euler_angles",
     "euler_rate_matrix", "euler_singularity", "check_euler", "velocity_map",
@@ -115,36 +117,6 @@ def velocity_map_dot_qd(q, qd) -> np.ndarray:
     out[4] = (-st * pitch_d * sr + ct * cr * roll_d) * yaw_d - sr * roll_d * pitch_d
     out[5] = (-st * pitch_d * cr - ct * sr * roll_d) * yaw_d - cr * roll_d * pitch_d
     return out
-
-
-def matrix_quaternion(R) -> np.ndarray:
-    """Unit quaternion (x, y, z, w), w ≥ 0, of a rotation matrix."""
-    R = np.asarray(R, dtype=float)
-    t = np.trace(R)
-    if t > 0:
-        s = 2.0 * np.sqrt(1.0 + t)
-        q = [(R[2, 1] - R[1, 2]) / s, (R[0, 2] - R[2, 0]) / s, (R[1, 0] - R[0, 1]) / s, s / 4]
-    else:
-        i = int(np.argmax(np.diag(R)))
-        j, k = (i + 1) % 3, (i + 2) % 3
-        s = 2.0 * np.sqrt(1.0 + R[i, i] - R[j, j] - R[k, k])
-        q = [0.0] * 4
-        q[i] = s / 4
-        q[j] = (R[j, i] + R[i, j]) / s
-        q[k] = (R[k, i] + R[i, k]) / s
-        q[3] = (R[k, j] - R[j, k]) / s
-    q = np.array(q)
-    return q if q[3] >= 0 else -q
-
-
-def quaternion_matrix(xyzw) -> np.ndarray:
-    """The rotation matrix of quaternion ``(x, y, z, w)``, normalised first (any nonzero
-    multiple gives the same rotation)."""
-    x, y, z, w = np.asarray(xyzw, dtype=float) / np.linalg.norm(xyzw)
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
 
 
 def to_free_flyer(q, qd) -> tuple[np.ndarray, np.ndarray]:

@@ -198,7 +198,7 @@ class NumericModel:
     @property
     def nq(self) -> int:
         """Length of the configuration ``q`` (NQ): :attr:`n`, plus one per quaternion joint."""
-        return self.n + len(self.quaternion_joints)
+        return self.n + sum(j.nq - j.nv for j in self.quaternion_joints)
 
     @property
     def nb(self) -> int:

@@ -23,18 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-
-def quaternion_rotation(numbers, x, y, z, w) -> np.ndarray:
-    """The rotation matrix (3, 3) of quaternion ``(x, y, z, w)``, normalised first: the quadratic
-    form divided by ``x² + y² + z² + w²`` (any nonzero multiple gives the same rotation; a zero
-    quaternion gives entries that are not finite). ``numbers``: a
-    :class:`~eomgen.numeric.Numbers`."""
-    s = numbers.value(1) / (x * x + y * y + z * z + w * w)
-    return np.array([
-        [s * (w * w + x * x - y * y - z * z), 2 * s * (x * y - z * w), 2 * s * (x * z + y * w)],
-        [2 * s * (x * y + z * w), s * (w * w - x * x + y * y - z * z), 2 * s * (y * z - x * w)],
-        [2 * s * (x * z - y * w), 2 * s * (y * z + x * w), s * (w * w - x * x - y * y + z * z)],
-    ], dtype=numbers.dtype)
+from ..model.joints.lie import motion_cross, quaternion_rotation  # noqa: F401 (importable here)
 
 
 def chart_coordinates(joints, q: np.ndarray, nv: int, numbers) -> np.ndarray:
@@ -54,25 +43,11 @@ def chart_coordinates(joints, q: np.ndarray, nv: int, numbers) -> np.ndarray:
 
 
 def placements(joints, q: np.ndarray, numbers) -> dict[int, tuple[np.ndarray, np.ndarray]]:
-    """``{v_index: (R, p)}``: the pose each quaternion joint puts before its chain, from ``q``
-    (NQ): the rotation of its quaternion, and the free flyer's origin ``q[0:3]`` [m] (zero for a
-    ball joint), both in the frame of the joint's origin."""
-    out = {}
-    for joint in joints:
-        k = joint.quaternion
-        R = quaternion_rotation(numbers, *q[k:k + 4])
-        p = (np.array(q[joint.q_index:joint.q_index + 3], dtype=numbers.dtype) if joint.nv == 6
-             else numbers.zeros(3))
-        out[joint.v_index] = (R, p)
-    return out
-
-
-def _motion_cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a × b`` of two spatial motions (6,), linear then angular."""
-    out = np.empty(6, dtype=a.dtype)
-    out[:3] = np.cross(a[3:], b[:3]) + np.cross(a[:3], b[3:])
-    out[3:] = np.cross(a[3:], b[3:])
-    return out
+    """``{v_index: (R, p)}``: the pose each joint of ``joints`` puts before its chain, from
+    ``q`` (NQ), in the frame of the joint's origin: its kind's
+    :meth:`~eomgen.model.joints.ChartKind.pose` (the rotation of a quaternion, and a free
+    flyer's origin ``q[0:3]`` [m]; a planar joint's rotation about z and origin)."""
+    return {joint.v_index: joint.kind.pose(q[joint.q_slice], numbers) for joint in joints}
 
 
 def chart_offset(joints, qd: np.ndarray, numbers) -> np.ndarray:
@@ -88,7 +63,7 @@ def chart_offset(joints, qd: np.ndarray, numbers) -> np.ndarray:
         total = numbers.zeros(6)
         later = numbers.zeros(6)
         for i in reversed(range(joint.nv)):  # Σ_i (Sᵢ vᵢ) × (Σ_{j>i} Sⱼ vⱼ)
-            total = total + _motion_cross(motions[i], later)
+            total = total + motion_cross(motions[i], later)
             later = later + motions[i]
         for i, axis in enumerate(joint.motions):
             out[joint.v_index + i] = total[axis]

@@ -36,8 +36,11 @@ Decisions
   ``<inertia>`` is more often an authoring slip than a deliberate point mass.
 * A ``floating`` joint from a massless root link with nothing else attached is read as the
   quaternion free flyer (:func:`eomgen.free_flyer.add_free_flyer` with the joint's origin, as
-  Pinocchio reads it); any other ``floating`` joint and ``planar`` joints raise
+  Pinocchio reads it); any other ``floating`` joint raises
   :class:`~eomgen.errors.UnsupportedError`.
+* A ``planar`` joint is Pinocchio's ``JointModelPlanar`` (:mod:`eomgen.model.joints.planar`):
+  the child moves in the joint frame's xy plane, its ``<axis>`` (the plane's normal, default
+  ``0 0 1``) must be ``0 0 1``.
 * A root link that looks like the floating base of a legged robot (quadrupeds and humanoids
   are written as trees rooted at the trunk, without a floating joint) is read as bolted to
   the world, with one :class:`~eomgen.errors.UnsupportedFeatureWarning` naming the file and
@@ -129,8 +132,12 @@ GRAVITY = (0, 0, -9.81)
 DEFAULT_AXIS = (1.0, 0.0, 0.0)
 ZEROS = (0.0, 0.0, 0.0)
 
-_JOINT_TYPES = {t.value: t for t in JointType}
-_UNSUPPORTED_JOINT_TYPES = ("floating", "planar")
+_JOINT_TYPES = {t.value: t for t in (JointType.REVOLUTE, JointType.CONTINUOUS,
+                                      JointType.PRISMATIC, JointType.FIXED, JointType.PLANAR)}
+_UNSUPPORTED_JOINT_TYPES = ("floating",)
+#: A planar joint's plane normal when ``<axis>`` is absent: the joint frame's z (the plane of
+#: Pinocchio's ``JointModelPlanar``).
+PLANAR_AXIS = (0.0, 0.0, 1.0)
 _INERTIA_ATTRIBUTES = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 _SHOWN_CHARACTERS = 40
 
@@ -386,7 +393,7 @@ def _read_joint(element: ET.Element, index: int, source: str) -> tuple[Joint, Co
     child = _link_reference(element, "child", source, where)
     xyz, rpy = _read_origin(_single_child(element, "origin", source, where), source,
                             f"{where} <origin>")
-    axis = DEFAULT_AXIS
+    axis = PLANAR_AXIS if joint_type is JointType.PLANAR else DEFAULT_AXIS
     axis_element = _single_child(element, "axis", source, where)
     if joint_type.is_movable and axis_element is not None:
         axis = _vector_attribute(axis_element, "xyz", 3, source, f"{where} <axis>")
@@ -451,11 +458,6 @@ def _read_joint_type(element: ET.Element, source: str, where: str) -> JointType:
     text = element.get("type")
     if text is None:
         raise SchemaError(source, where, "no 'type' attribute")
-    if text == "planar":
-        raise UnsupportedError(
-            source, where,
-            "planar joints are not supported (eomgen models revolute, continuous, prismatic "
-            "and fixed joints)")
     try:
         return _JOINT_TYPES[text]
     except KeyError:

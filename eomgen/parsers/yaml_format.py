@@ -17,7 +17,8 @@
         inertia: {izz: I1}         # about the COM, link-frame axes; missing entries are 0
     joints:
       - name: joint1
-        type: revolute             # revolute | continuous | prismatic | fixed | spherical
+        type: revolute             # revolute | continuous | prismatic | fixed | spherical |
+                                   # planar | helical (with pitch: [m/rad])
         parent: base
         child: link1
         origin: {xyz: [0, 0, 0], rpy: [0, 0, 0]}   # optional, default identity
@@ -33,7 +34,10 @@ Frames and units follow :mod:`eomgen.model` (URDF's conventions). Values are num
 expressions read by :func:`eomgen.expressions.parse_scalar`; every symbol must be declared under
 ``parameters``. A ``spherical`` joint (a ball joint, no ``axis``) is Pinocchio's
 ``JointModelSpherical``: its configuration is a unit quaternion, its velocity the angular
-velocity of the child in the child frame (:mod:`eomgen.model.quaternion`). Unknown keys are errors. The full reference is ``docs/formats.md``.
+velocity of the child in the child frame (:mod:`eomgen.model.quaternion`). A ``planar`` joint
+(its axis, the plane's normal, 0 0 1) is ``JointModelPlanar``, a ``helical`` joint with
+``pitch`` (metres per radian) is ``JointModelHelicalUnaligned``
+(:mod:`eomgen.model.joints`). Unknown keys are errors. The full reference is ``docs/formats.md``.
 """
 
 from __future__ import annotations
@@ -49,10 +53,10 @@ from ._yaml import Reader, read_document, top_level_key
 
 TOP_KEYS = ("name", "description", "gravity", "parameters", "links", "joints")
 LINK_KEYS = ("name", "mass", "com", "inertia")
-JOINT_KEYS = ("name", "type", "parent", "child", "origin", "axis", "actuator")
+JOINT_KEYS = ("name", "type", "parent", "child", "origin", "axis", "pitch", "actuator")
 ORIGIN_KEYS = ("xyz", "rpy")
 JOINT_TYPES = {t.value: t for t in JointType}
-UNSUPPORTED_TYPES = ("floating", "planar", "mimic")
+UNSUPPORTED_TYPES = ("floating", "mimic")
 
 
 def sniff(text: str) -> bool:
@@ -124,13 +128,17 @@ def parse(data: dict, source: str, strict: bool = False, default_name: str = "ro
             raise UnsupportedError(source, f"{where} axis", "a spherical joint has no axis "
                                    "(it turns about all three)")
         axis = r.vector(entry["axis"], f"{where} axis") if "axis" in entry else vec3([0, 0, 1])
+        if ("pitch" in entry) != (kind is JointType.HELICAL):
+            raise UnsupportedError(source, f"{where} pitch", "a helical joint needs a pitch "
+                                   "[m/rad], and only a helical joint has one")
+        pitch = r.scalar(entry["pitch"], f"{where} pitch") if "pitch" in entry else 0
         actuator = r.actuator(entry["actuator"], f"{where} actuator") \
             if "actuator" in entry else None
         joints.append(Joint(
             joint_name, kind,
             r.name(entry["parent"], f"{where} parent"),
             r.name(entry["child"], f"{where} child"),
-            origin, axis, actuator))
+            origin, axis, actuator, pitch))
 
     info = {"description": r.text(data["description"], "description")} \
         if "description" in data else {}

@@ -491,7 +491,7 @@ def _merge(model: RobotModel, payloads: Sequence[Payload]):
     reduced = RobotModel(name=model.name, links=tuple(links), joints=tuple(joints),
                          root=model.root, gravity=model.gravity, parameters=model.parameters,
                          source=model.source, info=info, free_flyer=model.free_flyer,
-                         ball_joints=model.ball_joints, couplings=model.couplings)
+                         compound_joints=model.compound_joints, couplings=model.couplings)
     return reduced, tuple(merged), tuple(dropped), tuple(dropped_payloads)
 
 

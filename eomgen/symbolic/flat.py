@@ -46,7 +46,6 @@ from ..model import flexible_indices, joint_actuators
 from .builders import builds
 from .drives import friction_torque_expr, require_flexible
 from .program import ProgramBuilder
-from .quaternion_joints import quaternion_rotation
 from .transforms import time_derivative
 
 #: The symbols :func:`build_flat` makes (all need flexible joints).
@@ -154,17 +153,8 @@ def configuration_rates(model, q, v) -> dict:
             rates[q[iq]] = v[k]
             k, iq = k + 1, iq + 1
             continue
-        x, y, z, w = quat = q[joint.quaternion:joint.quaternion + 4]
-        wx, wy, wz = omega = v[k + joint.nv - 3:k + joint.nv]
-        vector = (x, y, z)
-        cross = (y * wz - z * wy, z * wx - x * wz, x * wy - y * wx)
-        for i in range(3):
-            rates[vector[i]] = (w * omega[i] + cross[i]) / 2
-        rates[w] = -(x * wx + y * wy + z * wz) / 2
-        if joint.nv == 6:
-            R = quaternion_rotation(*quat)
-            for i in range(3):
-                rates[q[iq + i]] = sum((R[i][c] * v[k + c] for c in range(3)), sp.Integer(0))
+        rates.update(joint.kind.symbolic_rate(tuple(q[joint.q_slice]),
+                                              tuple(v[joint.v_slice])))
         k, iq = k + joint.nv, iq + joint.nq
     return rates
 

@@ -32,46 +32,29 @@ from __future__ import annotations
 import sympy as sp
 
 from ..model import QuaternionJoint, Transform
+from ..model.joints.lie import quaternion_rotation_symbolic as quaternion_rotation
 
 _ZERO = sp.S.Zero
 
 
-def quaternion_rotation(x, y, z, w, s=None) -> tuple:
-    """The rotation matrix of quaternion ``(x, y, z, w)`` divided by its squared norm: the
-    rotation of the normalised quaternion (non-unit quaternions, :mod:`eomgen.free_flyer`).
-    ``s`` is ``1 / (x² + y² + z² + w²)`` when the caller has it named already."""
-    s = 1 / (x * x + y * y + z * z + w * w) if s is None else s
-    return ((s * (w * w + x * x - y * y - z * z), 2 * s * (x * y - z * w), 2 * s * (x * z + y * w)),
-            (2 * s * (x * y + z * w), s * (w * w - x * x + y * y - z * z), 2 * s * (y * z - x * w)),
-            (2 * s * (x * z - y * w), 2 * s * (y * z + x * w), s * (w * w - x * x - y * y + z * z)))
-
-
 def placement(joint: QuaternionJoint, q, b, number: int = 0) -> Transform:
-    """The pose the quaternion joint ``joint`` puts before its chain, from ``q`` (NQ entries):
-    its rotation's entries named in the program builder ``b``: ``Rb11 … Rb33`` for the free
-    flyer (with its origin ``q[0:3]``), ``Rs<number>_11 …`` for the ball joint numbered
-    ``number``."""
-    x, y, z, w = q[joint.quaternion:joint.quaternion + 4]
-    if joint.nv == 6:
-        norm, name, tag = "qn", "Rb{}{}", ("Rb",)
-    else:
-        norm, name, tag = f"qns{number}", f"Rs{number}_{{}}{{}}", ("Rs", number)
-    s = b.define(1 / (x * x + y * y + z * z + w * w), norm, (norm,))
-    R = quaternion_rotation(x, y, z, w, s)
-    R = tuple(tuple(b.define(R[i][j], name.format(i + 1, j + 1), (*tag, i + 1, j + 1))
-                    for j in range(3)) for i in range(3))
-    origin = tuple(q[joint.q_index:joint.q_index + 3]) if joint.nv == 6 else (_ZERO,) * 3
+    """The pose the joint ``joint`` puts before its chain, from ``q`` (NQ entries): its kind's
+    :meth:`~eomgen.model.joints.ChartKind.placement`, the rotation's entries named in the
+    program builder ``b`` (``Rb11 … Rb33`` for the free flyer with its origin ``q[0:3]``,
+    ``Rs<number>_11 …`` for the ball joint numbered ``number``, ``Rp<number>_11 …`` for a
+    planar joint)."""
+    R, origin = joint.kind.placement(tuple(q[joint.q_slice]), b, number)
     return Transform(R, origin)
 
 
 def placements(joints, q, b) -> dict[int, Transform]:
-    """:func:`placement` of each of ``joints`` (ball joints numbered from 1 in velocity
-    order), by the index of its first velocity (the ``q_index`` of the body whose joint starts
-    its chain)."""
-    out, balls = {}, 0
+    """:func:`placement` of each of ``joints`` (the joints of each kind numbered from 1 in
+    velocity order), by the index of its first velocity (the ``q_index`` of the body whose
+    joint starts its chain)."""
+    out, numbers = {}, {}
     for joint in joints:
-        balls += joint.nv == 3
-        out[joint.v_index] = placement(joint, q, b, balls)
+        numbers[joint.kind.name] = numbers.get(joint.kind.name, 0) + 1
+        out[joint.v_index] = placement(joint, q, b, numbers[joint.kind.name])
     return out
 
 

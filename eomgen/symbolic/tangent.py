@@ -31,9 +31,6 @@ from __future__ import annotations
 import sympy as sp
 
 from .quaternion_joints import placements
-from .spatial import skew
-
-_HALF = sp.Rational(1, 2)
 
 
 def tangent_seeds(derivation, prefix: str = "q") -> dict:
@@ -55,29 +52,10 @@ def tangent_seeds(derivation, prefix: str = "q") -> dict:
             seeds[q[iq]] = {(prefix, k): sp.Integer(1)}
             k, iq = k + 1, iq + 1
             continue
-        if joint.nv == 6:  # the origin moves along R's columns
-            R = placed[joint.v_index].rotation
-            for row in range(3):
-                seeds[q[iq + row]] = {(prefix, k + col): R[row][col] for col in range(3)}
-        x, y, z, w = q[joint.quaternion:joint.quaternion + 4]
-        first = k + joint.nv - 3
-        vector = (x, y, z)
-        for c in range(3):  # d(x, y, z)/dω_c = ½ (w e_c + (x, y, z) × e_c)
-            column = _cross_unit(vector, c)
-            for row, entry in enumerate(vector):
-                d = _HALF * ((w if row == c else 0) + column[row])
-                if d != 0:
-                    seeds.setdefault(entry, {})[(prefix, first + c)] = d
-        seeds[w] = {(prefix, first + c): -_HALF * vector[c] for c in range(3)}
+        seeds.update(joint.kind.tangent_seeds(tuple(q[joint.q_slice]),
+                                              placed[joint.v_index].rotation, k, prefix))
         k, iq = k + joint.nv, iq + joint.nq
     return seeds
-
-
-def _cross_unit(a, c: int) -> tuple:
-    """``a × e_c``."""
-    e = [0, 0, 0]
-    e[c] = 1
-    return (a[1] * e[2] - a[2] * e[1], a[2] * e[0] - a[0] * e[2], a[0] * e[1] - a[1] * e[0])
 
 
 def velocity_transport(derivation) -> sp.Matrix:
@@ -87,14 +65,7 @@ def velocity_transport(derivation) -> sp.Matrix:
     nv, v = derivation.model.dof, derivation.inputs["qd"]
     out = sp.zeros(nv, nv)
     for joint in derivation.model.quaternion_joints:
-        k = joint.v_index
-        if joint.nv == 6:
-            linear, omega = v[k:k + 3], v[k + 3:k + 6]
-            out[k:k + 3, k:k + 3] = -_HALF * sp.Matrix(skew(omega))
-            out[k:k + 3, k + 3:k + 6] = -_HALF * sp.Matrix(skew(linear))
-            out[k + 3:k + 6, k + 3:k + 6] = -_HALF * sp.Matrix(skew(omega))
-        else:
-            out[k:k + 3, k:k + 3] = -_HALF * sp.Matrix(skew(v[k:k + 3]))
+        out[joint.v_slice, joint.v_slice] = joint.kind.velocity_transport(tuple(v[joint.v_slice]))
     return out
 
 

@@ -26,17 +26,8 @@ def _layout_rows(model) -> tuple:
     for joint in model.quaternion_joints:
         q = f"$q_{{{joint.q_index + 1}}} \\dots q_{{{joint.q_index + joint.nq}}}$"
         v = f"$v_{{{joint.v_index + 1}}} \\dots v_{{{joint.v_index + joint.nv}}}$"
-        if joint.nv == 6:
-            what_q = "root origin $p$ in the world (m), then the quaternion $(x, y, z, w)$ of "
-            what_q += "the root's orientation $R$"
-            what_v = "the root's twist in the root frame: linear velocity $R^{T} \\dot{p}$ "
-            what_v += "(m/s), then angular velocity $\\omega$ (rad/s)"
-        else:
-            what_q = "the quaternion $(x, y, z, w)$ of the rotation from the joint frame to "
-            what_q += "the child link's frame"
-            what_v = "the angular velocity $\\omega$ of the child link relative to its parent, "
-            what_v += "in the child frame (rad/s)"
-        rows.append(((code(joint.name),), prose("free flyer" if joint.nv == 6 else "ball"),
+        word, what_q, what_v = joint.kind.describe()
+        rows.append(((code(joint.name),), prose(word),
                      prose(q, ": ", what_q), prose(v, ": ", what_v)))
     return tuple(rows)
 

@@ -538,7 +538,8 @@ BAD = {
     "floating joint": (chain("", "floating"), U, "joint 'j2'",
                        "a floating joint is read as the robot's free flyer only from a massless "
                        "root link"),
-    "planar joint": (chain("", "planar"), U, "joint 'j2'", "planar joints"),
+    "planar joint off z": (chain('<axis xyz="0 1 0"/>', "planar"), U, "joint 'j2' axis",
+                           "must be 0 0 1"),
     "mimic without joint": (robot(link("a"), link("b"), link("c"), joint("j1", "a", "b"),
                                   joint("j2", "a", "c", body='<mimic multiplier="2"/>')),
                             D, "joint 'j2' <mimic>", "no 'joint' attribute"),

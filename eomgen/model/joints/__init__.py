@@ -1,0 +1,35 @@
+"""Joint kinds as types: one module per kind, one instance of each in :data:`KINDS`.
+
+===============  ====  ====  =====================================================
+ kind             nq    nv    module
+===============  ====  ====  =====================================================
+ revolute          1     1    :mod:`~eomgen.model.joints.revolute` (and continuous)
+ prismatic         1     1    :mod:`~eomgen.model.joints.prismatic`
+ helical           1     1    :mod:`~eomgen.model.joints.helical`
+ fixed             0     0    :mod:`~eomgen.model.joints.fixed`
+ spherical         4     3    :mod:`~eomgen.model.joints.spherical`
+ planar            4     3    :mod:`~eomgen.model.joints.planar`
+ free flyer        7     6    :mod:`~eomgen.model.joints.free_flyer`
+===============  ====  ====  =====================================================
+
+:mod:`~eomgen.model.joints.base` says what a kind is (frames, signs, and how the algorithms
+see it); :mod:`~eomgen.model.joints.lie` holds the rotations and rigid motions they share.
+"""
+
+from __future__ import annotations
+
+from .base import ChartKind, JointKind
+from .fixed import FIXED
+from .free_flyer import FREE_FLYER
+from .helical import HELICAL
+from .planar import PLANAR
+from .prismatic import PRISMATIC
+from .revolute import CONTINUOUS, REVOLUTE
+from .spherical import SPHERICAL
+
+#: Every kind by its name.
+KINDS: dict[str, JointKind] = {kind.name: kind for kind in (
+    REVOLUTE, CONTINUOUS, PRISMATIC, HELICAL, FIXED, SPHERICAL, PLANAR, FREE_FLYER)}
+
+__all__ = ["CONTINUOUS", "ChartKind", "FIXED", "FREE_FLYER", "HELICAL", "JointKind", "KINDS",
+           "PLANAR", "PRISMATIC", "REVOLUTE", "SPHERICAL"]
