@@ -144,7 +144,8 @@ class Scene:
         The moving part is every movable joint on a path from ``base`` (default: the root) to
         one of ``tips`` (default: every joint below ``base``).
     locked:
-        ``(joint, position)`` pairs [rad or m], in file order.
+        ``(joint, position)`` pairs [rad or m], in file order; a ball or planar joint's
+        position is its configuration entries (a ball joint's quaternion x, y, z, w).
     payloads:
         Loads fixed to links.
     actuators:
@@ -306,13 +307,15 @@ def _read(data: dict, source: str, strict: bool) -> Scene:
             if name in tips:
                 raise r.error(f"tips[{k}] '{name}'", "listed twice")
             tips.append(name)
-    locked: list[tuple[str, float]] = []
+    locked: list[tuple[str, float | tuple[float, ...]]] = []
     if data.get("locked") is not None:
         if not isinstance(data["locked"], dict):
             raise r.error("locked", "expected a mapping of joint: position [rad or m]")
         for joint, value in data["locked"].items():
             name = r.name(joint, "locked")
-            locked.append((name, r.number(value, f"locked '{name}'")))
+            where = f"locked '{name}'"
+            locked.append((name, tuple(r.number(x, where) for x in r.sequence(value, where))
+                           if isinstance(value, list) else r.number(value, where)))
     payloads = []
     if data.get("payloads") is not None:
         for k, entry in enumerate(r.sequence(data["payloads"], "payloads")):

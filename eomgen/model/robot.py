@@ -8,6 +8,7 @@ from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Iterable, Mapping
 
+import numpy as np
 import sympy as sp
 
 from .. import reprs
@@ -17,6 +18,7 @@ from .contact import Contact
 from .coupling import Coupling, locked_couplings
 from .loop import Loop
 from .notices import Notice
+from .joints import KINDS
 from .parts import Inertial, Joint, JointType, Link, Parameter
 from .quaternion import (QuaternionJoint,
                          quaternion_layout)
@@ -313,8 +315,35 @@ def joint_motion(joint: Joint, value) -> Transform:
     return Transform()
 
 
+def compound_names(model: RobotModel) -> dict[str, tuple[str, tuple[str, ...]]]:
+    """``{name: (kind, virtual joints)}`` of the model's :attr:`~RobotModel.compound_joints`
+    (a ball joint ``hip``: ``("spherical", ("hip_wx", "hip_wy", "hip_wz"))``)."""
+    return {name: (kind, KINDS[kind].velocity_names(name)) for kind, name in model.compound_joints}
+
+
+def _lock_compound(model: RobotModel, name: str, configuration) -> dict[str, Transform]:
+    """The fixed origins of compound joint ``name``'s virtual joints locked at its
+    ``configuration`` (the kind's NQ entries): the first one's origin moved by the kind's pose
+    (:meth:`~eomgen.model.joints.ChartKind.pose`), the others at their own; at the kind's
+    neutral configuration the origins stay exact."""
+    kind_name, virtual = compound_names(model)[name]
+    kind = KINDS[kind_name]
+    values = np.asarray(configuration, dtype=float)
+    joints = {j.name: j for j in model.joints}
+    origins = {v: joints[v].origin for v in virtual}
+    if not np.array_equal(values, kind.neutral()):
+        R, p = kind.pose(values)
+        pose = Transform(tuple(tuple(scalar(float(x)) for x in row) for row in R),
+                         tuple(scalar(float(x)) for x in p))
+        origins[virtual[0]] = origins[virtual[0]] @ pose
+    return origins
+
+
 def lock_joints(model: RobotModel, positions: Mapping[str, object]) -> RobotModel:
     """A copy of ``model`` with the named movable joints made fixed at the given positions.
+    A compound joint (:attr:`RobotModel.compound_joints`: a ball or planar joint) is locked by
+    its name at its configuration (the kind's NQ entries, e.g. a ball joint's quaternion
+    ``(x, y, z, w)``, normalised): its virtual joints become fixed, the pose at the first.
 
     A follower of a coupling (:attr:`RobotModel.couplings`) whose leaders are all locked is
     locked where its coupling puts it; locked leaders of a coupling that keeps others move its
@@ -327,14 +356,29 @@ def lock_joints(model: RobotModel, positions: Mapping[str, object]) -> RobotMode
         its coupling.
     """
     movable = {j.name for j in model.movable_joints}
-    for name in positions:
-        if name not in movable:
+    compound = compound_names(model)
+    fixed_origins: dict[str, Transform] = {}
+    for name, value in positions.items():
+        if name in compound:
+            kind = KINDS[compound[name][0]]
+            if len(np.atleast_1d(np.asarray(value, dtype=object))) != kind.nq:
+                raise KinematicTreeError(model.source, f"joint '{name}'", f"cannot lock: a "
+                                         f"{kind.describe()[0]} joint is locked at its {kind.nq} "
+                                         f"configuration entries ({', '.join(kind.configuration_names(name))})")
+            fixed_origins.update(_lock_compound(model, name, value))
+        elif name not in movable:
             raise KinematicTreeError(model.source, f"joint '{name}'",
                                    "cannot lock: not a movable joint of this model")
+    positions = {k: v for k, v in positions.items() if k not in compound}
     positions, couplings = locked_couplings(model, positions)
     joints = tuple(
         replace(j, type=JointType.FIXED, origin=j.origin @ joint_motion(j, positions[j.name]))
-        if j.name in positions else j
+        if j.name in positions else
+        replace(j, type=JointType.FIXED, origin=fixed_origins[j.name])
+        if j.name in fixed_origins else j
         for j in model.joints
     )
-    return replace(model, joints=joints, couplings=couplings)
+    locked = {name for name in compound if any(v in fixed_origins for v in compound[name][1])}
+    return replace(model, joints=joints, couplings=couplings,
+                   compound_joints=tuple((k, n) for k, n in model.compound_joints
+                                         if n not in locked))

@@ -30,6 +30,8 @@ from ..model import (
     with_couplings,
 )
 from ..model.coupling import locked_couplings
+from ..model.joints import KINDS
+from ..model.robot import compound_names
 from ..model.moving_mass import massless_problem
 from ..outputs import select
 from ..parsers import load
@@ -96,9 +98,15 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
     base = scene.base or model.root
     moving = _moving_joints(model, scene, base)
     listed = scene.locked_positions
+    compound = compound_names(model)
+    inside = {v: name for name, (_, virtual) in compound.items() for v in virtual}
     locks = [LockedJoint(j.name, float(listed.get(j.name, 0.0)), j.name in listed)
-             for j in model.movable_joints if j.name not in moving]
+             for j in model.movable_joints if j.name not in moving and j.name not in inside]
     locks = _coupled_locks(model, locks)
+    for name, (kind, virtual) in compound.items():  # ball and planar joints: whole or not
+        if virtual[0] not in moving:
+            position = listed.get(name, tuple(float(x) for x in KINDS[kind].neutral()))
+            locks.append(LockedJoint(name, tuple(position), name in listed))
     locked_model = lock_joints(model, {j.name: j.position for j in locks})
     reduced, merged, dropped, dropped_payloads = _merge(locked_model, payloads)
     gravity = model.gravity if scene_gravity is None else scene_gravity
@@ -404,7 +412,23 @@ def _check_names(model: RobotModel, scene: Scene, payloads: Sequence[Payload]) -
         link(scene.base, f"base '{scene.base}'")
     for k, tip in enumerate(scene.tips):
         link(tip, f"tips[{k}] '{tip}'")
-    for name, _ in scene.locked:
+    compound = compound_names(model)
+    inside = {v: name for name, (_, virtual) in compound.items() for v in virtual}
+    for name, value in scene.locked:
+        if name in compound:
+            kind = KINDS[compound[name][0]]
+            if not isinstance(value, tuple) or len(value) != kind.nq:
+                raise scene.error(f"locked '{name}'", f"a {kind.describe()[0]} joint is locked "
+                                  f"at its {kind.nq} configuration entries: "
+                                  f"[{', '.join(kind.configuration_names(name))}]")
+            continue
+        if name in inside:
+            kind = KINDS[compound[inside[name]][0]]
+            raise scene.error(f"locked '{name}'", f"a virtual joint of {kind.describe()[0]} "
+                              f"joint '{inside[name]}': lock '{inside[name]}' at its "
+                              f"configuration [{', '.join(kind.configuration_names(inside[name]))}]")
+        if isinstance(value, tuple):
+            raise scene.error(f"locked '{name}'", "expected a number [rad or m]")
         if name not in joints:
             raise scene.error(f"locked '{name}'", f"no joint '{name}' in robot '{model.name}'"
                               + did_you_mean(name, joints))
@@ -439,7 +463,10 @@ def _moving_joints(model: RobotModel, scene: Scene, base: str) -> set[str]:
             if joint.parent in below:
                 below.add(joint.child)
                 on_paths.add(joint.name)
-    locked = scene.locked_positions
+    locked = set(scene.locked_positions)
+    for name, (_, virtual) in compound_names(model).items():
+        if name in locked:
+            locked.update(virtual)
     moving = {j.name for j in model.movable_joints if j.name in on_paths and j.name not in locked}
     if not moving:
         what = (f"between base '{base}' and the tips" if scene.tips else f"below '{base}'")

@@ -31,12 +31,22 @@ class ModelSize:
 
 @dataclass(frozen=True)
 class LockedJoint:
-    """A movable joint of the description held still at ``position`` [rad or m]; ``listed`` when
-    the scene gives the position, else it lies outside the moving part and is locked at 0."""
+    """A movable joint of the description held still at ``position`` [rad or m; a compound
+    joint (ball, planar): its configuration entries]; ``listed`` when the scene gives the
+    position, else it lies outside the moving part and is locked at 0 (a compound joint at its
+    kind's neutral configuration)."""
 
     name: str
-    position: float
+    position: float | tuple[float, ...]
     listed: bool
+
+    @property
+    def shown(self) -> str:
+        """The position as a report writes it: ``0.5``; a compound joint's configuration
+        ``(0, 0, 0.38, 0.92)``."""
+        if isinstance(self.position, tuple):
+            return "(" + ", ".join(f"{x:g}" for x in self.position) + ")"
+        return f"{self.position:g}"
 
 
 @dataclass(frozen=True)
@@ -168,7 +178,7 @@ class ReductionReport:
         out += ["", "## Locked", ""]
         listed = [j for j in self.locked if j.listed]
         for j in listed:
-            out.append(f"- `{_md(j.name)}` at {j.position:g} (from the scene)")
+            out.append(f"- `{_md(j.name)}` at {j.shown} (from the scene)")
         if self.locked_by_default:
             out.append(f"- at 0, because they lie outside the moving part and the scene does not "
                        f"list them ({len(self.locked_by_default)}): "

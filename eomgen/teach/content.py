@@ -82,7 +82,7 @@ def _scene_paragraph(report) -> Paragraph:
     if report.locked:
         parts.append("; locked (rad or m): ")
         for k, lock in enumerate(report.locked):
-            parts += ([", "] if k else []) + [code(lock.name), f" = {lock.position:g}"]
+            parts += ([", "] if k else []) + [code(lock.name), f" = {lock.shown}"]
     parts.append("; links rigidly attached to a moving body are merged into it.")
     return Paragraph(prose(*parts))
 

@@ -345,9 +345,10 @@ def test_a_broken_ball_chain_is_refused():
 
 def test_scene_keeps_or_refuses_a_ball_joint(tmp_path):
     """A scene that locks another joint keeps the ball joint (its quaternion in q); one that
-    locks one of its virtual joints leaves no ball joint: refused in one line by name."""
+    locks one of its virtual joints is refused in one line naming the entry and the ball joint
+    (tests/scenes/test_lock_compound.py locks the ball joint whole)."""
     import eomgen
-    from eomgen.errors import KinematicTreeError
+    from eomgen.errors import SceneError
     from eomgen.reduction import apply_scene
     from eomgen.scene import load_scene
     path = tmp_path / "pendulum.yaml"
@@ -360,10 +361,9 @@ def test_scene_keeps_or_refuses_a_ball_joint(tmp_path):
     kept, _ = apply_scene(model, load_scene("s.yaml", text="version: 1\nlocked: {elbow: 0}\n"))
     assert kept.configuration_names == ("shoulder_qx", "shoulder_qy", "shoulder_qz",
                                         "shoulder_qw")
-    broken, _ = apply_scene(model, load_scene("s.yaml",
-                                              text="version: 1\nlocked: {shoulder_wy: 0}\n"))
-    with pytest.raises(KinematicTreeError, match="ball joint 'shoulder': its joints"):
-        eomgen.derive(broken)
+    with pytest.raises(SceneError, match="locked 'shoulder_wy': a virtual joint of ball joint "
+                       "'shoulder': lock 'shoulder' at its configuration"):
+        apply_scene(model, load_scene("s.yaml", text="version: 1\nlocked: {shoulder_wy: 0}\n"))
 
 
 def test_verify_checks_ball_joints():
