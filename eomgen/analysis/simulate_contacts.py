@@ -24,12 +24,13 @@ where a contact gives some, else :data:`DEFAULT_GAINS`), and reports, sampled on
   work, so E is conserved up to the integrator's error; Baumgarte forces do work while they
   correct an error.
 
-With quaternion joints (a free flyer, ball joints) the state is the configuration ``q`` (NQ
-entries) and the velocity ``v`` (NV): every integrator moves ``q`` at
-:func:`eomgen.quaternion_joints.configuration_rate` (a quaternion integrated as a vector, as
-:class:`eomgen.analysis.simulate.System` does; the dynamics and the contact kinematics use the
-normalised quaternion), and the runs also report the **quaternion norm drift**
-``max_t max_j |‖quaternion_j‖ − 1|``, the integrator's error off the unit sphere.
+With quaternion joints (a free flyer, ball or planar joints) the state is the configuration
+``q`` (NQ entries) and the velocity ``v`` (NV): every fixed-step integrator moves ``q`` along
+the joints' exponentials, ``q ⊕ h v`` (:meth:`ContactSystem.integrate`, as
+:class:`eomgen.analysis.simulate.System` does; the adaptive ones put their outputs back on the
+manifold), and the runs also report the **quaternion norm drift**
+``max_t max_j |‖quaternion_j‖ − 1|`` (a planar joint's ``|‖(cos θ, sin θ)‖ − 1|``): round-off,
+the check that every configuration stayed on its manifold.
 
 The implicit midpoint rule of :mod:`eomgen.analysis.simulate` works on the unconstrained
 canonical form and is not used here. Contacts whose rows are dependent at ``q0`` (a planar
@@ -55,7 +56,7 @@ from ..progress import plural
 from ..quaternion_joints import configuration_rate
 from .report import csv_text, fmt, markdown_table, pyplot
 from .routes import numeric_only
-from .simulate import (OUTPUT_POINTS, Diverged, ImplicitMidpoint, initial_state,
+from .simulate import (OUTPUT_POINTS, Diverged, ImplicitMidpoint, advance, initial_state,
                        quaternion_start, simulate)
 
 #: ``(kp [1/s²], kd [1/s])`` for contacts whose scene gives no Baumgarte gains: the error
@@ -153,6 +154,12 @@ class ContactSystem:
         """``q̇`` at velocity ``qd``: ``qd`` itself, or with quaternion joints
         :func:`eomgen.quaternion_joints.configuration_rate` (module docstring)."""
         return configuration_rate(q, qd, self.model) if self.quaternion else qd
+
+    def integrate(self, q, qd, h: float) -> np.ndarray:
+        """``q ⊕ h q̇`` along each joint's manifold
+        (:func:`~eomgen.analysis.simulate.advance`): how the integrators step ``q``
+        with quaternion joints."""
+        return advance(self.model, np.asarray(q, float), np.asarray(qd, float), h)
 
     def quaternion_norm_error(self, q) -> float:
         """``max_j |‖quaternion_j‖ − 1|`` over the quaternion joints at ``q`` (0 without)."""

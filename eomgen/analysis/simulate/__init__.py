@@ -8,10 +8,12 @@ grows like ``e^{λt}``; past a few seconds it measures the horizon of predictabi
 the method.
 
 * :mod:`~eomgen.analysis.simulate.system`: :class:`System`, the dynamics every integrator calls
-  (one derivation printed over Python floats, a plain-Python Cholesky solve);
+  (one derivation printed over Python floats, a plain-Python Cholesky solve), and
+  :func:`advance`, the step ``q ⊕ h v`` of a configuration that is not a vector;
 * :mod:`~eomgen.analysis.simulate.integrators`: :class:`ExplicitEuler`,
   :class:`SemiImplicitEuler`, :class:`RK4`, :class:`ImplicitMidpoint`, :class:`Adaptive`, and
-  their command-line names (:data:`INTEGRATORS`);
+  their command-line names (:data:`INTEGRATORS`); with quaternion (or planar) joints each steps
+  the configuration along the joints' own manifolds (Lie group steps);
 * :mod:`~eomgen.analysis.simulate.study`: :func:`simulate` (one run on the output grid) and
   :func:`run_study` (every integrator measured against the reference), :class:`Study`;
 * :mod:`~eomgen.analysis.simulate.files`: the Markdown, CSV and PNG files
@@ -30,9 +32,9 @@ from .integrators import (INTEGRATORS, STIFF, RK4, Adaptive, ExplicitEuler, Fixe
                           integrators_named)
 from .study import (OUTPUT_POINTS, REFERENCE_TOLERANCE, Run, Study, Trajectory, energies,
                     initial_state, quaternion_start, run_study, simulate)
-from .system import Diverged, System
+from .system import Diverged, System, advance
 
-__all__ = ["System", "ExplicitEuler", "SemiImplicitEuler", "RK4", "ImplicitMidpoint", "Adaptive",
+__all__ = ["System", "advance", "ExplicitEuler", "SemiImplicitEuler", "RK4", "ImplicitMidpoint", "Adaptive",
            "Diverged", "Run", "Study", "Trajectory", "simulate", "run_study", "energies",
            "initial_state", "quaternion_start",
            "default_integrators", "integrators_named", "INTEGRATORS", "STIFF", "plot",

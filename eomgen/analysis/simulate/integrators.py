@@ -16,6 +16,32 @@
 Each has ``run(system, q0, qd0, times) -> (states, step)``; the system is a
 :class:`~eomgen.analysis.simulate.system.System` or one with its methods (the flexible-joint,
 contact and loop systems).
+
+**Configurations that are not vectors.** For a system whose ``quaternion`` is true (a free
+flyer, ball or planar joints: ``q`` holds unit quaternions or ``(cos θ, sin θ)``, NQ ≠ NV) the
+fixed-step methods move ``q`` by the joints' exponentials, ``system.integrate(q, v, h) = q ⊕ h
+v`` (:func:`~eomgen.analysis.simulate.system.advance`), and add velocities as vectors, so every
+quaternion stays unit, and every ``(cos θ, sin θ)`` on its circle, up to round-off whatever the
+step:
+
+* explicit Euler ``qₖ₊₁ = qₖ ⊕ h vₖ``; semi-implicit Euler ``qₖ₊₁ = qₖ ⊕ h vₖ₊₁``;
+* RK4 the commutator-free Lie group method of order 4 of Celledoni, Marthinsen and Owren
+  (2003), whose velocities and stage velocities are the classical RK4's:
+  ``Q₂ = q ⊕ ½h V₁``, ``Q₃ = q ⊕ ½h V₂``, ``Q₄ = Q₂ ⊕ h (V₃ − ½V₁)``, ``qₖ₊₁ = (q ⊕
+  h (3V₁ + 2V₂ + 2V₃ − V₄)/12) ⊕ h (−V₁ + 2V₂ + 2V₃ + 3V₄)/12``. The "frozen" scheme
+  ``q ⊕ h Σ bᵢ Vᵢ`` with RK4's weights is only of order 2 when the angular velocity turns
+  (it leaves out the commutator ``h³/12 [ω, ω̇]`` of each step);
+* the implicit midpoint rule ``ξ = h M⁻¹(Q) (p₀ + p₁)/2``, ``Q = q ⊕ ξ/2``, ``qₖ₊₁ = q ⊕ ξ``
+  (symmetric, order 2), iterated on ``(ξ, p₁)``;
+* the adaptive methods (SciPy's steps cannot be group steps) integrate the embedded form
+  ``q̇ = configuration_rate(q, v)``, a quaternion as a vector (its norm drifts by about the
+  tolerance), and put each output after the start back on its manifold, ``q ⊕ 0``
+  (normalised): their outputs are unit, their error shows in the trajectory error.
+  (Restarting from each projected output instead would cap their steps at the output
+  spacing.)
+
+A system without such joints (or without ``quaternion``) is integrated as a vector,
+``q + h q̇``.
 """
 
 from __future__ import annotations
@@ -27,6 +53,12 @@ from typing import Protocol, Sequence
 import numpy as np
 
 from .system import Diverged, System
+
+
+def _on_manifold(system) -> bool:
+    """True when the system's configuration is stepped by ``system.integrate`` (module
+    docstring)."""
+    return bool(getattr(system, "quaternion", False))
 
 
 def _rate(system, q, qd):
@@ -86,6 +118,8 @@ class ExplicitEuler(FixedStep):
 
     def step(self, system, state, h):
         q, qd = state
+        if _on_manifold(system):
+            return system.integrate(q, qd, h), qd + h * system.forward_dynamics(q, qd)
         return q + h * _rate(system, q, qd), qd + h * system.forward_dynamics(q, qd)
 
 
@@ -96,6 +130,8 @@ class SemiImplicitEuler(FixedStep):
     def step(self, system, state, h):
         q, qd = state
         qd = qd + h * system.forward_dynamics(q, qd)
+        if _on_manifold(system):
+            return system.integrate(q, qd, h), qd
         return q + h * _rate(system, q, qd), qd
 
 
@@ -104,6 +140,8 @@ class RK4(FixedStep):
     name = "RK4"
 
     def step(self, system, state, h):
+        if _on_manifold(system):
+            return self.lie_step(system, state, h)
         q, qd = state
         f = system.forward_dynamics
 
@@ -119,6 +157,24 @@ class RK4(FixedStep):
         k4q, k4v = rate(q4, v4), f(q4, v4)
         return (q + h / 6 * (k1q + 2 * k2q + 2 * k3q + k4q),
                 qd + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v))
+
+    @staticmethod
+    def lie_step(system, state, h):
+        """One step of the commutator-free method of order 4 (module docstring): the stage
+        velocities ``Vᵢ`` and the new velocity are RK4's, the configurations move by
+        ``system.integrate``."""
+        q, v1 = state
+        f, move = system.forward_dynamics, system.integrate
+        a1 = f(q, v1)
+        q2, v2 = move(q, v1, h / 2), v1 + h / 2 * a1
+        a2 = f(q2, v2)
+        q3, v3 = move(q, v2, h / 2), v1 + h / 2 * a2
+        a3 = f(q3, v3)
+        q4, v4 = move(q2, v3 - v1 / 2, h), v1 + h * a3
+        a4 = f(q4, v4)
+        half = move(q, (3 * v1 + 2 * v2 + 2 * v3 - v4) / 12, h)
+        return (move(half, (-v1 + 2 * v2 + 2 * v3 + 3 * v4) / 12, h),
+                v1 + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4))
 
 
 @dataclass(frozen=True)
@@ -143,6 +199,8 @@ class ImplicitMidpoint(FixedStep):
         return q, system.velocity(q, p)
 
     def step(self, system, state, h):
+        if _on_manifold(system):
+            return self.lie_step(system, state, h)
         q0, p0 = state
         qd, pdot = system.velocity_and_momentum_rate(q0, p0)
         q1, p1 = q0 + h * _rate(system, q0, qd), p0 + h * pdot
@@ -155,6 +213,27 @@ class ImplicitMidpoint(FixedStep):
             q1, p1 = q_next, p_next
             if change <= self.tolerance * scale:
                 return q1, p1
+            if not np.isfinite(change):
+                break
+        raise Diverged(f"the implicit midpoint iteration did not converge (h = {h:g} s)")
+
+    def lie_step(self, system, state, h):
+        """The midpoint rule on the manifold (module docstring): iterate ``ξ = h q̇(Q, p̄)``,
+        ``Q = q₀ ⊕ ξ/2``, ``p₁ = p₀ + h ṗ(Q, p̄)``, ``p̄ = (p₀ + p₁)/2`` from the explicit Euler
+        guess, to the same tolerance; then ``q₁ = q₀ ⊕ ξ``."""
+        q0, p0 = state
+        qd, pdot = system.velocity_and_momentum_rate(q0, p0)
+        xi, p1 = h * qd, p0 + h * pdot
+        scale_q = np.max(np.abs(q0))
+        for _ in range(self.max_iterations):
+            middle = system.integrate(q0, xi, 0.5)
+            qd, pdot = system.velocity_and_momentum_rate(middle, (p0 + p1) / 2)
+            xi_next, p_next = h * qd, p0 + h * pdot
+            change = max(np.max(np.abs(xi_next - xi)), np.max(np.abs(p_next - p1)))
+            scale = 1 + max(scale_q, np.max(np.abs(p_next)))
+            xi, p1 = xi_next, p_next
+            if change <= self.tolerance * scale:
+                return system.integrate(q0, xi, 1.0), p1
             if not np.isfinite(change):
                 break
         raise Diverged(f"the implicit midpoint iteration did not converge (h = {h:g} s)")
@@ -189,6 +268,11 @@ class Adaptive:
                              rtol=self.rtol, atol=self.rtol)
         if solution.status != 0 or solution.y.shape[1] != len(times):
             raise Diverged(f"solve_ivp ({self.method}) failed: {solution.message}")
+        if _on_manifold(system):  # each output after the start put back on the manifold
+            zero = np.zeros(len(z0) - n)
+            return [(z0[:n], z0[n:])] + [
+                (system.integrate(solution.y[:n, k], zero, 0.0), solution.y[n:, k])
+                for k in range(1, len(times))], None
         return [(solution.y[:n, k], solution.y[n:, k]) for k in range(len(times))], None
 
 

@@ -21,9 +21,24 @@ import numpy as np
 from ...dynamics import derive
 from ...model import RobotModel
 from ...numeric import kinetic_energy, numeric_model, potential_energy
-from ...quaternion_joints import configuration_rate
+from ...quaternion_joints import configuration_rate, integrate
 from ..conditioning import EXACT_FROM
 from ..routes import compile_scalar, numeric_only
+
+
+def advance(model: RobotModel, q: np.ndarray, v: np.ndarray, h: float) -> np.ndarray:
+    """``q ⊕ h v``: each joint moved along its kind's exponential
+    (:func:`eomgen.quaternion_joints.integrate`), so every quaternion is unit and a planar
+    joint's ``(cos θ, sin θ)`` on its circle, up to round-off, whatever the step. Each
+    quaternion of the result is the one of ``±`` nearest ``q``'s (both are the same rotation):
+    a trajectory stepped with it is continuous, as the reference it is compared with."""
+    out = integrate(q, v, h, model)
+    for joint in model.quaternion_joints:
+        if joint.quaternion is not None:
+            k = slice(joint.quaternion, joint.quaternion + 4)
+            if out[k] @ q[k] < 0.0:
+                out[k] = -out[k]
+    return out
 
 
 class Diverged(ArithmeticError):
@@ -59,7 +74,8 @@ class System:
         self._M = compile_scalar(dyn.program, dyn.q, ["M"])
         self._bias = compile_scalar(dyn.program, dyn.q + dyn.qd, ["tau"], fixed=zero_qdd)
         self._Cg = compile_scalar(dyn.program, dyn.q + dyn.qd, ["C", "g"])
-        #: True when q holds quaternions (a free flyer, ball joints): NQ ≠ NV.
+        #: True when the configuration is not a vector (a free flyer, ball or planar joints:
+        #: NQ ≠ NV): the integrators step it along its manifold (:meth:`integrate`).
         self.quaternion = bool(self.model.quaternion_joints)
         self._nm = numeric_model(self.model)
         self._shape = (n, n)
@@ -149,12 +165,17 @@ class System:
     def configuration_rate(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
         """``q̇`` of the configuration at velocity ``qd``: ``qd`` itself, or with quaternion
         joints (:mod:`eomgen.quaternion_joints`) a free flyer's root position rate (``R v``),
-        each quaternion's rate (``½ quaternion ⊗ (ω, 0)``) and the other joints' rates; so
-        every integrator integrates a quaternion as a vector (its norm drifts with the error
-        of the method; the dynamics normalise it)."""
+        each quaternion's rate (``½ quaternion ⊗ (ω, 0)``) and the other joints' rates (the
+        embedded form the adaptive methods integrate between output times)."""
         if not self.quaternion:
             return qd
         return configuration_rate(q, qd, self.model)
 
+    def integrate(self, q: np.ndarray, qd: np.ndarray, h: float) -> np.ndarray:
+        """``q ⊕ h q̇``: the configuration reached from ``q`` at the constant velocity ``qd``
+        after ``h`` seconds, each joint along its own manifold (:func:`advance`); how the
+        integrators step a system whose :attr:`quaternion` is true."""
+        return advance(self.model, q, qd, h)
 
-__all__ = ["Diverged", "System"]
+
+__all__ = ["Diverged", "System", "advance"]
