@@ -117,9 +117,10 @@ def ball_velocity_names(name: str) -> tuple[str, str, str]:
 def _chart_chain(model, joint: Joint, kind: ChartKind, taken: set) -> tuple[list, list]:
     """The virtual joints and massless links of ``joint``'s chart (its kind's chain)."""
     where = f"{kind.describe()[0]} joint '{joint.name}'"
-    if joint.actuator is not None:
-        raise UnsupportedError(model.source, where, f"a {kind.describe()[0]} joint takes no "
-                               "actuator (armature, friction, stiffness) yet")
+    if joint.actuator is not None and joint.actuator.flexible:
+        raise UnsupportedError(model.source, where, f"a {kind.describe()[0]} joint's stiffness "
+                               "is not modelled yet (its spring acts on a rotation, not on one "
+                               "angle); armature, damping and friction are")
     steps = kind.chain()
     names = [f"{joint.name}_{suffix}" for suffix, _, _ in steps]
     links = [f"{joint.child}_{name}" for name in names[:-1]]
@@ -130,7 +131,7 @@ def _chart_chain(model, joint: Joint, kind: ChartKind, taken: set) -> tuple[list
         taken.add(name)
     chain = [joint.parent, *links, joint.child]
     joints = [Joint(names[k], JointType(step[1]), chain[k], chain[k + 1],
-                    joint.origin if k == 0 else Transform(), vec3(step[2]))
+                    joint.origin if k == 0 else Transform(), vec3(step[2]), joint.actuator)
               for k, step in enumerate(steps)]
     return joints, [Link(name) for name in links]
 
@@ -166,8 +167,10 @@ def expand_joints(model: "RobotModel") -> "RobotModel":
     KinematicTreeError
         A name the chain needs is taken by a link or joint.
     UnsupportedError
-        A ball or planar joint carries an actuator (armature, friction, stiffness): not
-        modelled yet.
+        A ball or planar joint's actuator has a stiffness (a flexible joint): not modelled
+        yet. Its armature, damping and friction act on each of its velocity coordinates (as
+        MuJoCo's act on each dof of a ball joint): the actuator is given to every virtual
+        joint of the chain.
     """
     expanded = [j for j in model.joints if isinstance(j.type.kind, ChartKind)
                 or j.type is JointType.HELICAL]

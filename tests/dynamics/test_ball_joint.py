@@ -312,7 +312,8 @@ joints:
 
 @pytest.mark.parametrize("text, message", [
     ("axis: [0, 0, 1]", r"joints\[0\] 'shoulder' axis: a spherical joint has no axis"),
-    ("actuator: {armature: 0.1}", r"ball joint 'shoulder': a ball joint takes no actuator"),
+    ("actuator: {armature: 0.1, stiffness: 20}",
+     r"ball joint 'shoulder': a ball joint's stiffness is not modelled yet"),
 ])
 def test_yaml_spherical_joint_errors(tmp_path, text, message):
     import eomgen

@@ -50,7 +50,7 @@ def derived():
     for name in ("arm.xml", "floating.xml", "ball.xml", "gymnasium/hopper.xml",
                  "gymnasium/ant.xml"):
         model = quiet_load(DATA / name)
-        outputs = (("M", "h") if model.quaternion_joints else ("M", "h", "M_a", "tau_f"))
+        outputs = ("M", "h", "M_a", "tau_f")
         out[name] = (model, compile_mjcf(DATA / name),
                      eomgen.derive(model, outputs=outputs).lambdify().module)
     return out
@@ -75,10 +75,11 @@ def test_dynamics_agree_with_mujoco(derived, name):
         assert relative(module.nonlinear_effects(q, v).ravel(), ref["h"]) < TOLERANCE
         assert relative(M + np.diag(armature), ref["M_a"]) < TOLERANCE
         assert np.allclose(-damping * v, ref["damper"], rtol=TOLERANCE, atol=1e-14)
-        if not model.quaternion_joints:  # the generated drive outputs (not yet for these)
-            assert relative(module.drive_mass_matrix(q), ref["M_a"]) < TOLERANCE
-            tau_f = module.friction_torque(v).ravel() - friction * np.sign(v)
-            assert relative(tau_f, -ref["damper"]) < TOLERANCE
+        # the generated drive outputs (ball joints' too: their drive on each dof)
+        assert relative(module.drive_mass_matrix(q), ref["M_a"]) < TOLERANCE
+        tau_f = module.friction_torque(v).ravel() - friction * np.sign(v)
+        assert relative(tau_f, -ref["damper"]) < TOLERANCE
+        if armature.any():
             assert relative(module.drive_mass_matrix(q), M) > 1e-6  # armature is there
 
 

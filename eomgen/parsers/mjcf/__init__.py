@@ -69,7 +69,8 @@ one; two ``joint`` equalities on one joint or a cycle of them
 (:class:`~eomgen.errors.KinematicTreeError`). ``ball`` joints are ball joints
 (:mod:`eomgen.model.quaternion`): MuJoCo's ``(qw, qx, qy, qz)`` is eomgen's ``(qx, qy, qz,
 qw)``; the velocity is the same (the child's angular velocity in the child frame); their
-armature, damping and frictionloss are warned about and left out.
+armature, damping and frictionloss are each of their velocity coordinates' drive, as MuJoCo
+applies them per dof.
 
 Contacts, joint limits, geoms, sites, sensors and the rendering options do not enter the
 equations of motion and are ignored.

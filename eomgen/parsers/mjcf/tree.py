@@ -120,7 +120,8 @@ def _inertial(m, body: int) -> Inertial | None:
 
 def _actuator(m, joint: int) -> Actuator | None:
     """The drive of a joint from its first dof's armature, damping and frictionloss (a free
-    joint's are the same on its six dofs)."""
+    joint's are the same on its six dofs, a ball joint's on its three: eomgen gives the drive
+    to each of the ball joint's velocity coordinates)."""
     dof = int(m.jnt_dofadr[joint])
     values = {"armature": float(m.dof_armature[dof]),
               "damping": 0.0 if disabled(m, "DAMPER") else float(m.dof_damping[dof]),
@@ -128,16 +129,6 @@ def _actuator(m, joint: int) -> Actuator | None:
     if not any(values.values()):
         return None
     return Actuator(**values)
-
-
-def ball_drive_notice(m, source: str, joint: int, name: str, body: str) -> Notice | None:
-    """A ball joint's armature, damping or frictionloss: eomgen's drives act on one-axis
-    joints only, so they are left out, said by name (None when the joint has none)."""
-    if _actuator(m, joint) is None:
-        return None
-    return Notice(NoticeKind.NOT_MODELLED, source, f"joint '{name}' (ball, body '{body}')",
-                  "armature, damping and frictionloss of a ball joint are not modelled",
-                  "left out", joints=(name,))
 
 
 def build_tree(m, source: str) -> RobotModel:
@@ -198,8 +189,6 @@ def build_tree(m, source: str) -> RobotModel:
             ref = float(m.qpos0[int(m.jnt_qposadr[j])])
             if types[k] == BALL:  # a quaternion joint at its anchor, MuJoCo's axes
                 R_j, p_j, kind = R, p + R @ anchor, JointType.SPHERICAL
-                notices.extend(n for n in [ball_drive_notice(m, source, j, jnames[j], name)]
-                               if n is not None)
             elif types[k] == HINGE:
                 R_j, p_j = R @ _axis_rotation(axis, -ref), p + R @ anchor
                 kind = JointType.CONTINUOUS
@@ -216,7 +205,7 @@ def build_tree(m, source: str) -> RobotModel:
             joints.append(Joint(jnames[j], kind, previous, child,
                                 _transform(R_j, p_j, f"joint '{jnames[j]}'"),
                                 vec3(float(a) for a in axis),
-                                None if types[k] == BALL else _actuator(m, j)))
+                                _actuator(m, j)))
             previous = child
             # what follows is placed from this joint's frame: back from its anchor
             R, p = np.eye(3), -anchor
