@@ -148,7 +148,7 @@ def _screw_chain(model, joint: Joint, taken: set) -> tuple[list, list, object]:
     turn = replace(joint, type=JointType.CONTINUOUS, child=link, pitch=0)
     slide = Joint(screw, JointType.PRISMATIC, link, joint.child, Transform(), joint.axis)
     coupling = make_coupling(screw, [(joint.name, joint.pitch)],
-                             element=f"helical joint '{joint.name}' pitch")
+                             element=KINDS["helical"].element(joint.name))
     return [turn, slide], [Link(link)], coupling
 
 

@@ -174,3 +174,15 @@ def test_c_string_literals_hold_any_name_in_utf8():
         literal = c_string_literal(text)
         assert literal.isascii() and "??" not in literal
         assert ast.literal_eval("b" + literal).decode("utf-8") == text
+
+
+def test_the_powers_of_a_lanes_kernel_print_without_pow():
+    """A lanes kernel (SIMD vectors of states) has sin, cos and sqrt lane by lane but no
+    ``pow``: every power in_lanes admits prints as products, quotients and sqrt (a planar
+    joint's 1/sqrt(cos² + sin²) once printed as pow(·, -0.5), which did not compile)."""
+    import sympy as sp
+    x, y = sp.symbols("x y", real=True)
+    printer = fast_backend.FastCPrinter()
+    for exponent in fast_backend.LANES_EXPONENTS:
+        text = printer.doprint((x * x + y) ** exponent)
+        assert "pow" not in text, (exponent, text)

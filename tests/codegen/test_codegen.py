@@ -1196,3 +1196,16 @@ def test_cli_bad_request_is_one_error_line_and_writes_nothing(cli, name, mention
     assert run.stdout == ""
     assert not run.outdir.exists()
     assert [p.name for p in run.outdir.parent.iterdir()] == []
+
+
+def test_casadi_printer_takes_square_roots_with_casadi():
+    """x**(1/2) and x**(-1/2) (a planar joint's 1/sqrt(cos² + sin²)) print through ca.sqrt:
+    the printed text evaluates on CasADi symbols with only ``ca`` in scope, to the value."""
+    from eomgen.codegen.backends.casadi_backend import CasADiPrinter
+    x, y = sp.symbols("x y", real=True)
+    printer = CasADiPrinter({"standard": "python3"})
+    sx, sy = ca.SX.sym("x"), ca.SX.sym("y")
+    for expr in (sp.sqrt(x * x + y), 1 / sp.sqrt(x * x + y), x / sp.sqrt(x * x + y)):
+        value = eval(printer.doprint(expr), {"__builtins__": {}, "ca": ca, "x": sx, "y": sy})
+        got = float(ca.Function("f", [sx, sy], [value])(0.3, 1.7))
+        assert got == pytest.approx(float(expr.subs({x: 0.3, y: 1.7})), rel=1e-15)

@@ -15,7 +15,6 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
-import sympy as sp
 from sympy.printing.pycode import PythonCodePrinter
 
 from ...outputs import exported, function_names
@@ -43,10 +42,9 @@ class CasADiPrinter(TermOrderShared, FloatLiteralMixin, PythonCodePrinter):
     _print_sin = _print_cos = _print_tan = _print_tanh = _print_sign = _print_Function
 
     def _print_Pow(self, expr, rational=False):
-        base, exponent = expr.args
-        if exponent == sp.Rational(1, 2):
-            return f"ca.sqrt({self._print(base)})"
-        return super()._print_Pow(expr, rational)
+        # x**(1/2) and x**(-1/2) through ca.sqrt (PythonCodePrinter's math.sqrt fails on
+        # CasADi symbols, and the module imports no math)
+        return self._hprint_Pow(expr, rational=rational, sqrt="ca.sqrt")
 
     def _print_Pi(self, expr):
         return "ca.pi"

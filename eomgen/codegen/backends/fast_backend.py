@@ -67,7 +67,8 @@ _BARE = PRECEDENCE["Atom"] - 1
 
 class FastCPrinter(FloatLiteralMixin, C99CodePrinter):
     """C99 over doubles: the literals of :class:`~eomgen.symbolic.printing.FloatLiteralMixin`
-    written as C doubles, ``x*x`` for small powers."""
+    written as C doubles, ``x*x`` for small powers, ``1.0/sqrt(x)`` for ``x**(-1/2)`` (the
+    powers a lanes kernel computes, :data:`LANES_EXPONENTS`, never ``pow``)."""
 
     def _literal(self, value: float) -> str:
         text = repr(value)
@@ -84,6 +85,8 @@ class FastCPrinter(FloatLiteralMixin, C99CodePrinter):
             return product if exponent > 0 else f"1.0/({product})"
         if exponent == -1:
             return f"1.0/{self.parenthesize(base, _BARE)}"
+        if exponent == sp.Rational(-1, 2):  # sqrt, not pow: a lanes kernel has no pow
+            return f"1.0/sqrt({self._print(base)})"
         return super()._print_Pow(expr)
 
 

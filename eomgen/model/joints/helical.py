@@ -40,6 +40,20 @@ class Helical(JointKind):
         virtual prismatic joint and of the link between it and the continuous joint."""
         return f"{joint}_{SCREW}", f"{child}_{joint}_{SCREW}"
 
+    def element(self, joint: str) -> str:
+        """The element the coupling of helical joint ``joint``'s screw names (its errors')."""
+        return f"helical joint '{joint}' pitch"
+
+    def coupled(self, coupling) -> str | None:
+        """The helical joint whose screw ``coupling`` couples (a
+        :class:`~eomgen.model.coupling.Coupling`), or None for a coupling a description
+        wrote."""
+        leader = coupling.leaders[0][0] if len(coupling.leaders) == 1 else None
+        if leader is not None and (coupling.follower, coupling.element) == (
+                self.chain(leader, "")[0], self.element(leader)):
+            return leader
+        return None
+
 
 HELICAL = Helical()
 
