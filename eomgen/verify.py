@@ -36,6 +36,7 @@ from .errors import ParameterError
 from .model import all_scalars, massless_joints
 from .model.moving_mass import massless_problem
 from .numeric import numeric_model
+from .outputs import BY_SYMBOL
 from .numeric import rnea as numeric_rnea
 from .quaternion_joints import configuration_rate
 from .symbolic.evaluate import compile_program
@@ -185,8 +186,13 @@ def verify(dynamics: Dynamics, samples: int = 20, seed: int = 0,
         raise ParameterError(model.source, "parameters",
                              "verification needs a value for " + ", ".join(missing))
     n = model.dof
-    evaluate_all = compile_program(dynamics.program, list(dynamics.q) + list(dynamics.qd)
-                                   + list(dynamics.qdd) + params)
+    # the outputs of (q, q̇, q̈) only: one that takes τ (qdd_aba) or another input is not
+    # checked here and would leave that input unbound
+    checked = [name for name, _ in dynamics.program.outputs
+               if set(getattr(BY_SYMBOL.get(name), "inputs", ())) <= {"q", "qd", "qdd"}]
+    evaluate_all = compile_program(dynamics.program.pruned(checked),
+                                   list(dynamics.q) + list(dynamics.qd) + list(dynamics.qdd)
+                                   + params)
     zero_qdd = [0.0] * len(dynamics.qd)
     n_x = len(dynamics.q) + len(dynamics.qd)  # q (NQ) and qd (NV)
 

@@ -320,3 +320,17 @@ def test_joints_that_move_no_mass_are_the_zero_rows_of_M(parts, expected):
         M = np.column_stack([rnea(q, zeros, e) - rnea(q, zeros, zeros) for e in np.eye(n)])
         zero_rows &= {i for i in range(n) if np.abs(M[i]).max() < 1e-12}
     assert sorted(zero_rows) == sorted(model.joint_names.index(j) for j, _ in expected)
+
+
+def test_verify_runs_beside_an_output_that_takes_tau():
+    """A derivation holding the ABA's q̈ (inputs q, q̇, τ) is verified on its M, C, g as one
+    without it: the output that takes τ is left out of the evaluation instead of leaving τ
+    unbound (it raised NameError: tau1)."""
+    import eomgen
+    from eomgen.verify import verify
+    model = eomgen.load(eomgen.example_path("planar_2link"))
+    plain = verify(eomgen.derive(model), samples=3)
+    with_aba = verify(eomgen.derive(model, outputs=("M", "C", "g", "qdd_aba")), samples=3)
+    assert [c.name for c in with_aba.checks] == [c.name for c in plain.checks]
+    assert all(c.passed for c in with_aba.checks)
+    assert [c.max_rel_error for c in with_aba.checks] == [c.max_rel_error for c in plain.checks]
