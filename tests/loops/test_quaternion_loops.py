@@ -13,6 +13,8 @@ passed unchanged, no adapter):
   whose ``lambda_c`` is the force on frame a's side: ``λ = −λ_pin``;
 * a simulation's trajectory is an RK4 of ``constraintDynamics`` written here (the configuration
   embedded, its quaternions' rates ``½ q ⊗ (ω, 0)``), compared with ``pin.difference``.
+* the constrained dynamics' derivatives (along the tangent) are
+  ``computeConstraintDynamicsDerivatives``'.
 
 The generated NumPy module is checked (every backend in the slow test), and the numeric
 :class:`eomgen.loops.LoopDynamics` (Newton closure on the manifold, the parallel inverse
@@ -304,3 +306,28 @@ def test_every_backend_prints_the_quaternion_loop_rows(case, tmp_path):
         else:
             qdd, F = (np.asarray(x, dtype=float) for x in f(q, v, tau))
         assert relative(qdd, qdd_ref) < 1e-10 and relative(F, F_ref) < 1e-10, backend
+
+
+@pytest.mark.slow  # the derivatives' program is generated: about 10 s
+def test_constrained_derivatives_against_pinocchio(case, tmp_path):
+    """The generated constrained_forward_dynamics_derivatives (dKKT along the tangent) with the
+    loop's rows: Pinocchio's computeConstraintDynamicsDerivatives of the same constraint
+    (ddq_dq, ddq_dv, ddq_dtau; dlambda_* of the force on frame a, so negated)."""
+    _, modules = generated(case["model"], ["constrained_forward_dynamics_derivatives"], tmp_path,
+                           ("numpy",))
+    pm = case["pm"]
+    data = pm.createData()
+    models = pin.StdVec_RigidConstraintModel()
+    models.append(case["constraint"])
+    datas = pin.StdVec_RigidConstraintData([c.createData() for c in models])
+    pin.initConstraintDynamics(pm, data, models, datas)
+    (q, v, tau), = _closed_states(case, 1, seed=4)
+    ours = modules["numpy"]["constrained_forward_dynamics_derivatives"](q, v, tau)
+    pin.constraintDynamics(pm, data, q, v, tau, models, datas,
+                           pin.ProximalSettings(1e-14, 0.0, 100))
+    pin.computeConstraintDynamicsDerivatives(pm, data, models, datas)
+    expected = (data.ddq_dq, data.ddq_dv, data.ddq_dtau,
+                -data.dlambda_dq, -data.dlambda_dv, -data.dlambda_dtau)
+    for name, got, value in zip(("dqdd_dq", "dqdd_dqd", "dqdd_dtau", "dF_dq", "dF_dqd",
+                                 "dF_dtau"), ours, expected):
+        assert relative(got, value) < 1e-10, name
