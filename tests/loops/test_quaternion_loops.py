@@ -190,8 +190,9 @@ def test_loop_rows_against_pinocchio_frames(case):
 
 def test_constrained_dynamics_against_pinocchio(case):
     """q̈ and the loop force of the generated module and of LoopDynamics are constraintDynamics'
-    at closed states; the parallel inverse dynamics (the base, the second knee and the rod passive) gives
-    back the efforts and the force of a motion driven by the actuated joints alone."""
+    at closed states; the parallel inverse dynamics (the base, the second knee and the rod
+    passive) gives back the efforts and the force of a motion driven by the actuated joints
+    alone."""
     module, dyn = case["module"], case["dyn"]
     reference = _pinocchio_dynamics(case)
     for q, v, tau in _closed_states(case, 2, seed=11):
