@@ -324,16 +324,16 @@ LOOP_CONSTRAINT = _listed(Output(
     "loop_constraint", "Phi_l", "Loop closure error Phi_l(q) (m_l,), zero on closed loops: "
     "frame b less frame a, LOOP_ROWS order (eomgen.symbolic.loops).", ("q",), True,
     "m (translational rows), 1 (rotational rows: sines)", ("Phi_l",), default=False,
-    constants=_LOOP_NAMES, quaternion_joints=False))
+    constants=_LOOP_NAMES))
 LOOP_JACOBIAN = _listed(Output(
     "loop_jacobian", "J_l", "Loop Jacobian J_l(q) (m_l, n): the velocity of each loop's frame "
     "b relative to its frame a in the rows' axes, J_l qd, LOOP_ROWS order.", ("q",), False,
     "m/rad (translational rows), 1 (rotational rows)", ("J_l",), default=False,
-    constants=_LOOP_NAMES, quaternion_joints=False))
+    constants=_LOOP_NAMES))
 LOOP_BIAS = _listed(Output(
     "loop_bias", "dJqd_l", "Loop bias J_l-dot qd (m_l,): the loops' relative accelerations at "
     "qdd = 0, LOOP_ROWS order.", ("q", "qd"), True, "m/s^2, rad/s^2", ("dJqd_l",), default=False,
-    constants=_LOOP_NAMES, quaternion_joints=False))
+    constants=_LOOP_NAMES))
 CONTACT_BIAS = _listed(Output(
     "contact_bias", "dJqd_c", "Contact bias J_c-dot qd (m,): the constraint accelerations at "
     "qdd = 0, CONTACT_ROWS order.", ("q", "qd"), True, "m/s^2, rad/s^2", ("dJqd_c",),

@@ -308,9 +308,10 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     # body has columns of its own, multiplied by zero parameters; Y_base by the numeric route,
     # without them; Y_SL against M, computeCoriolisMatrix and g; Y_K, Y_P against Pinocchio's
     # energies; the drive outputs against model.armature and the friction law; the flat outputs
-    # against finite differences along a trajectory integrated on the configuration space). The
-    # others (loop closures) are refused in one line; the derivatives, the drives' too, are
-    # taken along the tangent (eomgen.symbolic.tangent).
+    # against finite differences along a trajectory integrated on the configuration space; the
+    # loop rows against Pinocchio's frames and constraintDynamics). An output the catalogue
+    # marks quaternion_joints=False would be refused in one line; the derivatives, the drives'
+    # too, are taken along the tangent (eomgen.symbolic.tangent).
     refused_here = sorted(s for s in outputs if not BY_SYMBOL[s].quaternion_joints)
     if model.quaternion_joints and refused_here:
         first = model.quaternion_joints[0]

@@ -17,6 +17,12 @@ drift ``max_t |E − E0|`` [J] (E from :mod:`eomgen.numeric`, independent of the
 program: without Baumgarte the loop forces do no work, so E is conserved up to the
 integrator's error).
 
+With quaternion joints (a free flyer, ball joints: NQ ≠ NV) ``q0`` is the configuration (NQ
+values, identity quaternions by default: :func:`~eomgen.analysis.simulate.quaternion_start`),
+``q̇0`` the velocity (NV), Newton's closure and every step move ``q`` along the joints'
+exponentials (``q ⊕ h v``, :func:`~eomgen.analysis.simulate.advance`), as the simulation without
+loops does, so each quaternion stays unit.
+
 With the scene's **contacts** as well (loops and contacts together), the KKT system holds the
 contact rows then the loop rows (``CONTACT_ROWS``), every contact held still where it is at the
 closed ``q0`` (its anchor, as :mod:`eomgen.analysis.simulate_contacts` does), ``q̇0`` projected
@@ -45,9 +51,11 @@ from ..numeric.loops import RANK_TOLERANCE, LoopDynamics
 from ..numeric.so3 import so3_log
 from ..symbolic.frames import derive_frames
 from ..progress import plural
+from ..quaternion_joints import configuration_rate
 from .report import csv_text, fmt, markdown_table
 from .routes import numeric_only
-from .simulate import OUTPUT_POINTS, Diverged, ImplicitMidpoint, initial_state, simulate
+from .simulate import (OUTPUT_POINTS, Diverged, ImplicitMidpoint, advance, initial_state,
+                       quaternion_start, simulate)
 from .simulate_contacts import DEPENDENT_DAMPING
 
 #: ``(kp [1/s²], kd [1/s])`` by default: ``Φ̈ + kd Φ̇ + kp Φ = 0`` critically damped at 10 rad/s.
@@ -128,6 +136,9 @@ class LoopSystem:
         self.contacts = contacts
         self.damping = damping
         self.tau = np.zeros(self.n)
+        #: Whether ``q`` holds quaternions (NQ ≠ NV): the integrators then step it by
+        #: :meth:`integrate`.
+        self.quaternion = bool(model.quaternion_joints)
         self._nm = numeric_model(model)
         self.evaluations = 0
         self.max_condition = float("nan")
@@ -149,6 +160,16 @@ class LoopSystem:
     def forward_dynamics(self, q, qd) -> np.ndarray:
         self.evaluations += 1
         return self.constrained(q, qd)[0]
+
+    def configuration_rate(self, q, qd) -> np.ndarray:
+        """``q̇`` at velocity ``qd``: ``qd`` itself, or with quaternion joints
+        :func:`eomgen.quaternion_joints.configuration_rate`."""
+        return configuration_rate(q, qd, self.model) if self.quaternion else qd
+
+    def integrate(self, q, qd, h: float) -> np.ndarray:
+        """``q ⊕ h q̇`` along each joint's manifold (:func:`~eomgen.analysis.simulate.advance`):
+        how the integrators step ``q`` with quaternion joints."""
+        return advance(self.model, np.asarray(q, float), np.asarray(qd, float), h)
 
     def energy(self, q, qd) -> float:
         """``K + P`` [J] from :mod:`eomgen.numeric`."""
@@ -280,7 +301,10 @@ def run_loop_study(model: RobotModel, integrators: Sequence, duration: float, q0
     ``diverged``. ``gains`` ``(kp, kd)``: the Baumgarte gains of every row (default: the
     loops' :data:`DEFAULT_GAINS`, each contact's own)."""
     model = numeric_only(model)
-    q0, qd0 = initial_state(q0, qd0, model.dof, model.joint_names)
+    if model.quaternion_joints:
+        q0, qd0 = quaternion_start(model, q0, qd0)
+    else:
+        q0, qd0 = initial_state(q0, qd0, model.dof, model.joint_names)
     progress(f"deriving M, h and the loops of {model.name}")
     program = LoopDynamics(model)
     q0, qd0 = consistent_start(program, q0, qd0)

@@ -16,6 +16,12 @@ rows in ``J_c`` (after the contacts'), closure by Newton, parallel inverse dynam
   squares, whose residual must vanish (a q̈ consistent with the loops);
 * ``assemble(q)``: the loops closed by Newton's method on ``Φ`` over the passive coordinates
   (the actuated ones held), :class:`AssemblyError` when it does not converge.
+
+Sizes: ``q`` is the configuration (NQ, ``CONFIGURATION_NAMES``), ``q̇``, ``q̈``, ``τ`` and the
+columns of ``J_l`` the velocity coordinates (n = NV, ``JOINT_NAMES``). With quaternion joints (a
+free flyer, ball joints: NQ ≠ NV) ``J_l`` is in ``v`` and ``J̇_l q̇`` is ``J̇_l v``, as the
+contact rows (:mod:`eomgen.symbolic.frames`), and Newton's steps move ``q`` along the joints'
+exponentials (:func:`eomgen.quaternion_joints.integrate`), so its quaternions stay unit.
 """
 
 from __future__ import annotations
@@ -28,7 +34,9 @@ import numpy as np
 from ..dynamics import derive
 from ..errors import AnalysisError
 from ..model import RobotModel
+from ..quaternion_joints import integrate
 from ..symbolic.evaluate import compile_program
+from .pinocchio import pinocchio_name
 
 #: The unconstrained KKT solve refuses rows whose smallest singular value is below this
 #: fraction of the largest (dependent rows: use damping, or a planar loop).
@@ -183,7 +191,8 @@ class LoopDynamics:
     def assemble(self, q, tolerance: float = 1e-12, iterations: int = 50) -> np.ndarray:
         """``q`` with its passive coordinates moved so that every loop closes (``|Φ|∞ ≤
         tolerance``), the actuated ones held; Newton's method (least-norm steps
-        ``Δq_p = −J_l,p⁺ Φ``) from ``q``.
+        ``Δv_p = −J_l,p⁺ Φ`` on the passive velocity coordinates, ``q ← q ⊕ Δv``) from ``q``
+        (NQ,).
 
         Raises
         ------
@@ -198,8 +207,9 @@ class LoopDynamics:
             error = float(np.max(np.abs(e["Phi_l"]))) if len(e["Phi_l"]) else 0.0
             if error <= tolerance:
                 return q
-            step = np.linalg.lstsq(e["J_l"][:, passive], -e["Phi_l"], rcond=None)[0]
-            q[passive] += step
+            step = np.zeros(self.model.dof)
+            step[passive] = np.linalg.lstsq(e["J_l"][:, passive], -e["Phi_l"], rcond=None)[0]
+            q = integrate(q, step, 1.0, self.model) if self.model.quaternion_joints else q + step
             if not np.all(np.isfinite(q)):
                 break
         raise AssemblyError(f"the loops of '{self.model.name}' do not assemble from this "
@@ -213,7 +223,7 @@ __all__ = ["RANK_TOLERANCE", "AssemblyError", "LoopDynamics", "kkt_solve", "pino
 def pinocchio_loops(model: RobotModel, pm, reference=None):
     """Pinocchio's ``RigidConstraintModel`` of each loop of ``model`` between the Pinocchio
     joints of its two frames (``pm``: :func:`eomgen.numeric.pinocchio.to_pinocchio` of
-    ``model``): ``CONTACT_3D`` for a point loop (a planar one too: its third row is then
+    ``model``; a ball joint or the free flyer is one Pinocchio joint): ``CONTACT_3D`` for a point loop (a planar one too: its third row is then
     dependent), ``CONTACT_6D`` for a weld, joint 1 the loop's frame a, joint 2 its frame b,
     placements the frames in the joints' frames, in ``reference`` (default ``LOCAL``: the
     forces in frame a's axes).
@@ -228,6 +238,10 @@ def pinocchio_loops(model: RobotModel, pm, reference=None):
     from ..symbolic.frames import frame_site  # the numeric layer reads the tree's frames
 
     reference = pin.ReferenceFrame.LOCAL if reference is None else reference
+    # a quaternion joint is one Pinocchio joint (a free flyer's named root_joint): each of
+    # its virtual joints stands for it
+    names = {virtual: pinocchio_name(j) for j in model.quaternion_joints
+             for virtual in (m.name for m in model.movable_joints[j.v_slice])}
     models = pin.StdVec_RigidConstraintModel()
     for loop in model.loops:
         if loop.kind == "hinge":
@@ -236,7 +250,8 @@ def pinocchio_loops(model: RobotModel, pm, reference=None):
         for frame in (loop.a, loop.b):
             body, pose = frame_site(model, frame.link)
             T = pose @ frame.pose
-            joint = pm.model.getJointId(model.parent_joint[body].name) if body else 0
+            name = model.parent_joint[body].name if body else None
+            joint = pm.model.getJointId(names.get(name, name)) if body else 0
             R = np.array([[float(x) for x in row] for row in T.rotation])
             ends += [joint, pin.SE3(R, np.array([float(x) for x in T.translation]))]
         kind = pin.ContactType.CONTACT_3D if loop.kind == "point" else pin.ContactType.CONTACT_6D

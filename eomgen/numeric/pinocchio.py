@@ -39,7 +39,7 @@ from ..model.joints import FREE_FLYER
 from .floating_base import dynamics_from_free_flyer, to_free_flyer
 from .model import configuration_map
 
-__all__ = ["PinocchioModel", "to_pinocchio", "plain_calls", "PinocchioFreeFlyer"]
+__all__ = ["PinocchioModel", "to_pinocchio", "plain_calls", "PinocchioFreeFlyer", "pinocchio_name"]
 
 
 def _floats(v) -> np.ndarray:
@@ -141,7 +141,7 @@ def to_pinocchio(model: RobotModel) -> PinocchioModel:
         elif joint.name in chains:
             q_joint = chains[joint.name]
             jid = pmodel.addJoint(parent_id, getattr(pin, q_joint.kind.pinocchio)(), T,
-                                  _pinocchio_name(q_joint))
+                                  pinocchio_name(q_joint))
             anchor[joint.child] = (jid, pin.SE3.Identity())
             for later in model.movable_joints[q_joint.v_index + 1:q_joint.v_index + q_joint.nv]:
                 inside[later.name] = jid
@@ -161,7 +161,7 @@ def to_pinocchio(model: RobotModel) -> PinocchioModel:
         inertia = pin.Inertia(float(i.mass), _floats(i.com), _matrix(i.inertia))
         pmodel.appendBodyToJoint(jid, inertia, T)
     pmodel.gravity = pin.Motion(_floats(model.gravity), np.zeros(3))
-    starts = {_pinocchio_name(j): j for j in model.quaternion_joints}
+    starts = {pinocchio_name(j): j for j in model.quaternion_joints}
     q_index = _configuration_indices(model)
     perm, qperm = np.empty(pmodel.nv, dtype=int), np.empty(pmodel.nq, dtype=int)
     for jid in range(1, pmodel.njoints):
@@ -177,7 +177,7 @@ def to_pinocchio(model: RobotModel) -> PinocchioModel:
                           None if np.array_equal(perm, qperm) else qperm, coupling)
 
 
-def _pinocchio_name(joint) -> str:
+def pinocchio_name(joint) -> str:
     """The name of a chart joint in the Pinocchio model: ``root_joint`` for the free flyer
     (as Pinocchio's URDF reader names it), the joint's own name otherwise."""
     return "root_joint" if joint.kind is FREE_FLYER else joint.name
