@@ -20,7 +20,7 @@ are generated into a temporary folder, then on the same random batch of ``--stat
   every entry's loop, which for M costs more than fusing saves;
 * **torch**: the functions on CPU tensors (no autograd recording), on one thread as NumPy's
   element-wise operations (the target), and on torch's default number of threads;
-* **dask**: ``eomgen.batch.dask_map`` of the NumPy functions over ``--dask-states`` states in
+* **dask**: ``eomgen.analysis.batch.dask_map`` of the NumPy functions over ``--dask-states`` states in
   chunks of a quarter of them, made and kept on a ``distributed.LocalCluster`` of 2 worker
   processes with one thread each, against the plain NumPy batch on the same states in this
   process (throughput only; no target).
@@ -49,7 +49,7 @@ ROOT = HERE.parent
 sys.path.insert(0, str(ROOT))
 
 import eomgen  # noqa: E402
-from eomgen.batch import dask_map  # noqa: E402
+from eomgen.analysis.batch import dask_map  # noqa: E402
 from eomgen.codegen.scene_generate import generate_scene  # noqa: E402
 from eomgen.scene import load_scene  # noqa: E402
 

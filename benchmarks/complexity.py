@@ -60,7 +60,7 @@ import sympy as sp
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from eomgen.bodies import body_tree  # noqa: E402
+from eomgen.model.bodies import body_tree  # noqa: E402
 from eomgen.dynamics import derive, joint_symbols  # noqa: E402
 from eomgen.model import Inertial, Joint, JointType, Link, Transform, build_model, vec3  # noqa: E402
 from eomgen.symbolic.aba import aba_program, cholesky_program  # noqa: E402

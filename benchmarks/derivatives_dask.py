@@ -5,7 +5,7 @@ The statistic: over N random states (q, q̇, q̈ uniform in [−1.5, 1.5] per jo
 chunk by chunk where the chunk is evaluated), the largest |∂τ_i/∂q_j| of each entry, a 7 × 7 table of the arm's
 worst-case torque sensitivity to its joint angles (N m/rad). ∂τ/∂q comes from the Panda's fast
 module (``inverse_dynamics_derivative_q``, the loop over a block of states in C) through
-``eomgen.batch.dask_map`` with ``statistic=``: each chunk is evaluated 4,096 states at a time
+``eomgen.analysis.batch.dask_map`` with ``statistic=``: each chunk is evaluated 4,096 states at a time
 and reduced where it runs, so only a 7 × 7 table per chunk leaves it (never the chunk's 98 MB of
 matrices); dask reduces the tables.
 
@@ -51,7 +51,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import eomgen  # noqa: E402
 from codegen_speed import erd_robots_dir  # noqa: E402
-from eomgen.batch import dask_map  # noqa: E402
+from eomgen.analysis.batch import dask_map  # noqa: E402
 from eomgen.codegen.generate import render_files  # noqa: E402
 from eomgen.model import lock_joints  # noqa: E402
 from fair_speed import LOCKED, spread  # noqa: E402

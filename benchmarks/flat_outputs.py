@@ -14,13 +14,13 @@ fingers locked). Printed:
    printed NumPy code (:mod:`eomgen.symbolic.opcount`), with their ratio to ``inverse_dynamics``
    (forward mode: the k-th derivative should cost a small multiple of τ_L's program, not grow
    with expansion); and, for comparison, the size of the program
-   :func:`eomgen.actuators.actuated_model` differentiates (τ_L from the Lagrangian M, C, g);
+   :func:`eomgen.analysis.actuators.actuated_model` differentiates (τ_L from the Lagrangian M, C, g);
 2. CPU seconds of ``derive`` for the flat outputs, and the wall seconds (median, min, max of
    ``--repeat`` runs) of ``eomgen generate --outputs motor_angles,motor_velocities,
    flat_motor_torque,flat_motor_torque_smooth --backend numpy,casadi --no-cache`` in a fresh
    process (issue 17's target for the flexible Panda: ≤ 30 s);
 3. the largest relative difference, at 5 random states, between the generated NumPy
-   ``flat_motor_torque`` and :func:`eomgen.actuators.flexible_inverse_dynamics`.
+   ``flat_motor_torque`` and :func:`eomgen.analysis.actuators.flexible_inverse_dynamics`.
 """
 
 from __future__ import annotations

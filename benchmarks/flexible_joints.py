@@ -8,14 +8,14 @@ Usage::
 1. **Panda, 7 flexible joints** (example-robot-data ``panda.urdf`` with the scene
    ``examples/scenes/panda_flexible.yaml``: K = 1e4 N m/rad, motor inertia 0.1 kg m², fingers
    locked): seconds to load, derive (``eomgen.derive``), compile the numeric model with the
-   flatness program (:func:`eomgen.actuators.actuated_model`) and print that program on first
-   use (the first :func:`~eomgen.actuators.flexible_inverse_dynamics` call). Target: ≤ 30 s.
+   flatness program (:func:`eomgen.analysis.actuators.actuated_model`) and print that program on first
+   use (the first :func:`~eomgen.analysis.actuators.flexible_inverse_dynamics` call). Target: ≤ 30 s.
 2. **Integrators on the stiff system**: the Panda released from rest at a bent posture with the
    springs wound for gravity, no input and no friction (the URDF's damping set to 0), for
    ``--duration`` seconds with SciPy's ``solve_ivp`` (RK45, DOP853, Radau, BDF, LSODA; rtol =
    atol = 1e-8): right-hand-side calls, accepted steps, CPU seconds and the energy error
    max |E(t) − E(0)| / (max E − min E over the links' potential range), E the total energy of
-   :func:`~eomgen.actuators.flexible_energy`. The highest joint frequency sqrt(K (1/B + 1/m))
+   :func:`~eomgen.analysis.actuators.flexible_energy`. The highest joint frequency sqrt(K (1/B + 1/m))
    is printed to show the stiffness.
 3. **K → ∞** on the 2-link flexible arm (``examples/robots/flexible_2link.yaml``): link angles
    after 0.5 s under constant torques against the rigid model with reflected inertia

@@ -9,7 +9,7 @@ largest relative difference over random states between eomgen and Pinocchio's fr
 (its own URDF reader; M, C q̇, g mapped to Euler coordinates, eomgen.floating) of:
 
 * M, C q̇, g from eomgen's numeric Newton–Euler and from the derived (symbolic) program;
-* constrained q̈ and F_c (eomgen.contacts) against ``pinocchio.constraintDynamics`` with 4
+* constrained q̈ and F_c (eomgen.numeric.contacts) against ``pinocchio.constraintDynamics`` with 4
   CONTACT_3D (LOCAL_WORLD_ALIGNED) and 1 CONTACT_6D (LOCAL) on solo12;
 
 and the derivation time of the floating solo12 (M, C, g; the frame kinematics of its feet),
@@ -50,7 +50,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 import eomgen  # noqa: E402
 from support import erd_robots_dir  # noqa: E402
 from eomgen import floating, numeric  # noqa: E402
-from eomgen.contacts import Contact, ContactDynamics  # noqa: E402
+from eomgen.numeric.contacts import Contact, ContactDynamics  # noqa: E402
 from eomgen.reduction import apply_scene  # noqa: E402
 from eomgen.scene import load_scene  # noqa: E402
 from eomgen.symbolic.evaluate import compile_program  # noqa: E402

@@ -46,7 +46,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import eomgen  # noqa: E402
-from eomgen.loops import LoopDynamics  # noqa: E402
+from eomgen.numeric.loops import LoopDynamics  # noqa: E402
 from eomgen.numeric.loops import pinocchio_loops  # noqa: E402
 from eomgen.numeric.pinocchio import to_pinocchio  # noqa: E402
 from eomgen.reduction import apply_scene  # noqa: E402

@@ -170,7 +170,7 @@ def symbolic_access(name: str) -> dict:
 def notebook(name: str) -> dict:
     return run(f"""
     import nbclient, tempfile
-    from eomgen.notebook import build_notebook
+    from eomgen.teach.notebook import build_notebook
     model = model_named({name!r})
     if model is None:
         print(json.dumps({{"skipped": "example-robot-data is not installed"}}))

@@ -30,6 +30,9 @@ import types  # noqa: E402
 from typing import TYPE_CHECKING  # noqa: E402
 
 from .errors import DescriptionError, EomgenError, SceneError, UnsupportedError  # noqa: E402
+from .moved import install as _install_moved  # noqa: E402
+
+_install_moved()  # the old module paths, each warning once (eomgen.moved)
 
 if TYPE_CHECKING:  # what the lazy names are, for readers and type checkers
     from .dynamics import Dynamics, derive
@@ -88,4 +91,4 @@ class _Package(types.ModuleType):
 
 sys.modules[__name__].__class__ = _Package
 
-from . import display  # noqa: E402,F401  (registers the notebook display of models and dynamics)
+from .present import display  # noqa: E402,F401  (registers the notebook display of models and dynamics)

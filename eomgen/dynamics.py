@@ -17,7 +17,7 @@ from typing import Iterable
 
 import sympy as sp
 
-from . import reprs
+from .common import reprs
 from .errors import TooLargeError, UnsupportedError
 from .model import Parameter, RobotModel
 from .model.joints import HELICAL
@@ -231,11 +231,11 @@ class Dynamics:
         """NumPy functions ``M(q, **p)``, ``C(q, qd, **p)``, ``g(q, **p)``,
         ``tau(q, qd, qdd, **p)`` compiled from the program (not from expanded matrices): the
         generated NumPy module's functions, with the parameters kept symbolic as keyword
-        arguments. See :class:`eomgen.lambdify.NumericDynamics`. A façade for the README's
-        API: the work is :func:`eomgen.lambdify.lambdify`."""
+        arguments. See :class:`eomgen.codegen.lambdify.NumericDynamics`. A façade for the README's
+        API: the work is :func:`eomgen.codegen.lambdify.lambdify`."""
         # Imported on first use: lambdify prints through code generation (Jinja, the NumPy
         # backend), which derive never needs (start-up time).
-        from .lambdify import lambdify
+        from .codegen.lambdify import lambdify
 
         return lambdify(self)
 
@@ -249,7 +249,7 @@ class Dynamics:
                 f"{reprs.names(self.outputs, most=8)}; {params}"
                 + ("; simplified" if self.simplified else "") + ">")
 
-    def _repr_latex_(self) -> str | None:  # rich display in notebooks: registered by eomgen.display
+    def _repr_latex_(self) -> str | None:  # rich display in notebooks: registered by eomgen.present.display
         return reprs.render("dynamics", self, "text/latex")
 
 

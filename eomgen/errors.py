@@ -155,7 +155,7 @@ class SchemaError(DescriptionError):
 class InvalidNumberError(DescriptionError):
     """Text that should be a number is not a finite real number (``nan``, ``inf``, ``abc``), not
     an expression eomgen reads, or has a magnitude above
-    :data:`eomgen.expressions.MAX_MAGNITUDE`."""
+    :data:`eomgen.model.expressions.MAX_MAGNITUDE`."""
 
 
 class ParameterError(DescriptionError):

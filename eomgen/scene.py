@@ -33,7 +33,7 @@ Version 1 of the format (every key but ``version`` is optional)::
     parameters: {m_load: 1.5}     # new symbols for payload values (name: default value)
     symbolic: [m_load]            # parameters kept symbolic (default: all; none for none)
     outputs: [M, C, g]            # symbols or function names of eomgen.outputs.OUTPUTS
-    contacts:                     # frames held still (see eomgen.contacts, docs/contact.md)
+    contacts:                     # frames held still (see eomgen.numeric.contacts, docs/contact.md)
       - frame: FL_FOOT            # a link of the robot
         type: point               # point (3D, default) or surface (6D)
         mu: 0.7                   # friction coefficient, >= 0 (optional)

@@ -38,9 +38,9 @@ from typing import Callable, Protocol
 
 import numpy as np
 
-from ..compiler import c_compiler
+from ..common.compiler import c_compiler
 from ..model import RobotModel
-from ..progress import plural
+from ..common.progress import plural
 from ..verify import random_configuration
 from .precision import Reference, relative_error
 from .report import csv_text, fmt, markdown_table, pareto_front, pyplot

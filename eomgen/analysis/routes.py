@@ -48,10 +48,10 @@ import numpy as np
 import sympy as sp
 
 from ..codegen import available_backends, make_job
-from ..compiler import c_compiler
+from ..common.compiler import c_compiler
 from ..dynamics import Dynamics, derive
 from ..model import RobotModel
-from ..progress import plural
+from ..common.progress import plural
 from ..numeric import M_crba, numeric_model, rnea
 from ..numeric.pinocchio import plain_calls, to_pinocchio
 from ..outputs import INVERSE, MASS

@@ -2,7 +2,7 @@
 
 ``eomgen simulate`` on a description (or scene) whose actuators give a ``stiffness``
 integrates the 2(n + m)-dimensional state ``(q, θ, q̇, θ̇)`` of the reduced model
-(:mod:`eomgen.actuators`, docs/actuators.md)::
+(:mod:`eomgen.analysis.actuators`, docs/actuators.md)::
 
     M_a(q) q̈ + C(q, q̇) q̇ + g(q) = S_R τ + E K (θ − Eᵀ q)
     B θ̈ + K (θ − Eᵀ q) = Eᵀ τ

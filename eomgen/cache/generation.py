@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Callable, Sequence
 
 from ..errors import recorded_warnings
-from ..output import GeneratedFile
+from ..common.output import GeneratedFile
 from .keys import CacheRequest, generation_key
 from .store import Cache
 

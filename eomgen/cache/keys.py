@@ -18,7 +18,7 @@ Two callers build keys:
   implementing them, and the description file's bytes (every file's header quotes their hash):
   library callers pass models no file describes (locked joints, substituted parameters).
 
-Only the standard library and :mod:`eomgen.compiler` are imported at the top (no SymPy, NumPy
+Only the standard library and :mod:`eomgen.common.compiler` are imported at the top (no SymPy, NumPy
 or CasADi); the backend registry is imported by :func:`generation_key` alone.
 """
 
@@ -34,7 +34,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Mapping, Sequence
 
-from ..compiler import c_compiler_path
+from ..common.compiler import c_compiler_path
 
 #: Version of the entry layout; keys and entries of another format are stale.
 FORMAT = 1
@@ -80,7 +80,7 @@ def code_version() -> str:
 
 def toolchain() -> dict[str, str | bool | None]:
     """What outside the inputs changes the files: the C compiler the C backends would use
-    (:func:`eomgen.compiler.c_compiler_path`), and for the fast backend's compiled extension
+    (:func:`eomgen.common.compiler.c_compiler_path`), and for the fast backend's compiled extension
     the Python it is built for (its ``EXT_SUFFIX`` names the ABI) and whether Python's headers are there. (NumPy's C API is backward compatible: an
     extension built against NumPy 2 headers targets the oldest supported NumPy by default.)"""
     compiler = c_compiler_path()

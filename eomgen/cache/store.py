@@ -35,7 +35,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Sequence
 
-from ..output import GeneratedFile
+from ..common.output import GeneratedFile
 from .keys import FORMAT, code_version
 
 #: Entries kept; the least recently used beyond are deleted when a new one is stored.

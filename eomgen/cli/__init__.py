@@ -17,9 +17,9 @@ Exit codes: 0 success, 1 a verification check failed, 2 bad input (one line on s
 file, the element and the problem; a traceback only with ``--debug``), 130 interrupted (SIGINT,
 Ctrl-C) and 143 terminated (SIGTERM), each with the one line ``eomgen: interrupted``.
 
-Every command that writes checks first that its output can be written (:mod:`eomgen.output`),
+Every command that writes checks first that its output can be written (:mod:`eomgen.common.output`),
 so that a bad ``-o`` is one error line before minutes of work. Progress goes to stderr through
-one :class:`eomgen.progress.Progress` (``--quiet`` on every command silences it).
+one :class:`eomgen.common.progress.Progress` (``--quiet`` on every command silences it).
 
 The command modules import SymPy, NumPy and the rest only when a command runs: ``eomgen
 --help`` and a cached ``eomgen generate`` stay light.

@@ -2,7 +2,7 @@
 
 ``--scene`` reduces the model by a scene file (``eomgen.scene``, ``eomgen.reduction``) before
 anything is measured. Whether OUTPUT can be written is checked before the work
-(:func:`eomgen.output.check_output_folder`); progress goes through :class:`eomgen.progress.Progress`
+(:func:`eomgen.common.output.check_output_folder`); progress goes through :class:`eomgen.common.progress.Progress`
 (stage lines with elapsed times in a log, a bar on a terminal, nothing with ``--quiet``).
 The analysis modules (NumPy, SciPy, Matplotlib, the ``analysis`` extra) are imported when a
 command runs, after its optional dependencies are checked.
@@ -16,8 +16,8 @@ from pathlib import Path
 import click
 
 from ..errors import AnalysisError
-from ..output import check_output_folder
-from ..progress import Progress, plural
+from ..common.output import check_output_folder
+from ..common.progress import Progress, plural
 from .handling import handle_errors
 from .loading import load_reduced, output_stem
 from .options import (description_argument, output_folder_option, quiet_option, scene_option,

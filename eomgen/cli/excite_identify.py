@@ -2,7 +2,7 @@
 ``eomgen identify`` (base parameters from measurements): the command-line side of
 :mod:`eomgen.identification`.
 
-Output is checked before any work and written all or nothing (:mod:`eomgen.output`). The
+Output is checked before any work and written all or nothing (:mod:`eomgen.common.output`). The
 identification modules (NumPy, SciPy, cvxpy for ``--physical``) and the regressor (SymPy) are
 imported when a command runs, after its optional dependencies are checked.
 """
@@ -15,8 +15,8 @@ from pathlib import Path
 import click
 
 from ..errors import IdentificationError, ParameterError
-from ..output import GeneratedFile, check_output_file, check_output_folder, write_atomically
-from ..progress import Progress, plural
+from ..common.output import GeneratedFile, check_output_file, check_output_folder, write_atomically
+from ..common.progress import Progress, plural
 from .handling import handle_errors
 from .loading import load_reduced, output_stem
 from .options import (description_argument, output_file_option, output_folder_option,

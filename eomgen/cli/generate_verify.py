@@ -15,8 +15,8 @@ from pathlib import Path
 import click
 
 from ..errors import GenerationError, VerificationError
-from ..output import check_output_folder, checked_stem, python_module_name, write_atomically
-from ..progress import Progress, plural
+from ..common.output import check_output_folder, checked_stem, python_module_name, write_atomically
+from ..common.progress import Progress, plural
 from .handling import handle_errors, recorded_warnings
 from .loading import command_params, default_description, load, load_reduced
 from .options import (description_argument, output_folder_option, quiet_option, scene_option,
@@ -111,7 +111,7 @@ def functions_option(text: str | None) -> tuple[str, ...] | None:
 def import_hint(paths: list[Path], outdir: Path, stem_given: bool) -> str | None:
     """The line saying how to import the Python modules among ``paths`` (None when there are
     none: LaTeX or C only): every ``.py`` file and extension module
-    (:func:`eomgen.output.python_module_name`; no C library)."""
+    (:func:`eomgen.common.output.python_module_name`; no C library)."""
     modules = {python_module_name(p.name) for p in paths} - {None}
     modules = sorted(modules, key=lambda m: (not m.endswith("_numpy"), m))
     if not modules:

@@ -18,7 +18,7 @@ import warnings
 import click
 
 from ..errors import EomgenError, one_line, recorded_warnings  # noqa: F401  (the CLI's)
-from ..progress import end_line
+from ..common.progress import end_line
 
 
 class Terminated(KeyboardInterrupt):

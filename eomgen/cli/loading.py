@@ -12,7 +12,7 @@ from pathlib import Path
 
 import click
 
-from ..output import module_name
+from ..common.output import module_name
 from ..robots import example_path
 from .options import MIMIC_KEY
 

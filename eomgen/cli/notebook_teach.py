@@ -1,5 +1,5 @@
 """``eomgen notebook`` (a Jupyter notebook deriving the equations step by step) and
-``eomgen teach`` (a handout for students): the command-line side of :mod:`eomgen.notebook` and
+``eomgen teach`` (a handout for students): the command-line side of :mod:`eomgen.teach.notebook` and
 :mod:`eomgen.teach`, imported when a command runs (they import SymPy).
 """
 
@@ -12,8 +12,8 @@ from pathlib import Path
 import click
 
 from ..errors import EomgenError, GenerationError
-from ..output import check_output_file, check_output_folder
-from ..progress import Progress
+from ..common.output import check_output_file, check_output_folder
+from ..common.progress import Progress
 from .handling import handle_errors
 from .loading import load_reduced
 from .options import (description_argument, output_file_option, output_folder_option,
@@ -66,7 +66,7 @@ def notebook(description, output, scene_path, no_check, quiet, strict):
       eomgen notebook ur5.urdf -o ur5.ipynb
       eomgen notebook panda.urdf --scene examples/scenes/panda_two_joints.yaml
     """
-    from ..notebook import build_notebook, write_notebook  # SymPy: when the command runs
+    from ..teach.notebook import build_notebook, write_notebook  # SymPy: when the command runs
 
     if output is not None:
         check_output_file(output)

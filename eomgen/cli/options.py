@@ -4,7 +4,7 @@ Each is a click decorator (or a function making one, where commands differ in a 
 help text): the DESCRIPTION argument (a file, or a bundled example's name; with it
 ``--mimic``), ``--scene``, ``--quiet``, ``--strict`` and ``-o/--output``
 (a folder or a file). Whether an output can be written is checked by the command itself
-(:mod:`eomgen.output`: one error line, not click's usage text). ``--debug`` comes with the error
+(:mod:`eomgen.common.output`: one error line, not click's usage text). ``--debug`` comes with the error
 handling (:func:`eomgen.cli.handling.handle_errors`).
 """
 
@@ -69,7 +69,7 @@ strict_option = click.option(
 
 
 def quiet_option(help: str = QUIET_HELP):
-    """``--quiet``: no :class:`eomgen.progress.Progress` lines."""
+    """``--quiet``: no :class:`eomgen.common.progress.Progress` lines."""
     return click.option("--quiet", is_flag=True, help=help)
 
 
@@ -81,14 +81,14 @@ def scene_option(help: str = SCENE_HELP):
 
 def output_folder_option(default: str):
     """``-o/--output`` (parameter ``outdir``) for a folder (see
-    :func:`eomgen.output.check_output_folder`)."""
+    :func:`eomgen.common.output.check_output_folder`)."""
     return click.option("-o", "--output", "outdir", default=default, show_default=True,
                         type=click.Path(path_type=Path), help="Output folder.")
 
 
 def output_file_option(help: str, default: str | None = None):
     """``-o/--output`` (parameter ``output``) for one file (see
-    :func:`eomgen.output.check_output_file`); the default is shown when there is one."""
+    :func:`eomgen.common.output.check_output_file`); the default is shown when there is one."""
     return click.option("-o", "--output", "output", default=default,
                         show_default=default is not None, type=click.Path(path_type=Path),
                         help=help)

@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from .. import __version__
-from ..output import GeneratedFile  # noqa: F401  (backends import it from here)
+from ..common.output import GeneratedFile  # noqa: F401  (backends import it from here)
 from ..outputs import function_names
 from .functions import (
     FunctionSpec,
@@ -70,7 +70,7 @@ def make_job(dynamics: "Dynamics", functions=None, notes=(), count_operations: b
     :func:`~eomgen.codegen.functions.select_functions`). ``notes`` are extra header lines;
     ``count_operations=False`` leaves the operation counts of the header at 0 (faster);
     ``stem`` names the files and modules (default: the robot's name,
-    :func:`eomgen.output.module_name`)."""
+    :func:`eomgen.common.output.module_name`)."""
     source = Path(dynamics.model.source)
     digest = hashlib.sha256(source.read_bytes()).hexdigest() if source.is_file() else "0" * 64
     chosen = select_functions(functions)

@@ -20,13 +20,13 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..output import module_name  # noqa: F401  (re-exported: its earlier home)
+from ..common.output import module_name  # noqa: F401  (re-exported: its earlier home)
 from ..outputs import BY_SYMBOL, INPUTS, OUTPUTS, select, splits
 from ..symbolic.builders import constants_provider
 from ..symbolic.program import Program, count_ops as count_ops_of
 
 # ``dynamics`` arguments are eomgen.dynamics.Dynamics, named in strings only: eomgen.dynamics
-# imports eomgen.lambdify, which prints through this module (no import back up).
+# imports eomgen.codegen.lambdify, which prints through this module (no import back up).
 
 
 @dataclass(frozen=True)

@@ -15,8 +15,8 @@ from ..dynamics import derive
 from ..cache import CacheRequest, render_cached
 from ..errors import GenerationError
 from ..model import RobotModel, snap_summary
-from ..output import checked_stem, import_collisions, write_atomically  # noqa: F401
-from ..progress import plural
+from ..common.output import checked_stem, import_collisions, write_atomically  # noqa: F401
+from ..common.progress import plural
 from ..outputs import OUTPUTS
 from . import GeneratedFile, available_backends, make_job
 from .functions import derived_outputs, select_functions
@@ -181,7 +181,7 @@ def generate(model: RobotModel, outdir: Path, backends: str | Sequence[str] = "a
         backend's extension module); ``False`` writes their text files only.
     stem:
         The files' and modules' name (``<stem>_numpy.py``; a Python identifier); default: the
-        robot's name (:func:`eomgen.output.module_name`).
+        robot's name (:func:`eomgen.common.output.module_name`).
     """
     stem = checked_stem(stem)
     chosen = select_backends(backends)

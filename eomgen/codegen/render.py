@@ -1,6 +1,6 @@
-"""Deprecated path: the Jinja environment moved to :mod:`eomgen.templating` (layer 0), which code
+"""Deprecated path: the Jinja environment moved to :mod:`eomgen.common.templating` (layer 0), which code
 generation and the teaching handouts share."""
 
-from ..templating import TEMPLATES_DIR, environment, render  # noqa: F401
+from ..common.templating import TEMPLATES_DIR, environment, render  # noqa: F401
 
 __all__ = ["TEMPLATES_DIR", "environment", "render"]

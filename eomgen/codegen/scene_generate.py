@@ -17,8 +17,8 @@ from typing import Iterable, Sequence
 from ..cache import Cache, CacheRequest
 from ..dynamics import derive
 from ..model import RobotModel
-from ..output import checked_stem
-from ..progress import plural
+from ..common.output import checked_stem
+from ..common.progress import plural
 from ..reduction import (
     MEASURE_TIMEOUT,
     DerivationCost,

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..output import GeneratedFile
+from ..common.output import GeneratedFile
 from .fit import Estimate, PhysicalFit
 from .measurements import Measurements
 

@@ -13,7 +13,7 @@ Conventions (URDF's, whatever the input format):
 * ``gravity`` is the gravitational acceleration [m/s²] in the root link frame, e.g.
   ``(0, 0, -9.81)`` for URDF input.
 * A movable joint may carry an :class:`Actuator` (armature, friction, stiffness): the rigid
-  bodies' ``M``, ``C``, ``g`` do not use it; :mod:`eomgen.actuators` does (docs/actuators.md).
+  bodies' ``M``, ``C``, ``g`` do not use it; :mod:`eomgen.analysis.actuators` does (docs/actuators.md).
 
 Every geometric and inertial quantity is a SymPy expression: a number (exact integers are kept
 exact so that structural zeros stay zeros) or an expression in the model's parameter symbols.

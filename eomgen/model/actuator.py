@@ -7,7 +7,7 @@ from typing import Mapping
 
 import sympy as sp
 
-from .. import reprs
+from ..common import reprs
 from .scalars import Scalar, scalar
 
 #: Coulomb friction is smoothed as ``friction · tanh(q̇ / friction_width)`` for simulation; this

@@ -1,6 +1,6 @@
 """A contact of a scene (:class:`Contact`): a frame held still at a point (3 rows of ``J_c``) or
 over a surface (6 rows). Plain data; the contact dynamics are computed from it by
-:mod:`eomgen.symbolic.frames` (generated) and :mod:`eomgen.contacts` (numerically), whose
+:mod:`eomgen.symbolic.frames` (generated) and :mod:`eomgen.numeric.contacts` (numerically), whose
 docstring gives the conventions (axes, signs, Baumgarte terms)."""
 
 from __future__ import annotations

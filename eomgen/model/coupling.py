@@ -28,7 +28,7 @@ from typing import Mapping, Sequence
 
 import sympy as sp
 
-from .. import reprs
+from ..common import reprs
 from ..errors import KinematicTreeError, UnsupportedError
 from .joints import KINDS
 from .scalars import scalar

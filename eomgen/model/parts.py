@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
-from .. import reprs
+from ..common import reprs
 from .actuator import Actuator
 from .joints import KINDS, JointKind
 from .scalars import ZERO3, Mat3, Scalar, Vec3, mat3, scalar, vec3

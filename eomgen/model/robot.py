@@ -11,7 +11,7 @@ from typing import Iterable, Mapping
 import numpy as np
 import sympy as sp
 
-from .. import reprs
+from ..common import reprs
 from ..errors import KinematicTreeError, ParameterError
 from .actuator import Actuator
 from .contact import Contact
@@ -166,7 +166,7 @@ class RobotModel:
     def parameter_names(self) -> tuple[str, ...]:
         return tuple(p.name for p in self.parameters)
 
-    def _repr_html_(self) -> str | None:  # rich display in notebooks: registered by eomgen.display
+    def _repr_html_(self) -> str | None:  # rich display in notebooks: registered by eomgen.present.display
         return reprs.render("model", self, "text/html")
 
     @property

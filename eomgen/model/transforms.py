@@ -8,7 +8,7 @@ from typing import Iterable
 
 import sympy as sp
 
-from .. import reprs
+from ..common import reprs
 from .scalars import IDENTITY3, ZERO3, Mat3, Vec3, mat3, vec3
 from .snapping import exact_angle, snap
 

@@ -1,6 +1,6 @@
 """Actuated models, numerically: armature, friction and Spong's flexible joints in NumPy.
 
-The equations and conventions are those of :mod:`eomgen.actuators` (docs/actuators.md).
+The equations and conventions are those of :mod:`eomgen.analysis.actuators` (docs/actuators.md).
 :func:`actuated_model` compiles a :class:`~eomgen.dynamics.Dynamics` (``M``, ``C``, ``g``,
 ``P``) with its model's actuators once into an :class:`ActuatedModel`; the evaluators are free
 functions of it: the rigid model with actuators (:func:`rigid_M`, :func:`friction_torque`,

@@ -13,7 +13,7 @@ Values are checked by :class:`Reader`, which turns every problem into a one-line
 (``links[2] 'link2' inertia``): a :class:`~eomgen.errors.SchemaError` for the document's
 structure, an :class:`~eomgen.errors.InvalidNumberError` for values and a
 :class:`~eomgen.errors.ParameterError` for parameter names and undeclared symbols. Numbers and expressions go through
-:func:`eomgen.expressions.parse_scalar` only; every symbol must be declared under
+:func:`eomgen.model.expressions.parse_scalar` only; every symbol must be declared under
 ``parameters``.
 """
 
@@ -38,7 +38,7 @@ from ..errors import (
     YAMLFormatError,
     one_line,
 )
-from ..expressions import check_parameter_name, parse_scalar
+from ..model.expressions import check_parameter_name, parse_scalar
 from ..model import Actuator, Mat3, Parameter, Vec3, parameter_symbol, scalar
 
 MAX_BYTES = 1024 * 1024

@@ -20,7 +20,7 @@ What is read
 * ``<dynamics damping friction>`` of a movable joint (both default 0): viscous friction
   [N m s/rad] and Coulomb friction [N m] of the joint's :class:`~eomgen.model.Actuator` (see
   docs/actuators.md; MuJoCo reads the same attributes as ``damping`` and ``frictionloss``).
-  They enter the equations of motion only through :mod:`eomgen.actuators` (the generated
+  They enter the equations of motion only through :mod:`eomgen.analysis.actuators` (the generated
   ``M``, ``C``, ``g`` stay those of the rigid bodies). A ``<dynamics>`` on a fixed joint is
   ignored.
 
@@ -100,7 +100,7 @@ from ..errors import (
     UnsupportedError,
     XMLSyntaxError,
 )
-from ..expressions import MAX_MAGNITUDE
+from ..model.expressions import MAX_MAGNITUDE
 from ..model import (
     Actuator,
     Inertial,
@@ -530,7 +530,7 @@ def _number_attribute(element: ET.Element, attribute: str, source: str, where: s
 
 def _finite(text: str, label: str, source: str, where: str) -> float:
     """``float(text)``, refusing text that is not a number, not finite (nan, inf) or of a
-    magnitude above :data:`~eomgen.expressions.MAX_MAGNITUDE`."""
+    magnitude above :data:`~eomgen.model.expressions.MAX_MAGNITUDE`."""
     try:
         value = float(text)
     except ValueError:

@@ -31,7 +31,7 @@
           stiffness: K1            # [N m/rad]: a flexible joint (Spong's model)
 
 Frames and units follow :mod:`eomgen.model` (URDF's conventions). Values are numbers or
-expressions read by :func:`eomgen.expressions.parse_scalar`; every symbol must be declared under
+expressions read by :func:`eomgen.model.expressions.parse_scalar`; every symbol must be declared under
 ``parameters``. A ``spherical`` joint (a ball joint, no ``axis``) is Pinocchio's
 ``JointModelSpherical``: its configuration is a unit quaternion, its velocity the angular
 velocity of the child in the child frame (:mod:`eomgen.model.quaternion`). A ``planar`` joint

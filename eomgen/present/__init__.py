@@ -15,7 +15,7 @@ generation.
   textbook steps, program of named subexpressions, regressor) as printed LaTeX.
 
 Used alike by the LaTeX backend (:mod:`eomgen.codegen.backends.latex_backend`), the handout
-(:mod:`eomgen.teach`), the notebook (:mod:`eomgen.notebook`) and the Jupyter display
-(:mod:`eomgen.display`). Nothing here imports :mod:`eomgen.codegen`; this package's own
+(:mod:`eomgen.teach`), the notebook (:mod:`eomgen.teach.notebook`) and the Jupyter display
+(:mod:`eomgen.present.display`). Nothing here imports :mod:`eomgen.codegen`; this package's own
 ``__init__`` imports nothing, so that the display can import what it prints with lazily.
 """

@@ -21,7 +21,7 @@ def body_masses(book: TextbookDerivation) -> list[sp.Symbol]:
 def grouped_matrices(book: TextbookDerivation) -> dict:
     """M, C and g of ``book``: entries of M grouped by body mass, those of g by trigonometric
     factor (sums built unevaluated, so their order is kept; print them with
-    :func:`eomgen.display.expression_latex`)."""
+    :func:`eomgen.present.display.expression_latex`)."""
     masses = body_masses(book)
     angles = list(book.q)
     return {"M": book.M.applyfunc(lambda e: rd.mass_grouped(e, masses)),

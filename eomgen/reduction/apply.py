@@ -8,7 +8,7 @@ from typing import Sequence
 
 import sympy as sp
 
-from ..bodies import attach_fixed_links
+from ..model.bodies import attach_fixed_links
 from ..errors import DescriptionError
 from ..floating import EULER_JOINTS, add_floating_base
 from ..free_flyer import VELOCITY_NAMES, add_free_flyer
@@ -125,7 +125,7 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
     reduced = replace(reduced, contacts=scene.contacts, frames=scene.frames)
     reduced = with_loops(reduced, scene, notes)
     if scene.contacts:
-        notes.append("contacts (generated with --outputs contact_jacobian, contact_bias, constrained_forward_dynamics; numerically eomgen.contacts.ContactDynamics): "
+        notes.append("contacts (generated with --outputs contact_jacobian, contact_bias, constrained_forward_dynamics; numerically eomgen.numeric.contacts.ContactDynamics): "
                      + ", ".join(f"{c.name} on '{c.frame}' ({c.kind}"
                                  + (f", μ = {c.mu:g}" if c.mu is not None else "") + ")"
                                  for c in scene.contacts))
@@ -394,7 +394,7 @@ def _actuator_notes(model: RobotModel, scene: Scene) -> list[str]:
         notes.append("actuators of joints that do not move (no effect): " + ", ".join(ignored))
     flexible = [j.name for j in model.movable_joints if j.actuator and j.actuator.flexible]
     if flexible:
-        notes.append("flexible joints (Spong's model, eomgen.actuators; the generated M, C, g "
+        notes.append("flexible joints (Spong's model, eomgen.analysis.actuators; the generated M, C, g "
                      "are the rigid links'): " + ", ".join(flexible))
     return notes
 

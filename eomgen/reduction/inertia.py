@@ -8,7 +8,7 @@ from typing import Iterable
 
 import sympy as sp
 
-from ..bodies import InertialParameters, merged_inertial
+from ..model.bodies import InertialParameters, merged_inertial
 from ..model import ZERO3, Inertial, Transform, scalar
 
 #: Relative size below which a number computed while merging is roundoff of an exact zero.

@@ -39,7 +39,7 @@ def with_loops(reduced: RobotModel, scene: Scene, notes: list[str]) -> RobotMode
     if scene.loops:
         notes.append("loops (generated with --outputs loop_constraint, loop_jacobian, "
                      "loop_bias, and in contact_jacobian and constrained_forward_dynamics; "
-                     "numerically eomgen.loops.LoopDynamics): "
+                     "numerically eomgen.numeric.loops.LoopDynamics): "
                      + ", ".join(f"{loop.name} ({loop.kind}"
                                  + (", planar" if loop.plane is not None else "")
                                  + f", {loop.size} rows)" for loop in scene.loops))

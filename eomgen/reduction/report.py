@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import NamedTuple
 
-from .. import reprs
+from ..common import reprs
 from ..model import RobotModel
 from .inertia import is_zero_inertial
 from .planar import PlanarMotion

@@ -13,7 +13,7 @@ from typing import Iterable, Mapping, Sequence
 import numpy as np
 import sympy as sp
 
-from ..bodies import BodyTree
+from ..model.bodies import BodyTree
 from ..errors import ParameterError
 from ..model import RobotModel, parameter_symbol
 from ..symbolic.derivation import new_derivation

@@ -13,7 +13,7 @@ frame after the joint has moved, see :mod:`eomgen.model`), as pairs of 3-vectors
 * motion ``v = (ω, v_O)``: angular velocity and linear velocity of the point at the origin;
 * force ``f = (n, f)``: moment about the origin and force;
 * inertia ``I = (A, B, C)``: the symmetric 6×6 ``[[A, B], [Bᵀ, C]]`` with ``f = I v``; a rigid
-  body has ``A = I_O``, ``B = [h]×``, ``C = m 1`` (m, h = m c, I_O as in :mod:`eomgen.bodies`).
+  body has ``A = I_O``, ``B = [h]×``, ``C = m 1`` (m, h = m c, I_O as in :mod:`eomgen.model.bodies`).
 
 The joint motion subspace is ``S = (k, 0)`` for a revolute joint about the unit axis ``k``,
 ``(0, k)`` for a prismatic one. Gravity enters as the base acceleration ``a_0 = (0, −g_vec)``.
@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..bodies import BodyTree
+from ..model.bodies import BodyTree
 from ..model import RobotModel, Vec3
 from .builders import builds
 from .derivation import new_derivation
@@ -55,7 +55,7 @@ def forward_dynamics_program(tree: BodyTree, q, qd, tau, gravity: Vec3, b: Progr
     Parameters
     ----------
     tree:
-        The moving bodies (:func:`eomgen.bodies.body_tree`).
+        The moving bodies (:func:`eomgen.model.bodies.body_tree`).
     q, qd, tau:
         Joint position, velocity and effort symbols, in ``JOINT_NAMES`` order [rad or m, rad/s or
         m/s, N m or N].

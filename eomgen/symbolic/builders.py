@@ -55,7 +55,7 @@ def builds(*symbols: str) -> Callable[[Callable], Callable]:
     unknown = [s for s in symbols if s not in BY_SYMBOL]
     if unknown or not symbols:
         raise ValueError(f"no printed output {', '.join(unknown) or '(none named)'} in the "
-                         "catalogue (eomgen.catalogue)")
+                         "catalogue (eomgen.outputs.catalogue)")
     return lambda function: _register(BUILDERS, symbols, function, "builder of")
 
 

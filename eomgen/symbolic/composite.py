@@ -44,7 +44,7 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
-from ..bodies import BodyTree
+from ..model.bodies import BodyTree
 from ..model import Vec3
 from .program import ProgramBuilder
 from .spatial import (SpatialInertia, cross, dot, force_cross, matmul, matvec, motion_cross,

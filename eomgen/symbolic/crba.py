@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..bodies import BodyTree
+from ..model.bodies import BodyTree
 from ..model import RobotModel
 from .derivation import new_derivation
 from .newton_euler import grouped_inertials

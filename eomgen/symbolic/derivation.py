@@ -1,6 +1,6 @@
 """The derivation: what every symbolic algorithm works on, made in one place.
 
-A :class:`Derivation` holds a model, its body tree (fixed links merged, :mod:`eomgen.bodies`),
+A :class:`Derivation` holds a model, its body tree (fixed links merged, :mod:`eomgen.model.bodies`),
 the symbols of each input vector in ``JOINT_NAMES`` order and the program builder the
 algorithms define their intermediates in. :func:`new_derivation` is the only function that
 builds one; :func:`eomgen.derive`, the algorithm entry points (CRBA, ABA, Newton–Euler, the
@@ -22,7 +22,7 @@ from typing import Iterable
 
 import sympy as sp
 
-from ..bodies import BodyTree, body_tree
+from ..model.bodies import BodyTree, body_tree
 from ..model import RobotModel, configuration_size, float_constants
 from ..errors import UnsupportedError
 from ..outputs import BY_SYMBOL, INPUTS

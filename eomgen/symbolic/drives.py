@@ -1,5 +1,5 @@
 """Builders of the drive outputs (issue 17): armature, friction and Spong's flexible joints as
-generated functions. The equations and conventions are those of :mod:`eomgen.actuators`
+generated functions. The equations and conventions are those of :mod:`eomgen.analysis.actuators`
 (docs/actuators.md):
 
 * rigid joints with drives: ``(M(q) + diag(a)) q̈ + C q̇ + g + τ_f(q̇) = τ``, with
@@ -22,7 +22,7 @@ real one-DOF joints only (a quaternion joint's entries have no armature, frictio
 0 there), and ``q`` of ``τ_K`` is the flexible joint's own angle.
 
 Units: N m (N for prismatic joints), kg m², rad, rad/s. The friction law itself is
-:func:`friction_torque_expr`, shared with :mod:`eomgen.actuators` and :mod:`eomgen.symbolic.flat`.
+:func:`friction_torque_expr`, shared with :mod:`eomgen.analysis.actuators` and :mod:`eomgen.symbolic.flat`.
 """
 
 from __future__ import annotations

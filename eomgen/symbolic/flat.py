@@ -15,8 +15,8 @@ and on every rigid joint ``i`` (armature ``a_i``) the joint torque of the rigid 
 ``τ_i = τ_L,i + a_i q̈_i + d_i q̇_i + f_i sign(q̇_i)``, with ``θ_i = q_i``, ``θ̇_i = q̇_i`` (a
 rigid joint's motor turns with its link). The ``_smooth`` output uses ``f tanh(v / w)`` in place
 of ``f sign(v)``, the law of ``motor_forward_dynamics`` and of
-:func:`eomgen.actuators.flexible_forward_dynamics` (``smooth=True``), so that a simulation fed
-with it follows ``q(t)``. Conventions (frames, units, signs) are those of :mod:`eomgen.actuators`:
+:func:`eomgen.analysis.actuators.flexible_forward_dynamics` (``smooth=True``), so that a simulation fed
+with it follows ``q(t)``. Conventions (frames, units, signs) are those of :mod:`eomgen.analysis.actuators`:
 motor angles on the link side of the gear [rad], torques along the joint axes [N m; N for a
 prismatic joint], one torque vector ``tau`` (joint torque of a rigid joint, motor torque of a
 flexible one) in ``JOINT_NAMES`` order.

@@ -330,7 +330,7 @@ def _require_contacts(model: RobotModel) -> None:
 
 def build_contacts(derivation, wanted) -> dict:
     """The builder of ``J_c`` (m×n) and ``dJqd_c`` (``J̇_c q̇``, (m,)): the rows of the model's
-    contacts as :class:`eomgen.contacts.ContactDynamics` stacks them, in contact order. A
+    contacts as :class:`eomgen.numeric.contacts.ContactDynamics` stacks them, in contact order. A
     point contact gives the linear rows of the world-aligned frame Jacobian (its force in world
     axes); a surface contact the six rows of the body Jacobian (its wrench in the frame's
     axes). Baumgarte gains are not part of these rows.

@@ -17,7 +17,7 @@ parent, and is pushed there:
   inertia about its origin, ``(0, 0, I)``, is pushed (the mass and first moments stay).
 
 A pushed part ``(m, h, I)`` is moved into the parent's frame through the fixed joint placement
-(:meth:`~eomgen.bodies.InertialParameters.transformed`): DH lengths kept as symbols stay symbols.
+(:meth:`~eomgen.model.bodies.InertialParameters.transformed`): DH lengths kept as symbols stay symbols.
 What a body on the fixed base pushes is unidentifiable and is dropped. The remaining special
 cases (columns that vanish because of gravity or axes parallel to the first ones) are left to
 the caller, who finds them numerically (:func:`eomgen.regressor.symbolic_base_parameters`).
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..bodies import BodyTree, InertialParameters
+from ..model.bodies import BodyTree, InertialParameters
 from .spatial import aligned_axis
 
 #: Slot of each Pinocchio-ordered parameter: ("m",), ("h", a), ("I", a, b).

@@ -8,7 +8,7 @@ Frames and conventions: every body quantity is in its own body frame (the joint 
 joint has moved, see :mod:`eomgen.model`). ``ω``, ``ω̇`` are the body's angular velocity and
 acceleration, ``a`` the linear acceleration of the body-frame origin, with gravity entering as a
 base acceleration ``a_0 = −g_vec``. Body inertial parameters are about the body origin (m, h, I_O,
-see :mod:`eomgen.bodies`). With Khalil's matrix ``U = [ω̇]× + [ω]×[ω]×`` (so that the
+see :mod:`eomgen.model.bodies`). With Khalil's matrix ``U = [ω̇]× + [ω]×[ω]×`` (so that the
 acceleration of a point at ``r`` on the body is ``a + U r``), the net force and moment about the
 origin are
 
@@ -48,7 +48,7 @@ from __future__ import annotations
 import sympy as sp
 from mpmath.libmp import prec_to_dps
 
-from ..bodies import BodyTree, InertialParameters
+from ..model.bodies import BodyTree, InertialParameters
 from ..model import Transform, Vec3
 from .builders import builds
 from .program import ProgramBuilder, name_expr, name_exprs

@@ -1,6 +1,6 @@
 """The joint torque regressor τ = Y(q, q̇, q̈) π as a straight-line program.
 
-Inverse dynamics is linear in the inertial parameters. Per moving body j (a :class:`~eomgen.bodies.
+Inverse dynamics is linear in the inertial parameters. Per moving body j (a :class:`~eomgen.model.bodies.
 RigidBody`: the child link of a movable joint with its fixed descendants merged) the ten
 parameters, in Pinocchio's order (``Inertia.toDynamicParameters``), are::
 
@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..bodies import BodyTree
+from ..model.bodies import BodyTree
 from .program import ProgramBuilder
 from .spatial import JointFrames, cross, dot
 

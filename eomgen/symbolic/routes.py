@@ -24,7 +24,7 @@ from typing import Iterable
 
 import sympy as sp
 
-from ..bodies import BodyTree
+from ..model.bodies import BodyTree
 from ..model import Vec3
 from .builders import builds
 from .composite import (christoffel_coriolis_program, composite_gravity_program,

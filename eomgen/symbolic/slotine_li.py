@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..bodies import BodyTree
+from ..model.bodies import BodyTree
 from .program import ProgramBuilder
 from .spatial import JointFrames, cross, dot
 

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..bodies import BodyTree
+from ..model.bodies import BodyTree
 from ..model import Vec3
 from .monomials import difference, mul, negated, total
 from .program import ProgramBuilder, name_expr, name_exprs, name_matrix, name_symmetric

@@ -1,7 +1,7 @@
 """The textbook Lagrangian derivation, body by body, for teaching-sized models.
 
 For each moving body i (a movable joint's child link with its fixed descendants merged, see
-:mod:`eomgen.bodies`), in the world (root link) frame:
+:mod:`eomgen.model.bodies`), in the world (root link) frame:
 
 * ``p_ci(q)``: position of the centre of mass [m];
 * ``J_vi = ∂p_ci/∂q`` (3×n) and ``J_ωi`` (3×n): column k is the world axis ``z_k`` of joint k
@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..bodies import body_tree
+from ..model.bodies import body_tree
 from ..model import IDENTITY3, RobotModel, Transform, ZERO3, all_scalars, joint_motion
 from .derivation import joint_symbols
 # The algebra the derivation computes in; its functions are also imported from here.

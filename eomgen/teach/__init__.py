@@ -4,7 +4,7 @@ The pipeline is the code generator's, for documents: a robot model →
 :func:`~eomgen.teach.content.build_handout` (what the handout says, as plain data:
 :mod:`eomgen.teach.document`) → a format of :mod:`eomgen.teach.formats` (LaTeX, PDF, Markdown,
 HTML, each a template under ``templates/teach/``) → files written all at once
-(:func:`eomgen.output.write_atomically`). The kinematic sketch is :mod:`eomgen.teach.sketch`.
+(:func:`eomgen.common.output.write_atomically`). The kinematic sketch is :mod:`eomgen.teach.sketch`.
 
 >>> import eomgen
 >>> from eomgen.teach import handout_files
@@ -20,7 +20,7 @@ from typing import Callable, Sequence
 
 from ..errors import GenerationError
 from ..model import RobotModel
-from ..output import GeneratedFile, write_atomically
+from ..common.output import GeneratedFile, write_atomically
 from .content import build_handout
 from .formats import FORMATS
 

@@ -95,7 +95,7 @@ def contact_section(dyn: Dynamics, contacts, book: TextbookDerivation | None, co
             "For a robot of this size $J_{c}$ and $\\dot{J}_{c} \\dot{q}$ are not written out "
             "here; eomgen derives them as a program of named subexpressions "
             "(eomgen.symbolic.frames.derive_frames) and evaluates them numerically "
-            "(eomgen.contacts).")))
+            "(eomgen.numeric.contacts).")))
         return Section("Contact", tuple(blocks))
     Jc, dJqd, F, equations = contact_equations(dyn, contacts, book, coriolis)
     angles = list(dyn.q)

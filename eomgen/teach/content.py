@@ -11,7 +11,7 @@ Control*, the planar two-link arm):
    symbols and C (common factors named, e.g. ``h = m_2 l_1 l_{c2} s_2``), the gravity vector
    (grouped by the trigonometric functions), the complete equations of motion;
    for larger models, the straight-line program of named subexpressions instead, saying so;
-4. when the joints have drives (:mod:`eomgen.actuators`): Spong's link and motor equations
+4. when the joints have drives (:mod:`eomgen.analysis.actuators`): Spong's link and motor equations
    for flexible joints, or ``M + diag(a)`` and the friction torque for rigid ones, joint by
    joint (:func:`drive_equations`); when the scene has contacts: ``M q̈ + C q̇ + g = τ +
    J_cᵀ F_c``, ``J_c q̈ + J̇_c q̇ = 0`` and ``J_c`` written out (:func:`contact_equations`);
@@ -34,8 +34,8 @@ from typing import Callable
 import sympy as sp
 
 from .. import __version__
-from ..actuators import spong_dynamics
-from ..output import module_name
+from ..analysis.actuators import spong_dynamics
+from ..common.output import module_name
 from ..dynamics import Dynamics, derive
 from ..errors import ParameterError, UnsupportedError
 from ..model import IDENTITY3, RobotModel
@@ -43,7 +43,7 @@ from ..present import notation as nt
 from ..present import readability as rd
 from ..present.grouping import body_masses
 from ..present.sections import program_sections
-from ..progress import plural
+from ..common.progress import plural
 from ..symbolic.textbook import TextbookDerivation
 from ..verify import VerificationReport, verify
 from .loops import loop_section, loop_symbol_names

@@ -1,4 +1,4 @@
-"""The handout's section on drives (:mod:`eomgen.actuators`): Spong's link and motor equations
+"""The handout's section on drives (:mod:`eomgen.analysis.actuators`): Spong's link and motor equations
 for flexible joints, or ``M + diag(a)`` and the friction torque for rigid ones, joint by joint
 (:func:`drive_equations`, printed by :func:`drives_section`).
 """
@@ -9,7 +9,7 @@ from typing import Callable
 
 import sympy as sp
 
-from ..actuators import SpongDynamics, joint_actuators
+from ..analysis.actuators import SpongDynamics, joint_actuators
 from ..model import RobotModel
 from ..present import notation as nt
 from ..symbolic.textbook import TextbookDerivation
@@ -79,8 +79,8 @@ def drive_equations(spong: SpongDynamics, book: TextbookDerivation | None, corio
         reads ``τ_{m,k} = B_k θ̈_k + K_k (θ_k − q_k) + τ_f,k(θ̇_k)``. With
         :func:`~eomgen.teach.writer.abbreviation_values` and :func:`spring_values`
         substituted, ``terms − lhs`` are the residuals of
-        :meth:`~eomgen.actuators.SpongDynamics.link_equations` and
-        :meth:`~eomgen.actuators.SpongDynamics.motor_equations` (exact friction).
+        :meth:`~eomgen.analysis.actuators.SpongDynamics.link_equations` and
+        :meth:`~eomgen.analysis.actuators.SpongDynamics.motor_equations` (exact friction).
     """
     dyn = spong.dynamics
     links, motors = [], []

@@ -27,9 +27,9 @@ import tempfile
 from pathlib import Path
 from typing import Callable
 
-from ..templating import render
+from ..common.templating import render
 from ..errors import GenerationError
-from ..output import GeneratedFile
+from ..common.output import GeneratedFile
 from ..present.printer import latex_comment, latex_escape
 from .document import Equations, Figure, Handout, Inline, Paragraph, Table
 

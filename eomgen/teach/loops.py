@@ -81,7 +81,7 @@ def loop_section(dyn: Dynamics, book: TextbookDerivation | None, coriolis, w: Wr
         blocks.append(Paragraph(prose(
             "For a robot of this size $\\Phi$, $J_{l}$ and $\\dot{J}_{l} \\dot{q}$ are not "
             "written out here; eomgen derives them as a program of named subexpressions "
-            "(eomgen.symbolic.loops) and evaluates them numerically (eomgen.loops).")))
+            "(eomgen.symbolic.loops) and evaluates them numerically (eomgen.numeric.loops).")))
         return Section("Loop closures", tuple(blocks))
     Phi, J, bias, lam, equations = loop_equations(dyn, book, coriolis)
     angles = list(dyn.q)

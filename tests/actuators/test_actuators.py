@@ -1,4 +1,4 @@
-"""Actuators and flexible joints (eomgen.actuators, docs/actuators.md).
+"""Actuators and flexible joints (eomgen.analysis.actuators, docs/actuators.md).
 
 References: MuJoCo (``qM``, ``qfrc_bias``, ``qfrc_passive`` with ``armature`` and ``damping``
 set on the same URDF) for the rigid model with actuators; eomgen's numeric Newton–Euler for
@@ -18,7 +18,7 @@ import pytest
 import sympy as sp
 
 import eomgen
-from eomgen import actuators as A
+from eomgen.analysis import actuators as A
 from eomgen.errors import InvalidActuatorError, SceneError, SchemaError
 from eomgen.model import Actuator
 from eomgen.numeric import numeric_model, rnea

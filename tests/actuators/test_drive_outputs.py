@@ -6,7 +6,7 @@ joints printed by every backend, against independent computations:
   with NumPy (d q̇ + f sign(q̇), and f tanh(q̇ / w));
 * MuJoCo's ``qM`` with ``dof_armature`` and ``qfrc_passive`` with ``dof_damping`` (UR5);
 * the flexible model's accelerations, assembled from the generated functions, against
-  :func:`eomgen.actuators.flexible_forward_dynamics`.
+  :func:`eomgen.analysis.actuators.flexible_forward_dynamics`.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import eomgen
-from eomgen import actuators as A
+from eomgen.analysis import actuators as A
 from eomgen.numeric import M_rnea, numeric_model, rnea
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene

@@ -1,8 +1,8 @@
 """The flat inverse dynamics of Spong's flexible-joint model as generated functions (issue 17):
 ``motor_angles``, ``motor_velocities``, ``flat_motor_torque`` and ``flat_motor_torque_smooth``
-printed by every backend, against :func:`eomgen.actuators.flexible_inverse_dynamics` (its own
+printed by every backend, against :func:`eomgen.analysis.actuators.flexible_inverse_dynamics` (its own
 forward-mode program, compiled separately) at random states, and fed to
-:func:`eomgen.actuators.flexible_forward_dynamics`: the simulated links follow q(t).
+:func:`eomgen.analysis.actuators.flexible_forward_dynamics`: the simulated links follow q(t).
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import eomgen
-from eomgen import actuators as A
+from eomgen.analysis import actuators as A
 from support.generated import BACKENDS, generated as generate_all
 from support.robots import FLEXIBLE_2LINK, drive_arm as arm
 

@@ -1,4 +1,4 @@
-"""The output registry upside down, checked: the catalogue (:mod:`eomgen.catalogue`) is data, and
+"""The output registry upside down, checked: the catalogue (:mod:`eomgen.outputs.catalogue`) is data, and
 each printed output has exactly one builder, registered by the module that builds it
 (:mod:`eomgen.symbolic.builders`), once the place that derives (:mod:`eomgen.dynamics`) is
 imported; so are the sizes of the inputs and the module constants the catalogue names.
@@ -20,7 +20,8 @@ from types import SimpleNamespace
 import pytest
 
 import eomgen
-from eomgen import catalogue, outputs
+from eomgen import outputs
+from eomgen.outputs import catalogue
 from eomgen.symbolic import builders
 from support import ROOT
 
@@ -98,7 +99,7 @@ def test_the_input_sizes_come_from_the_registered_functions():
 def test_the_catalogue_is_data():
     """It imports nothing but the standard library and holds no callable but its record type
     (no builder named, by reference or by string)."""
-    tree = ast.parse((ROOT / "eomgen" / "catalogue.py").read_text(encoding="utf-8"))
+    tree = ast.parse((ROOT / "eomgen" / "outputs" / "catalogue.py").read_text(encoding="utf-8"))
     imported = [node.module if isinstance(node, ast.ImportFrom) else a.name
                 for node in ast.walk(tree) if isinstance(node, (ast.Import, ast.ImportFrom))
                 for a in node.names]

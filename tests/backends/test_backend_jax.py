@@ -215,10 +215,10 @@ def test_parameters_named_like_the_framework_do_not_shadow_it(tmp_path):
 
 
 def test_dask_map_takes_dask_inputs_and_jax_functions(robot):
-    """eomgen.batch.dask_map over a JAX function (issue 12, item 7): chunks of a dask array,
+    """eomgen.analysis.batch.dask_map over a JAX function (issue 12, item 7): chunks of a dask array,
     the joints of a state joined into one chunk, equal to the NumPy batch."""
     da = need("dask.array", reason="dask_map runs on dask")
-    from eomgen.batch import dask_map
+    from eomgen.analysis.batch import dask_map
 
     modules = robot("planar_2link")
     rng = np.random.default_rng(1)

@@ -17,7 +17,7 @@ import pytest
 
 from eomgen.codegen.backends.fast_backend import (RUNTIME_DIR, RUNTIME_FILES, RUNTIME_MARKER,
                                                   python_headers, runtime_source)
-from eomgen.compiler import c_compiler
+from eomgen.common.compiler import c_compiler
 from support import ROOT
 
 WARNINGS = ("-Wall", "-Wextra", "-Werror")

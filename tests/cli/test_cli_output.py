@@ -30,8 +30,8 @@ from pathlib import Path
 
 import pytest
 
-from eomgen.output import GeneratedFile, OutputError, check_output_folder, write_atomically
-from eomgen.progress import Progress, plural
+from eomgen.common.output import GeneratedFile, OutputError, check_output_folder, write_atomically
+from eomgen.common.progress import Progress, plural
 
 from support import ERROR, ROOT, SCENES, erd_robots_dir, run_in_process, run_process
 
@@ -282,7 +282,7 @@ def test_steps_in_a_log_print_each_tenth_and_each_named_step():
 
 
 def test_a_warning_or_error_after_a_terminal_line_starts_a_new_line():
-    from eomgen.progress import end_line
+    from eomgen.common.progress import end_line
 
     stream = io.StringIO()
     progress = Progress(stream=stream, tty=True)

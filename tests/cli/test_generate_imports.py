@@ -14,8 +14,8 @@ import pytest
 
 import eomgen
 from eomgen.codegen import available_backends
-from eomgen.compiler import c_compiler
-from eomgen.output import import_collisions, python_module_name
+from eomgen.common.compiler import c_compiler
+from eomgen.common.output import import_collisions, python_module_name
 from support import run_in_process
 from support.extras import need
 

@@ -1,4 +1,4 @@
-"""eomgen.batch.dask_map: generated functions over dask arrays, on a distributed.LocalCluster of
+"""eomgen.analysis.batch.dask_map: generated functions over dask arrays, on a distributed.LocalCluster of
 worker processes, equal to the NumPy module on the whole batch (the ``dask`` extra). Other
 backends' functions through dask_map: with their own tests."""
 
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import eomgen
-from eomgen.batch import dask_map
+from eomgen.analysis.batch import dask_map
 from eomgen.codegen.generate import generate
 from support.extras import need
 

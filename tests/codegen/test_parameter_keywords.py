@@ -17,7 +17,7 @@ import sympy as sp
 import eomgen
 from eomgen.codegen.backends.casadi_backend import library_name
 from eomgen.codegen.generate import generate
-from eomgen.compiler import c_compiler
+from eomgen.common.compiler import c_compiler
 from eomgen.model import Parameter
 from support import load_module
 from support.extras import need

@@ -1,5 +1,5 @@
 """The registries: outputs declared once (:mod:`eomgen.outputs`), backends found where they are
-defined (:mod:`eomgen.codegen.backends`), one C compiler lookup (:mod:`eomgen.compiler`).
+defined (:mod:`eomgen.codegen.backends`), one C compiler lookup (:mod:`eomgen.common.compiler`).
 
 The generated modules are checked against the registry (names, inputs, shapes) and the
 registry against what the project documented before it existed (the function table, the
@@ -18,7 +18,8 @@ import sympy as sp
 import pytest
 
 import eomgen
-from eomgen import cache, compiler, outputs
+from eomgen import cache, outputs
+from eomgen.common import compiler
 from eomgen.codegen import BACKENDS, available_backends, loadable_backends, make_job
 from eomgen.codegen.backends import BACKEND_MODULES, casadi_backend, fast_backend
 from eomgen.codegen.functions import (RESERVED_IDENTIFIERS, derived_outputs,

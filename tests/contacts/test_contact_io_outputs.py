@@ -4,7 +4,7 @@ body ``J̇ q̇`` of the frames.
 
 References: the planar 2-link arm's closed-form tip Jacobian with eomgen.numeric's Newton–Euler
 τ; the generated ``constrained_forward_dynamics`` (q̈, F_c) fed back (the contact inverse dynamics
-must return the τ it was given); the cone formulas written out in NumPy, and eomgen.contacts'
+must return the τ it was given); the cone formulas written out in NumPy, and eomgen.numeric.contacts'
 numeric cone check; finite differences in time of the generated body Jacobians.
 """
 
@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import eomgen
-from eomgen.contacts import ContactDynamics
+from eomgen.numeric.contacts import ContactDynamics
 from eomgen.errors import GenerationError
 from eomgen.numeric import numeric_model, rnea
 from eomgen.reduction import apply_scene
@@ -63,7 +63,7 @@ def test_contact_inverse_dynamics_is_newton_euler_minus_the_contact_forces(arm):
         F = rng.uniform(-5, 5, 6)
         J_tip = _tip_jacobian(model, q)
         expected = rnea(numeric, q, qd, qdd) - cd.contact_jacobian(q).T @ F
-        # the tip's rows are the closed form (the elbow's from eomgen.contacts)
+        # the tip's rows are the closed form (the elbow's from eomgen.numeric.contacts)
         np.testing.assert_allclose(cd.contact_jacobian(q)[:3], J_tip, atol=1e-12)
         for backend, call in calls.items():
             got = call("contact_inverse_dynamics", q, qd, qdd, F)
@@ -118,7 +118,7 @@ def test_friction_margins_in_every_backend(arm):
                                        atol=1e-12, err_msg=backend)
             np.testing.assert_allclose(call("friction_pyramid_margins", F), p, rtol=1e-12,
                                        atol=1e-12, err_msg=backend)
-    # the exact margin is eomgen.contacts' numeric cone check
+    # the exact margin is eomgen.numeric.contacts' numeric cone check
     for F, c in zip(forces, cone):
         np.testing.assert_allclose([m for _, m in cd.friction_cone(F)], c, rtol=1e-12)
     # batch shapes, and the sign at the cone's edge: f_t = μ f_n (1 ± 1e-6)

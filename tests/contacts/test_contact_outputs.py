@@ -6,7 +6,7 @@ statics against a wall (docs/contact.md), in every backend; Pinocchio's frame pl
 ``getFrameJacobian`` (LOCAL_WORLD_ALIGNED, LOCAL), classical frame accelerations and
 ``constraintDynamics`` (CONTACT_3D) on the floating solo12 with its four feet held, through
 eomgen.floating's map to Pinocchio's free flyer; finite differences of the generated positions;
-eomgen.contacts' numeric KKT (Newton–Euler M and h).
+eomgen.numeric.contacts' numeric KKT (Newton–Euler M and h).
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from support.reference import pinocchio_contacts
 from eomgen import floating
 from eomgen.codegen.functions import select_functions
 from eomgen.codegen.generate import render_files
-from eomgen.contacts import ContactDynamics
+from eomgen.numeric.contacts import ContactDynamics
 from eomgen.errors import SceneError
 from eomgen.outputs import CONSTRAINED_FORWARD, OUTPUTS
 from eomgen.reduction import apply_scene

@@ -1,4 +1,4 @@
-"""Contacts (eomgen.contacts, scene ``contacts``): KKT constrained dynamics and its checks.
+"""Contacts (eomgen.numeric.contacts, scene ``contacts``): KKT constrained dynamics and its checks.
 
 References: Pinocchio's ``constraintDynamics`` with ``RigidConstraintModel`` (CONTACT_3D in
 LOCAL_WORLD_ALIGNED, CONTACT_6D in LOCAL) on the free-flyer solo12 from its own URDF reader;
@@ -18,7 +18,7 @@ from support import (
     CONTACTS, DOCS, erd_robots_dir, floating_states, load_quietly, relative, run_in_process,
 )
 from eomgen import floating, numeric
-from eomgen.contacts import Contact, ContactDynamics, derived_mass_and_bias
+from eomgen.numeric.contacts import Contact, ContactDynamics, derived_mass_and_bias
 from eomgen.errors import SceneError
 from eomgen.free_flyer import add_free_flyer
 from eomgen.model import Inertial, Joint, JointType, Link, Transform, build_model

@@ -1,9 +1,9 @@
 """``eomgen simulate`` with contacts held and with flexible joints (issues 16 and 17).
 
 References: the closed form of the planar arm held at its tip (docs/contact.md), the KKT
-acceleration of eomgen.contacts from eomgen's numeric Newton–Euler, SciPy's rotation vector
+acceleration of eomgen.numeric.contacts from eomgen's numeric Newton–Euler, SciPy's rotation vector
 for the SO(3) logarithm, the energy of eomgen.numeric (links) plus motors and springs, the
-functions of eomgen.actuators, and the rigid model with reflected inertia integrated from
+functions of eomgen.analysis.actuators, and the rigid model with reflected inertia integrated from
 eomgen.numeric's M and h.
 """
 
@@ -19,10 +19,10 @@ from click.testing import CliRunner
 import eomgen
 from support import ROOT
 from support.extras import need
-from eomgen import actuators as A
+from eomgen.analysis import actuators as A
 from eomgen import numeric
 from eomgen.cli import _load_reduced, main
-from eomgen.contacts import Contact, ContactDynamics, derived_mass_and_bias, rotation_log
+from eomgen.numeric.contacts import Contact, ContactDynamics, derived_mass_and_bias, rotation_log
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 
@@ -135,7 +135,7 @@ def test_orientation_drift_decays_with_baumgarte_and_stays_without():
 # ----------------------------------------------------------------------------------------------
 
 def test_one_integrated_step_is_the_kkt_acceleration():
-    """One explicit Euler step of the simulator is q̇0 + h q̈ with q̈ from eomgen.contacts' KKT
+    """One explicit Euler step of the simulator is q̇0 + h q̈ with q̈ from eomgen.numeric.contacts' KKT
     solve on eomgen's numeric Newton–Euler (not the derived program the simulator uses); one
     RK4 step agrees to O(h)."""
     model, report = _top()
@@ -232,7 +232,7 @@ def test_flexible_system_is_the_reduced_spong_model(flexible):
     am = A.actuated_model(eomgen.derive(flexible))
     rng = np.random.default_rng(5)
     q, qd, th, thd = rng.normal(size=(4, 2))
-    x = np.concatenate([q, qd, th, thd])  # eomgen.actuators' order
+    x = np.concatenate([q, qd, th, thd])  # eomgen.analysis.actuators' order
     Q, Qd = np.concatenate([q, th]), np.concatenate([qd, thd])
     expected = A.flexible_forward_dynamics(am, x, [1.5, -0.7])
     got = system.forward_dynamics(Q, Qd)

@@ -1,4 +1,4 @@
-"""Contacts on a quaternion free flyer: eomgen.contacts' J_c, J̇_c q̇ and KKT dynamics on solo12's
+"""Contacts on a quaternion free flyer: eomgen.numeric.contacts' J_c, J̇_c q̇ and KKT dynamics on solo12's
 feet, and ``eomgen simulate`` holding the heavy top's tip with ``floating_base: quaternion``.
 
 References: Pinocchio on solo12 from its own URDF reader with its own JointModelFreeFlyer (q of
@@ -15,7 +15,7 @@ import csv
 import numpy as np
 import pytest
 
-from eomgen.contacts import Contact, ContactDynamics
+from eomgen.numeric.contacts import Contact, ContactDynamics
 from eomgen.free_flyer import add_free_flyer
 from eomgen.numeric.frames import frame_function
 from support import ROOT, erd_robots_or_skip, load_quietly, relative, run_cli, write

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from eomgen.compiler import c_compiler
+from eomgen.common.compiler import c_compiler
 from support.held import held_robot, pinocchio_constrained_derivatives
 from test_constrained_derivatives import DERIVATIVES, leg, states
 from support.extras import need

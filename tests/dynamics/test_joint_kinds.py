@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from eomgen.model import Joint, JointType, Link, Transform, build_model, mat3, vec3
-from eomgen.quaternion_joints import difference, integrate, neutral
+from eomgen.numeric.configuration import difference, integrate, neutral
 from support import relative
 from support.extras import need, skip_backend
 from support.generated import generated

@@ -12,7 +12,7 @@ import pytest
 import eomgen
 from eomgen import dynamics, parsers
 from eomgen.errors import DescriptionError, InvalidNumberError, TooLargeError
-from eomgen.expressions import MAX_MAGNITUDE, parse_scalar
+from eomgen.model.expressions import MAX_MAGNITUDE, parse_scalar
 from eomgen.model import MAX_JOINTS, Joint, JointType, Link, build_model
 from eomgen.parsers import _yaml
 

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from support.extras import need
-from eomgen import contacts, quaternion_joints
+from eomgen.numeric import contacts
+from eomgen.numeric import configuration as quaternion_joints
 from eomgen.numeric import contacts as numeric_contacts
 from eomgen.numeric.so3 import left_jacobian, rotation_about, skew, so3_exp, so3_log
 

@@ -256,7 +256,7 @@ def test_display_and_documents_share_the_reduced_form():
     (``dyn.textbook``), grouped the same way, with the same printer."""
     from eomgen.codegen import make_job
     from eomgen.codegen.backends.latex_backend import render_document
-    from eomgen.display import readable_matrices
+    from eomgen.present.display import readable_matrices
 
     dyn = eomgen.derive(eomgen.load(example_path("elbow_rrr")), outputs=("M", "C", "g", "tau"))
     shown = readable_matrices(dyn)
@@ -289,7 +289,7 @@ GROUPED_FORMS = {
 def test_grouped_forms_are_exact_and_textbook_like(name):
     """The grouped M and g every document prints equal the derived ones exactly
     (expand(grouped − derived) = 0), and show the textbook's groupings."""
-    from eomgen.display import readable_matrices
+    from eomgen.present.display import readable_matrices
     from eomgen.teach import readability as rd
 
     dyn = dynamics(name)
@@ -351,7 +351,7 @@ def test_large_models_are_bounded_before_anything_is_expanded():
 
     from support.reference import random_robot
 
-    from eomgen.notebook import build_notebook
+    from eomgen.teach.notebook import build_notebook
     from eomgen.symbolic.textbook import TEXTBOOK_MAX_OPERATIONS
 
     model = replace(random_robot(np.random.default_rng(0), 3), name="general_arm")

@@ -19,7 +19,7 @@ import sympy as sp
 
 import eomgen
 from eomgen.errors import SceneError
-from eomgen.loops import AssemblyError, LoopDynamics
+from eomgen.numeric.loops import AssemblyError, LoopDynamics
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import ROOT

@@ -1,6 +1,6 @@
 """The loop outputs in every code backend: ``loop_constraint``, ``loop_jacobian``,
 ``loop_bias`` and ``constrained_forward_dynamics`` with the loop rows (and contacts and loops
-together), against the numeric :class:`eomgen.loops.LoopDynamics` (checked against closed
+together), against the numeric :class:`eomgen.numeric.loops.LoopDynamics` (checked against closed
 forms and Pinocchio in the other tests of this folder)."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import pytest
 
 import eomgen
 from eomgen.errors import GenerationError
-from eomgen.loops import LoopDynamics
+from eomgen.numeric.loops import LoopDynamics
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import ROOT, relative

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 import eomgen
-from eomgen.loops import LoopDynamics
+from eomgen.numeric.loops import LoopDynamics
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import ROOT

@@ -11,7 +11,7 @@ import pytest
 
 import eomgen
 from eomgen.codegen.backends.casadi_backend import library_name
-from eomgen.loops import LoopDynamics
+from eomgen.numeric.loops import LoopDynamics
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import ROOT, relative
@@ -111,7 +111,7 @@ def test_casadi_c_library(fivebar, tmp_path):
     casadi = need("casadi")
     from eomgen.codegen.functions import select_functions
     from eomgen.codegen.generate import render_files
-    from eomgen.compiler import c_compiler
+    from eomgen.common.compiler import c_compiler
 
     if c_compiler() is None:
         pytest.skip("needs a C compiler")

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import eomgen
-from eomgen.loops import LoopDynamics
+from eomgen.numeric.loops import LoopDynamics
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import ROOT, relative

@@ -17,7 +17,7 @@ passed unchanged, no adapter):
   ``computeConstraintDynamicsDerivatives``'.
 
 The generated NumPy module is checked (every backend in the slow test), and the numeric
-:class:`eomgen.loops.LoopDynamics` (Newton closure on the manifold, the parallel inverse
+:class:`eomgen.numeric.loops.LoopDynamics` (Newton closure on the manifold, the parallel inverse
 dynamics) and :func:`eomgen.numeric.loops.pinocchio_loops` through eomgen's adapter.
 """
 
@@ -27,9 +27,9 @@ import numpy as np
 import pytest
 
 from eomgen.free_flyer import add_free_flyer
-from eomgen.loops import LoopDynamics
+from eomgen.numeric.loops import LoopDynamics
 from eomgen.model import Joint, JointType, Link, Transform, build_model, vec3
-from eomgen.quaternion_joints import integrate
+from eomgen.numeric.configuration import integrate
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import relative

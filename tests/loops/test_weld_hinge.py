@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import eomgen
-from eomgen.loops import LoopDynamics
+from eomgen.numeric.loops import LoopDynamics
 from eomgen.model import HINGE, WELD, Loop, LoopFrame, Transform, mat3, vec3
 from eomgen.symbolic.frames import derive_frames
 from eomgen.symbolic.loops import plane_axes

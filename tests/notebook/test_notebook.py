@@ -1,4 +1,4 @@
-"""Rich display in Jupyter (eomgen/display.py) and ``eomgen notebook`` (eomgen/notebook.py): the
+"""Rich display in Jupyter (eomgen/present/display.py) and ``eomgen notebook`` (eomgen/teach/notebook.py): the
 generated notebook for the bundled arm runs in a real kernel without a cell error."""
 
 from __future__ import annotations
@@ -11,9 +11,9 @@ import sympy as sp
 
 import eomgen
 from support import run_cli as run
-from eomgen.display import dynamics_latex, expression_latex, grouped_matrices
+from eomgen.present.display import dynamics_latex, expression_latex, grouped_matrices
 from eomgen.symbolic.textbook import textbook_derivation
-from eomgen.notebook import build_notebook
+from eomgen.teach.notebook import build_notebook
 from support.extras import need
 
 
@@ -123,9 +123,9 @@ def test_every_block_of_the_cells_template_is_a_cell_of_some_notebook():
     exactly the template's blocks, each once per notebook, markdown blocks named ``*_text``."""
     from itertools import product
 
-    from eomgen.notebook import CELLS_TEMPLATE, cell_blocks
+    from eomgen.teach.notebook import CELLS_TEMPLATE, cell_blocks
     from eomgen.teach.embedded import EmbeddedSource
-    from eomgen.templating import environment
+    from eomgen.common.templating import environment
 
     sources = [EmbeddedSource("arm.yaml", description='"""..."""'),
                EmbeddedSource("arm.xml", relative="robots/arm.xml"),

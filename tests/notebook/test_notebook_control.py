@@ -8,7 +8,7 @@ import nbformat
 import pytest
 
 import eomgen
-from eomgen.notebook import build_notebook
+from eomgen.teach.notebook import build_notebook
 from support.extras import need
 
 CHECK = "largest |Y_SL beta - (M qdd_r + C qd_r + g)|:"

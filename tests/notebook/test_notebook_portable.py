@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import eomgen
-from eomgen.notebook import build_notebook, text_literal
+from eomgen.teach.notebook import build_notebook, text_literal
 from eomgen.numeric import numeric_model, rnea
 from support import run_cli, write as write_file
 from support.extras import need

@@ -11,7 +11,7 @@ import nbformat
 import pytest
 
 import eomgen
-from eomgen.notebook import build_notebook
+from eomgen.teach.notebook import build_notebook
 from support import run_cli, write
 from support.extras import need
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import nbformat
 import pytest
 
-import eomgen.notebook
+import eomgen.teach.notebook
 from support import run_in_process, write
 from support.extras import need
 from support.robots import turned_arm_yaml
@@ -74,7 +74,7 @@ def test_an_unexpected_error_is_the_clis_one_line(tmp_path, monkeypatch):
     def broken(*args, **kwargs):
         raise ZeroDivisionError("a defect")
 
-    monkeypatch.setattr(eomgen.notebook, "build_notebook", broken)
+    monkeypatch.setattr(eomgen.teach.notebook, "build_notebook", broken)
     description = write(tmp_path / "turned.yaml", turned_arm_yaml())
     result = run_in_process("notebook", description, "--quiet", "-o", tmp_path / "t.ipynb")
     assert result.returncode == 2 and "Traceback" not in result.stderr

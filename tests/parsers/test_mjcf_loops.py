@@ -18,7 +18,7 @@ import pytest
 
 import eomgen
 from eomgen.errors import SceneError
-from eomgen.loops import kkt_solve
+from eomgen.numeric.loops import kkt_solve
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import relative, run_cli

@@ -19,7 +19,7 @@ import pytest
 import sympy as sp
 
 import eomgen
-from eomgen.bodies import body_tree
+from eomgen.model.bodies import body_tree
 from eomgen.dynamics import derive
 from eomgen.model import Inertial, Joint, JointType, Link, Parameter, Transform, build_model, vec3
 from eomgen.numeric import M_rnea, numeric_model, rnea

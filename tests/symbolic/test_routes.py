@@ -20,7 +20,7 @@ import pytest
 import sympy as sp
 
 import eomgen
-from eomgen.bodies import body_tree
+from eomgen.model.bodies import body_tree
 from eomgen.dynamics import derive, joint_symbols
 from eomgen.numeric import coriolis_times_qd, gravity_torques, M_rnea, numeric_model
 from eomgen.symbolic.composite import coriolis_program

@@ -14,7 +14,7 @@ import pytest
 import sympy as sp
 
 import eomgen
-from eomgen.display import expression_latex
+from eomgen.present.display import expression_latex
 from eomgen.present import notation as nt
 from eomgen.regressor import regressor_form
 from eomgen.teach import handout_files

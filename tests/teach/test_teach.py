@@ -567,9 +567,9 @@ def test_numbers_lead_their_groups():
 
 def _drive_residuals(model, textbook: bool = True):
     """The handout's drive equations as residuals (``terms − lhs``, every name replaced by its
-    value), beside eomgen.actuators' own, for the same derivation; ``textbook=False``: as
+    value), beside eomgen.analysis.actuators' own, for the same derivation; ``textbook=False``: as
     written for large models (``C_{i,j}`` in place of the Christoffel factors)."""
-    from eomgen.actuators import spong_dynamics
+    from eomgen.analysis.actuators import spong_dynamics
     from eomgen.teach.content import (abbreviation_values, drive_equations, has_drives,
                                       spring_values)
     assert has_drives(model)
@@ -642,7 +642,7 @@ def test_mixed_rigid_and_flexible_joints_with_friction(arm, textbook):
 
 
 def test_rigid_joints_with_armature_and_friction(arm):
-    from eomgen.actuators import rigid_with_actuators
+    from eomgen.analysis.actuators import rigid_with_actuators
     from eomgen.model import Actuator
     model = _with_actuators(arm, Actuator(armature=0.5, damping=0.1),
                             Actuator(armature=0.25, friction=0.2))
@@ -668,10 +668,10 @@ WALL_SCENE = (ROOT / "examples" / "contacts"
 
 def test_wall_contact_equations_are_the_closed_form_and_newton_euler(arm):
     """J_c of the tip equals ∂p/∂q of the tip position written by hand, J̇_c q̇ its time
-    derivative, and the printed torque rows (names replaced by values) equal eomgen.contacts'
+    derivative, and the printed torque rows (names replaced by values) equal eomgen.numeric.contacts'
     numeric inverse dynamics (Newton–Euler) at a moving state."""
     import numpy as np
-    from eomgen.contacts import ContactDynamics
+    from eomgen.numeric.contacts import ContactDynamics
     from eomgen.reduction import apply_scene
     from eomgen.scene import load_scene
     from eomgen.teach.content import abbreviation_values, contact_equations

@@ -24,8 +24,8 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ...model import RobotModel
-from ...progress import plural
-from ...quaternion_joints import neutral
+from ...common.progress import plural
+from ...numeric.configuration import neutral
 from ..conditioning import CONDITION_LIMIT, IllConditionedWarning, ill_conditioned_message
 from ..report import fmt, markdown_table
 from .integrators import Adaptive

@@ -18,10 +18,10 @@ from pathlib import Path
 from sympy.printing.pycode import PythonCodePrinter
 
 from ...outputs import exported, function_names
-from ...compiler import c_compiler, shared_library
+from ...common.compiler import c_compiler, shared_library
 from .. import GeneratedFile, Job, Loaded, register
 from ...symbolic.printing import FloatLiteralMixin, exec_source
-from ...templating import render
+from ...common.templating import render
 from .common import TermOrderShared, python_module_context
 
 _FUNCTIONS = ("sin", "cos", "tan", "sqrt", "exp", "log", "asin", "acos", "atan", "atan2",

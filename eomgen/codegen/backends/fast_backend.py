@@ -28,14 +28,14 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.precedence import PRECEDENCE
 
-from ...compiler import c_compiler, shared_library
+from ...common.compiler import c_compiler, shared_library
 from .. import GeneratedFile, Job, Loaded, register
 from ...outputs import (CONSTRAINED_DERIVATIVES, CONSTRAINED_FORWARD, CONSTRAINED_PARTIALS,
                        FORWARD, INPUT_SIZES, PARALLEL_INVERSE,
                        TASK_SPACE, composition_names, constrained_names, exported,
                        parallel_names, task_space_names)
 from ...symbolic.printing import FloatLiteralMixin, renamed
-from ...templating import TEMPLATES_DIR, render
+from ...common.templating import TEMPLATES_DIR, render
 from .common import (import_file, parallel_indices, positional, printed_once,
                      warning_exports)
 

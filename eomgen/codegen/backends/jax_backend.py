@@ -30,7 +30,7 @@ import ast
 from dataclasses import dataclass, replace
 
 from .. import GeneratedFile, Job, register
-from ...templating import render
+from ...common.templating import render
 from .common import PrintedFunction, python_loader, python_module_context
 from .numpy_backend import ArrayModulePrinter
 

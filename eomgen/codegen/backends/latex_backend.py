@@ -36,7 +36,7 @@ from ...present.sections import (  # noqa: F401  (re-exported: once defined here
     PROGRAM_NAMES, document_context, program_sections,
 )
 from .. import GeneratedFile, Job, register
-from ...templating import render
+from ...common.templating import render
 
 
 def render_document(job: Job, config: LatexConfig = LatexConfig()) -> str:

@@ -12,7 +12,7 @@ from sympy.printing.numpy import NumPyPrinter
 
 from .. import GeneratedFile, Job, register
 from ...symbolic.printing import NumPyModulePrinter
-from ...templating import render
+from ...common.templating import render
 from ...runtime.cholesky import included_source
 from ...runtime import task_space
 from .common import TermOrderShared, python_loader, python_module_context, warning_exports
@@ -47,7 +47,7 @@ def generate_numpy(job: Job, config: NumPyConfig = NumPyConfig()) -> list[Genera
 
 def numpy_source(job: Job, printer, config: NumPyConfig = NumPyConfig()) -> str:
     """The NumPy module's text for ``job`` printed with ``printer`` (also what
-    :func:`eomgen.lambdify` executes): the template, with the Cholesky runtime
+    :func:`eomgen.codegen.lambdify` executes): the template, with the Cholesky runtime
     (:mod:`eomgen.runtime.cholesky`) included where forward dynamics needs it; ``xp``, the
     array module's name that the composed functions call (common/composed.py.jinja)."""
     return render(config.template, xp=ArrayModulePrinter.alias,

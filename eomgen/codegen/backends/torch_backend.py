@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .. import GeneratedFile, Job, register
-from ...templating import render
+from ...common.templating import render
 from .common import python_loader, python_module_context, warning_exports
 from .numpy_backend import ArrayModulePrinter
 

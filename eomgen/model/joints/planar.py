@@ -2,14 +2,10 @@
 normal its ``axis``, which must be the joint frame's z axis), as Pinocchio's
 ``JointModelPlanar``:
 
-=====================  ============================================  ==================================
- entries                configuration (NQ = 4)                        velocity (NV = 3)
-=====================  ============================================  ==================================
- ``<name>_x``, ``_y``    the child origin in the joint frame [m]        ``<name>_vx``, ``_vy``: the child
- ``<name>_cos``,         cos θ, sin θ of the child's rotation θ         origin's velocity in the child
- ``<name>_sin``          about z                                        frame [m/s]; ``<name>_wz``: θ̇
-                                                                        [rad/s]
-=====================  ============================================  ==================================
+* configuration (NQ = 4): ``<name>_x``, ``<name>_y``, the child origin in the joint frame
+  [m]; ``<name>_cos``, ``<name>_sin``, cos θ and sin θ of the child's rotation θ about z;
+* velocity (NV = 3): ``<name>_vx``, ``<name>_vy``, the child origin's velocity in the child
+  frame [m/s]; ``<name>_wz``, θ̇ [rad/s].
 
 ``q ⊕ v`` is the SE(2) exponential in the child frame, ``(θ + ω, p + Rz(θ) V(ω) v_lin)``;
 ``(cos θ, sin θ)`` of any nonzero length stands for the normalised pair. In the tree: two

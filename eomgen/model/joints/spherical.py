@@ -1,13 +1,10 @@
 """Spherical (ball) joints: three rotational freedoms, the configuration a unit quaternion
 (Pinocchio's ``JointModelSpherical``).
 
-==================  ============================================  ===================================
- entries             configuration (NQ = 4)                        velocity (NV = 3)
-==================  ============================================  ===================================
- ``<name>_q*``,      quaternion (x, y, z, w) of the rotation R      angular velocity ω of the child
- ``<name>_w*``       from the joint frame to the child link frame   relative to the parent, in the
-                                                                    child frame [rad/s]
-==================  ============================================  ===================================
+* configuration (NQ = 4), ``<name>_qx … <name>_qw``: the quaternion (x, y, z, w) of the
+  rotation R from the joint frame to the child link frame;
+* velocity (NV = 3), ``<name>_wx … <name>_wz``: the angular velocity ω of the child relative
+  to the parent, in the child frame [rad/s].
 
 ``q ⊕ v = R exp([v]×)``, ``q1 ⊖ q0 = log(R0ᵀ R1)``; a non-unit quaternion stands for the
 normalised one. In the tree: three continuous joints ``<name>_wx``, ``<name>_wy``, ``<name>_wz``

@@ -77,7 +77,7 @@ def dask_map(function: Callable, *states, chunks: int = 100_000,
     try:  # optional dependency (eomgen[dask])
         import dask.array as da
     except ImportError as exc:  # pragma: no cover - depends on the environment
-        raise ImportError("eomgen.batch.dask_map needs dask: pip install 'eomgen[dask]'") from exc
+        raise ImportError("eomgen.analysis.batch.dask_map needs dask: pip install 'eomgen[dask]'") from exc
     if not states:
         raise ValueError("dask_map: give at least one state array (q, ...)")
     if not isinstance(block, (int, np.integer)) or block < 1:

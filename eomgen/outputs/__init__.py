@@ -23,7 +23,7 @@ Cholesky solve of ``M q̈ = τ − (C q̇ + g)``), whose names it receives from 
 Further outputs are derived and exported only when asked for (``default=False``: ``eomgen
 generate --outputs Y`` or a scene's ``outputs``), so that existing modules stay as they were.
 
-The outputs are declared as data in :mod:`eomgen.catalogue` (re-exported here, the public
+The outputs are declared as data in :mod:`eomgen.outputs.catalogue` (re-exported here, the public
 name); this module indexes them (:data:`OUTPUTS`, :data:`BY_SYMBOL`) and answers what is asked
 of them. It names no function that builds an output and imports nothing of eomgen but the
 catalogue, so every layer may read it (docs/architecture.md: layer 0). Adding an output is one
@@ -45,10 +45,10 @@ from .catalogue import (CATALOGUE, CONSTRAINED_DERIVATIVES, CONSTRAINED_FORWARD,
                         PARALLEL_INVERSE, TASK_SPACE, Output)
 
 #: The vector inputs a generated function may take, by name, with their docstring line
-#: (:data:`eomgen.catalogue.INPUTS`).
+#: (:data:`eomgen.outputs.catalogue.INPUTS`).
 INPUTS = catalogue.INPUTS
 #: The inputs whose length is not the number of joints, with what their length is
-#: (:data:`eomgen.catalogue.INPUT_SIZES`; the function giving it is registered with
+#: (:data:`eomgen.outputs.catalogue.INPUT_SIZES`; the function giving it is registered with
 #: :func:`eomgen.symbolic.builders.sizes`).
 INPUT_SIZES = catalogue.INPUT_SIZES
 
@@ -60,7 +60,7 @@ def __getattr__(name: str):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-#: Every output, by function name, in module order (:data:`~eomgen.catalogue.CATALOGUE`, then
+#: Every output, by function name, in module order (:data:`~eomgen.outputs.catalogue.CATALOGUE`, then
 #: any registered later).
 OUTPUTS: dict[str, Output] = {}
 

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import jinja2
 
-_PACKAGE = Path(__file__).resolve().parent
+_PACKAGE = Path(__file__).resolve().parents[1]  # eomgen/ (this module is eomgen/common/)
 
 
 def _templates_dir() -> Path:

@@ -66,16 +66,16 @@ from typing import Callable, Mapping, Sequence
 import numpy as np
 import sympy as sp
 
-from .dynamics import Dynamics
-from .errors import ParameterError
-from .model import Actuator, RobotModel, flexible_indices, joint_actuators, joint_motion
-from .symbolic.drives import friction_torque_expr
-from .symbolic.program import Program
-from .symbolic.transforms import time_derivative_program
+from ..dynamics import Dynamics
+from ..errors import ParameterError
+from ..model import Actuator, RobotModel, flexible_indices, joint_actuators, joint_motion
+from ..symbolic.drives import friction_torque_expr
+from ..symbolic.program import Program
+from ..symbolic.transforms import time_derivative_program
 
 # Deprecated path of the numeric evaluators: they moved to eomgen.numeric.actuated (docs and
-# tests name them here, as eomgen.actuators.flexible_forward_dynamics and so on).
-from .numeric.actuated import (
+# tests name them here, as eomgen.analysis.actuators.flexible_forward_dynamics and so on).
+from ..numeric.actuated import (
     ActuatedModel,
     actuated_model,
     flexible_energy,

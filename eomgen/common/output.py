@@ -26,7 +26,7 @@ from keyword import iskeyword
 from pathlib import Path
 from typing import Sequence
 
-from .errors import GenerationError, one_line
+from ..errors import GenerationError, one_line
 
 
 def module_name(robot_name: str) -> str:

@@ -27,13 +27,13 @@ from pathlib import Path
 import nbformat
 from nbformat import v4
 
-from .dynamics import derive
-from .errors import ParameterError
-from .model import RobotModel
-from .present.notation import teaching_sized
-from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS
-from .teach.embedded import EmbeddedSource, embedded_source, text_literal
-from .templating import render_block
+from ..dynamics import derive
+from ..errors import ParameterError
+from ..model import RobotModel
+from ..present.notation import teaching_sized
+from ..symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS
+from .embedded import EmbeddedSource, embedded_source, text_literal
+from ..common.templating import render_block
 
 
 def _teaching_sized(model: RobotModel) -> bool:

@@ -8,7 +8,7 @@ big objects a user meets (a model, derived dynamics, a scene's report).
 Data classes (:class:`eomgen.model.RobotModel`, :class:`eomgen.dynamics.Dynamics`) keep the
 ``_repr_html_`` / ``_repr_latex_`` methods Jupyter looks for, and each asks this registry for the
 renderer of its kind (``"model"``, ``"dynamics"``). The renderers live with the presentation
-code (:mod:`eomgen.display`), which registers them when it is imported (``import eomgen`` does,
+code (:mod:`eomgen.present.display`), which registers them when it is imported (``import eomgen`` does,
 cheaply: display imports what it renders with only when it renders). So the data classes depend
 on nothing above them, and a kind with no renderer registered falls back to the plain ``repr``.
 

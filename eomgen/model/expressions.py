@@ -17,7 +17,7 @@ import re
 
 import sympy as sp
 
-from .model import parameter_symbol, scalar
+from . import parameter_symbol, scalar
 
 MAX_LENGTH = 200
 MAX_EXPONENT = 16

@@ -14,8 +14,8 @@ import types
 from dataclasses import dataclass
 from typing import Callable
 
-from .outputs import BY_SYMBOL, FORWARD, OUTPUTS
-from .symbolic.printing import exec_source
+from ..outputs import BY_SYMBOL, FORWARD, OUTPUTS
+from ..symbolic.printing import exec_source
 
 
 @dataclass(frozen=True)
@@ -76,8 +76,8 @@ def lambdify(dynamics: "eomgen.dynamics.Dynamics") -> NumericDynamics:  # noqa: 
     """
     # Imported on first use (start-up time): code generation loads Jinja and the backends,
     # which `import eomgen` and derive never need.
-    from .codegen import make_job
-    from .codegen.backends.numpy_backend import NumPyConfig, NumPyModulePrinter, numpy_source
+    from . import make_job
+    from .backends.numpy_backend import NumPyConfig, NumPyModulePrinter, numpy_source
 
     derived = set(dynamics.outputs)
     functions = [f for f, o in OUTPUTS.items() if set(o.needs) <= derived]

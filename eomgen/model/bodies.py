@@ -17,7 +17,7 @@ from typing import Callable, Iterable
 
 import sympy as sp
 
-from .model import Inertial, Joint, Mat3, RobotModel, Transform, Vec3, ZERO3
+from . import Inertial, Joint, Mat3, RobotModel, Transform, Vec3, ZERO3
 
 ZERO33: Mat3 = tuple(tuple(sp.Integer(0) for _ in range(3)) for _ in range(3))  # type: ignore
 

@@ -9,14 +9,14 @@
 
 The printing is :mod:`eomgen.present`'s, shared with the LaTeX document, the handout and the
 notebook. The model and dynamics shown (``RobotModel``, ``Dynamics`` in annotations) are passed
-in, not imported: the data classes find these renderers through :mod:`eomgen.reprs`.
+in, not imported: the data classes find these renderers through :mod:`eomgen.common.reprs`.
 """
 
 from __future__ import annotations
 
 import html
 
-from . import reprs
+from ..common import reprs
 
 #: Models with more joints display a summary instead of M, C and g.
 DISPLAY_MAX_DOF = 3
@@ -56,13 +56,13 @@ def model_html(model: RobotModel) -> str:
 
 
 def _printer(dynamics: Dynamics, names: dict | None = None):
-    from .present.notation import LatexConfig, printing  # start-up time (SymPy)
+    from .notation import LatexConfig, printing  # start-up time (SymPy)
 
     return printing(dynamics, LatexConfig(), compact_trig=True, extra_names=names).printer
 
 
 def _text(value: str) -> str:
-    from .present.printer import latex_escape  # start-up time (SymPy)
+    from .printer import latex_escape  # start-up time (SymPy)
 
     return r"\text{" + latex_escape(value) + "}"
 
@@ -73,7 +73,7 @@ def readable_matrices(dynamics: Dynamics) -> dict | None:
     factor), or None when the model is not teaching-sized (the bounds of
     :func:`eomgen.present.notation.textbook_for`, checked on the program's size before anything
     is expanded) and ``derive(..., simplify=True)`` did not force it."""
-    from .present.notation import textbook_for  # start-up time (SymPy)
+    from .notation import textbook_for  # start-up time (SymPy)
 
     if dynamics.simplified:  # derive(..., simplify=True) asked for it whatever the size
         book = dynamics.textbook
@@ -89,7 +89,7 @@ def grouped_matrices(book) -> dict:
     prints them: entries of M grouped by body mass, those of g by trigonometric factor (sums
     built unevaluated, so their order is kept; print them with :func:`expression_latex`). Kept
     here for notebooks; the grouping is :func:`eomgen.present.grouping.grouped_matrices`."""
-    from .present import grouping  # start-up time (SymPy)
+    from . import grouping  # start-up time (SymPy)
 
     return grouping.grouped_matrices(book)
 
@@ -171,6 +171,6 @@ def expression_latex(dynamics: Dynamics, expr, names: dict | None = None) -> str
     return printer.doprint(expr)
 
 
-# What RobotModel._repr_html_ and Dynamics._repr_latex_ show (eomgen.reprs).
+# What RobotModel._repr_html_ and Dynamics._repr_latex_ show (eomgen.common.reprs).
 reprs.register("model", "text/html", model_html)
 reprs.register("dynamics", "text/latex", dynamics_latex)

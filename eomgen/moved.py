@@ -1,0 +1,88 @@
+"""Old module paths, kept for one more release: importing one warns and gives the module at its
+new place (docs/architecture.md lays the layers out).
+
+=============================  =====================================
+ old path                        new path
+=============================  =====================================
+ ``eomgen.actuators``            :mod:`eomgen.analysis.actuators`
+ ``eomgen.batch``                :mod:`eomgen.analysis.batch`
+ ``eomgen.bodies``               :mod:`eomgen.model.bodies`
+ ``eomgen.catalogue``            :mod:`eomgen.outputs.catalogue`
+ ``eomgen.compiler``             :mod:`eomgen.common.compiler`
+ ``eomgen.contacts``             :mod:`eomgen.numeric.contacts`
+ ``eomgen.display``              :mod:`eomgen.present.display`
+ ``eomgen.expressions``          :mod:`eomgen.model.expressions`
+ ``eomgen.lambdify``             :mod:`eomgen.codegen.lambdify`
+ ``eomgen.loops``                :mod:`eomgen.numeric.loops`
+ ``eomgen.notebook``             :mod:`eomgen.teach.notebook`
+ ``eomgen.output``               :mod:`eomgen.common.output`
+ ``eomgen.progress``             :mod:`eomgen.common.progress`
+ ``eomgen.quaternion_joints``    :mod:`eomgen.numeric.configuration`
+ ``eomgen.reprs``                :mod:`eomgen.common.reprs`
+ ``eomgen.templating``           :mod:`eomgen.common.templating`
+=============================  =====================================
+
+``import eomgen.quaternion_joints`` (or ``from eomgen.quaternion_joints import integrate``)
+emits one :class:`DeprecationWarning` naming the new path and :data:`REMOVED_IN`, and binds the
+new module under the old name: its functions and classes are the same objects.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.abc
+import importlib.util
+import sys
+import warnings
+
+#: The release that drops the old paths.
+REMOVED_IN = "0.3.0"
+
+#: Old module → its new place.
+MOVED: dict[str, str] = {
+    "eomgen.actuators": "eomgen.analysis.actuators",
+    "eomgen.batch": "eomgen.analysis.batch",
+    "eomgen.bodies": "eomgen.model.bodies",
+    "eomgen.catalogue": "eomgen.outputs.catalogue",
+    "eomgen.compiler": "eomgen.common.compiler",
+    "eomgen.contacts": "eomgen.numeric.contacts",
+    "eomgen.display": "eomgen.present.display",
+    "eomgen.expressions": "eomgen.model.expressions",
+    "eomgen.lambdify": "eomgen.codegen.lambdify",
+    "eomgen.loops": "eomgen.numeric.loops",
+    "eomgen.notebook": "eomgen.teach.notebook",
+    "eomgen.output": "eomgen.common.output",
+    "eomgen.progress": "eomgen.common.progress",
+    "eomgen.quaternion_joints": "eomgen.numeric.configuration",
+    "eomgen.reprs": "eomgen.common.reprs",
+    "eomgen.templating": "eomgen.common.templating",
+}
+
+
+class MovedModules(importlib.abc.MetaPathFinder, importlib.abc.Loader):
+    """The import hook of :data:`MOVED` (installed by ``import eomgen``)."""
+
+    def find_spec(self, fullname, path=None, target=None):
+        if fullname in MOVED:
+            return importlib.util.spec_from_loader(fullname, self)
+        return None
+
+    def create_module(self, spec):
+        return None  # a placeholder, replaced in sys.modules by exec_module
+
+    def exec_module(self, module) -> None:
+        """Import the new module and put it in the old name's place (the import system then
+        hands out what ``sys.modules`` holds under that name)."""
+        new = MOVED[module.__name__]
+        warnings.warn(f"{module.__name__} moved to {new}; the old path goes in eomgen "
+                      f"{REMOVED_IN}", DeprecationWarning, stacklevel=2)
+        sys.modules[module.__name__] = importlib.import_module(new)
+
+
+def install() -> None:
+    """Put the hook on ``sys.meta_path`` once."""
+    if not any(isinstance(finder, MovedModules) for finder in sys.meta_path):
+        sys.meta_path.append(MovedModules())
+
+
+__all__ = ["MOVED", "MovedModules", "REMOVED_IN", "install"]
