@@ -12,6 +12,7 @@ q̈ too, and the screw chain's joint torque regressor is Pinocchio's.
 from __future__ import annotations
 
 import numpy as np
+import sympy as sp
 import pytest
 
 from eomgen.model import Joint, JointType, Link, Transform, build_model, mat3, vec3
@@ -229,3 +230,52 @@ def test_integrate_difference_and_neutral_equal_pinocchio(name):
         assert relative(integrate(q, v, dt, model), q1) < 1e-12
         assert relative(difference(q, q1, model), v * dt) < 1e-10
         assert relative(difference(q, q1, model), pin.difference(pm, q, q1)) < 1e-10
+
+
+#: Helical joints alone (with a revolute one between): the base regressor and the textbook.
+HELIX = (("a", "helical", -1), ("b", "revolute", 0), ("c", "helical", 1))
+
+
+@pytest.fixture(scope="module")
+def helix(tmp_path_factory):
+    model, pm = robots(HELIX, seed=4)
+    calls, _ = generated(model, ("Y_base", "beta", "Y_SL_base", "C", "g"),
+                         tmp_path_factory.mktemp("helix"), backends=("numpy",))
+    return model, pm, calls["numpy"]
+
+
+def test_base_regressors_give_pinocchios_torques(helix):
+    """Y_base β = τ (Pinocchio's rnea) and Y_SL,base(q, q̇, q̇_r, q̈_r) β = M q̈_r + C q̇_r + g
+    (Pinocchio's M, C, g), with Y_base of full column rank over random states: the grouping
+    of a helical joint's parameters (only β (1 − k kᵀ) of its body's inertia crosses it) keeps
+    the torques and leaves no dependent column."""
+    model, pm, call = helix
+    beta = call("base_parameters")
+    data = pm.createData()
+    rows = []
+    for q, v, a in states(pm, count=12, seed=21):
+        Y_base = call("base_regressor", q, v, a)
+        rows.append(Y_base)
+        assert relative(Y_base @ beta, pin.rnea(pm, data, q, v, a)) < 1e-10
+        qd_r = a[::-1].copy()
+        M = symmetric(pin.crba(pm, data, q))
+        C = pin.computeCoriolisMatrix(pm, data, q, v)
+        target = M @ a + C @ qd_r + pin.computeGeneralizedGravity(pm, data, q)
+        assert relative(call("slotine_li_base_regressor", q, v, qd_r, a) @ beta, target) < 1e-10
+    s = np.linalg.svd(np.vstack(rows), compute_uv=False)
+    assert np.sum(s > 1e-9 * s[0]) == len(beta)
+
+
+def test_textbook_derivation_equals_pinocchio():
+    """The teaching derivation (a helical joint's ω along its axis, its slide in the pose) gives
+    Pinocchio's M, C q̇ + g."""
+    from eomgen.symbolic.textbook import textbook_derivation
+    model, pm = robots(HELIX[:2], seed=4)
+    book = textbook_derivation(model)
+    data = pm.createData()
+    for q, v, _ in states(pm, count=2, seed=23):
+        values = dict(zip((*book.q, *book.qd), (*q, *v)))
+        M = np.array(book.M.subs(values), dtype=float)
+        h = np.array((book.C * sp.Matrix(v) + book.g).subs(values), dtype=float).ravel()
+        assert relative(M, symmetric(pin.crba(pm, data, q))) < 1e-10
+        assert relative(h, pin.nonLinearEffects(pm, data, q, v)) < 1e-10
