@@ -30,8 +30,9 @@ A parser writes a ball joint as a :class:`~eomgen.model.Joint` of type
 :attr:`JointType.SPHERICAL <eomgen.model.JointType.SPHERICAL>` (its origin the joint frame,
 its axis unused), a planar joint as one of type ``PLANAR``;
 :func:`~eomgen.model.build_model` calls :func:`expand_joints`, which replaces each by its
-chain (a ``HELICAL`` joint is one joint of the tree and stays). Every question about a joint's kind (sizes, names, configuration space, pose) is
-a method of its kind (:mod:`eomgen.model.joints`); this module only lays them out.
+chain (a ``HELICAL`` joint is one joint of the tree and stays). Every question about a
+joint's kind (sizes, names, configuration space, pose) is a method of its kind
+(:mod:`eomgen.model.joints`); this module only lays them out.
 """
 
 from __future__ import annotations

@@ -94,7 +94,7 @@ def forward_kinematics(tree: BodyTree, q, b: ProgramBuilder) -> Kinematics:
             p = p0
             if joint.lead == 0:
                 S = z + b.define_all(cross(p, z), f"v{n}_", ("v", n))
-            else:  # helical: the origin slides λ q along z (p × z is p0 × z), S = (z, p × z + λ z)
+            else:  # helical: the origin slides λ q along z; S = (z, p × z + λ z)
                 lead = joint.lead
                 p = b.define_all(tuple(p0[r] + z[r] * (lead * qi) for r in range(3)),
                                  f"p{n}_", ("p", n))

@@ -31,7 +31,6 @@ def M_program(tree: BodyTree, q, b: ProgramBuilder, grouped: bool = True) -> sp.
     """Build M(q) into ``b`` by the body-frame CRBA; returns the symmetric n×n matrix
     [kg m², kg m, kg] in ``JOINT_NAMES`` order."""
     n = len(tree.bodies)
-    zero = (_ZERO,) * 3
     frames = JointFrames.named(tree, q, b)
     inertials = grouped_inertials(tree) if grouped else [body.inertial for body in tree.bodies]
     IC = []

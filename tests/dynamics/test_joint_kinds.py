@@ -245,8 +245,8 @@ def helix(tmp_path_factory):
 
 
 def test_base_regressors_give_pinocchios_torques(helix):
-    """Y_base β = τ (Pinocchio's rnea) and Y_SL,base(q, q̇, q̇_r, q̈_r) β = M q̈_r + C q̇_r + g
-    (Pinocchio's M, C, g), with Y_base of full column rank over random states: the grouping
+    """Y_base β = τ (Pinocchio's rnea) and Y_SL,base(q, q̇, q̇_r, q̈_r) β = M q̈_r + C q̇_r
+    + g (Pinocchio's M, C, g), with Y_base of full column rank over random states: the grouping
     of a helical joint's parameters (only β (1 − k kᵀ) of its body's inertia crosses it) keeps
     the torques and leaves no dependent column."""
     model, pm, call = helix
