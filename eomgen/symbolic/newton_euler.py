@@ -147,7 +147,7 @@ def leaf_phases(tree: BodyTree, inertials: list) -> tuple[list, dict]:
         first = [sp.Integer(0)] * 3
         first[x] = length  # and h[y] is now exactly 0
         turned = InertialParameters(turned.mass, tuple(first), turned.inertia)
-        moved = _invariant_part(body.joint.axis, True, turned)
+        moved = _invariant_part(body.joint, turned)
         inertials[i] = _folded(turned + _negated(moved))
         if body.parent >= 0:
             placement = Transform(body.placement.rotation, body.placement.translation)
