@@ -117,8 +117,9 @@ def leaf_phases(tree: BodyTree, inertials: list) -> tuple[list, dict]:
     :func:`grouped_inertials`) points along the first axis after ``k``, ``U h`` needs one column
     of U instead of two and ``h × a`` two products instead of four. The turned inertia is
     regrouped (its invariant part moves to the parent), so the body keeps its number of
-    non-zero parameters. Only for revolute joints about a coordinate axis and numeric first
-    moments with both perpendicular components non-zero; other bodies keep φ = 0.
+    non-zero parameters (a helical joint's body keeps its first moment along ``k``). Only for
+    revolute and helical joints about a coordinate axis and numeric first moments with both
+    perpendicular components non-zero; other bodies keep φ = 0.
 
     Returns
     -------
@@ -146,6 +147,8 @@ def leaf_phases(tree: BodyTree, inertials: list) -> tuple[list, dict]:
         turned = inertials[i].transformed(Transform(tuple(zip(*turn)), (0, 0, 0)))
         first = [sp.Integer(0)] * 3
         first[x] = length  # and h[y] is now exactly 0
+        if h[a] != 0:  # a helical joint's body keeps its first moment along the axis
+            first[a] = h[a]
         turned = InertialParameters(turned.mass, tuple(first), turned.inertia)
         moved = _invariant_part(body.joint, turned)
         inertials[i] = _folded(turned + _negated(moved))
