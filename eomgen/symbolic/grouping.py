@@ -101,8 +101,8 @@ def group_parameters(tree: BodyTree, pi: tuple[sp.Symbol, ...]) -> Grouping:
             aligned = aligned_axis(body.joint.axis)
             if aligned is None:
                 raise ValueError(f"joint '{body.joint.name}': the closed-form grouping needs a "
-                                 f"{body.joint.type.value} axis along ±x, ±y or ±z of the "
-                                 "joint frame")
+                                 f"{'helical' if body.joint.lead != 0 else 'revolute'} axis "
+                                 "along ±x, ±y or ±z of the joint frame")
             k = aligned[0]
             a, b = sorted(((k + 1) % 3, (k + 2) % 3))
             c = par.inertia[b][b]
