@@ -20,7 +20,6 @@ import sympy as sp
 from .common import reprs
 from .errors import TooLargeError, UnsupportedError
 from .model import Parameter, RobotModel
-from .model.joints import HELICAL
 from .outputs import BY_SYMBOL, derived_symbols
 # Derivation, joint_symbols and vector_symbols live in eomgen.symbolic.derivation; re-exported here
 # because the docs and earlier code import them from eomgen.dynamics.
@@ -323,13 +322,6 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
         raise UnsupportedError(
             model.source, where, f"{', '.join(refused_here)} not derived for {what} yet (it "
             f"has {', '.join(derived)}){hint}")
-    helical = [j for j in map(HELICAL.coupled, model.couplings) if j is not None]
-    if helical and refused(outputs):  # a helical joint is a continuous and a coupled prismatic
-        raise UnsupportedError(
-            model.source, f"helical joint '{helical[0]}'", f"{', '.join(refused(outputs))} "
-            "not derived for a helical joint yet (in the tree a continuous joint and a coupled "
-            "prismatic one, eomgen.model.joints.helical; eomgen.symbolic.couplings says which "
-            "outputs a coupling takes)")
     if model.couplings and refused(outputs):
         raise UnsupportedError(
             model.source, "couplings", f"{', '.join(refused(outputs))} not derived for a model "

@@ -374,7 +374,7 @@ def _coupling_matrix(model: RobotModel, q: Sequence[sp.Symbol], actuators: Seque
         axis[joint.name] = R_joint * sp.Matrix(joint.axis)
         value = q[index[joint.name]] if joint.name in index else 0
         R[joint.child] = R_joint * sp.Matrix(joint_motion(joint, value).rotation)
-        moved = (joint.name,) if joint.type.is_revolute else ()
+        moved = (joint.name,) if joint.rotates else ()
         ancestors[joint.child] = ancestors[joint.parent] + moved
     S = sp.zeros(len(q), len(flexible))
     for col, k in enumerate(flexible):

@@ -145,7 +145,8 @@ def high_precision_model(model: RobotModel, values=None, dps: int = MODEL_DPS) -
         axis = j.axis
         if j.type.is_movable and any(_has_float(a) for a in axis):
             axis = _unit(axis, dps)
-        joints.append(replace(j, origin=Transform(R, vec(j.origin.translation)), axis=axis))
+        joints.append(replace(j, origin=Transform(R, vec(j.origin.translation)), axis=axis,
+                              pitch=_precise(j.pitch, dps)))
     return replace(model, links=tuple(links), joints=tuple(joints), gravity=vec(model.gravity))
 
 

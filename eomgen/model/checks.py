@@ -349,7 +349,7 @@ def build_model(
     model = RobotModel(name=name, links=links, joints=joints, root=root, gravity=gravity,
                        parameters=params, source=str(source),
                        info=tuple((info or {}).items()), notices=tuple(notices))
-    model = expand_joints(model)  # a parser's ball, planar and helical joints: their chains
+    model = expand_joints(model)  # a parser's ball and planar joints: their chains
     undeclared = sorted((s for s in model.free_symbols if s.name not in names), key=str)
     if undeclared:
         model = replace(model, parameters=params + tuple(Parameter(s) for s in undeclared))

@@ -13,7 +13,8 @@ physical rigid body, but the dynamics may still be those of a physical robot: li
 another move as one body (their combined inertia is what counts); a body fixed to the world
 never moves; and a rotational inertia ``β (E − a aᵀ)`` (no mass) about a revolute joint's axis
 ``a`` moves across the joint without changing M, C or g (its kinetic energy sees only the
-angular velocity across ``a``, which both sides share; across a prismatic joint, any rotational
+angular velocity across ``a``, which both sides share; a helical joint turns as a revolute one
+and a massless inertia does not see its translation; across a prismatic joint, any rotational
 inertia moves). In the second moments ``Σ = tr(I)/2 E − I`` (physical ⇔ Σ ⪰ 0) a body takes
 ``β a aᵀ`` from its parent. Bodies are settled from the leaves up, each taking the least it
 needs (taking less never hurts the parent), the world giving whatever is asked: a finding is
@@ -29,7 +30,7 @@ from dataclasses import replace
 import sympy as sp
 
 from .notices import Notice, NoticeKind
-from .parts import Inertial, Joint, JointType
+from .parts import Inertial, Joint
 from .robot import RobotModel
 
 #: Relative tolerance of "Σ ⪰ 0" and of an axis being parallel to another (as the triangle
@@ -84,7 +85,7 @@ def _carries_nothing(inertial: Inertial | None, joint: Joint, path: list[Joint])
     inertia = _floats(inertial.inertia)
     if mass is None or inertia is None or abs(mass) > 0:
         return False
-    if joint.type is JointType.PRISMATIC or not any(any(row) for row in inertia):
+    if not joint.rotates or not any(any(row) for row in inertia):
         return True
     axis = [_float(v) for v in joint.axis]
     for step in path:  # the joint's axis in the frames down to the link
@@ -92,7 +93,7 @@ def _carries_nothing(inertial: Inertial | None, joint: Joint, path: list[Joint])
         if None in axis or rotation is None:
             return False
         axis = [sum(rotation[k][i] * axis[k] for k in range(3)) for i in range(3)]
-        if step.type.is_revolute:  # turns the frame about its own axis: parallel only
+        if step.rotates:  # turns the frame about its own axis: parallel only
             b = [_float(v) for v in step.axis]
             if None in b or math.dist([0, 0, 0], _cross(axis, b)) > TOLERANCE:
                 return False
@@ -219,7 +220,7 @@ def physical_bodies(model: RobotModel) -> set[str] | None:
             return None
         to_parent = R @ np.array(rotation)
         scale = max(1.0, float(np.abs(S).max()))
-        if joint.type is JointType.PRISMATIC:  # any rotational inertia crosses
+        if not joint.rotates:  # prismatic: any rotational inertia crosses
             eig, vec = np.linalg.eigh(S)
             need = -(vec * np.minimum(eig, 0)) @ vec.T
         else:

@@ -17,9 +17,11 @@ class JointType(enum.Enum):
     """The joint types a description writes, each naming its kind (:attr:`kind`, a type of
     :mod:`eomgen.model.joints` that answers every question about it). A URDF ``<mimic>`` joint
     is a movable joint that a coupling makes follow another (:mod:`eomgen.model.coupling`).
-    ``SPHERICAL`` (a ball joint), ``PLANAR`` and ``HELICAL`` are what a parser writes;
+    ``SPHERICAL`` (a ball joint) and ``PLANAR`` are what a parser writes;
     :func:`~eomgen.model.build_model` turns each into its chain of one-axis joints
-    (:func:`eomgen.model.expand_joints`), so no model holds one."""
+    (:func:`eomgen.model.expand_joints`), so no model holds one. ``HELICAL`` is a one-axis
+    joint of the tree like ``REVOLUTE`` and ``PRISMATIC`` (:attr:`Joint.rotates`,
+    :attr:`Joint.lead`)."""
 
     REVOLUTE = "revolute"
     CONTINUOUS = "continuous"
@@ -90,6 +92,18 @@ class Joint:
     def __post_init__(self):  # accept plain numbers from Python callers
         object.__setattr__(self, "axis", vec3(self.axis))
         object.__setattr__(self, "pitch", scalar(self.pitch))
+
+    @property
+    def rotates(self) -> bool:
+        """True when the joint turns its child by its coordinate about ``axis`` (revolute,
+        continuous, helical)."""
+        return self.type.kind.rotates
+
+    @property
+    def lead(self) -> Scalar:
+        """The child's translation along ``axis`` per unit of the coordinate: 1 (prismatic),
+        the pitch [m/rad] (helical), 0 (a joint that does not translate)."""
+        return self.type.kind.lead(self.pitch)
 
 
 @dataclass(frozen=True)

@@ -28,10 +28,11 @@ rotation of the quaternion before them.
 
 A parser writes a ball joint as a :class:`~eomgen.model.Joint` of type
 :attr:`JointType.SPHERICAL <eomgen.model.JointType.SPHERICAL>` (its origin the joint frame,
-its axis unused), a planar joint as one of type ``PLANAR``, a screw as one of type
-``HELICAL``; :func:`~eomgen.model.build_model` calls :func:`expand_joints`, which replaces each
-by its chain. Every question about a joint's kind (sizes, names, configuration space, pose) is
-a method of its kind (:mod:`eomgen.model.joints`); this module only lays them out.
+its axis unused), a planar joint as one of type ``PLANAR``;
+:func:`~eomgen.model.build_model` calls :func:`expand_joints`, which replaces each by its
+chain (a ``HELICAL`` joint is one joint of the tree and stays). Every question about a
+joint's kind (sizes, names, configuration space, pose) is a method of its kind
+(:mod:`eomgen.model.joints`); this module only lays them out.
 """
 
 from __future__ import annotations
@@ -39,7 +40,6 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from ..errors import KinematicTreeError, UnsupportedError
-from .coupling import make_coupling
 from .joints import FREE_FLYER, KINDS, SPHERICAL, ChartKind, JointKind
 from .joints.free_flyer import CONFIGURATION as FREE_FLYER_CONFIGURATION
 from .joints.free_flyer import VELOCITY as FREE_FLYER_VELOCITY
@@ -136,31 +136,13 @@ def _chart_chain(model, joint: Joint, kind: ChartKind, taken: set) -> tuple[list
     return joints, [Link(name) for name in links]
 
 
-def _screw_chain(model, joint: Joint, taken: set) -> tuple[list, list, object]:
-    """A helical joint's continuous joint, massless link and coupled prismatic joint
-    (:mod:`eomgen.model.joints.helical`)."""
-    screw, link = KINDS["helical"].chain(joint.name, joint.child)
-    for name in (screw, link):
-        if name in taken:
-            raise KinematicTreeError(model.source, f"helical joint '{joint.name}'",
-                                     f"the name '{name}' of its virtual joint or link is taken")
-        taken.add(name)
-    turn = replace(joint, type=JointType.CONTINUOUS, child=link, pitch=0)
-    slide = Joint(screw, JointType.PRISMATIC, link, joint.child, Transform(), joint.axis)
-    coupling = make_coupling(screw, [(joint.name, joint.pitch)],
-                             element=KINDS["helical"].element(joint.name))
-    return [turn, slide], [Link(link)], coupling
-
-
 def expand_joints(model: "RobotModel") -> "RobotModel":
     """``model`` with each joint of a kind that is a chain in the tree replaced by its chain, in
     the joint's place in the joint order: a :attr:`~eomgen.model.JointType.SPHERICAL` or
     ``PLANAR`` joint by its chart's virtual joints ``<name>_<suffix>`` (the kind's
     :meth:`~eomgen.model.joints.ChartKind.chain`, the first at the joint's origin) through
     massless links ``<child>_<name>_<suffix>``, recorded in
-    :attr:`~eomgen.model.RobotModel.compound_joints`; a ``HELICAL`` joint by a continuous
-    joint and a coupled prismatic one (:mod:`eomgen.model.joints.helical`). The hook a parser
-    calls (:func:`~eomgen.model.build_model` does it for every parser).
+    :attr:`~eomgen.model.RobotModel.compound_joints`. The hook a parser calls (:func:`~eomgen.model.build_model` does it for every parser).
 
     Raises
     ------
@@ -172,26 +154,20 @@ def expand_joints(model: "RobotModel") -> "RobotModel":
         MuJoCo's act on each dof of a ball joint): the actuator is given to every virtual
         joint of the chain.
     """
-    expanded = [j for j in model.joints if isinstance(j.type.kind, ChartKind)
-                or j.type is JointType.HELICAL]
+    expanded = [j for j in model.joints if isinstance(j.type.kind, ChartKind)]
     if not expanded:
         return model
     taken = {link.name for link in model.links} | {j.name for j in model.joints}
     chains: dict[str, list[Link]] = {}
     joints: list[Joint] = []
-    couplings = list(model.couplings)
     compound = list(model.compound_joints)
     for joint in model.joints:
         kind = joint.type.kind
-        if isinstance(kind, ChartKind):
-            virtual, links = _chart_chain(model, joint, kind, taken)
-            compound.append((kind.name, joint.name))
-        elif joint.type is JointType.HELICAL:
-            virtual, links, coupling = _screw_chain(model, joint, taken)
-            couplings.append(coupling)
-        else:
+        if not isinstance(kind, ChartKind):
             joints.append(joint)
             continue
+        virtual, links = _chart_chain(model, joint, kind, taken)
+        compound.append((kind.name, joint.name))
         joints += virtual
         chains[joint.child] = links
     links_out: list[Link] = []
@@ -199,7 +175,7 @@ def expand_joints(model: "RobotModel") -> "RobotModel":
         links_out += chains.get(link.name, ())
         links_out.append(link)
     return replace(model, links=tuple(links_out), joints=tuple(joints),
-                   compound_joints=tuple(compound), couplings=tuple(couplings))
+                   compound_joints=tuple(compound))
 
 
 _COUNT = {2: "two", 3: "three", 6: "six"}
@@ -222,7 +198,7 @@ def quaternion_layout(model: "RobotModel") -> tuple[QuaternionJoint, ...]:
         The model holds a joint of a chain kind that was not expanded (:func:`expand_joints`).
     """
     for joint in model.joints:
-        if isinstance(joint.type.kind, ChartKind) or joint.type is JointType.HELICAL:
+        if isinstance(joint.type.kind, ChartKind):
             raise UnsupportedError(model.source, f"joint '{joint.name}'",
                                    f"a {joint.type.value} joint must be expanded first "
                                    "(eomgen.model.expand_joints; build_model does it)")

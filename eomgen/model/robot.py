@@ -213,6 +213,7 @@ class RobotModel:
                     tuple(sv(r) for r in j.origin.rotation), sv(j.origin.translation)
                 ),
                 axis=sv(j.axis),
+                pitch=s(j.pitch),
                 actuator=None if j.actuator is None else j.actuator.substitute(subs),
             )
             for j in self.joints
@@ -254,6 +255,8 @@ def all_scalars(model: RobotModel) -> Iterable[sp.Expr]:
         yield from joint.origin.translation
         for row in joint.origin.rotation:
             yield from row
+        if joint.pitch != 0:  # a helical joint's
+            yield joint.pitch
         if joint.actuator is not None:
             yield from joint.actuator.scalars()
 
@@ -288,7 +291,8 @@ def float_constants(model: RobotModel) -> RobotModel:
         if link.inertial is not None else link for link in model.links)
     joints = tuple(
         replace(j, origin=Transform(tuple(vector(r) for r in j.origin.rotation),
-                                    vector(j.origin.translation)), axis=vector(j.axis))
+                                    vector(j.origin.translation)), axis=vector(j.axis),
+                pitch=floated(j.pitch))
         for j in model.joints)
     return replace(model, links=links, joints=joints)
 
@@ -306,13 +310,15 @@ def flexible_indices(model: RobotModel) -> tuple[int, ...]:
 
 def joint_motion(joint: Joint, value) -> Transform:
     """The transform a joint applies at position ``value`` (rad or m): child frame in joint
-    frame."""
+    frame (a helical joint's turns by ``value`` and moves ``pitch · value`` along its axis)."""
     value = scalar(value) if not isinstance(value, sp.Basic) else value
-    if joint.type.is_revolute:
-        return Transform(rotation_about_axis(joint.axis, value), ZERO3)
-    if joint.type is JointType.PRISMATIC:
-        return Transform(IDENTITY3, tuple(a * value for a in joint.axis))  # type: ignore[arg-type]
-    return Transform()
+    if not joint.type.is_movable:
+        return Transform()
+    rotation = rotation_about_axis(joint.axis, value) if joint.rotates else IDENTITY3
+    if not joint.type.kind.translates:
+        return Transform(rotation, ZERO3)
+    move = value if not joint.rotates else joint.lead * value
+    return Transform(rotation, tuple(a * move for a in joint.axis))  # type: ignore[arg-type]
 
 
 def compound_names(model: RobotModel) -> dict[str, tuple[str, tuple[str, ...]]]:

@@ -24,6 +24,7 @@ from __future__ import annotations
 from .newton_euler import (
     FIXED,
     FLOAT64,
+    HELICAL,
     PRISMATIC,
     REVOLUTE,
     M_crba,
@@ -44,5 +45,5 @@ __all__ = [
     "Numbers", "FLOAT64", "NumericModel", "numeric_model", "rnea", "gravity_torques", "M_rnea",
     "M_crba",
     "coriolis_times_qd", "forward_dynamics", "kinetic_energy", "potential_energy", "link_poses",
-    "FIXED", "REVOLUTE", "PRISMATIC",
+    "FIXED", "REVOLUTE", "PRISMATIC", "HELICAL",
 ]

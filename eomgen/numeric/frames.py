@@ -34,7 +34,7 @@ from typing import Callable, Iterable
 
 import numpy as np
 
-from .model import REVOLUTE, NumericModel, numeric_model
+from .model import REVOLUTE, TURNING, NumericModel, numeric_model
 from .newton_euler import world_state
 
 
@@ -70,11 +70,11 @@ def frame_kinematics(nm: NumericModel, q, qd=None, frames: Iterable[str] | None 
         while k > 0:
             col = nm.q_index[k]
             if col >= 0:
-                if nm.joint_type[k] == REVOLUTE:
+                if nm.joint_type[k] in TURNING:
                     J[:3, col] = np.cross(z[k], p - pw[k])
                     J[3:, col] = z[k]
-                else:
-                    J[:3, col] = z[k]
+                if nm.joint_type[k] != REVOLUTE:  # prismatic, helical: lead · z
+                    J[:3, col] = J[:3, col] + nm.lead[k] * z[k]
             k = nm.parent[k]
         if nm.coupling is not None:
             J = J @ nm.coupling

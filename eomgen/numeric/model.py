@@ -17,13 +17,17 @@ from ..model import (JointType, QuaternionJoint, RobotModel, coupling_map, param
 from ..model.coupling import full_configuration
 
 #: Joint type codes stored in :attr:`NumericModel.joint_type`.
-FIXED, REVOLUTE, PRISMATIC = 0, 1, 2
+FIXED, REVOLUTE, PRISMATIC, HELICAL = 0, 1, 2, 3
+#: The codes of the joints that turn their child about the axis (a helical joint also moves
+#: it along the axis: :attr:`NumericModel.lead`).
+TURNING = (REVOLUTE, HELICAL)
 
 _TYPE_CODE = {
     JointType.FIXED: FIXED,
     JointType.REVOLUTE: REVOLUTE,
     JointType.CONTINUOUS: REVOLUTE,
     JointType.PRISMATIC: PRISMATIC,
+    JointType.HELICAL: HELICAL,
 }
 
 
@@ -119,7 +123,12 @@ class NumericModel:
     parent : (nb,) int array
         Parent body index; ``-1`` for the root.
     joint_type : (nb,) int array
-        :data:`FIXED`, :data:`REVOLUTE` or :data:`PRISMATIC` (the root counts as fixed).
+        :data:`FIXED`, :data:`REVOLUTE`, :data:`PRISMATIC` or :data:`HELICAL` (the root counts
+        as fixed); the codes of :data:`TURNING` turn the body about the axis.
+    lead : (nb,) array
+        The body's translation along the axis per unit of its coordinate: 1 (prismatic), the
+        pitch [m/rad] (helical), 0 (revolute, fixed, the root); the motion subspace of a
+        moving joint is ``S = (ω, v) = (z if it turns else 0, lead · z)``.
     q_index : (nb,) int array
         Index of the body's joint among the tree's movable joints (``tree_joint_names``:
         ``q`` itself without couplings); ``-1`` for fixed joints and the root.
@@ -170,6 +179,7 @@ class NumericModel:
     joint_type: np.ndarray
     q_index: np.ndarray
     axis: np.ndarray
+    lead: np.ndarray
     origin_rotation: np.ndarray
     origin_translation: np.ndarray
     mass: np.ndarray
@@ -278,6 +288,7 @@ def numeric_model(model: RobotModel, values: Mapping | None = None,
     q_index = np.full(nb, -1, dtype=np.int64)
     axis = numbers.zeros((nb, 3))
     axis[:, 2] = numbers.value(1)
+    lead = numbers.zeros(nb)
     rot = numbers.zeros((nb, 3, 3))
     rot[:] = numbers.eye(3)
     trans = numbers.zeros((nb, 3))
@@ -287,6 +298,7 @@ def numeric_model(model: RobotModel, values: Mapping | None = None,
         joint_type[i] = _TYPE_CODE[joint.type]
         q_index[i] = q_of_joint.get(joint.name, -1)
         axis[i] = _vec(numbers, joint.axis, where + " axis")
+        lead[i] = _number(numbers, joint.lead, where + " pitch")
         rot[i] = _mat(numbers, joint.origin.rotation, where + " origin")
         trans[i] = _vec(numbers, joint.origin.translation, where + " origin")
 
@@ -302,7 +314,7 @@ def numeric_model(model: RobotModel, values: Mapping | None = None,
         com[i] = _vec(numbers, inertial.com, where)
         inertia[i] = _mat(numbers, inertial.inertia, where)
 
-    arrays = dict(parent=parent, joint_type=joint_type, q_index=q_index, axis=axis,
+    arrays = dict(parent=parent, joint_type=joint_type, q_index=q_index, axis=axis, lead=lead,
                   origin_rotation=rot, origin_translation=trans, mass=mass, com=com,
                   inertia=inertia, gravity=_vec(numbers, model.gravity, "gravity"))
     for a in arrays.values():
@@ -332,5 +344,6 @@ def numeric_model(model: RobotModel, values: Mapping | None = None,
     )
 
 
-__all__ = ["FIXED", "FLOAT64", "Numbers", "NumericModel", "PRISMATIC", "REVOLUTE",
+__all__ = ["FIXED", "FLOAT64", "HELICAL", "Numbers", "NumericModel", "PRISMATIC", "REVOLUTE",
+           "TURNING",
            "configuration_map", "numeric_model"]

@@ -56,7 +56,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .model import (FIXED, FLOAT64, PRISMATIC, REVOLUTE, Numbers, NumericModel,
+from .model import (FIXED, FLOAT64, HELICAL, PRISMATIC, REVOLUTE, TURNING, Numbers, NumericModel,
                     numeric_model)
 from .quaternion_chart import chart_coordinates, chart_offset, placements
 from .so3 import rotation_about, skew
@@ -124,10 +124,10 @@ def _parent_transforms(nm: NumericModel, q: np.ndarray, placed: dict | None = No
             Rq, pq = placed[k]
             p[i] = p[i] + R[i] @ pq
             R[i] = R[i] @ Rq
-        if nm.joint_type[i] == REVOLUTE:
+        if nm.joint_type[i] != REVOLUTE:  # prismatic, helical: moves along the axis
+            p[i] = p[i] + R[i] @ (nm.axis[i] * (nm.lead[i] * q[k]))
+        if nm.joint_type[i] in TURNING:  # (the axis is the same in the turned frame)
             R[i] = R[i] @ rotation_about(nm.axis[i], q[k], nm.numbers)
-        else:  # prismatic: the child frame moves along the axis, without rotating
-            p[i] = p[i] + R[i] @ (nm.axis[i] * q[k])
     return R, p
 
 
@@ -143,10 +143,10 @@ def _velocities(nm: NumericModel, R: np.ndarray, p: np.ndarray, qd: np.ndarray):
         v[i] = Rt @ (v[j] + np.cross(w[j], p[i]))
         k = nm.q_index[i]
         if k >= 0:
-            if nm.joint_type[i] == REVOLUTE:
+            if nm.joint_type[i] in TURNING:
                 w[i] += qd[k] * nm.axis[i]
-            else:
-                v[i] += qd[k] * nm.axis[i]
+            if nm.joint_type[i] != REVOLUTE:
+                v[i] += (nm.lead[i] * qd[k]) * nm.axis[i]
     return w, v
 
 
@@ -161,10 +161,10 @@ def rnea(nm: NumericModel, q, qd, qdd) -> np.ndarray:
     with ``R = ᵖR_i``, ``p = ᵖp_i`` the pose of body ``i`` in its parent ``p``, ``z`` the
     joint axis and ``q̇, q̈`` the joint rate and acceleration::
 
-        ω_i  = Rᵀ ω_p                    (+ q̇ z                     revolute)
-        ω̇_i  = Rᵀ ω̇_p                    (+ Rᵀω_p × q̇ z + q̈ z       revolute)
+        ω_i  = Rᵀ ω_p                    (+ q̇ z                     revolute, helical)
+        ω̇_i  = Rᵀ ω̇_p                    (+ Rᵀω_p × q̇ z + q̈ z       revolute, helical)
         v̇_i  = Rᵀ (v̇_p + ω̇_p × p + ω_p × (ω_p × p))
-                                         (+ 2 ω_i × q̇ z + q̈ z        prismatic)
+                                         (+ λ (2 ω_i × q̇ z + q̈ z)    prismatic, helical)
         v̇_ci = v̇_i + ω̇_i × c_i + ω_i × (ω_i × c_i)
         F_i  = m_i v̇_ci,     N_i = I_ci ω̇_i + ω_i × I_ci ω_i
 
@@ -176,7 +176,9 @@ def rnea(nm: NumericModel, q, qd, qdd) -> np.ndarray:
 
         f_i = F_i + Σ_children ⁱR_c f_c
         n_i = N_i + c_i × F_i + Σ_children (ⁱR_c n_c + ⁱp_c × ⁱR_c f_c)
-        tau = n_i · z  (revolute)   or   f_i · z  (prismatic)
+        tau = n_i · z  (revolute),   f_i · z  (prismatic),   n_i · z + λ f_i · z  (helical)
+
+    with ``λ`` the joint's lead (1 prismatic, the pitch helical: :attr:`NumericModel.lead`).
 
     Fixed joints are bodies with no joint motion; the root's forces are not returned. A
     quaternion joint's chain runs with its virtual joints at zero below the pose placed from
@@ -230,11 +232,12 @@ def rnea(nm: NumericModel, q, qd, qdd) -> np.ndarray:
         k = nm.q_index[i]
         if k >= 0:
             z = nm.axis[i]
-            if nm.joint_type[i] == REVOLUTE:
+            if nm.joint_type[i] in TURNING:
                 wd[i] += np.cross(w[i], qd[k] * z) + qdd[k] * z
                 w[i] += qd[k] * z
-            else:
-                vd[i] += 2.0 * np.cross(w[i], qd[k] * z) + qdd[k] * z
+            if nm.joint_type[i] != REVOLUTE:  # (ω_i × z is the parent's: z × z = 0)
+                lead = nm.lead[i]
+                vd[i] += 2.0 * np.cross(w[i], (lead * qd[k]) * z) + (lead * qdd[k]) * z
         c = nm.com[i]
         vdc = vd[i] + np.cross(wd[i], c) + np.cross(w[i], np.cross(w[i], c))
         I = nm.inertia[i]
@@ -247,7 +250,9 @@ def rnea(nm: NumericModel, q, qd, qdd) -> np.ndarray:
     for i in range(nb - 1, 0, -1):
         k = nm.q_index[i]
         if k >= 0:
-            s = n[i] if nm.joint_type[i] == REVOLUTE else f[i]
+            kind = nm.joint_type[i]
+            s = n[i] if kind == REVOLUTE else f[i] if kind == PRISMATIC else (
+                n[i] + nm.lead[i] * f[i])
             tau[k] = s @ nm.axis[i]
         j = nm.parent[i]
         fj = R[i] @ f[i]
@@ -289,7 +294,7 @@ def M_crba(nm: NumericModel, q) -> np.ndarray:
     (the body and everything below it) gathers each child's through ``ᶜX_iᵀ I^c_c ᶜX_i``,
     ``ᶜX_i = [[Rᵀ, 0], [−Rᵀ [p]×, Rᵀ]]`` taking motions from body ``i`` to its child
     (pose ``(R, p)`` in ``i``). With ``S_i`` the joint's motion (``(z, 0)`` revolute, ``(0, z)``
-    prismatic), ``M[k_i, k_j] = S_jᵀ (ʲX_iᵀ I^c_i S_i)`` for every joint ``j`` on the path from
+    prismatic, ``(z, λ z)`` helical of lead ``λ``, its pitch), ``M[k_i, k_j] = S_jᵀ (ʲX_iᵀ I^c_i S_i)`` for every joint ``j`` on the path from
     ``i`` to the root. ``q`` (nq,) as :func:`rnea` takes it; with couplings ``Tᵀ M_tree T``.
     """
     x, placed = _configuration(nm, q)
@@ -310,8 +315,10 @@ def M_crba(nm: NumericModel, q) -> np.ndarray:
         Ic[i, :3, 3:] = m * C
         Ic[i, 3:, :3] = -m * C
         Ic[i, 3:, 3:] = m * numbers.eye(3)
-        half = 0 if nm.joint_type[i] == REVOLUTE else 3
-        S[i, half:half + 3] = nm.axis[i]
+        if nm.joint_type[i] in TURNING:
+            S[i, :3] = nm.axis[i]
+        if nm.joint_type[i] != REVOLUTE:
+            S[i, 3:] = nm.lead[i] * nm.axis[i]
     for i in range(nb - 1, 1, -1):
         j = nm.parent[i]
         if j > 0:
@@ -410,12 +417,13 @@ def world_state(nm: NumericModel, q, qd) -> tuple[np.ndarray, ...]:
         if k < 0:
             continue
         motion = z[i] * qd[k]
-        if nm.joint_type[i] == REVOLUTE:
+        if nm.joint_type[i] in TURNING:
             wd[i] = wd[i] + np.cross(w[j], motion) + z[i] * qdd[k]
             w[i] = w[i] + motion
-        else:
-            v[i] = v[i] + motion
-            a[i] = a[i] + 2.0 * np.cross(w[j], motion) + z[i] * qdd[k]
+        if nm.joint_type[i] != REVOLUTE:  # prismatic, helical: lead · the motion along z
+            lead = nm.lead[i]
+            v[i] = v[i] + lead * motion
+            a[i] = a[i] + 2.0 * np.cross(w[j], lead * motion) + z[i] * (lead * qdd[k])
     return Rw, pw, z, w, v, wd, a, qd
 
 
@@ -476,4 +484,6 @@ __all__ = [
     "FIXED",
     "REVOLUTE",
     "PRISMATIC",
+    "HELICAL",
+    "TURNING",
 ]

@@ -147,7 +147,9 @@ def to_pinocchio(model: RobotModel) -> PinocchioModel:
                 inside[later.name] = jid
         elif joint.type.is_movable:
             axis = _floats(joint.axis)
-            kind = (pin.JointModelRevoluteUnaligned(axis) if joint.type.is_revolute
+            kind = (pin.JointModelHelicalUnaligned(axis, float(joint.pitch))
+                    if joint.rotates and joint.type.kind.translates
+                    else pin.JointModelRevoluteUnaligned(axis) if joint.rotates
                     else pin.JointModelPrismaticUnaligned(axis))
             jid = pmodel.addJoint(parent_id, kind, T, joint.name)
             anchor[joint.child] = (jid, pin.SE3.Identity())

@@ -50,8 +50,9 @@ def planar_motion(model: RobotModel, tolerance: float = 1e-9) -> PlanarMotion | 
     axes = _world_axes(model)
     if not axes:
         return None
-    revolute = [np.array(axes[j.name]) for j in model.movable_joints if j.type.is_revolute]
-    prismatic = [np.array(axes[j.name]) for j in model.movable_joints if not j.type.is_revolute]
+    # a helical joint both turns and slides along its axis: it is in both lists (never planar)
+    revolute = [np.array(axes[j.name]) for j in model.movable_joints if j.rotates]
+    prismatic = [np.array(axes[j.name]) for j in model.movable_joints if j.lead != 0]
     if not revolute:
         return None
     n = revolute[0]

@@ -43,7 +43,7 @@ from .crba import M_program
 from .newton_euler import grouped_inertials, inverse_dynamics_program
 from .quaternion_joints import true_accelerations as chart_to_true
 from .program import Program, ProgramBuilder, name_expr, name_exprs, name_matrix, name_symmetric
-from .spatial import JointFrames, add, cross, dot, matvec, scale, skew, transpose
+from .spatial import JointFrames, add, cross, dot, joint_subspace, matvec, scale, skew, transpose
 
 _ZERO = sp.Integer(0)
 
@@ -83,9 +83,7 @@ def forward_dynamics_program(tree: BodyTree, q, qd, tau, gravity: Vec3, b: Progr
     inertials = grouped_inertials(tree) if grouped else [body.inertial for body in tree.bodies]
 
     def subspace(i):
-        body = tree.bodies[i]
-        k = tuple(body.joint.axis)
-        return (k, zero) if body.joint.type.is_revolute else (zero, k)
+        return joint_subspace(tree.bodies[i].joint)
 
     # pass 1: velocities, velocity-product accelerations, bias forces
     vel, cvec, IA, pA = [], [], [], []

@@ -18,7 +18,8 @@ number of links:
   digits of a robot far from its root origin (a mobile base in a map frame): about the root
   origin, a robot at distance d with links of size ℓ has inertias with terms m d² that cancel in
   M and lose (d/ℓ)² relative; about ``o`` only link-sized offsets appear. ``S_i`` is the motion axis of joint i
-  (``[z_i; p_i × z_i]`` for a revolute joint through ``p_i``, ``[0; z_i]`` for a prismatic one),
+  (``[z_i; p_i × z_i]`` for a revolute joint through ``p_i``, ``[0; z_i]`` for a prismatic one,
+  ``[z_i; p_i × z_i + λ z_i]`` for a helical one of pitch ``λ``),
   so that the column i of the spatial Jacobian of any body after joint i is ``S_i``.
 * ``I^c_j`` is the spatial inertia of the subtree rooted at body j about ``o``, a sum of the
   bodies' inertial parameters (m, h, Ī) moved to the world orientation and to ``o``.
@@ -84,14 +85,21 @@ def forward_kinematics(tree: BodyTree, q, b: ProgramBuilder) -> Kinematics:
                                 ("o", n))
         z = b.define_all(matvec(R0, joint.axis), f"z{n}_", ("z", n))
         qi = q[body.q_index]
-        if joint.type.is_revolute:
+        if joint.rotates:
             s = b.define(sp.sin(qi), f"s{n}", ("s", n))
             c = b.define(sp.cos(qi), f"c{n}", ("c", n))
             kin.sin_cos.append((s, c))
             R = tuple(b.define_all(row, f"R{n}_{r}", ("R", n, r)) for r, row in
                       enumerate(matmul(R0, rotation(joint.axis, c, s))))
             p = p0
-            S = z + b.define_all(cross(p, z), f"v{n}_", ("v", n))
+            if joint.lead == 0:
+                S = z + b.define_all(cross(p, z), f"v{n}_", ("v", n))
+            else:  # helical: the origin slides λ q along z; S = (z, p × z + λ z)
+                lead = joint.lead
+                p = b.define_all(tuple(p0[r] + z[r] * (lead * qi) for r in range(3)),
+                                 f"p{n}_", ("p", n))
+                S = z + b.define_all(tuple(e + lead * z[r] for r, e in enumerate(cross(p0, z))),
+                                     f"v{n}_", ("v", n))
         else:
             kin.sin_cos.append(None)
             R = R0

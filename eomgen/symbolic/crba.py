@@ -22,7 +22,7 @@ from ..model import RobotModel
 from .derivation import new_derivation
 from .newton_euler import grouped_inertials
 from .program import Program, ProgramBuilder, name_expr, name_exprs, name_matrix, name_symmetric
-from .spatial import JointFrames, dot, matvec, skew, transpose
+from .spatial import JointFrames, dot, joint_subspace, matvec, skew, transpose
 
 _ZERO = sp.Integer(0)
 
@@ -31,7 +31,6 @@ def M_program(tree: BodyTree, q, b: ProgramBuilder, grouped: bool = True) -> sp.
     """Build M(q) into ``b`` by the body-frame CRBA; returns the symmetric n×n matrix
     [kg m², kg m, kg] in ``JOINT_NAMES`` order."""
     n = len(tree.bodies)
-    zero = (_ZERO,) * 3
     frames = JointFrames.named(tree, q, b)
     inertials = grouped_inertials(tree) if grouped else [body.inertial for body in tree.bodies]
     IC = []
@@ -41,9 +40,7 @@ def M_program(tree: BodyTree, q, b: ProgramBuilder, grouped: bool = True) -> sp.
                                           for r in range(3))])
 
     def subspace(i):
-        body = tree.bodies[i]
-        k = tuple(body.joint.axis)
-        return (k, zero) if body.joint.type.is_revolute else (zero, k)
+        return joint_subspace(tree.bodies[i].joint)
 
     M = sp.zeros(n, n)
     for i in reversed(range(n)):

@@ -13,6 +13,10 @@ parent, and is pushed there:
   and their velocity terms do not involve q̇_j. With (a, b) the two other axes in x, y, z order,
   ``c`` is the b-b moment: for z, ``c = YY`` and ``XXR = XX − YY`` remains (Khalil's rule); for
   x, ``c = ZZ`` (YYR = YY − ZZ); for y, ``c = ZZ`` (XXR = XX − ZZ).
+* **helical joint about ±e_k** (a screw of pitch λ ≠ 0): the mass and the first moments move
+  along the axis with the joint (their velocity terms involve λ q̇_j), so only the inertia
+  ``c (1 − e_k e_kᵀ)`` is invariant (it turns about its axis and does not see a translation);
+  ``c`` as for a revolute joint.
 * **prismatic joint** (any axis): the body does not rotate relative to its parent, so the whole
   inertia about its origin, ``(0, 0, I)``, is pushed (the mass and first moments stay).
 
@@ -83,7 +87,8 @@ def group_parameters(tree: BodyTree, pi: tuple[sp.Symbol, ...]) -> Grouping:
     Raises
     ------
     ValueError
-        For a revolute joint whose axis is not ±x, ±y or ±z of its frame (names the joint).
+        For a revolute or helical joint whose axis is not ±x, ±y or ±z of its frame (names
+        the joint).
     """
     grouped = [_symbolic_body(pi[10 * b.q_index:10 * b.q_index + 10]) for b in tree.bodies]
     eliminated: set[int] = set()
@@ -92,11 +97,12 @@ def group_parameters(tree: BodyTree, pi: tuple[sp.Symbol, ...]) -> Grouping:
         body = tree.bodies[i]
         par = grouped[i]
         col = 10 * body.q_index
-        if body.joint.type.is_revolute:
+        if body.joint.rotates:
             aligned = aligned_axis(body.joint.axis)
             if aligned is None:
                 raise ValueError(f"joint '{body.joint.name}': the closed-form grouping needs a "
-                                 "revolute axis along ±x, ±y or ±z of the joint frame")
+                                 f"{'helical' if body.joint.lead != 0 else 'revolute'} axis "
+                                 "along ±x, ±y or ±z of the joint frame")
             k = aligned[0]
             a, b = sorted(((k + 1) % 3, (k + 2) % 3))
             c = par.inertia[b][b]
@@ -109,6 +115,10 @@ def group_parameters(tree: BodyTree, pi: tuple[sp.Symbol, ...]) -> Grouping:
                 tuple(tuple(par.inertia[r][s] - inertia_c[r][s] for s in range(3))
                       for r in range(3)))  # type: ignore[arg-type]
             eliminated |= {col, col + 1 + k, col + SLOTS.index(("I", b, b))}
+            if body.joint.lead != 0:  # helical: the mass and first moments stay (docstring)
+                pushed = InertialParameters(zero, (zero,) * 3, inertia_c)  # type: ignore
+                remainder = InertialParameters(par.mass, par.first_moment, remainder.inertia)
+                eliminated -= {col, col + 1 + k}
         else:
             pushed = InertialParameters(zero, (zero,) * 3, par.inertia)  # type: ignore[arg-type]
             remainder = InertialParameters(par.mass, par.first_moment)

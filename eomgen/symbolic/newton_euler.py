@@ -15,15 +15,17 @@ origin are
     f = m a + U h,
     n = I_O ω̇ + ω × (I_O ω) + h × a,
 
-and the joint torque is ``τ_i = k_i · n_i`` (revolute) or ``k_i · f_i`` (prismatic), ``k_i`` the
-unit joint axis in body coordinates. ``U`` costs 6 products of ω's components once per body and
+and the joint torque is ``τ_i = k_i · n_i`` (revolute), ``k_i · f_i`` (prismatic) or
+``k_i · n_i + λ_i k_i · f_i`` (helical of pitch ``λ_i``), ``k_i`` the unit joint axis in body
+coordinates. ``U`` costs 6 products of ω's components once per body and
 is shared by ``U h`` and by the children's origin accelerations ``a + U r``.
 
 Leaner programs (Khalil and Kleinfinger's customised Newton–Euler): besides the structural zeros
 of rotations, offsets and inertias, which SymPy folds, the inertial parameters are **regrouped**
 before the recursion (:func:`grouped_inertials`): the part of a body's parameters that looks the
 same at every angle of its joint (for a revolute joint about ``k``: the mass, the first moment
-along ``k`` and an inertia ``β (1 − k kᵀ)``; for a prismatic joint: the rotational inertia) moves
+along ``k`` and an inertia ``β (1 − k kᵀ)``; for a helical joint that inertia alone; for a
+prismatic joint: the rotational inertia) moves
 to the parent body, and off a root body into the fixed base, where it does nothing. The joint
 efforts are exactly those of the original parameters (the moved part's kinetic and potential
 energy do not depend on that joint's position or rate), while most bodies lose their mass and
@@ -52,25 +54,29 @@ from ..model.bodies import BodyTree, InertialParameters
 from ..model import Transform, Vec3
 from .builders import builds
 from .program import ProgramBuilder, name_expr, name_exprs
-from .spatial import JointFrames, aligned_axis, cross, dot, matvec, mul, rotation, skew
+from .spatial import (JointFrames, aligned_axis, cross, dot, joint_subspace, matvec, mul, rotation,
+                      skew)
 
 
-def _invariant_part(axis: Vec3, revolute: bool, par: InertialParameters) -> InertialParameters:
+def _invariant_part(joint, par: InertialParameters) -> InertialParameters:
     """The part of ``par`` that is the same at every position of the joint (see module doc).
 
     Revolute about the unit axis ``k``: mass m, first moment (h·k) k and inertia β (1 − k kᵀ),
     with β the inertia about the first body axis after ``k`` when ``k`` is a coordinate axis
     (making that entry zero on the body) and 0 otherwise. Prismatic: the inertia I_O alone.
+    Helical: the inertia β (1 − k kᵀ) alone (a mass moves along the axis with the screw).
     """
     zero = sp.Integer(0)
-    if not revolute:
+    if not joint.rotates:
         return InertialParameters(zero, (zero,) * 3, par.inertia)
-    k = tuple(axis)
+    k = tuple(joint.axis)
     along = dot(k, par.first_moment)
     aligned = aligned_axis(k)
     beta = par.inertia[(aligned[0] + 2) % 3][(aligned[0] + 2) % 3] if aligned else zero
     inertia = tuple(tuple(beta * ((1 if r == c else 0) - k[r] * k[c]) for c in range(3))
                     for r in range(3))
+    if joint.lead != 0:
+        return InertialParameters(zero, (zero,) * 3, inertia)  # type: ignore[arg-type]
     return InertialParameters(par.mass, tuple(along * x for x in k), inertia)  # type: ignore
 
 
@@ -91,7 +97,7 @@ def grouped_inertials(tree: BodyTree) -> list[InertialParameters]:
     params = [body.inertial for body in tree.bodies]
     for i in reversed(range(len(tree.bodies))):
         body = tree.bodies[i]
-        moved = _invariant_part(body.joint.axis, body.joint.type.is_revolute, params[i])
+        moved = _invariant_part(body.joint, params[i])
         if moved.is_zero:
             continue
         params[i] = params[i] + _negated(moved)
@@ -111,8 +117,9 @@ def leaf_phases(tree: BodyTree, inertials: list) -> tuple[list, dict]:
     :func:`grouped_inertials`) points along the first axis after ``k``, ``U h`` needs one column
     of U instead of two and ``h × a`` two products instead of four. The turned inertia is
     regrouped (its invariant part moves to the parent), so the body keeps its number of
-    non-zero parameters. Only for revolute joints about a coordinate axis and numeric first
-    moments with both perpendicular components non-zero; other bodies keep φ = 0.
+    non-zero parameters (a helical joint's body keeps its first moment along ``k``). Only for
+    revolute and helical joints about a coordinate axis and numeric first moments with both
+    perpendicular components non-zero; other bodies keep φ = 0.
 
     Returns
     -------
@@ -124,7 +131,7 @@ def leaf_phases(tree: BodyTree, inertials: list) -> tuple[list, dict]:
     phases = {}
     for i, body in enumerate(tree.bodies):
         aligned = aligned_axis(body.joint.axis)
-        if i in parents or not body.joint.type.is_revolute or aligned is None:
+        if i in parents or not body.joint.rotates or aligned is None:
             continue
         a, sign = aligned
         x, y = (a + 1) % 3, (a + 2) % 3
@@ -140,8 +147,10 @@ def leaf_phases(tree: BodyTree, inertials: list) -> tuple[list, dict]:
         turned = inertials[i].transformed(Transform(tuple(zip(*turn)), (0, 0, 0)))
         first = [sp.Integer(0)] * 3
         first[x] = length  # and h[y] is now exactly 0
+        if h[a] != 0:  # a helical joint's body keeps its first moment along the axis
+            first[a] = h[a]
         turned = InertialParameters(turned.mass, tuple(first), turned.inertia)
-        moved = _invariant_part(body.joint.axis, True, turned)
+        moved = _invariant_part(body.joint, turned)
         inertials[i] = _folded(turned + _negated(moved))
         if body.parent >= 0:
             placement = Transform(body.placement.rotation, body.placement.translation)
@@ -163,7 +172,7 @@ def acceleration_length(tree: BodyTree, inertials: list, gravity: Vec3) -> sp.Ex
     parameter and gravity component is a number (otherwise 1: a symbolic or a prismatic factor
     would cost products)."""
     one = sp.Integer(1)
-    if not all(body.joint.type.is_revolute for body in tree.bodies):
+    if not all(body.joint.lead == 0 for body in tree.bodies):  # a joint translates
         return one
     numbers = [*gravity, *(x for body in tree.bodies for x in body.placement.translation)]
     for par in inertials:
@@ -287,7 +296,7 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
         k = body.q_index
         tag = k + 1
         z = body.joint.axis
-        if body.joint.type.is_revolute:
+        if body.joint.rotates:
             angle = q[k]
             if i in phases:  # the leaf's turned frame (leaf_phases)
                 angle = b.define(q[k] + phases[i], f"qp{tag}", ("qp", tag))
@@ -304,9 +313,16 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
         Ur = matvec(U_p, tuple(_scaled(x, length) for x in offset(i)))
         a_o = name_exprs(b, tuple(a_p[j] + Ur[j] for j in range(3)), f"ap{tag}_", ("ap", tag),
                         scaled=True)
-        if body.joint.type.is_revolute:
-            a = name_exprs(b, to_body(i, a_o), f"a{tag}_", ("a", tag))
+        lead = body.joint.lead
+        if body.joint.rotates:
+            if lead == 0:
+                a = name_exprs(b, to_body(i, a_o), f"a{tag}_", ("a", tag))
             w_in = name_exprs(b, to_body(i, w_p), f"wp{tag}_", ("wp", tag))
+            if lead != 0:  # helical: the origin slides λ q along z too (ω × z is ω_in × z)
+                s = joint_subspace(body.joint)[1]
+                cor = cross(w_in, tuple(2 * s[j] * qd[k] for j in range(3)))
+                a = name_exprs(b, tuple(e + cor[j] + s[j] * qdd[k] for j, e in
+                                       enumerate(to_body(i, a_o))), f"a{tag}_", ("a", tag))
             w = name_exprs(b, tuple(w_in[j] + z[j] * qd[k] for j in range(3)), f"w{tag}_",
                           ("w", tag))
             ww = _omega_products(w, b, tag)
@@ -350,8 +366,10 @@ def inverse_dynamics_program(tree: BodyTree, q, qd, qdd, gravity: Vec3, b: Progr
         f = name_exprs(b, force[i], f"f{tag}_", ("f", tag), scaled=True)
         nn = name_exprs(b, moment[i], f"n{tag}_", ("n", tag), scaled=True)
         axis = body.joint.axis
-        tau[body.q_index, 0] = name_expr(b, dot(axis, nn if body.joint.type.is_revolute else f),
-                                        f"{hint}{tag}", ("effort", tag))
+        effort = dot(axis, nn if body.joint.rotates else f)
+        if body.joint.rotates and body.joint.lead != 0:  # helical: n·k + λ f·k
+            effort = effort + dot(joint_subspace(body.joint)[1], f)
+        tau[body.q_index, 0] = name_expr(b, effort, f"{hint}{tag}", ("effort", tag))
         p = body.parent
         if p >= 0:
             f_p = name_exprs(b, to_parent(i, f), f"fp{tag}_", ("fp", tag))

@@ -40,7 +40,7 @@ import sympy as sp
 
 from ..model.bodies import BodyTree
 from .program import ProgramBuilder
-from .spatial import JointFrames, cross, dot
+from .spatial import JointFrames, cross, dot, joint_subspace
 
 #: Column names of one body's block, Pinocchio's order; the joint number (1-based, JOINT_NAMES
 #: order) is appended: ``M1, MX1, …`` (Khalil's names: mass, first moments, inertia about the
@@ -91,14 +91,16 @@ def regressor_program(tree: BodyTree, q, qd, qdd, gravity, b: ProgramBuilder,
     to_body = JointFrames(tree, q, sincos).to_body  # sincos is filled body by body below
 
     def offset(i):
-        """Body i's origin in its parent's frame (moves with a prismatic joint)."""
+        """Body i's origin in its parent's frame (moves with a prismatic or helical joint)."""
         body = tree.bodies[i]
         r = body.placement.translation
-        if body.joint.type.is_revolute:
+        lead = body.joint.lead
+        if lead == 0:
             return r
         R = body.placement.rotation
         z = body.joint.axis
-        return tuple(r[a] + sp.Add(*[R[a][k] * z[k] for k in range(3)]) * q[body.q_index]
+        move = q[body.q_index] if lead == 1 else lead * q[body.q_index]
+        return tuple(r[a] + sp.Add(*[R[a][k] * z[k] for k in range(3)]) * move
                      for a in range(3))
 
     omega, domega, acc, vel, grav, height = [], [], [], [], [], []
@@ -106,7 +108,7 @@ def regressor_program(tree: BodyTree, q, qd, qdd, gravity, b: ProgramBuilder,
         k = body.q_index
         tag = k + 1
         z = body.joint.axis
-        revolute = body.joint.type.is_revolute
+        revolute = body.joint.rotates
         sincos.append((b.define(sp.sin(q[k]), f"s{tag}"), b.define(sp.cos(q[k]), f"c{tag}"))
                       if revolute else None)
         if body.parent < 0:
@@ -130,8 +132,15 @@ def regressor_program(tree: BodyTree, q, qd, qdd, gravity, b: ProgramBuilder,
             rel = cross(w_in, tuple(z[a] * qd[k] for a in range(3)))
             dw = b.define_all(tuple(dw_in[a] + rel[a] + z[a] * qdd[k] for a in range(3)),
                               f"dw{tag}_")
-            a_ = b.define_all(a_in, f"a{tag}_")
-            v = b.define_all(v_in, f"v{tag}_")
+            if body.joint.lead == 0:
+                a_ = b.define_all(a_in, f"a{tag}_")
+                v = b.define_all(v_in, f"v{tag}_")
+            else:  # helical: the origin slides λ q along z too (ω × z is ω_in × z)
+                s = joint_subspace(body.joint)[1]
+                cor = cross(w_in, tuple(2 * s[a] * qd[k] for a in range(3)))
+                a_ = b.define_all(tuple(a_in[a] + cor[a] + s[a] * qdd[k] for a in range(3)),
+                                  f"a{tag}_")
+                v = b.define_all(tuple(v_in[a] + s[a] * qd[k] for a in range(3)), f"v{tag}_")
         else:
             w = w_in
             dw = b.define_all(dw_in, f"dw{tag}_")
@@ -167,8 +176,7 @@ def regressor_program(tree: BodyTree, q, qd, qdd, gravity, b: ProgramBuilder,
             YP[0, col + 1 + e] = -grav[j][e]
         # torque columns: the motion axis s_i^j of every joint i on the path, in body j's
         # frame at its origin, carried from the parent's (X_{j←p}: rotate, shift by r × ω)
-        z = tuple(body.joint.axis)
-        axes = {j: (z, zero3) if body.joint.type.is_revolute else (zero3, z)}
+        axes = {j: joint_subspace(body.joint)}
         if body.parent >= 0:
             r = offset(j)
             for anc, (w_s, v_s) in axes_at[body.parent].items():

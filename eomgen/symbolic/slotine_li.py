@@ -39,7 +39,7 @@ import sympy as sp
 
 from ..model.bodies import BodyTree
 from .program import ProgramBuilder
-from .spatial import JointFrames, cross, dot
+from .spatial import JointFrames, cross, dot, joint_subspace
 
 # (row, col) pairs of the six inertia parameters, Pinocchio's order xx, xy, yy, xz, yz, zz
 INERTIA_ENTRIES = ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2))
@@ -108,8 +108,8 @@ def slotine_li_program(tree: BodyTree, q, qd, qd_r, qdd_r, gravity, b: ProgramBu
     vel, vel_r, acc_r, axes_at, blocks = [], [], [], [], []
     for i, body in enumerate(tree.bodies):
         k, tag = body.q_index, body.q_index + 1
-        z = tuple(body.joint.axis)
-        s = (z + zero3) if body.joint.type.is_revolute else (zero3 + z)
+        S_ang, S_lin = joint_subspace(body.joint)
+        s = S_ang + S_lin
         if body.parent < 0:
             v_p, vr_p, ar_p = zero3 * 2, zero3 * 2, zero3 + tuple(-x for x in gravity)
         else:

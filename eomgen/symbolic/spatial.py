@@ -14,8 +14,9 @@ Two descriptions of the same quantities are used, each by the algorithms it suit
 * **Body coordinates about the body origin** (:class:`JointFrames`): each body's frame is the
   joint frame after the joint has moved (see :mod:`eomgen.model`); a body's quantities go to
   its parent's frame through the joint's placement ``(R_place, r)`` and its motion
-  ``Rot(k, q)`` (revolute) or ``k q`` (prismatic). A spatial inertia in body coordinates is the
-  three 3×3 blocks ``(A, B, C)`` of the symmetric 6×6 ``[[A, B], [Bᵀ, C]]`` with ``f = I v``;
+  ``Rot(k, q)`` (revolute), ``k q`` (prismatic) or both, ``Rot(k, q)`` and ``pitch · k q``
+  (helical); :func:`joint_subspace` is its motion subspace. A spatial inertia in body
+  coordinates is the three 3×3 blocks ``(A, B, C)`` of the symmetric 6×6 ``[[A, B], [Bᵀ, C]]`` with ``f = I v``;
   a rigid body has ``A = I_O``, ``B = [h]×``, ``C = m 1``. Used by the Newton–Euler, CRBA and
   ABA programs and the regressor.
 
@@ -140,6 +141,17 @@ def rotate_aligned(k: int, c, s, v, transpose: bool) -> tuple:
     return tuple(w)
 
 
+def joint_subspace(joint) -> tuple[tuple, tuple]:
+    """``(S_ang, S_lin)``: the motion subspace of a one-axis ``joint`` (a
+    :class:`~eomgen.model.Joint`) in its body frame, angular part first: ``(k, 0)`` revolute,
+    ``(0, k)`` prismatic, ``(k, pitch · k)`` helical (``k`` the unit axis;
+    :attr:`~eomgen.model.Joint.rotates`, :attr:`~eomgen.model.Joint.lead`)."""
+    k, zero = tuple(joint.axis), (sp.Integer(0),) * 3
+    lead = joint.lead
+    return (k if joint.rotates else zero,
+            zero if lead == 0 else k if lead == 1 else tuple(mul(lead, x) for x in k))
+
+
 @dataclass
 class SpatialInertia:
     """The spatial inertia of a body or subtree **in world axes about a fixed reference point**
@@ -189,10 +201,10 @@ class JointFrames:
     """Transforms between each body's frame and its parent's, through the joint.
 
     Body i's frame is its joint frame after the joint has moved: a parent-frame vector ``v``
-    reads ``Rot(k, q)ᵀ R_placeᵀ v`` in body i (revolute joint about the unit axis ``k``,
-    placement rotation ``R_place``; a prismatic joint rotates nothing), and body i's origin
-    sits at :meth:`offset` in the parent frame. Rotations use each revolute joint's sine and
-    cosine, ``sincos[i] = (s_i, c_i)`` (None for a prismatic joint).
+    reads ``Rot(k, q)ᵀ R_placeᵀ v`` in body i (a revolute or helical joint about the unit axis
+    ``k``, placement rotation ``R_place``; a prismatic joint rotates nothing), and body i's
+    origin sits at :meth:`offset` in the parent frame. Rotations use each rotating joint's sine
+    and cosine, ``sincos[i] = (s_i, c_i)`` (None for a prismatic joint).
     """
 
     def __init__(self, tree: BodyTree, q, sincos):
@@ -200,11 +212,11 @@ class JointFrames:
 
     @classmethod
     def named(cls, tree: BodyTree, q, b: ProgramBuilder) -> "JointFrames":
-        """The frames of ``tree`` with each revolute joint's ``s_k``, ``c_k`` named in ``b``."""
+        """The frames of ``tree`` with each rotating joint's ``s_k``, ``c_k`` named in ``b``."""
         sincos = []
         for body in tree.bodies:
             k = body.q_index
-            if body.joint.type.is_revolute:
+            if body.joint.rotates:
                 sincos.append((name_expr(b, sp.sin(q[k]), f"s{k + 1}", ("s", k + 1)),
                                name_expr(b, sp.cos(q[k]), f"c{k + 1}", ("c", k + 1))))
             else:
@@ -215,7 +227,7 @@ class JointFrames:
         """Parent-frame 3-vector → body i frame: Rot(k, q)ᵀ R_placeᵀ v."""
         body = self.tree.bodies[i]
         w = transpose_apply(body.placement.rotation, v)
-        if body.joint.type.is_revolute:
+        if body.joint.rotates:
             s, c = self.sincos[i]
             aligned = aligned_axis(body.joint.axis)
             if aligned is not None:
@@ -227,7 +239,7 @@ class JointFrames:
         """Body i frame 3-vector → parent frame: R_place Rot(k, q) v."""
         body = self.tree.bodies[i]
         w = v
-        if body.joint.type.is_revolute:
+        if body.joint.rotates:
             s, c = self.sincos[i]
             aligned = aligned_axis(body.joint.axis)
             if aligned is not None:
@@ -237,13 +249,16 @@ class JointFrames:
         return matvec(body.placement.rotation, w)
 
     def offset(self, i) -> tuple:
-        """Body i's origin in the parent frame [m] (moved by q for a prismatic joint)."""
+        """Body i's origin in the parent frame [m] (moved by ``q`` along the axis for a
+        prismatic joint, by ``pitch · q`` for a helical one)."""
         body = self.tree.bodies[i]
         r = body.placement.translation
-        if body.joint.type.is_revolute:
+        lead = body.joint.lead
+        if lead == 0:
             return r
         k = matvec(body.placement.rotation, body.joint.axis)
-        return tuple(r[j] + k[j] * self.q[body.q_index] for j in range(3))
+        move = self.q[body.q_index] if lead == 1 else mul(lead, self.q[body.q_index])
+        return tuple(r[j] + k[j] * move for j in range(3))
 
     def motion_to_body(self, i, ang, lin) -> tuple:
         """Motion ``(ω, v)`` in parent coordinates about the parent origin → body i coordinates

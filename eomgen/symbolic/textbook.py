@@ -228,7 +228,7 @@ def textbook_derivation(model: RobotModel, max_dof: int = TEXTBOOK_MAX_DOF) -> T
         R = [[A(x) for x in row] for row in pose.rotation]
         axis = [A(x) for x in body.joint.axis]
         axes.append([A.reduce(sum((R[r][k] * axis[k] for k in range(3)), zero))
-                     for r in range(3)] if body.joint.type.is_revolute else [zero] * 3)
+                     for r in range(3)] if body.joint.rotates else [zero] * 3)
     # Chains of parallel revolute joints (the elbow arm's shoulder and elbow): write results in
     # the absolute angles q2 + q3 where that is shorter.
     parallel = {body.q_index: tree.bodies[body.parent].q_index

@@ -170,7 +170,7 @@ def _numeric_gravity(model: RobotModel) -> np.ndarray | None:
 
 
 def _format_pose(model: RobotModel, q) -> str:
-    parts = [f"{math.degrees(x):.4g}°" if j.type.is_revolute else f"{x:.4g} m"
+    parts = [f"{math.degrees(x):.4g}°" if j.rotates else f"{x:.4g} m"
              for j, x in zip(model.movable_joints, q)]
     return textwrap.fill("(" + ", ".join(parts) + ")", width=60, break_long_words=False)
 
@@ -349,13 +349,13 @@ def _draw_planar(fig, model: RobotModel, geo: SketchGeometry, scale: float, grav
     turn = {}  # link -> sign of its joint's arc, for the side of its c label
     for k, jt in enumerate(model.movable_joints):
         p = joint_at[jt.name]
-        ax.plot(*p, marker="o" if jt.type.is_revolute else "s", ms=_Style.joint_size,
+        ax.plot(*p, marker="o" if jt.rotates else "s", ms=_Style.joint_size,
                 mfc="white", mec="black", mew=1.4, zorder=5)
         label = f"$q_{{{k + 1}}}$"
         ahead = [joint_at[c] for c in children.get(jt.child, ())]
         ahead += [com_at[jt.child]] if jt.child in com_at else []
         ahead = [t - p for t in ahead if np.linalg.norm(t - p) > 1e-6 * scale]
-        if jt.type.is_revolute and ahead:
+        if jt.rotates and ahead:
             sign = math.copysign(1.0, float(view_normal @ world_axis[jt.name]))
             turn[jt.child] = math.copysign(1.0, sign * geo.q[k])
             pts += _angle_arc(ax, p, ahead[0], sign * geo.q[k], 0.3 * scale, label)
@@ -431,7 +431,7 @@ def _draw_3d(fig, model: RobotModel, geo: SketchGeometry, scale: float, gravity)
         ax.quiver(0, 0, 0, *e, color="black", lw=_Style.thin, arrow_length_ratio=0.2, zorder=4)
         pts.append(e)
     for jt in model.movable_joints:
-        ax.plot(*joint_at[jt.name], marker="o" if jt.type.is_revolute else "s",
+        ax.plot(*joint_at[jt.name], marker="o" if jt.rotates else "s",
                 ms=_Style.joint_size, mfc="white", mec="black", mew=1.3, ls="", zorder=5)
     for link in com_at:
         _draw_com(ax, com_at[link], _Style.com_size - 3, 6)

@@ -87,7 +87,7 @@ def sketch_pose(model: RobotModel) -> tuple[float, ...]:
     >>> sketch_pose(eomgen.load(eomgen.example_path("planar_2link")))  # doctest: +ELLIPSIS
     (0.5235987755982..., 0.5235987755982...)
     """
-    return tuple(SKETCH_ANGLE if j.type.is_revolute else 0.0 for j in model.movable_joints)
+    return tuple(SKETCH_ANGLE if j.rotates else 0.0 for j in model.movable_joints)
 
 
 def _point(v) -> Point:

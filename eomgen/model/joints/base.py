@@ -14,9 +14,10 @@ A kind is a type (:class:`JointKind`), one module per kind in this package, one 
   (``q1 ⊖ q0``), :meth:`JointKind.configuration_rate` is ``q̇`` at velocity ``v``.
 
 How the algorithms see a kind. One-coordinate kinds (revolute, continuous, prismatic,
-helical) are joints of the kinematic tree; the derivation and the references read their axis
-from :attr:`rotates` and :attr:`translates` (and a helical joint is a revolute joint followed
-by a coupled prismatic one, :mod:`~eomgen.model.joints.helical`). A kind whose configuration is
+helical) are joints of the kinematic tree; the derivation and the references read their motion
+from :attr:`rotates` (the child turns by ``q`` about the axis) and :meth:`lead` (it moves
+``lead · q`` along the axis: 0, 1 or the helical joint's pitch), so the motion subspace is
+``S = (lead · axis, axis if rotates else 0)``. A kind whose configuration is
 not its coordinates (:class:`ChartKind`: the free flyer, a ball joint, a planar joint) is, in
 the tree, a chain of virtual one-axis joints at the joint's place (its :attr:`~ChartKind.motions`)
 held at zero, with the pose from ``q`` placed before it (:meth:`ChartKind.pose`,
@@ -46,6 +47,13 @@ class JointKind:
     #: True when the kind rotates its child about its axis, or translates it along its axis.
     rotates: bool = False
     translates: bool = False
+
+    def lead(self, pitch=0):
+        """The translation along the axis per unit of the coordinate: 1 for a prismatic joint
+        [m/m], the pitch for a helical one [m/rad], 0 for a kind that does not translate (the
+        linear part of ``S`` is ``lead · axis``, its angular part ``axis`` when it
+        :attr:`rotates`)."""
+        return 0
 
     def __repr__(self) -> str:
         return f"<joint kind {self.name}: nq={self.nq}, nv={self.nv}>"

@@ -13,6 +13,9 @@ class Prismatic(JointKind):
     pinocchio = "JointModelPrismaticUnaligned"
     translates = True
 
+    def lead(self, pitch=0):
+        return 1
+
     def transform(self, axis, q, pitch: float = 0.0):
         return np.eye(3), np.asarray(axis, dtype=float) * float(np.ravel(q)[0])
 
