@@ -22,7 +22,7 @@ exceptions, one class per kind of problem, are in :mod:`eomgen.errors`.
 
 from __future__ import annotations
 
-__version__ = "0.1.0"
+from .common.version import __version__  # noqa: E402
 
 import importlib  # noqa: E402
 import sys  # noqa: E402

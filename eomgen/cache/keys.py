@@ -73,9 +73,9 @@ def code_version() -> str:
     The version alone would serve stale results to anyone editing a checkout (or its
     templates) without bumping it.
     """
-    from .. import __version__  # read at each call: tests change it
+    from ..common import version  # read at each call: tests change it
 
-    return f"{__version__}+{_code_fingerprint()[:16]}"
+    return f"{version.__version__}+{_code_fingerprint()[:16]}"
 
 
 def toolchain() -> dict[str, str | bool | None]:

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import click
 
-from .. import __version__
+from ..common.version import __version__
 from .bench_simulate import bench, simulate
 from .excite_identify import excite, identify
 from .generate_verify import generate, verify

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-from .. import __version__
+from ..common.version import __version__
 from ..common.output import GeneratedFile  # noqa: F401  (backends import it from here)
 from ..outputs import function_names
 from .functions import (

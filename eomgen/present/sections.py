@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from .. import __version__
+from ..common.version import __version__
 from ..model import IDENTITY3, RobotModel
 from ..regressor import parameter_latex
 from ..symbolic.textbook import TextbookDerivation

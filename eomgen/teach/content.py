@@ -33,7 +33,7 @@ from typing import Callable
 
 import sympy as sp
 
-from .. import __version__
+from ..common.version import __version__
 from ..analysis.actuators import spong_dynamics
 from ..common.output import module_name
 from ..dynamics import Dynamics, derive

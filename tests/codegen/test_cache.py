@@ -172,7 +172,7 @@ def test_key_changes_with_every_input(monkeypatch):
         assert base != cache_key(b"robot", changed), changed
     scene = cache_key(b"robot", {}, scene=b"lock: {joint1: 0}")
     assert scene != cache_key(b"robot", {}, scene=b"lock: {joint1: 1}")
-    monkeypatch.setattr(eomgen, "__version__", "99.0")
+    monkeypatch.setattr(eomgen.common.version, "__version__", "99.0")
     assert base != cache_key(b"robot", {"backends": ["numpy"], "symbolic": None, "strict": False})
 
 
