@@ -32,7 +32,7 @@ quaternion.
 current configuration they are a chart whose velocities are the root twist. The derivation
 (:mod:`eomgen.symbolic.free_flyer`) puts the root pose from ``q[0:7]`` above them and corrects
 the chart's second-order terms, so that τ, M, C, g, h and q̈ are the free flyer's. Ball joints (:mod:`eomgen.model.quaternion`) are the same mechanism with
-three rotations; :mod:`eomgen.numeric.configuration` integrates and differences any such model.
+three rotations; :mod:`eomgen.model.configuration` integrates and differences any such model.
 
 Examples
 --------
@@ -48,10 +48,10 @@ from __future__ import annotations
 from dataclasses import replace
 
 from .floating import WORLD, virtual_chain
-from .numeric.floating_base import matrix_quaternion, quaternion_matrix
+from .model.joints.lie import matrix_quaternion, quaternion_matrix
 # integrate, difference, neutral and q̇ of any model with quaternion joints: without a model,
 # the free flyer's layout (q[0:7], v[0:6]) and no ball joint.
-from .numeric.configuration import configuration_rate, difference, integrate, neutral
+from .model.configuration import configuration_rate, difference, integrate, neutral
 from .model import (FREE_FLYER_CONFIGURATION, FREE_FLYER_VELOCITY, Joint, JointType, Link,
                     NoticeKind, RobotModel, Transform, vec3)
 

@@ -17,7 +17,7 @@ new place (docs/architecture.md lays the layers out).
  ``eomgen.notebook``             :mod:`eomgen.teach.notebook`
  ``eomgen.output``               :mod:`eomgen.common.output`
  ``eomgen.progress``             :mod:`eomgen.common.progress`
- ``eomgen.quaternion_joints``    :mod:`eomgen.numeric.configuration`
+ ``eomgen.quaternion_joints``    :mod:`eomgen.model.configuration`
  ``eomgen.reprs``                :mod:`eomgen.common.reprs`
  ``eomgen.templating``           :mod:`eomgen.common.templating`
 =============================  =====================================
@@ -53,7 +53,7 @@ MOVED: dict[str, str] = {
     "eomgen.notebook": "eomgen.teach.notebook",
     "eomgen.output": "eomgen.common.output",
     "eomgen.progress": "eomgen.common.progress",
-    "eomgen.quaternion_joints": "eomgen.numeric.configuration",
+    "eomgen.quaternion_joints": "eomgen.model.configuration",
     "eomgen.reprs": "eomgen.common.reprs",
     "eomgen.templating": "eomgen.common.templating",
 }

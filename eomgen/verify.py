@@ -21,7 +21,7 @@ kept symbolic are given their default values. Errors are relative to the size of
 With quaternion joints (a free flyer, ball joints) ``q`` is the configuration (NQ entries, each
 quaternion drawn uniformly on the unit sphere) and ``qd``, ``qdd`` the velocities and
 accelerations (NV); Ṁ is taken along ``q̇ = configuration_rate(q, v)``
-(:mod:`eomgen.numeric.configuration`), and the checks are sampled (never exact).
+(:mod:`eomgen.model.configuration`), and the checks are sampled (never exact).
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ from .model.moving_mass import massless_problem
 from .numeric import numeric_model
 from .outputs import BY_SYMBOL
 from .numeric import rnea as numeric_rnea
-from .numeric.configuration import configuration_rate
+from .model.configuration import configuration_rate
 from .symbolic.evaluate import compile_program
 
 #: Default relative tolerance of the numeric identities.

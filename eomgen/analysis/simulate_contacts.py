@@ -53,7 +53,7 @@ from ..numeric.contacts import ContactDynamics, derived_mass_and_bias
 from ..numeric import kinetic_energy, numeric_model, potential_energy
 from ..numeric.so3 import so3_log
 from ..common.progress import plural
-from ..numeric.configuration import configuration_rate
+from ..model.configuration import configuration_rate
 from .report import csv_text, fmt, markdown_table, pyplot
 from .routes import numeric_only
 from .simulate import (OUTPUT_POINTS, Diverged, ImplicitMidpoint, advance, initial_state,
@@ -152,7 +152,7 @@ class ContactSystem:
 
     def configuration_rate(self, q, qd) -> np.ndarray:
         """``q̇`` at velocity ``qd``: ``qd`` itself, or with quaternion joints
-        :func:`eomgen.numeric.configuration.configuration_rate` (module docstring)."""
+        :func:`eomgen.model.configuration.configuration_rate` (module docstring)."""
         return configuration_rate(q, qd, self.model) if self.quaternion else qd
 
     def integrate(self, q, qd, h: float) -> np.ndarray:

@@ -51,7 +51,7 @@ from ..numeric.loops import RANK_TOLERANCE, LoopDynamics
 from ..numeric.so3 import so3_log
 from ..symbolic.frames import derive_frames
 from ..common.progress import plural
-from ..numeric.configuration import configuration_rate
+from ..model.configuration import configuration_rate
 from .report import csv_text, fmt, markdown_table
 from .routes import numeric_only
 from .simulate import (OUTPUT_POINTS, Diverged, ImplicitMidpoint, advance, initial_state,
@@ -163,7 +163,7 @@ class LoopSystem:
 
     def configuration_rate(self, q, qd) -> np.ndarray:
         """``q̇`` at velocity ``qd``: ``qd`` itself, or with quaternion joints
-        :func:`eomgen.numeric.configuration.configuration_rate`."""
+        :func:`eomgen.model.configuration.configuration_rate`."""
         return configuration_rate(q, qd, self.model) if self.quaternion else qd
 
     def integrate(self, q, qd, h: float) -> np.ndarray:

@@ -7,7 +7,7 @@ With quaternion joints ``q`` (NQ) and ``v`` (NV) have different sizes: a positio
 the velocity ``e = difference(q_d, q)`` that moves ``q_d`` to ``q`` in unit time (Pinocchio's
 ``difference``: ``q − q_d`` for the other joints, ``log(R_dᵀ R)`` for a ball joint, the SE(3)
 logarithm in the desired root frame for the free flyer), and the configuration moves at
-``q̇ = configuration_rate(q, v)`` (:mod:`eomgen.numeric.configuration`).
+``q̇ = configuration_rate(q, v)`` (:mod:`eomgen.model.configuration`).
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import numpy as np
 
 from ..model import QuaternionJoint
 from ..model.joints import FREE_FLYER, KINDS, ChartKind
-from ..numeric.configuration import configuration_rate, difference
+from ..model.configuration import configuration_rate, difference
 
 
 def module_layout(module) -> tuple[QuaternionJoint, ...]:
@@ -58,7 +58,7 @@ def position_error(joints, q, q_d) -> np.ndarray:
 
 def rate(joints, q, v) -> np.ndarray:
     """``q̇`` (NQ) at velocity ``v``: ``v`` without quaternion joints, else
-    :func:`~eomgen.numeric.configuration.configuration_rate`."""
+    :func:`~eomgen.model.configuration.configuration_rate`."""
     return np.asarray(v, dtype=float) if not joints else configuration_rate(q, v, joints)
 
 

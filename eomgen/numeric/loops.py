@@ -21,7 +21,7 @@ Sizes: ``q`` is the configuration (NQ, ``CONFIGURATION_NAMES``), ``q̇``, ``q̈`
 columns of ``J_l`` the velocity coordinates (n = NV, ``JOINT_NAMES``). With quaternion joints (a
 free flyer, ball joints: NQ ≠ NV) ``J_l`` is in ``v`` and ``J̇_l q̇`` is ``J̇_l v``, as the
 contact rows (:mod:`eomgen.symbolic.frames`), and Newton's steps move ``q`` along the joints'
-exponentials (:func:`eomgen.numeric.configuration.integrate`), so its quaternions stay unit.
+exponentials (:func:`eomgen.model.configuration.integrate`), so its quaternions stay unit.
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ import numpy as np
 from ..dynamics import derive
 from ..errors import AnalysisError
 from ..model import RobotModel
-from .configuration import integrate
+from ..model.configuration import integrate
 from ..symbolic.evaluate import compile_program
 from .pinocchio import pinocchio_name
 

@@ -4,7 +4,7 @@ A model's configuration ``q`` has NQ entries, its velocity ``v`` NV: a quaternio
 ball joint (:mod:`eomgen.model.quaternion`) holds four quaternion entries for three rotational
 velocities. A derivative "with respect to q" is then, as in Pinocchio, the derivative along the
 tangent: column ``i`` of ∂f/∂q is ``d/dε f(q ⊕ ε eᵢ)`` at ``ε = 0``, with
-``q ⊕ δ`` :func:`eomgen.numeric.configuration.integrate` (the joint's pose times the exponential of
+``q ⊕ δ`` :func:`eomgen.model.configuration.integrate` (the joint's pose times the exponential of
 ``δ`` in its own frame: ``M exp(δ)``), ``v`` and the other arguments held fixed (``v`` is the
 body twist of the free flyer, the child-frame angular velocity of a ball joint).
 

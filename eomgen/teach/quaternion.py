@@ -64,7 +64,7 @@ def chart_method_section(model) -> Section:
             "$\\dot{M} - 2C$ is skew-symmetric along the motion. To simulate, integrate "
             "$\\dot{v}$ and move the configuration with the exponential map, "
             "$q \\leftarrow \\mathrm{integrate}(q, v\\, \\Delta t)$ (", code(
-                "eomgen.numeric.configuration.integrate"), ", Pinocchio's ", code("integrate"),
+                "eomgen.model.configuration.integrate"), ", Pinocchio's ", code("integrate"),
             "), never $q + v\\, \\Delta t$: the quaternion stays a rotation.")),
         Paragraph(prose(
             "How it is derived: each quaternion joint is a chain of virtual one-axis joints "

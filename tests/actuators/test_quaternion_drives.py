@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from eomgen.model import Actuator
-from eomgen.numeric.configuration import configuration_rate
+from eomgen.model.configuration import configuration_rate
 from support import relative
 from support.generated import generated
 from support.quaternion import pinocchio_states, quaternion_robot

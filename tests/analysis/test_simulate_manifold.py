@@ -20,7 +20,7 @@ import eomgen
 from eomgen.free_flyer import add_free_flyer
 from eomgen.model import Inertial, Joint, JointType, Link, build_model
 from eomgen.model.joints.lie import quaternion_matrix
-from eomgen.numeric.configuration import difference
+from eomgen.model.configuration import difference
 from support import write
 from support.extras import need
 

@@ -51,8 +51,6 @@ UPWARD_TODAY: frozenset[tuple[str, str]] = frozenset({
     ('eomgen.floating', 'eomgen.numeric.floating_base'),
     ('eomgen.floating', 'eomgen.numeric.newton_euler'),
     ('eomgen.floating', 'eomgen.numeric.pinocchio'),
-    ('eomgen.free_flyer', 'eomgen.numeric.floating_base'),
-    ('eomgen.free_flyer', 'eomgen.numeric.configuration'),
     ('eomgen.reduction.apply', 'eomgen.symbolic.frames'),
     ('eomgen.reduction.cost', 'eomgen.dynamics'),
     ('eomgen.reduction.loops', 'eomgen.symbolic.frames'),

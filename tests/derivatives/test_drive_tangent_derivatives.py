@@ -20,7 +20,7 @@ import pytest
 
 import eomgen
 from eomgen.model import joint_actuators
-from eomgen.numeric.configuration import integrate
+from eomgen.model.configuration import integrate
 from support.generated import BACKENDS, generated
 from support.extras import need
 

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import eomgen
-from eomgen.numeric.configuration import integrate
+from eomgen.model.configuration import integrate
 from support.generated import generated
 from support.extras import need
 

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from eomgen.model import Joint, JointType, Link, Transform, build_model, mat3, vec3
-from eomgen.numeric.configuration import difference, integrate, neutral
+from eomgen.model.configuration import difference, integrate, neutral
 from support import relative
 from support.generated import generated
 from support.reference import pinocchio_free_motion, random_inertial, random_rotation

@@ -16,7 +16,7 @@ import sympy as sp
 import pytest
 
 from eomgen.model import Joint, JointType, Link, Transform, build_model, mat3, vec3
-from eomgen.numeric.configuration import difference, integrate, neutral
+from eomgen.model.configuration import difference, integrate, neutral
 from support import relative
 from support.extras import need, skip_backend
 from support.generated import generated

@@ -20,7 +20,7 @@ import pytest
 import eomgen
 from eomgen.identification import FourierTrajectory, measurements_csv, Measurements
 from eomgen.identification.charts import trajectory_states
-from eomgen.numeric.configuration import configuration_rate
+from eomgen.model.configuration import configuration_rate
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import relative, run_cli, write

@@ -29,7 +29,7 @@ import pytest
 from eomgen.free_flyer import add_free_flyer
 from eomgen.numeric.loops import LoopDynamics
 from eomgen.model import Joint, JointType, Link, Transform, build_model, vec3
-from eomgen.numeric.configuration import integrate
+from eomgen.model.configuration import integrate
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import relative

@@ -89,7 +89,7 @@ def constrained_central_differences(model, forward, q, v, tau, h: float = 1e-6) 
     """Central differences of ``forward(q, v, tau) -> (q̈, F_c)`` (a generated
     ``constrained_forward_dynamics``) in the order of ``constrained_forward_dynamics_derivatives``:
     q̈ then F_c, each by q (along eomgen's ``integrate`` for quaternion joints), v and τ."""
-    from eomgen.numeric.configuration import integrate
+    from eomgen.model.configuration import integrate
 
     steps = np.eye(model.dof) * h
     columns = []

@@ -25,7 +25,7 @@ import numpy as np
 
 from ...model import RobotModel
 from ...common.progress import plural
-from ...numeric.configuration import neutral
+from ...model.configuration import neutral
 from ..conditioning import CONDITION_LIMIT, IllConditionedWarning, ill_conditioned_message
 from ..report import fmt, markdown_table
 from .integrators import Adaptive

@@ -21,14 +21,14 @@ import numpy as np
 from ...dynamics import derive
 from ...model import RobotModel
 from ...numeric import kinetic_energy, numeric_model, potential_energy
-from ...numeric.configuration import configuration_rate, integrate
+from ...model.configuration import configuration_rate, integrate
 from ..conditioning import EXACT_FROM
 from ..routes import compile_scalar, numeric_only
 
 
 def advance(model: RobotModel, q: np.ndarray, v: np.ndarray, h: float) -> np.ndarray:
     """``q ⊕ h v``: each joint moved along its kind's exponential
-    (:func:`eomgen.numeric.configuration.integrate`), so every quaternion is unit and a planar
+    (:func:`eomgen.model.configuration.integrate`), so every quaternion is unit and a planar
     joint's ``(cos θ, sin θ)`` on its circle, up to round-off, whatever the step. Each
     quaternion of the result is the one of ``±`` nearest ``q``'s (both are the same rotation):
     a trajectory stepped with it is continuous, as the reference it is compared with."""
@@ -164,7 +164,7 @@ class System:
 
     def configuration_rate(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
         """``q̇`` of the configuration at velocity ``qd``: ``qd`` itself, or with quaternion
-        joints (:mod:`eomgen.numeric.configuration`) a free flyer's root position rate (``R v``),
+        joints (:mod:`eomgen.model.configuration`) a free flyer's root position rate (``R v``),
         each quaternion's rate (``½ quaternion ⊗ (ω, 0)``) and the other joints' rates (the
         embedded form the adaptive methods integrate between output times)."""
         if not self.quaternion:

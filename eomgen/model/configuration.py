@@ -35,10 +35,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model import QuaternionJoint, RobotModel
-from ..model.joints import FREE_FLYER
+from .joints import FREE_FLYER
+from .quaternion import QuaternionJoint
+from .robot import RobotModel
 # kept importable here: the rotations every kind uses (eomgen.model.joints.lie)
-from ..model.joints.lie import left_jacobian, skew, so3_exp, so3_log
+from .joints.lie import left_jacobian, skew, so3_exp, so3_log
 
 
 def layout(model, nv: int | None = None) -> tuple[QuaternionJoint, ...]:
