@@ -3,6 +3,7 @@
 A :class:`BodyTree` is what the dynamics algorithms walk. Each body is the child link of one
 movable joint together with every link rigidly attached to it through fixed joints; links
 rigidly attached to the root never move and are dropped (they cannot change M, C or g).
+:func:`frame_site` says on which body a link sits, and where.
 
 Inertial data are kept as the ten *inertial parameters about the body frame origin*, which are
 linear in the link data and add up when bodies are merged (and are the parameters π of the
@@ -17,7 +18,8 @@ from typing import Callable, Iterable
 
 import sympy as sp
 
-from . import Inertial, Joint, Mat3, RobotModel, Transform, Vec3, ZERO3
+from ..errors import KinematicTreeError
+from . import IDENTITY3, Inertial, Joint, Mat3, RobotModel, Transform, Vec3, ZERO3
 
 ZERO33: Mat3 = tuple(tuple(sp.Integer(0) for _ in range(3)) for _ in range(3))  # type: ignore
 
@@ -204,3 +206,28 @@ def body_tree(model: RobotModel) -> BodyTree:
         for k, (joint, parent, placement) in enumerate(rigid.movers)
     )
     return BodyTree(bodies, model.gravity, model.joint_names, tuple(rigid.links_of(-1)))
+
+
+def frame_site(model: RobotModel, name: str) -> tuple[str | None, Transform]:
+    """Where link ``name`` sits: ``(body link, pose in that link's frame)``.
+
+    The body link is the child link of the nearest movable joint above ``name`` (``name``
+    itself when its own joint moves); None when ``name`` is rigidly attached to the root
+    (the pose is then in the root frame).
+
+    Raises
+    ------
+    KinematicTreeError
+        When the model has no link ``name``.
+    """
+    if name not in model.link_by_name:
+        raise KinematicTreeError(model.source, f"frame '{name}'",
+                                 f"no link '{name}' in robot '{model.name}'")
+    pose = Transform(IDENTITY3, ZERO3)
+    link = name
+    parent = model.parent_joint
+    while link in parent and not parent[link].type.is_movable:
+        joint = parent[link]
+        pose = joint.origin @ pose
+        link = joint.parent
+    return (link if link in parent else None), pose

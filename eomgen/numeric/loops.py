@@ -34,6 +34,7 @@ import numpy as np
 from ..dynamics import derive
 from ..errors import AnalysisError
 from ..model import RobotModel
+from ..model.bodies import frame_site
 from ..model.configuration import integrate
 from ..symbolic.evaluate import compile_program
 from .pinocchio import pinocchio_name
@@ -235,7 +236,6 @@ def pinocchio_loops(model: RobotModel, pm, reference=None):
     """
     import pinocchio as pin  # optional dependency: imported when used
 
-    from ..symbolic.frames import frame_site  # the numeric layer reads the tree's frames
 
     reference = pin.ReferenceFrame.LOCAL if reference is None else reference
     # a quaternion joint is one Pinocchio joint (a free flyer's named root_joint): each of

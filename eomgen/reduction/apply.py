@@ -36,7 +36,7 @@ from ..model.moving_mass import massless_problem
 from ..outputs import select
 from ..parsers import load
 from ..scene import Payload, Scene, did_you_mean, scene_error
-from ..symbolic.frames import frame_site
+from ..model.bodies import frame_site
 from .inertia import (clean_transform, combined_inertial, inertial_scalars,
                       substituted_inertial, tidy)
 from .planar import in_plane, planar_motion

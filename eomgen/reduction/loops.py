@@ -6,7 +6,7 @@ from dataclasses import replace
 
 from ..model import RobotModel
 from ..scene import Scene, did_you_mean
-from ..symbolic.frames import frame_site
+from ..model.bodies import frame_site
 
 
 def with_loops(reduced: RobotModel, scene: Scene, notes: list[str]) -> RobotModel:

@@ -33,8 +33,9 @@ from typing import TYPE_CHECKING, Iterable
 
 import sympy as sp
 
-from ..errors import GenerationError, KinematicTreeError
-from ..model import IDENTITY3, POINT, RobotModel, Transform, ZERO3
+from ..errors import GenerationError
+from ..model import POINT, RobotModel
+from ..model.bodies import frame_site  # where a link sits on its body; importable here
 from .builders import builds, provides
 from .composite import forward_kinematics
 from .derivation import new_derivation
@@ -48,31 +49,6 @@ if TYPE_CHECKING:  # the annotations only: NumPy is imported where it is used
 
 #: The outputs of each frame, ``<kind>_<k>`` with k the frame's index in ``frames``.
 FRAME_OUTPUTS = ("p", "R", "J", "Jb", "dJqd", "dJbqd")
-
-
-def frame_site(model: RobotModel, name: str) -> tuple[str | None, Transform]:
-    """Where link ``name`` sits: ``(body link, pose in that link's frame)``.
-
-    The body link is the child link of the nearest movable joint above ``name`` (``name``
-    itself when its own joint moves); None when ``name`` is rigidly attached to the root
-    (the pose is then in the root frame).
-
-    Raises
-    ------
-    KinematicTreeError
-        When the model has no link ``name``.
-    """
-    if name not in model.link_by_name:
-        raise KinematicTreeError(model.source, f"frame '{name}'",
-                                 f"no link '{name}' in robot '{model.name}'")
-    pose = Transform(IDENTITY3, ZERO3)
-    link = name
-    parent = model.parent_joint
-    while link in parent and not parent[link].type.is_movable:
-        joint = parent[link]
-        pose = joint.origin @ pose
-        link = joint.parent
-    return (link if link in parent else None), pose
 
 
 @dataclass(frozen=True)

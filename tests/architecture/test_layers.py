@@ -51,9 +51,7 @@ UPWARD_TODAY: frozenset[tuple[str, str]] = frozenset({
     ('eomgen.floating', 'eomgen.numeric.floating_base'),
     ('eomgen.floating', 'eomgen.numeric.newton_euler'),
     ('eomgen.floating', 'eomgen.numeric.pinocchio'),
-    ('eomgen.reduction.apply', 'eomgen.symbolic.frames'),
     ('eomgen.reduction.cost', 'eomgen.dynamics'),
-    ('eomgen.reduction.loops', 'eomgen.symbolic.frames'),
 })
 
 #: Import cycles today, each as the sorted tuple of its modules.
