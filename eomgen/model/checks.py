@@ -17,11 +17,10 @@ from ..errors import (
     KinematicTreeError,
     ParameterError,
     TooLargeError,
-    UnsupportedError,
 )
 from .moving_mass import settled
 from .notices import Notice, NoticeKind, emit_notices
-from .parts import Inertial, Joint, JointType, Link, Parameter
+from .parts import Inertial, Joint, Link, Parameter
 from .quaternion import expand_joints
 from .robot import RobotModel
 from .scalars import Vec3, scalar, vec3
@@ -203,18 +202,10 @@ def check_axis(source: str, joint: str, axis: Vec3) -> Vec3:
 
 
 def check_kind(source: str, joint: Joint) -> None:
-    """Refuse what a joint's kind cannot be: a planar joint whose axis (the plane's normal) is
-    not the joint frame's z axis, a helical joint whose pitch is not a finite number."""
-    if joint.type is JointType.PLANAR and tuple(joint.axis) != (0, 0, 1):
-        raise UnsupportedError(source, f"joint '{joint.name}' axis", "a planar joint moves in "
-                               "its joint frame's xy plane (Pinocchio's JointModelPlanar): its "
-                               "axis, the plane's normal, must be 0 0 1; turn the plane with "
-                               "the joint's origin")
-    if joint.type is JointType.HELICAL:
-        pitch = _number(joint.pitch)
-        if pitch is not None and not math.isfinite(pitch):
-            raise InvalidNumberError(source, f"joint '{joint.name}' pitch",
-                                     "the pitch is not finite")
+    """Refuse what a joint's kind cannot be (its kind's
+    :meth:`~eomgen.model.joints.JointKind.check`: a planar joint whose axis is not the joint
+    frame's z axis, a helical joint whose pitch is not a finite number)."""
+    joint.type.kind.check(source, joint)
 
 
 def _is_symbolic(inertial: Inertial) -> bool:

@@ -13,23 +13,8 @@ from .joints import KINDS, JointKind
 from .scalars import ZERO3, Mat3, Scalar, Vec3, mat3, scalar, vec3
 from .transforms import Transform
 
-class JointType(enum.Enum):
-    """The joint types a description writes, each naming its kind (:attr:`kind`, a type of
-    :mod:`eomgen.model.joints` that answers every question about it). A URDF ``<mimic>`` joint
-    is a movable joint that a coupling makes follow another (:mod:`eomgen.model.coupling`).
-    ``SPHERICAL`` (a ball joint) and ``PLANAR`` are what a parser writes;
-    :func:`~eomgen.model.build_model` turns each into its chain of one-axis joints
-    (:func:`eomgen.model.expand_joints`), so no model holds one. ``HELICAL`` is a one-axis
-    joint of the tree like ``REVOLUTE`` and ``PRISMATIC`` (:attr:`Joint.rotates`,
-    :attr:`Joint.lead`)."""
-
-    REVOLUTE = "revolute"
-    CONTINUOUS = "continuous"
-    PRISMATIC = "prismatic"
-    FIXED = "fixed"
-    SPHERICAL = "spherical"
-    PLANAR = "planar"
-    HELICAL = "helical"
+class _JointTypes(enum.Enum):
+    """What every :class:`JointType` member answers (the members are made from the kinds)."""
 
     @property
     def kind(self) -> JointKind:
@@ -38,11 +23,25 @@ class JointType(enum.Enum):
 
     @property
     def is_movable(self) -> bool:
-        return self is not JointType.FIXED
+        return self.kind.nv > 0
 
     @property
     def is_revolute(self) -> bool:
-        return self in (JointType.REVOLUTE, JointType.CONTINUOUS)
+        return self.value in ("revolute", "continuous")
+
+
+#: The joint types a description writes, one member per kind of :mod:`eomgen.model.joints`
+#: that a description writes (``JointType.REVOLUTE``, ``CONTINUOUS``, ``PRISMATIC``,
+#: ``FIXED``, ``SPHERICAL``, ``PLANAR``, ``HELICAL``), each naming its kind (:attr:`kind`,
+#: which answers every question about it). A URDF ``<mimic>`` joint is a movable joint that a
+#: coupling makes follow another (:mod:`eomgen.model.coupling`). ``SPHERICAL`` (a ball joint)
+#: and ``PLANAR`` are what a parser writes; :func:`~eomgen.model.build_model` turns each into
+#: its chain of one-axis joints (:func:`eomgen.model.expand_joints`), so no model holds one.
+#: ``HELICAL`` is a one-axis joint of the tree like ``REVOLUTE`` and ``PRISMATIC``
+#: (:attr:`Joint.rotates`, :attr:`Joint.lead`).
+JointType = _JointTypes("JointType", [(kind.name.upper(), kind.name)
+                                      for kind in KINDS.values() if kind.described],
+                        module=__name__, qualname="JointType")
 
 
 @dataclass(frozen=True)

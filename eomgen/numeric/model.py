@@ -12,7 +12,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 import sympy as sp
 
-from ..model import (JointType, QuaternionJoint, RobotModel, coupling_map, parameter_symbol,
+from ..model import (QuaternionJoint, RobotModel, coupling_map, parameter_symbol,
                      uncoupled)
 from ..model.coupling import full_configuration
 
@@ -22,13 +22,16 @@ FIXED, REVOLUTE, PRISMATIC, HELICAL = 0, 1, 2, 3
 #: it along the axis: :attr:`NumericModel.lead`).
 TURNING = (REVOLUTE, HELICAL)
 
-_TYPE_CODE = {
-    JointType.FIXED: FIXED,
-    JointType.REVOLUTE: REVOLUTE,
-    JointType.CONTINUOUS: REVOLUTE,
-    JointType.PRISMATIC: PRISMATIC,
-    JointType.HELICAL: HELICAL,
-}
+
+
+def _type_code(kind) -> int:
+    """The code of a one-axis joint kind, from what it does (its motion: ``rotates`` and
+    ``translates``), so that a new kind needs no entry here."""
+    if kind.nv == 0:
+        return FIXED
+    if kind.rotates:
+        return HELICAL if kind.translates else REVOLUTE
+    return PRISMATIC
 
 
 @dataclass(frozen=True)
@@ -295,7 +298,7 @@ def numeric_model(model: RobotModel, values: Mapping | None = None,
     for i, joint in enumerate(order, start=1):
         where = f"joint '{joint.name}'"
         parent[i] = index[joint.parent]
-        joint_type[i] = _TYPE_CODE[joint.type]
+        joint_type[i] = _type_code(joint.type.kind)
         q_index[i] = q_of_joint.get(joint.name, -1)
         axis[i] = _vec(numbers, joint.axis, where + " axis")
         lead[i] = _number(numbers, joint.lead, where + " pitch")

@@ -11,7 +11,7 @@ import pytest
 
 from support.extras import need
 from eomgen.numeric import contacts
-from eomgen.numeric import configuration as quaternion_joints
+from eomgen.model import configuration as quaternion_joints
 from eomgen.numeric import contacts as numeric_contacts
 from eomgen.numeric.so3 import left_jacobian, rotation_about, skew, so3_exp, so3_log
 

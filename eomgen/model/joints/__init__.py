@@ -27,9 +27,11 @@ from .prismatic import PRISMATIC
 from .revolute import CONTINUOUS, REVOLUTE
 from .spherical import SPHERICAL
 
-#: Every kind by its name.
+#: Every kind by its name. :class:`eomgen.model.JointType` has a member for each kind a
+#: description writes (:attr:`JointKind.described`): adding a kind is its module and its line
+#: here.
 KINDS: dict[str, JointKind] = {kind.name: kind for kind in (
-    REVOLUTE, CONTINUOUS, PRISMATIC, HELICAL, FIXED, SPHERICAL, PLANAR, FREE_FLYER)}
+    REVOLUTE, CONTINUOUS, PRISMATIC, FIXED, SPHERICAL, PLANAR, HELICAL, FREE_FLYER)}
 
 __all__ = ["CONTINUOUS", "ChartKind", "FIXED", "FREE_FLYER", "HELICAL", "JointKind", "KINDS",
            "PLANAR", "PRISMATIC", "REVOLUTE", "SPHERICAL"]

@@ -44,6 +44,9 @@ class JointKind:
     nv: int = 1
     #: The class of Pinocchio's joint model of this kind (``JointModelRevoluteUnaligned``, …).
     pinocchio: str = ""
+    #: True when a description writes it as a joint's type (a :class:`eomgen.model.JointType`
+    #: member); the free flyer is put under a robot instead.
+    described: bool = True
     #: True when the kind rotates its child about its axis, or translates it along its axis.
     rotates: bool = False
     translates: bool = False
@@ -73,6 +76,11 @@ class JointKind:
     def configuration_names(self, joint: str) -> tuple[str, ...]:
         """The names of the joint's configuration entries (of ``CONFIGURATION_NAMES``)."""
         return self.velocity_names(joint)
+
+    def check(self, source: str, joint) -> None:
+        """Refuse, in one line naming ``source`` and the joint, what this kind cannot be (a
+        planar joint off its plane, a helical joint without a finite pitch); a kind without
+        such rules accepts every joint."""
 
     # -- the configuration space (float64, the joint's own entries) --------------------------
     def neutral(self) -> np.ndarray:

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from .base import ChartKind, zeros
+from .base import ChartKind
 from .lie import (left_jacobian, matrix_quaternion, quaternion_matrix, quaternion_rate,
                   quaternion_rotation, quaternion_rotation_symbolic, rotation_rates, so3_exp,
                   so3_log)
@@ -37,6 +37,7 @@ VELOCITY = ("base_vx", "base_vy", "base_vz", "base_wx", "base_wy", "base_wz")
 
 class FreeFlyer(ChartKind):
     name = "free_flyer"
+    described = False  # put under a robot (eomgen.free_flyer.add_free_flyer), not written
     nq, nv = 7, 6
     pinocchio = "JointModelFreeFlyer"
     motions = (0, 1, 2, 3, 4, 5)

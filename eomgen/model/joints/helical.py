@@ -12,8 +12,11 @@ derived for it.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
+from ...errors import InvalidNumberError
 from .base import JointKind
 from .lie import rotation_about
 
@@ -25,6 +28,15 @@ class Helical(JointKind):
 
     def lead(self, pitch=0):
         return pitch
+
+    def check(self, source: str, joint) -> None:
+        try:
+            pitch = float(joint.pitch)
+        except TypeError:  # a symbolic pitch: a parameter, checked where it has a value
+            return
+        if not math.isfinite(pitch):
+            raise InvalidNumberError(source, f"joint '{joint.name}' pitch",
+                                     "the pitch is not finite")
 
     def transform(self, axis, q, pitch: float = 0.0):
         axis, angle = np.asarray(axis, dtype=float), float(np.ravel(q)[0])

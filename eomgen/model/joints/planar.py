@@ -18,7 +18,8 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from .base import ChartKind, zeros
+from ...errors import UnsupportedError
+from .base import ChartKind
 from .lie import planar_left_jacobian
 
 _HALF = sp.Rational(1, 2)
@@ -42,6 +43,13 @@ class Planar(ChartKind):
     velocity_suffixes = ("vx", "vy", "wz")
     configuration_suffixes = ("x", "y", "cos", "sin")
     placement_prefix = "Rp"
+
+    def check(self, source: str, joint) -> None:
+        if tuple(joint.axis) != (0, 0, 1):
+            raise UnsupportedError(source, f"joint '{joint.name}' axis", "a planar joint moves "
+                                   "in its joint frame's xy plane (Pinocchio's JointModelPlanar):"
+                                   " its axis, the plane's normal, must be 0 0 1; turn the plane "
+                                   "with the joint's origin")
 
     def neutral(self) -> np.ndarray:
         return np.array([0.0, 0.0, 1.0, 0.0])

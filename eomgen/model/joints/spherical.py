@@ -53,7 +53,6 @@ def quaternion_symbolic_rate(quaternion, omega) -> tuple:
     x, y, z, w = quaternion
     wx, wy, wz = omega
     cross = (y * wz - z * wy, z * wx - x * wz, x * wy - y * wx)
-    vector = (x, y, z)
     return tuple((w * omega[i] + cross[i]) / 2 for i in range(3)) + (
         -(x * wx + y * wy + z * wz) / 2,)
 
