@@ -327,6 +327,12 @@ def compound_names(model: RobotModel) -> dict[str, tuple[str, tuple[str, ...]]]:
     return {name: (kind, KINDS[kind].velocity_names(name)) for kind, name in model.compound_joints}
 
 
+def compound_of(model: RobotModel) -> dict[str, str]:
+    """``{virtual joint: compound joint}`` for the virtual joints of the model's
+    :attr:`~RobotModel.compound_joints` (``hip_wy`` → ``hip``)."""
+    return {v: name for name, (_, virtual) in compound_names(model).items() for v in virtual}
+
+
 def _lock_compound(model: RobotModel, name: str, configuration) -> dict[str, Transform]:
     """The fixed origins of compound joint ``name``'s virtual joints locked at its
     ``configuration`` (the kind's NQ entries): the first one's origin moved by the kind's pose

@@ -31,7 +31,7 @@ from ..model import (
 )
 from ..model.coupling import locked_couplings
 from ..model.joints import KINDS
-from ..model.robot import compound_names
+from ..model.robot import compound_names, compound_of
 from ..model.moving_mass import massless_problem
 from ..outputs import select
 from ..parsers import load
@@ -99,7 +99,7 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
     moving = _moving_joints(model, scene, base)
     listed = scene.locked_positions
     compound = compound_names(model)
-    inside = {v: name for name, (_, virtual) in compound.items() for v in virtual}
+    inside = compound_of(model)
     locks = [LockedJoint(j.name, float(listed.get(j.name, 0.0)), j.name in listed)
              for j in model.movable_joints if j.name not in moving and j.name not in inside]
     locks = _coupled_locks(model, locks)
@@ -413,7 +413,7 @@ def _check_names(model: RobotModel, scene: Scene, payloads: Sequence[Payload]) -
     for k, tip in enumerate(scene.tips):
         link(tip, f"tips[{k}] '{tip}'")
     compound = compound_names(model)
-    inside = {v: name for name, (_, virtual) in compound.items() for v in virtual}
+    inside = compound_of(model)
     for name, value in scene.locked:
         if name in compound:
             kind = KINDS[compound[name][0]]
