@@ -107,7 +107,7 @@ RESERVED_IDENTIFIERS = RESERVED_KEYWORDS | frozenset(
 def _backends_reserved() -> tuple[tuple[str, ...], ...]:
     # The package's registry: complete only once eomgen.codegen has imported every backend,
     # which happens after this module (imported by eomgen.codegen) is loaded.
-    from . import available_backends
+    from .registry import available_backends
 
     return tuple(b.reserved for b in available_backends().values())
 

@@ -18,7 +18,9 @@ from ..model import RobotModel, snap_summary
 from ..common.output import checked_stem, import_collisions, write_atomically  # noqa: F401
 from ..common.progress import plural
 from ..outputs import OUTPUTS
-from . import GeneratedFile, available_backends, make_job
+from ..common.output import GeneratedFile
+from .job import make_job
+from .registry import available_backends
 from .functions import derived_outputs, select_functions
 
 Progress = Callable[[str], None]

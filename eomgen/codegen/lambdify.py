@@ -76,7 +76,7 @@ def lambdify(dynamics: "eomgen.dynamics.Dynamics") -> NumericDynamics:  # noqa: 
     """
     # Imported on first use (start-up time): code generation loads Jinja and the backends,
     # which `import eomgen` and derive never need.
-    from . import make_job
+    from .job import make_job
     from .backends.numpy_backend import NumPyConfig, NumPyModulePrinter, numpy_source
 
     derived = set(dynamics.outputs)

@@ -28,7 +28,8 @@ from ..reduction import (
     measure_derivation,
 )
 from ..scene import Scene
-from . import GeneratedFile, make_job
+from ..common.output import GeneratedFile
+from .job import make_job
 from .functions import derived_outputs
 from .generate import (
     Progress,
@@ -141,7 +142,7 @@ def generate_scene(model: RobotModel, scene: Scene | None, outdir: Path,
     outputs = scene.outputs if scene is not None else None
     if backends == "all" or list(backends) == ["all"]:
         # The package's registry, complete once eomgen.codegen has imported every backend.
-        from . import available_backends
+        from .registry import available_backends
 
         chosen, skipped = usable_backends(chosen, outputs)
         for name in skipped:

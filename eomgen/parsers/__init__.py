@@ -8,38 +8,12 @@ format touches no other module.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
-from typing import Callable
-
 from ..errors import TooLargeError, UnknownFormatError, UnreadableFileError, closest_name
 from ..model import Notice, NoticeKind, RobotModel, emit_notices, settled, snapping, uncoupled
 from ..robots import EXAMPLES
-
-#: ``load(path, strict, defer_notices=False)``.
-Loader = Callable[..., RobotModel]
-
-
-@dataclass(frozen=True)
-class Format:
-    name: str
-    suffixes: tuple[str, ...]
-    load: Loader
-    sniff: Callable[[str], bool] | None = None
-
-
-FORMATS: list[Format] = []
-
-
-def register(name: str, suffixes: tuple[str, ...], sniff: Callable[[str], bool] | None = None):
-    """Decorator registering ``load(path, strict, defer_notices=False)`` for files with the
-    given suffixes."""
-
-    def decorate(load: Loader) -> Loader:
-        FORMATS.append(Format(name, suffixes, load, sniff))
-        return load
-
-    return decorate
+from .registry import FORMATS, Format, Loader, register  # noqa: F401  (the formats' registry)
 
 
 MAX_FILE_BYTES = 50 * 1024 * 1024

@@ -52,7 +52,7 @@ from ..model import (
     IDENTITY3, Inertial, Joint, JointType, Link, Mat3, RobotModel, Transform, build_model,
     check_size, mat3, rotation_about_axis, vec3,
 )
-from . import register
+from .registry import register
 from ._yaml import Reader, read_document, top_level_key
 
 TOP_KEYS = ("name", "description", "convention", "gravity", "parameters", "dh")

@@ -123,7 +123,7 @@ from ..model import (
     vec3,
 )
 from ..free_flyer import add_free_flyer
-from . import register
+from .registry import register
 from .legged import floating_base_notice
 
 #: Gravitational acceleration [m/s²] in the root link frame (URDF: z up).

@@ -48,7 +48,7 @@ from ..errors import UnsupportedError
 from ..model import (
     Inertial, Joint, JointType, Link, RobotModel, Transform, build_model, check_size, vec3,
 )
-from . import register
+from .registry import register
 from ._yaml import Reader, read_document, top_level_key
 
 TOP_KEYS = ("name", "description", "gravity", "parameters", "links", "joints")

@@ -19,7 +19,9 @@ from sympy.printing.pycode import PythonCodePrinter
 
 from ...outputs import exported, function_names
 from ...common.compiler import c_compiler, shared_library
-from .. import GeneratedFile, Job, Loaded, register
+from ...common.output import GeneratedFile
+from ..job import Job
+from ..registry import Loaded, register
 from ...symbolic.printing import FloatLiteralMixin, exec_source
 from ...common.templating import render
 from .common import TermOrderShared, python_module_context

@@ -10,7 +10,8 @@ from typing import Callable
 
 import sympy as sp
 
-from .. import Job, Loaded
+from ..job import Job
+from ..registry import Loaded
 from ...outputs import (CONSTRAINED_DERIVATIVES, CONSTRAINED_FORWARD, CONSTRAINED_PARTIALS,
                        FORWARD, INPUT_SIZES, INPUTS, PARALLEL_INVERSE,
                        TASK_SPACE, composition_names, constrained_names, exported,

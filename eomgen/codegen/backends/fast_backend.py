@@ -29,7 +29,9 @@ from sympy.printing.c import C99CodePrinter
 from sympy.printing.precedence import PRECEDENCE
 
 from ...common.compiler import c_compiler, shared_library
-from .. import GeneratedFile, Job, Loaded, register
+from ...common.output import GeneratedFile
+from ..job import Job
+from ..registry import Loaded, register
 from ...outputs import (CONSTRAINED_DERIVATIVES, CONSTRAINED_FORWARD, CONSTRAINED_PARTIALS,
                        FORWARD, INPUT_SIZES, PARALLEL_INVERSE,
                        TASK_SPACE, composition_names, constrained_names, exported,

@@ -29,7 +29,9 @@ from __future__ import annotations
 import ast
 from dataclasses import dataclass, replace
 
-from .. import GeneratedFile, Job, register
+from ...common.output import GeneratedFile
+from ..job import Job
+from ..registry import register
 from ...common.templating import render
 from .common import PrintedFunction, python_loader, python_module_context
 from .numpy_backend import ArrayModulePrinter

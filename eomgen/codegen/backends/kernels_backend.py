@@ -13,7 +13,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .. import GeneratedFile, Job, register
+from ...common.output import GeneratedFile
+from ..job import Job
+from ..registry import register
 from .fast_backend import FastCPrinter, render_source
 
 

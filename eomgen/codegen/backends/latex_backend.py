@@ -35,7 +35,9 @@ from ...present.notation import (  # noqa: F401  (re-exported: once defined here
 from ...present.sections import (  # noqa: F401  (re-exported: once defined here)
     PROGRAM_NAMES, document_context, program_sections,
 )
-from .. import GeneratedFile, Job, register
+from ...common.output import GeneratedFile
+from ..job import Job
+from ..registry import register
 from ...common.templating import render
 
 

@@ -10,7 +10,9 @@ from dataclasses import dataclass
 
 from sympy.printing.numpy import NumPyPrinter
 
-from .. import GeneratedFile, Job, register
+from ...common.output import GeneratedFile
+from ..job import Job
+from ..registry import register
 from ...symbolic.printing import NumPyModulePrinter
 from ...common.templating import render
 from ...runtime.cholesky import included_source

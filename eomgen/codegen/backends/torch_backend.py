@@ -12,7 +12,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .. import GeneratedFile, Job, register
+from ...common.output import GeneratedFile
+from ..job import Job
+from ..registry import register
 from ...common.templating import render
 from .common import python_loader, python_module_context, warning_exports
 from .numpy_backend import ArrayModulePrinter

@@ -85,7 +85,7 @@ from pathlib import Path
 
 from ...errors import DescriptionError, UnknownFormatError, UnreadableFileError, UnsupportedError
 from ...model import RobotModel, emit_notices, settled
-from .. import register
+from ..registry import register
 from .extras import model_notices, motors, with_equalities
 from .tree import build_tree
 
