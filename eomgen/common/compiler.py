@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import signal
 import subprocess
 import tempfile
 from pathlib import Path
@@ -49,12 +50,50 @@ def shared_library(compiler: str, source: str, name: str, flags: Sequence[str],
         c_path = Path(tmp, name + ".c")
         c_path.write_text(source, encoding="utf-8")
         library = Path(tmp, name + suffix)
-        result = subprocess.run([compiler, *flags, "-o", str(library), str(c_path), "-lm"],
-                                capture_output=True, text=True)
-        if result.returncode != 0:
-            raise RuntimeError(f"compiling {name}.c failed: "
-                               f"{result.stderr.strip()[:message_limit]}")
+        returncode, stderr = run_compiler([compiler, *flags, "-o", str(library), str(c_path),
+                                           "-lm"])
+        if returncode != 0:
+            raise RuntimeError(f"compiling {name}.c failed: {stderr.strip()[:message_limit]}")
         return library.read_bytes()
 
 
-__all__ = ["c_compiler", "c_compiler_path", "shared_library", "CANDIDATES"]
+#: Seconds the compiler's process group has to end after SIGTERM before it gets SIGKILL.
+STOP_GRACE = 2.0
+
+
+def run_compiler(command: Sequence[str]) -> tuple[int, str]:
+    """Run ``command`` (a compiler) and return its exit code and what it printed on stderr.
+
+    The compiler runs in a process group of its own (``cc`` starts ``cc1``, ``as`` and ``ld``
+    as children). Whatever ends the wait here (an interrupt, SIGTERM raised as an exception,
+    any error), the whole group is sent SIGTERM, then SIGKILL after :data:`STOP_GRACE`
+    seconds, and reaped before the exception goes on: no compiler outlives eomgen's call."""
+    process = subprocess.Popen(list(command), stdin=subprocess.DEVNULL,
+                               stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                               start_new_session=True)
+    try:
+        _, stderr = process.communicate()
+    except BaseException:
+        stop_group(process)
+        raise
+    return process.returncode, stderr or ""
+
+
+def stop_group(process: subprocess.Popen) -> None:
+    """End ``process`` and every process of its group (SIGTERM, then SIGKILL), and reap it."""
+    for signum, wait in ((signal.SIGTERM, STOP_GRACE), (signal.SIGKILL, None)):
+        try:
+            os.killpg(process.pid, signum)
+        except (ProcessLookupError, PermissionError):
+            pass
+        try:
+            process.communicate(timeout=wait)
+            return
+        except subprocess.TimeoutExpired:
+            continue
+        except BaseException:  # a second interrupt while stopping: finish the job first
+            continue
+
+
+__all__ = ["c_compiler", "c_compiler_path", "run_compiler", "shared_library", "stop_group",
+           "CANDIDATES", "STOP_GRACE"]

@@ -1,4 +1,4 @@
-"""Interrupting ``eomgen generate`` (SIGINT, SIGTERM) mid-derivation.
+"""Interrupting ``eomgen generate`` (SIGINT, SIGTERM) mid-derivation and mid-compile.
 
 A 12-link spatial chain takes seconds to derive. ``eomgen generate`` runs on it in a real
 process, over a folder holding a previous complete output; once the process reports that it is
@@ -108,3 +108,67 @@ def test_interrupt_mid_derivation_keeps_the_previous_output(chain, tmp_path, sig
     assert [p.name for p in work.iterdir()] == ["out"]  # no staging folder
     leftovers = [p for p in cache.rglob("*") if p.name.startswith(".")] if cache.exists() else []
     assert leftovers == []
+
+
+def _children_of(pid: int) -> list[int]:
+    """Processes whose parent is ``pid`` (from /proc)."""
+    found = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            found.append(int(stat.parent.name))
+    return found
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs /proc to find the compiler")
+@pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)],
+                         ids=["SIGINT", "SIGTERM"])
+def test_interrupt_during_the_compile_ends_the_compiler(tmp_path, signum, code):
+    """A signal to eomgen alone (not to its process group, as ``kill`` sends it) while the C
+    compiler runs: eomgen ends the compiler and what the compiler started, then exits.
+
+    The compiler is a stand-in (``$CC``, which eomgen honours): a script that starts a child,
+    as ``cc`` starts ``cc1``, and waits for it; both must be gone when eomgen has exited."""
+    compiler = tmp_path / "slow-cc"
+    compiler.write_text("#!/bin/sh\nsleep 300 &\nwait\n", encoding="utf-8")
+    compiler.chmod(0o755)
+    outdir = tmp_path / "out"
+    env = {**os.environ, "CC": str(compiler)}
+    with _children_with_default_sigint():
+        process = subprocess.Popen(
+            [sys.executable, "-m", "eomgen.cli", "generate", "planar_2link", "-o", str(outdir),
+             "--backend", "fast", "--no-cache"],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        deadline, sleeper, cc = time.monotonic() + 120, None, None
+        while time.monotonic() < deadline and sleeper is None and process.poll() is None:
+            for child in _children_of(process.pid):
+                grandchildren = _children_of(child)
+                if grandchildren:
+                    cc, sleeper = child, grandchildren[0]
+            time.sleep(0.05)
+        assert sleeper is not None, "the stand-in compiler never started"
+        process.send_signal(signum)
+        stdout, stderr = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.communicate()
+    assert process.returncode == code, stderr
+    assert stderr.strip().splitlines()[-1] == "eomgen: interrupted", stderr
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and (_alive(cc) or _alive(sleeper)):
+        time.sleep(0.05)
+    assert not _alive(cc) and not _alive(sleeper), "the compiler outlived eomgen"
+    assert not outdir.exists()
