@@ -14,6 +14,7 @@ from typing import Sequence
 
 import numpy as np
 
+from ..common.reading import not_regular
 from ..errors import IdentificationError, one_line
 
 #: Column prefixes of a CSV file, in the order written: positions, velocities, accelerations,
@@ -138,6 +139,9 @@ def read_measurements(path: Path | str, joint_names: Sequence[str],
     """
     path = Path(path)
     source = str(path)
+    problem = not_regular(path)
+    if problem is not None:
+        raise IdentificationError(f"{source}: {problem}")
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
+from ..common.reading import not_regular
 from ..errors import TooLargeError, UnknownFormatError, UnreadableFileError, closest_name
 from ..model import Notice, NoticeKind, RobotModel, emit_notices, settled, snapping, uncoupled
 from ..robots import EXAMPLES
@@ -66,8 +67,10 @@ def load(path, strict: bool = False, defer_notices: bool = False,
     path = Path(path)
     if not path.exists() and str(path) in EXAMPLES:
         path = EXAMPLES[str(path)]
-    if not path.is_file():
-        raise UnreadableFileError(str(path), "", "no such file" + near_miss(path))
+    problem = not_regular(path)
+    if problem is not None:
+        hint = near_miss(path) if problem == "no such file" else ""
+        raise UnreadableFileError(str(path), "", problem + hint)
     if path.stat().st_size > MAX_FILE_BYTES:
         raise TooLargeError(str(path), "", f"file larger than {MAX_FILE_BYTES} bytes")
     suffix = path.suffix.lower()

@@ -28,6 +28,7 @@ from typing import Iterable
 import sympy as sp
 import yaml
 
+from ..common.reading import not_regular
 from ..errors import (
     DescriptionError,
     InvalidNumberError,
@@ -132,6 +133,9 @@ def read_document(path: Path | str, text: str | None = None) -> dict:
     source = str(path)
     if text is None:
         path = Path(path)
+        problem = not_regular(path)
+        if problem is not None:
+            raise UnreadableFileError(source, "", problem)
         try:
             size = path.stat().st_size
         except OSError as exc:
