@@ -128,6 +128,10 @@ def _problem(exc: OSError, folder: Path) -> str:
         return f"no permission to write in {folder}"
     if exc.errno in (errno.ENOSPC, errno.EDQUOT):
         return f"no space left in {folder}"
+    if exc.errno == errno.EFBIG:
+        return f"a file in {folder} would pass the largest size this process may write"
+    if exc.errno == errno.ENAMETOOLONG:
+        return f"a name is longer than the file system allows in {folder}"
     return f"{folder} does not accept new files ({(exc.strerror or str(exc)).lower()})"
 
 
@@ -153,10 +157,27 @@ def _check_parent(path: Path) -> None:
     _probe(ancestor, path)
 
 
+def _check_names(path: Path) -> None:
+    """Each missing folder or file name of ``path`` fits the file system (``NAME_MAX`` bytes,
+    255 on most), so that making it cannot fail with ``ENAMETOOLONG``."""
+    ancestor = _existing_ancestor(path)
+    try:
+        limit = os.pathconf(ancestor, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        limit = 255
+    missing = path.relative_to(ancestor).parts if path.is_relative_to(ancestor) else path.parts
+    for name in missing:
+        size = len(os.fsencode(name))
+        if size > limit:
+            raise _refuse(path, f"the name '{name[:24]}…' is {size} bytes, longer than the "
+                                f"{limit} bytes a name may have on this file system")
+
+
 def check_output_folder(outdir: Path) -> None:
     """Raise :class:`OutputError` unless files can be written into the folder ``outdir``
     (made when missing, with its parents). Nothing is left behind."""
     outdir = Path(outdir)
+    _check_names(outdir)
     if os.path.lexists(outdir):
         if not outdir.is_dir():
             raise _refuse(outdir, "it is a file, not a folder")
@@ -171,6 +192,7 @@ def check_output_file(path: Path) -> None:
     path = Path(path)
     if path.is_dir():
         raise _refuse(path, "it is a folder, not a file")
+    _check_names(path)
     if path.parent.is_dir():
         _probe(path.parent, path)
     else:
@@ -204,15 +226,20 @@ def write_atomically(files: Sequence[GeneratedFile], outdir: Path) -> list[Path]
     removed.
     """
     outdir = Path(outdir)
-    made = _make_folders(outdir.parent)
+    try:
+        made = _make_folders(outdir.parent)
+    except OSError as exc:
+        raise _refuse(outdir, _problem(exc, _existing_ancestor(outdir))) from None
     fresh = not os.path.lexists(outdir)
     try:
         if fresh:
-            staging = Path(tempfile.mkdtemp(prefix=f".{outdir.name}.staging-", dir=outdir.parent))
+            staging = Path(tempfile.mkdtemp(prefix=".eomgen-staging-", dir=outdir.parent))
         else:
             staging = Path(tempfile.mkdtemp(prefix=".eomgen-staging-", dir=outdir))
-    except BaseException:
+    except BaseException as exc:
         _remove_folders(made)
+        if isinstance(exc, OSError):
+            raise _refuse(outdir, _problem(exc, outdir if not fresh else outdir.parent)) from None
         raise
     try:
         for f in files:
@@ -236,12 +263,14 @@ def write_atomically(files: Sequence[GeneratedFile], outdir: Path) -> list[Path]
                     os.replace(staging / f.name, outdir / f.name)
         finally:
             signal.pthread_sigmask(signal.SIG_SETMASK, previous)
-    except BaseException:
+    except BaseException as exc:
         if staging is not None:
             shutil.rmtree(staging, ignore_errors=True)
             staging = None
         if fresh:
             _remove_folders(made)
+        if isinstance(exc, OSError):  # a full disk, a name too long: one line, not a traceback
+            raise _refuse(outdir, _problem(exc, outdir if not fresh else outdir.parent)) from None
         raise
     finally:
         if staging is not None:
