@@ -1049,7 +1049,8 @@ def _snapshot(folder: Path) -> dict[str, bytes]:
 
 
 def _staging_folders(outdir: Path) -> list[Path]:
-    return list(outdir.parent.glob(f".{outdir.name}.staging-*"))
+    """Staging folders left beside ``outdir`` (a new output) or in it (an existing one)."""
+    return [*outdir.parent.glob(".eomgen-staging-*"), *outdir.glob(".eomgen-staging-*")]
 
 
 def test_failing_backend_writes_nothing(build, tmp_path, monkeypatch):
