@@ -185,6 +185,11 @@ def simulate(description, outdir, duration, dts, rtols, names, q0, qd0, gains, s
         if values is not None and len(values) != len(names):
             raise AnalysisError(f"{option}: {model.name} takes {len(names)} values "
                                 f"({', '.join(names)}), got {len(values)}")
+    from ..model.configuration import degenerate  # NumPy: only when the command runs
+
+    problem = None if start is None else degenerate(start, model)
+    if problem is not None:
+        raise AnalysisError(f"--q0: {problem}")
     if model.loops:
         _simulate_loops(model, integrators, duration, start, velocity, gain_list, outdir,
                         progress)

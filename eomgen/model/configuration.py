@@ -64,6 +64,26 @@ def _pieces(joints, nv: int):
         k, iq = k + width, iq + length
 
 
+#: A unit part (quaternion, (cos, sin) pair) shorter than this stands for no configuration.
+DEGENERATE_LENGTH = 1e-9
+
+
+def degenerate(q, model=None) -> str | None:
+    """None when every joint's configuration in ``q`` (NQ) stands for one (each quaternion and
+    planar ``(cos, sin)`` pair longer than :data:`DEGENERATE_LENGTH`: it stands for its
+    normalised value); otherwise what is wrong, in words naming the first joint and its
+    entries, e.g. ``"joint 'hip': its quaternion (hip_qx, hip_qy, hip_qz, hip_qw) has zero
+    length"``."""
+    q = np.asarray(q, dtype=float)
+    for joint in layout(model):
+        unit = joint.kind.unit_entries
+        if unit is not None and not np.linalg.norm(q[joint.q_slice][unit]) > DEGENERATE_LENGTH:
+            names = ", ".join(joint.kind.configuration_names(joint.name)[unit])
+            return (f"joint '{joint.name}': its {joint.kind.unit_name} ({names}) has zero "
+                    "length; give a unit one")
+    return None
+
+
 def configuration_rate(q, v, model=None) -> np.ndarray:
     """``q̇`` (NQ) at velocity ``v`` (NV): each joint's kind's rate
     (:meth:`~eomgen.model.joints.JointKind.configuration_rate`): a free flyer's origin moves at
@@ -115,5 +135,5 @@ def neutral(model) -> np.ndarray:
     return q
 
 
-__all__ = ["configuration_rate", "difference", "integrate", "layout", "left_jacobian",
+__all__ = ["DEGENERATE_LENGTH", "configuration_rate", "degenerate", "difference", "integrate", "layout", "left_jacobian",
            "neutral", "skew", "so3_exp", "so3_log"]

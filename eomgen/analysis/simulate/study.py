@@ -25,7 +25,7 @@ import numpy as np
 
 from ...model import RobotModel
 from ...common.progress import plural
-from ...model.configuration import neutral
+from ...model.configuration import degenerate, neutral
 from ..conditioning import CONDITION_LIMIT, IllConditionedWarning, ill_conditioned_message
 from ..report import fmt, markdown_table
 from .integrators import Adaptive
@@ -76,9 +76,15 @@ def simulate(system: System, integrator, q0, qd0, duration: float,
 
     Raises
     ------
+    ValueError
+        When ``q0`` holds a quaternion or planar ``(cos, sin)`` pair of zero length
+        (:func:`eomgen.model.configuration.degenerate`).
     Diverged
         When the state stops being finite or M stops being positive definite.
     """
+    problem = degenerate(q0, system.model)
+    if problem is not None:
+        raise ValueError(f"q0: {problem}")
     times = np.linspace(0.0, float(duration), points)
     system.reset()
     start = time.perf_counter()

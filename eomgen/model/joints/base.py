@@ -127,6 +127,11 @@ class ChartKind(JointKind):
     configuration_suffixes: tuple[str, ...] = ()
     #: Where the kind's quaternion starts in its configuration entries (None: it has none).
     quaternion_offset: int | None = None
+    #: The entries of the configuration (NQ,) that stand for their normalised value (a
+    #: quaternion; a planar joint's ``(cos θ, sin θ)``), and their name for messages; None
+    #: when the kind has none. Zero length stands for no configuration at all.
+    unit_entries: slice | None = None
+    unit_name: str = ""
     #: The prefix of the names the derivation gives the pose's entries.
     placement_prefix: str = ""
 

@@ -43,6 +43,7 @@ class FreeFlyer(ChartKind):
     motions = (0, 1, 2, 3, 4, 5)
     velocity_suffixes = ("vx", "vy", "vz", "wx", "wy", "wz")
     configuration_suffixes = ("x", "y", "z", "qx", "qy", "qz", "qw")
+    unit_entries, unit_name = slice(3, 7), "quaternion"
     quaternion_offset = 3
     placement_prefix = "Rb"
 

@@ -42,6 +42,7 @@ class Planar(ChartKind):
     motions = (0, 1, 5)
     velocity_suffixes = ("vx", "vy", "wz")
     configuration_suffixes = ("x", "y", "cos", "sin")
+    unit_entries, unit_name = slice(2, 4), "(cos, sin) pair"
     placement_prefix = "Rp"
 
     def check(self, source: str, joint) -> None:

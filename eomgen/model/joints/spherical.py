@@ -70,6 +70,7 @@ class Spherical(ChartKind):
     motions = (3, 4, 5)
     velocity_suffixes = ("wx", "wy", "wz")
     configuration_suffixes = ("qx", "qy", "qz", "qw")
+    unit_entries, unit_name = slice(0, 4), "quaternion"
     quaternion_offset = 0
     placement_prefix = "Rs"
 
