@@ -79,7 +79,7 @@ def test_transform_and_motion_subspace_are_the_joint_datas(kind):
             assert relative(p, jdata.M.translation) < 1e-12
         else:
             assert not np.abs(p).any()
-        assert relative(kind.motion_subspace(axis, PITCH), np.asarray(jdata.S).reshape(6, pm.nv)) \
+        assert relative(kind.motion_subspace(axis, q, PITCH), np.asarray(jdata.S).reshape(6, pm.nv)) \
             < 1e-12
         moved = max(moved, np.abs(jdata.M.homogeneous - np.eye(4)).max())
     assert moved > 0.05  # the joint moved: the check is not at the identity

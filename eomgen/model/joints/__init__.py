@@ -18,7 +18,7 @@ see it); :mod:`~eomgen.model.joints.lie` holds the rotations and rigid motions t
 
 from __future__ import annotations
 
-from .base import ChartKind, JointKind
+from .base import ChainKind, ChartKind, JointKind
 from .fixed import FIXED
 from .free_flyer import FREE_FLYER
 from .helical import HELICAL
@@ -33,5 +33,5 @@ from .spherical import SPHERICAL
 KINDS: dict[str, JointKind] = {kind.name: kind for kind in (
     REVOLUTE, CONTINUOUS, PRISMATIC, FIXED, SPHERICAL, PLANAR, HELICAL, FREE_FLYER)}
 
-__all__ = ["CONTINUOUS", "ChartKind", "FIXED", "FREE_FLYER", "HELICAL", "JointKind", "KINDS",
+__all__ = ["CONTINUOUS", "ChainKind", "ChartKind", "FIXED", "FREE_FLYER", "HELICAL", "JointKind", "KINDS",
            "PLANAR", "PRISMATIC", "REVOLUTE", "SPHERICAL"]
