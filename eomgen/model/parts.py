@@ -31,14 +31,15 @@ class _JointTypes(enum.Enum):
 
 
 #: The joint types a description writes, one member per kind of :mod:`eomgen.model.joints`
-#: that a description writes (``JointType.REVOLUTE``, ``CONTINUOUS``, ``PRISMATIC``,
-#: ``FIXED``, ``SPHERICAL``, ``PLANAR``, ``HELICAL``), each naming its kind (:attr:`kind`,
-#: which answers every question about it). A URDF ``<mimic>`` joint is a movable joint that a
-#: coupling makes follow another (:mod:`eomgen.model.coupling`). ``SPHERICAL`` (a ball joint)
-#: and ``PLANAR`` are what a parser writes; :func:`~eomgen.model.build_model` turns each into
-#: its chain of one-axis joints (:func:`eomgen.model.expand_joints`), so no model holds one.
-#: ``HELICAL`` is a one-axis joint of the tree like ``REVOLUTE`` and ``PRISMATIC``
-#: (:attr:`Joint.rotates`, :attr:`Joint.lead`).
+#: that a description writes (``JointType.REVOLUTE``, ``PLANAR``, …: the table of
+#: :mod:`eomgen.model.joints`), each naming its kind (:attr:`kind`, which answers every
+#: question about it). A URDF ``<mimic>`` joint is a movable joint that a coupling makes follow
+#: another (:mod:`eomgen.model.coupling`). A joint of a kind of several coordinates
+#: (``SPHERICAL``: a ball joint, ``PLANAR``, …: a :class:`~eomgen.model.joints.ChainKind`) is
+#: what a parser writes; :func:`~eomgen.model.build_model` turns each into its chain of
+#: one-axis joints (:func:`eomgen.model.expand_joints`), so no model holds one. ``HELICAL`` is
+#: a one-axis joint of the tree like ``REVOLUTE`` and ``PRISMATIC`` (:attr:`Joint.rotates`,
+#: :attr:`Joint.lead`).
 JointType = _JointTypes("JointType", [(kind.name.upper(), kind.name)
                                       for kind in KINDS.values() if kind.described],
                         module=__name__, qualname="JointType")

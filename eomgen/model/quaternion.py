@@ -29,9 +29,11 @@ rotation of the quaternion before them.
 A parser writes a ball joint as a :class:`~eomgen.model.Joint` of type
 :attr:`JointType.SPHERICAL <eomgen.model.JointType.SPHERICAL>` (its origin the joint frame,
 its axis unused), a planar joint as one of type ``PLANAR``;
-:func:`~eomgen.model.build_model` calls :func:`expand_joints`, which replaces each by its
-chain (a ``HELICAL`` joint is one joint of the tree and stays). Every question about a
-joint's kind (sizes, names, configuration space, pose) is a method of its kind
+:func:`~eomgen.model.build_model` calls :func:`expand_joints`, which replaces each joint of a
+:class:`~eomgen.model.joints.ChainKind` by its chain (a ``HELICAL`` joint is one joint of the
+tree and stays; a chain whose configuration is its coordinates, not a
+:class:`~eomgen.model.joints.ChartKind`, has no place in :func:`quaternion_layout`). Every
+question about a joint's kind (sizes, names, configuration space, pose) is a method of its kind
 (:mod:`eomgen.model.joints`); this module only lays them out.
 """
 
@@ -40,7 +42,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from ..errors import KinematicTreeError, UnsupportedError
-from .joints import FREE_FLYER, KINDS, SPHERICAL, ChartKind, JointKind
+from .joints import FREE_FLYER, KINDS, SPHERICAL, ChainKind, ChartKind, JointKind
 from .joints.free_flyer import CONFIGURATION as FREE_FLYER_CONFIGURATION
 from .joints.free_flyer import VELOCITY as FREE_FLYER_VELOCITY
 from .parts import Joint, JointType, Link
@@ -114,8 +116,8 @@ def ball_velocity_names(name: str) -> tuple[str, str, str]:
     return SPHERICAL.velocity_names(name)  # type: ignore[return-value]
 
 
-def _chart_chain(model, joint: Joint, kind: ChartKind, taken: set) -> tuple[list, list]:
-    """The virtual joints and massless links of ``joint``'s chart (its kind's chain)."""
+def _chain(model, joint: Joint, kind: ChainKind, taken: set) -> tuple[list, list]:
+    """The virtual joints and massless links of ``joint``'s chain (its kind's)."""
     where = f"{kind.describe()[0]} joint '{joint.name}'"
     if joint.actuator is not None and joint.actuator.flexible:
         raise UnsupportedError(model.source, where, f"a {kind.describe()[0]} joint's stiffness "
@@ -137,10 +139,10 @@ def _chart_chain(model, joint: Joint, kind: ChartKind, taken: set) -> tuple[list
 
 
 def expand_joints(model: "RobotModel") -> "RobotModel":
-    """``model`` with each joint of a kind that is a chain in the tree replaced by its chain, in
-    the joint's place in the joint order: a :attr:`~eomgen.model.JointType.SPHERICAL` or
-    ``PLANAR`` joint by its chart's virtual joints ``<name>_<suffix>`` (the kind's
-    :meth:`~eomgen.model.joints.ChartKind.chain`, the first at the joint's origin) through
+    """``model`` with each joint of a kind that is a chain in the tree (a
+    :class:`~eomgen.model.joints.ChainKind`: a ball or a planar joint, …) replaced by its
+    chain, in the joint's place in the joint order: the virtual joints ``<name>_<suffix>`` (the
+    kind's :meth:`~eomgen.model.joints.ChainKind.chain`, the first at the joint's origin) through
     massless links ``<child>_<name>_<suffix>``, recorded in
     :attr:`~eomgen.model.RobotModel.compound_joints`. The hook a parser calls (:func:`~eomgen.model.build_model` does it for every parser).
 
@@ -154,7 +156,7 @@ def expand_joints(model: "RobotModel") -> "RobotModel":
         MuJoCo's act on each dof of a ball joint): the actuator is given to every virtual
         joint of the chain.
     """
-    expanded = [j for j in model.joints if isinstance(j.type.kind, ChartKind)]
+    expanded = [j for j in model.joints if isinstance(j.type.kind, ChainKind)]
     if not expanded:
         return model
     taken = {link.name for link in model.links} | {j.name for j in model.joints}
@@ -163,10 +165,10 @@ def expand_joints(model: "RobotModel") -> "RobotModel":
     compound = list(model.compound_joints)
     for joint in model.joints:
         kind = joint.type.kind
-        if not isinstance(kind, ChartKind):
+        if not isinstance(kind, ChainKind):
             joints.append(joint)
             continue
-        virtual, links = _chart_chain(model, joint, kind, taken)
+        virtual, links = _chain(model, joint, kind, taken)
         compound.append((kind.name, joint.name))
         joints += virtual
         chains[joint.child] = links
@@ -198,7 +200,7 @@ def quaternion_layout(model: "RobotModel") -> tuple[QuaternionJoint, ...]:
         The model holds a joint of a chain kind that was not expanded (:func:`expand_joints`).
     """
     for joint in model.joints:
-        if isinstance(joint.type.kind, ChartKind):
+        if isinstance(joint.type.kind, ChainKind):
             raise UnsupportedError(model.source, f"joint '{joint.name}'",
                                    f"a {joint.type.value} joint must be expanded first "
                                    "(eomgen.model.expand_joints; build_model does it)")
@@ -207,6 +209,8 @@ def quaternion_layout(model: "RobotModel") -> tuple[QuaternionJoint, ...]:
     found = [(0, FREE_FLYER, "base")] if model.free_flyer else []
     for kind_name, name in model.compound_joints:
         kind = KINDS[kind_name]
+        if not isinstance(kind, ChartKind):  # its configuration is its coordinates
+            continue
         names = kind.velocity_names(name)
         k = index.get(names[0], -1)
         chain = movable[k:k + kind.nv] if k >= 0 else ()

@@ -17,8 +17,8 @@
         inertia: {izz: I1}         # about the COM, link-frame axes; missing entries are 0
     joints:
       - name: joint1
-        type: revolute             # revolute | continuous | prismatic | fixed | spherical |
-                                   # planar | helical (with pitch: [m/rad])
+        type: revolute             # a joint kind (docs/formats.md lists them; helical
+                                   # with pitch: [m/rad])
         parent: base
         child: link1
         origin: {xyz: [0, 0, 0], rpy: [0, 0, 0]}   # optional, default identity

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from eomgen.model.joints import KINDS
+from eomgen.model.joints import KINDS, ChainKind, ChartKind
 from support import relative
 from support.extras import need
 
@@ -33,9 +33,12 @@ def test_every_kind_but_fixed_names_a_pinocchio_joint_model():
 
 
 def one_joint(kind, axis):
-    """Pinocchio's model holding one joint of ``kind`` (about ``axis``, with :data:`PITCH`)."""
+    """Pinocchio's model holding one joint of ``kind`` (about ``axis``, with :data:`PITCH`; a
+    chain whose configuration is its coordinates, a universal joint: about its chain's axes)."""
     cls = getattr(pin, kind.pinocchio)
-    if kind.rotates and kind.translates:
+    if isinstance(kind, ChainKind) and not isinstance(kind, ChartKind):
+        joint = cls(*(np.array(axis, dtype=float) for _, _, axis in kind.chain()))
+    elif kind.rotates and kind.translates:
         joint = cls(axis, PITCH)
     elif kind.rotates or kind.translates:
         joint = cls(axis)
@@ -79,7 +82,7 @@ def test_transform_and_motion_subspace_are_the_joint_datas(kind):
             assert relative(p, jdata.M.translation) < 1e-12
         else:
             assert not np.abs(p).any()
-        assert relative(kind.motion_subspace(axis, PITCH), np.asarray(jdata.S).reshape(6, pm.nv)) \
+        assert relative(kind.motion_subspace(axis, q, PITCH), np.asarray(jdata.S).reshape(6, pm.nv)) \
             < 1e-12
         moved = max(moved, np.abs(jdata.M.homogeneous - np.eye(4)).max())
     assert moved > 0.05  # the joint moved: the check is not at the identity

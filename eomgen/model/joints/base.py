@@ -7,8 +7,8 @@ A kind is a type (:class:`JointKind`), one module per kind in this package, one 
 * ``q`` holds the kind's NQ configuration entries, ``v`` its NV velocity entries;
 * :meth:`JointKind.transform` is the pose ``(R, p)`` of the child link frame in the joint frame
   at ``q`` (``R`` rotates child-frame vectors into the joint frame, ``p`` [m]);
-* :meth:`JointKind.motion_subspace` ``S`` (6 × NV, linear rows first) gives the child's
-  velocity relative to the parent, in the child frame, about its origin: ``S v``;
+* :meth:`JointKind.motion_subspace` ``S`` (6 × NV, linear rows first) at ``q`` gives the
+  child's velocity relative to the parent, in the child frame, about its origin: ``S v``;
 * :meth:`JointKind.integrate` moves ``q`` along the constant velocity ``v`` for unit time (the
   kind's Lie-group exponential, ``q ⊕ v``), :meth:`JointKind.difference` is its inverse
   (``q1 ⊖ q0``), :meth:`JointKind.configuration_rate` is ``q̇`` at velocity ``v``.
@@ -17,11 +17,14 @@ How the algorithms see a kind. One-coordinate kinds (revolute, continuous, prism
 helical) are joints of the kinematic tree; the derivation and the references read their motion
 from :attr:`rotates` (the child turns by ``q`` about the axis) and :meth:`lead` (it moves
 ``lead · q`` along the axis: 0, 1 or the helical joint's pitch), so the motion subspace is
-``S = (lead · axis, axis if rotates else 0)``. A kind whose configuration is
-not its coordinates (:class:`ChartKind`: the free flyer, a ball joint, a planar joint) is, in
-the tree, a chain of virtual one-axis joints at the joint's place (its :attr:`~ChartKind.motions`)
-held at zero, with the pose from ``q`` placed before it (:meth:`ChartKind.pose`,
-:meth:`ChartKind.placement`); :mod:`eomgen.symbolic.quaternion_joints` has the argument.
+``S = (lead · axis, axis if rotates else 0)``. A kind of several coordinates
+(:class:`ChainKind`) is, in the tree, a chain of virtual one-axis joints through massless links
+at the joint's place (its :meth:`~ChainKind.chain`; :func:`eomgen.model.expand_joints` puts it
+there). When its configuration is the chain's coordinates (a universal joint), the chain's
+joints are joints of the tree like any other. When it is not (:class:`ChartKind`: the free
+flyer, a ball joint, a planar joint), the chain is held at zero, with the pose from ``q`` placed
+before it (:meth:`ChainKind.pose`, :meth:`ChartKind.placement`);
+:mod:`eomgen.symbolic.quaternion_joints` has the argument.
 """
 
 from __future__ import annotations
@@ -109,21 +112,60 @@ class JointKind:
         """``(R, p)``: the child frame in the joint frame at ``q`` (module docstring)."""
         return np.eye(3), np.zeros(3)
 
-    def motion_subspace(self, axis, pitch: float = 0.0) -> np.ndarray:
-        """``S`` (6 × NV), linear rows first: the child's velocity ``S v`` in its own frame."""
+    def motion_subspace(self, axis, q=None, pitch: float = 0.0) -> np.ndarray:
+        """``S`` (6 × NV), linear rows first, at ``q`` (NQ; None will do for a kind whose ``S``
+        does not depend on it): the child's velocity ``S v`` in its own
+        frame."""
         return np.zeros((6, self.nv))
 
 
-class ChartKind(JointKind):
-    """A kind whose configuration is not its coordinates (NQ > NV): in the tree a chain of
-    virtual one-axis joints, its chart (module docstring)."""
+class ChainKind(JointKind):
+    """A kind of several coordinates: in the tree a chain of virtual one-axis joints through
+    massless links (:meth:`chain`), ``<joint>_<suffix>`` each, the joint recorded in
+    :attr:`~eomgen.model.RobotModel.compound_joints` (locked, reduced and named as one). The
+    base is a chain whose configuration is its coordinates (module docstring)."""
 
     #: The chain's unit motions in chain order, as indices into a spatial motion vector
-    #: (linear then angular); the kind's velocity coordinates are along them, in the child
-    #: frame.
+    #: (linear then angular): each virtual joint moves along (0, 1, 2) or turns about
+    #: (3, 4, 5) the x, y or z axis of its own joint frame.
     motions: tuple[int, ...] = ()
-    #: Suffixes of the velocity and configuration entries' names (``<joint>_<suffix>``).
+    #: Suffixes of the velocity entries' names (``<joint>_<suffix>``), the chain's joints.
     velocity_suffixes: tuple[str, ...] = ()
+
+    def velocity_names(self, joint: str) -> tuple[str, ...]:
+        return tuple(f"{joint}_{s}" for s in self.velocity_suffixes)
+
+    def chain(self) -> tuple[tuple[str, str, tuple[int, int, int]], ...]:
+        """The virtual joints: ``(suffix, "prismatic" or "continuous", axis)`` in chain order
+        (a translation along, or a rotation about, an axis of the virtual joint's frame)."""
+        out = []
+        for suffix, motion in zip(self.velocity_suffixes, self.motions):
+            axis = tuple(1 if i == motion % 3 else 0 for i in range(3))
+            out.append((suffix, "prismatic" if motion < 3 else "continuous", axis))
+        return tuple(out)
+
+    def transform(self, axis, q, pitch: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        return self.pose(np.asarray(q, dtype=float))
+
+    def pose(self, q, numbers=None) -> tuple[np.ndarray, np.ndarray]:
+        """``(R, p)``: the child frame in the joint frame at the configuration entries ``q``,
+        in the number type ``numbers`` (a :class:`~eomgen.numeric.Numbers`; None: float64).
+        A chart places it before its chain (held at zero); a joint locked at ``q`` is fixed
+        there (:func:`eomgen.model.lock_joints`)."""
+        raise NotImplementedError
+
+    def describe(self) -> tuple[str, str, str]:
+        """``(name, configuration, velocity)`` in prose with LaTeX, for documents and
+        messages."""
+        raise NotImplementedError
+
+
+class ChartKind(ChainKind):
+    """A kind whose configuration is not its coordinates (NQ > NV): in the tree a chain of
+    virtual one-axis joints held at zero, their axes the child frame's (:attr:`motions`),
+    after the pose of ``q``, its chart (module docstring)."""
+
+    #: Suffixes of the configuration entries' names (``<joint>_<suffix>``).
     configuration_suffixes: tuple[str, ...] = ()
     #: Where the kind's quaternion starts in its configuration entries (None: it has none).
     quaternion_offset: int | None = None
@@ -135,35 +177,16 @@ class ChartKind(JointKind):
     #: The prefix of the names the derivation gives the pose's entries.
     placement_prefix: str = ""
 
-    def velocity_names(self, joint: str) -> tuple[str, ...]:
-        return tuple(f"{joint}_{s}" for s in self.velocity_suffixes)
-
     def configuration_names(self, joint: str) -> tuple[str, ...]:
         return tuple(f"{joint}_{s}" for s in self.configuration_suffixes)
 
-    def chain(self) -> tuple[tuple[str, str, tuple[int, int, int]], ...]:
-        """The virtual joints of the chart: ``(suffix, "prismatic" or "continuous", axis)`` in
-        chain order (a translation along, or a rotation about, a joint-frame axis)."""
-        out = []
-        for suffix, motion in zip(self.velocity_suffixes, self.motions):
-            axis = tuple(1 if i == motion % 3 else 0 for i in range(3))
-            out.append((suffix, "prismatic" if motion < 3 else "continuous", axis))
-        return tuple(out)
-
-    def motion_subspace(self, axis=None, pitch: float = 0.0) -> np.ndarray:
+    def motion_subspace(self, axis=None, q=None, pitch: float = 0.0) -> np.ndarray:
         S = np.zeros((6, self.nv))
         for i, motion in enumerate(self.motions):
             S[motion, i] = 1.0
         return S
 
-    def transform(self, axis, q, pitch: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-        return self.pose(np.asarray(q, dtype=float))
-
     # -- the chart: the pose placed before the chain -----------------------------------------
-    def pose(self, q, numbers=None) -> tuple[np.ndarray, np.ndarray]:
-        """``(R, p)`` placed before the chain from the joint's configuration entries ``q``, in
-        the number type ``numbers`` (a :class:`~eomgen.numeric.Numbers`; None: float64)."""
-        raise NotImplementedError
 
     def placement(self, q, b, number: int) -> tuple[tuple, tuple]:
         """:meth:`pose` over SymPy: ``(R, p)`` from the configuration symbols ``q`` (NQ), the
@@ -197,9 +220,5 @@ class ChartKind(JointKind):
         unit part (a quaternion; a planar joint's ``(cos θ, sin θ)``)."""
         raise NotImplementedError
 
-    def describe(self) -> tuple[str, str, str]:
-        """``(name, configuration, velocity)`` in prose with LaTeX, for documents."""
-        raise NotImplementedError
 
-
-__all__ = ["ChartKind", "JointKind", "zeros"]
+__all__ = ["ChainKind", "ChartKind", "JointKind", "zeros"]

@@ -42,7 +42,7 @@ class Helical(JointKind):
         axis, angle = np.asarray(axis, dtype=float), float(np.ravel(q)[0])
         return rotation_about(axis, angle), axis * (pitch * angle)
 
-    def motion_subspace(self, axis, pitch: float = 0.0) -> np.ndarray:
+    def motion_subspace(self, axis, q=None, pitch: float = 0.0) -> np.ndarray:
         axis = np.asarray(axis, dtype=float)
         return np.concatenate([pitch * axis, axis]).reshape(6, 1)
 

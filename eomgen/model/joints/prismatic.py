@@ -19,7 +19,7 @@ class Prismatic(JointKind):
     def transform(self, axis, q, pitch: float = 0.0):
         return np.eye(3), np.asarray(axis, dtype=float) * float(np.ravel(q)[0])
 
-    def motion_subspace(self, axis, pitch: float = 0.0) -> np.ndarray:
+    def motion_subspace(self, axis, q=None, pitch: float = 0.0) -> np.ndarray:
         return np.concatenate([np.asarray(axis, dtype=float), np.zeros(3)]).reshape(6, 1)
 
 

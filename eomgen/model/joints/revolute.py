@@ -19,7 +19,7 @@ class Revolute(JointKind):
     def transform(self, axis, q, pitch: float = 0.0):
         return rotation_about(np.asarray(axis, dtype=float), float(np.ravel(q)[0])), np.zeros(3)
 
-    def motion_subspace(self, axis, pitch: float = 0.0) -> np.ndarray:
+    def motion_subspace(self, axis, q=None, pitch: float = 0.0) -> np.ndarray:
         return np.concatenate([np.zeros(3), np.asarray(axis, dtype=float)]).reshape(6, 1)
 
 
