@@ -17,7 +17,7 @@ import click
 
 from ..errors import AnalysisError
 from ..common.output import check_output_folder
-from ..common.progress import Progress, plural
+from ..common.progress import HEARTBEAT_SECONDS, Progress, plural
 from .handling import handle_errors
 from .loading import load_reduced, output_stem
 from .options import (description_argument, output_folder_option, quiet_option, scene_option,
@@ -87,7 +87,7 @@ def bench(description, outdir, samples, seed, repeats, batch_size, quiet, strict
     # NumPy, mpmath, Matplotlib (optional, checked above): only when the command runs
     from ..analysis.bench import prepare_bench, write_outputs
 
-    progress = Progress(quiet)
+    progress = Progress(quiet, heartbeat=HEARTBEAT_SECONDS)
     model = load_reduced(description, scene_path, strict)[0]
     plan = prepare_bench(model, samples=samples, seed=seed, batch_size=batch_size,
                          repeats=repeats, log=progress)
@@ -171,7 +171,7 @@ def simulate(description, outdir, duration, dts, rtols, names, q0, qd0, gains, s
     except ValueError as exc:
         raise AnalysisError(f"--integrators: {exc}") from None
     check_output_folder(outdir)
-    progress = Progress(quiet)
+    progress = Progress(quiet, heartbeat=HEARTBEAT_SECONDS)
     model, report = load_reduced(description, scene_path, strict)
     contacts = report.contacts if report is not None else ()
     from ..model import flexible_indices  # SymPy: only when the command runs

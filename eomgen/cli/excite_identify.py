@@ -16,7 +16,7 @@ import click
 
 from ..errors import IdentificationError, ParameterError
 from ..common.output import GeneratedFile, check_output_file, check_output_folder, write_atomically
-from ..common.progress import Progress, plural
+from ..common.progress import HEARTBEAT_SECONDS, Progress, plural
 from .handling import handle_errors
 from .loading import load_reduced, output_stem
 from .options import (description_argument, output_file_option, output_folder_option,
@@ -124,7 +124,7 @@ def excite(description, output, duration, samples, harmonics, amplitude, max_vel
     if not amplitude > 0 or not noise >= 0 or noise == float("inf"):
         raise IdentificationError("--amplitude must be positive and --noise non-negative")
     check_output_file(output)
-    progress = Progress(quiet)
+    progress = Progress(quiet, heartbeat=HEARTBEAT_SECONDS)
     model, _ = load_reduced(description, scene_path, strict)
     if positions_only and model.quaternion_joints:
         raise IdentificationError(f"{description}: --positions-only: a model with quaternion "
@@ -210,7 +210,7 @@ def identify(description, data, outdir, physical, friction, cutoff, scene_path, 
     if physical and importlib.util.find_spec("cvxpy") is None:
         raise IdentificationError("--physical needs cvxpy: pip install 'eomgen[identify]'")
     check_output_folder(outdir)
-    progress = Progress(quiet)
+    progress = Progress(quiet, heartbeat=HEARTBEAT_SECONDS)
     model, _ = load_reduced(description, scene_path, strict)
     terms = _terms(model, friction)
     progress(f"reading {data}")

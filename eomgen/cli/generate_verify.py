@@ -16,7 +16,7 @@ import click
 
 from ..errors import GenerationError, VerificationError
 from ..common.output import check_output_folder, checked_stem, python_module_name, write_atomically
-from ..common.progress import Progress, plural
+from ..common.progress import HEARTBEAT_SECONDS, Progress, plural
 from .handling import handle_errors, recorded_warnings
 from .loading import command_params, default_description, load, load_reduced
 from .options import (description_argument, output_folder_option, quiet_option, scene_option,
@@ -52,7 +52,7 @@ def verify(description, samples, seed, tolerance, scene_path, quiet, strict):
 
     if samples < 1:
         raise VerificationError(f"--samples must be at least 1, got {samples}")
-    progress = Progress(quiet)
+    progress = Progress(quiet, heartbeat=HEARTBEAT_SECONDS)
     model, _ = load_reduced(description, scene_path, strict)
     start = time.perf_counter()
     progress(f"deriving M, C, g and tau of {model.name} ({plural(model.dof, 'joint')})")
@@ -192,7 +192,7 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
     checked_stem(name)
     check_output_folder(outdir)
     functions = functions_option(outputs)
-    progress = Progress(quiet)
+    progress = Progress(quiet, heartbeat=HEARTBEAT_SECONDS)
     request = None
     if not no_cache:
         from ..cache import command_request  # start-up time (certifi): only when asked

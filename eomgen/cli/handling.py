@@ -18,7 +18,7 @@ import warnings
 import click
 
 from ..errors import EomgenError, one_line, recorded_warnings  # noqa: F401  (the CLI's)
-from ..common.progress import end_line
+from ..common.progress import end_line, stop_heartbeats
 
 
 class Terminated(KeyboardInterrupt):
@@ -56,7 +56,10 @@ def handle_errors(command):
         warnings.showwarning = show_warning
         try:
             with sigterm_raises():
-                return command(*args, **kwargs)
+                try:
+                    return command(*args, **kwargs)
+                finally:
+                    stop_heartbeats()  # no progress line once the command is over
         except EomgenError as exc:
             end_line()
             if debug:

@@ -13,7 +13,7 @@ import click
 
 from ..errors import EomgenError, GenerationError
 from ..common.output import check_output_file, check_output_folder
-from ..common.progress import Progress
+from ..common.progress import HEARTBEAT_SECONDS, Progress
 from .handling import handle_errors
 from .loading import load_reduced
 from .options import (description_argument, output_file_option, output_folder_option,
@@ -70,7 +70,7 @@ def notebook(description, output, scene_path, no_check, quiet, strict):
 
     if output is not None:
         check_output_file(output)
-    progress = Progress(quiet)
+    progress = Progress(quiet, heartbeat=HEARTBEAT_SECONDS)
     model, _ = load_reduced(description, scene_path, strict)
     path = output or Path(f"{model.name}_derivation.ipynb")
     if output is None:
@@ -116,7 +116,7 @@ def teach(description, formats, outdir, scene_path, no_check, quiet, strict):
     """
     from ..teach import parse_formats, write_handout  # SymPy: when the command runs
 
-    progress = Progress(quiet)
+    progress = Progress(quiet, heartbeat=HEARTBEAT_SECONDS)
     have_pdflatex = shutil.which("pdflatex") is not None
     if formats is None:
         chosen = ["pdf"] if have_pdflatex else ["html"]

@@ -11,6 +11,12 @@ plain callable ``progress(line)`` (library code never needs more, and defaults t
   command ends;
 * ``quiet``: nothing.
 
+A command's :class:`Progress` is made with ``heartbeat=HEARTBEAT_SECONDS``: when a stage runs
+longer than that (a derivation of a long chain, a C compile), its line is repeated with the
+time spent in it, ``eomgen: <stage> (still working, 30 s) [+42.0 s]``, so that no stretch of
+a command is silent for longer. The repeats come from a thread that
+:func:`stop_heartbeats` ends (the CLI does, when a command returns or fails).
+
 :meth:`Progress.steps` counts the steps of a loop (integrators, measurements): a click progress
 bar on a terminal, and in a log a line at each tenth of the way and for each named step.
 """
@@ -19,12 +25,25 @@ from __future__ import annotations
 
 import contextlib
 import sys
+import threading
 import time
 from typing import Callable, Iterator, TextIO
 
 
 #: The Progress whose terminal line is open (not ended by a newline), if any.
 _open: "Progress | None" = None
+
+#: Seconds a command's stage may run before its line is repeated (:class:`Progress`).
+HEARTBEAT_SECONDS = 10.0
+
+#: Progress objects whose heartbeat thread runs.
+_beating: "set[Progress]" = set()
+
+
+def stop_heartbeats() -> None:
+    """End every heartbeat thread (:class:`Progress`); the CLI calls it when a command ends."""
+    for progress in list(_beating):
+        progress.stop()
 
 
 def end_line() -> None:
@@ -56,16 +75,25 @@ class Progress:
         Whether ``stream`` is a terminal (default: ``stream.isatty()``).
     clock:
         Seconds, for the elapsed times (default: :func:`time.monotonic`).
+    heartbeat:
+        Repeat a stage's line when it has run this many seconds without a new one (module
+        docstring); None: never.
     """
 
     def __init__(self, quiet: bool = False, stream: TextIO | None = None,
-                 tty: bool | None = None, clock: Callable[[], float] = time.monotonic):
+                 tty: bool | None = None, clock: Callable[[], float] = time.monotonic,
+                 heartbeat: float | None = None):
         self.quiet = quiet
         self._stream = stream
         self._tty = tty
         self._clock = clock
         self._start = clock()
         self._pending = False  # a terminal line not yet cleared
+        self._heartbeat = heartbeat
+        self._lock = threading.Lock()
+        self._stage: tuple[str, float] | None = None  # the last stage and when it began
+        self._shown = 0.0  # when a line was last written
+        self._stopped: threading.Event | None = None
 
     @property
     def stream(self) -> TextIO:
@@ -88,6 +116,16 @@ class Progress:
         """Report a stage (``line`` without the ``eomgen:`` prefix)."""
         if self.quiet:
             return
+        with self._lock:
+            self._stage = (line, self._clock())
+            self._write(line)
+        if self._heartbeat is not None and self._stopped is None:
+            self._stopped = threading.Event()
+            _beating.add(self)
+            threading.Thread(target=self._beat, args=(self._stopped,), daemon=True,
+                             name="eomgen-progress").start()
+
+    def _write(self, line: str) -> None:
         if self.tty:
             global _open
             self.stream.write(f"\r\x1b[Keomgen: {line}")
@@ -96,17 +134,45 @@ class Progress:
         else:
             self.stream.write(f"eomgen: {line} [+{self.elapsed():.1f} s]\n")
         self.stream.flush()
+        self._shown = self._clock()
+
+    def _beat(self, stopped: threading.Event) -> None:
+        """The heartbeat thread: repeat the stage's line when none was written for
+        ``heartbeat`` seconds, until :meth:`stop`."""
+        interval = self._heartbeat
+        while not stopped.wait(min(interval / 4, 1.0)):
+            with self._lock:
+                now = self._clock()
+                if stopped.is_set() or self._stage is None or now - self._shown < interval:
+                    continue
+                line, began = self._stage
+                try:
+                    self._write(f"{line} (still working, {now - began:.0f} s)")
+                except (OSError, ValueError):  # the stream closed under us: nothing to say
+                    return
+
+    def stop(self) -> None:
+        """End the heartbeat thread, if one runs (the next stage starts it again)."""
+        stopped, self._stopped = self._stopped, None
+        _beating.discard(self)
+        if stopped is not None:
+            stopped.set()
 
     def note(self, line: str) -> None:
         """A line that stays on a terminal too (e.g. a fallback taken), unless ``quiet``."""
         if self.quiet:
             return
-        self.clear()
-        self.stream.write(f"eomgen: {line}\n")
-        self.stream.flush()
+        with self._lock:
+            if self._pending:
+                self.stream.write("\r\x1b[K")
+                self._pending = False
+            self.stream.write(f"eomgen: {line}\n")
+            self.stream.flush()
+            self._shown = self._clock()
 
     def clear(self) -> None:
-        """End the updating terminal line (before printing results)."""
+        """End the updating terminal line (before printing results) and the heartbeat."""
+        self.stop()
         if self._pending:
             self.stream.write("\r\x1b[K")
             self.stream.flush()

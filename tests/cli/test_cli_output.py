@@ -295,6 +295,73 @@ def test_a_warning_or_error_after_a_terminal_line_starts_a_new_line():
     assert stream.getvalue().endswith("compiling\n")  # nothing left to clear
 
 
+class _Clock:
+    """A clock the test moves (seconds)."""
+
+    def __init__(self):
+        self.now = 0.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def _wait_for(condition, seconds: float = 10.0) -> None:
+    import time
+
+    deadline = time.monotonic() + seconds
+    while not condition() and time.monotonic() < deadline:
+        time.sleep(0.01)
+
+
+def test_a_long_stage_is_repeated_with_its_time_until_the_next():
+    """Issue 40: no stretch of a command is silent for longer than the heartbeat (10 s in the
+    CLI): a stage that runs on is repeated with the time spent in it; a new stage, ``clear``
+    (the results) and ``quiet`` end the repeats."""
+    stream, clock = io.StringIO(), _Clock()
+    progress = Progress(stream=stream, tty=False, clock=clock, heartbeat=10.0)
+    progress("deriving M of a long chain")
+    clock.now = 9.0
+    import time
+    time.sleep(0.5)  # the thread looks several times: under 10 s, nothing yet
+    assert stream.getvalue().count("\n") == 1
+    clock.now = 25.0
+    _wait_for(lambda: stream.getvalue().count("\n") >= 2)
+    clock.now = 26.0
+    progress("compiling")
+    progress.clear()
+    clock.now = 100.0
+    time.sleep(0.5)  # the thread would have had its chance
+    assert stream.getvalue().splitlines() == [
+        "eomgen: deriving M of a long chain [+0.0 s]",
+        "eomgen: deriving M of a long chain (still working, 25 s) [+25.0 s]",
+        "eomgen: compiling [+26.0 s]"]
+    quiet = io.StringIO()
+    silent = Progress(quiet=True, stream=quiet, tty=False, clock=clock, heartbeat=0.01)
+    silent("deriving")
+    time.sleep(0.1)
+    assert quiet.getvalue() == ""
+
+
+def test_the_cli_stops_the_heartbeat_when_the_command_ends(monkeypatch, tmp_path):
+    """Through the CLI with a heartbeat of 0.05 s: repeated stage lines while it works, and
+    none once the command has returned (the thread would write into whatever stderr is
+    then)."""
+    import threading
+    import time
+
+    from eomgen.common import progress as progress_module
+
+    monkeypatch.setattr(progress_module, "HEARTBEAT_SECONDS", 0.05)
+    from eomgen.cli import generate_verify
+
+    monkeypatch.setattr(generate_verify, "HEARTBEAT_SECONDS", 0.05)
+    done = run_in_process("verify", "elbow_rrr", "--samples", "3")
+    assert done.returncode == 0, done.stderr
+    assert "(still working, " in done.stderr, done.stderr
+    time.sleep(0.2)
+    assert not [t for t in threading.enumerate() if t.name == "eomgen-progress"]
+
+
 def test_plural():
     assert [plural(n, "joint") for n in (0, 1, 2)] == ["0 joints", "1 joint", "2 joints"]
 
