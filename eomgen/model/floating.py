@@ -85,9 +85,10 @@ import numpy as np
 from ..errors import InvalidInertiaError, KinematicTreeError, ParameterError
 from .bodies import InertialParameters
 # integrate, difference, neutral and q̇ of any model with quaternion joints: without a model,
-# the free flyer's layout (q[0:7], v[0:6]) and no ball joint.
-from .configuration import configuration_rate, difference, integrate, neutral
-from .joints.lie import matrix_quaternion, quaternion_matrix
+# the free flyer's layout (q[0:7], v[0:6]) and no ball joint; importable here, as the quaternion
+# maps are.
+from .configuration import configuration_rate, difference, integrate, neutral  # noqa: F401
+from .joints.lie import matrix_quaternion, quaternion_matrix  # noqa: F401
 from .notices import NoticeKind
 from .parts import Joint, JointType, Link
 from .quaternion import FREE_FLYER_CONFIGURATION, FREE_FLYER_VELOCITY
