@@ -6,7 +6,7 @@
 
 Prints, for the floating-base solo12 and Talos (legs only, everything else locked at 0), the
 largest relative difference over random states between eomgen and Pinocchio's free flyer
-(its own URDF reader; M, C q̇, g mapped to Euler coordinates, eomgen.floating) of:
+(its own URDF reader; M, C q̇, g mapped to Euler coordinates, eomgen.numeric.floating_base) of:
 
 * M, C q̇, g from eomgen's numeric Newton–Euler and from the derived (symbolic) program;
 * constrained q̈ and F_c (eomgen.numeric.contacts) against ``pinocchio.constraintDynamics`` with 4
@@ -49,7 +49,9 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 import eomgen  # noqa: E402
 from support import erd_robots_dir  # noqa: E402
-from eomgen import floating, numeric  # noqa: E402
+from eomgen import numeric  # noqa: E402
+from eomgen.model import floating  # noqa: E402
+from eomgen.numeric import floating_base  # noqa: E402
 from eomgen.numeric.contacts import Contact, ContactDynamics  # noqa: E402
 from eomgen.reduction import apply_scene  # noqa: E402
 from eomgen.scene import load_scene  # noqa: E402
@@ -109,7 +111,7 @@ def dynamics_agreement(name, model, ref, count, derived=True):
 def contact_agreement(path, model, count):
     import pinocchio as pin
 
-    ref = floating.PinocchioFreeFlyer(path, model.joint_names)
+    ref = floating_base.PinocchioFreeFlyer(path, model.joint_names)
     pm, pd, idx = ref.model, ref.data, ref.idx
     ok = True
     for kind, feet, ctype, frame in (("point", FEET, pin.ContactType.CONTACT_3D,
@@ -129,12 +131,12 @@ def contact_agreement(path, model, count):
             tau = rng.uniform(-2, 2, 18)
             qdd, F = cd.constrained_forward_dynamics(q, qd, tau)
             q_pin, v = ref.state(q, qd)
-            T = floating.velocity_map(q)
+            T = floating_base.velocity_map(q)
             a = pin.constraintDynamics(pm, pd, q_pin, v, np.linalg.solve(T.T, tau)[idx],
                                        models, datas, pin.ProximalSettings(1e-14, 1e-12, 1))
             a_ours = np.empty(18)
             a_ours[idx] = a
-            qdd_pin = np.linalg.solve(T, a_ours - floating.velocity_map_dot_qd(q, qd))
+            qdd_pin = np.linalg.solve(T, a_ours - floating_base.velocity_map_dot_qd(q, qd))
             worst = [max(worst[0], rel(qdd, qdd_pin)), max(worst[1], rel(F, pd.lambda_c))]
         print(f"solo12 {len(feet)} {kind} contact(s) vs constraintDynamics: q̈ {worst[0]:.1e}, "
               f"F_c {worst[1]:.1e}")
@@ -197,7 +199,7 @@ def generated_contacts(solo_path) -> bool:
         spec.loader.exec_module(fast)
         print(f"CasADi constrained_forward_dynamics: {sx.n_instructions()} SX instructions "
               "(M, C q̇ + g, J_c, J̇_c q̇ and the Cholesky-Schur KKT solve)")
-        ref = floating.PinocchioFreeFlyer(solo_path, model.joint_names)
+        ref = floating_base.PinocchioFreeFlyer(solo_path, model.joint_names)
         pm, pd, idx = ref.model, ref.data, ref.idx
         models = pin.StdVec_RigidConstraintModel()
         for c in model.contacts:
@@ -211,7 +213,7 @@ def generated_contacts(solo_path) -> bool:
         (q, qd), = states(18, 1, 7)
         tau = np.random.default_rng(8).uniform(-2, 2, 18)
         q_pin, v = ref.state(q, qd)
-        T = floating.velocity_map(q)
+        T = floating_base.velocity_map(q)
         tau_pin = np.linalg.solve(T.T, tau)[idx]
         n_in = f.n_in()
         args = [np.array(q), np.array(qd), np.array(tau)] + [np.zeros(1)] * (n_in - 3)
@@ -225,7 +227,7 @@ def generated_contacts(solo_path) -> bool:
         a = pin.constraintDynamics(pm, pd, q_pin, v, tau_ff := tau_pin, models, datas, settings)
         a_ours = np.empty(18)
         a_ours[idx] = a
-        qdd_pin = np.linalg.solve(T, a_ours - floating.velocity_map_dot_qd(q, qd))
+        qdd_pin = np.linalg.solve(T, a_ours - floating_base.velocity_map_dot_qd(q, qd))
         agree = max(rel(qdd, qdd_pin), rel(F, pd.lambda_c))
         print(f"compiled constrained_forward_dynamics vs constraintDynamics: {agree:.1e} "
               "(largest relative difference of q̈, F_c)")
@@ -274,7 +276,7 @@ def main() -> int:
         return 0 if generated_contacts(solo_path) else 2
     solo = floating.add_floating_base(load(solo_path))
     ok = dynamics_agreement("solo12", solo,
-                            floating.PinocchioFreeFlyer(solo_path, solo.joint_names), count)
+                            floating_base.PinocchioFreeFlyer(solo_path, solo.joint_names), count)
     talos_path = robots / "talos_data/robots/talos_reduced.urdf"
     talos = load(talos_path)
     scene = load_scene("legs.yaml", text="version: 1\nfloating_base: euler\n"
@@ -282,7 +284,7 @@ def main() -> int:
     legs = apply_scene(talos, scene).model
     locked = [j.name for j in talos.movable_joints if j.name not in legs.joint_names]
     ok &= dynamics_agreement("talos legs", legs,
-                             floating.PinocchioFreeFlyer(talos_path, legs.joint_names, locked),
+                             floating_base.PinocchioFreeFlyer(talos_path, legs.joint_names, locked),
                              count)
     start = time.perf_counter()
     derive_frames(solo, FEET)

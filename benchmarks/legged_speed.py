@@ -42,7 +42,7 @@ import eomgen  # noqa: E402
 from codegen_speed import erd_robots_dir  # noqa: E402
 from eomgen.codegen.generate import render_files  # noqa: E402
 from eomgen.codegen.functions import select_functions  # noqa: E402
-from eomgen.free_flyer import add_free_flyer  # noqa: E402
+from eomgen.model.floating import add_free_flyer  # noqa: E402
 from fair_speed import spread, timed  # noqa: E402
 
 SOLO = "solo_description/robots/solo12.urdf"

@@ -12,19 +12,35 @@ new place (docs/architecture.md lays the layers out).
  ``eomgen.contacts``             :mod:`eomgen.numeric.contacts`
  ``eomgen.display``              :mod:`eomgen.present.display`
  ``eomgen.expressions``          :mod:`eomgen.model.expressions`
+ ``eomgen.floating``             :mod:`eomgen.numeric.floating_base`
+ ``eomgen.free_flyer``           :mod:`eomgen.model.floating`
  ``eomgen.lambdify``             :mod:`eomgen.codegen.lambdify`
  ``eomgen.loops``                :mod:`eomgen.numeric.loops`
  ``eomgen.notebook``             :mod:`eomgen.teach.notebook`
  ``eomgen.output``               :mod:`eomgen.common.output`
  ``eomgen.progress``             :mod:`eomgen.common.progress`
  ``eomgen.quaternion_joints``    :mod:`eomgen.model.configuration`
+ ``eomgen.reduction.cost``       :mod:`eomgen.codegen.derivation_cost`
  ``eomgen.reprs``                :mod:`eomgen.common.reprs`
  ``eomgen.templating``           :mod:`eomgen.common.templating`
 =============================  =====================================
 
 ``import eomgen.quaternion_joints`` (or ``from eomgen.quaternion_joints import integrate``)
 emits one :class:`DeprecationWarning` naming the new path and :data:`REMOVED_IN`, and binds the
-new module under the old name: its functions and classes are the same objects.
+new module under the old name: its functions and classes are the same objects. The new module
+offers every public name of the old one (``eomgen.numeric.floating_base`` offers
+``add_floating_base``, ``EULER_JOINTS`` and ``WORLD`` of the model layer with its own maps).
+
+Names that left a module which stays (:data:`MOVED_NAMES`) are looked up by that module's
+``__getattr__`` through :func:`moved_name`, with the same warning:
+
+================================================  =====================================
+ old name                                           new place
+================================================  =====================================
+ ``eomgen.reduction.derivation_cost``               :mod:`eomgen.codegen.derivation_cost`
+ ``eomgen.reduction.measure_derivation``            :mod:`eomgen.codegen.derivation_cost`
+ ``eomgen.reduction.MEASURE_TIMEOUT``               :mod:`eomgen.codegen.derivation_cost`
+================================================  =====================================
 """
 
 from __future__ import annotations
@@ -48,15 +64,41 @@ MOVED: dict[str, str] = {
     "eomgen.contacts": "eomgen.numeric.contacts",
     "eomgen.display": "eomgen.present.display",
     "eomgen.expressions": "eomgen.model.expressions",
+    "eomgen.floating": "eomgen.numeric.floating_base",
+    "eomgen.free_flyer": "eomgen.model.floating",
     "eomgen.lambdify": "eomgen.codegen.lambdify",
     "eomgen.loops": "eomgen.numeric.loops",
     "eomgen.notebook": "eomgen.teach.notebook",
     "eomgen.output": "eomgen.common.output",
     "eomgen.progress": "eomgen.common.progress",
     "eomgen.quaternion_joints": "eomgen.model.configuration",
+    "eomgen.reduction.cost": "eomgen.codegen.derivation_cost",
     "eomgen.reprs": "eomgen.common.reprs",
     "eomgen.templating": "eomgen.common.templating",
 }
+
+#: Module that stays → {name that left it: the module it went to}.
+MOVED_NAMES: dict[str, dict[str, str]] = {
+    "eomgen.reduction": {
+        "derivation_cost": "eomgen.codegen.derivation_cost",
+        "measure_derivation": "eomgen.codegen.derivation_cost",
+        "MEASURE_TIMEOUT": "eomgen.codegen.derivation_cost",
+    },
+}
+
+
+def moved_name(module: str, name: str):
+    """``module``'s ``__getattr__``: a name of :data:`MOVED_NAMES` warns and is taken from its
+    new module, then bound in ``module`` (so it warns once, as an old module path does); any
+    other name is missing (:class:`AttributeError`)."""
+    new = MOVED_NAMES.get(module, {}).get(name)
+    if new is None:
+        raise AttributeError(f"module {module!r} has no attribute {name!r}")
+    warnings.warn(f"{module}.{name} moved to {new}; the old path goes in eomgen {REMOVED_IN}",
+                  DeprecationWarning, stacklevel=3)
+    value = getattr(importlib.import_module(new), name)
+    setattr(sys.modules[module], name, value)
+    return value
 
 
 class MovedModules(importlib.abc.MetaPathFinder, importlib.abc.Loader):
@@ -85,4 +127,4 @@ def install() -> None:
         sys.meta_path.append(MovedModules())
 
 
-__all__ = ["MOVED", "MovedModules", "REMOVED_IN", "install"]
+__all__ = ["MOVED", "MOVED_NAMES", "MovedModules", "REMOVED_IN", "install", "moved_name"]

@@ -19,16 +19,10 @@ from ..dynamics import derive
 from ..model import RobotModel
 from ..common.output import checked_stem
 from ..common.progress import plural
-from ..reduction import (
-    MEASURE_TIMEOUT,
-    DerivationCost,
-    ReductionReport,
-    apply_scene,
-    derivation_cost,
-    measure_derivation,
-)
+from ..reduction import DerivationCost, ReductionReport, apply_scene
 from ..scene import Scene
 from ..common.output import GeneratedFile
+from .derivation_cost import MEASURE_TIMEOUT, derivation_cost, measure_derivation
 from .job import make_job
 from .functions import derived_outputs
 from .generate import (
@@ -66,7 +60,7 @@ def render_scene_files(model: RobotModel, scene: Scene | None, backends: Sequenc
     files (default: the robot's name).
 
     With ``explain``, the whole description and the reduced model are both derived again, each
-    in a fresh process (:func:`~eomgen.reduction.measure_derivation`, at most ``timeout``
+    in a fresh process (:func:`~.derivation_cost.measure_derivation`, at most ``timeout``
     seconds), so that the report compares like with like; otherwise the report gives the cost
     of the derivation made for the files.
     """

@@ -7,7 +7,7 @@ layout): a free flyer moves along the SE(3) exponential of its twist (root frame
 along the SO(3) exponential of its angular velocity (child frame), ``R(t) = R exp([ω t]×)``, the
 other joints by ``q + v t``. Every function takes the model (or its
 :attr:`~eomgen.model.RobotModel.quaternion_joints`) as ``model``; without it ``q`` is taken to
-start with a free flyer and to hold no other quaternion joint (:mod:`eomgen.free_flyer`).
+start with a free flyer and to hold no other quaternion joint (:mod:`eomgen.model.floating`).
 
 **Non-unit quaternions** on input: every generated function and these ones use the normalised
 quaternion (any nonzero multiple of a unit quaternion gives the same result; a zero quaternion

@@ -67,7 +67,7 @@ class RobotModel:
     #: Frame kinematics are given in the description's frame.
     root_pose: Transform | None = None
     #: True when the first six movable joints are a quaternion free flyer's velocity
-    #: coordinates (:mod:`eomgen.free_flyer`): the configuration ``q`` then has ``dof + 1``
+    #: coordinates (:mod:`eomgen.model.floating`): the configuration ``q`` then has ``dof + 1``
     #: entries (root position, unit quaternion), the velocity ``v`` has ``dof``.
     free_flyer: bool = False
     #: ``(kind, name)`` of each joint that is a chart of virtual joints in the tree (a ball

@@ -90,7 +90,7 @@ class ContactDynamics:
     Attributes
     ----------
     model:
-        The robot (a floating one from :func:`eomgen.floating.add_floating_base`, or not).
+        The robot (a floating one from :func:`eomgen.model.floating.add_floating_base`, or not).
     contacts:
         The contacts, in the order of the rows of ``J_c`` and of ``F_c``.
     anchors:

@@ -1,10 +1,28 @@
 """Floating-base coordinates, numerically: ZYX Euler angles of the base and the map to and from
 Pinocchio's free flyer (quaternion position, body-frame velocity), in NumPy.
 
-The coordinates are those :func:`eomgen.floating.add_floating_base` gives a robot (its module
-docstring has the conventions and the formulas): ``q[0:3]`` the root origin in the world,
-``q[3:6]`` yaw, pitch, roll. These functions need no Pinocchio; the adapter to a Pinocchio model
-is :class:`eomgen.numeric.pinocchio.PinocchioFreeFlyer`.
+The coordinates are those :func:`eomgen.model.floating.add_floating_base` gives a robot (its
+module docstring has the layout): ``q[0:3]`` the root origin in the world, ``q[3:6]`` yaw ψ,
+pitch θ, roll φ, the root's rotation ``R = Rz(ψ) Ry(θ) Rx(φ)``. These functions need no
+Pinocchio; :class:`PinocchioFreeFlyer` evaluates a Pinocchio model in these coordinates.
+
+**The singularity.** The map from Euler rates to the body angular velocity,
+``ω_b = E(θ, φ) [ψ̇, θ̇, φ̇]`` (:func:`euler_rate_matrix`), has ``det E = −cos θ``: at pitch
+θ = ±π/2 the yaw and roll axes line up (gimbal lock), a rotation about the lost axis has no
+Euler rates, and the mass matrix in these coordinates is singular. :func:`euler_singularity`
+measures ``|cos θ|`` and :func:`check_euler` refuses states closer than a tolerance; keep the
+trunk's pitch well inside (−π/2, π/2) (a walking or standing robot does).
+
+**Pinocchio's free flyer** (``JointModelFreeFlyer``) uses ``q = [p, quaternion (x, y, z, w)]``
+(nq = 7) and ``v = [Rᵀ ṗ, ω_b]`` (nv = 6): the linear velocity of the root origin and the
+angular velocity, both in the *root link* frame. With ``T(q)`` the block-diagonal
+``diag(Rᵀ, E(θ, φ), 1)`` (:func:`velocity_map`), ``v = T q̇`` and, because generalised
+forces map by the transpose (virtual work),
+
+    M = Tᵀ M_pin T,    C q̇ = Tᵀ (h_pin(q, v) + M_pin Ṫ q̇),    g = Tᵀ g_pin,
+
+where ``h_pin = C_pin v`` (:func:`dynamics_from_free_flyer`). :func:`to_free_flyer` and
+:func:`from_free_flyer` convert states both ways.
 
 >>> q = np.array([0.1, 0.2, 0.3, 0.4, -0.5, 0.6])
 >>> qp, v = to_free_flyer(q, np.arange(6.0))
@@ -18,12 +36,20 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.joints.lie import matrix_quaternion, quaternion_matrix  # importable here too
+# The model operations its old path offered with these maps (eomgen.moved points it here).
+from ..model.floating import (  # noqa: F401
+    EULER_JOINTS,
+    WORLD,
+    add_floating_base,
+    check_spatial_inertia,
+    virtual_chain,
+)
 
 __all__ = [
     "SINGULARITY_TOLERANCE", "EulerSingularityError", "base_rotation", "euler_angles",
     "euler_rate_matrix", "euler_singularity", "check_euler", "velocity_map",
     "velocity_map_dot_qd", "to_free_flyer", "from_free_flyer", "dynamics_from_free_flyer",
-    "matrix_quaternion", "quaternion_matrix",
+    "matrix_quaternion", "quaternion_matrix", "PinocchioFreeFlyer",
 ]
 
 #: :func:`check_euler` refuses states with ``|cos θ|`` below this.
@@ -180,3 +206,66 @@ def dynamics_from_free_flyer(q, qd, M_pin, h_pin, g_pin):
     M_pin = np.asarray(M_pin, dtype=float)
     return (T.T @ M_pin @ T, T.T @ (np.asarray(h_pin) + M_pin @ velocity_map_dot_qd(q, qd)),
             T.T @ np.asarray(g_pin))
+
+
+class PinocchioFreeFlyer:
+    """Pinocchio's free-flyer model of a URDF (its own reader, ``JointModelFreeFlyer``),
+    evaluated in eomgen's Euler coordinates: for interoperation and as a reference.
+
+    Pinocchio is optional; it is imported when an instance is made.
+
+    Parameters
+    ----------
+    urdf:
+        The URDF file.
+    joint_names:
+        The floating eomgen model's ``joint_names`` (virtual joints first): the order of
+        eomgen's q.
+    locked:
+        Joints Pinocchio locks at 0 (``buildReducedModel``), as a scene locks them.
+
+    Attributes
+    ----------
+    model, data:
+        ``pinocchio.Model`` and ``pinocchio.Data``.
+    idx:
+        (n,) ints: Pinocchio's velocity coordinate k is eomgen's ``idx[k]``.
+    """
+
+    def __init__(self, urdf, joint_names, locked=()):
+        import pinocchio as pin  # optional dependency: imported when an instance is made
+
+        self.pin = pin
+        model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
+        if locked:
+            ids = [model.getJointId(name) for name in locked]
+            model = pin.buildReducedModel(model, ids, pin.neutral(model))
+        self.model, self.data = model, model.createData()
+        names = list(model.names)[2:]  # after 'universe' and the free flyer
+        if sorted(names) != sorted(joint_names[6:]):
+            raise ValueError("Pinocchio's joints are not the model's: "
+                             f"{sorted(set(names) ^ set(joint_names[6:]))}")
+        self.idx = np.array(list(range(6)) + [joint_names.index(n) for n in names])
+
+    def state(self, q, qd):
+        """Pinocchio's ``(q, v)`` (its joint order) of eomgen's Euler state."""
+        q = np.asarray(q, dtype=float)
+        q_ff, v = to_free_flyer(q, qd)
+        q_pin = np.concatenate([q_ff[:7], q[self.idx[6:]]])
+        return q_pin, v[self.idx]
+
+    def dynamics(self, q, qd):
+        """Pinocchio's M, C q̇, g mapped to Euler coordinates (:func:`dynamics_from_free_flyer`),
+        eomgen's order."""
+        pin = self.pin
+        q_pin, v = self.state(q, qd)
+        n = len(q)
+        M = pin.crba(self.model, self.data, q_pin)
+        M = np.triu(M) + np.triu(M, 1).T
+        g = pin.computeGeneralizedGravity(self.model, self.data, q_pin)
+        h = pin.rnea(self.model, self.data, q_pin, v, np.zeros(n)) - g
+        M_o = np.empty((n, n))
+        M_o[np.ix_(self.idx, self.idx)] = M
+        h_o, g_o = np.empty(n), np.empty(n)
+        h_o[self.idx], g_o[self.idx] = h, g
+        return dynamics_from_free_flyer(q, qd, M_o, h_o, g_o)

@@ -3,8 +3,8 @@
 * :func:`to_pinocchio` builds a ``pinocchio.Model`` from a :class:`~eomgen.model.RobotModel`,
   joint by joint (:class:`PinocchioModel`, in eomgen's joint order), and :func:`plain_calls`
   gives its dynamics as a user would call them (the benchmark's Pinocchio route).
-* :class:`PinocchioFreeFlyer` reads a URDF with Pinocchio's own free flyer and evaluates it in
-  eomgen's Euler coordinates (:mod:`eomgen.numeric.floating_base`).
+* :class:`~eomgen.numeric.floating_base.PinocchioFreeFlyer` (importable here too) reads a URDF
+  with Pinocchio's own free flyer and evaluates it in eomgen's Euler coordinates.
 
 Building from the model rather than from URDF text means every input eomgen reads (URDF, DH
 tables, eomgen YAML, scenes, locked joints) gets the same Pinocchio model, and a continuous
@@ -36,10 +36,11 @@ import numpy as np
 
 from ..model import RobotModel, coupling_map, uncoupled
 from ..model.joints import FREE_FLYER
-from .floating_base import dynamics_from_free_flyer, to_free_flyer
+# PinocchioFreeFlyer lives with the Euler maps it uses; importable here too.
+from .floating_base import PinocchioFreeFlyer  # noqa: F401
 from .model import configuration_map
 
-__all__ = ["PinocchioModel", "to_pinocchio", "plain_calls", "PinocchioFreeFlyer", "pinocchio_name"]
+__all__ = ["PinocchioModel", "to_pinocchio", "plain_calls", "pinocchio_name"]
 
 
 def _floats(v) -> np.ndarray:
@@ -218,66 +219,3 @@ def plain_calls(pm: PinocchioModel, n: int):
     return (pm.rnea, pm.crba,
             f"pinocchio {pin.__version__}: pin.rnea and pin.crba with the joints "
             "reordered to eomgen's order (a conversion a user of this model needs)")
-
-
-class PinocchioFreeFlyer:
-    """Pinocchio's free-flyer model of a URDF (its own reader, ``JointModelFreeFlyer``),
-    evaluated in eomgen's Euler coordinates: for interoperation and as a reference.
-
-    Pinocchio is optional; it is imported when an instance is made.
-
-    Parameters
-    ----------
-    urdf:
-        The URDF file.
-    joint_names:
-        The floating eomgen model's ``joint_names`` (virtual joints first): the order of
-        eomgen's q.
-    locked:
-        Joints Pinocchio locks at 0 (``buildReducedModel``), as a scene locks them.
-
-    Attributes
-    ----------
-    model, data:
-        ``pinocchio.Model`` and ``pinocchio.Data``.
-    idx:
-        (n,) ints: Pinocchio's velocity coordinate k is eomgen's ``idx[k]``.
-    """
-
-    def __init__(self, urdf, joint_names, locked=()):
-        import pinocchio as pin  # optional dependency: imported when an instance is made
-
-        self.pin = pin
-        model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
-        if locked:
-            ids = [model.getJointId(name) for name in locked]
-            model = pin.buildReducedModel(model, ids, pin.neutral(model))
-        self.model, self.data = model, model.createData()
-        names = list(model.names)[2:]  # after 'universe' and the free flyer
-        if sorted(names) != sorted(joint_names[6:]):
-            raise ValueError("Pinocchio's joints are not the model's: "
-                             f"{sorted(set(names) ^ set(joint_names[6:]))}")
-        self.idx = np.array(list(range(6)) + [joint_names.index(n) for n in names])
-
-    def state(self, q, qd):
-        """Pinocchio's ``(q, v)`` (its joint order) of eomgen's Euler state."""
-        q = np.asarray(q, dtype=float)
-        q_ff, v = to_free_flyer(q, qd)
-        q_pin = np.concatenate([q_ff[:7], q[self.idx[6:]]])
-        return q_pin, v[self.idx]
-
-    def dynamics(self, q, qd):
-        """Pinocchio's M, C q̇, g mapped to Euler coordinates (:func:`dynamics_from_free_flyer`),
-        eomgen's order."""
-        pin = self.pin
-        q_pin, v = self.state(q, qd)
-        n = len(q)
-        M = pin.crba(self.model, self.data, q_pin)
-        M = np.triu(M) + np.triu(M, 1).T
-        g = pin.computeGeneralizedGravity(self.model, self.data, q_pin)
-        h = pin.rnea(self.model, self.data, q_pin, v, np.zeros(n)) - g
-        M_o = np.empty((n, n))
-        M_o[np.ix_(self.idx, self.idx)] = M
-        h_o, g_o = np.empty(n), np.empty(n)
-        h_o[self.idx], g_o[self.idx] = h, g
-        return dynamics_from_free_flyer(q, qd, M_o, h_o, g_o)

@@ -35,7 +35,7 @@ Decisions
   (ROS, Pinocchio) requires; a point mass is written with zero moments of inertia. A missing
   ``<inertia>`` is more often an authoring slip than a deliberate point mass.
 * A ``floating`` joint from a massless root link with nothing else attached is read as the
-  quaternion free flyer (:func:`eomgen.free_flyer.add_free_flyer` with the joint's origin, as
+  quaternion free flyer (:func:`eomgen.model.floating.add_free_flyer` with the joint's origin, as
   Pinocchio reads it); any other ``floating`` joint raises
   :class:`~eomgen.errors.UnsupportedError`.
 * A ``planar`` joint is Pinocchio's ``JointModelPlanar`` (:mod:`eomgen.model.joints.planar`):
@@ -122,7 +122,7 @@ from ..model import (
     scalar,
     vec3,
 )
-from ..free_flyer import add_free_flyer
+from ..model.floating import add_free_flyer
 from .registry import register
 from .legged import floating_base_notice
 
@@ -408,7 +408,7 @@ def _read_joint(element: ET.Element, index: int, source: str) -> tuple[Joint, Co
 def _read_floating_joint(element: ET.Element, index: int, source: str, document: ET.Element,
                          found: Joint | None) -> Joint:
     """A ``floating`` joint, read as the robot's quaternion free flyer
-    (:mod:`eomgen.free_flyer`, Pinocchio's reading) when it joins a massless root link with
+    (:mod:`eomgen.model.floating`, Pinocchio's reading) when it joins a massless root link with
     nothing else attached to the robot: returned as a fixed joint whose origin places the
     free flyer and whose parent is the root link to leave out. Anywhere else it is refused."""
     name = _required_name(element, source, f"<joint> number {index}")

@@ -43,8 +43,8 @@ snapped to an exact zero (as :data:`eomgen.model.SNAP_TOLERANCE` does for parsed
 
 One module a concept, all importable from here: :mod:`~eomgen.reduction.apply` (the steps above),
 :mod:`~eomgen.reduction.report` (the report), :mod:`~eomgen.reduction.inertia` (exact merged
-inertial data), :mod:`~eomgen.reduction.planar` (planar motion) and
-:mod:`~eomgen.reduction.cost` (what a derivation costs, measured in a subprocess).
+inertial data) and :mod:`~eomgen.reduction.planar` (planar motion). What a derivation costs
+is measured above the derivation, in :mod:`eomgen.codegen.derivation_cost`.
 
 Examples
 --------
@@ -59,8 +59,8 @@ Examples
 
 from __future__ import annotations
 
+from ..moved import moved_name
 from .apply import SCENE_WORLD, apply_scene, load_for_scene
-from .cost import MEASURE_TIMEOUT, derivation_cost, measure_derivation
 from .inertia import ROUNDOFF
 from .planar import PlanarMotion, planar_motion
 from .report import (DerivationCost, LockedJoint, MergedBody, ModelSize, Reduction,
@@ -68,6 +68,11 @@ from .report import (DerivationCost, LockedJoint, MergedBody, ModelSize, Reducti
 
 __all__ = [
     "apply_scene", "load_for_scene", "SCENE_WORLD", "Reduction", "ReductionReport", "ModelSize",
-    "LockedJoint", "MergedBody", "PlanarMotion", "planar_motion", "DerivationCost",
-    "derivation_cost", "measure_derivation", "MEASURE_TIMEOUT", "ROUNDOFF",
+    "LockedJoint", "MergedBody", "PlanarMotion", "planar_motion", "DerivationCost", "ROUNDOFF",
 ]
+
+
+def __getattr__(name: str):
+    """The names that moved from here (derivation_cost, ...): a warning, then the object at its
+    new place (:data:`eomgen.moved.MOVED_NAMES`)."""
+    return moved_name(__name__, name)

@@ -10,8 +10,7 @@ import sympy as sp
 
 from ..model.bodies import attach_fixed_links
 from ..errors import DescriptionError
-from ..floating import EULER_JOINTS, add_floating_base
-from ..free_flyer import VELOCITY_NAMES, add_free_flyer
+from ..model.floating import EULER_JOINTS, VELOCITY_NAMES, add_floating_base, add_free_flyer
 from ..model import (
     Actuator,
     Joint,
@@ -87,12 +86,12 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
         notes.append(f"the root link '{model.joints[5].child}' floats: a free flyer (q: "
                      "position and quaternion x, y, z, w; v: the root twist "
                      f"{', '.join(VELOCITY_NAMES)}) from the fixed link '{model.root}' (see "
-                     "eomgen.free_flyer)")
+                     "eomgen.model.floating)")
     elif scene.floating_base:
         model = _float(model, scene, add_floating_base)
         notes.append(f"the root link '{model.joints[5].child}' floats: six virtual joints "
                      f"{', '.join(EULER_JOINTS)} (position, ZYX Euler angles) from the fixed "
-                     f"link '{model.root}' (see eomgen.floating)")
+                     f"link '{model.root}' (see eomgen.model.floating)")
     _check_names(model, scene, payloads)
     model = _with_scene_couplings(model, scene)
     base = scene.base or model.root
@@ -183,8 +182,8 @@ def _with_scene_couplings(model: RobotModel, scene: Scene) -> RobotModel:
 
 
 def _float(model: RobotModel, scene: Scene, add) -> RobotModel:
-    """``model`` with a floating base (``add``: :func:`eomgen.floating.add_floating_base` or
-    :func:`eomgen.free_flyer.add_free_flyer`); its errors name the scene's ``floating_base``
+    """``model`` with a floating base (``add``: :func:`eomgen.model.floating.add_floating_base` or
+    :func:`~eomgen.model.floating.add_free_flyer`); its errors name the scene's ``floating_base``
     entry."""
     try:
         return add(model)

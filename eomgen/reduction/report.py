@@ -1,6 +1,6 @@
 """The report of a reduction (:class:`ReductionReport`, with the model: :class:`Reduction`):
 sizes before and after, what was locked, merged and dropped, derivation costs when measured
-(:class:`DerivationCost`, measured by :mod:`eomgen.reduction.cost`), as data and as Markdown."""
+(:class:`DerivationCost`, measured by :mod:`eomgen.codegen.derivation_cost`), as data and as Markdown."""
 
 from __future__ import annotations
 

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import eomgen
-from eomgen.free_flyer import add_free_flyer
+from eomgen.model.floating import add_free_flyer
 from eomgen.model import Joint, JointType, Link, Transform, build_model, mat3, vec3
 from eomgen.numeric import (M_crba, M_rnea, coriolis_times_qd, forward_dynamics, gravity_torques,
                             kinetic_energy, link_poses, numeric_model, potential_energy, rnea)

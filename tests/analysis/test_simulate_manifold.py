@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 import eomgen
-from eomgen.free_flyer import add_free_flyer
+from eomgen.model.floating import add_free_flyer
 from eomgen.model import Inertial, Joint, JointType, Link, build_model
 from eomgen.model.joints.lie import quaternion_matrix
 from eomgen.model.configuration import difference

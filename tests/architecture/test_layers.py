@@ -29,7 +29,7 @@ PACKAGE = ROOT / "eomgen"
 LAYERS: tuple[tuple[int, tuple[str, ...]], ...] = (
     (0, ("errors", "moved", "common", "runtime", "robots", "outputs")),
     (1, ("model",)),
-    (2, ("parsers", "scene", "reduction", "floating", "free_flyer")),
+    (2, ("parsers", "scene", "reduction")),
     (3, ("symbolic.monomials", "symbolic.spatial", "symbolic.program", "symbolic.transforms",
          "symbolic.printing", "symbolic.evaluate", "symbolic.derivation", "symbolic.builders",
          "symbolic.quaternion_joints", "symbolic.couplings")),
@@ -48,10 +48,6 @@ MAX_LINES = 600
 #: Imports that point up the table today: (importer, imported).
 UPWARD_TODAY: frozenset[tuple[str, str]] = frozenset({
     ('eomgen.dynamics', 'eomgen.codegen.lambdify'),
-    ('eomgen.floating', 'eomgen.numeric.floating_base'),
-    ('eomgen.floating', 'eomgen.numeric.newton_euler'),
-    ('eomgen.floating', 'eomgen.numeric.pinocchio'),
-    ('eomgen.reduction.cost', 'eomgen.dynamics'),
 })
 
 #: Import cycles today, each as the sorted tuple of its modules.

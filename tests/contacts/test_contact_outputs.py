@@ -5,7 +5,7 @@ References: the closed form of the planar 2-link arm's tip (position, Jacobian, 
 statics against a wall (docs/contact.md), in every backend; Pinocchio's frame placements,
 ``getFrameJacobian`` (LOCAL_WORLD_ALIGNED, LOCAL), classical frame accelerations and
 ``constraintDynamics`` (CONTACT_3D) on the floating solo12 with its four feet held, through
-eomgen.floating's map to Pinocchio's free flyer; finite differences of the generated positions;
+eomgen.numeric.floating_base's map to Pinocchio's free flyer; finite differences of the generated positions;
 eomgen.numeric.contacts' numeric KKT (Newton–Euler M and h).
 """
 
@@ -20,7 +20,7 @@ import eomgen
 from eomgen.codegen import loadable_backends
 from support import ROOT, erd_robots_dir, floating_states, run_in_process
 from support.reference import pinocchio_contacts
-from eomgen import floating
+from eomgen.numeric import floating_base
 from eomgen.codegen.functions import select_functions
 from eomgen.codegen.generate import render_files
 from eomgen.numeric.contacts import ContactDynamics
@@ -172,12 +172,12 @@ def test_solo_frames_match_pinocchio_and_finite_differences(solo):
     path, model, np_module, ca_module = solo
     feet = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
     assert tuple(np_module["FRAME_NAMES"]) == feet  # the contact frames, by the rule
-    ref = floating.PinocchioFreeFlyer(path, model.joint_names)
+    ref = floating_base.PinocchioFreeFlyer(path, model.joint_names)
     pm, pd, idx = ref.model, ref.data, ref.idx
     for q, qd, _ in _states(2, 5):
         q_pin, v = ref.state(q, qd)
-        T = floating.velocity_map(q)  # Pinocchio's v = T q̇ (base twist from Euler rates)
-        pin.forwardKinematics(pm, pd, q_pin, v, floating.velocity_map_dot_qd(q, qd)[idx])
+        T = floating_base.velocity_map(q)  # Pinocchio's v = T q̇ (base twist from Euler rates)
+        pin.forwardKinematics(pm, pd, q_pin, v, floating_base.velocity_map_dot_qd(q, qd)[idx])
         pin.updateFramePlacements(pm, pd)
         pin.computeJointJacobians(pm, pd, q_pin)
         got = {f: np_module[f](q, qd) if f == "frame_jacobians_dot_qd" else np_module[f](q)
@@ -215,17 +215,17 @@ def test_solo_constrained_dynamics_matches_pinocchio_and_the_numeric_kkt(solo):
     path, model, np_module, ca_module = solo
     assert len(np_module["CONTACT_ROWS"]) == 12 and np_module["CONTACT_ROWS"][0] == "FL_FOOT.f_x"
     cd = ContactDynamics(model, model.contacts)
-    ref = floating.PinocchioFreeFlyer(path, model.joint_names)
+    ref = floating_base.PinocchioFreeFlyer(path, model.joint_names)
     pm, pd, idx = ref.model, ref.data, ref.idx
     models, datas = pinocchio_contacts(pm, pd, [c.frame for c in model.contacts])
     for q, qd, tau in _states(3, 8):
         q_pin, v = ref.state(q, qd)
-        T = floating.velocity_map(q)
+        T = floating_base.velocity_map(q)
         a = pin.constraintDynamics(pm, pd, q_pin, v, np.linalg.solve(T.T, tau)[idx], models,
                                    datas, pin.ProximalSettings(1e-14, 1e-12, 1))
         a_ours = np.empty(18)
         a_ours[idx] = a
-        qdd_pin = np.linalg.solve(T, a_ours - floating.velocity_map_dot_qd(q, qd))
+        qdd_pin = np.linalg.solve(T, a_ours - floating_base.velocity_map_dot_qd(q, qd))
         qdd_kkt, F_kkt = cd.constrained_forward_dynamics(q, qd, tau)
         np.testing.assert_allclose(np_module["contact_jacobian"](q), cd.contact_jacobian(q),
                                    rtol=0, atol=1e-12)

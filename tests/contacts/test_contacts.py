@@ -17,10 +17,12 @@ import eomgen
 from support import (
     CONTACTS, DOCS, erd_robots_dir, floating_states, load_quietly, relative, run_in_process,
 )
-from eomgen import floating, numeric
+from eomgen import numeric
+from eomgen.model import floating
+from eomgen.numeric import floating_base
 from eomgen.numeric.contacts import Contact, ContactDynamics, derived_mass_and_bias
 from eomgen.errors import SceneError
-from eomgen.free_flyer import add_free_flyer
+from eomgen.model.floating import add_free_flyer
 from eomgen.model import Inertial, Joint, JointType, Link, Transform, build_model
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
@@ -52,13 +54,13 @@ def test_constrained_dynamics_matches_pinocchio(solo, kind, feet):
         tau = rng.uniform(-2, 2, 18)
         qdd, F = cd.constrained_forward_dynamics(q, qd, tau)
         q_pin, v = ref.state(q, qd)
-        T = floating.velocity_map(q)
+        T = floating_base.velocity_map(q)
         tau_pin = np.linalg.solve(T.T, tau)  # generalised forces map by Tᵀ
         a = pin.constraintDynamics(pm, pd, q_pin, v, tau_pin[idx], models, datas,
                                    pin.ProximalSettings(1e-14, 1e-12, 1))
         a_ours = np.empty(18)
         a_ours[idx] = a
-        qdd_pin = np.linalg.solve(T, a_ours - floating.velocity_map_dot_qd(q, qd))
+        qdd_pin = np.linalg.solve(T, a_ours - floating_base.velocity_map_dot_qd(q, qd))
         assert relative(qdd, qdd_pin) <= 1e-8
         assert relative(F, pd.lambda_c) <= 1e-8
         # the contact inverse dynamics gives back τ

@@ -4,7 +4,7 @@ References: the NumPy module's KKT solve by LU (numpy.linalg.solve of the full s
 different algorithm from the fast module's Cholesky range-space form) and Pinocchio's
 ``constraintDynamics`` (CONTACT_3D, LOCAL_WORLD_ALIGNED) on the planar 2-link arm against a
 wall (Pinocchio reading the arm's URDF written by tests/reference.py) and on the floating solo12
-with its four feet held (through eomgen.floating's map to Pinocchio's free flyer).
+with its four feet held (through eomgen.numeric.floating_base's map to Pinocchio's free flyer).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ import pytest
 import eomgen
 from support import ROOT, erd_robots_dir, load_module
 from support.reference import pinocchio_contacts
-from eomgen import floating
+from eomgen.numeric import floating_base
 from eomgen.codegen.functions import select_functions
 from eomgen.codegen.generate import render_files
 from eomgen.reduction import apply_scene
@@ -160,7 +160,7 @@ def test_solo_fast_equals_numpy_and_pinocchio(tmp_path):
             load_scene(STANDING), floating_base="euler")).model  # the Euler chart's map
     fast, numpy_module = _modules(model, tmp_path)
     assert len(fast.CONTACT_ROWS) == 12
-    ref = floating.PinocchioFreeFlyer(path, model.joint_names)
+    ref = floating_base.PinocchioFreeFlyer(path, model.joint_names)
     pm, pd, idx = ref.model, ref.data, ref.idx
     models, datas = pinocchio_contacts(pm, pd, [c.frame for c in model.contacts])
     rng = np.random.default_rng(8)
@@ -171,12 +171,12 @@ def test_solo_fast_equals_numpy_and_pinocchio(tmp_path):
         qd, tau = rng.uniform(-1, 1, 18), rng.uniform(-2, 2, 18)
         batch.append((q, qd, tau))
         q_pin, v = ref.state(q, qd)
-        T = floating.velocity_map(q)  # Pinocchio's v = T q̇
+        T = floating_base.velocity_map(q)  # Pinocchio's v = T q̇
         a = pin.constraintDynamics(pm, pd, q_pin, v, np.linalg.solve(T.T, tau)[idx], models,
                                    datas, pin.ProximalSettings(1e-14, 1e-12, 1))
         a_ours = np.empty(18)
         a_ours[idx] = a
-        qdd_pin = np.linalg.solve(T, a_ours - floating.velocity_map_dot_qd(q, qd))
+        qdd_pin = np.linalg.solve(T, a_ours - floating_base.velocity_map_dot_qd(q, qd))
         qdd, F = fast.constrained_forward_dynamics(q, qd, tau)
         qdd_np, F_np = numpy_module.constrained_forward_dynamics(q, qd, tau)
         assert relative(qdd, qdd_np) < 1e-12 and relative(F, F_np) < 1e-12

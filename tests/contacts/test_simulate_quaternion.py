@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from eomgen.numeric.contacts import Contact, ContactDynamics
-from eomgen.free_flyer import add_free_flyer
+from eomgen.model.floating import add_free_flyer
 from eomgen.numeric.frames import frame_function
 from support import ROOT, erd_robots_or_skip, load_quietly, relative, run_cli, write
 from support.reference import pinocchio_contacts

@@ -142,7 +142,7 @@ def test_panda_with_a_free_flyer_and_mimic_fingers_equals_pinocchio(panda):
     (NQ = 16) with the free flyer's seven entries copied; against Pinocchio's free flyer with
     mimic joints, arrays unchanged."""
     pin = need("pinocchio", reason="Pinocchio's mimic joints are the reference")
-    from eomgen.free_flyer import add_free_flyer
+    from eomgen.model.floating import add_free_flyer
     from eomgen.numeric.frames import frame_kinematics
 
     path, model = panda

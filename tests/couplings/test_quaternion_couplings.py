@@ -11,7 +11,7 @@ import pytest
 
 import eomgen
 from eomgen.errors import UnsupportedError
-from eomgen.free_flyer import add_free_flyer
+from eomgen.model.floating import add_free_flyer
 from eomgen.model import couple, uncoupled
 from eomgen.model.coupling import full_configuration
 from support import relative
@@ -94,7 +94,7 @@ def test_dynamics_equal_pinocchio_mimic_on_a_free_flyer(case):
 
 def test_coriolis_is_skew_compatible(case):
     """Ṁ − 2C skew-symmetric (Ṁ by a central difference along the motion of q)."""
-    from eomgen.free_flyer import integrate
+    from eomgen.model.floating import integrate
     model, _, module = case
     rng = np.random.default_rng(3)
     q = rng.uniform(-1, 1, model.nq)

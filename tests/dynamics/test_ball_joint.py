@@ -39,7 +39,7 @@ GRAVITY = np.array([0.3, -0.2, -9.81])
 def robots(spec, seed, free_flyer=False):
     """The eomgen model (build_model, so ball joints are expanded) and Pinocchio's model built
     by hand from ``spec``: random joint placements and axes, every link with mass."""
-    from eomgen.free_flyer import add_free_flyer
+    from eomgen.model.floating import add_free_flyer
     rng = np.random.default_rng(seed)
     root_inertia = random_inertial(rng)
     links, joints = [Link("trunk", root_inertia)], []

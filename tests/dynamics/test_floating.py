@@ -1,4 +1,5 @@
-"""Floating bases (eomgen.floating): six virtual joints against Pinocchio's free flyer.
+"""Floating bases (eomgen.model.floating; the maps: eomgen.numeric.floating_base): six virtual
+joints against Pinocchio's free flyer.
 
 Reference: Pinocchio's own URDF reader with ``JointModelFreeFlyer`` (independent of eomgen's
 parser and of its numeric Newton–Euler), its dynamics mapped to Euler coordinates through
@@ -13,7 +14,9 @@ import pytest
 
 import eomgen
 from support import erd_robots_dir, floating_states, load_quietly, relative
-from eomgen import floating, numeric
+from eomgen import numeric
+from eomgen.model import floating
+from eomgen.numeric import floating_base
 from eomgen.errors import InvalidInertiaError, KinematicTreeError, SceneError
 from eomgen.model import Inertial, Joint, JointType, Link, build_model, vec3
 from eomgen.reduction import apply_scene
@@ -95,9 +98,9 @@ def test_state_maps_round_trip_and_match_pinocchio_kinematics(solo):
     model, ref = solo
     pin = ref.pin
     for q, qd in floating_states(18, 3, seed=3):
-        q_ff, v = floating.to_free_flyer(q, qd)
+        q_ff, v = floating_base.to_free_flyer(q, qd)
         assert np.isclose(np.linalg.norm(q_ff[3:7]), 1.0)
-        q2, qd2 = floating.from_free_flyer(q_ff, v)
+        q2, qd2 = floating_base.from_free_flyer(q_ff, v)
         assert np.allclose(q2, q, atol=1e-12) and np.allclose(qd2, qd, atol=1e-12)
         # the base pose eomgen's kinematics gives is Pinocchio's free-flyer placement
         q_pin, _ = ref.state(q, qd)
@@ -113,8 +116,9 @@ def test_velocity_map_derivative_is_a_finite_difference():
     rng = np.random.default_rng(4)
     q, qd = rng.uniform(-1, 1, 8), rng.uniform(-1, 1, 8)
     h = 1e-6
-    fd = (floating.velocity_map(q + h * qd) - floating.velocity_map(q - h * qd)) @ qd / (2 * h)
-    assert np.allclose(floating.velocity_map_dot_qd(q, qd), fd, atol=1e-8)
+    T = floating_base.velocity_map
+    fd = (T(q + h * qd) - T(q - h * qd)) @ qd / (2 * h)
+    assert np.allclose(floating_base.velocity_map_dot_qd(q, qd), fd, atol=1e-8)
 
 
 def test_body_angular_velocity_is_that_of_the_rotation():
@@ -122,30 +126,30 @@ def test_body_angular_velocity_is_that_of_the_rotation():
     rng = np.random.default_rng(5)
     angles, rates = rng.uniform(-1, 1, 3), rng.uniform(-1, 1, 3)
     h = 1e-6
-    R = floating.base_rotation(*angles)
-    Rdot = (floating.base_rotation(*(angles + h * rates))
-            - floating.base_rotation(*(angles - h * rates))) / (2 * h)
+    R = floating_base.base_rotation(*angles)
+    Rdot = (floating_base.base_rotation(*(angles + h * rates))
+            - floating_base.base_rotation(*(angles - h * rates))) / (2 * h)
     W = R.T @ Rdot
     assert np.allclose([W[2, 1], W[0, 2], W[1, 0]],
-                       floating.euler_rate_matrix(angles[1], angles[2]) @ rates, atol=1e-8)
-    assert np.isclose(np.linalg.det(floating.euler_rate_matrix(0.3, 0.7)), -np.cos(0.3))
+                       floating_base.euler_rate_matrix(angles[1], angles[2]) @ rates, atol=1e-8)
+    assert np.isclose(np.linalg.det(floating_base.euler_rate_matrix(0.3, 0.7)), -np.cos(0.3))
 
 
 def test_singularity_is_detected_and_real(solo):
     model, _ = solo
     q = np.zeros(18)
     q[4] = np.pi / 2
-    assert floating.euler_singularity(q) < 1e-15
-    with pytest.raises(floating.EulerSingularityError, match="singularity"):
-        floating.check_euler(q)
-    q_ff, v = floating.to_free_flyer(q, np.zeros(18))
-    with pytest.raises(floating.EulerSingularityError):
-        floating.from_free_flyer(q_ff, v)
+    assert floating_base.euler_singularity(q) < 1e-15
+    with pytest.raises(floating_base.EulerSingularityError, match="singularity"):
+        floating_base.check_euler(q)
+    q_ff, v = floating_base.to_free_flyer(q, np.zeros(18))
+    with pytest.raises(floating_base.EulerSingularityError):
+        floating_base.from_free_flyer(q_ff, v)
     # the mass matrix in Euler coordinates is singular there: yaw and roll move alike
     M = numeric.M_rnea(numeric.numeric_model(model), q)
     assert np.linalg.eigvalsh(M).min() < 1e-12 * np.linalg.eigvalsh(M).max()
     q[4] = 0.5
-    floating.check_euler(q)
+    floating_base.check_euler(q)
 
 
 def _point_mass_robot(root_mass):
@@ -218,3 +222,68 @@ def test_scene_floating_base_takes_its_chart():
         with pytest.raises(SceneError, match="^s.yaml: floating_base: expected true, false, "
                                              "'euler' or 'quaternion'"):
             load_scene("s.yaml", text=f"version: 1\nfloating_base: {text}")
+
+
+def _numeric_total(model):
+    """Mass, first moment and rotational inertia about the root origin of ``model`` at q = 0,
+    from the numeric model's forward kinematics (eomgen.numeric, float arrays)."""
+    nm = numeric.numeric_model(model)
+    poses = numeric.link_poses(nm, np.zeros(nm.n))
+    mass, h, I_O = 0.0, np.zeros(3), np.zeros((3, 3))
+    for i, name in enumerate(nm.body_names):
+        R, p = poses[name]
+        c = p + R @ nm.com[i]
+        mass += nm.mass[i]
+        h += nm.mass[i] * c
+        I_O += R @ nm.inertia[i] @ R.T + nm.mass[i] * (c @ c * np.eye(3) - np.outer(c, c))
+    return mass, h, I_O
+
+
+def _bundled(name, couple_offset=None):
+    model = eomgen.load(eomgen.example_path(name))
+    if couple_offset is not None:  # the second joint follows the first, at an offset
+        from eomgen.model import couple
+        first, second = model.joint_names[:2]
+        model = couple(model, second, first, ratio=-0.5, offset=couple_offset)
+    return model.with_numeric_parameters()
+
+
+@pytest.mark.parametrize("robot", ["puma560_arm3", "scara_rrp", "stanford_rrp", "elbow_rrr",
+                                   "elbow_rrr coupled", "point mass", "solo12"])
+def test_total_inertia_at_zero_is_the_numeric_models(robot):
+    """The model layer's total spatial inertia (what check_spatial_inertia refuses on) equals
+    the one of the numeric model's link poses at q = 0: total mass, centre of mass, rotational
+    inertia; a coupled joint sits at its offset."""
+    if robot == "solo12":
+        robots = erd_robots_dir()
+        if robots is None:
+            pytest.skip("example-robot-data is not installed")
+        model = load_quietly(robots / SOLO)
+    elif robot == "point mass":
+        model = _point_mass_robot(2.0)
+    else:
+        model = _bundled(robot.split()[0], 0.7 if "coupled" in robot else None)
+    total = floating.total_inertial(model)
+    mass, h, I_O = _numeric_total(model)
+    assert abs(float(total.mass) - mass) <= 1e-12 * mass
+    assert np.allclose([float(x) for x in total.first_moment], h, rtol=1e-12, atol=1e-12 * mass)
+    assert np.allclose(np.array(total.inertia, dtype=float), I_O, rtol=1e-12,
+                       atol=1e-12 * np.abs(I_O).max())
+    if robot == "elbow_rrr coupled":  # the offset moves mass: not the uncoupled pose
+        from eomgen.model import uncoupled
+        assert not np.allclose(_numeric_total(uncoupled(model))[2], I_O)
+
+
+def test_parameters_without_values_are_not_checked_here():
+    """A robot whose masses are symbols without values floats (checked when they get values),
+    as before; the same robot with a value of zero mass is refused."""
+    import sympy as sp
+    from eomgen.model import Parameter
+    m = sp.Symbol("m")
+    links = [Link("a"), Link("b", Inertial(m, (0, 0, -0.5)))]
+    joints = [Joint("j", JointType.REVOLUTE, "a", "b")]
+    free = build_model("s.yaml", "s", links, joints, parameters=[Parameter(m, None)])
+    assert floating.add_floating_base(free).dof == 7
+    zero = build_model("s.yaml", "s", links, joints, parameters=[Parameter(m, 0.0)])
+    with pytest.raises(InvalidInertiaError, match="no mass"):
+        floating.add_floating_base(zero)

@@ -1,4 +1,4 @@
-"""The quaternion free flyer (eomgen.free_flyer): every code backend's M, C, g, tau, h and q̈
+"""The quaternion free flyer (eomgen.model.floating): every code backend's M, C, g, tau, h and q̈
 against Pinocchio's JointModelFreeFlyer with the same arrays, q (NQ) and v (NV) passed
 unchanged; integrate and difference against Pinocchio's; Ṁ − 2C skew by finite differences.
 
@@ -14,7 +14,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from eomgen.free_flyer import add_free_flyer, difference, integrate, neutral
+from eomgen.model.floating import add_free_flyer, difference, integrate, neutral
 from support import relative
 from support.generated import generated
 from support.reference import massive_tree as floating_tree, pinocchio_free_motion, to_urdf

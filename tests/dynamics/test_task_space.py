@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from eomgen.free_flyer import add_free_flyer
+from eomgen.model.floating import add_free_flyer
 from support import relative
 from support.generated import generated
 from support.reference import massive_tree as floating_tree, to_urdf

@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from eomgen.free_flyer import add_free_flyer
+from eomgen.model.floating import add_free_flyer
 from eomgen.numeric.loops import LoopDynamics
 from eomgen.model import Joint, JointType, Link, Transform, build_model, vec3
 from eomgen.model.configuration import integrate

@@ -337,7 +337,7 @@ def test_report_markdown_lists_steps_and_measured_costs():
     model = eomgen.load(eomgen.example_path("planar_2link"))
     reduction = apply_scene(model, scene_text("version: 1\nlocked: {joint2: 0.5}\n"
                                               "description: elbow held\noutputs: [g]\n"))
-    from eomgen.reduction import derivation_cost
+    from eomgen.codegen.derivation_cost import derivation_cost
 
     after = derivation_cost(derive(reduction.model, outputs=("g",)))
     text = reduction.report.markdown(None, after)
@@ -447,7 +447,7 @@ def test_explain_prints_the_report_with_both_derivations(tmp_path):
 
 
 def test_a_derivation_past_its_time_limit_is_reported_as_such():
-    from eomgen.reduction import measure_derivation
+    from eomgen.codegen.derivation_cost import measure_derivation
 
     model = eomgen.load(eomgen.example_path("planar_2link"))
     cost = measure_derivation(model, ("M", "C", "g"), timeout=0.05)

@@ -1,6 +1,6 @@
 """Small models with quaternion joints (a free flyer, ball joints) built twice from one list of
 joints: as eomgen's model (:func:`eomgen.model.build_model`, which expands each ball joint, and
-:func:`eomgen.free_flyer.add_free_flyer`) and as Pinocchio's, by hand
+:func:`eomgen.model.floating.add_free_flyer`) and as Pinocchio's, by hand
 (``pin.Model.addJoint`` with ``JointModelFreeFlyer``, ``JointModelSpherical`` and unaligned
 revolute or prismatic joints), so that the same arrays q (NQ) and v (NV) feed both.
 """
@@ -57,7 +57,7 @@ def quaternion_robot(spec, seed: int = 0, free_flyer: bool = False, actuators=No
     ``actuators`` maps joint names to :class:`~eomgen.model.Actuator` (Pinocchio's model gets
     their armature in ``model.armature``)."""
     import pinocchio as pin
-    from eomgen.free_flyer import add_free_flyer
+    from eomgen.model.floating import add_free_flyer
 
     actuators = actuators or {}
     rng = np.random.default_rng(seed)

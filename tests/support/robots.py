@@ -22,7 +22,7 @@ from xml.sax.saxutils import quoteattr
 
 
 import eomgen
-from eomgen.floating import PinocchioFreeFlyer as FreeFlyerReference  # noqa: F401  (re-export)
+from eomgen.numeric.floating_base import PinocchioFreeFlyer as FreeFlyerReference  # noqa: F401  (re-export)
 from eomgen.model import Actuator, Inertial, Joint, JointType, Link, RobotModel, Transform
 from eomgen.model import build_model, vec3
 

@@ -11,7 +11,9 @@ import numpy as np
 import pytest
 
 import eomgen
-from eomgen import floating, numeric
+from eomgen import numeric
+from eomgen.model import floating
+from eomgen.numeric import floating_base
 from eomgen.errors import KinematicTreeError
 from eomgen.symbolic.frames import derive_frames, frame_site
 from support import floating_states, load_quietly
@@ -69,8 +71,8 @@ def test_frames_match_pinocchio(solo):
     for q, qd in floating_states(18, 3, seed=11):
         out = fk.evaluate(q, qd)
         q_pin, v = ref.state(q, qd)
-        T = floating.velocity_map(q)
-        a = floating.velocity_map_dot_qd(q, qd)[idx]  # Pinocchio's v̇ when q̈ = 0
+        T = floating_base.velocity_map(q)
+        a = floating_base.velocity_map_dot_qd(q, qd)[idx]  # Pinocchio's v̇ when q̈ = 0
         pin.forwardKinematics(pm, pd, q_pin, v, a)
         pin.updateFramePlacements(pm, pd)
         pin.computeJointJacobians(pm, pd, q_pin)

@@ -25,7 +25,7 @@ What is read
   order.
 * A body without joints is welded to its parent by a fixed joint ``<body>_weld``.
 * The ``free`` joint (a body of the world) is the quaternion free flyer of
-  :mod:`eomgen.free_flyer` (Pinocchio's layout): ``q[0:7] = (x, y, z, qx, qy, qz, qw)`` where
+  :mod:`eomgen.model.floating` (Pinocchio's layout): ``q[0:7] = (x, y, z, qx, qy, qz, qw)`` where
   MuJoCo's ``qpos`` has ``(x, y, z, qw, qx, qy, qz)``; ``v[0:6]`` is the body twist in the body
   frame (linear, then angular) where MuJoCo's ``qvel`` has the linear velocity in *world* axes
   (the angular one in the body frame, as eomgen's). The joint's MuJoCo name is in

@@ -17,7 +17,7 @@ from dataclasses import replace
 import numpy as np
 
 from ...errors import KinematicTreeError, UnsupportedError
-from ...free_flyer import add_free_flyer, quaternion_matrix
+from ...model.floating import add_free_flyer, quaternion_matrix
 from ...model import (
     Actuator,
     Notice,

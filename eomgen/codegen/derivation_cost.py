@@ -1,7 +1,8 @@
 """Measuring what a derivation costs (a :class:`~eomgen.reduction.report.DerivationCost`): of a
 finished derivation (:func:`derivation_cost`), or in a fresh Python process
 (:func:`measure_derivation`, whose subprocess runs :func:`measure_main` through
-``python -m eomgen.reduction``)."""
+``python -m eomgen.codegen.derivation_cost``). The scene's report compares the two
+(:mod:`eomgen.codegen.scene_generate`)."""
 
 from __future__ import annotations
 
@@ -16,8 +17,8 @@ from ..dynamics import derive
 from ..model import RobotModel
 from ..outputs import derived_symbols
 from ..parsers import load
+from ..reduction.report import DerivationCost
 from ..robots import example_path
-from .report import DerivationCost
 
 #: Default time limit [s] of :func:`measure_derivation`.
 MEASURE_TIMEOUT = 300.0
@@ -38,8 +39,8 @@ def measure_derivation(model: RobotModel, outputs: Sequence[str],
     derivation that takes longer than ``timeout`` seconds is stopped and reported as such."""
     payload = pickle.dumps((model, tuple(outputs)))
     try:
-        done = subprocess.run([sys.executable, "-m", "eomgen.reduction"], input=payload,
-                              capture_output=True, timeout=timeout)
+        done = subprocess.run([sys.executable, "-m", "eomgen.codegen.derivation_cost"],
+                              input=payload, capture_output=True, timeout=timeout)
     except subprocess.TimeoutExpired:
         return DerivationCost(None, (), timeout=timeout)
     if done.returncode != 0:
@@ -57,3 +58,7 @@ def measure_main() -> None:  # pragma: no cover - runs in the subprocess
     seconds = time.perf_counter() - start
     cost = derivation_cost(dynamics)
     json.dump({"seconds": seconds, "operations": list(cost.operations)}, sys.stdout)
+
+
+if __name__ == "__main__":  # pragma: no cover - the subprocess of measure_derivation
+    measure_main()
