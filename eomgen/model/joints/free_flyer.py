@@ -1,5 +1,5 @@
 """The free flyer: a root that moves freely in space, its configuration the root origin and a
-unit quaternion (Pinocchio's ``JointModelFreeFlyer``; :func:`eomgen.free_flyer.add_free_flyer`
+unit quaternion (Pinocchio's ``JointModelFreeFlyer``; :func:`eomgen.model.floating.add_free_flyer`
 puts one under a robot).
 
 ==========  =====================================  =========  ===============================
@@ -37,7 +37,7 @@ VELOCITY = ("base_vx", "base_vy", "base_vz", "base_wx", "base_wy", "base_wz")
 
 class FreeFlyer(ChartKind):
     name = "free_flyer"
-    described = False  # put under a robot (eomgen.free_flyer.add_free_flyer), not written
+    described = False  # put under a robot (eomgen.model.floating.add_free_flyer), not written
     nq, nv = 7, 6
     pinocchio = "JointModelFreeFlyer"
     motions = (0, 1, 2, 3, 4, 5)
