@@ -91,7 +91,7 @@ from .configuration import configuration_rate, difference, integrate, neutral  #
 from .joints.lie import matrix_quaternion, quaternion_matrix  # noqa: F401
 from .notices import NoticeKind
 from .parts import Joint, JointType, Link
-from .quaternion import FREE_FLYER_CONFIGURATION, FREE_FLYER_VELOCITY
+from .quaternion import FREE_FLYER_CONFIGURATION, FREE_FLYER_VELOCITY, check_entry_names
 from .robot import RobotModel, joint_motion
 from .scalars import vec3
 from .transforms import Transform
@@ -154,7 +154,8 @@ def add_free_flyer(model: RobotModel, origin: Transform | None = None) -> RobotM
     Raises
     ------
     KinematicTreeError
-        A root named ``world``, or a link or joint name the free flyer takes.
+        A root named ``world``, or a link or joint name the free flyer takes (its virtual
+        joints ``base_vx … base_wz``, its configuration entries ``base_x … base_qw``).
     InvalidInertiaError
         The robot's total spatial inertia is singular (see :func:`add_floating_base`).
     """
@@ -163,12 +164,14 @@ def add_free_flyer(model: RobotModel, origin: Transform | None = None) -> RobotM
                           (origin or Transform()) if k == 0 else Transform(), vec3(axis))
                     for k, (name, kind, axis)
                     in enumerate(zip(VELOCITY_NAMES, _TYPES, _FREE_FLYER_AXES)))
-    return replace(
+    floating = replace(
         model,
         links=(*(Link(name) for name in chain[:-1]), *model.links),
         joints=virtual + pinocchio_order(model),
         root=WORLD, free_flyer=True,
         notices=tuple(n for n in model.notices if n.kind is not NoticeKind.FLOATING_BASE))
+    check_entry_names(floating)  # a joint named base_x: CONFIGURATION_NAMES would repeat it
+    return floating
 
 
 def pinocchio_order(model: RobotModel) -> tuple[Joint, ...]:

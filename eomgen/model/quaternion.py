@@ -176,8 +176,37 @@ def expand_joints(model: "RobotModel") -> "RobotModel":
     for link in model.links:
         links_out += chains.get(link.name, ())
         links_out.append(link)
-    return replace(model, links=tuple(links_out), joints=tuple(joints),
-                   compound_joints=tuple(compound))
+    expanded_model = replace(model, links=tuple(links_out), joints=tuple(joints),
+                             compound_joints=tuple(compound))
+    check_entry_names(expanded_model)
+    return expanded_model
+
+
+def check_entry_names(model: "RobotModel") -> None:
+    """Every entry of ``q`` and of ``v`` has a name of its own (``CONFIGURATION_NAMES`` and
+    ``JOINT_NAMES`` of the generated modules): a joint named like an entry of a compound joint
+    (``hip_qx`` beside a ball joint ``hip``; ``base_x`` on a robot with a free flyer, whose
+    position entries are ``base_x, base_y, base_z``) is refused, naming both.
+
+    Raises
+    ------
+    KinematicTreeError
+        Naming the joint whose name is taken and the compound joint that takes it.
+    """
+    owners = {}  # an entry's name → the compound joint (kind, name) it belongs to
+    for joint in quaternion_layout(model):
+        for name in (*joint.kind.configuration_names(joint.name),
+                     *joint.kind.velocity_names(joint.name)):
+            owners[name] = joint
+    for name in model.joint_names:
+        joint = owners.get(name)
+        if joint is None or name in joint.kind.velocity_names(joint.name):
+            continue  # not a compound joint's entry, or its own virtual joint
+        entries = ", ".join(joint.kind.configuration_names(joint.name))
+        raise KinematicTreeError(model.source, f"joint '{name}'",
+                                 f"'{name}' is also an entry of the configuration of the "
+                                 f"{joint.kind.describe()[0]} joint '{joint.name}' ({entries}):"
+                                 " rename the joint")
 
 
 _COUNT = {2: "two", 3: "three", 6: "six"}
