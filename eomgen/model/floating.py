@@ -91,6 +91,7 @@ from .configuration import configuration_rate, difference, integrate, neutral  #
 from .joints.lie import matrix_quaternion, quaternion_matrix  # noqa: F401
 from .notices import NoticeKind
 from .parts import Joint, JointType, Link
+from .joints import FREE_FLYER
 from .quaternion import FREE_FLYER_CONFIGURATION, FREE_FLYER_VELOCITY, check_entry_names
 from .robot import RobotModel, joint_motion
 from .scalars import vec3
@@ -168,7 +169,7 @@ def add_free_flyer(model: RobotModel, origin: Transform | None = None) -> RobotM
         model,
         links=(*(Link(name) for name in chain[:-1]), *model.links),
         joints=virtual + pinocchio_order(model),
-        root=WORLD, free_flyer=True,
+        root=WORLD, compound_joints=((FREE_FLYER.name, "base"), *model.compound_joints),
         notices=tuple(n for n in model.notices if n.kind is not NoticeKind.FLOATING_BASE))
     check_entry_names(floating)  # a joint named base_x: CONFIGURATION_NAMES would repeat it
     return floating

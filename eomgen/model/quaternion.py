@@ -235,7 +235,7 @@ def quaternion_layout(model: "RobotModel") -> tuple[QuaternionJoint, ...]:
                                    "(eomgen.model.expand_joints; build_model does it)")
     movable = model.coordinate_joints  # the followers of couplings are no coordinates
     index = {j.name: k for k, j in enumerate(movable)}
-    found = [(0, FREE_FLYER, "base")] if model.free_flyer else []
+    found = []
     for kind_name, name in model.compound_joints:
         kind = KINDS[kind_name]
         if not isinstance(kind, ChartKind):  # its configuration is its coordinates

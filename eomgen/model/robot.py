@@ -66,14 +66,11 @@ class RobotModel:
     #: moved the fixed frame (:func:`eomgen.reduction.apply_scene`); None when they coincide.
     #: Frame kinematics are given in the description's frame.
     root_pose: Transform | None = None
-    #: True when the first six movable joints are a quaternion free flyer's velocity
-    #: coordinates (:mod:`eomgen.model.floating`): the configuration ``q`` then has ``dof + 1``
-    #: entries (root position, unit quaternion), the velocity ``v`` has ``dof``.
-    free_flyer: bool = False
-    #: ``(kind, name)`` of each joint that is a chart of virtual joints in the tree (a ball
+    #: ``(kind, name)`` of each joint that is a chain of virtual joints in the tree (a ball
     #: joint: three movable virtual joints ``<name>_wx … <name>_wz`` whose configuration is a
-    #: unit quaternion; a planar joint), :mod:`eomgen.model.quaternion`,
-    #: :func:`~eomgen.model.expand_joints`.
+    #: unit quaternion; a planar joint; the free flyer ``("free_flyer", "base")``),
+    #: :mod:`eomgen.model.quaternion`, :func:`~eomgen.model.expand_joints`,
+    #: :func:`~eomgen.model.floating.add_free_flyer`.
     compound_joints: tuple[tuple[str, str], ...] = ()
     #: Coupled joints (:mod:`eomgen.model.coupling`): each follower's position is an affine
     #: function of its leaders'; followers are no coordinates (``joint_names``, ``dof``).
@@ -109,6 +106,13 @@ class RobotModel:
         """The number of velocity coordinates (NV): one per movable joint that follows no
         other (:attr:`couplings`)."""
         return len(self.coordinate_joints)
+
+    @property
+    def free_flyer(self) -> bool:
+        """True when the first six movable joints are a quaternion free flyer's velocity
+        coordinates (:mod:`eomgen.model.floating`): the configuration ``q`` then has ``dof + 1``
+        entries (root position, unit quaternion), the velocity ``v`` has ``dof``."""
+        return any(kind == "free_flyer" for kind, _ in self.compound_joints)
 
     @property
     def ball_joints(self) -> tuple[str, ...]:

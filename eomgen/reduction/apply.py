@@ -516,7 +516,7 @@ def _merge(model: RobotModel, payloads: Sequence[Payload]):
     info = tuple((k, v) for k, v in model.info if not str(k).startswith("dh"))
     reduced = RobotModel(name=model.name, links=tuple(links), joints=tuple(joints),
                          root=model.root, gravity=model.gravity, parameters=model.parameters,
-                         source=model.source, info=info, free_flyer=model.free_flyer,
+                         source=model.source, info=info,
                          compound_joints=model.compound_joints, couplings=model.couplings)
     return reduced, tuple(merged), tuple(dropped), tuple(dropped_payloads)
 

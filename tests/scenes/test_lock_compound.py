@@ -111,3 +111,40 @@ def test_bad_locks_of_a_ball_joint_are_one_line_errors(tmp_path, text, element, 
         apply_scene(whole, scene(tmp_path, text))
     message = str(error.value)
     assert "\n" not in message and element in message and problem in message
+
+
+def test_a_locked_free_flyer_bolts_the_robot_at_its_pose(tmp_path):
+    """``locked: {base: [x, y, z, qx, qy, qz, qw]}`` on a robot with Pinocchio's free flyer:
+    the robot is held at that pose of its root. Its inverse dynamics equal the floating
+    robot's rows of the other joints with the free flyer at rest at that pose, and the base
+    rows carry the load (gravity turned by the pose: it is not the fixed robot's)."""
+    from eomgen.model.floating import add_free_flyer
+
+    whole = add_free_flyer(robot(tmp_path, "spherical"))
+    values = [0.3, -0.2, 0.5, 0.2, -0.1, 0.4, 0.9]
+    reduced = apply_scene(whole, scene(tmp_path, f"locked:\n  base: {values}\n"))
+    model = reduced.model
+    assert not model.free_flyer and model.joint_names == ("hip_wx", "hip_wy", "hip_wz", "elbow")
+    assert model.compound_joints == (("spherical", "hip"),)
+    full, small = numeric_model(whole), numeric_model(model)
+    upright = numeric_model(robot(tmp_path, "spherical"))  # bolted at the identity
+    rng = np.random.default_rng(5)
+    for _ in range(3):
+        hip = rng.normal(size=4)
+        hip /= np.linalg.norm(hip)
+        x, v, a = np.r_[hip, rng.normal()], rng.normal(size=4), rng.normal(size=4)
+        q = np.concatenate([values, x])
+        expected = rnea(full, q, np.r_[np.zeros(6), v], np.r_[np.zeros(6), a])
+        got = rnea(small, x, v, a)
+        assert np.allclose(got, expected[6:], rtol=1e-12, atol=1e-12)
+        assert np.linalg.norm(expected[:6]) > 1e-3
+        assert not np.allclose(got, rnea(upright, x, v, a), atol=1e-6)  # the pose matters
+
+
+def test_a_virtual_joint_of_the_free_flyer_is_not_locked_alone(tmp_path):
+    from eomgen.model.floating import add_free_flyer
+
+    whole = add_free_flyer(robot(tmp_path, "planar"))
+    with pytest.raises(SceneError, match="locked 'base_wz': a virtual joint of free flyer "
+                                         "joint 'base': lock 'base' at its configuration"):
+        apply_scene(whole, scene(tmp_path, "locked:\n  base_wz: 0.1\n"))
