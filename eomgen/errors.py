@@ -137,8 +137,8 @@ class XMLSyntaxError(DescriptionError):
 
 
 class ForbiddenXMLError(DescriptionError):
-    """The URDF uses XML features refused for safety: entity declarations (billion laughs),
-    external entities or DTDs."""
+    """The URDF or MJCF file uses XML features refused for safety: entity declarations
+    (billion laughs), external entities or DTDs."""
 
 
 class YAMLFormatError(DescriptionError):

@@ -82,10 +82,11 @@ def check_numbers(values: Iterable, source: str, where: str, label: str = "") ->
 
 
 def _show(value) -> str:
-    if isinstance(value, float):
-        return repr(value)
-    text = str(value)
-    return text if len(text) <= 24 else text[:24] + "..."
+    try:
+        return f"{float(value):g}"
+    except (TypeError, OverflowError):
+        text = str(value)
+        return text if len(text) <= 24 else text[:24] + "..."
 
 
 def model_numbers(links, joints, gravity) -> Iterator[tuple[str, str, object]]:
