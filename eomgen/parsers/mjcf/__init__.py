@@ -72,6 +72,12 @@ qw)``; the velocity is the same (the child's angular velocity in the child frame
 armature, damping and frictionloss are each of their velocity coordinates' drive, as MuJoCo
 applies them per dof.
 
+Every number eomgen takes from the compiled model is held to the rule for numbers in
+descriptions (finite, magnitude at most 1e12: :mod:`eomgen.model.numbers`) before anything is
+built, an :class:`~eomgen.errors.InvalidNumberError` naming the element and the attribute
+(:mod:`eomgen.parsers.mjcf.numbers`). A DTD with entity declarations or an external identifier
+is refused (:class:`~eomgen.errors.ForbiddenXMLError`), as in URDF.
+
 Contacts, joint limits, geoms, sites, sensors and the rendering options do not enter the
 equations of motion and are ignored.
 """
