@@ -137,8 +137,8 @@ class XMLSyntaxError(DescriptionError):
 
 
 class ForbiddenXMLError(DescriptionError):
-    """The URDF uses XML features refused for safety: entity declarations (billion laughs),
-    external entities or DTDs."""
+    """The URDF or MJCF file uses XML features refused for safety: entity declarations
+    (billion laughs), external entities or DTDs."""
 
 
 class YAMLFormatError(DescriptionError):
@@ -155,7 +155,8 @@ class SchemaError(DescriptionError):
 class InvalidNumberError(DescriptionError):
     """Text that should be a number is not a finite real number (``nan``, ``inf``, ``abc``), not
     an expression eomgen reads, or has a magnitude above
-    :data:`eomgen.model.expressions.MAX_MAGNITUDE`."""
+    :data:`eomgen.model.numbers.MAX_MAGNITUDE` (1e12): the rule for every number read from a
+    description or a scene, MJCF values as MuJoCo compiles them included."""
 
 
 class ParameterError(DescriptionError):

@@ -77,6 +77,7 @@ from pathlib import Path
 from .model import HINGE, LOOP_KINDS, POINT, SURFACE, Contact, Loop, LoopFrame, Transform
 from .errors import DescriptionError, SceneError, did_you_mean  # noqa: F401  (re-export)
 from .model import Coupling, Inertial, Parameter, Vec3, check_inertial, make_coupling, mat3, vec3
+from .model import Link, check_model_numbers
 from .outputs import select
 from .parsers._yaml import Reader, read_document
 
@@ -373,7 +374,8 @@ def _payload(r: _SceneReader, entry, k: int, source: str, strict: bool) -> Paylo
     inertial = Inertial(mass, com, inertia)
     values = {p.symbol: p.value for p in r.declared.values() if p.value is not None}
     numeric = Inertial(*(_at(x, values) for x in (inertial.mass, inertial.com, inertial.inertia)))
-    try:
+    try:  # expressions at their defaults: finite and of magnitude at most 1e12 too
+        check_model_numbers(source, [Link(name, numeric)], [], [])
         found = check_inertial(source, name, numeric)
     except DescriptionError as exc:
         raise scene_error(type(exc))(source, where, exc.problem) from None

@@ -26,7 +26,8 @@ The package holds one concept per module, bottom up: :mod:`~eomgen.model.scalars
 :mod:`~eomgen.model.notices`, :mod:`~eomgen.model.coupling` (coupled joints),
 :mod:`~eomgen.model.quaternion` (free flyer and ball joints: the layout of q and v),
 :mod:`~eomgen.model.robot` (:class:`RobotModel`),
-:mod:`~eomgen.model.checks` (validation, :func:`build_model`) and
+:mod:`~eomgen.model.numbers` (the rule for every number read from a file: finite, magnitude
+at most 1e12), :mod:`~eomgen.model.checks` (validation, :func:`build_model`) and
 :mod:`~eomgen.model.moving_mass` (what the dynamics see of the masses: joints that move no
 mass, inertias whose findings do not matter). Import every name from
 ``eomgen.model``.
@@ -48,6 +49,7 @@ from .contact import POINT, SURFACE, Contact
 from .coupling import Coupling, couple, coupling_map, make_coupling, uncoupled, with_couplings
 from .loop import HINGE, LOOP_KINDS, POINT_LOOP, WELD, Loop, LoopFrame
 from .notices import Notice, NoticeKind, emit_notices
+from .numbers import MAX_MAGNITUDE, check_model_numbers, check_number
 from .moving_mass import massless_joints, massless_notices, settled
 from .parts import Inertial, Joint, JointType, Link, Parameter
 from .quaternion import (
@@ -74,6 +76,7 @@ from .transforms import Transform, rotation_about_axis, rotation_from_rpy
 
 __all__ = [
     "HINGE", "LOOP_KINDS", "POINT_LOOP", "WELD", "Loop", "LoopFrame",
+    "MAX_MAGNITUDE", "check_model_numbers", "check_number",
     "ANGLE_SNAP_TOLERANCE", "DEFAULT_FRICTION_WIDTH", "FREE_FLYER_CONFIGURATION", "FREE_FLYER_VELOCITY", "IDENTITY3", "MAX_JOINTS", "POINT", "SNAP_TOLERANCE", "SURFACE",
     "ZERO3", "Actuator", "Contact", "Coupling", "couple", "coupling_map", "uncoupled",
     "make_coupling", "with_couplings", "Inertial", "Joint", "JointType", "Link", "Mat3", "Notice",

@@ -13,13 +13,13 @@ from ..errors import (
     InvalidActuatorError,
     InvalidAxisError,
     InvalidInertiaError,
-    InvalidNumberError,
     KinematicTreeError,
     ParameterError,
     TooLargeError,
 )
 from .moving_mass import settled
 from .notices import Notice, NoticeKind, emit_notices
+from .numbers import check_model_numbers
 from .parts import Inertial, Joint, Link, Parameter
 from .quaternion import expand_joints
 from .robot import RobotModel
@@ -304,18 +304,22 @@ def build_model(
     element at fault: :class:`~eomgen.errors.TooLargeError` (more than :data:`MAX_JOINTS`
     joints), :class:`~eomgen.errors.InvalidAxisError`,
     :class:`~eomgen.errors.KinematicTreeError`, :class:`~eomgen.errors.InvalidInertiaError`,
-    :class:`~eomgen.errors.InvalidNumberError` (gravity) or
+    :class:`~eomgen.errors.InvalidNumberError` (a number that is not finite or of magnitude
+    above 1e12: :mod:`eomgen.model.numbers`) or
     :class:`~eomgen.errors.ParameterError` (duplicate parameters).
     """
     links = tuple(links)
     joints = tuple(joints)
     check_size(source, len(links), len(joints))
+    params = tuple(parameters)
+    defaults = {p.symbol: scalar(p.value) for p in params if p.value is not None}
+    gravity = vec3(gravity)
+    # every number finite and of magnitude at most 1e12, expressions at the defaults
+    check_model_numbers(source, links, joints, gravity, defaults)
     joints = tuple(replace(j, axis=check_axis(source, j.name, j.axis)) for j in joints)
     for joint in joints:
         check_kind(source, joint)
     root = check_tree(source, (l.name for l in links), joints)
-    params = tuple(parameters)
-    defaults = {p.symbol: scalar(p.value) for p in params if p.value is not None}
     notices: list[Notice] = []
     for link in links:
         if link.inertial is not None:
@@ -328,11 +332,6 @@ def build_model(
         if defaults and joint.actuator is not None:
             check_actuator(source, joint, defaults, where=f"joint '{joint.name}' actuator at "
                            "the parameters' default values")
-    gravity = vec3(gravity)
-    for v in gravity:
-        g = _number(v)
-        if g is not None and not math.isfinite(g):
-            raise InvalidNumberError(source, "gravity", "gravity is not finite")
     names = [p.name for p in params]
     for p in params:
         if names.count(p.name) > 1:

@@ -3,7 +3,7 @@
 User text is never passed to ``eval`` or ``sympify``. This module accepts exactly: decimal
 numbers, parameter names (identifiers), the constant ``pi``, the operators ``+ - * / **`` with
 parentheses, and the functions ``sin cos tan sqrt``; numbers must be finite and of magnitude
-at most :data:`MAX_MAGNITUDE`. Anything else is refused with a
+at most :data:`MAX_MAGNITUDE` (:mod:`eomgen.model.numbers`). Anything else is refused with a
 :class:`ValueError` whose message says what was not understood; parsers turn it into a
 :class:`~eomgen.errors.DescriptionError` naming file and element.
 """
@@ -18,12 +18,10 @@ import re
 import sympy as sp
 
 from . import parameter_symbol, scalar
+from .numbers import MAX_MAGNITUDE, number_problem  # noqa: F401  (MAX_MAGNITUDE: its home)
 
 MAX_LENGTH = 200
 MAX_EXPONENT = 16
-#: Numbers of larger magnitude are refused: no robot needs them, and products of a few of them
-#: overflow double precision in the generated code (1e100³ = 1e300 < 1.8e308).
-MAX_MAGNITUDE = 1e100
 
 _FUNCTIONS = {"sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "sqrt": sp.sqrt}
 _CONSTANTS = {"pi": sp.pi}
@@ -83,13 +81,11 @@ def parse_scalar(text) -> sp.Expr:
 
 
 def _check_magnitude(value, shown: str) -> None:
-    """Refuse a number (int, float or SymPy number) of magnitude above :data:`MAX_MAGNITUDE`."""
-    try:
-        magnitude = abs(float(value))
-    except OverflowError:  # an integer beyond the float range
-        magnitude = math.inf
-    if not magnitude <= MAX_MAGNITUDE:
-        raise ValueError(f"{shown} is out of range (magnitude above {MAX_MAGNITUDE:g})")
+    """Refuse a number (int, float or SymPy number) that breaks the rule of
+    :mod:`eomgen.model.numbers` (finite, magnitude at most :data:`MAX_MAGNITUDE`)."""
+    problem = number_problem(value)
+    if problem is not None:
+        raise ValueError(f"{shown} {problem}")
 
 
 def _shorten(text: str, length: int = 24) -> str:

@@ -60,7 +60,9 @@ Decisions
   refused (:class:`~eomgen.errors.KinematicTreeError`). A ``<mimic>`` on a *fixed* joint
   (Talos' reduced models) couples nothing and is ignored.
 * Numbers are plain decimal numbers read with :func:`float` (URDF has no expressions); they
-  must be finite. Exact integers stay exact (see :func:`eomgen.model.scalar`).
+  must be finite and of magnitude at most 1e12 (:mod:`eomgen.model.numbers`), but for the
+  ``<limit>`` read by :func:`joint_limits`, where ``inf`` or ``1e16`` is no limit. Exact
+  integers stay exact (see :func:`eomgen.model.scalar`).
 * A singleton element (``<inertial>``, ``<origin>``, ``<axis>``, ...) given twice is an error
   rather than a silent choice of one of them.
 * ``<limit>`` is not required for revolute and prismatic joints (urdfdom requires it): limits
@@ -100,7 +102,7 @@ from ..errors import (
     UnsupportedError,
     XMLSyntaxError,
 )
-from ..model.expressions import MAX_MAGNITUDE
+from ..model.numbers import check_number
 from ..model import (
     Actuator,
     Inertial,
@@ -268,7 +270,7 @@ def joint_limits(path) -> dict[str, JointLimit]:
     ------
     DescriptionError
         Unreadable file, malformed XML, two ``<limit>`` elements in a joint, an attribute that
-        is not a finite number.
+        is not a number or is ``nan`` (``inf`` and large numbers are no limit).
     """
     source = str(path)
     try:
@@ -284,7 +286,7 @@ def joint_limits(path) -> dict[str, JointLimit]:
         element = _single_child(joint, "limit", source, f"joint '{name}'")
         if element is None:
             continue
-        values = {a: (_finite(element.get(a), a, source, where)
+        values = {a: (_limit(element.get(a), a, source, where)
                       if element.get(a) is not None else None)
                   for a in ("lower", "upper", "velocity", "effort")}
         if kind == "continuous":
@@ -529,18 +531,26 @@ def _number_attribute(element: ET.Element, attribute: str, source: str, where: s
 
 
 def _finite(text: str, label: str, source: str, where: str) -> float:
-    """``float(text)``, refusing text that is not a number, not finite (nan, inf) or of a
-    magnitude above :data:`~eomgen.model.expressions.MAX_MAGNITUDE`."""
+    """``float(text)``, refusing text that is not a number or breaks the rule for numbers in
+    descriptions (:mod:`eomgen.model.numbers`: finite, magnitude at most 1e12)."""
+    return check_number(_float(text, label, source, where), source, where, label, _show(text))
+
+
+def _float(text: str, label: str, source: str, where: str) -> float:
+    """``float(text)``, refusing text that is not a number."""
     try:
-        value = float(text)
+        return float(text)
     except ValueError:
         raise InvalidNumberError(source, where,
                                  f"{label} {_show(text)} is not a number") from None
-    if not math.isfinite(value):
-        raise InvalidNumberError(source, where, f"{label} {_show(text)} is not a finite number")
-    if abs(value) > MAX_MAGNITUDE:
-        raise InvalidNumberError(source, where, f"{label} {_show(text)} is out of range "
-                                 f"(magnitude above {MAX_MAGNITUDE:g})")
+
+
+def _limit(text: str, label: str, source: str, where: str) -> float:
+    """A ``<limit>`` attribute: any number but ``nan`` (limits do not enter the equations of
+    motion; ``inf`` or ``1e16`` is no limit)."""
+    value = _float(text, label, source, where)
+    if math.isnan(value):
+        raise InvalidNumberError(source, where, f"{label} {_show(text)} is not a number")
     return value
 
 

@@ -72,6 +72,12 @@ qw)``; the velocity is the same (the child's angular velocity in the child frame
 armature, damping and frictionloss are each of their velocity coordinates' drive, as MuJoCo
 applies them per dof.
 
+Every number eomgen takes from the compiled model is held to the rule for numbers in
+descriptions (finite, magnitude at most 1e12: :mod:`eomgen.model.numbers`) before anything is
+built, an :class:`~eomgen.errors.InvalidNumberError` naming the element and the attribute
+(:mod:`eomgen.parsers.mjcf.numbers`). A DTD with entity declarations or an external identifier
+is refused (:class:`~eomgen.errors.ForbiddenXMLError`), as in URDF.
+
 Contacts, joint limits, geoms, sites, sensors and the rendering options do not enter the
 equations of motion and are ignored.
 """
@@ -83,16 +89,23 @@ import warnings
 from dataclasses import replace
 from pathlib import Path
 
-from ...errors import DescriptionError, UnknownFormatError, UnreadableFileError, UnsupportedError
+from ...errors import (DescriptionError, ForbiddenXMLError, UnknownFormatError,
+                       UnreadableFileError, UnsupportedError)
 from ...model import RobotModel, emit_notices, settled
 from ..registry import register
 from .extras import model_notices, motors, with_equalities
+from .numbers import check_compiled
 from .tree import build_tree
 
 #: The optional extra that installs MuJoCo.
 EXTRA = "simulators"
 
 _LEADING = re.compile(r"\s*(<\?.*?\?>|<!--.*?-->|<!DOCTYPE[^>]*>)", re.S)
+#: A document type declaration with an internal subset (entity declarations) or an external
+#: identifier, or an entity declaration: refused, as in URDF (a bare ``<!DOCTYPE mujoco>`` is
+#: read).
+_DTD = re.compile(r"<!DOCTYPE\b[^>\[]*(?:\[|\b(?:SYSTEM|PUBLIC)\b)|<!ENTITY\b")
+_COMMENT = re.compile(r"<!--.*?-->", re.S)
 
 
 class MujocoCompileError(DescriptionError):
@@ -121,6 +134,8 @@ def load_mjcf(path: Path, strict: bool = False, defer_notices: bool = False) -> 
         MuJoCo is not installed (naming the extra); higher-order joint equalities; under ``strict``, every warned feature.
     MujocoCompileError
         The compiler rejected the file (its message).
+    ForbiddenXMLError
+        A DTD with entity declarations or an external identifier.
     UnknownFormatError
         The root element is not ``<mujoco>``.
     """
@@ -129,6 +144,9 @@ def load_mjcf(path: Path, strict: bool = False, defer_notices: bool = False) -> 
         text = Path(path).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise UnreadableFileError(source, "", f"cannot read the file ({exc})") from None
+    if _DTD.search(_COMMENT.sub("", text)):
+        raise ForbiddenXMLError(source, "<!DOCTYPE>", "XML with a DTD, entity declarations or "
+                                "external references is not read (security)")
     if not is_mjcf(text):
         raise UnknownFormatError(source, "", "not an MJCF file: the root element is not "
                                  "<mujoco>")
@@ -183,7 +201,15 @@ def import_mujoco(source: str):
 def model_from_mujoco(m, source: str = "<mujoco>", strict: bool = False,
                       defer_notices: bool = False) -> RobotModel:
     """eomgen's model of the compiled MuJoCo model ``m`` (``mujoco.MjModel``); see the module
-    docstring. ``source`` names it in messages."""
+    docstring. ``source`` names it in messages.
+
+    Raises
+    ------
+    InvalidNumberError
+        A number eomgen reads that is not finite or of magnitude above 1e12
+        (:mod:`eomgen.parsers.mjcf.numbers`), naming the element and the attribute.
+    """
+    check_compiled(m, source)
     model = with_equalities(build_tree(m, source), m, source)
     present = {joint.name for joint in model.joints}
     # what concerns only the joints of a dropped free body goes with it

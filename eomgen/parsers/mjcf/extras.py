@@ -63,10 +63,10 @@ def motors(m) -> tuple[tuple[str, str, float], ...]:
     jnames = joint_names(m)
     return tuple((_name(m, "actuator", i), jnames[int(m.actuator_trnid[i, 0])],
                   float(m.actuator_gear[i, 0] * m.actuator_gainprm[i, 0]))
-                 for i in range(m.nu) if _is_motor(m, i))
+                 for i in range(m.nu) if is_motor(m, i))
 
 
-def _is_motor(m, i: int) -> bool:
+def is_motor(m, i: int) -> bool:
     if int(m.actuator_trntype[i]) not in (_TRN_JOINT, _TRN_JOINT_IN_PARENT):
         return False
     joint = int(m.actuator_trnid[i, 0])
@@ -123,7 +123,7 @@ def model_notices(m, source: str) -> tuple[Notice, ...]:
                                "tendons are not modelled (their springs, damping and the "
                                "actuators on them)", "left out", joints=joints))
     for i in range(m.nu):
-        if not _is_motor(m, i):
+        if not is_motor(m, i):
             on_joint = int(m.actuator_trntype[i]) in (_TRN_JOINT, _TRN_JOINT_IN_PARENT)
             notices.append(_notice(source, f"actuator '{_name(m, 'actuator', i)}'",
                                    f"{_actuator_kind(m, i)} is not modelled",
