@@ -127,7 +127,7 @@ def check_loops(model: RobotModel, seed: int = 0) -> LoopMobility:
                               f"'{loop.b.link}') are on the same rigid body {body}: the loop "
                               "constrains nothing")
     rng = np.random.default_rng(seed)
-    rows = _LoopRows(model)
+    rows = LoopRows(model)
     samples = [rows.at(_random(model, rng)) for _ in range(SAMPLES)]
     J = np.stack([s[1] for s in samples])               # (samples, m, n)
     scale = max(float(np.abs(J).max(initial=0.0)), 1.0)
@@ -185,7 +185,7 @@ def _check_plane(k: int, loop: Loop, dropped: np.ndarray, scale: float) -> None:
                       "mechanism's normal, or declare the loop spatial")
 
 
-class _LoopRows:
+class LoopRows:
     """The loops' rows ``Φ`` and ``J_l`` at a configuration, and the rows a planar loop
     leaves out, from :func:`eomgen.numeric.frames.frame_kinematics`."""
 
@@ -254,7 +254,7 @@ def _random(model: RobotModel, rng) -> np.ndarray:
     return integrate(neutral(model), rng.uniform(-np.pi, np.pi, model.dof), 1.0, model)
 
 
-def _closed(model: RobotModel, rows: _LoopRows, rng) -> list[np.ndarray]:
+def _closed(model: RobotModel, rows: LoopRows, rng) -> list[np.ndarray]:
     """Configurations where the loops close: Newton's least-norm steps over every coordinate
     from the neutral configuration then from random ones until one closes, then from
     :data:`MOVES` random moves away from it (a start may close at a singular
@@ -275,7 +275,7 @@ def _closed(model: RobotModel, rows: _LoopRows, rng) -> list[np.ndarray]:
     return found
 
 
-def _newton(model: RobotModel, rows: _LoopRows, q) -> np.ndarray | None:
+def _newton(model: RobotModel, rows: LoopRows, q) -> np.ndarray | None:
     for _ in range(ITERATIONS):
         Phi, J, _ = rows.at(q)
         if np.abs(Phi).max(initial=0.0) <= CLOSED:
@@ -301,4 +301,4 @@ def _vector(v) -> str:
     return "(" + ", ".join(f"{float(x):.6g}" for x in v) + ")"
 
 
-__all__ = ["LoopMobility", "LoopProblem", "SAMPLES", "check_loops"]
+__all__ = ["LoopMobility", "LoopProblem", "LoopRows", "SAMPLES", "check_loops"]
