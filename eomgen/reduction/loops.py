@@ -6,15 +6,17 @@ from dataclasses import replace
 
 from ..errors import InvalidLoopError
 from ..model import RobotModel
-from ..numeric.loop_checks import LoopProblem, check_loops
+from ..numeric.loop_checks import LoopMobility, LoopProblem, check_loops
 from ..scene import Scene, did_you_mean, scene_error
 
 
-def with_loops(reduced: RobotModel, scene: Scene, notes: list[str]) -> RobotModel:
-    """``reduced`` carrying ``scene``'s loops and actuated joints (their links are already
-    kept in the reduced model), checked against its joints
-    (:func:`eomgen.numeric.loop_checks.check_loops`); a note says what they are and the
-    degrees of freedom they leave.
+def with_loops(reduced: RobotModel, scene: Scene, notes: list[str]
+               ) -> tuple[RobotModel, LoopMobility | None]:
+    """``(model, mobility)``: ``reduced`` carrying ``scene``'s loops and actuated joints (their
+    links are already kept in the reduced model), checked against its joints
+    (:func:`eomgen.numeric.loop_checks.check_loops`), and what the loops leave of the
+    mechanism (None without loops); a note says what they are and the degrees of freedom
+    they leave.
 
     Raises
     ------
@@ -38,7 +40,7 @@ def with_loops(reduced: RobotModel, scene: Scene, notes: list[str]) -> RobotMode
     own = {loop.name for loop in reduced.loops}  # the description's (MJCF equalities)
     model = replace(reduced, loops=scene.loops, actuated=actuated)
     if not scene.loops:
-        return model
+        return model, None
     try:
         mobility = check_loops(model)
     except LoopProblem as exc:
@@ -50,7 +52,7 @@ def with_loops(reduced: RobotModel, scene: Scene, notes: list[str]) -> RobotMode
                                  + (", planar" if loop.plane is not None else "")
                                  + f", {loop.size} rows)" for loop in scene.loops)
                  + "; " + mobility.describe())
-    return model
+    return model, mobility
 
 
 def loop_error(model: RobotModel, scene: Scene, k: int, problem: str,
