@@ -236,3 +236,22 @@ def test_the_cli_refuses_in_one_line_and_writes_nothing(tmp_path, command):
     assert line.startswith(f"eomgen: error: {sc}: loops[0] '"), result.stderr
     assert not [l for l in result.stderr.splitlines() if "error" in l][1:]
     assert not out.exists()
+
+
+def test_a_planar_loop_on_a_free_base_is_refused_and_a_spatial_one_accepted(tmp_path):
+    """The four-bar on a free base (its ground given a mass): the base turns the mechanism out
+    of the loop's world plane, so the planar loop is refused; declared spatial it is accepted,
+    the base's six coordinates free (7 = 9 − 2: its out-of-plane row is dependent where the
+    loop closes); witness: the spatial loop's derived z row moves at a tilted base."""
+    text = (ROBOTS / "fourbar.yaml").read_text().replace(
+        "  - name: ground\n", "  - name: ground\n    mass: 2.0\n"
+        "    inertia: {ixx: 0.1, iyy: 0.1, izz: 0.1}\n")
+    model = eomgen.load(write(tmp_path / "fourbar.yaml", text))
+    loops = (LOOPS / "fourbar_loop.yaml").read_text()
+    message = refused(model, load_scene("free.yaml", text=loops + "floating_base: true\n"))
+    assert "loops[0] 'pin': the plane (normal (0, 0, 1), world axes) does not hold" in message
+    spatial = loops.replace("    plane: [0, 0, 1]\n", "") + "floating_base: true\n"
+    reduced, report = apply_scene(model, load_scene("free.yaml", text=spatial))
+    assert report.mobility.dof == 7 and report.mobility.closed
+    q = np.array([0, 0, 0, np.sin(0.2), 0, 0, np.cos(0.2), 0.3, 1.0, 2.0])  # base about x
+    assert np.abs(LoopDynamics(reduced).loop_jacobian(q)[2, 6:]).max() > 0.01
