@@ -28,6 +28,8 @@ tests) can tell them apart without reading messages::
     │   │                         motor inertia
     │   ├── KinematicTreeError    duplicate names, undefined links or joints, two parents,
     │   │                         cycles, disconnected links, no root
+    │   ├── InvalidLoopError      a loop closure that constrains nothing, a planar loop whose
+    │   │                         plane does not hold the motion, loops leaving no freedom
     │   ├── UnsupportedError      floating and planar joints; mimic joints read as
     │   │                         independent (couplings=False) under strict
     │   └── SceneError            a scene file (eomgen.scene) that is malformed or does not fit
@@ -186,6 +188,13 @@ class KinematicTreeError(DescriptionError):
     (or a mimic naming an undefined joint), a link with two parents or joined to itself, a
     cycle, links not connected to the root, no root; couplings (URDF ``<mimic>``) of missing or
     fixed joints, in a cycle, or of a follower that leads another."""
+
+
+class InvalidLoopError(DescriptionError):
+    """A loop closure (a scene's ``loops:``, an MJCF ``connect`` or ``weld``) does not
+    constrain what it claims (:mod:`eomgen.numeric.loop_checks`): no joint moves its frames
+    apart, a planar loop whose plane does not hold the motion, loops that leave no degree of
+    freedom or fewer than the joints named in ``actuated:``."""
 
 
 class UnsupportedError(DescriptionError):

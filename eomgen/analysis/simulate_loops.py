@@ -269,8 +269,11 @@ class LoopStudy:
             text += (" Forces at t = 0 (CONTACT_ROWS: contacts, then loops): "
                      f"({', '.join(f'{x + 0.0:.6g}' for x in self.initial_force)}).")
         if self.damping:
-            text += (" The rows are dependent at q0 (a direction no joint moves a contact in, "
-                     f"or redundant loops): damped KKT solve, ε = {self.damping:g}.")
+            why = ("a direction no joint moves a contact or a loop in, or redundant loops"
+                   if self.contacts else "a loop row no joint moves, as the out-of-plane rows "
+                   "of a spatial loop on a planar mechanism, or redundant loops")
+            text += (f" The rows are dependent at q0 ({why}): damped KKT solve, "
+                     f"ε = {self.damping:g}.")
         return text
 
 

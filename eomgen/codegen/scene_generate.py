@@ -67,8 +67,9 @@ def render_scene_files(model: RobotModel, scene: Scene | None, backends: Sequenc
     start = time.perf_counter()
     reduced, report = apply_scene(model, scene)
     progress(f"scene {Path(report.scene).name}: {report.moving_summary()}, "
-             f"{report.after.links} of {report.before.links} links kept "
-             f"({time.perf_counter() - start:.2f} s)")
+             f"{report.before.links} links in the description, {report.after.links} in the "
+             f"model ({time.perf_counter() - start:.2f} s)"
+             + (f"; {report.mobility.describe()}" if report.mobility is not None else ""))
     reduced = keep_symbolic(reduced, symbolic)
     functions = report.outputs
     outputs = derived_outputs(functions)

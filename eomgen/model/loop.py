@@ -67,7 +67,7 @@ class Loop:
     @property
     def translations(self) -> tuple[str, ...]:
         """Names of its translational rows: ``x, y, z`` (world axes), or ``u, v`` (the in-plane
-        axes of :func:`eomgen.symbolic.loops.plane_axes`)."""
+        axes of :func:`in_plane_axes`)."""
         return ("x", "y", "z") if self.plane is None else ("u", "v")
 
     @property
@@ -90,3 +90,23 @@ class Loop:
     def size(self) -> int:
         """Rows of the loop: point 3, hinge 5, weld 6; planar point or hinge 2, planar weld 3."""
         return len(self.rows)
+
+
+def in_plane_axes(normal) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """Two unit vectors ``t1, t2`` with ``(t1, t2, n)`` right-handed, ``n`` the unit ``normal``:
+    ``t1`` is the coordinate axis least aligned with ``n`` (the first of a tie), made
+    orthogonal to it, ``t2 = n × t1`` (for ``n = z``: ``x`` and ``y``; ``n = y``: ``z`` and
+    ``x``). A planar loop's rows ``u, v``, and a hinge's two rotation rows about its axis.
+
+    >>> in_plane_axes((0, 0, 1))
+    ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0))
+    """
+    n = [float(x) for x in normal]
+    norm = sum(x * x for x in n) ** 0.5
+    n = [x / norm for x in n]
+    k = min(range(3), key=lambda i: (abs(n[i]), i))
+    t1 = [(1.0 if i == k else 0.0) - n[k] * n[i] for i in range(3)]
+    s = sum(x * x for x in t1) ** 0.5
+    t1 = [x / s for x in t1]
+    t2 = [n[1] * t1[2] - n[2] * t1[1], n[2] * t1[0] - n[0] * t1[2], n[0] * t1[1] - n[1] * t1[0]]
+    return tuple(t1), tuple(t2)

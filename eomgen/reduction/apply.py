@@ -122,7 +122,7 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
     reduced, world = _reroot(reduced)
     reduced = _keep_contact_frames(locked_model, reduced, scene, set(dropped))
     reduced = replace(reduced, contacts=scene.contacts, frames=scene.frames)
-    reduced = with_loops(reduced, scene, notes)
+    reduced, mobility = with_loops(reduced, scene, notes)
     if scene.contacts:
         notes.append("contacts (generated with --outputs contact_jacobian, contact_bias, constrained_forward_dynamics; numerically eomgen.numeric.contacts.ContactDynamics): "
                      + ", ".join(f"{c.name} on '{c.frame}' ({c.kind}"
@@ -146,7 +146,7 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
         moving=reduced.joint_names, world=world, locked=tuple(locks), merged=merged,
         dropped=dropped,
         dropped_payloads=dropped_payloads, planar=planar, notes=tuple(notes),
-        outputs=select(scene.outputs), contacts=scene.contacts,
+        outputs=select(scene.outputs), contacts=scene.contacts, mobility=mobility,
         virtual_joints=(VELOCITY_NAMES if scene.floating_base == "quaternion" else
                         EULER_JOINTS if scene.floating_base else ()))
     return Reduction(reduced, report)

@@ -108,6 +108,9 @@ class ReductionReport:
     #: The six virtual joints a scene's ``floating_base`` put above the root (moving, but not
     #: the description's); empty without a floating base.
     virtual_joints: tuple[str, ...] = ()
+    #: What the loops leave of the mechanism (:class:`eomgen.numeric.loop_checks.LoopMobility`:
+    #: ``dof``, ``describe()``); None without loops.
+    mobility: object = None
 
     def __repr__(self) -> str:
         """One line: the robot, the scene, what moves (the whole report: :meth:`markdown`)."""

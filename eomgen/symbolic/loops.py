@@ -32,6 +32,7 @@ import sympy as sp
 
 from ..errors import GenerationError
 from ..model import HINGE, WELD, RobotModel, Transform
+from ..model.loop import in_plane_axes
 from .builders import builds, provides, sizes
 from .frames import build_contacts, contact_rows, frame_kinematics
 from .spatial import cross, matmul, matvec
@@ -46,22 +47,12 @@ def _exact(x) -> sp.Expr:
 
 
 def plane_axes(normal) -> tuple[tuple, tuple]:
-    """Two unit vectors ``t1, t2`` with ``(t1, t2, n)`` right-handed, ``n`` the unit
-    ``normal``: ``t1`` is the coordinate axis least aligned with ``n``, made orthogonal to it
-    (for ``n = z``: ``x`` and ``y``; ``n = y``: ``z`` and ``x``); SymPy numbers, exact for axes.
+    """:func:`eomgen.model.loop.in_plane_axes` of ``normal`` as SymPy numbers, exact for axes.
 
     >>> plane_axes((0, 0, 1))
     ((1, 0, 0), (0, 1, 0))
     """
-    n = [float(x) for x in normal]
-    norm = sum(x * x for x in n) ** 0.5
-    n = [x / norm for x in n]
-    k = min(range(3), key=lambda i: (abs(n[i]), i))
-    t1 = [(1.0 if i == k else 0.0) - n[k] * n[i] for i in range(3)]
-    s = sum(x * x for x in t1) ** 0.5
-    t1 = [x / s for x in t1]
-    t2 = [n[1] * t1[2] - n[2] * t1[1], n[2] * t1[0] - n[0] * t1[2], n[0] * t1[1] - n[1] * t1[0]]
-    return tuple(_exact(x) for x in t1), tuple(_exact(x) for x in t2)
+    return tuple(tuple(_exact(x) for x in t) for t in in_plane_axes(normal))
 
 
 def loop_rows(model: RobotModel) -> tuple[str, ...]:

@@ -29,7 +29,10 @@ PACKAGE = ROOT / "eomgen"
 LAYERS: tuple[tuple[int, tuple[str, ...]], ...] = (
     (0, ("errors", "moved", "common", "runtime", "robots", "outputs")),
     (1, ("model",)),
-    (2, ("parsers", "scene", "reduction")),
+    (2, ("parsers", "scene", "reduction",
+         # the float kinematics floor, which the loop checks of a scene or an MJCF file use
+         "numeric.model", "numeric.newton_euler", "numeric.frames", "numeric.so3",
+         "numeric.quaternion_chart", "numeric.loop_checks")),
     (3, ("symbolic.monomials", "symbolic.spatial", "symbolic.program", "symbolic.transforms",
          "symbolic.printing", "symbolic.evaluate", "symbolic.derivation", "symbolic.builders",
          "symbolic.quaternion_joints", "symbolic.couplings")),

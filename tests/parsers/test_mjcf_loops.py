@@ -112,8 +112,10 @@ def test_qpos0_closes_the_loops_and_the_constrained_accelerations_are_mujocos(ca
 
 def test_a_scene_keeps_the_description_loops_and_adds_its_own(case):
     model = case[0]
-    scene = load_scene("s.yaml", "version: 1\nloops:\n  - {name: extra, type: point, a: {link: A1}, "
-                        "b: {link: C1}}\n")
+    # A1's point 0.1 m from its axis held at its place at q = 0 (A1's origin and C1's, each
+    # on its own axis, never move: a loop between them constrains nothing, and is refused)
+    scene = load_scene("s.yaml", "version: 1\nloops:\n  - {name: extra, type: point, a: {link: "
+                        "world, xyz: [0.1, 0, 0.1]}, b: {link: A1, xyz: [0.1, 0, 0]}}\n")
     reduced = apply_scene(model, scene).model
     assert [loop.name for loop in reduced.loops] == ["pin", "glue", "extra"]
     clash = load_scene("s.yaml", "version: 1\nloops:\n  - {name: pin, type: point, a: {link: A1}, "
@@ -125,7 +127,8 @@ def test_a_scene_keeps_the_description_loops_and_adds_its_own(case):
 def test_site_connect_rotation_free_weld_and_a_coupling(tmp_path):
     """A connect between two sites holds their origins; a weld with torquescale 0 is a
     point loop (MuJoCo's rotational rows are then zero); with a joint equality too, J_l is
-    projected onto the independent joints (J_l T)."""
+    projected onto the independent joints (J_l T). (b2's second joint leaves the mechanism one
+    degree of freedom: without it, the loops make it rigid, which is refused.)"""
     path = tmp_path / "s.xml"
     path.write_text("""<mujoco model="s"><worldbody>
       <body name="a" pos="0 0 0.1"><joint name="ja" axis="0 0 1"/><geom size="0.05" pos="0.1 0 0"/>
@@ -133,7 +136,8 @@ def test_site_connect_rotation_free_weld_and_a_coupling(tmp_path):
         <body name="a2" pos="0.2 0 0"><joint name="ja2" axis="0 1 0"/><geom size="0.05"/></body></body>
       <body name="b" pos="0.4 0 0.1"><joint name="jb" axis="1 0 0"/><geom size="0.05"/>
         <site name="sb" pos="-0.2 0.01 0"/>
-        <body name="b2" pos="-0.1 0 0"><joint name="jb2" axis="0 0 1"/><geom size="0.05"/></body></body>
+        <body name="b2" pos="-0.1 0 0"><joint name="jb2" axis="0 0 1"/><joint name="jb3" axis="0 1 0"/>
+          <geom size="0.05"/></body></body>
       </worldbody><equality><connect name="c" site1="sa" site2="sb"/>
       <weld name="w" body1="a2" body2="b2" torquescale="0"/>
       <joint joint1="jb2" joint2="ja2" polycoef="0.1 0.5 0 0 0"/></equality></mujoco>""",
@@ -142,10 +146,10 @@ def test_site_connect_rotation_free_weld_and_a_coupling(tmp_path):
     assert [(loop.name, loop.kind) for loop in model.loops] == [("c", "point"), ("w", "point")]
     lay = layout(m, model)
     f = eomgen.derive(model, outputs=("Phi_l", "J_l")).lambdify().module
-    assert model.joint_names == ("ja", "ja2", "jb")
-    q = np.array([0.3, -0.2, 0.5])
-    J_mj, pos = equality_rows(m, lay, q, np.zeros(3))
-    J = f.loop_jacobian(q).reshape(6, 3)
+    assert model.joint_names == ("ja", "ja2", "jb", "jb3")
+    q = np.array([0.3, -0.2, 0.5, 0.4])
+    J_mj, pos = equality_rows(m, lay, q, np.zeros(4))
+    J = f.loop_jacobian(q).reshape(6, 4)
     assert relative(J, J_mj[:6]) < 1e-12 and np.abs(J_mj[6]).max() < 1e-12
     assert relative(f.loop_constraint(q).ravel(), pos[:6]) < 1e-12
 

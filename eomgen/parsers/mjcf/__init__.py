@@ -66,7 +66,9 @@ than motors on hinge and slide joints, equalities that are inactive (``active="f
 (``density``, ``viscosity``), gravity compensation (``gravcomp``). Refused
 (:class:`~eomgen.errors.UnsupportedError`), by name: ``joint`` equalities of order above
 one; two ``joint`` equalities on one joint or a cycle of them
-(:class:`~eomgen.errors.KinematicTreeError`). ``ball`` joints are ball joints
+(:class:`~eomgen.errors.KinematicTreeError`); a ``connect`` or ``weld`` that fails the checks
+of a scene's loops (:mod:`eomgen.numeric.loop_checks`: between bodies welded together, loops
+leaving no degree of freedom; :class:`~eomgen.errors.InvalidLoopError`). ``ball`` joints are ball joints
 (:mod:`eomgen.model.quaternion`): MuJoCo's ``(qw, qx, qy, qz)`` is eomgen's ``(qx, qy, qz,
 qw)``; the velocity is the same (the child's angular velocity in the child frame); their
 armature, damping and frictionloss are each of their velocity coordinates' drive, as MuJoCo
@@ -89,9 +91,10 @@ import warnings
 from dataclasses import replace
 from pathlib import Path
 
-from ...errors import (DescriptionError, ForbiddenXMLError, UnknownFormatError,
-                       UnreadableFileError, UnsupportedError)
+from ...errors import (DescriptionError, ForbiddenXMLError, InvalidLoopError,
+                       UnknownFormatError, UnreadableFileError, UnsupportedError)
 from ...model import RobotModel, emit_notices, settled
+from ...numeric.loop_checks import LoopProblem, check_loops
 from ..registry import register
 from .extras import model_notices, motors, with_equalities
 from .numbers import check_compiled
@@ -211,6 +214,12 @@ def model_from_mujoco(m, source: str = "<mujoco>", strict: bool = False,
     """
     check_compiled(m, source)
     model = with_equalities(build_tree(m, source), m, source)
+    if model.loops:  # the same checks as a scene's loops (eomgen.numeric.loop_checks)
+        try:
+            check_loops(model)
+        except LoopProblem as exc:
+            raise InvalidLoopError(source, f"equality '{model.loops[exc.index].name}'",
+                                   exc.problem) from None
     present = {joint.name for joint in model.joints}
     # what concerns only the joints of a dropped free body goes with it
     notices = tuple(n for n in model_notices(m, source)
