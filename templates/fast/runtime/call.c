@@ -142,16 +142,16 @@ static const char *not_finite(double value)
 }
 
 /* 0 when the `count` values (`size` a state) are finite, else -1 with a FloatingPointError
- * naming the input, its first bad entry and (batch) its state. One pass: x * 0 is 0 for every
- * finite x and nan for nan and +-inf. */
+ * naming the input, its first bad entry and (batch) its state. One pass without a branch or a
+ * chain of dependent additions: x - x is 0 for every finite x and nan for nan and +-inf. */
 static int check_finite(const function_t *f, const double *x, npy_intp count, int size,
                         int batch, const char *name)
 {
-    double zero = 0.0;
+    int finite = 1;
     npy_intp i;
     for (i = 0; i < count; ++i)
-        zero += x[i] * 0.0;
-    if (zero == 0.0)
+        finite &= (x[i] - x[i] == 0.0);
+    if (finite)
         return 0;
     for (i = 0; isfinite(x[i]); ++i)
         ;
