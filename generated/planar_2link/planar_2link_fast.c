@@ -360,7 +360,58 @@ static void release(call_t *call)
         Py_CLEAR(call->arrays[i]);
 }
 
-static PyArrayObject *as_states(PyObject *object, const char *name, int size)
+/* The type (TypeError) and value (FloatingPointError) errors of an input: the eomgen rule for
+ * every function of the NumPy and fast modules (docs/backends.md, "Values a function refuses").
+ * refuse_type: the input `name` does not hold real numbers (complex, text, ...). */
+static void refuse_type(const function_t *f, PyObject *object, const char *name)
+{
+    PyObject *array = PyArray_FROM_O(object), *dtype = NULL;
+    PyErr_Clear();
+    if (array != NULL)
+        dtype = PyObject_GetAttrString(array, "dtype");
+    PyErr_Clear();
+    if (dtype != NULL)
+        PyErr_Format(PyExc_TypeError, "%s: %s must hold real numbers, got dtype %S", f->name,
+                     name, dtype);
+    else
+        PyErr_Format(PyExc_TypeError, "%s: %s must hold real numbers, got %R", f->name, name,
+                     object);
+    Py_XDECREF(dtype);
+    Py_XDECREF(array);
+}
+
+/* The words for a value that is not finite: "nan", "inf" or "-inf", as Python prints them. */
+static const char *not_finite(double value)
+{
+    return isnan(value) ? "nan" : value > 0 ? "inf" : "-inf";
+}
+
+/* 0 when the `count` values (`size` a state) are finite, else -1 with a FloatingPointError
+ * naming the input, its first bad entry and (batch) its state. One pass without a branch or a
+ * chain of dependent additions: x - x is 0 for every finite x and nan for nan and +-inf. */
+static int check_finite(const function_t *f, const double *x, npy_intp count, int size,
+                        int batch, const char *name)
+{
+    int finite = 1;
+    npy_intp i;
+    for (i = 0; i < count; ++i)
+        finite &= (x[i] - x[i] == 0.0);
+    if (finite)
+        return 0;
+    for (i = 0; isfinite(x[i]); ++i)
+        ;
+    if (batch)
+        PyErr_Format(PyExc_FloatingPointError, "%s: %s is not finite at state %zd: entry %d "
+                     "is %s", f->name, name, (Py_ssize_t)(i / size), (int)(i % size),
+                     not_finite(x[i]));
+    else
+        PyErr_Format(PyExc_FloatingPointError, "%s: %s is not finite: entry %d is %s", f->name,
+                     name, (int)i, not_finite(x[i]));
+    return -1;
+}
+
+static PyArrayObject *as_states(const function_t *f, PyObject *object, const char *name,
+                                int size)
 {
     PyArrayObject *array;
     if (PyArray_CheckExact(object) && PyArray_TYPE((PyArrayObject *)object) == NPY_DOUBLE &&
@@ -369,8 +420,12 @@ static PyArrayObject *as_states(PyObject *object, const char *name, int size)
         array = (PyArrayObject *)object;
     } else {
         array = (PyArrayObject *)PyArray_FROMANY(object, NPY_DOUBLE, 0, 0, NPY_ARRAY_IN_ARRAY);
-        if (array == NULL)
+        if (array == NULL) {
+            if (PyErr_ExceptionMatches(PyExc_TypeError) ||
+                    PyErr_ExceptionMatches(PyExc_ValueError))
+                refuse_type(f, object, name);
             return NULL;
+        }
     }
     if (!((PyArray_NDIM(array) == 1 && PyArray_DIM(array, 0) == size) ||
           (PyArray_NDIM(array) == 2 && PyArray_DIM(array, 1) == size))) {
@@ -381,7 +436,29 @@ static PyArrayObject *as_states(PyObject *object, const char *name, int size)
         Py_DECREF(array);
         return NULL;
     }
+    if (check_finite(f, (const double *)PyArray_DATA(array), PyArray_SIZE(array), size,
+                     PyArray_NDIM(array) == 2, name) < 0) {
+        Py_DECREF(array);
+        return NULL;
+    }
     return array;
+}
+
+/* A keyword's number: -1 with a TypeError naming f and the keyword (`what`: "parameter 'm1'",
+ * "damping") when value is no real number (text, complex, an array of several ...). */
+static int keyword_number(const function_t *f, PyObject *value, const char *what, double *out)
+{
+    const int refused = PyComplex_Check(value) || PyUnicode_Check(value) ||
+        PyBytes_Check(value) || PyArray_IsScalar(value, ComplexFloating) ||
+        (PyArray_Check(value) && PyArray_ISCOMPLEX((PyArrayObject *)value));
+    *out = refused ? -1.0 : PyFloat_AsDouble(value);
+    if (refused || (*out == -1.0 && PyErr_Occurred())) {
+        PyErr_Clear();
+        PyErr_Format(PyExc_TypeError, "%s(): %s must be a real number, got %R", f->name, what,
+                     value);
+        return -1;
+    }
+    return 0;
 }
 
 static int parse(const function_t *f, PyObject *const *args, Py_ssize_t nargs,
@@ -414,9 +491,15 @@ static int parse(const function_t *f, PyObject *const *args, Py_ssize_t nargs,
             }
         for (j = 0; j < NP && !found; ++j)
             if (PyUnicode_CompareWithASCIIString(key, parameter_names[j]) == 0) {
-                call->p[j] = PyFloat_AsDouble(value);
-                if (call->p[j] == -1.0 && PyErr_Occurred())
+                char what[160];
+                snprintf(what, sizeof what, "parameter '%s'", parameter_names[j]);
+                if (keyword_number(f, value, what, &call->p[j]) < 0)
                     return -1;
+                if (!isfinite(call->p[j])) {
+                    PyErr_Format(PyExc_FloatingPointError, "%s(): %s is not finite: %s",
+                                 f->name, what, not_finite(call->p[j]));
+                    return -1;
+                }
                 set[j] = 1;
                 found = 1;
             }
@@ -430,8 +513,7 @@ static int parse(const function_t *f, PyObject *const *args, Py_ssize_t nargs,
         }
         if (!found && (takes & TAKES_DAMPING) &&
                 PyUnicode_CompareWithASCIIString(key, "damping") == 0) {
-            call->damping = PyFloat_AsDouble(value);
-            if (call->damping == -1.0 && PyErr_Occurred())
+            if (keyword_number(f, value, "damping", &call->damping) < 0)
                 return -1;
             if (!(call->damping >= 0.0 && isfinite(call->damping))) {
                 PyErr_Format(PyExc_ValueError, "%s(): damping must be a finite number >= 0, "
@@ -475,7 +557,7 @@ static int parse(const function_t *f, PyObject *const *args, Py_ssize_t nargs,
             release(call);
             return -1;
         }
-        call->arrays[j] = as_states(given[j], f->inputs[j], f->sizes[j] ? f->sizes[j] : NV);
+        call->arrays[j] = as_states(f, given[j], f->inputs[j], f->sizes[j] ? f->sizes[j] : NV);
         if (call->arrays[j] == NULL) {
             release(call);
             return -1;

@@ -43,13 +43,65 @@ PARAMETERS = {
 
 
 def _batch(x, name, size=NV):
-    """x as a float array of shape (N, size), and whether it was a single state."""
+    """x as a float array of shape (N, size), and whether it was a single state. A TypeError
+    unless x holds real numbers, a FloatingPointError naming the state and entry where it
+    holds NaN or +-inf."""
+    x = np.asarray(x)
+    if x.dtype.kind not in "biuf":
+        x = _real(x, name)
     x = np.asarray(x, dtype=float)
     if x.ndim == 1 and x.shape[0] == size:
-        return x[np.newaxis, :], True
-    if x.ndim == 2 and x.shape[1] == size:
-        return x, False
-    raise ValueError(f"{name} must have shape ({size},) or (N, {size}), got {x.shape}")
+        x, single = x[np.newaxis, :], True
+    elif x.ndim == 2 and x.shape[1] == size:
+        single = False
+    else:
+        raise ValueError(f"{name} must have shape ({size},) or (N, {size}), got {x.shape}")
+    if not np.all(np.isfinite(x)):
+        k, i = np.argwhere(~np.isfinite(x))[0]
+        raise FloatingPointError(f"{_caller()}: {name} is not finite"
+                                 + ("" if single else f" at state {k}")
+                                 + f": entry {i} is {float(x[k, i])!r}")
+    return x, single
+
+
+def _real(x, name):
+    """x, an array of Python objects, as floats; TypeError for any other kind (complex, text)."""
+    if x.dtype.kind == "O":
+        try:
+            return x.astype(float)
+        except (TypeError, ValueError):
+            pass
+    raise TypeError(f"{_caller()}: {name} must hold real numbers, got dtype {x.dtype}")
+
+
+def _caller():
+    """The name of the function of this module that was called (the outermost one on the
+    stack), for an error's message: the stack walked from a traceback's frame (the module
+    imports nothing but NumPy)."""
+    try:
+        raise RuntimeError
+    except RuntimeError as error:
+        frame, name = error.__traceback__.tb_frame, "?"
+    home = frame.f_globals  # this module's
+    while frame is not None and frame.f_globals is home:
+        name = frame.f_code.co_name if frame.f_code.co_name in __all__ else name
+        frame = frame.f_back
+    return name
+
+
+def _parameters(**values):
+    """TypeError unless every parameter's value is a real number or array, FloatingPointError
+    where one is NaN or +-inf."""
+    for name, value in values.items():
+        if type(value) is float and value - value == 0.0:
+            continue
+        x = np.asarray(value)
+        if x.dtype.kind not in "biuf":
+            raise TypeError(f"{_caller()}(): parameter {name!r} must be a real number, got "
+                            f"{value!r}")
+        if not np.all(np.isfinite(x)):
+            raise FloatingPointError(f"{_caller()}(): parameter {name!r} is not finite: "
+                                     f"{float(x) if x.ndim == 0 else value!r}")
 
 
 def _states(*named):
@@ -81,6 +133,7 @@ def mass_matrix(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81, l1
 
     19 arithmetic operations per state.
     """
+    _parameters(I1=I1, I2=I2, g=g, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
     g_ = g
     q, single = _states((q, "q"))
     batch = q.shape[0]
@@ -121,6 +174,7 @@ def coriolis_matrix(q, qd, *, I1=0.08333333333333333, I2=0.08333333333333333, g=
 
     43 arithmetic operations per state.
     """
+    _parameters(I1=I1, I2=I2, g=g, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
     g_ = g
     q, qd, single = _states((q, "q"), (qd, "qd"))
     batch = q.shape[0]
@@ -180,6 +234,7 @@ def gravity_vector(q, *, I1=0.08333333333333333, I2=0.08333333333333333, g=9.81,
 
     16 arithmetic operations per state.
     """
+    _parameters(I1=I1, I2=I2, g=g, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
     g_ = g
     q, single = _states((q, "q"))
     batch = q.shape[0]
@@ -225,6 +280,7 @@ def inverse_dynamics(q, qd, qdd, *, I1=0.08333333333333333, I2=0.083333333333333
 
     46 arithmetic operations per state.
     """
+    _parameters(I1=I1, I2=I2, g=g, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
     g_ = g
     q, qd, qdd, single = _states((q, "q"), (qd, "qd"), (qdd, "qdd"))
     batch = q.shape[0]
@@ -403,6 +459,7 @@ def forward_dynamics(q, qd, tau, *, I1=0.08333333333333333, I2=0.083333333333333
     FloatingPointError
         When M, C qd + g or tau is not finite at some state (overflow, non-finite input).
     """
+    _parameters(I1=I1, I2=I2, g=g, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)
     g_ = g
     q_batch, qd_batch, tau_batch, single = _states((q, "q", NQ), (qd, "qd"), (tau, "tau"))
     M = mass_matrix(q_batch, I1=I1, I2=I2, g=g_, l1=l1, l2=l2, lc1=lc1, lc2=lc2, m1=m1, m2=m2)

@@ -40,13 +40,50 @@ PARAMETERS = {
 
 
 def _batch(x, name, size=NV):
-    """x as a float array of shape (N, size), and whether it was a single state."""
+    """x as a float array of shape (N, size), and whether it was a single state. A TypeError
+    unless x holds real numbers, a FloatingPointError naming the state and entry where it
+    holds NaN or +-inf."""
+    x = np.asarray(x)
+    if x.dtype.kind not in "biuf":
+        x = _real(x, name)
     x = np.asarray(x, dtype=float)
     if x.ndim == 1 and x.shape[0] == size:
-        return x[np.newaxis, :], True
-    if x.ndim == 2 and x.shape[1] == size:
-        return x, False
-    raise ValueError(f"{name} must have shape ({size},) or (N, {size}), got {x.shape}")
+        x, single = x[np.newaxis, :], True
+    elif x.ndim == 2 and x.shape[1] == size:
+        single = False
+    else:
+        raise ValueError(f"{name} must have shape ({size},) or (N, {size}), got {x.shape}")
+    if not np.all(np.isfinite(x)):
+        k, i = np.argwhere(~np.isfinite(x))[0]
+        raise FloatingPointError(f"{_caller()}: {name} is not finite"
+                                 + ("" if single else f" at state {k}")
+                                 + f": entry {i} is {float(x[k, i])!r}")
+    return x, single
+
+
+def _real(x, name):
+    """x, an array of Python objects, as floats; TypeError for any other kind (complex, text)."""
+    if x.dtype.kind == "O":
+        try:
+            return x.astype(float)
+        except (TypeError, ValueError):
+            pass
+    raise TypeError(f"{_caller()}: {name} must hold real numbers, got dtype {x.dtype}")
+
+
+def _caller():
+    """The name of the function of this module that was called (the outermost one on the
+    stack), for an error's message: the stack walked from a traceback's frame (the module
+    imports nothing but NumPy)."""
+    try:
+        raise RuntimeError
+    except RuntimeError as error:
+        frame, name = error.__traceback__.tb_frame, "?"
+    home = frame.f_globals  # this module's
+    while frame is not None and frame.f_globals is home:
+        name = frame.f_code.co_name if frame.f_code.co_name in __all__ else name
+        frame = frame.f_back
+    return name
 
 
 def _states(*named):

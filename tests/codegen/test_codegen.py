@@ -737,8 +737,10 @@ NUMPY_CALLS = {"_batch", "_states", "mass_matrix", "inverse_dynamics", "ValueErr
                "_renamed_keywords", "function", "TypeError",
                # the Cholesky runtime (eomgen/runtime/cholesky.py), included verbatim
                "_cholesky_solve", "_condition_number", "_condition_estimate",
-               "_ill_conditioned_message"}
-NUMPY_LOCAL_OBJECTS = {"arrays", "singles", "_warnings"}
+               "_ill_conditioned_message",
+               # the checks of the values (docs/backends.md, "Values a function refuses")
+               "_real", "_caller", "_parameters", "float", "type", "RuntimeError"}
+NUMPY_LOCAL_OBJECTS = {"arrays", "singles", "_warnings", "x", "values", "error", "frame"}
 CASADI_LOCAL_OBJECTS = {"PARAMETERS"}  # the module's dict literal: PARAMETERS.values()
 CASADI_CALLS = {"_build", "_function", "_cholesky_solve", "sum", "range", "reversed", "len",
                 "float", "_Function", "TypeError", "isinstance"} | {
