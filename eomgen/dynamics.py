@@ -318,10 +318,10 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
                               "; use floating_base: euler") if model.free_flyer else
                              (f"a {first.kind.describe()[0]} joint",
                               f"{first.kind.describe()[0]} joint '{first.name}'", ""))
-        derived = [s for s, o in BY_SYMBOL.items() if o.quaternion_joints]
         raise UnsupportedError(
-            model.source, where, f"{', '.join(refused_here)} not derived for {what} yet (it "
-            f"has {', '.join(derived)}){hint}")
+            model.source, where, f"{', '.join(refused_here)} not derived for {what} yet; "
+            f"leave {'it' if len(refused_here) == 1 else 'them'} out of the outputs (every "
+            f"other output is derived for it){hint}")
     if model.couplings and refused(outputs):
         raise UnsupportedError(
             model.source, "couplings", f"{', '.join(refused(outputs))} not derived for a model "
