@@ -90,7 +90,6 @@ def check_couplings(source: str, model, couplings: Sequence[Coupling]) -> None:
     """
     joints = {j.name: j for j in model.joints}
     movable = {j.name for j in model.movable_joints}
-    virtual = set(j.name for j in model.movable_joints[:6]) if model.free_flyer else set()
     balls = {virtual: (KINDS[kind].describe()[0], name) for kind, name in model.compound_joints
              for virtual in KINDS[kind].velocity_names(name)}
     followers: dict[str, Coupling] = {}
@@ -106,9 +105,6 @@ def check_couplings(source: str, model, couplings: Sequence[Coupling]) -> None:
                 raise KinematicTreeError(source, where, f"joint '{name}' is "
                                          f"{joints[name].type.value}: only movable joints "
                                          "can be coupled")
-            if name in virtual:
-                raise UnsupportedError(source, where, f"joint '{name}' is a virtual joint of "
-                                       "the floating base: it cannot be coupled")
             if name in balls:
                 raise UnsupportedError(source, where, f"joint '{name}' is a virtual joint of "
                                        f"{balls[name][0]} joint '{balls[name][1]}': only one-axis joints "

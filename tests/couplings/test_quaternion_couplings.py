@@ -121,5 +121,5 @@ def test_full_configuration_copies_the_quaternion_and_couples_the_followers(case
 
 def test_coupling_a_virtual_joint_is_refused(case):
     model = case[0]
-    with pytest.raises(UnsupportedError, match="virtual joint of the floating base"):
+    with pytest.raises(UnsupportedError, match="virtual joint of free flyer joint .base.: only one-axis joints"):
         couple(model, "hip", "base_wz")
