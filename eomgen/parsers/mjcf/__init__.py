@@ -96,7 +96,7 @@ from ...errors import (DescriptionError, ForbiddenXMLError, InvalidLoopError,
 from ...model import RobotModel, emit_notices, settled
 from ...numeric.loop_checks import LoopProblem, check_loops
 from ..registry import register
-from .extras import model_notices, motors, with_equalities
+from .extras import model_notices, motors, with_equalities, with_tendons
 from .numbers import check_compiled
 from .tree import build_tree
 
@@ -213,7 +213,7 @@ def model_from_mujoco(m, source: str = "<mujoco>", strict: bool = False,
         (:mod:`eomgen.parsers.mjcf.numbers`), naming the element and the attribute.
     """
     check_compiled(m, source)
-    model = with_equalities(build_tree(m, source), m, source)
+    model = with_equalities(with_tendons(build_tree(m, source), m, source), m, source)
     if model.loops:  # the same checks as a scene's loops (eomgen.numeric.loop_checks)
         try:
             check_loops(model)

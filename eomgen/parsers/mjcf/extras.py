@@ -14,6 +14,8 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Callable, NamedTuple, Union
 
+import numpy as np
+
 from ...errors import UnsupportedError
 from ...model import (
     POINT_LOOP,
@@ -24,6 +26,7 @@ from ...model import (
     Notice,
     NoticeKind,
     RobotModel,
+    Tendon,
     Transform,
     lock_joints,
     make_coupling,
@@ -31,7 +34,7 @@ from ...model import (
     vec3,
     with_couplings,
 )
-from .tree import FREE, HINGE, SLIDE, body_names, disabled, joint_names, rotation_of_quaternion
+from .tree import BALL, FREE, HINGE, SLIDE, body_names, disabled, joint_names, rotation_of_quaternion
 
 #: MuJoCo's transmission, dynamics, gain and bias types of a plain motor (``mjTRN_JOINT``,
 #: ``mjDYN_NONE``, ``mjGAIN_FIXED``, ``mjBIAS_NONE``) and of ``mjTRN_JOINTINPARENT``.
@@ -102,12 +105,10 @@ def model_notices(m, source: str) -> tuple[Notice, ...]:
     if not disabled(m, "SPRING"):
         for j in range(m.njnt):
             k = float(m.jnt_stiffness[j])
-            if k:
-                ref = float(m.qpos_spring[int(m.jnt_qposadr[j])])
+            if k and int(m.jnt_type[j]) == BALL:
                 notices.append(_notice(source, f"joint '{jnames[j]}' stiffness",
-                                       f"the joint spring -{k:g} (q - {ref:g}) (stiffness, "
-                                       "springref) is not modelled", "left out",
-                                       joints=(jnames[j],)))
+                                       f"the spring {k:g} of a ball joint is not modelled",
+                                       "left out", joints=(jnames[j],)))
     for j in range(m.njnt):
         if int(m.jnt_type[j]) == FREE and float(m.dof_armature[int(m.jnt_dofadr[j])]):
             notices.append(_notice(source, f"joint '{jnames[j]}' (free) armature",
@@ -116,12 +117,19 @@ def model_notices(m, source: str) -> tuple[Notice, ...]:
                                    "M + a I, a bias a (omega x v) apart)",
                                    "read on eomgen's coordinates", joints=(jnames[j],)))
     for t in range(m.ntendon):
-        start, count = int(m.tendon_adr[t]), int(m.tendon_num[t])
-        joints = tuple(jnames[int(m.wrap_objid[w])] for w in range(start, start + count)
-                       if int(m.wrap_type[w]) == _WRAP_JOINT)
-        notices.append(_notice(source, f"tendon '{_name(m, 'tendon', t)}'",
-                               "tendons are not modelled (their springs, damping and the "
-                               "actuators on them)", "left out", joints=joints))
+        joints = _tendon_joints(m, t)
+        where = f"tendon '{_name(m, 'tendon', t)}'"
+        if not is_fixed(m, t):
+            notices.append(_notice(source, where, "a spatial tendon is not modelled (its "
+                                   "spring, damping and the actuators on it)", "left out",
+                                   joints=tuple(jnames[j] for j, _ in joints)))
+            continue
+        for attribute, values in (("armature", getattr(m, "tendon_armature", None)),
+                                  ("frictionloss", m.tendon_frictionloss)):
+            if values is not None and float(values[t]):
+                notices.append(_notice(source, f"{where} {attribute}", f"a tendon's "
+                                       f"{attribute} is not modelled", "left out",
+                                       joints=tuple(jnames[j] for j, _ in joints)))
     for i in range(m.nu):
         if not is_motor(m, i):
             on_joint = int(m.actuator_trntype[i]) in (_TRN_JOINT, _TRN_JOINT_IN_PARENT)
@@ -139,6 +147,55 @@ def model_notices(m, source: str) -> tuple[Notice, ...]:
             notices.append(_notice(source, f"body '{_name(m, 'body', b)}' gravcomp",
                                    "gravity compensation is not modelled", "left out"))
     return tuple(notices)
+
+
+def _tendon_joints(m, t: int) -> tuple[tuple[int, float], ...]:
+    """``(joint, coefficient)`` of each joint wrap of tendon ``t``."""
+    start, count = int(m.tendon_adr[t]), int(m.tendon_num[t])
+    return tuple((int(m.wrap_objid[w]), float(m.wrap_prm[w])) for w in range(start, start + count)
+                 if int(m.wrap_type[w]) == _WRAP_JOINT)
+
+
+def is_fixed(m, t: int) -> bool:
+    """Whether tendon ``t`` is a fixed tendon (every wrap a joint)."""
+    start, count = int(m.tendon_adr[t]), int(m.tendon_num[t])
+    return all(int(m.wrap_type[w]) == _WRAP_JOINT for w in range(start, start + count))
+
+
+def fixed_tendons(m) -> tuple[Tendon, ...]:
+    """The fixed tendons of ``m`` that pull (a stiffness or a damping): ``L = Σ c_i q_i``
+    (``wrap_prm`` the coefficients), the rest lengths ``tendon_lengthspring`` (a dead band
+    since MuJoCo 3; both ends the one length otherwise), ``tendon_stiffness`` (0 when the
+    ``spring`` flag is disabled) and ``tendon_damping`` (0 when ``damper`` is)."""
+    jnames = joint_names(m)
+    out = []
+    for t in range(m.ntendon):
+        k = 0.0 if disabled(m, "SPRING") else float(m.tendon_stiffness[t])
+        b = 0.0 if disabled(m, "DAMPER") else float(m.tendon_damping[t])
+        if not is_fixed(m, t) or not (k or b):
+            continue
+        rest = np.atleast_1d(np.asarray(m.tendon_lengthspring[t], dtype=float))
+        out.append(Tendon(_name(m, "tendon", t), tuple((jnames[j], c) for j, c in
+                                                       _tendon_joints(m, t)),
+                          k, (float(rest[0]), float(rest[-1])), b))
+    return tuple(out)
+
+
+def with_tendons(model: RobotModel, m, source: str) -> RobotModel:
+    """``model`` (the tree of ``m``) with its fixed tendons (:func:`fixed_tendons`); one on
+    a dropped free body's joints goes with it, one joining such a joint to a kept one is a
+    notice."""
+    present = {joint.name for joint in model.joints}
+    tendons, notices = [], []
+    for tendon in fixed_tendons(m):
+        names = [name for name, _ in tendon.coefficients]
+        kept = tuple(n for n in names if n in present)
+        if len(kept) == len(names):
+            tendons.append(tendon)
+        elif kept:
+            notices.append(_notice(source, f"tendon '{tendon.name}'", "it joins a dropped free "
+                                   "body", "left out", joints=kept))
+    return replace(model, tendons=tuple(tendons), notices=tuple(model.notices) + tuple(notices))
 
 
 def _equality_where(m, e: int, kind: str) -> str:
