@@ -134,3 +134,23 @@ def drift(lay, qpos, v):
         qa, da = lay.free
         out[da:da + 3] = rotation_of_quaternion(qpos[qa + 3:qa + 7]) @ np.cross(v[3:6], v[0:3])
     return out
+
+
+@pytest.mark.parametrize("name", ["half_cheetah", "hopper", "humanoid"])
+def test_gymnasium_models_passive_forces_are_mujocos(name):
+    """gymnasium's own assets (the ``mjcf-models`` extra): half_cheetah's 6 and the humanoid's
+    14 joint springs, every joint's damping."""
+    gymnasium = need("gymnasium", reason="gymnasium ships the MuJoCo models")
+    path = Path(gymnasium.__file__).parent / "envs" / "mujoco" / "assets" / f"{name}.xml"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the compiler's deprecations, motors on the free joint
+        model = eomgen.load(path)
+        m = compile_mjcf(path)
+    assert sum(j.spring is not None for j in model.joints) == {
+        "half_cheetah": 6, "hopper": 0, "humanoid": 14}[name]
+    module = eomgen.derive(model, outputs=("tau_p",)).lambdify().module
+    lay = layout(m, model)
+    for q, v in model_states(model, count=4):
+        ref = mujoco_dynamics(m, lay, q, v)["passive"]
+        assert np.abs(ref).max() > 0
+        assert relative(module.passive_forces(q, v).ravel(), ref) < TOLERANCE
