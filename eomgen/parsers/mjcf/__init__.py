@@ -37,6 +37,11 @@ What is read
   :class:`~eomgen.model.Actuator` (``armature``, viscous ``damping``, Coulomb ``friction``;
   docs/actuators.md); those of the free joint go to the six free-flyer coordinates (equal on
   all six, so they map exactly).
+* Each hinge or slide joint's ``stiffness`` and ``springref``: its
+  :class:`~eomgen.model.Spring` ``−k (q − qpos_spring)``; each fixed tendon with a stiffness
+  or a damping: a :class:`~eomgen.model.Tendon` of ``model.tendons`` (``L = Σ cᵢ qᵢ``, the
+  rest lengths ``springlength``, a dead band since MuJoCo 3). With the joints' damping they
+  are the output ``tau_p`` (MuJoCo's ``qfrc_passive``, :mod:`eomgen.symbolic.passive`).
 * ``<option gravity>`` (zero when the ``gravity`` flag is disabled).
 * ``<motor>`` actuators on hinge and slide joints: the joint torque is ``gear · ctrl``;
   ``model.info["mujoco_motors"]`` lists ``(actuator, joint, gear)``.
@@ -60,7 +65,8 @@ Unnamed bodies and joints are named ``body<i>`` and ``joint<i>`` with MuJoCo's i
 a name that is taken gets ``_2``, ``_3``, … appended.
 
 Warned about (:class:`~eomgen.errors.UnsupportedFeatureWarning`, refused under ``strict``),
-by name: joint springs (``stiffness``, ``springref``: not modelled), tendons, actuators other
+by name: ball joints' springs, spatial tendons (and a fixed tendon's armature and
+frictionloss), actuators other
 than motors on hinge and slide joints, equalities that are inactive (``active="false"``),
 ``tendon`` and flex equalities, an equality joining a dropped free body, fluid forces
 (``density``, ``viscosity``), gravity compensation (``gravcomp``). Refused

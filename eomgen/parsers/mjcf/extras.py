@@ -1,5 +1,5 @@
-"""What a compiled MuJoCo model holds besides its tree: the motors eomgen maps to joint torques,
-and the findings warned about (or refused) by name: joint springs, tendons, other actuators,
+"""What a compiled MuJoCo model holds besides its tree: the motors eomgen maps to joint torques, the fixed tendons,
+and the findings warned about (or refused) by name: ball joints' springs, spatial tendons, other actuators,
 equality constraints, fluid forces, gravity compensation (:mod:`eomgen.parsers.mjcf`).
 
 Each equality kind has its reader in :data:`EQUALITY_READERS`: a first-order ``joint``
@@ -92,7 +92,7 @@ def _actuator_kind(m, i: int) -> str:
 
 def model_notices(m, source: str) -> tuple[Notice, ...]:
     """The findings about ``m`` eomgen warns about (or refuses under ``strict``), in this
-    order: joint springs, tendons, actuators other than motors, equalities, fluid forces,
+    order: ball joints' springs, spatial tendons, actuators other than motors, equalities, fluid forces,
     gravity compensation.
 
     Raises
