@@ -154,3 +154,32 @@ def test_gymnasium_models_passive_forces_are_mujocos(name):
         ref = mujoco_dynamics(m, lay, q, v)["passive"]
         assert np.abs(ref).max() > 0
         assert relative(module.passive_forces(q, v).ravel(), ref) < TOLERANCE
+
+
+TENDON_EQUALITY = """<mujoco model="teq"><worldbody>
+<body><joint name="j1" axis="0 1 0" ref="5"/><geom size=".1"/>
+ <body pos=".3 0 0"><joint name="j2" axis="0 1 0"/><geom size=".1"/>
+  <body pos=".3 0 0"><joint name="j3" type="slide" axis="1 0 0"/><geom size=".1"/>
+  </body></body></body></worldbody>
+<tendon><fixed name="t1"><joint joint="j1" coef="2"/><joint joint="j2" coef="-1"/></fixed>
+<fixed name="t2"><joint joint="j3" coef="0.5"/><joint joint="j2" coef="1"/></fixed></tendon>
+<equality><tendon tendon1="t1" tendon2="t2" polycoef="0.1 1.5 0 0 0"/></equality></mujoco>"""
+
+
+def test_a_tendon_equality_is_a_coupling_mujoco_holds(tmp_path):
+    """At eomgen's states (the follower where the coupling puts it), MuJoCo's own tendon
+    lengths satisfy L1 − L1_0 = c0 + c1 (L2 − L2_0)."""
+    path = tmp_path / "teq.xml"
+    path.write_text(TENDON_EQUALITY)
+    model = quiet_load(path)
+    m = compile_mjcf(path)
+    assert [c.follower for c in model.couplings] == ["j1"]
+    assert model.joint_names == ("j2", "j3")
+    lay = layout(m, model)
+    data = mujoco.MjData(m)
+    for q, v in model_states(model, count=3):
+        data.qpos[:], data.qvel[:] = to_mujoco(lay, q, v)
+        mujoco.mj_forward(m, data)
+        L, L0 = data.ten_length, m.tendon_length0
+        assert abs(L[0] - L0[0] - 0.1 - 1.5 * (L[1] - L0[1])) < 1e-12
+        assert abs(data.ten_velocity[0] - 1.5 * data.ten_velocity[1]) < 1e-12

@@ -4,9 +4,10 @@ equality constraints, fluid forces, gravity compensation (:mod:`eomgen.parsers.m
 
 Each equality kind has its reader in :data:`EQUALITY_READERS`: a first-order ``joint``
 equality is a coupling (:class:`~eomgen.model.Coupling`) or, without a second joint, a locked
-joint (:class:`JointLock`); ``connect`` is a point loop and ``weld`` a weld loop
-(:class:`~eomgen.model.Loop`); a ``joint`` equality of higher order is refused; an inactive
-equality, a ``tendon`` or flex one is a notice.
+joint (:class:`JointLock`), and so is a first-order ``tendon`` equality between fixed
+tendons; ``connect`` is a point loop and ``weld`` a weld loop (:class:`~eomgen.model.Loop`); a
+``joint`` equality of higher order is refused; an inactive equality, a flex one, a ``tendon``
+one of higher order or on a spatial tendon is a notice.
 """
 
 from __future__ import annotations
@@ -311,8 +312,46 @@ def equality_joint(m, e: int, source: str) -> Union[Coupling, JointLock, Notice]
     return make_coupling(joints[0], {joints[1]: c1}, ref[0] + c0 - c1 * ref[1], where)
 
 
+def equality_tendon(m, e: int, source: str) -> Union[Coupling, JointLock, Notice]:
+    """A ``tendon`` equality between fixed tendons, MuJoCo's ``L1 − L1_0 = c0 + c1 (L2 −
+    L2_0)`` (``L_0`` the lengths at ``qpos0``, ``tendon_length0``; ``L = Σ a_i q_i``): first
+    order, the coupling of the first joint ``f`` of tendon1, ``q_f = (L1_0 + c0 − c1 L2_0 −
+    Σ_{i≠f} a_i q_i + c1 Σ b_j q_j) / a_f``, or its lock when no other joint is left; a spatial
+    tendon's, one of higher order or an inactive one, a notice.
+    """
+    jnames = joint_names(m)
+    where = _equality_where(m, e, "tendon")
+    ids = [int(m.eq_obj1id[e])] + ([int(m.eq_obj2id[e])] if int(m.eq_obj2id[e]) >= 0 else [])
+    coefficients = [float(c) for c in m.eq_data[e, :5]]
+    order = max((k for k, c in enumerate(coefficients) if c), default=0)
+    joints = tuple(jnames[j] for t in ids for j, _ in _tendon_joints(m, t))
+    if not all(is_fixed(m, t) for t in ids) or order > 1:
+        why = "a spatial tendon's" if order <= 1 else f"an order {order}"
+        return _notice(source, where, f"{why} equality is not modelled: the model is the tree "
+                       "without it", joints=joints)
+    if not bool(m.eq_active0[e]):
+        return replace(_inactive(m, e, source, where), links=(), joints=joints)
+    c0, c1 = coefficients[:2]
+    gains: dict[int, float] = {}
+    for j, a in _tendon_joints(m, ids[0]):
+        gains[j] = gains.get(j, 0.0) + a
+    rhs = float(m.tendon_length0[ids[0]]) + c0
+    if len(ids) > 1 and c1:
+        rhs -= c1 * float(m.tendon_length0[ids[1]])
+        for j, b in _tendon_joints(m, ids[1]):
+            gains[j] = gains.get(j, 0.0) - c1 * b
+    follower = next((j for j, _ in _tendon_joints(m, ids[0]) if gains[j]), None)
+    if follower is None:
+        return _notice(source, where, "the equality moves no joint of tendon1", joints=joints)
+    a_f = gains.pop(follower)
+    leaders = {jnames[j]: -g / a_f for j, g in gains.items() if g}
+    if not leaders:
+        return JointLock(jnames[follower], rhs / a_f, where)
+    return make_coupling(jnames[follower], leaders, rhs / a_f, where)
+
+
 def other_equality(m, e: int, source: str) -> Notice:
-    """A tendon, flex or distance equality: not modelled."""
+    """A flex or distance equality: not modelled."""
     kinds = {TENDON: "tendon", 4: "flex", 5: "flexvert", 6: "flexstrain", 7: "distance"}
     return _notice(source, _equality_where(m, e, kinds.get(int(m.eq_type[e]), "other")),
                    "this equality is not modelled: the model is the tree without it")
@@ -321,7 +360,8 @@ def other_equality(m, e: int, source: str) -> Notice:
 #: The reader of each equality kind (MuJoCo's ``mjtEq`` code): what the equality is in
 #: eomgen's model (a coupling, a locked joint), or the notice that it is not modelled.
 EQUALITY_READERS: dict[int, Callable[..., Union[Coupling, JointLock, Notice]]] = {
-    CONNECT: equality_connect, WELD: equality_weld, JOINT: equality_joint}
+    CONNECT: equality_connect, WELD: equality_weld, JOINT: equality_joint,
+    TENDON: equality_tendon}
 
 
 def equalities(m, source: str) -> list:
