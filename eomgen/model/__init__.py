@@ -51,6 +51,7 @@ from .loop import HINGE, LOOP_KINDS, POINT_LOOP, WELD, Loop, LoopFrame
 from .notices import Notice, NoticeKind, emit_notices
 from .numbers import MAX_MAGNITUDE, check_model_numbers, check_number
 from .moving_mass import massless_joints, massless_notices, settled
+from .passive import Spring, Tendon, tendon_force
 from .parts import Inertial, Joint, JointType, Link, Parameter
 from .quaternion import (
     FREE_FLYER_CONFIGURATION,
@@ -75,6 +76,7 @@ from .snapping import ANGLE_SNAP_TOLERANCE, SNAP_TOLERANCE, Snap, snap, snap_sum
 from .transforms import Transform, rotation_about_axis, rotation_from_rpy
 
 __all__ = [
+    "Spring", "Tendon", "tendon_force",
     "HINGE", "LOOP_KINDS", "POINT_LOOP", "WELD", "Loop", "LoopFrame",
     "MAX_MAGNITUDE", "check_model_numbers", "check_number",
     "ANGLE_SNAP_TOLERANCE", "DEFAULT_FRICTION_WIDTH", "FREE_FLYER_CONFIGURATION", "FREE_FLYER_VELOCITY", "IDENTITY3", "MAX_JOINTS", "POINT", "SNAP_TOLERANCE", "SURFACE",

@@ -10,6 +10,7 @@ import sympy as sp
 from ..common import reprs
 from .actuator import Actuator
 from .joints import KINDS, JointKind
+from .passive import Spring
 from .scalars import ZERO3, Mat3, Scalar, Vec3, mat3, scalar, vec3
 from .transforms import Transform
 
@@ -88,6 +89,9 @@ class Joint:
     actuator: "Actuator | None" = None
     #: A helical joint's pitch [m/rad]: its translation along ``axis`` per radian turned.
     pitch: Scalar = 0
+    #: A spring pulling the joint back to its reference (:class:`~eomgen.model.passive.Spring`,
+    #: MuJoCo's ``stiffness`` and ``springref``); None for none.
+    spring: "Spring | None" = None
 
     def __post_init__(self):  # accept plain numbers from Python callers
         object.__setattr__(self, "axis", vec3(self.axis))

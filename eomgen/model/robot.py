@@ -18,6 +18,7 @@ from .contact import Contact
 from .coupling import Coupling, locked_couplings
 from .loop import Loop
 from .notices import Notice
+from .passive import Tendon
 from .joints import KINDS
 from .parts import Inertial, Joint, JointType, Link, Parameter
 from .quaternion import (QuaternionJoint,
@@ -75,6 +76,9 @@ class RobotModel:
     #: Coupled joints (:mod:`eomgen.model.coupling`): each follower's position is an affine
     #: function of its leaders'; followers are no coordinates (``joint_names``, ``dof``).
     couplings: tuple[Coupling, ...] = ()
+    #: Fixed tendons (:class:`~eomgen.model.passive.Tendon`): springs and dampers on linear
+    #: combinations of joint coordinates, in the passive forces (``tau_p``).
+    tendons: tuple[Tendon, ...] = ()
 
     @cached_property
     def link_by_name(self) -> dict[str, Link]:
@@ -388,7 +392,8 @@ def lock_joints(model: RobotModel, positions: Mapping[str, object]) -> RobotMode
     positions = {k: v for k, v in positions.items() if k not in compound}
     positions, couplings = locked_couplings(model, positions)
     joints = tuple(
-        replace(j, type=JointType.FIXED, origin=j.origin @ joint_motion(j, positions[j.name]))
+        replace(j, type=JointType.FIXED, origin=j.origin @ joint_motion(j, positions[j.name]),
+                spring=None)
         if j.name in positions else
         replace(j, type=JointType.FIXED, origin=fixed_origins[j.name])
         if j.name in fixed_origins else j
@@ -396,5 +401,6 @@ def lock_joints(model: RobotModel, positions: Mapping[str, object]) -> RobotMode
     )
     locked = {name for name in compound if any(v in fixed_origins for v in compound[name][1])}
     return replace(model, joints=joints, couplings=couplings,
+                   tendons=tuple(t.locked(positions) for t in model.tendons),
                    compound_joints=tuple((k, n) for k, n in model.compound_joints
                                          if n not in locked))

@@ -505,5 +505,13 @@ DYNAMICALLY_CONSISTENT_INVERSE = _listed(Output(
     constants=_FRAME_NAMES, backends=_TASK_BACKENDS))
 TASK_SPACE = (OPERATIONAL_SPACE_INERTIA, OPERATIONAL_SPACE_BIAS, DYNAMICALLY_CONSISTENT_INVERSE)
 
+# Issue 41: the passive forces of MuJoCo models (joint springs, drive damping, fixed tendons:
+# eomgen.symbolic.passive, docs/formats.md), exported when asked for.
+PASSIVE = _listed(Output(
+    "passive_forces", "tau_p", "Passive joint forces -k (q - q_ref) - d qd + J_t^T f_t of the "
+    "joint springs, the drives' viscous damping and the fixed tendons (MuJoCo's qfrc_passive), "
+    "added to tau: M qdd + C qd + g = tau + tau_p.", ("q", "qd"), True, _REVOLUTE_EFFORT,
+    ("tau_p",), default=False))
+
 #: Every output, in module order (:mod:`eomgen.outputs` indexes them).
 CATALOGUE: tuple[Output, ...] = tuple(_ENTRIES)

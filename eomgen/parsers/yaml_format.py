@@ -29,6 +29,8 @@
           damping: 0.1             # viscous [N m s/rad]
           friction: 0.5            # Coulomb [N m], smoothed over friction_width [rad/s]
           stiffness: K1            # [N m/rad]: a flexible joint (Spong's model)
+        spring: {stiffness: 2.0, reference: 0.1}   # optional: -k (q - q_ref) on the joint
+                                                   # (passive_forces; one-axis joints only)
 
 Frames and units follow :mod:`eomgen.model` (URDF's conventions). Values are numbers or
 expressions read by :func:`eomgen.model.expressions.parse_scalar`; every symbol must be declared under
@@ -46,14 +48,16 @@ from pathlib import Path
 
 from ..errors import UnsupportedError
 from ..model import (
-    Inertial, Joint, JointType, Link, RobotModel, Transform, build_model, check_size, vec3,
+    Inertial, Joint, JointType, Link, RobotModel, Spring, Transform, build_model, check_size,
+    vec3,
 )
 from .registry import register
 from ._yaml import Reader, read_document, top_level_key
 
 TOP_KEYS = ("name", "description", "gravity", "parameters", "links", "joints")
 LINK_KEYS = ("name", "mass", "com", "inertia")
-JOINT_KEYS = ("name", "type", "parent", "child", "origin", "axis", "pitch", "actuator")
+JOINT_KEYS = ("name", "type", "parent", "child", "origin", "axis", "pitch", "actuator", "spring")
+SPRING_KEYS = ("stiffness", "reference")
 ORIGIN_KEYS = ("xyz", "rpy")
 JOINT_TYPES = {t.value: t for t in JointType}
 UNSUPPORTED_TYPES = ("floating", "mimic")
@@ -134,11 +138,13 @@ def parse(data: dict, source: str, strict: bool = False, default_name: str = "ro
         pitch = r.scalar(entry["pitch"], f"{where} pitch") if "pitch" in entry else 0
         actuator = r.actuator(entry["actuator"], f"{where} actuator") \
             if "actuator" in entry else None
+        spring = _spring(r, entry["spring"], f"{where} spring", kind, source) \
+            if "spring" in entry else None
         joints.append(Joint(
             joint_name, kind,
             r.name(entry["parent"], f"{where} parent"),
             r.name(entry["child"], f"{where} child"),
-            origin, axis, actuator, pitch))
+            origin, axis, actuator, pitch, spring))
 
     info = {"description": r.text(data["description"], "description")} \
         if "description" in data else {}
@@ -157,3 +163,19 @@ def _inertial(r: Reader, entry: dict, where: str) -> Inertial | None:
     if "inertia" in entry:
         return Inertial(mass, com, r.inertia(entry["inertia"], f"{where} inertia"))
     return Inertial(mass, com)
+
+
+def _spring(r: Reader, value, where: str, kind: JointType, source: str) -> Spring:
+    """A joint's ``spring: {stiffness, reference}`` (:class:`~eomgen.model.Spring`):
+    ``stiffness`` ``k ≥ 0`` [N m/rad or N/m], ``reference`` [rad or m] (default 0), on a
+    joint of one coordinate."""
+    r.mapping(value, where, required=("stiffness",), optional=SPRING_KEYS)
+    if kind.kind.nv != 1 or not kind.is_movable:
+        raise UnsupportedError(source, where, f"a {kind.value} joint has no spring: only "
+                               "joints of one coordinate (revolute, prismatic, ...) have one")
+    stiffness = r.scalar(value["stiffness"], f"{where} stiffness")
+    if stiffness.is_number and stiffness < 0:
+        raise UnsupportedError(source, f"{where} stiffness", f"a negative stiffness "
+                               f"({stiffness}): a spring pulls back, k >= 0")
+    return Spring(stiffness, r.scalar(value["reference"], f"{where} reference")
+                  if "reference" in value else 0)

@@ -32,6 +32,7 @@ EXTRAS: dict[str, tuple[str, str]] = {
     "dask": ("dask", "dask"),
     "distributed": ("distributed", "dask"),
     "mujoco": ("mujoco", "simulators"),
+    "gymnasium": ("gymnasium", "mjcf-models"),
     "jax": ("jax", "jax"),
     "torch": ("torch", "torch"),
     "selenium": ("selenium", "browser"),

@@ -37,6 +37,11 @@ What is read
   :class:`~eomgen.model.Actuator` (``armature``, viscous ``damping``, Coulomb ``friction``;
   docs/actuators.md); those of the free joint go to the six free-flyer coordinates (equal on
   all six, so they map exactly).
+* Each hinge or slide joint's ``stiffness`` and ``springref``: its
+  :class:`~eomgen.model.Spring` ``−k (q − qpos_spring)``; each fixed tendon with a stiffness
+  or a damping: a :class:`~eomgen.model.Tendon` of ``model.tendons`` (``L = Σ cᵢ qᵢ``, the
+  rest lengths ``springlength``, a dead band since MuJoCo 3). With the joints' damping they
+  are the output ``tau_p`` (MuJoCo's ``qfrc_passive``, :mod:`eomgen.symbolic.passive`).
 * ``<option gravity>`` (zero when the ``gravity`` flag is disabled).
 * ``<motor>`` actuators on hinge and slide joints: the joint torque is ``gear · ctrl``;
   ``model.info["mujoco_motors"]`` lists ``(actuator, joint, gear)``.
@@ -60,7 +65,8 @@ Unnamed bodies and joints are named ``body<i>`` and ``joint<i>`` with MuJoCo's i
 a name that is taken gets ``_2``, ``_3``, … appended.
 
 Warned about (:class:`~eomgen.errors.UnsupportedFeatureWarning`, refused under ``strict``),
-by name: joint springs (``stiffness``, ``springref``: not modelled), tendons, actuators other
+by name: ball joints' springs, spatial tendons (and a fixed tendon's armature and
+frictionloss), actuators other
 than motors on hinge and slide joints, equalities that are inactive (``active="false"``),
 ``tendon`` and flex equalities, an equality joining a dropped free body, fluid forces
 (``density``, ``viscosity``), gravity compensation (``gravcomp``). Refused
@@ -96,7 +102,7 @@ from ...errors import (DescriptionError, ForbiddenXMLError, InvalidLoopError,
 from ...model import RobotModel, emit_notices, settled
 from ...numeric.loop_checks import LoopProblem, check_loops
 from ..registry import register
-from .extras import model_notices, motors, with_equalities
+from .extras import model_notices, motors, with_equalities, with_tendons
 from .numbers import check_compiled
 from .tree import build_tree
 
@@ -213,7 +219,7 @@ def model_from_mujoco(m, source: str = "<mujoco>", strict: bool = False,
         (:mod:`eomgen.parsers.mjcf.numbers`), naming the element and the attribute.
     """
     check_compiled(m, source)
-    model = with_equalities(build_tree(m, source), m, source)
+    model = with_equalities(with_tendons(build_tree(m, source), m, source), m, source)
     if model.loops:  # the same checks as a scene's loops (eomgen.numeric.loop_checks)
         try:
             check_loops(model)

@@ -1,18 +1,21 @@
-"""What a compiled MuJoCo model holds besides its tree: the motors eomgen maps to joint torques,
-and the findings warned about (or refused) by name: joint springs, tendons, other actuators,
+"""What a compiled MuJoCo model holds besides its tree: the motors eomgen maps to joint torques, the fixed tendons,
+and the findings warned about (or refused) by name: ball joints' springs, spatial tendons, other actuators,
 equality constraints, fluid forces, gravity compensation (:mod:`eomgen.parsers.mjcf`).
 
 Each equality kind has its reader in :data:`EQUALITY_READERS`: a first-order ``joint``
 equality is a coupling (:class:`~eomgen.model.Coupling`) or, without a second joint, a locked
-joint (:class:`JointLock`); ``connect`` is a point loop and ``weld`` a weld loop
-(:class:`~eomgen.model.Loop`); a ``joint`` equality of higher order is refused; an inactive
-equality, a ``tendon`` or flex one is a notice.
+joint (:class:`JointLock`), and so is a first-order ``tendon`` equality between fixed
+tendons; ``connect`` is a point loop and ``weld`` a weld loop (:class:`~eomgen.model.Loop`); a
+``joint`` equality of higher order is refused; an inactive equality, a flex one, a ``tendon``
+one of higher order or on a spatial tendon is a notice.
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
 from typing import Callable, NamedTuple, Union
+
+import numpy as np
 
 from ...errors import UnsupportedError
 from ...model import (
@@ -24,6 +27,7 @@ from ...model import (
     Notice,
     NoticeKind,
     RobotModel,
+    Tendon,
     Transform,
     lock_joints,
     make_coupling,
@@ -31,7 +35,7 @@ from ...model import (
     vec3,
     with_couplings,
 )
-from .tree import FREE, HINGE, SLIDE, body_names, disabled, joint_names, rotation_of_quaternion
+from .tree import BALL, FREE, HINGE, SLIDE, body_names, disabled, joint_names, rotation_of_quaternion
 
 #: MuJoCo's transmission, dynamics, gain and bias types of a plain motor (``mjTRN_JOINT``,
 #: ``mjDYN_NONE``, ``mjGAIN_FIXED``, ``mjBIAS_NONE``) and of ``mjTRN_JOINTINPARENT``.
@@ -89,7 +93,7 @@ def _actuator_kind(m, i: int) -> str:
 
 def model_notices(m, source: str) -> tuple[Notice, ...]:
     """The findings about ``m`` eomgen warns about (or refuses under ``strict``), in this
-    order: joint springs, tendons, actuators other than motors, equalities, fluid forces,
+    order: ball joints' springs, spatial tendons, actuators other than motors, equalities, fluid forces,
     gravity compensation.
 
     Raises
@@ -102,12 +106,10 @@ def model_notices(m, source: str) -> tuple[Notice, ...]:
     if not disabled(m, "SPRING"):
         for j in range(m.njnt):
             k = float(m.jnt_stiffness[j])
-            if k:
-                ref = float(m.qpos_spring[int(m.jnt_qposadr[j])])
+            if k and int(m.jnt_type[j]) == BALL:
                 notices.append(_notice(source, f"joint '{jnames[j]}' stiffness",
-                                       f"the joint spring -{k:g} (q - {ref:g}) (stiffness, "
-                                       "springref) is not modelled", "left out",
-                                       joints=(jnames[j],)))
+                                       f"the spring {k:g} of a ball joint is not modelled",
+                                       "left out", joints=(jnames[j],)))
     for j in range(m.njnt):
         if int(m.jnt_type[j]) == FREE and float(m.dof_armature[int(m.jnt_dofadr[j])]):
             notices.append(_notice(source, f"joint '{jnames[j]}' (free) armature",
@@ -116,12 +118,19 @@ def model_notices(m, source: str) -> tuple[Notice, ...]:
                                    "M + a I, a bias a (omega x v) apart)",
                                    "read on eomgen's coordinates", joints=(jnames[j],)))
     for t in range(m.ntendon):
-        start, count = int(m.tendon_adr[t]), int(m.tendon_num[t])
-        joints = tuple(jnames[int(m.wrap_objid[w])] for w in range(start, start + count)
-                       if int(m.wrap_type[w]) == _WRAP_JOINT)
-        notices.append(_notice(source, f"tendon '{_name(m, 'tendon', t)}'",
-                               "tendons are not modelled (their springs, damping and the "
-                               "actuators on them)", "left out", joints=joints))
+        joints = _tendon_joints(m, t)
+        where = f"tendon '{_name(m, 'tendon', t)}'"
+        if not is_fixed(m, t):
+            notices.append(_notice(source, where, "a spatial tendon is not modelled (its "
+                                   "spring, damping and the actuators on it)", "left out",
+                                   joints=tuple(jnames[j] for j, _ in joints)))
+            continue
+        for attribute, values in (("armature", getattr(m, "tendon_armature", None)),
+                                  ("frictionloss", m.tendon_frictionloss)):
+            if values is not None and float(values[t]):
+                notices.append(_notice(source, f"{where} {attribute}", f"a tendon's "
+                                       f"{attribute} is not modelled", "left out",
+                                       joints=tuple(jnames[j] for j, _ in joints)))
     for i in range(m.nu):
         if not is_motor(m, i):
             on_joint = int(m.actuator_trntype[i]) in (_TRN_JOINT, _TRN_JOINT_IN_PARENT)
@@ -139,6 +148,55 @@ def model_notices(m, source: str) -> tuple[Notice, ...]:
             notices.append(_notice(source, f"body '{_name(m, 'body', b)}' gravcomp",
                                    "gravity compensation is not modelled", "left out"))
     return tuple(notices)
+
+
+def _tendon_joints(m, t: int) -> tuple[tuple[int, float], ...]:
+    """``(joint, coefficient)`` of each joint wrap of tendon ``t``."""
+    start, count = int(m.tendon_adr[t]), int(m.tendon_num[t])
+    return tuple((int(m.wrap_objid[w]), float(m.wrap_prm[w])) for w in range(start, start + count)
+                 if int(m.wrap_type[w]) == _WRAP_JOINT)
+
+
+def is_fixed(m, t: int) -> bool:
+    """Whether tendon ``t`` is a fixed tendon (every wrap a joint)."""
+    start, count = int(m.tendon_adr[t]), int(m.tendon_num[t])
+    return all(int(m.wrap_type[w]) == _WRAP_JOINT for w in range(start, start + count))
+
+
+def fixed_tendons(m) -> tuple[Tendon, ...]:
+    """The fixed tendons of ``m`` that pull (a stiffness or a damping): ``L = Σ c_i q_i``
+    (``wrap_prm`` the coefficients), the rest lengths ``tendon_lengthspring`` (a dead band
+    since MuJoCo 3; both ends the one length otherwise), ``tendon_stiffness`` (0 when the
+    ``spring`` flag is disabled) and ``tendon_damping`` (0 when ``damper`` is)."""
+    jnames = joint_names(m)
+    out = []
+    for t in range(m.ntendon):
+        k = 0.0 if disabled(m, "SPRING") else float(m.tendon_stiffness[t])
+        b = 0.0 if disabled(m, "DAMPER") else float(m.tendon_damping[t])
+        if not is_fixed(m, t) or not (k or b):
+            continue
+        rest = np.atleast_1d(np.asarray(m.tendon_lengthspring[t], dtype=float))
+        out.append(Tendon(_name(m, "tendon", t), tuple((jnames[j], c) for j, c in
+                                                       _tendon_joints(m, t)),
+                          k, (float(rest[0]), float(rest[-1])), b))
+    return tuple(out)
+
+
+def with_tendons(model: RobotModel, m, source: str) -> RobotModel:
+    """``model`` (the tree of ``m``) with its fixed tendons (:func:`fixed_tendons`); one on
+    a dropped free body's joints goes with it, one joining such a joint to a kept one is a
+    notice."""
+    present = {joint.name for joint in model.joints}
+    tendons, notices = [], []
+    for tendon in fixed_tendons(m):
+        names = [name for name, _ in tendon.coefficients]
+        kept = tuple(n for n in names if n in present)
+        if len(kept) == len(names):
+            tendons.append(tendon)
+        elif kept:
+            notices.append(_notice(source, f"tendon '{tendon.name}'", "it joins a dropped free "
+                                   "body", "left out", joints=kept))
+    return replace(model, tendons=tuple(tendons), notices=tuple(model.notices) + tuple(notices))
 
 
 def _equality_where(m, e: int, kind: str) -> str:
@@ -254,8 +312,46 @@ def equality_joint(m, e: int, source: str) -> Union[Coupling, JointLock, Notice]
     return make_coupling(joints[0], {joints[1]: c1}, ref[0] + c0 - c1 * ref[1], where)
 
 
+def equality_tendon(m, e: int, source: str) -> Union[Coupling, JointLock, Notice]:
+    """A ``tendon`` equality between fixed tendons, MuJoCo's ``L1 − L1_0 = c0 + c1 (L2 −
+    L2_0)`` (``L_0`` the lengths at ``qpos0``, ``tendon_length0``; ``L = Σ a_i q_i``): first
+    order, the coupling of the first joint ``f`` of tendon1, ``q_f = (L1_0 + c0 − c1 L2_0 −
+    Σ_{i≠f} a_i q_i + c1 Σ b_j q_j) / a_f``, or its lock when no other joint is left; a spatial
+    tendon's, one of higher order or an inactive one, a notice.
+    """
+    jnames = joint_names(m)
+    where = _equality_where(m, e, "tendon")
+    ids = [int(m.eq_obj1id[e])] + ([int(m.eq_obj2id[e])] if int(m.eq_obj2id[e]) >= 0 else [])
+    coefficients = [float(c) for c in m.eq_data[e, :5]]
+    order = max((k for k, c in enumerate(coefficients) if c), default=0)
+    joints = tuple(jnames[j] for t in ids for j, _ in _tendon_joints(m, t))
+    if not all(is_fixed(m, t) for t in ids) or order > 1:
+        why = "a spatial tendon's" if order <= 1 else f"an order {order}"
+        return _notice(source, where, f"{why} equality is not modelled: the model is the tree "
+                       "without it", joints=joints)
+    if not bool(m.eq_active0[e]):
+        return replace(_inactive(m, e, source, where), links=(), joints=joints)
+    c0, c1 = coefficients[:2]
+    gains: dict[int, float] = {}
+    for j, a in _tendon_joints(m, ids[0]):
+        gains[j] = gains.get(j, 0.0) + a
+    rhs = float(m.tendon_length0[ids[0]]) + c0
+    if len(ids) > 1 and c1:
+        rhs -= c1 * float(m.tendon_length0[ids[1]])
+        for j, b in _tendon_joints(m, ids[1]):
+            gains[j] = gains.get(j, 0.0) - c1 * b
+    follower = next((j for j, _ in _tendon_joints(m, ids[0]) if gains[j]), None)
+    if follower is None:
+        return _notice(source, where, "the equality moves no joint of tendon1", joints=joints)
+    a_f = gains.pop(follower)
+    leaders = {jnames[j]: -g / a_f for j, g in gains.items() if g}
+    if not leaders:
+        return JointLock(jnames[follower], rhs / a_f, where)
+    return make_coupling(jnames[follower], leaders, rhs / a_f, where)
+
+
 def other_equality(m, e: int, source: str) -> Notice:
-    """A tendon, flex or distance equality: not modelled."""
+    """A flex or distance equality: not modelled."""
     kinds = {TENDON: "tendon", 4: "flex", 5: "flexvert", 6: "flexstrain", 7: "distance"}
     return _notice(source, _equality_where(m, e, kinds.get(int(m.eq_type[e]), "other")),
                    "this equality is not modelled: the model is the tree without it")
@@ -264,7 +360,8 @@ def other_equality(m, e: int, source: str) -> Notice:
 #: The reader of each equality kind (MuJoCo's ``mjtEq`` code): what the equality is in
 #: eomgen's model (a coupling, a locked joint), or the notice that it is not modelled.
 EQUALITY_READERS: dict[int, Callable[..., Union[Coupling, JointLock, Notice]]] = {
-    CONNECT: equality_connect, WELD: equality_weld, JOINT: equality_joint}
+    CONNECT: equality_connect, WELD: equality_weld, JOINT: equality_joint,
+    TENDON: equality_tendon}
 
 
 def equalities(m, source: str) -> list:

@@ -20,6 +20,7 @@ from ...errors import KinematicTreeError, UnsupportedError
 from ...model.floating import add_free_flyer, quaternion_matrix
 from ...model import (
     Actuator,
+    Spring,
     Notice,
     NoticeKind,
     Inertial,
@@ -131,6 +132,15 @@ def _actuator(m, joint: int) -> Actuator | None:
     return Actuator(**values)
 
 
+def _spring(m, joint: int) -> Spring | None:
+    """The spring of a hinge or slide joint: ``−stiffness (q − qpos_spring)`` (none when the
+    ``spring`` flag is disabled)."""
+    k = float(m.jnt_stiffness[joint])
+    if not k or disabled(m, "SPRING") or int(m.jnt_type[joint]) not in (HINGE, SLIDE):
+        return None
+    return Spring(k, float(m.qpos_spring[int(m.jnt_qposadr[joint])]))
+
+
 def build_tree(m, source: str) -> RobotModel:
     """The links and joints of the compiled model ``m`` (module docstring), validated by
     :func:`eomgen.model.build_model`, with the free flyer of its free joint if it has one.
@@ -205,7 +215,7 @@ def build_tree(m, source: str) -> RobotModel:
             joints.append(Joint(jnames[j], kind, previous, child,
                                 _transform(R_j, p_j, f"joint '{jnames[j]}'"),
                                 vec3(float(a) for a in axis),
-                                _actuator(m, j)))
+                                _actuator(m, j), spring=_spring(m, j)))
             previous = child
             # what follows is placed from this joint's frame: back from its anchor
             R, p = np.eye(3), -anchor
