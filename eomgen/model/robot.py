@@ -15,6 +15,7 @@ from ..common import reprs
 from ..errors import KinematicTreeError, ParameterError
 from .actuator import Actuator
 from .contact import Contact
+from .control import Control
 from .coupling import Coupling, locked_couplings
 from .loop import Loop
 from .notices import Notice
@@ -75,6 +76,9 @@ class RobotModel:
     #: Coupled joints (:mod:`eomgen.model.coupling`): each follower's position is an affine
     #: function of its leaders'; followers are no coordinates (``joint_names``, ``dof``).
     couplings: tuple[Coupling, ...] = ()
+    #: The control inputs (:class:`~eomgen.model.Control`: MuJoCo's actuators on joints, YAML's
+    #: ``controls:``), entries of ``ctrl`` in this order; empty: the input is the joint effort.
+    controls: tuple[Control, ...] = ()
 
     @cached_property
     def link_by_name(self) -> dict[str, Link]:
