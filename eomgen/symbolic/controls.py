@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ..errors import GenerationError
 from ..model import RobotModel, joint_actuators
 from .aba import forward_dynamics_program, true_accelerations
 from .builders import builds, provides, sizes
@@ -100,7 +101,18 @@ def passive_forces(derivation) -> sp.Matrix:
 @builds("tau_act", "qdd_ctrl", "dqdd_dctrl")
 def build_controls(derivation, wanted) -> dict:
     """The builder of ``tau_act``, ``qdd_ctrl`` and ``dqdd_dctrl`` in :mod:`eomgen.outputs`
-    (see the module docstring)."""
+    (see the module docstring).
+
+    Raises
+    ------
+    GenerationError
+        For a model without controls (nothing to generate a function of ``ctrl`` from).
+    """
+    model = derivation.model
+    if not model.controls:
+        raise GenerationError(f"{model.source}: {', '.join(sorted(wanted))} need controls "
+                              "(MJCF actuators on joints, YAML controls:), but the model has "
+                              "none (docs/formats.md)")
     out = {}
     forces = control_forces(derivation)
     tau = out["tau_act"] = actuator_forces(derivation, forces)
