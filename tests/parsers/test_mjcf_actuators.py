@@ -124,3 +124,18 @@ def test_gymnasium_motors_are_mujocos(name, tmp_path):
     # the actuators act on hinges only: eomgen's forces are MuJoCo's, in eomgen's order
     assert np.allclose(call("actuator_forces", q, v, ctrl), force[lay.dof_index], rtol=0,
                        atol=1e-13 * np.abs(force).max())
+
+
+@pytest.mark.slow
+def test_every_code_backend_gives_mujocos_forces_and_accelerations(tmp_path):
+    model = quiet_load(DATA / "actuated.xml")
+    m = mujoco.MjModel.from_xml_path(str(DATA / "actuated.xml"))
+    calls, _ = generated(model, OUTPUTS, tmp_path)
+    q, qd, ctrl = np.array([0.4, -0.7, 0.2]), np.array([1.1, 0.3, -2.0]), \
+        np.array([1.7, 0.2, -1.3, 0.9, 1.5, 0.0])
+    force, acc = mujoco_at(m, q, qd, ctrl)
+    for name, call in calls.items():
+        assert np.allclose(call("actuator_forces", q, qd, ctrl[:5]), force, rtol=1e-12,
+                           atol=1e-12), name
+        assert np.allclose(call("forward_dynamics_ctrl", q, qd, ctrl[:5]), acc, rtol=1e-11,
+                           atol=1e-11), name
