@@ -33,8 +33,8 @@ from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS, textbo
 # before derive() builds one (tests/architecture checks that every printed output has one).
 from . import regressor  # noqa: F401  (the regressor outputs: eomgen.regressor.generated)
 from .regressor import slotine_li  # noqa: F401
-from .symbolic import (aba, centroidal, combined, contact_derivatives, derivatives,  # noqa: F401
-                       drives, flat, frames, loops, newton_euler, passive, routes)
+from .symbolic import (aba, centroidal, combined, contact_derivatives, controls,  # noqa: F401
+                       derivatives, drives, flat, frames, loops, newton_euler, passive, routes)
 
 #: What generated modules export by default: the mass matrix, Coriolis matrix, gravity vector
 #: and the inverse dynamics τ(q, q̇, q̈) (by a symbolic Newton–Euler pass; cheaper to evaluate).

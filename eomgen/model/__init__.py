@@ -46,6 +46,7 @@ from .checks import (
     check_tree,
 )
 from .contact import POINT, SURFACE, Contact
+from .control import Control, make_control
 from .coupling import Coupling, couple, coupling_map, make_coupling, uncoupled, with_couplings
 from .loop import HINGE, LOOP_KINDS, POINT_LOOP, WELD, Loop, LoopFrame
 from .notices import Notice, NoticeKind, emit_notices
@@ -80,7 +81,7 @@ __all__ = [
     "HINGE", "LOOP_KINDS", "POINT_LOOP", "WELD", "Loop", "LoopFrame",
     "MAX_MAGNITUDE", "check_model_numbers", "check_number",
     "ANGLE_SNAP_TOLERANCE", "DEFAULT_FRICTION_WIDTH", "FREE_FLYER_CONFIGURATION", "FREE_FLYER_VELOCITY", "IDENTITY3", "MAX_JOINTS", "POINT", "SNAP_TOLERANCE", "SURFACE",
-    "ZERO3", "Actuator", "Contact", "Coupling", "couple", "coupling_map", "uncoupled",
+    "ZERO3", "Actuator", "Contact", "Control", "make_control", "Coupling", "couple", "coupling_map", "uncoupled",
     "make_coupling", "with_couplings", "Inertial", "Joint", "JointType", "Link", "Mat3", "Notice",
     "NoticeKind", "Parameter", "QuaternionJoint", "RobotModel", "Scalar", "Snap", "Transform", "Vec3",
     "all_scalars", "build_model", "check_actuator", "float_constants", "check_axis", "check_inertial",

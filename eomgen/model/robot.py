@@ -15,6 +15,7 @@ from ..common import reprs
 from ..errors import KinematicTreeError, ParameterError
 from .actuator import Actuator
 from .contact import Contact
+from .control import Control
 from .coupling import Coupling, locked_couplings
 from .loop import Loop
 from .notices import Notice
@@ -79,6 +80,9 @@ class RobotModel:
     #: Fixed tendons (:class:`~eomgen.model.passive.Tendon`): springs and dampers on linear
     #: combinations of joint coordinates, in the passive forces (``tau_p``).
     tendons: tuple[Tendon, ...] = ()
+    #: The control inputs (:class:`~eomgen.model.Control`: MuJoCo's actuators on joints, YAML's
+    #: ``controls:``), entries of ``ctrl`` in this order; empty: the input is the joint effort.
+    controls: tuple[Control, ...] = ()
 
     @cached_property
     def link_by_name(self) -> dict[str, Link]:

@@ -38,6 +38,7 @@ INPUTS: dict[str, str] = {
            "then the loop forces on each loop's frame b, in its rows' axes)",
     "qd_r": "reference joint velocities of the Slotine-Li controller [rad/s or m/s]",
     "qdd_r": "reference joint accelerations of the Slotine-Li controller [rad/s^2 or m/s^2]",
+    "ctrl": "controls of the actuators, in ACTUATOR_NAMES order (MuJoCo's ctrl)",
 }
 
 #: The inputs whose length is not the number of joints, with what their length is; the function
@@ -46,6 +47,7 @@ INPUTS: dict[str, str] = {
 INPUT_SIZES: dict[str, str] = {
     "q": "NQ, the configuration size (NV + 1 per quaternion joint)",
     "F_c": "m, the constraint rows: the contacts' (CONTACT_ROWS), then the loops'",
+    "ctrl": "nu, the model's controls (ACTUATOR_NAMES)",
 }
 
 
@@ -512,6 +514,24 @@ PASSIVE = _listed(Output(
     "joint springs, the drives' viscous damping and the fixed tendons (MuJoCo's qfrc_passive), "
     "added to tau: M qdd + C qd + g = tau + tau_p.", ("q", "qd"), True, _REVOLUTE_EFFORT,
     ("tau_p",), default=False))
+# --- issue 41: MuJoCo's actuators on joints (eomgen.symbolic.controls, docs/formats.md): the
+# joint forces of the controls and the forward dynamics they drive, exported when asked for.
+_ACTUATOR_NAMES = ("ACTUATOR_NAMES",)
+ACTUATOR_FORCES = _listed(Output(
+    "actuator_forces", "tau_act", "Joint forces of the actuators sum gear clamp(gain(q, qd) "
+    "clamp(ctrl) + bias(q, qd)) (MuJoCo's qfrc_actuator).", ("q", "qd", "ctrl"), True,
+    _REVOLUTE_EFFORT, ("tau_act",), default=False, constants=_ACTUATOR_NAMES))
+FORWARD_CTRL = _listed(Output(
+    "forward_dynamics_ctrl", "qdd_ctrl", "Joint accelerations qdd = (M(q) + diag(a))^-1 "
+    "(actuator_forces - d qd - C(q, qd) qd - g(q)) by the Articulated-Body Algorithm "
+    "(MuJoCo's qacc_smooth without springs).", ("q", "qd", "ctrl"), True,
+    "rad/s^2 (revolute), m/s^2 (prismatic)", ("qdd_ctrl",), default=False,
+    constants=_ACTUATOR_NAMES))
+FORWARD_CTRL_DERIVATIVE = _listed(Output(
+    "forward_dynamics_ctrl_derivative_ctrl", "dqdd_dctrl", "dqdd/dctrl (nv, nu) of "
+    "forward_dynamics_ctrl: (M + diag(a))^-1 dtau_act/dctrl (zero where a clamp holds).",
+    ("q", "qd", "ctrl"), False, "rad/s^2 (revolute rows), m/s^2 (prismatic) per unit of ctrl",
+    ("dqdd_dctrl",), default=False, constants=_ACTUATOR_NAMES))
 
 #: Every output, in module order (:mod:`eomgen.outputs` indexes them).
 CATALOGUE: tuple[Output, ...] = tuple(_ENTRIES)

@@ -31,10 +31,20 @@
           stiffness: K1            # [N m/rad]: a flexible joint (Spong's model)
         spring: {stiffness: 2.0, reference: 0.1}   # optional: -k (q - q_ref) on the joint
                                                    # (passive_forces; one-axis joints only)
+    controls:                      # optional: MuJoCo's actuators on joints, entries of ctrl
+      - name: shoulder_servo
+        joint: joint1              # a revolute, prismatic or helical joint
+        gear: 1                    # optional, default 1: force on the joint gear * force
+        gain: [kp, 0, 0]           # force = gain * ctrl + bias, each c0 + c1 gear q + c2 gear qd
+        bias: [0, -kp, -kv]        # optional, default 0; gain optional, default 1
+        ctrlrange: [-1, 1]         # optional: ctrl clamped to it
+        forcerange: [-10, 10]      # optional: force clamped to it
 
 Frames and units follow :mod:`eomgen.model` (URDF's conventions). Values are numbers or
 expressions read by :func:`eomgen.model.expressions.parse_scalar`; every symbol must be declared under
-``parameters``. A ``spherical`` joint (a ball joint, no ``axis``) is Pinocchio's
+``parameters``. ``controls:`` is not the joint's ``actuator:`` (the drive: armature,
+friction): each entry is one control input (:class:`~eomgen.model.Control`) of
+``actuator_forces`` and ``forward_dynamics_ctrl``. A ``spherical`` joint (a ball joint, no ``axis``) is Pinocchio's
 ``JointModelSpherical``: its configuration is a unit quaternion, its velocity the angular
 velocity of the child in the child frame (:mod:`eomgen.model.quaternion`). A ``planar`` joint
 (its axis, the plane's normal, 0 0 1) is ``JointModelPlanar``, a ``helical`` joint with
@@ -44,17 +54,19 @@ velocity of the child in the child frame (:mod:`eomgen.model.quaternion`). A ``p
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 from ..errors import UnsupportedError
 from ..model import (
-    Inertial, Joint, JointType, Link, RobotModel, Spring, Transform, build_model, check_size,
-    vec3,
+    Control, Inertial, Joint, JointType, Link, RobotModel, Spring, Transform, build_model,
+    check_size, scalar, vec3,
 )
 from .registry import register
 from ._yaml import Reader, read_document, top_level_key
 
-TOP_KEYS = ("name", "description", "gravity", "parameters", "links", "joints")
+TOP_KEYS = ("name", "description", "gravity", "parameters", "links", "joints", "controls")
+CONTROL_KEYS = ("name", "joint", "gear", "gain", "bias", "ctrlrange", "forcerange")
 LINK_KEYS = ("name", "mass", "com", "inertia")
 JOINT_KEYS = ("name", "type", "parent", "child", "origin", "axis", "pitch", "actuator", "spring")
 SPRING_KEYS = ("stiffness", "reference")
@@ -148,8 +160,56 @@ def parse(data: dict, source: str, strict: bool = False, default_name: str = "ro
 
     info = {"description": r.text(data["description"], "description")} \
         if "description" in data else {}
-    return build_model(source, name, links, joints, gravity, r.used_parameters(), strict, info,
-                       defer_notices=defer_notices)
+    controls = _controls(r, data["controls"], joints) if "controls" in data else ()
+    model = build_model(source, name, links, joints, gravity, r.used_parameters(), strict, info,
+                        defer_notices=defer_notices)
+    return replace(model, controls=controls) if controls else model
+
+
+def _controls(r: Reader, value, joints: list[Joint]) -> tuple[Control, ...]:
+    """The ``controls:`` entries (module docstring), each on a one-coordinate joint."""
+    kinds = {joint.name: joint.type for joint in joints}
+    one = (JointType.REVOLUTE, JointType.CONTINUOUS, JointType.PRISMATIC, JointType.HELICAL)
+    out, seen = [], set()
+    for i, entry in enumerate(r.sequence(value, "controls")):
+        r.mapping(entry, r.named(entry, f"controls[{i}]"), required=("name", "joint"),
+                  optional=CONTROL_KEYS)
+        name = r.name(entry["name"], f"controls[{i}] name")
+        where = f"controls[{i}] '{name}'"
+        if name in seen:
+            raise r.error(f"{where} name", "a second control of this name")
+        seen.add(name)
+        joint = r.name(entry["joint"], f"{where} joint")
+        if kinds.get(joint) not in one:
+            raise r.error(f"{where} joint", f"'{joint}' is not a revolute, prismatic or "
+                          "helical joint of the robot")
+        gain = entry.get("gain", 1)
+        gain = [gain, 0, 0] if not isinstance(gain, list) else gain
+        out.append(Control(
+            name, joint, r.scalar(entry.get("gear", 1), f"{where} gear"),
+            _triple(r, gain, f"{where} gain"), _triple(r, entry.get("bias", [0, 0, 0]),
+                                                       f"{where} bias"),
+            _range(r, entry.get("ctrlrange"), f"{where} ctrlrange"),
+            _range(r, entry.get("forcerange"), f"{where} forcerange")))
+    return tuple(out)
+
+
+def _triple(r: Reader, value, where: str) -> tuple:
+    if not isinstance(value, list) or len(value) != 3:
+        raise r.error(where, "expected a number or a list of 3 values [c0, c_length, "
+                      "c_velocity]")
+    return tuple(r.scalar(v, f"{where}[{k}]") for k, v in enumerate(value))
+
+
+def _range(r: Reader, value, where: str):
+    if value is None:
+        return None
+    if not isinstance(value, list) or len(value) != 2:
+        raise r.error(where, "expected a list of 2 numbers [low, high]")
+    low, high = (r.number(v, f"{where}[{k}]") for k, v in enumerate(value))
+    if not low < high:
+        raise r.error(where, f"low {low:g} is not below high {high:g}")
+    return scalar(low), scalar(high)
 
 
 def _inertial(r: Reader, entry: dict, where: str) -> Inertial | None:

@@ -43,7 +43,7 @@ PROJECTIONS: dict[str, tuple[bool, bool]] = {
     "M": (True, True), "C": (True, True), "g": (True, False), "P": (False, False),
     "tau": (True, False), "h": (True, False),
     "M_a": (True, True), "tau_f": (True, False), "tau_f_smooth": (True, False),
-    "tau_a": (True, False), "tau_p": (True, False),
+    "tau_a": (True, False), "tau_p": (True, False), "tau_act": (True, False),
     "Y": (True, False), "Y_SL": (True, False), "pi": (False, False), "Y_K": (False, False), "Y_P": (False, False),
     "p_f": (False, False), "R_f": (False, False), "J_f": (False, True),
     "Jb_f": (False, True), "dJqd_f": (False, False), "dJbqd_f": (False, False),

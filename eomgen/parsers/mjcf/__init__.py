@@ -43,8 +43,15 @@ What is read
   rest lengths ``springlength``, a dead band since MuJoCo 3). With the joints' damping they
   are the output ``tau_p`` (MuJoCo's ``qfrc_passive``, :mod:`eomgen.symbolic.passive`).
 * ``<option gravity>`` (zero when the ``gravity`` flag is disabled).
-* ``<motor>`` actuators on hinge and slide joints: the joint torque is ``gear · ctrl``;
-  ``model.info["mujoco_motors"]`` lists ``(actuator, joint, gear)``.
+* Actuators with a joint transmission on hinge and slide joints and no activation dynamics
+  (``<motor>``, ``<position>`` and ``<velocity>`` without ``timeconst``, ``<general>`` with a
+  fixed or affine gain and bias): the model's :attr:`~eomgen.model.RobotModel.controls`
+  (:class:`~eomgen.model.Control`), entries of the input ``ctrl`` in MuJoCo's actuator order
+  (``ACTUATOR_NAMES``), with MuJoCo's ``gear`` (first component), ``gainprm``, ``biasprm``,
+  ``ctrlrange`` (when ``ctrllimited``) and ``forcerange`` (when ``forcelimited``); the
+  outputs ``actuator_forces`` and ``forward_dynamics_ctrl`` (docs/formats.md).
+  ``model.info["mujoco_motors"]`` lists ``(actuator, joint, gear · gain)`` of the plain
+  motors.
 * First-order ``joint`` equalities (``polycoef`` ``c0 c1 0 0 0``): MuJoCo's ``q1 − ref1 = c0
   + c1 (q2 − ref2)`` is the coupling ``q1 = c1 q2 + (ref1 + c0 − c1 ref2)``
   (:mod:`eomgen.model.coupling`; ``q`` is ``qpos``, so the refs enter the offset): ``joint1``
@@ -66,8 +73,10 @@ a name that is taken gets ``_2``, ``_3``, … appended.
 
 Warned about (:class:`~eomgen.errors.UnsupportedFeatureWarning`, refused under ``strict``),
 by name: ball joints' springs, spatial tendons (and a fixed tendon's armature and
-frictionloss), actuators other
-than motors on hinge and slide joints, equalities that are inactive (``active="false"``),
+frictionloss), the actuators not read (one line per kind, with their count and first names:
+activation dynamics ``dyntype`` filter, integrator, DC motor; tendon, site, slider-crank or
+body transmissions; muscles; free and ball joints; user-defined gains), equalities that are
+inactive (``active="false"``),
 ``tendon`` and flex equalities, an equality joining a dropped free body, fluid forces
 (``density``, ``viscosity``), gravity compensation (``gravcomp``). Refused
 (:class:`~eomgen.errors.UnsupportedError`), by name: ``joint`` equalities of order above
@@ -102,7 +111,7 @@ from ...errors import (DescriptionError, ForbiddenXMLError, InvalidLoopError,
 from ...model import RobotModel, emit_notices, settled
 from ...numeric.loop_checks import LoopProblem, check_loops
 from ..registry import register
-from .extras import model_notices, motors, with_equalities, with_tendons
+from .extras import controls, model_notices, motors, with_equalities, with_tendons
 from .numbers import check_compiled
 from .tree import build_tree
 
@@ -231,6 +240,7 @@ def model_from_mujoco(m, source: str = "<mujoco>", strict: bool = False,
     notices = tuple(n for n in model_notices(m, source)
                     if not n.joints or any(j in present for j in n.joints))
     model = replace(model, notices=tuple(model.notices) + notices,
+                    controls=tuple(c for c in controls(m) if c.joint in present),
                     info=model.info + (("mujoco_motors", tuple(
                         motor for motor in motors(m) if motor[1] in present)),))
     if not defer_notices:

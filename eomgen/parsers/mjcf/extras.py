@@ -21,6 +21,7 @@ from ...errors import UnsupportedError
 from ...model import (
     POINT_LOOP,
     WELD as WELD_LOOP,
+    Control,
     Coupling,
     Loop,
     LoopFrame,
@@ -30,6 +31,7 @@ from ...model import (
     Tendon,
     Transform,
     lock_joints,
+    make_control,
     make_coupling,
     scalar,
     vec3,
@@ -42,7 +44,8 @@ from .tree import BALL, FREE, HINGE, SLIDE, body_names, disabled, joint_names, r
 _TRN_JOINT, _TRN_JOINT_IN_PARENT = 0, 1
 _TRN_NAMES = {2: "slider-crank", 3: "tendon", 4: "site", 5: "body"}
 _DYN_NAMES = {1: "integrator", 2: "filter", 3: "filter", 4: "muscle", 5: "DC motor", 6: "PID"}
-_GAIN_MUSCLE, _BIAS_AFFINE = 2, 1
+_GAIN_FIXED, _GAIN_AFFINE, _GAIN_MUSCLE = 0, 1, 2
+_BIAS_NONE, _BIAS_AFFINE = 0, 1
 #: MuJoCo's equality types (``mjtEq``) and wrap type of a joint in a fixed tendon.
 CONNECT, WELD, JOINT, TENDON = 0, 1, 2, 3
 _WRAP_JOINT = 1
@@ -71,24 +74,88 @@ def motors(m) -> tuple[tuple[str, str, float], ...]:
 
 
 def is_motor(m, i: int) -> bool:
+    """Whether actuator ``i`` is a plain motor (fixed gain, no bias) eomgen reads."""
+    return (is_control(m, i) and int(m.actuator_gaintype[i]) == _GAIN_FIXED
+            and int(m.actuator_biastype[i]) == _BIAS_NONE)
+
+
+def is_control(m, i: int) -> bool:
+    """Whether actuator ``i`` is one eomgen reads as a :class:`~eomgen.model.Control`: a joint
+    transmission on a hinge or slide joint, no activation dynamics, a fixed or affine gain and
+    no or an affine bias (``<motor>``, ``<position>`` and ``<velocity>`` without a time
+    constant, ``<general>`` of those types)."""
     if int(m.actuator_trntype[i]) not in (_TRN_JOINT, _TRN_JOINT_IN_PARENT):
         return False
     joint = int(m.actuator_trnid[i, 0])
     return (int(m.jnt_type[joint]) in (HINGE, SLIDE) and int(m.actuator_dyntype[i]) == 0
-            and int(m.actuator_gaintype[i]) == 0 and int(m.actuator_biastype[i]) == 0)
+            and int(m.actuator_gaintype[i]) in (_GAIN_FIXED, _GAIN_AFFINE)
+            and int(m.actuator_biastype[i]) in (_BIAS_NONE, _BIAS_AFFINE))
 
 
-def _actuator_kind(m, i: int) -> str:
+def controls(m) -> tuple[Control, ...]:
+    """The :class:`~eomgen.model.Control` of each actuator :func:`is_control` reads, in
+    MuJoCo's actuator order: ``gear`` its first component, the gain and bias the first three
+    of ``gainprm``/``biasprm`` (a fixed gain keeps only the first, no bias is zero), the
+    control clamped to ``ctrlrange`` when ``ctrllimited`` (and clamping is not disabled), the
+    force to ``forcerange`` when ``forcelimited``."""
+    jnames = joint_names(m)
+    clamp_ctrl = not disabled(m, "CLAMPCTRL")
+    out = []
+    for i in (i for i in range(m.nu) if is_control(m, i)):
+        gain = [float(x) for x in m.actuator_gainprm[i, :3]]
+        if int(m.actuator_gaintype[i]) == _GAIN_FIXED:
+            gain[1:] = [0.0, 0.0]
+        bias = ([float(x) for x in m.actuator_biasprm[i, :3]]
+                if int(m.actuator_biastype[i]) == _BIAS_AFFINE else [0.0, 0.0, 0.0])
+        ctrl = (m.actuator_ctrlrange[i].tolist()
+                if clamp_ctrl and bool(m.actuator_ctrllimited[i]) else None)
+        force = m.actuator_forcerange[i].tolist() if bool(m.actuator_forcelimited[i]) else None
+        out.append(make_control(_name(m, "actuator", i), jnames[int(m.actuator_trnid[i, 0])],
+                                float(m.actuator_gear[i, 0]), gain, bias, ctrl, force))
+    return tuple(out)
+
+
+def _actuator_kind(m, i: int) -> tuple[str, str]:
+    """What actuator ``i`` (one :func:`is_control` does not read) is: ``(one, several)``."""
     trn = int(m.actuator_trntype[i])
     if trn in _TRN_NAMES:
-        return f"an actuator on a {_TRN_NAMES[trn]}"
+        kind = f"on a {_TRN_NAMES[trn]}"
+        return f"an actuator {kind} is", f"actuators {kind} are"
     if int(m.actuator_gaintype[i]) == _GAIN_MUSCLE or int(m.actuator_dyntype[i]) == 4:
-        return "a muscle"
-    if int(m.jnt_type[int(m.actuator_trnid[i, 0])]) == FREE:
-        return "an actuator on a free joint"
-    if int(m.actuator_biastype[i]) == _BIAS_AFFINE:
-        return "a servo (position or velocity feedback)"
-    return f"an actuator with {_DYN_NAMES.get(int(m.actuator_dyntype[i]), 'its own')} dynamics"
+        return "a muscle is", "muscles are"
+    if int(m.jnt_type[int(m.actuator_trnid[i, 0])]) not in (HINGE, SLIDE):
+        return "an actuator on a free or ball joint is", "actuators on free or ball joints are"
+    if int(m.actuator_dyntype[i]):
+        dynamics = _DYN_NAMES.get(int(m.actuator_dyntype[i]), "its own")
+        return (f"an actuator with {dynamics} dynamics (activation) is",
+                f"actuators with {dynamics} dynamics (activation) are")
+    return ("an actuator with a user-defined gain or bias is",
+            "actuators with a user-defined gain or bias are")
+
+
+def _actuator_notices(m, source: str) -> list[Notice]:
+    """One notice per kind of actuator eomgen does not read (:func:`_actuator_kind`), with
+    their count and first three names."""
+    jnames = joint_names(m)
+    kinds: dict[tuple[str, str], list[tuple[str, tuple[str, ...]]]] = {}
+    for i in range(m.nu):
+        if is_control(m, i):
+            continue
+        on_joint = int(m.actuator_trntype[i]) in (_TRN_JOINT, _TRN_JOINT_IN_PARENT)
+        joints = (jnames[int(m.actuator_trnid[i, 0])],) if on_joint else ()
+        kinds.setdefault(_actuator_kind(m, i), []).append((_name(m, "actuator", i), joints))
+    notices = []
+    for kind, found in kinds.items():
+        names = [f"'{name}'" for name, _ in found]
+        shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
+        joints = tuple(j for _, js in found for j in js)
+        every_on_joint = all(js for _, js in found)
+        notices.append(_notice(source, f"actuator {shown}" if len(found) == 1 else
+                               f"{len(found)} actuators {shown}",
+                               f"{kind[0] if len(found) == 1 else kind[1]} not modelled",
+                               "left out of ctrl (docs/formats.md, "
+                               "MJCF actuators)", joints=joints if every_on_joint else ()))
+    return notices
 
 
 def model_notices(m, source: str) -> tuple[Notice, ...]:
@@ -131,14 +198,7 @@ def model_notices(m, source: str) -> tuple[Notice, ...]:
                 notices.append(_notice(source, f"{where} {attribute}", f"a tendon's "
                                        f"{attribute} is not modelled", "left out",
                                        joints=tuple(jnames[j] for j, _ in joints)))
-    for i in range(m.nu):
-        if not is_motor(m, i):
-            on_joint = int(m.actuator_trntype[i]) in (_TRN_JOINT, _TRN_JOINT_IN_PARENT)
-            notices.append(_notice(source, f"actuator '{_name(m, 'actuator', i)}'",
-                                   f"{_actuator_kind(m, i)} is not modelled",
-                                   "eomgen's input is the joint torque",
-                                   joints=(jnames[int(m.actuator_trnid[i, 0])],) if on_joint
-                                   else ()))
+    notices += _actuator_notices(m, source)
     notices += [found for found in equalities(m, source) if isinstance(found, Notice)]
     if m.opt.density or m.opt.viscosity:
         notices.append(_notice(source, "option density, viscosity",

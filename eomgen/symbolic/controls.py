@@ -1,0 +1,142 @@
+"""Builders of the control outputs (issue 41): MuJoCo's actuators on joints as generated
+functions of ``(q, q̇, ctrl)`` (:class:`~eomgen.model.Control`, docs/formats.md).
+
+* ``tau_act`` (``actuator_forces``): ``τ_act = Σ_i gear_i · clamp(gain_i · clamp(ctrl_i) +
+  bias_i)`` on each control's joint, with ``gain = g0 + g1 l + g2 v``, ``bias = b0 + b1 l + b2
+  v`` on the joint's length ``l = gear · q`` and velocity ``v = gear · q̇`` (MuJoCo's
+  ``qfrc_actuator`` of a joint transmission: ``force = gain · ctrl + bias``, the control
+  clamped to ``ctrlrange`` and the force to ``forcerange``, then ``Jᵀ force`` with ``J =
+  gear``);
+* ``qdd_ctrl`` (``forward_dynamics_ctrl``): ``q̈ = (M + diag(a))⁻¹ (τ_act − d q̇ − C q̇ − g)``
+  by the Articulated-Body Algorithm with the drives' armature ``a`` and viscous damping ``d``
+  (MuJoCo's ``armature`` and ``damping``): MuJoCo's ``qacc_smooth`` of a model without
+  springs. Coulomb friction (MuJoCo's ``frictionloss``, a constraint there) is left out.
+  :func:`passive_forces` is the one place passive joint forces enter (the hook for joint
+  springs and tendons);
+* ``dqdd_dctrl``: ``∂q̈/∂ctrl = (M + diag(a))⁻¹ ∂τ_act/∂ctrl`` (nv × nu), zero in the columns
+  whose clamp holds.
+
+A clamp is the piecewise-linear ``clamp(x, lo, hi) = (lo + hi + |x − lo| − |x − hi|) / 2``:
+exact inside the range (up to rounding of order ``ulp(max(|lo|, |hi|))``), ``lo`` below and
+``hi`` above, and its derivative ``(sign(x − lo) − sign(x − hi)) / 2`` is 1 inside, 0 outside
+(½ on the bound itself). Every backend prints ``Abs`` and ``sign``.
+
+A control on a joint the model no longer moves (locked by a scene or an equality) gives no
+force; its ``ctrl`` entry stays.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from ..errors import GenerationError
+from ..model import RobotModel, joint_actuators
+from .aba import forward_dynamics_program, true_accelerations
+from .builders import builds, provides, sizes
+from .derivatives import symmetric_inverse
+from .program import name_expr
+
+
+@sizes("ctrl")
+def control_count(model: RobotModel) -> int:
+    """The length of ``ctrl``: the model's controls."""
+    return len(model.controls)
+
+
+@provides("ACTUATOR_NAMES")
+def actuator_names(dynamics) -> dict[str, tuple[str, ...]]:
+    """``ACTUATOR_NAMES``: the controls' names, the entries of ``ctrl`` in order."""
+    return {"ACTUATOR_NAMES": tuple(c.name for c in dynamics.model.controls)}
+
+
+def clamp(x, bounds):
+    """``x`` clamped to ``bounds = (lo, hi)`` as a piecewise-linear expression (module
+    docstring); ``x`` itself when ``bounds`` is None."""
+    if bounds is None:
+        return x
+    lo, hi = bounds
+    return (lo + hi + sp.Abs(x - lo) - sp.Abs(x - hi)) / 2
+
+
+def control_forces(derivation) -> list[tuple[int, sp.Expr, sp.Expr]]:
+    """``(joint index, gear, force)`` of each control of the derivation's model (``None`` for
+    a control on a joint it does not move), the force an expression of ``q``, ``q̇`` and
+    ``ctrl`` (module docstring)."""
+    model = derivation.model
+    names = list(model.joint_names)
+    q, qd, ctrl = derivation.q, derivation.qd, derivation.inputs["ctrl"]
+    out = []
+    for i, control in enumerate(model.controls):
+        if control.joint not in names:
+            out.append(None)
+            continue
+        k = names.index(control.joint)
+        length, velocity = control.gear * q[k], control.gear * qd[k]
+        gain = control.gain[0] + control.gain[1] * length + control.gain[2] * velocity
+        bias = control.bias[0] + control.bias[1] * length + control.bias[2] * velocity
+        force = clamp(gain * clamp(ctrl[i], control.ctrlrange) + bias, control.forcerange)
+        out.append((k, control.gear, force))
+    return out
+
+
+def actuator_forces(derivation, forces) -> sp.Matrix:
+    """τ_act (nv × 1) of :func:`control_forces` ``forces``, each force named ``f_act<i>``."""
+    tau = [sp.Integer(0)] * len(derivation.model.joint_names)
+    for i, found in enumerate(forces):
+        if found is not None:
+            k, gear, force = found
+            tau[k] += gear * name_expr(derivation.builder, force, f"f_act{i + 1}",
+                                       ("f_act", i + 1))
+    return sp.Matrix(tau)
+
+
+def passive_forces(derivation) -> sp.Matrix:
+    """The passive joint forces the forward dynamics of the controls adds (nv × 1): the drives'
+    viscous damping ``−d q̇`` (MuJoCo's ``damping``). Joint springs and tendons, once modelled,
+    are added here."""
+    return sp.Matrix([-a.damping * v for a, v in
+                      zip(joint_actuators(derivation.model), derivation.qd)])
+
+
+@builds("tau_act", "qdd_ctrl", "dqdd_dctrl")
+def build_controls(derivation, wanted) -> dict:
+    """The builder of ``tau_act``, ``qdd_ctrl`` and ``dqdd_dctrl`` in :mod:`eomgen.outputs`
+    (see the module docstring).
+
+    Raises
+    ------
+    GenerationError
+        For a model without controls (nothing to generate a function of ``ctrl`` from).
+    """
+    model = derivation.model
+    if not model.controls:
+        raise GenerationError(f"{model.source}: {', '.join(sorted(wanted))} need controls "
+                              "(MJCF actuators on joints, YAML controls:), but the model has "
+                              "none (docs/formats.md)")
+    out = {}
+    forces = control_forces(derivation)
+    tau = out["tau_act"] = actuator_forces(derivation, forces)
+    armature = [a.armature for a in joint_actuators(derivation.model)]
+    if "qdd_ctrl" in wanted:
+        effort = tau + passive_forces(derivation)
+        qdd = forward_dynamics_program(derivation.tree, derivation.q, derivation.qd,
+                                       list(effort), derivation.model.gravity,
+                                       derivation.builder, armature=armature)
+        out["qdd_ctrl"] = true_accelerations(derivation, qdd)
+    if "dqdd_dctrl" in wanted:
+        b = derivation.builder
+        ctrl = derivation.inputs["ctrl"]
+        M = derivation.output("M") + sp.diag(*armature)
+        Minv = symmetric_inverse(b, M, "Minv_u")
+        B = sp.zeros(len(tau), len(ctrl))
+        for i, found in enumerate(forces):
+            if found is not None:
+                k, gear, force = found
+                B[k, i] += name_expr(b, gear * sp.diff(force, ctrl[i]), f"dtau_act{i + 1}",
+                                     ("dtau_act", i + 1))
+        out["dqdd_dctrl"] = Minv * B
+    return out
+
+
+__all__ = ["actuator_forces", "actuator_names", "build_controls", "clamp", "control_count",
+           "control_forces", "passive_forces"]

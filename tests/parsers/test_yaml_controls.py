@@ -1,0 +1,75 @@
+"""YAML ``controls:`` (eomgen.model.Control): read, refused in one line when wrong, and generated
+as actuator_forces against the clamps computed here with np.clip, and forward_dynamics_ctrl
+against the generated forward_dynamics at those forces (minus the drive's damping)."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+import eomgen
+from eomgen.errors import DescriptionError
+from support.generated import generated
+
+ROBOT = """
+name: two
+parameters: {kp: 20, kv: 1.5}
+links:
+  - {name: base}
+  - {name: l1, mass: 1.2, com: [0.3, 0, 0], inertia: {izz: 0.02, iyy: 0.03, ixx: 0.01}}
+  - {name: l2, mass: 0.7, com: [0.2, 0.01, 0], inertia: {izz: 0.01, iyy: 0.01, ixx: 0.004}}
+joints:
+  - {name: a, type: revolute, parent: base, child: l1, axis: [0, 1, 0]}
+  - {name: b, type: prismatic, parent: l1, child: l2, origin: {xyz: [0.5, 0, 0]},
+     axis: [1, 0, 0], actuator: {damping: 0.4}}
+controls:
+  - {name: servo, joint: a, gear: 2, gain: [kp, 0, 0], bias: [0, -kp, -kv],
+     forcerange: [-3, 4]}
+  - {name: push, joint: b, gain: 5, ctrlrange: [-1, 0.5]}
+"""
+
+
+@pytest.fixture(scope="module")
+def two(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("two")
+    (folder / "two.yaml").write_text(ROBOT, encoding="utf-8")
+    model = eomgen.load(folder / "two.yaml")
+    calls = generated(model, ["actuator_forces", "forward_dynamics_ctrl", "forward_dynamics"],
+                      folder, ("numpy",))[0]
+    return model, calls["numpy"]
+
+
+def test_forces_are_the_clamped_affine_laws(two):
+    model, call = two
+    assert [c.name for c in model.controls] == ["servo", "push"]
+    rng = np.random.default_rng(2)
+    for _ in range(6):
+        q, qd, u = rng.uniform(-1, 1, 2), rng.uniform(-2, 2, 2), rng.uniform(-2, 2, 2)
+        servo = np.clip(20 * u[0] - 20 * 2 * q[0] - 1.5 * 2 * qd[0], -3, 4)
+        push = 5 * np.clip(u[1], -1, 0.5)
+        expected = np.array([2 * servo, push])
+        assert np.allclose(call("actuator_forces", q, qd, u), expected, rtol=1e-14, atol=1e-14)
+        tau = expected - np.array([0, 0.4 * qd[1]])
+        assert np.allclose(call("forward_dynamics_ctrl", q, qd, u),
+                           call("forward_dynamics", q, qd, tau), rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("entry, where", [
+    ("{name: c, joint: nowhere}", "controls[0] 'c' joint"),
+    ("{name: c, joint: a, ctrlrange: [1, -1]}", "controls[0] 'c' ctrlrange"),
+    ("{name: c, joint: a, gain: [1, 2]}", "controls[0] 'c' gain"),
+    ("{name: c, joint: a, colour: red}", "controls[0]"),
+])
+def test_a_wrong_control_is_refused_in_one_line(tmp_path, entry, where):
+    text = ROBOT[:ROBOT.index("controls:")] + f"controls:\n  - {entry}\n"
+    (tmp_path / "two.yaml").write_text(text, encoding="utf-8")
+    with pytest.raises(DescriptionError, match=re.escape(where)) as caught:
+        eomgen.load(tmp_path / "two.yaml")
+    assert "\n" not in str(caught.value)
+
+
+def test_a_model_without_controls_refuses_the_control_outputs():
+    with pytest.raises(eomgen.errors.GenerationError, match="need controls"):
+        eomgen.derive(eomgen.load(eomgen.example_path("planar_2link")), ["tau_act"])
