@@ -523,8 +523,8 @@ ACTUATOR_FORCES = _listed(Output(
     _REVOLUTE_EFFORT, ("tau_act",), default=False, constants=_ACTUATOR_NAMES))
 FORWARD_CTRL = _listed(Output(
     "forward_dynamics_ctrl", "qdd_ctrl", "Joint accelerations qdd = (M(q) + diag(a))^-1 "
-    "(actuator_forces - d qd - C(q, qd) qd - g(q)) by the Articulated-Body Algorithm "
-    "(MuJoCo's qacc_smooth without springs).", ("q", "qd", "ctrl"), True,
+    "(actuator_forces + passive_forces - C(q, qd) qd - g(q)) by the Articulated-Body "
+    "Algorithm (MuJoCo's qacc_smooth).", ("q", "qd", "ctrl"), True,
     "rad/s^2 (revolute), m/s^2 (prismatic)", ("qdd_ctrl",), default=False,
     constants=_ACTUATOR_NAMES))
 FORWARD_CTRL_DERIVATIVE = _listed(Output(

@@ -7,12 +7,11 @@ functions of ``(q, q̇, ctrl)`` (:class:`~eomgen.model.Control`, docs/formats.md
   ``qfrc_actuator`` of a joint transmission: ``force = gain · ctrl + bias``, the control
   clamped to ``ctrlrange`` and the force to ``forcerange``, then ``Jᵀ force`` with ``J =
   gear``);
-* ``qdd_ctrl`` (``forward_dynamics_ctrl``): ``q̈ = (M + diag(a))⁻¹ (τ_act − d q̇ − C q̇ − g)``
-  by the Articulated-Body Algorithm with the drives' armature ``a`` and viscous damping ``d``
-  (MuJoCo's ``armature`` and ``damping``): MuJoCo's ``qacc_smooth`` of a model without
-  springs. Coulomb friction (MuJoCo's ``frictionloss``, a constraint there) is left out.
-  :func:`passive_forces` is the one place passive joint forces enter (the hook for joint
-  springs and tendons);
+* ``qdd_ctrl`` (``forward_dynamics_ctrl``): ``q̈ = (M + diag(a))⁻¹ (τ_act + τ_p − C q̇ − g)``
+  by the Articulated-Body Algorithm with the drives' armature ``a`` (MuJoCo's ``armature``)
+  and the passive forces ``τ_p`` of :mod:`eomgen.symbolic.passive` (joint springs, the drives'
+  viscous damping, fixed tendons): MuJoCo's ``qacc_smooth``. Coulomb friction (MuJoCo's
+  ``frictionloss``, a constraint there) is left out;
 * ``dqdd_dctrl``: ``∂q̈/∂ctrl = (M + diag(a))⁻¹ ∂τ_act/∂ctrl`` (nv × nu), zero in the columns
   whose clamp holds.
 
@@ -34,6 +33,7 @@ from ..model import RobotModel, joint_actuators
 from .aba import forward_dynamics_program, true_accelerations
 from .builders import builds, provides, sizes
 from .derivatives import symmetric_inverse
+from .passive import passive_forces
 from .program import name_expr
 
 
@@ -90,14 +90,6 @@ def actuator_forces(derivation, forces) -> sp.Matrix:
     return sp.Matrix(tau)
 
 
-def passive_forces(derivation) -> sp.Matrix:
-    """The passive joint forces the forward dynamics of the controls adds (nv × 1): the drives'
-    viscous damping ``−d q̇`` (MuJoCo's ``damping``). Joint springs and tendons, once modelled,
-    are added here."""
-    return sp.Matrix([-a.damping * v for a, v in
-                      zip(joint_actuators(derivation.model), derivation.qd)])
-
-
 @builds("tau_act", "qdd_ctrl", "dqdd_dctrl")
 def build_controls(derivation, wanted) -> dict:
     """The builder of ``tau_act``, ``qdd_ctrl`` and ``dqdd_dctrl`` in :mod:`eomgen.outputs`
@@ -139,4 +131,4 @@ def build_controls(derivation, wanted) -> dict:
 
 
 __all__ = ["actuator_forces", "actuator_names", "build_controls", "clamp", "control_count",
-           "control_forces", "passive_forces"]
+           "control_forces"]

@@ -22,6 +22,13 @@ from .builders import builds
 @builds("tau_p")
 def build_passive(derivation, wanted) -> dict:
     """The builder of ``tau_p`` (see the module docstring)."""
+    return {"tau_p": passive_forces(derivation)}
+
+
+def passive_forces(derivation) -> sp.Matrix:
+    """``τ_p`` (NV × 1) of the module docstring: what the springs and dampers add to the
+    joint efforts; the forward dynamics of the controls adds it too
+    (:mod:`eomgen.symbolic.controls`), as MuJoCo's ``qacc_smooth`` does."""
     model = derivation.model
     q, qd = derivation.q, derivation.qd
     out = [sp.Integer(0)] * len(qd)
@@ -39,4 +46,4 @@ def build_passive(derivation, wanted) -> dict:
         force = tendon_force(tendon, length, rate)
         for name, c in tendon.coefficients:
             out[index[name]] += c * force
-    return {"tau_p": sp.Matrix(out)}
+    return sp.Matrix(out)

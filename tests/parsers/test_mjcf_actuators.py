@@ -139,3 +139,44 @@ def test_every_code_backend_gives_mujocos_forces_and_accelerations(tmp_path):
                            atol=1e-12), name
         assert np.allclose(call("forward_dynamics_ctrl", q, qd, ctrl[:5]), acc, rtol=1e-11,
                            atol=1e-11), name
+
+
+#: Springs, a fixed tendon with a spring, a dead band and damping, and two servos.
+SPRUNG = """<mujoco model="sprung"><worldbody>
+  <body name="a"><joint name="j1" axis="0 0 1" stiffness="3" springref="0.2" damping="0.4"/>
+    <geom type="capsule" size="0.04" fromto="0 0 0 0.4 0 0" mass="1.2"/>
+    <body name="b" pos="0.4 0 0"><joint name="j2" axis="0 1 0" armature="0.02"/>
+      <geom type="capsule" size="0.03" fromto="0 0 0 0.3 0 0.1" mass="0.7"/>
+      <body name="c" pos="0.3 0 0.1"><joint name="j3" type="slide" axis="1 0 0" stiffness="40"
+          springref="0.05"/><geom type="box" size="0.03 0.03 0.03" mass="0.3"/></body>
+    </body></body></worldbody>
+  <tendon><fixed name="t" stiffness="5" springlength="-0.1 0.1" damping="0.3">
+    <joint joint="j1" coef="1"/><joint joint="j2" coef="-0.5"/></fixed></tendon>
+  <actuator><position name="p" joint="j2" kp="20" kv="1"/>
+    <motor name="m" joint="j3" gear="2" ctrlrange="-1 1" ctrllimited="true"/></actuator>
+</mujoco>"""
+
+
+def test_springs_and_tendons_are_in_the_forward_dynamics_of_the_controls(tmp_path):
+    """forward_dynamics_ctrl holds the passive forces (joint springs, damping, the tendon's
+    spring with its dead band and damping): MuJoCo's whole qacc_smooth, and the passive part
+    alone is qacc_smooth less what the actuators do."""
+    path = tmp_path / "sprung.xml"
+    path.write_text(SPRUNG, encoding="utf-8")
+    model = quiet_load(path)
+    out = tmp_path / "out"
+    out.mkdir()
+    calls, _ = generated(model, ["forward_dynamics_ctrl", "passive_forces"], out, ("numpy",))
+    call = calls["numpy"]
+    m = mujoco.MjModel.from_xml_path(str(path))
+    rng = np.random.default_rng(11)
+    for _ in range(6):
+        q, qd, ctrl = rng.uniform(-1, 1, 3), rng.uniform(-2, 2, 3), rng.uniform(-2, 2, 2)
+        _, acc = mujoco_at(m, q, qd, ctrl)
+        ours = call("forward_dynamics_ctrl", q, qd, ctrl)
+        assert np.abs(ours - acc).max() <= 1e-10 * np.abs(acc).max(), (ours, acc)
+        d = mujoco.MjData(m)
+        d.qpos[:], d.qvel[:] = q, qd
+        mujoco.mj_forward(m, d)
+        assert np.abs(call("passive_forces", q, qd) - d.qfrc_passive).max() \
+            <= 1e-10 * np.abs(d.qfrc_passive).max()
