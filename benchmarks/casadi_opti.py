@@ -108,12 +108,17 @@ def reach(f, n, steps, horizon, limit, hessian):
     opti.subject_to(X[:, steps] == ca.vertcat(0.5 * ca.DM.ones(n), ca.DM.zeros(n)))
     opti.subject_to(opti.bounded(-limit, ca.vec(U), limit))
     opti.minimize(dt * ca.sumsqr(U))
+    # initial guess: the states on the straight line to the goal
+    opti.set_initial(X[:n, :], 0.5 * np.tile(np.linspace(0, 1, steps + 1), (n, 1)))
     opti.solver("ipopt", {"print_time": False},
-                {"print_level": 0, "sb": "yes", "tol": 1e-8, "hessian_approximation": hessian})
+                {"print_level": 0, "sb": "yes", "tol": 1e-8, "max_iter": 1000,
+                 "hessian_approximation": hessian})
     start = time.perf_counter()
-    solution = opti.solve()
+    solution = opti.solve_limited()
     elapsed = time.perf_counter() - start
-    return elapsed, int(solution.stats()["iter_count"]), float(solution.value(opti.f))
+    stats = solution.stats()
+    optimum = float(solution.value(opti.f)) if stats["success"] else float("nan")
+    return elapsed, int(stats["iter_count"]), optimum
 
 
 def main() -> None:
