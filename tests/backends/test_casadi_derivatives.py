@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import eomgen
-from eomgen.codegen.backends.casadi_backend import jacobians, library_name
+from eomgen.codegen.backends.casadi_backend import library_name
 from eomgen.codegen.functions import module_name, select_functions
 from eomgen.codegen.generate import render_files
 from eomgen.common.compiler import c_compiler
