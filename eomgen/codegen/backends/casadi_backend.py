@@ -18,6 +18,8 @@ from pathlib import Path
 from sympy.printing.pycode import PythonCodePrinter
 
 from ...outputs import exported, function_names
+from ...outputs.catalogue import (FORWARD, FORWARD_DERIVATIVES, INVERSE, INVERSE_DERIVATIVES,
+                                  MASS)
 from ...common.compiler import c_compiler, shared_library
 from ...common.output import GeneratedFile
 from ..job import Job
@@ -58,11 +60,31 @@ class CasADiConfig:
     suffix: str = "_casadi.py"
 
 
+#: The functions whose Jacobian (in CasADi's MX graphs, and ``jac_<name>`` of the C library)
+#: is eomgen's derivative programs: {function: the functions whose results are its Jacobian's
+#: blocks for its vector inputs, in input order}. tau(q, qd, qdd) has dtau/dqdd = M.
+JACOBIAN_SOURCES: dict[str, tuple[str, ...]] = {
+    FORWARD.function: (FORWARD_DERIVATIVES.function,),
+    INVERSE.function: (INVERSE_DERIVATIVES.function, MASS.function),
+}
+
+
+def jacobians(job: Job) -> list[tuple[str, tuple[str, ...]]]:
+    """The (function, sources) of :data:`JACOBIAN_SOURCES` a job's CasADi module builds: the
+    function and all its sources exported, and no quaternion joint (whose derivatives are
+    along the tangent, nv columns, not the NQ entries of q)."""
+    if job.model.nq != job.model.dof:
+        return []
+    functions = exported(job.functions, "casadi")
+    return [(name, sources) for name, sources in JACOBIAN_SOURCES.items()
+            if name in functions and all(s in functions for s in sources)]
+
+
 def _render_module(job: Job, config: CasADiConfig) -> str:
     printer = CasADiPrinter({"standard": "python3"})
     # Parameters without a value have no default: the module refuses calls that leave them out.
     required = [p.keyword for p in job.parameters if p.default is None]
-    return render(config.template, required=required,
+    return render(config.template, required=required, jacobians=jacobians(job),
                   **python_module_context(job, printer, config.template, backend="casadi"))
 
 
@@ -128,8 +150,11 @@ def emit_c(job: Job, config: CasADiConfig = CasADiConfig()) -> list[GeneratedFil
     # keep the stem.
     prefix = re.sub(r"__+", "_", stem)
     generator = ca.CodeGenerator(prefix + ".c", {"with_header": True, "with_mem": False})
+    jacobians_of = namespace.get("_JACOBIANS", {})
     for name in exported(job.functions, "c"):
         generator.add(namespace[name])
+        if name in jacobians_of:  # casadi.external(name, library) finds jac_<name>
+            generator.add(jacobians_of[name])
     with tempfile.TemporaryDirectory() as tmp:
         generator.generate(tmp + os.sep)
         c_source = Path(tmp, prefix + ".c").read_text()
