@@ -13,6 +13,7 @@ from eomgen.errors import DescriptionError, EomgenError
 from eomgen.reduction import apply_scene
 from eomgen.scene import load_scene
 from support import run_in_process, write
+from support.extras import need
 
 ARM = """name: clash
 links:
@@ -65,6 +66,7 @@ def test_names_that_do_not_clash_are_the_kinds(tmp_path, compound, kind):
 
 
 def test_mjcf_hinge_named_like_the_free_flyer_position(tmp_path):
+    need("mujoco", reason="MJCF is read by MuJoCo's compiler")
     path = write(tmp_path / "clash.xml", MJCF % "base_qz")
     out = tmp_path / "out"
     done = run_in_process("generate", path, "-o", out, "--backend", "numpy")
