@@ -123,6 +123,16 @@ class RobotModel:
         return any(kind == "free_flyer" for kind, _ in self.compound_joints)
 
     @property
+    def base_kind(self):
+        """The kind of the virtual base joint that moves the root in the world (a
+        :class:`~eomgen.model.joints.JointKind` whose ``base`` is set: the quaternion free
+        flyer), its velocity first in ``v``; None for a fixed root or an Euler chain."""
+        for kind, _ in self.compound_joints:
+            if KINDS[kind].base:
+                return KINDS[kind]
+        return None
+
+    @property
     def ball_joints(self) -> tuple[str, ...]:
         """The names of the model's ball (spherical) joints (:attr:`compound_joints`)."""
         return tuple(name for kind, name in self.compound_joints if kind == "spherical")

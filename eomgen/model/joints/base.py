@@ -24,7 +24,7 @@ there). When its configuration is the chain's coordinates (a universal joint), t
 joints are joints of the tree like any other. When it is not (:class:`ChartKind`: the free
 flyer, a ball joint, a planar joint), the chain is held at zero, with the pose from ``q`` placed
 before it (:meth:`ChainKind.pose`, :meth:`ChartKind.placement`);
-:mod:`eomgen.symbolic.quaternion_joints` has the argument.
+:mod:`eomgen.symbolic.charts` has the argument.
 """
 
 from __future__ import annotations
@@ -50,6 +50,10 @@ class JointKind:
     #: True when a description writes it as a joint's type (a :class:`eomgen.model.JointType`
     #: member); the free flyer is put under a robot instead.
     described: bool = True
+    #: True for a virtual base joint: the joint a scene or a parser puts between the world and
+    #: a robot's root (Pinocchio's ``root_joint``; named ``base``), whose velocity is the root's
+    #: twist in the root frame (the free flyer).
+    base: bool = False
     #: True when the kind rotates its child about its axis, or translates it along its axis.
     rotates: bool = False
     translates: bool = False
@@ -158,6 +162,13 @@ class ChainKind(JointKind):
         """``(name, configuration, velocity)`` in prose with LaTeX, for documents and
         messages."""
         raise NotImplementedError
+
+    def refused_as(self, joint: str) -> tuple[str, str, str]:
+        """``(what, where, hint)`` for a one-line refusal of something not derived for the
+        joint ``joint`` of this kind: what it is, the element of the description that made it,
+        and a way out (empty when there is none)."""
+        name = self.describe()[0]
+        return f"a {name} joint", f"{name} joint '{joint}'", ""
 
 
 class ChartKind(ChainKind):
