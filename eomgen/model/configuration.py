@@ -84,6 +84,15 @@ def degenerate(q, model=None) -> str | None:
     return None
 
 
+def norm_error(q, model=None) -> float:
+    """How far ``q`` (NQ) is off the configuration manifold: the largest ``|‖u‖ − 1|`` over
+    the unit parts of its joints (each kind's
+    :meth:`~eomgen.model.joints.ChartKind.norm_error`: a quaternion, a planar joint's
+    ``(cos θ, sin θ)``); 0 without them."""
+    q = np.asarray(q, dtype=float)
+    return max((j.kind.norm_error(q[j.q_slice]) for j in layout(model)), default=0.0)
+
+
 def configuration_rate(q, v, model=None) -> np.ndarray:
     """``q̇`` (NQ) at velocity ``v`` (NV): each joint's kind's rate
     (:meth:`~eomgen.model.joints.JointKind.configuration_rate`): a free flyer's origin moves at
@@ -135,5 +144,60 @@ def neutral(model) -> np.ndarray:
     return q
 
 
-__all__ = ["DEGENERATE_LENGTH", "configuration_rate", "degenerate", "difference", "integrate", "layout", "left_jacobian",
-           "neutral", "skew", "so3_exp", "so3_log"]
+def random_configuration(model, coordinates: np.ndarray, rng: np.random.Generator
+                         ) -> np.ndarray:
+    """The configuration (``model.nq``) for tests and verification whose joints with a chart
+    take their kind's :meth:`~eomgen.model.joints.JointKind.random_configuration` of their
+    ``coordinates`` (a free flyer's origin; quaternions uniform on the unit sphere, from
+    ``rng``) and the others ``coordinates`` (``model.dof`` values, by velocity index):
+    ``coordinates`` itself when ``q`` is the coordinates."""
+    joints = model.quaternion_joints
+    if not joints:
+        return coordinates
+    q = np.empty(model.nq)
+    for joint, sv, sq in _pieces(joints, model.dof):
+        q[sq] = (coordinates[sv] if joint is None
+                 else joint.kind.random_configuration(coordinates[sv], rng))
+    return q
+
+
+def chart_indices(model) -> tuple[tuple[int, ...], tuple[int, ...]]:
+    """``(massless, charted)``: the velocity indices of ``model`` whose bodies are the massless
+    links inside the chain of a joint with a chart (all its virtual joints but the last:
+    their inertial parameters are zero by construction), and the velocity indices of those
+    joints (which take no drive); both empty when ``q`` is the coordinates."""
+    joints = model.quaternion_joints
+    return (tuple(k for joint in joints for k in joint.virtual),
+            tuple(k for joint in joints for k in range(joint.v_index, joint.v_index + joint.nv)))
+
+
+def chart_states(model, xi, xid, xidd) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(q, v, v̇)`` of the chart states ``(ξ, ξ̇, ξ̈)`` (each (N, NV)) of ``model`` (a
+    :class:`~eomgen.model.RobotModel`, or the joints of :func:`layout`): ``q`` (N, NQ), ``v``
+    and ``v̇`` (N, NV), each joint with a chart by its kind's
+    :meth:`~eomgen.model.joints.ChartKind.chart_states`
+    (:mod:`eomgen.identification.charts`); the inputs when ``q`` is the coordinates."""
+    xi, xid, xidd = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (xi, xid, xidd))
+    joints = layout(model)
+    if not joints:
+        return xi, xid, xidd
+    N, nv = xi.shape
+    q = np.empty((N, nv + sum(j.nq - j.nv for j in joints)))
+    v, vd = xid.copy(), xidd.copy()
+    for joint, sv, sq in _pieces(joints, nv):
+        if joint is None:
+            q[:, sq] = xi[:, sv]
+        else:
+            q[:, sq], v[:, sv], vd[:, sv] = joint.kind.chart_states(xi[:, sv], xid[:, sv],
+                                                                    xidd[:, sv])
+    return q, v, vd
+
+
+def quaternion_indices(model) -> tuple[int, ...]:
+    """The index in ``q`` of the x of each quaternion of ``model`` (then y, z, w), in order:
+    the joints whose kind holds one (its ``quaternion_offset``); empty without them."""
+    return tuple(j.quaternion for j in layout(model) if j.quaternion is not None)
+
+
+__all__ = ["DEGENERATE_LENGTH", "chart_indices", "chart_states", "configuration_rate", "degenerate", "difference", "integrate", "layout", "left_jacobian",
+           "neutral", "norm_error", "quaternion_indices", "random_configuration", "skew", "so3_exp", "so3_log"]

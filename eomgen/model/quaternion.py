@@ -60,7 +60,8 @@ class QuaternionJoint:
     """One joint of a model whose configuration is not its coordinates (a free flyer, a ball
     joint, a planar joint: a :class:`~eomgen.model.joints.ChartKind`): its ``kind``, its name
     (``base`` for the free flyer), the index of its first velocity entry in ``v``
-    (``v_index``) and of its first configuration entry in ``q`` (``q_index``)."""
+    (``v_index``) and of its first configuration entry in ``q`` (``q_index``). A one-coordinate
+    joint has a place of this type too (:attr:`~eomgen.model.RobotModel.joint_places`)."""
 
     kind: ChartKind
     name: str

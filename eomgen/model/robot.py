@@ -143,6 +143,21 @@ class RobotModel:
         (:func:`~eomgen.model.quaternion_layout`); empty for a model without them."""
         return quaternion_layout(self)
 
+    @cached_property
+    def joint_places(self) -> tuple[QuaternionJoint, ...]:
+        """Every joint of the configuration in velocity order, with its kind and the index of
+        its first entry in ``v`` and in ``q`` (Pinocchio's joints with their ``idx_v``,
+        ``idx_q``): a joint whose configuration is not its coordinates is one place (its
+        chain's virtual joints are not places of their own), every other coordinate joint
+        one place of its type's kind."""
+        charts = {j.v_index: j for j in self.quaternion_joints}
+        joints, out, k, iq = self.coordinate_joints, [], 0, 0
+        while k < len(joints):
+            place = charts.get(k) or QuaternionJoint(joints[k].type.kind, joints[k].name, k, iq)
+            out.append(place)
+            k, iq = k + place.nv, iq + place.nq
+        return tuple(out)
+
     @property
     def nq(self) -> int:
         """The number of configuration coordinates (NQ): :attr:`dof`, plus one for the

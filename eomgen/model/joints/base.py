@@ -57,6 +57,8 @@ class JointKind:
     #: True when the kind rotates its child about its axis, or translates it along its axis.
     rotates: bool = False
     translates: bool = False
+    #: Where the kind's quaternion starts in its configuration entries (None: it has none).
+    quaternion_offset: int | None = None
 
     def lead(self, pitch=0):
         """The translation along the axis per unit of the coordinate: 1 for a prismatic joint
@@ -105,6 +107,11 @@ class JointKind:
     def configuration_rate(self, q, v) -> np.ndarray:
         """``q̇`` (NQ,) at velocity ``v`` (NV,)."""
         return np.asarray(v, dtype=float).copy()
+
+    def symbolic_rate(self, q, v) -> dict:
+        """``{symbol: q̇}`` of the NQ configuration symbols ``q`` at velocity ``v`` (NV): ``v``
+        itself for a kind whose configuration is its coordinates."""
+        return dict(zip(q, v))
 
     def random_configuration(self, coordinates, rng) -> np.ndarray:
         """A configuration (NQ,) for tests and verification from ``coordinates`` (NV values
@@ -178,8 +185,6 @@ class ChartKind(ChainKind):
 
     #: Suffixes of the configuration entries' names (``<joint>_<suffix>``).
     configuration_suffixes: tuple[str, ...] = ()
-    #: Where the kind's quaternion starts in its configuration entries (None: it has none).
-    quaternion_offset: int | None = None
     #: The entries of the configuration (NQ,) that stand for their normalised value (a
     #: quaternion; a planar joint's ``(cos θ, sin θ)``), and their name for messages; None
     #: when the kind has none. Zero length stands for no configuration at all.
