@@ -38,6 +38,8 @@ Names that left a module which stays (:data:`MOVED_NAMES`) are looked up by that
 ================================================  =====================================
  old name                                           new place
 ================================================  =====================================
+ ``eomgen.model.FREE_FLYER_CONFIGURATION``          :mod:`eomgen.model.quaternion`
+ ``eomgen.model.FREE_FLYER_VELOCITY``               :mod:`eomgen.model.quaternion`
  ``eomgen.reduction.derivation_cost``               :mod:`eomgen.codegen.derivation_cost`
  ``eomgen.reduction.measure_derivation``            :mod:`eomgen.codegen.derivation_cost`
  ``eomgen.reduction.MEASURE_TIMEOUT``               :mod:`eomgen.codegen.derivation_cost`
@@ -81,6 +83,10 @@ MOVED: dict[str, str] = {
 
 #: Module that stays → {name that left it: the module it went to}.
 MOVED_NAMES: dict[str, dict[str, str]] = {
+    "eomgen.model": {
+        "FREE_FLYER_CONFIGURATION": "eomgen.model.quaternion",
+        "FREE_FLYER_VELOCITY": "eomgen.model.quaternion",
+    },
     "eomgen.reduction": {
         "derivation_cost": "eomgen.codegen.derivation_cost",
         "measure_derivation": "eomgen.codegen.derivation_cost",

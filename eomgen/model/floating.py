@@ -274,8 +274,13 @@ def check_spatial_inertia(model: RobotModel) -> None:
                                   "a floating base would have a singular mass matrix")
 
 
+#: How a scene's ``floating_base:`` floats a robot, by its value (``true`` is
+#: ``"quaternion"``): the free flyer, or the Euler chain.
+FLOATING_BASES = {"quaternion": add_free_flyer, "euler": add_floating_base}
+
+
 __all__ = [
-    "WORLD", "EULER_JOINTS", "CONFIGURATION_NAMES", "VELOCITY_NAMES",
+    "FLOATING_BASES", "WORLD", "EULER_JOINTS", "CONFIGURATION_NAMES", "VELOCITY_NAMES",
     "add_floating_base", "add_free_flyer", "pinocchio_order", "virtual_chain",
     "total_inertial", "check_spatial_inertia",
 ]

@@ -49,10 +49,12 @@ _ZERO = sp.S.Zero
 
 
 def _joints(source) -> tuple[QuaternionJoint, ...]:
-    """The joints with a chart of ``source`` (module docstring): a model's, a derivation's
-    model's, or ``source`` itself when it is the joints."""
+    """The joints with a chart of ``source`` (module docstring): the places of a model (a
+    derivation's model) whose configuration is not their coordinates (NQ ≠ NV), or
+    ``source`` itself when it is the joints."""
     model = getattr(source, "model", source)
-    return tuple(getattr(model, "quaternion_joints", model))
+    return tuple(place for place in getattr(model, "joint_places", model)
+                 if place.nq != place.nv)
 
 
 def placement(joint: QuaternionJoint, q, b, number: int = 0) -> Transform:
@@ -226,7 +228,7 @@ def independent_view(derivation):
         v = next(k for k in range(T.cols) if T[joint.v_index, k] != 0)
         joints.append(replace(joint, v_index=v, q_index=joint.q_index - joint.v_index + v))
     return SimpleNamespace(inputs=derivation.inputs, builder=derivation.builder,
-                           model=SimpleNamespace(quaternion_joints=tuple(joints), dof=T.cols))
+                           model=SimpleNamespace(joint_places=tuple(joints), dof=T.cols))
 
 
 __all__ = ["chart_accelerations", "chart_offset", "chart_reference_accelerations", "coordinates", "coriolis_correction",
