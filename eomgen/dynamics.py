@@ -302,10 +302,11 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     unknown = outputs - set(known)
     if unknown:
         raise ValueError(f"unknown outputs {sorted(unknown)}; choose from {known}")
-    # With a joint whose configuration is not its coordinates (nq > nv: a quaternion free flyer,
-    # ball joints, eomgen.model.quaternion), the outputs the catalogue marks, each checked against Pinocchio's free flyer
-    # and spherical joints (Y against computeJointTorqueRegressor: a virtual joint's massless
-    # body has columns of its own, multiplied by zero parameters; Y_base by the numeric route,
+    # With a joint whose configuration is not its coordinates (nq > nv: a quaternion free
+    # flyer, ball joints, eomgen.model.quaternion), the outputs the catalogue marks, each
+    # checked against Pinocchio's free flyer and spherical joints (Y against
+    # computeJointTorqueRegressor: a virtual joint's massless body has columns of its own,
+    # multiplied by zero parameters; Y_base by the numeric route,
     # without them; Y_SL against M, computeCoriolisMatrix and g; Y_K, Y_P against Pinocchio's
     # energies; the drive outputs against model.armature and the friction law; the flat outputs
     # against finite differences along a trajectory integrated on the configuration space; the

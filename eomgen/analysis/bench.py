@@ -22,8 +22,8 @@ What is measured
 
 States: ``q`` uniform in [−π, π], ``q̇`` and ``q̈`` standard normal (seeded). With quaternion
 joints (a free flyer, ball joints) ``q`` is the configuration (NQ entries) and each quaternion is
-uniform on the unit sphere (:func:`eomgen.model.configuration.random_configuration`); ``q̇``, ``q̈``, τ and M
-have NV entries.
+uniform on the unit sphere (:func:`eomgen.model.configuration.random_configuration`); ``q̇``,
+``q̈``, τ and M have NV entries.
 """
 
 from __future__ import annotations

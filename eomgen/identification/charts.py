@@ -2,8 +2,8 @@
 :mod:`eomgen.model.quaternion`): a curve ``ξ(t)`` in NV chart coordinates, mapped to the
 configuration ``q`` (NQ), the velocity ``v`` and its rate ``v̇`` (NV) the generated functions
 take (:func:`chart_states`, each joint's kind's map, walked over the model by
-:func:`eomgen.model.configuration.chart_states`), so that the Fourier series of :mod:`eomgen.identification.excitation`
-excite such a model as they excite an arm.
+:func:`eomgen.model.configuration.chart_states`), so that the Fourier series of
+:mod:`eomgen.identification.excitation` excite such a model as they excite an arm.
 
 Per quaternion joint, its NV entries of ``ξ`` (its velocity coordinates' places):
 

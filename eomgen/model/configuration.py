@@ -204,5 +204,7 @@ def quaternion_indices(model) -> tuple[int, ...]:
     return tuple(j.quaternion for j in layout(model) if j.quaternion is not None)
 
 
-__all__ = ["DEGENERATE_LENGTH", "chart_indices", "chart_states", "configuration_rate", "degenerate", "difference", "integrate", "layout", "left_jacobian",
-           "neutral", "norm_error", "quaternion_indices", "random_configuration", "skew", "so3_exp", "so3_log"]
+__all__ = ["BASE_KIND", "DEGENERATE_LENGTH", "chart_indices", "chart_states",
+           "configuration_rate", "degenerate", "difference", "integrate", "layout",
+           "left_jacobian", "neutral", "norm_error", "quaternion_indices",
+           "random_configuration", "skew", "so3_exp", "so3_log"]

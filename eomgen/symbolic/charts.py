@@ -178,10 +178,10 @@ def chart_reference_accelerations(source, qd, qd_r, qdd_r) -> tuple:
 
 
 def tangent_seeds(derivation, prefix: str = "q") -> dict:
-    """``{configuration symbol: {(prefix, i): ∂q/∂δᵢ}}`` at ``δ = 0`` (:mod:`eomgen.symbolic.tangent`), for
-    :func:`eomgen.symbolic.derivatives.forward_mode`: the seeds of a derivative with respect
-    to q in tangent coordinates (NV directions). For a model without a chart each
-    ``q`` entry is its own direction."""
+    """``{configuration symbol: {(prefix, i): ∂q/∂δᵢ}}`` at ``δ = 0``
+    (:mod:`eomgen.symbolic.tangent`), for :func:`eomgen.symbolic.derivatives.forward_mode`:
+    the seeds of a derivative with respect to q in tangent coordinates (NV directions). For a
+    model without a chart each ``q`` entry is its own direction."""
     q = derivation.inputs["q"]
     joints = _joints(derivation)
     if not joints:
@@ -203,9 +203,9 @@ def tangent_seeds(derivation, prefix: str = "q") -> dict:
 
 
 def velocity_transport(derivation) -> sp.Matrix:
-    """∂δ̇/∂δ at ``δ = 0`` of ``δ̇ = J_r(δ)⁻¹ v`` (NV × NV, module docstring): the block of the
-    state matrix A that the positions' rows take in tangent coordinates; zero without a
-    chart."""
+    """∂δ̇/∂δ at ``δ = 0`` of ``δ̇ = J_r(δ)⁻¹ v`` (NV × NV, :mod:`eomgen.symbolic.tangent`):
+    the block of the state matrix A that the positions' rows take in tangent coordinates;
+    zero without a chart."""
     nv, v = derivation.model.dof, derivation.inputs["qd"]
     out = sp.zeros(nv, nv)
     for joint in _joints(derivation):
@@ -231,6 +231,7 @@ def independent_view(derivation):
                            model=SimpleNamespace(joint_places=tuple(joints), dof=T.cols))
 
 
-__all__ = ["chart_accelerations", "chart_offset", "chart_reference_accelerations", "coordinates", "coriolis_correction",
-           "corrected_coriolis", "independent_view", "placement", "placements", "quaternion_rotation",
-           "tangent_seeds", "true_accelerations", "velocity_transport"]
+__all__ = ["chart_accelerations", "chart_offset", "chart_reference_accelerations",
+           "coordinates", "coriolis_correction", "corrected_coriolis", "independent_view",
+           "placement", "placements", "quaternion_rotation", "tangent_seeds",
+           "true_accelerations", "velocity_transport"]
