@@ -21,7 +21,7 @@ NAMES = re.compile(r"free_flyer|FREE_FLYER|quaternion_joints")
 #: The modules that name them today, and why.
 NAMING_TODAY: dict[str, str] = {
     # public names kept for users (API and old paths)
-    "eomgen/moved.py": "the old module paths and names (eomgen.free_flyer, ...)",
+    "eomgen/moved.py": "the old module paths and names, kept one more release",
     "eomgen/model/robot.py": "RobotModel.free_flyer and .quaternion_joints, public properties",
     "eomgen/model/floating.py": "add_free_flyer: the free flyer put under a robot",
     "eomgen/numeric/floating_base.py": "to_free_flyer, from_free_flyer: the Euler chart's maps",
