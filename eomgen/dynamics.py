@@ -20,6 +20,7 @@ import sympy as sp
 from .common import reprs
 from .errors import TooLargeError, UnsupportedError
 from .model import Parameter, RobotModel
+from .model.joints import KINDS
 from .outputs import BY_SYMBOL, derived_symbols
 # Derivation, joint_symbols and vector_symbols live in eomgen.symbolic.derivation; re-exported here
 # because the docs and earlier code import them from eomgen.dynamics.
@@ -301,23 +302,22 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     unknown = outputs - set(known)
     if unknown:
         raise ValueError(f"unknown outputs {sorted(unknown)}; choose from {known}")
-    # With a quaternion free flyer or ball joints (eomgen.model.quaternion), the outputs the
-    # catalogue marks (Output.quaternion_joints), each checked against Pinocchio's free flyer
-    # and spherical joints (Y against computeJointTorqueRegressor: a virtual joint's massless
-    # body has columns of its own, multiplied by zero parameters; Y_base by the numeric route,
+    # With a joint whose configuration is not its coordinates (nq > nv: a quaternion free
+    # flyer, ball joints, eomgen.model.quaternion), the outputs the catalogue marks, each
+    # checked against Pinocchio's free flyer and spherical joints (Y against
+    # computeJointTorqueRegressor: a virtual joint's massless body has columns of its own,
+    # multiplied by zero parameters; Y_base by the numeric route,
     # without them; Y_SL against M, computeCoriolisMatrix and g; Y_K, Y_P against Pinocchio's
     # energies; the drive outputs against model.armature and the friction law; the flat outputs
     # against finite differences along a trajectory integrated on the configuration space; the
     # loop rows against Pinocchio's frames and constraintDynamics). An output the catalogue
-    # marks quaternion_joints=False would be refused in one line; the derivatives, the drives'
-    # too, are taken along the tangent (eomgen.symbolic.tangent).
-    refused_here = sorted(s for s in outputs if not BY_SYMBOL[s].quaternion_joints)
-    if model.quaternion_joints and refused_here:
-        first = model.quaternion_joints[0]
-        what, where, hint = (("a quaternion free flyer", "floating_base: quaternion",
-                              "; use floating_base: euler") if model.free_flyer else
-                             (f"a {first.kind.describe()[0]} joint",
-                              f"{first.kind.describe()[0]} joint '{first.name}'", ""))
+    # does not mark would be refused in one line, in the words of the first such joint's kind;
+    # the derivatives, the drives' too, are taken along the tangent (eomgen.symbolic.tangent).
+    refused_here = sorted(s for s in outputs if not BY_SYMBOL[s].on_charts)
+    if model.nq > model.dof and refused_here:
+        kind, name = next((KINDS[k], n) for k, n in model.compound_joints
+                          if KINDS[k].nq > KINDS[k].nv)
+        what, where, hint = kind.refused_as(name)
         raise UnsupportedError(
             model.source, where, f"{', '.join(refused_here)} not derived for {what} yet; "
             f"leave {'it' if len(refused_here) == 1 else 'them'} out of the outputs (every "
@@ -346,7 +346,7 @@ def derive(model: RobotModel, outputs: Iterable[str] = DEFAULT_OUTPUTS, simplify
     if model.couplings:  # the projected outputs (eomgen.symbolic.couplings)
         result = dict(program.outputs)
     steps = _steps(program, result)
-    if model.quaternion_joints or model.couplings:  # the textbook forms take the joints as coordinates
+    if model.nq > model.dof or model.couplings:  # the textbook forms take q as the coordinates
         simplify = False
     if simplify is None:  # teaching-sized: few joints and a small program (a cheap estimate)
         counted = [o for o in ("M", "C", "g") if o in outputs]

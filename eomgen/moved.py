@@ -1,29 +1,30 @@
 """Old module paths, kept for one more release: importing one warns and gives the module at its
 new place (docs/architecture.md lays the layers out).
 
-=============================  =====================================
- old path                        new path
-=============================  =====================================
- ``eomgen.actuators``            :mod:`eomgen.analysis.actuators`
- ``eomgen.batch``                :mod:`eomgen.analysis.batch`
- ``eomgen.bodies``               :mod:`eomgen.model.bodies`
- ``eomgen.catalogue``            :mod:`eomgen.outputs.catalogue`
- ``eomgen.compiler``             :mod:`eomgen.common.compiler`
- ``eomgen.contacts``             :mod:`eomgen.numeric.contacts`
- ``eomgen.display``              :mod:`eomgen.present.display`
- ``eomgen.expressions``          :mod:`eomgen.model.expressions`
- ``eomgen.floating``             :mod:`eomgen.numeric.floating_base`
- ``eomgen.free_flyer``           :mod:`eomgen.model.floating`
- ``eomgen.lambdify``             :mod:`eomgen.codegen.lambdify`
- ``eomgen.loops``                :mod:`eomgen.numeric.loops`
- ``eomgen.notebook``             :mod:`eomgen.teach.notebook`
- ``eomgen.output``               :mod:`eomgen.common.output`
- ``eomgen.progress``             :mod:`eomgen.common.progress`
- ``eomgen.quaternion_joints``    :mod:`eomgen.model.configuration`
- ``eomgen.reduction.cost``       :mod:`eomgen.codegen.derivation_cost`
- ``eomgen.reprs``                :mod:`eomgen.common.reprs`
- ``eomgen.templating``           :mod:`eomgen.common.templating`
-=============================  =====================================
+========================================  =====================================
+ old path                                 new path
+========================================  =====================================
+ ``eomgen.actuators``                     :mod:`eomgen.analysis.actuators`
+ ``eomgen.batch``                         :mod:`eomgen.analysis.batch`
+ ``eomgen.bodies``                        :mod:`eomgen.model.bodies`
+ ``eomgen.catalogue``                     :mod:`eomgen.outputs.catalogue`
+ ``eomgen.compiler``                      :mod:`eomgen.common.compiler`
+ ``eomgen.contacts``                      :mod:`eomgen.numeric.contacts`
+ ``eomgen.display``                       :mod:`eomgen.present.display`
+ ``eomgen.expressions``                   :mod:`eomgen.model.expressions`
+ ``eomgen.floating``                      :mod:`eomgen.numeric.floating_base`
+ ``eomgen.free_flyer``                    :mod:`eomgen.model.floating`
+ ``eomgen.lambdify``                      :mod:`eomgen.codegen.lambdify`
+ ``eomgen.loops``                         :mod:`eomgen.numeric.loops`
+ ``eomgen.notebook``                      :mod:`eomgen.teach.notebook`
+ ``eomgen.output``                        :mod:`eomgen.common.output`
+ ``eomgen.progress``                      :mod:`eomgen.common.progress`
+ ``eomgen.quaternion_joints``             :mod:`eomgen.model.configuration`
+ ``eomgen.reduction.cost``                :mod:`eomgen.codegen.derivation_cost`
+ ``eomgen.reprs``                         :mod:`eomgen.common.reprs`
+ ``eomgen.symbolic.quaternion_joints``    :mod:`eomgen.symbolic.charts`
+ ``eomgen.templating``                    :mod:`eomgen.common.templating`
+========================================  =====================================
 
 ``import eomgen.quaternion_joints`` (or ``from eomgen.quaternion_joints import integrate``)
 emits one :class:`DeprecationWarning` naming the new path and :data:`REMOVED_IN`, and binds the
@@ -37,6 +38,8 @@ Names that left a module which stays (:data:`MOVED_NAMES`) are looked up by that
 ================================================  =====================================
  old name                                           new place
 ================================================  =====================================
+ ``eomgen.model.FREE_FLYER_CONFIGURATION``          :mod:`eomgen.model.quaternion`
+ ``eomgen.model.FREE_FLYER_VELOCITY``               :mod:`eomgen.model.quaternion`
  ``eomgen.reduction.derivation_cost``               :mod:`eomgen.codegen.derivation_cost`
  ``eomgen.reduction.measure_derivation``            :mod:`eomgen.codegen.derivation_cost`
  ``eomgen.reduction.MEASURE_TIMEOUT``               :mod:`eomgen.codegen.derivation_cost`
@@ -74,11 +77,16 @@ MOVED: dict[str, str] = {
     "eomgen.quaternion_joints": "eomgen.model.configuration",
     "eomgen.reduction.cost": "eomgen.codegen.derivation_cost",
     "eomgen.reprs": "eomgen.common.reprs",
+    "eomgen.symbolic.quaternion_joints": "eomgen.symbolic.charts",
     "eomgen.templating": "eomgen.common.templating",
 }
 
 #: Module that stays → {name that left it: the module it went to}.
 MOVED_NAMES: dict[str, dict[str, str]] = {
+    "eomgen.model": {
+        "FREE_FLYER_CONFIGURATION": "eomgen.model.quaternion",
+        "FREE_FLYER_VELOCITY": "eomgen.model.quaternion",
+    },
     "eomgen.reduction": {
         "derivation_cost": "eomgen.codegen.derivation_cost",
         "measure_derivation": "eomgen.codegen.derivation_cost",

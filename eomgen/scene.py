@@ -135,8 +135,8 @@ class Scene:
         root that looks like a floating base (:mod:`eomgen.parsers.urdf`), as the task holds
         the robot still (an arm of a humanoid on a fixed torso, a legged robot on a stand).
     floating_base:
-        The root link flies free: ``"quaternion"`` (what ``true`` means):
-        :func:`eomgen.model.floating.add_free_flyer`, Pinocchio's free flyer (a unit quaternion in
+        The root link flies free (:data:`eomgen.model.floating.FLOATING_BASES`):
+        ``"quaternion"`` (what ``true`` means): Pinocchio's free flyer (a unit quaternion in
         q, the root twist in v); ``"euler"``: :func:`eomgen.model.floating.add_floating_base` puts
         six virtual joints (x, y, z, yaw, pitch, roll) between a fixed ``world`` link and it
         (what ``true`` meant before the quaternion became the default). False for a root that

@@ -38,7 +38,7 @@ from .model.moving_mass import massless_problem
 from .numeric import numeric_model
 from .outputs import BY_SYMBOL
 from .numeric import rnea as numeric_rnea
-from .model.configuration import configuration_rate
+from .model.configuration import configuration_rate, random_configuration
 from .symbolic.evaluate import compile_program
 
 #: Default relative tolerance of the numeric identities.
@@ -130,28 +130,6 @@ def sample_states(n: int, samples: int, rng: np.random.Generator, model=None):
         yield (q if model is None else random_configuration(model, q, rng)), qd, qdd
 
 
-def random_configuration(model, coordinates: np.ndarray, rng: np.random.Generator
-                         ) -> np.ndarray:
-    """The configuration (``model.nq``) whose joints other than the quaternion joints take
-    ``coordinates`` (``model.dof`` values, by velocity index), a free flyer's origin too, and
-    whose quaternions are uniform on the unit sphere (normalised Gaussian draws)."""
-    joints = model.quaternion_joints
-    if not joints:
-        return coordinates
-    q = np.empty(model.nq)
-    starts = {j.v_index: j for j in joints}
-    k = iq = 0
-    while k < model.dof:
-        joint = starts.get(k)
-        if joint is None:
-            q[iq] = coordinates[k]
-            k, iq = k + 1, iq + 1
-            continue
-        q[joint.q_slice] = joint.kind.random_configuration(coordinates[joint.v_slice], rng)
-        k, iq = k + joint.nv, iq + joint.nq
-    return q
-
-
 def reference_rnea(model):
     """``rnea(q, qd, qdd)`` of ``model`` by the float Newton–Euler recursion, in its
     ``joint_names`` coordinates (with coupled joints ``Tᵀ RNEA(T q + c, T q̇, T q̈)`` on the
@@ -208,7 +186,7 @@ def verify(dynamics: Dynamics, samples: int = 20, seed: int = 0,
     how = f"{samples} samples"
     # exact checks reduce polynomials in sin q_i, cos q_i: not a quaternion's entries, nor the
     # sin(0.5 q1 − 0.3 q2) of a coupled joint
-    exact = (n <= EXACT_MAX_DOF and _is_exact(model) and not model.quaternion_joints
+    exact = (n <= EXACT_MAX_DOF and _is_exact(model) and model.nq == model.dof
              and not model.couplings)
 
     def record(name, pairs, how=how, extra_ok=True):
@@ -249,7 +227,7 @@ def verify(dynamics: Dynamics, samples: int = 20, seed: int = 0,
         pairs = []
         h = 1e-20
         for (q, qd, _), r in zip(states, results):
-            rate = configuration_rate(q, qd, model) if model.quaternion_joints else qd
+            rate = configuration_rate(q, qd, model) if model.nq > model.dof else qd
             stepped = evaluate(*(q + 1j * h * rate), *qd, *pvals)["M"]
             Mdot = stepped.imag / h
             N = Mdot - 2 * r["C"]

@@ -22,8 +22,8 @@ What is measured
 
 States: ``q`` uniform in [−π, π], ``q̇`` and ``q̈`` standard normal (seeded). With quaternion
 joints (a free flyer, ball joints) ``q`` is the configuration (NQ entries) and each quaternion is
-uniform on the unit sphere (:func:`eomgen.verify.random_configuration`); ``q̇``, ``q̈``, τ and M
-have NV entries.
+uniform on the unit sphere (:func:`eomgen.model.configuration.random_configuration`); ``q̇``,
+``q̈``, τ and M have NV entries.
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ import numpy as np
 from ..common.compiler import c_compiler
 from ..model import RobotModel
 from ..common.progress import plural
-from ..verify import random_configuration
+from ..model.configuration import random_configuration
 from .precision import Reference, relative_error
 from .report import csv_text, fmt, markdown_table, pareto_front, pyplot
 from .routes import Route, build_routes, numeric_only
@@ -185,7 +185,7 @@ def sample_states(n: int, samples: int, seed: int, model: RobotModel | None = No
     rng = np.random.default_rng(seed)
     q, qd, qdd = (rng.uniform(-np.pi, np.pi, (samples, n)), rng.normal(size=(samples, n)),
                   rng.normal(size=(samples, n)))
-    if model is not None and model.quaternion_joints:
+    if model is not None and model.nq > model.dof:
         q = np.array([random_configuration(model, x, rng) for x in q])
     return q, qd, qdd
 

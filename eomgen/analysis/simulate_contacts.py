@@ -53,7 +53,7 @@ from ..numeric.contacts import ContactDynamics, derived_mass_and_bias
 from ..numeric import kinetic_energy, numeric_model, potential_energy
 from ..numeric.so3 import so3_log
 from ..common.progress import plural
-from ..model.configuration import configuration_rate
+from ..model.configuration import configuration_rate, norm_error
 from .report import csv_text, fmt, markdown_table, pyplot
 from .routes import numeric_only
 from .simulate import (OUTPUT_POINTS, Diverged, ImplicitMidpoint, advance, initial_state,
@@ -99,7 +99,7 @@ class ContactSystem:
         self.n = n = self.model.dof
         #: Entries of the configuration, and whether it holds quaternions (NQ ≠ NV).
         self.nq = self.model.nq
-        self.quaternion = bool(self.model.quaternion_joints)
+        self.quaternion = self.model.nq > self.model.dof
         q0 = np.asarray(q0, dtype=float)
         self.tau = np.zeros(n) if tau is None else np.asarray(tau, dtype=float)
         held = []
@@ -162,10 +162,9 @@ class ContactSystem:
         return advance(self.model, np.asarray(q, float), np.asarray(qd, float), h)
 
     def quaternion_norm_error(self, q) -> float:
-        """``max_j |‖quaternion_j‖ − 1|`` over the quaternion joints at ``q`` (0 without)."""
-        q = np.asarray(q, float)
-        return max((j.kind.norm_error(q[j.q_slice]) for j in self.model.quaternion_joints),
-                   default=0.0)
+        """``max_j |‖quaternion_j‖ − 1|`` over the joints with a unit part at ``q`` (0
+        without): :func:`eomgen.model.configuration.norm_error`."""
+        return norm_error(q, self.model)
 
     def energy(self, q, qd) -> tuple[float, float]:
         """``(K, P)`` [J] from :mod:`eomgen.numeric`."""
@@ -280,7 +279,7 @@ def run_contact_study(model: RobotModel, contacts: Sequence[Contact], integrator
     raised."""
     model = numeric_only(model)
     n = model.dof
-    if model.quaternion_joints:
+    if model.nq > model.dof:
         q0, qd0 = quaternion_start(model, q0, qd0)
     else:
         q0, qd0 = initial_state(q0, qd0, n, model.joint_names)

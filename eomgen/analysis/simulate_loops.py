@@ -138,7 +138,7 @@ class LoopSystem:
         self.tau = np.zeros(self.n)
         #: Whether ``q`` holds quaternions (NQ ≠ NV): the integrators then step it by
         #: :meth:`integrate`.
-        self.quaternion = bool(model.quaternion_joints)
+        self.quaternion = model.nq > model.dof
         self._nm = numeric_model(model)
         self.evaluations = 0
         self.max_condition = float("nan")
@@ -304,7 +304,7 @@ def run_loop_study(model: RobotModel, integrators: Sequence, duration: float, q0
     ``diverged``. ``gains`` ``(kp, kd)``: the Baumgarte gains of every row (default: the
     loops' :data:`DEFAULT_GAINS`, each contact's own)."""
     model = numeric_only(model)
-    if model.quaternion_joints:
+    if model.nq > model.dof:
         q0, qd0 = quaternion_start(model, q0, qd0)
     else:
         q0, qd0 = initial_state(q0, qd0, model.dof, model.joint_names)

@@ -126,7 +126,7 @@ def excite(description, output, duration, samples, harmonics, amplitude, max_vel
     check_output_file(output)
     progress = Progress(quiet, heartbeat=HEARTBEAT_SECONDS)
     model, _ = load_reduced(description, scene_path, strict)
-    if positions_only and model.quaternion_joints:
+    if positions_only and model.nq > model.dof:
         raise IdentificationError(f"{description}: --positions-only: a model with quaternion "
                                   "joints needs its qd_, qdd_ columns (a quaternion's rate is "
                                   "not v)")
@@ -205,6 +205,7 @@ def identify(description, data, outdir, physical, friction, cutoff, scene_path, 
     from ..identification.estimation import (observation_matrix, physical_fit,
                                              read_measurements, weighted_least_squares)
     from ..identification.report import IdentificationReport
+    from ..model.configuration import quaternion_indices
     from ..regressor import description_values  # SymPy: only when the command runs
 
     if physical and importlib.util.find_spec("cvxpy") is None:
@@ -214,10 +215,9 @@ def identify(description, data, outdir, physical, friction, cutoff, scene_path, 
     model, _ = load_reduced(description, scene_path, strict)
     terms = _terms(model, friction)
     progress(f"reading {data}")
-    quaternions = [j.quaternion for j in model.quaternion_joints if j.quaternion is not None]
     measured = read_measurements(data, model.joint_names, cutoff,
-                                 model.configuration_names if model.quaternion_joints else None,
-                                 quaternions)
+                                 model.configuration_names if model.nq > model.dof else None,
+                                 list(quaternion_indices(model)))
     reg, base = _regressor(model, terms, progress)
     progress(f"stacking the base regressor over {plural(measured.N, 'sample')}")
     W = observation_matrix(reg, base.base, measured.q, measured.qd, measured.qdd)

@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model import QuaternionJoint
-from ..model.joints import FREE_FLYER, KINDS, ChartKind
-from ..model.configuration import configuration_rate, difference
+from ..model import QuaternionJoint, RobotModel
+from ..model.joints import KINDS, ChartKind
+from ..model.configuration import configuration_rate, difference, layout
 
 
 def module_layout(module) -> tuple[QuaternionJoint, ...]:
@@ -25,7 +25,10 @@ def module_layout(module) -> tuple[QuaternionJoint, ...]:
     names each kind gives its entries (:mod:`eomgen.model.joints`): a free flyer's ``base_vx …
     base_wz`` over ``base_x … base_qw``, a ball joint's ``<name>_wx … _wz`` over ``<name>_qx …
     _qw``, a planar joint's ``<name>_vx, _vy, _wz`` over ``<name>_x, _y, _cos, _sin``; empty
-    when the two lists are one."""
+    when the two lists are one. Of a :class:`~eomgen.model.RobotModel`, its own
+    (:func:`eomgen.model.configuration.layout`)."""
+    if isinstance(module, RobotModel):
+        return layout(module)
     velocity = tuple(getattr(module, "JOINT_NAMES", ()))
     configuration = tuple(getattr(module, "CONFIGURATION_NAMES", velocity))
     if configuration == velocity:
@@ -37,7 +40,7 @@ def module_layout(module) -> tuple[QuaternionJoint, ...]:
             name = velocity[k][:-len(kind.velocity_suffixes[0]) - 1]
             if (velocity[k:k + kind.nv] == kind.velocity_names(name)
                     and configuration[iq:iq + kind.nq] == kind.configuration_names(name)):
-                found.append(QuaternionJoint(kind, "base" if kind is FREE_FLYER else name,
+                found.append(QuaternionJoint(kind, "base" if kind.base else name,
                                              k, iq))
                 k, iq = k + kind.nv, iq + kind.nq
                 break

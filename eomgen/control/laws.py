@@ -37,9 +37,7 @@ def fourier_reference(trajectory, model=None) -> Desired:
     FourierTrajectory` (the excitation trajectories of ``eomgen excite``); for a ``model`` with
     quaternion joints (or a generated module of one) the trajectory is in the chart of
     :mod:`eomgen.identification.charts` and ``q_d`` has NQ entries."""
-    joints = () if model is None else getattr(model, "quaternion_joints", None)
-    if joints is None:
-        joints = module_layout(model)
+    joints = () if model is None else module_layout(model)
 
     def desired(t):
         q, qd, qdd = chart_states(joints, *trajectory.states(np.array([float(t)])))

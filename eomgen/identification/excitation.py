@@ -314,7 +314,7 @@ def simulate_measurements(model, trajectory: FourierTrajectory, t, noise: float 
     """
     t = np.asarray(t, dtype=float)
     q, qd, qdd = trajectory_states(model, trajectory, t)
-    if model.quaternion_joints:
+    if model.nq > model.dof:  # a chart: the regressor walks it
         tau = _regressor_efforts(model, values, tuple(actuators), q, qd, qdd)
     else:
         nm = numeric_model(model, values)

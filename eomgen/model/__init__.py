@@ -35,6 +35,7 @@ mass, inertias whose findings do not matter). Import every name from
 
 from __future__ import annotations
 
+from ..moved import moved_name
 from .actuator import DEFAULT_FRICTION_WIDTH, Actuator
 from .checks import (
     MAX_JOINTS,
@@ -55,8 +56,6 @@ from .moving_mass import massless_joints, massless_notices, settled
 from .passive import Spring, Tendon, tendon_force
 from .parts import Inertial, Joint, JointType, Link, Parameter
 from .quaternion import (
-    FREE_FLYER_CONFIGURATION,
-    FREE_FLYER_VELOCITY,
     QuaternionJoint,
     expand_ball_joints,
     expand_joints,
@@ -76,11 +75,20 @@ from .scalars import IDENTITY3, ZERO3, Mat3, Scalar, Vec3, mat3, parameter_symbo
 from .snapping import ANGLE_SNAP_TOLERANCE, SNAP_TOLERANCE, Snap, snap, snap_summary, snapping
 from .transforms import Transform, rotation_about_axis, rotation_from_rpy
 
+
+
+def __getattr__(name: str):
+    """The names that left this package for the module of their kind (the free flyer's entry
+    names): a warning, then the object at its new place (:data:`eomgen.moved.MOVED_NAMES`)."""
+    return moved_name(__name__, name)
+
+
 __all__ = [
     "Spring", "Tendon", "tendon_force",
     "HINGE", "LOOP_KINDS", "POINT_LOOP", "WELD", "Loop", "LoopFrame",
     "MAX_MAGNITUDE", "check_model_numbers", "check_number",
-    "ANGLE_SNAP_TOLERANCE", "DEFAULT_FRICTION_WIDTH", "FREE_FLYER_CONFIGURATION", "FREE_FLYER_VELOCITY", "IDENTITY3", "MAX_JOINTS", "POINT", "SNAP_TOLERANCE", "SURFACE",
+    "ANGLE_SNAP_TOLERANCE", "DEFAULT_FRICTION_WIDTH", "IDENTITY3", "MAX_JOINTS", "POINT",
+    "SNAP_TOLERANCE", "SURFACE",
     "ZERO3", "Actuator", "Contact", "Control", "make_control", "Coupling", "couple", "coupling_map", "uncoupled",
     "make_coupling", "with_couplings", "Inertial", "Joint", "JointType", "Link", "Mat3", "Notice",
     "NoticeKind", "Parameter", "QuaternionJoint", "RobotModel", "Scalar", "Snap", "Transform", "Vec3",

@@ -5,9 +5,10 @@ NumPy, one state.
 ``q`` has NQ entries and ``v`` NV, laid out as :mod:`eomgen.model.quaternion` says (Pinocchio's
 layout): a free flyer moves along the SE(3) exponential of its twist (root frame), a ball joint
 along the SO(3) exponential of its angular velocity (child frame), ``R(t) = R exp([ω t]×)``, the
-other joints by ``q + v t``. Every function takes the model (or its
-:attr:`~eomgen.model.RobotModel.quaternion_joints`) as ``model``; without it ``q`` is taken to
-start with a free flyer and to hold no other quaternion joint (:mod:`eomgen.model.floating`).
+other joints by ``q + v t``. Every function takes the model (or the joints of :func:`layout`)
+as ``model``; without it ``q`` is taken to start with the virtual base joint (the free flyer)
+and to hold no other joint whose configuration is not its coordinates
+(:mod:`eomgen.model.floating`).
 
 **Non-unit quaternions** on input: every generated function and these ones use the normalised
 quaternion (any nonzero multiple of a unit quaternion gives the same result; a zero quaternion
@@ -35,21 +36,25 @@ from __future__ import annotations
 
 import numpy as np
 
-from .joints import FREE_FLYER
+from .joints import KINDS
 from .quaternion import QuaternionJoint
 from .robot import RobotModel
 # kept importable here: the rotations every kind uses (eomgen.model.joints.lie)
 from .joints.lie import left_jacobian, skew, so3_exp, so3_log
 
 
+#: The kind of the virtual base joint (:attr:`~eomgen.model.joints.JointKind.base`).
+BASE_KIND = next(kind for kind in KINDS.values() if kind.base)
+
+
 def layout(model, nv: int | None = None) -> tuple[QuaternionJoint, ...]:
-    """The joints of ``model`` whose configuration is not their coordinates (a
-    :class:`~eomgen.model.RobotModel`, or its ``quaternion_joints``); None: one free flyer at
-    the start."""
+    """The joints of ``model`` whose configuration is not their coordinates (NQ ≠ NV), from
+    its :attr:`~eomgen.model.RobotModel.joint_places` (or ``model`` itself when it is such
+    joints); None: the virtual base joint (the free flyer) at the start."""
     if model is None:
-        return (QuaternionJoint(FREE_FLYER, "base", 0, 0),)
+        return (QuaternionJoint(BASE_KIND, "base", 0, 0),)
     if isinstance(model, RobotModel):
-        return model.quaternion_joints
+        return tuple(place for place in model.joint_places if place.nq != place.nv)
     return tuple(model)
 
 
@@ -82,6 +87,15 @@ def degenerate(q, model=None) -> str | None:
             return (f"joint '{joint.name}': its {joint.kind.unit_name} ({names}) has zero "
                     "length; give a unit one")
     return None
+
+
+def norm_error(q, model=None) -> float:
+    """How far ``q`` (NQ) is off the configuration manifold: the largest ``|‖u‖ − 1|`` over
+    the unit parts of its joints (each kind's
+    :meth:`~eomgen.model.joints.ChartKind.norm_error`: a quaternion, a planar joint's
+    ``(cos θ, sin θ)``); 0 without them."""
+    q = np.asarray(q, dtype=float)
+    return max((j.kind.norm_error(q[j.q_slice]) for j in layout(model)), default=0.0)
 
 
 def configuration_rate(q, v, model=None) -> np.ndarray:
@@ -127,7 +141,7 @@ def neutral(model) -> np.ndarray:
     a :class:`~eomgen.model.RobotModel`, or the NQ of a model whose only such joint is a free
     flyer at the start."""
     if isinstance(model, RobotModel):
-        q, joints = np.zeros(model.nq), model.quaternion_joints
+        q, joints = np.zeros(model.nq), layout(model)
     else:
         q, joints = np.zeros(int(model)), layout(None)
     for joint in joints:
@@ -135,5 +149,62 @@ def neutral(model) -> np.ndarray:
     return q
 
 
-__all__ = ["DEGENERATE_LENGTH", "configuration_rate", "degenerate", "difference", "integrate", "layout", "left_jacobian",
-           "neutral", "skew", "so3_exp", "so3_log"]
+def random_configuration(model, coordinates: np.ndarray, rng: np.random.Generator
+                         ) -> np.ndarray:
+    """The configuration (``model.nq``) for tests and verification whose joints with a chart
+    take their kind's :meth:`~eomgen.model.joints.JointKind.random_configuration` of their
+    ``coordinates`` (a free flyer's origin; quaternions uniform on the unit sphere, from
+    ``rng``) and the others ``coordinates`` (``model.dof`` values, by velocity index):
+    ``coordinates`` itself when ``q`` is the coordinates."""
+    joints = layout(model)
+    if not joints:
+        return coordinates
+    q = np.empty(model.nq)
+    for joint, sv, sq in _pieces(joints, model.dof):
+        q[sq] = (coordinates[sv] if joint is None
+                 else joint.kind.random_configuration(coordinates[sv], rng))
+    return q
+
+
+def chart_indices(model) -> tuple[tuple[int, ...], tuple[int, ...]]:
+    """``(massless, charted)``: the velocity indices of ``model`` whose bodies are the massless
+    links inside the chain of a joint with a chart (all its virtual joints but the last:
+    their inertial parameters are zero by construction), and the velocity indices of those
+    joints (which take no drive); both empty when ``q`` is the coordinates."""
+    joints = layout(model)
+    return (tuple(k for joint in joints for k in joint.virtual),
+            tuple(k for joint in joints for k in range(joint.v_index, joint.v_index + joint.nv)))
+
+
+def chart_states(model, xi, xid, xidd) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(q, v, v̇)`` of the chart states ``(ξ, ξ̇, ξ̈)`` (each (N, NV)) of ``model`` (a
+    :class:`~eomgen.model.RobotModel`, or the joints of :func:`layout`): ``q`` (N, NQ), ``v``
+    and ``v̇`` (N, NV), each joint with a chart by its kind's
+    :meth:`~eomgen.model.joints.ChartKind.chart_states`
+    (:mod:`eomgen.identification.charts`); the inputs when ``q`` is the coordinates."""
+    xi, xid, xidd = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (xi, xid, xidd))
+    joints = layout(model)
+    if not joints:
+        return xi, xid, xidd
+    N, nv = xi.shape
+    q = np.empty((N, nv + sum(j.nq - j.nv for j in joints)))
+    v, vd = xid.copy(), xidd.copy()
+    for joint, sv, sq in _pieces(joints, nv):
+        if joint is None:
+            q[:, sq] = xi[:, sv]
+        else:
+            q[:, sq], v[:, sv], vd[:, sv] = joint.kind.chart_states(xi[:, sv], xid[:, sv],
+                                                                    xidd[:, sv])
+    return q, v, vd
+
+
+def quaternion_indices(model) -> tuple[int, ...]:
+    """The index in ``q`` of the x of each quaternion of ``model`` (then y, z, w), in order:
+    the joints whose kind holds one (its ``quaternion_offset``); empty without them."""
+    return tuple(j.quaternion for j in layout(model) if j.quaternion is not None)
+
+
+__all__ = ["BASE_KIND", "DEGENERATE_LENGTH", "chart_indices", "chart_states",
+           "configuration_rate", "degenerate", "difference", "integrate", "layout",
+           "left_jacobian", "neutral", "norm_error", "quaternion_indices",
+           "random_configuration", "skew", "so3_exp", "so3_log"]

@@ -241,19 +241,10 @@ def full_configuration(model, q) -> tuple:
 
 def _configuration_slots(model) -> list[tuple[object, int, int]]:
     """Per coordinate, in ``q`` order: ``(key, index in q, entries in q)``, the key a joint
-    name of ``joint_names`` or ``("quaternion", name)`` for a quaternion joint."""
-    starts = {j.v_index: j for j in model.quaternion_joints}
-    names = model.joint_names
-    slots, k, iq = [], 0, 0
-    while k < len(names):
-        joint = starts.get(k)
-        if joint is None:
-            slots.append((names[k], iq, 1))
-            k, iq = k + 1, iq + 1
-        else:
-            slots.append((("quaternion", joint.name), iq, joint.nq))
-            k, iq = k + joint.nv, iq + joint.nq
-    return slots
+    name of ``joint_names`` or ``("quaternion", name)`` for a joint whose configuration is
+    not its coordinates (:attr:`~eomgen.model.RobotModel.joint_places`)."""
+    return [(place.name if place.nq == place.nv else ("quaternion", place.name),
+             place.q_index, place.nq) for place in model.joint_places]
 
 
 def locked_couplings(model, positions: Mapping[str, object]

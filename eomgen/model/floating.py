@@ -57,7 +57,7 @@ quaternion.
 *How it is derived.* Within the model the free flyer is six virtual joints under the root
 (translations along, then rotations about, the root frame's x, y, z axes), held at zero: at the
 current configuration they are a chart whose velocities are the root twist. The derivation
-(:mod:`eomgen.symbolic.quaternion_joints`) puts the root pose from ``q[0:7]`` above them and
+(:mod:`eomgen.symbolic.charts`) puts the root pose from ``q[0:7]`` above them and
 corrects the chart's second-order terms, so that τ, M, C, g, h and q̈ are the free flyer's.
 Ball joints (:mod:`eomgen.model.quaternion`) are the same mechanism with three rotations;
 :mod:`eomgen.model.configuration` integrates and differences any such model (its functions are
@@ -274,8 +274,13 @@ def check_spatial_inertia(model: RobotModel) -> None:
                                   "a floating base would have a singular mass matrix")
 
 
+#: How a scene's ``floating_base:`` floats a robot, by its value (``true`` is
+#: ``"quaternion"``): the free flyer, or the Euler chain.
+FLOATING_BASES = {"quaternion": add_free_flyer, "euler": add_floating_base}
+
+
 __all__ = [
-    "WORLD", "EULER_JOINTS", "CONFIGURATION_NAMES", "VELOCITY_NAMES",
+    "FLOATING_BASES", "WORLD", "EULER_JOINTS", "CONFIGURATION_NAMES", "VELOCITY_NAMES",
     "add_floating_base", "add_free_flyer", "pinocchio_order", "virtual_chain",
     "total_inertial", "check_spatial_inertia",
 ]

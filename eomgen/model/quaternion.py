@@ -23,7 +23,7 @@ links: the model's joints are its velocity coordinates. :attr:`RobotModel.free_f
 <eomgen.model.RobotModel.free_flyer>` and :attr:`RobotModel.ball_joints
 <eomgen.model.RobotModel.ball_joints>` say which joints they are, and
 :func:`quaternion_layout` lists them with their positions in ``q`` and ``v``; the derivation
-(:mod:`eomgen.symbolic.quaternion_joints`) holds the virtual joints at zero and places the
+(:mod:`eomgen.symbolic.charts`) holds the virtual joints at zero and places the
 rotation of the quaternion before them.
 
 A parser writes a ball joint as a :class:`~eomgen.model.Joint` of type
@@ -60,7 +60,8 @@ class QuaternionJoint:
     """One joint of a model whose configuration is not its coordinates (a free flyer, a ball
     joint, a planar joint: a :class:`~eomgen.model.joints.ChartKind`): its ``kind``, its name
     (``base`` for the free flyer), the index of its first velocity entry in ``v``
-    (``v_index``) and of its first configuration entry in ``q`` (``q_index``)."""
+    (``v_index``) and of its first configuration entry in ``q`` (``q_index``). A one-coordinate
+    joint has a place of this type too (:attr:`~eomgen.model.RobotModel.joint_places`)."""
 
     kind: ChartKind
     name: str

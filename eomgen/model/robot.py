@@ -123,6 +123,16 @@ class RobotModel:
         return any(kind == "free_flyer" for kind, _ in self.compound_joints)
 
     @property
+    def base_kind(self):
+        """The kind of the virtual base joint that moves the root in the world (a
+        :class:`~eomgen.model.joints.JointKind` whose ``base`` is set: the quaternion free
+        flyer), its velocity first in ``v``; None for a fixed root or an Euler chain."""
+        for kind, _ in self.compound_joints:
+            if KINDS[kind].base:
+                return KINDS[kind]
+        return None
+
+    @property
     def ball_joints(self) -> tuple[str, ...]:
         """The names of the model's ball (spherical) joints (:attr:`compound_joints`)."""
         return tuple(name for kind, name in self.compound_joints if kind == "spherical")
@@ -132,6 +142,21 @@ class RobotModel:
         """The free flyer and the ball joints, with their places in ``q`` and ``v``
         (:func:`~eomgen.model.quaternion_layout`); empty for a model without them."""
         return quaternion_layout(self)
+
+    @cached_property
+    def joint_places(self) -> tuple[QuaternionJoint, ...]:
+        """Every joint of the configuration in velocity order, with its kind and the index of
+        its first entry in ``v`` and in ``q`` (Pinocchio's joints with their ``idx_v``,
+        ``idx_q``): a joint whose configuration is not its coordinates is one place (its
+        chain's virtual joints are not places of their own), every other coordinate joint
+        one place of its type's kind."""
+        charts = {j.v_index: j for j in self.quaternion_joints}
+        joints, out, k, iq = self.coordinate_joints, [], 0, 0
+        while k < len(joints):
+            place = charts.get(k) or QuaternionJoint(joints[k].type.kind, joints[k].name, k, iq)
+            out.append(place)
+            k, iq = k + place.nv, iq + place.nq
+        return tuple(out)
 
     @property
     def nq(self) -> int:

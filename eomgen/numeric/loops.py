@@ -210,7 +210,7 @@ class LoopDynamics:
                 return q
             step = np.zeros(self.model.dof)
             step[passive] = np.linalg.lstsq(e["J_l"][:, passive], -e["Phi_l"], rcond=None)[0]
-            q = integrate(q, step, 1.0, self.model) if self.model.quaternion_joints else q + step
+            q = integrate(q, step, 1.0, self.model) if self.model.nq > self.model.dof else q + step
             if not np.all(np.isfinite(q)):
                 break
         raise AssemblyError(f"the loops of '{self.model.name}' do not assemble from this "
@@ -238,10 +238,11 @@ def pinocchio_loops(model: RobotModel, pm, reference=None):
 
 
     reference = pin.ReferenceFrame.LOCAL if reference is None else reference
-    # a quaternion joint is one Pinocchio joint (a free flyer's named root_joint): each of
-    # its virtual joints stands for it
-    names = {virtual: pinocchio_name(j) for j in model.quaternion_joints
-             for virtual in (m.name for m in model.movable_joints[j.v_slice])}
+    # a joint of several coordinates is one Pinocchio joint (a free flyer's named root_joint):
+    # each of its virtual joints stands for it
+    names = {virtual: pinocchio_name(place) for place in model.joint_places
+             if place.nq != place.nv
+             for virtual in (m.name for m in model.movable_joints[place.v_slice])}
     models = pin.StdVec_RigidConstraintModel()
     for loop in model.loops:
         if loop.kind == "hinge":

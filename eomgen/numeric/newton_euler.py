@@ -88,10 +88,9 @@ def _configuration(nm: NumericModel, q) -> tuple[np.ndarray, dict]:
     q = _check(nm, "q", q, nm.nq)
     if nm.coupling is not None:
         q = nm.configuration_coupling @ q + nm.coupling_offset
-    if not nm.quaternion_joints:
+    if nm.nq == nm.n:  # every configuration entry is a coordinate: no chart to place
         return q, {}
-    return (chart_coordinates(nm.quaternion_joints, q, nm.n_tree, nm.numbers),
-            placements(nm.quaternion_joints, q, nm.numbers))
+    return chart_coordinates(nm, q), placements(nm, q)
 
 
 def _tangent(nm: NumericModel, name: str, x) -> np.ndarray:
@@ -211,8 +210,8 @@ def rnea(nm: NumericModel, q, qd, qdd) -> np.ndarray:
     q, placed = _configuration(nm, q)
     qd = _tangent(nm, "qd", qd)
     qdd = _tangent(nm, "qdd", qdd)
-    if nm.quaternion_joints:
-        qdd = qdd - chart_offset(nm.quaternion_joints, qd, nm.numbers)
+    if nm.nq != nm.n:
+        qdd = qdd - chart_offset(nm, qd)
     nb = nm.nb
     R, p = _parent_transforms(nm, q, placed)
     zeros = nm.numbers.zeros
@@ -402,8 +401,8 @@ def world_state(nm: NumericModel, q, qd) -> tuple[np.ndarray, ...]:
     qd = _tangent(nm, "qd", qd)
     zeros = nm.numbers.zeros
     qdd = zeros(nm.n_tree)
-    if nm.quaternion_joints:
-        qdd = -chart_offset(nm.quaternion_joints, qd, nm.numbers)
+    if nm.nq != nm.n:
+        qdd = -chart_offset(nm, qd)
     Rw, pw = _world_poses(nm, x, placed)
     z = np.einsum("ijk,ik->ij", Rw, nm.axis)
     w, v, wd, a = (zeros((nm.nb, 3)) for _ in range(4))
@@ -460,7 +459,7 @@ def link_poses(nm: NumericModel, q) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         coordinates and ``p`` (3,) the link origin [m] in the root frame; the root maps to
         ``(I, 0)``. Every link is present, massless and fixed-joint links included.
     """
-    if nm.quaternion_joints and np.shape(q) == (nm.n,):
+    if nm.nq != nm.n and np.shape(q) == (nm.n,):
         Rw, pw = _world_poses(nm, _check(nm, "q", q), {})
     else:
         Rw, pw = _world_poses(nm, *_configuration(nm, q))

@@ -35,7 +35,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model import RobotModel, coupling_map, uncoupled
-from ..model.joints import FREE_FLYER
 # PinocchioFreeFlyer lives with the Euler maps it uses; importable here too.
 from .floating_base import PinocchioFreeFlyer  # noqa: F401
 from .model import configuration_map
@@ -131,8 +130,7 @@ def to_pinocchio(model: RobotModel) -> PinocchioModel:
     pmodel = pin.Model()
     pmodel.name = model.name
     anchor = {model.root: (0, pin.SE3.Identity())}  # link -> (joint id, placement in it)
-    movable = {j.name: k for k, j in enumerate(model.movable_joints)}
-    chains = {model.movable_joints[j.v_index].name: j for j in model.quaternion_joints}
+    chains = {model.movable_joints[p.v_index].name: p for p in model.joint_places if p.nq != p.nv}
     inside: dict[str, int] = {}  # a quaternion joint's later virtual joints -> its Pinocchio id
     for joint in model.topological_joints:  # depth-first preorder
         parent_id, placement = anchor[joint.parent]
@@ -164,16 +162,11 @@ def to_pinocchio(model: RobotModel) -> PinocchioModel:
         inertia = pin.Inertia(float(i.mass), _floats(i.com), _matrix(i.inertia))
         pmodel.appendBodyToJoint(jid, inertia, T)
     pmodel.gravity = pin.Motion(_floats(model.gravity), np.zeros(3))
-    starts = {pinocchio_name(j): j for j in model.quaternion_joints}
-    q_index = _configuration_indices(model)
+    places = {pinocchio_name(p): p for p in model.joint_places}
     perm, qperm = np.empty(pmodel.nv, dtype=int), np.empty(pmodel.nq, dtype=int)
     for jid in range(1, pmodel.njoints):
         name, pj = pmodel.names[jid], pmodel.joints[jid]
-        if name in starts:
-            v0, q0 = starts[name].v_index, starts[name].q_index
-        else:
-            v0 = movable[name]
-            q0 = q_index[v0]
+        v0, q0 = places[name].v_index, places[name].q_index
         perm[pj.idx_v:pj.idx_v + pj.nv] = np.arange(v0, v0 + pj.nv)
         qperm[pj.idx_q:pj.idx_q + pj.nq] = np.arange(q0, q0 + pj.nq)
     return PinocchioModel(pmodel, pmodel.createData(), perm,
@@ -181,20 +174,10 @@ def to_pinocchio(model: RobotModel) -> PinocchioModel:
 
 
 def pinocchio_name(joint) -> str:
-    """The name of a chart joint in the Pinocchio model: ``root_joint`` for the free flyer
-    (as Pinocchio's URDF reader names it), the joint's own name otherwise."""
-    return "root_joint" if joint.kind is FREE_FLYER else joint.name
-
-
-def _configuration_indices(model: RobotModel) -> list[int]:
-    """The index in ``q`` of each velocity coordinate's joint (quaternion joints: their first
-    entry)."""
-    out, shift, starts = [], 0, {j.v_index: j for j in model.quaternion_joints}
-    for k in range(model.dof):
-        out.append(k + shift)
-        if k in starts:
-            shift += starts[k].nq - starts[k].nv
-    return out
+    """The name of a joint (a place of :attr:`~eomgen.model.RobotModel.joint_places`) in the
+    Pinocchio model: ``root_joint`` for a virtual base joint (the free flyer, as Pinocchio's
+    URDF reader names it), the joint's own name otherwise."""
+    return "root_joint" if joint.kind.base else joint.name
 
 
 def plain_calls(pm: PinocchioModel, n: int):

@@ -4,7 +4,7 @@ generic over the number type (float64, mpmath).
 A quaternion joint (the free flyer, a ball joint: :mod:`eomgen.model.quaternion`) is, in the
 model, a chain of virtual one-axis joints between massless links. The recursions of
 :mod:`eomgen.numeric.newton_euler` do what the derivation does
-(:mod:`eomgen.symbolic.quaternion_joints`, whose module docstring has the argument): they hold
+(:mod:`eomgen.symbolic.charts`, whose module docstring has the argument): they hold
 the virtual joints at zero and place the joint's pose from ``q`` before the chain
 (:func:`placements`: ``(R(quaternion), p)`` for the free flyer, ``(R(quaternion), 0)`` for a ball
 joint, after the joint's origin). At the current configuration the chain is then a chart whose
@@ -26,11 +26,13 @@ import numpy as np
 from ..model.joints.lie import motion_cross, quaternion_rotation  # noqa: F401 (importable here)
 
 
-def chart_coordinates(joints, q: np.ndarray, nv: int, numbers) -> np.ndarray:
-    """The joint coordinates the recursions index (NV entries) from the configuration ``q``
-    (NQ): ``q``'s entries for the other joints, zero for the virtual joints of ``joints``."""
+def chart_coordinates(nm, q: np.ndarray) -> np.ndarray:
+    """The joint coordinates the recursions of the numeric model ``nm`` index (its ``n_tree``
+    entries) from the configuration ``q`` (NQ): ``q``'s entries for the joints without a
+    chart, zero for the virtual joints of the others (``q`` itself when none has one)."""
+    nv, numbers = nm.n_tree, nm.numbers
     out = numbers.zeros(nv)
-    starts = {j.v_index: j for j in joints}
+    starts = {j.v_index: j for j in nm.quaternion_joints}
     k = iq = 0
     while k < nv:
         joint = starts.get(k)
@@ -42,19 +44,22 @@ def chart_coordinates(joints, q: np.ndarray, nv: int, numbers) -> np.ndarray:
     return out
 
 
-def placements(joints, q: np.ndarray, numbers) -> dict[int, tuple[np.ndarray, np.ndarray]]:
-    """``{v_index: (R, p)}``: the pose each joint of ``joints`` puts before its chain, from
+def placements(nm, q: np.ndarray) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+    """``{v_index: (R, p)}``: the pose each joint with a chart of the numeric model ``nm``
+    puts before its chain (none when it has none), from
     ``q`` (NQ), in the frame of the joint's origin: its kind's
     :meth:`~eomgen.model.joints.ChartKind.pose` (the rotation of a quaternion, and a free
     flyer's origin ``q[0:3]`` [m]; a planar joint's rotation about z and origin)."""
-    return {joint.v_index: joint.kind.pose(q[joint.q_slice], numbers) for joint in joints}
+    return {joint.v_index: joint.kind.pose(q[joint.q_slice], nm.numbers)
+            for joint in nm.quaternion_joints}
 
 
-def chart_offset(joints, qd: np.ndarray, numbers) -> np.ndarray:
-    """``n(v)`` (module docstring) in velocity coordinates: ``len(qd)`` entries, zero outside
-    the quaternion joints."""
+def chart_offset(nm, qd: np.ndarray) -> np.ndarray:
+    """``n(v)`` (module docstring) of the numeric model ``nm`` in velocity coordinates:
+    ``len(qd)`` entries, zero outside the joints with a chart (all zero without them)."""
+    numbers = nm.numbers
     out = numbers.zeros(len(qd))
-    for joint in joints:
+    for joint in nm.quaternion_joints:
         motions = []
         for i, axis in enumerate(joint.motions):
             m = numbers.zeros(6)

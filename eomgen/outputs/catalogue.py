@@ -117,6 +117,12 @@ class Output:
         """Whether backends compose it from other functions instead of printing a program."""
         return bool(self.composed_from)
 
+    @property
+    def on_charts(self) -> bool:
+        """Whether it is derived for a model whose configuration is not its coordinates
+        (nq > nv: a joint kind with a chart, :class:`~eomgen.model.joints.ChartKind`)."""
+        return self.quaternion_joints
+
     def shape(self, n: int) -> tuple[int, ...]:
         """Its result's shape for ``n`` joints, for the outputs whose rows and columns are the
         joints (the printed shape of any output is that of the matrix its builder returns)."""

@@ -117,7 +117,7 @@ def teaching_sized(dynamics: Dynamics, config: LatexConfig = LatexConfig()) -> b
     and a small program (:class:`LatexConfig`). Costs nothing next to the derivation: it
     looks at the straight-line program only. Never for coupled joints nor quaternion joints
     (the textbook form takes every joint as a coordinate)."""
-    return (not dynamics.model.couplings and not dynamics.model.quaternion_joints
+    return (not dynamics.model.couplings and dynamics.model.nq == dynamics.model.dof
             and dynamics.model.dof <= config.textbook_max_dof
             and dynamics.operation_count(["M", "C", "g"]) <= config.textbook_max_operations)
 

@@ -10,7 +10,7 @@ import sympy as sp
 
 from ..model.bodies import attach_fixed_links
 from ..errors import DescriptionError
-from ..model.floating import EULER_JOINTS, VELOCITY_NAMES, add_floating_base, add_free_flyer
+from ..model.floating import EULER_JOINTS, FLOATING_BASES, VELOCITY_NAMES
 from ..model import (
     Actuator,
     Joint,
@@ -82,13 +82,13 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
     model = _with_actuators(model, scene)
     model, payloads, scene_gravity, notes = _parameters(model, scene)
     if scene.floating_base == "quaternion":
-        model = _float(model, scene, add_free_flyer)
+        model = _float(model, scene, FLOATING_BASES["quaternion"])
         notes.append(f"the root link '{model.joints[5].child}' floats: a free flyer (q: "
                      "position and quaternion x, y, z, w; v: the root twist "
                      f"{', '.join(VELOCITY_NAMES)}) from the fixed link '{model.root}' (see "
                      "eomgen.model.floating)")
     elif scene.floating_base:
-        model = _float(model, scene, add_floating_base)
+        model = _float(model, scene, FLOATING_BASES["euler"])
         notes.append(f"the root link '{model.joints[5].child}' floats: six virtual joints "
                      f"{', '.join(EULER_JOINTS)} (position, ZYX Euler angles) from the fixed "
                      f"link '{model.root}' (see eomgen.model.floating)")
@@ -182,9 +182,9 @@ def _with_scene_couplings(model: RobotModel, scene: Scene) -> RobotModel:
 
 
 def _float(model: RobotModel, scene: Scene, add) -> RobotModel:
-    """``model`` with a floating base (``add``: :func:`eomgen.model.floating.add_floating_base` or
-    :func:`~eomgen.model.floating.add_free_flyer`); its errors name the scene's ``floating_base``
-    entry."""
+    """``model`` with a floating base (``add``: one of
+    :data:`eomgen.model.floating.FLOATING_BASES`); its errors name the scene's
+    ``floating_base`` entry."""
     try:
         return add(model)
     except DescriptionError as exc:

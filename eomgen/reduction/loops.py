@@ -29,7 +29,8 @@ def with_loops(reduced: RobotModel, scene: Scene, notes: list[str]
         MJCF equality, naming the description file).
     """
     # a ball joint (or the free flyer, ``base``) named whole is its velocity coordinates
-    compound = {j.name: reduced.joint_names[j.v_slice] for j in reduced.quaternion_joints}
+    compound = {p.name: reduced.joint_names[p.v_slice] for p in reduced.joint_places
+                if p.nq != p.nv}
     for k, joint in enumerate(scene.actuated):
         if joint not in reduced.joint_names and joint not in compound:
             raise scene.error(f"actuated[{k}]", f"'{joint}' is not a moving joint of the "

@@ -155,7 +155,7 @@ def generated_base(model: RobotModel) -> GeneratedBase:
     pi = description_parameters(reg)
     subs = dict(zip(reg.parameter_symbols, pi))
     try:
-        if model.quaternion_joints:
+        if model.nq > model.dof:  # q is not the coordinates: no trigonometric base
             raise UnsupportedError(model.source, "base parameters", "quaternion joints")
         base = symbolic_base_parameters(reg)
         names, columns, route = base.names, base.base, "symbolic"

@@ -11,6 +11,7 @@ import numpy as np
 import sympy as sp
 
 from ..model import parameter_symbol
+from ..model.configuration import chart_indices
 from .derive import Regressor
 from .notation import by_coefficient, parameter_latex, tex_symbols
 
@@ -102,10 +103,9 @@ def sample_regressor(reg: Regressor, samples: int | None = None, seed: int = 0,
     samples = samples or max(20, 3 * p // max(n, 1) + 10)
     rng = np.random.default_rng(seed)
     rows = []
-    joints = reg.model.quaternion_joints
-    virtual = [10 * k + c for joint in joints for k in joint.virtual for c in range(10)]
-    virtual += [10 * n + g * n + k for g in range(len(reg.actuators)) for joint in joints
-                for k in range(joint.v_index, joint.v_index + joint.nv)]
+    chain, charted = chart_indices(reg.model)
+    virtual = [10 * k + c for k in chain for c in range(10)]
+    virtual += [10 * n + g * n + k for g in range(len(reg.actuators)) for k in charted]
     for _ in range(samples):
         q = rng.uniform(-np.pi, np.pi, len(reg.q))
         Y = np.array(f(q, rng.standard_normal(n), rng.standard_normal(n))["Y"], dtype=float)

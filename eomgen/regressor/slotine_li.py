@@ -7,11 +7,11 @@ are determined by τ = Y π (M's columns are τ(q, 0, e_i) − g, g = τ(q, 0, 0
 Y π ≡ 0 has Y_SL π ≡ 0 too, and the grouping that gives Y π = Y_base β gives Y_SL π =
 Y_SL[:, base] β with the same columns and the same β (docs/control.md).
 
-Quaternion joints (a free flyer, ball joints: :mod:`eomgen.model.quaternion`): q̇_r and q̈_r
-are quasi-velocities like v (the root twist, the ball's angular velocity in the child frame)
-and C is the matrix of Pinocchio's ``computeCoriolisMatrix``, the chart's Christoffel matrix
-plus ``M[:, cols] K(v)`` in each quaternion joint's columns
-(:mod:`eomgen.symbolic.quaternion_joints`). The program walks the chart, so it is given
+Joints whose configuration is not their coordinates (a free flyer, ball joints:
+:mod:`eomgen.model.quaternion`): q̇_r and q̈_r are quasi-velocities like v (the root twist, the
+ball's angular velocity in the child frame) and C is the matrix of Pinocchio's
+``computeCoriolisMatrix``, the chart's Christoffel matrix plus ``M[:, cols] K(v)`` in each such
+joint's columns (:mod:`eomgen.symbolic.charts`). The program walks the chart, so it is given
 ``q̈_r + K(v) q̇_r`` in place of ``q̈_r``: ``M (q̈_r + K q̇_r) + C_chart q̇_r + g = M q̈_r + C
 q̇_r + g``; at ``q̇_r = v`` this is ``q̈ − n(v)``, the chart accelerations of the joint torque
 regressor (``K(v) v = −n(v)``).
@@ -22,7 +22,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..symbolic.builders import builds
-from ..symbolic.quaternion_joints import coriolis_correction
+from ..symbolic.charts import chart_reference_accelerations
 from ..symbolic.slotine_li import slotine_li_program
 from .generated import declared_actuator_terms, generated_base
 
@@ -34,7 +34,7 @@ def build_slotine_li(derivation, wanted) -> dict:
     the actuator columns the model declares (:func:`declared_actuator_terms`)."""
     model = derivation.model
     qd_r = derivation.tangent(derivation.inputs["qd_r"])
-    qdd_r = chart_reference_accelerations(model.quaternion_joints, derivation.qd, qd_r,
+    qdd_r = chart_reference_accelerations(model, derivation.qd, qd_r,
                                           derivation.tangent(derivation.inputs["qdd_r"]))
     Y = slotine_li_program(derivation.tree, derivation.q, derivation.qd, qd_r, qdd_r,
                            model.gravity, derivation.builder, declared_actuator_terms(model))
@@ -44,19 +44,6 @@ def build_slotine_li(derivation, wanted) -> dict:
     if "Y_SL_base" in wanted:
         out["Y_SL_base"] = Y.extract(list(range(Y.rows)), list(generated_base(model).columns))
     return out
-
-
-def chart_reference_accelerations(joints, qd, qd_r, qdd_r) -> tuple:
-    """The reference accelerations the chart's program takes (module docstring): ``q̈_r +
-    K(v) q̇_r`` in the velocity entries of each quaternion joint of ``joints`` (``K`` of
-    :func:`eomgen.symbolic.quaternion_joints.coriolis_correction` at ``v = qd``), ``q̈_r``
-    elsewhere (all of it when ``joints`` is empty)."""
-    out = list(qdd_r)
-    for joint in joints:
-        K, k = coriolis_correction(joint, qd), joint.v_index
-        for r in range(joint.nv):
-            out[k + r] += sum((K[r, c] * qd_r[k + c] for c in range(joint.nv)), sp.Integer(0))
-    return tuple(out)
 
 
 __all__ = ["build_slotine_li", "chart_reference_accelerations"]

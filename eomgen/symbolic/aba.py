@@ -41,7 +41,7 @@ from .builders import builds
 from .derivation import new_derivation
 from .crba import M_program
 from .newton_euler import grouped_inertials, inverse_dynamics_program
-from .quaternion_joints import true_accelerations as chart_to_true
+from .charts import true_accelerations as chart_to_true
 from .program import Program, ProgramBuilder, name_expr, name_exprs, name_matrix, name_symmetric
 from .spatial import JointFrames, add, cross, dot, joint_subspace, matvec, scale, skew, transpose
 
@@ -287,12 +287,12 @@ def build_forward_dynamics_aba(derivation, wanted) -> dict:
 
 def true_accelerations(derivation, qdd: sp.Matrix) -> sp.Matrix:
     """``qdd`` (n×1) from a forward-dynamics program, as the model's accelerations: for
-    quaternion joints (free flyer, ball) the chart's turned into the derivative of the joint's
-    velocity (:func:`eomgen.symbolic.quaternion_joints.true_accelerations`), named ``vd…``."""
-    joints = derivation.model.quaternion_joints
-    if not joints:
+    a model whose configuration is not its coordinates (a free flyer, a ball joint) the chart's
+    turned into the derivative of the joint's velocity
+    (:func:`eomgen.symbolic.charts.true_accelerations`), named ``vd…``."""
+    if derivation.model.nq == derivation.model.dof:  # no chart
         return qdd
     b = derivation.builder
-    true = chart_to_true(joints, derivation.qd, list(qdd))
+    true = chart_to_true(derivation, derivation.qd, list(qdd))
     return sp.Matrix([b.define(e, f"vd{k + 1}", ("qdd", k + 1)) if e != qdd[k] else e
                       for k, e in enumerate(true)])

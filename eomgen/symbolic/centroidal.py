@@ -18,8 +18,9 @@ the centre of mass ``c`` (from o) the linear momentum is the same and the angula
   the rotational inertia of the whole robot about its centre of mass, world axes.
 
 The centroidal equations ``ḣ_G = A_G v̇ + Ȧ_G v = Σ external wrenches about c + [m g; 0]`` are
-what a legged robot's planner uses. With quaternion joints (free flyer, ball) the chart's ``Ȧ_G v`` is corrected by
-``A_G n(v)`` (:mod:`eomgen.symbolic.quaternion_joints`). Units: SI.
+what a legged robot's planner uses. Where the configuration is not the coordinates (a free
+flyer, a ball joint) the chart's ``Ȧ_G v`` is corrected by ``A_G n(v)``
+(:mod:`eomgen.symbolic.charts`). Units: SI.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ import sympy as sp
 
 from .builders import builds
 from .composite import world_composites
-from .quaternion_joints import chart_offset
+from .charts import chart_offset
 from .spatial import cross, force_cross, motion_cross
 
 
@@ -45,8 +46,9 @@ def _motions(tree, kin, qd, b) -> tuple[list, list]:
     return V, A
 
 
-def free_flyer_momentum(derivation) -> tuple[list, sp.Matrix]:
-    """The centre of mass (world) and A_G of a free-flyer model from the first six rows of M:
+def base_momentum(derivation) -> tuple[list, sp.Matrix]:
+    """The centre of mass (world) and A_G of a model on a virtual base joint (the free flyer,
+    :attr:`~eomgen.model.RobotModel.base_kind`) from the first six rows of M:
     with the root twist as the first velocities, ``M[0:6, :]`` is the robot's momentum map
     about the root origin in root axes (force rows first), and ``M[0:3, 3:6] = −m [c_b]×``
     gives the centre of mass ``c_b`` in root axes. Rotated by the root's R and shifted to the
@@ -83,8 +85,8 @@ def build_centroidal(derivation, wanted) -> dict:
     inv_mass = b.define(1 / mass, "inv_mtot", ("mtot",))
     c = b.define_all(tuple(first[r] * inv_mass for r in range(3)), "cG", ("cG",))
     result = {}
-    if derivation.model.free_flyer and wanted & {"c_G", "A_G", "J_G"}:
-        com, A_G = free_flyer_momentum(derivation)
+    if derivation.model.base_kind is not None and wanted & {"c_G", "A_G", "J_G"}:
+        com, A_G = base_momentum(derivation)
     else:
         com = [kin.origin[r] + c[r] for r in range(3)]
         A_G = sp.zeros(6, n)
@@ -110,8 +112,8 @@ def build_centroidal(derivation, wanted) -> dict:
         n_o, f = rate[:3], rate[3:]
         c_f = cross(c, f)
         bias = list(f) + [n_o[r] - c_f[r] for r in range(3)]
-        if derivation.model.quaternion_joints:
-            offset = chart_offset(derivation.model.quaternion_joints, derivation.qd)
+        if derivation.model.nq > derivation.model.dof:  # a chart: less A_G n(v)
+            offset = chart_offset(derivation, derivation.qd)
             bias = [bias[r] - sp.Add(*[A_G[r, k] * offset[k] for k in range(len(offset))
                                        if offset[k] != 0]) for r in range(6)]
         result["dAGv"] = sp.Matrix(b.define_all(tuple(bias), "dAGv", ("dAGv",)))

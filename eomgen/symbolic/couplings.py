@@ -29,13 +29,11 @@ directions of the independent coordinates).
 
 from __future__ import annotations
 
-from dataclasses import replace
-from types import SimpleNamespace
-
 import sympy as sp
 
 from ..model.coupling import coupling_map, full_configuration, uncoupled
 from ..outputs import BY_SYMBOL, splits
+from .charts import independent_view
 
 #: Per output symbol: ``(rows, columns)``, whether its rows are joint efforts (× Tᵀ) and its
 #: columns joint velocities (× T). Outputs not listed are refused under couplings.
@@ -119,21 +117,11 @@ def project(symbol: str, matrix: sp.Matrix, T: sp.Matrix) -> sp.Matrix:
 
 def independent(derivation):
     """What :func:`eomgen.symbolic.tangent.tangent_seeds` and
-    :func:`~eomgen.symbolic.tangent.velocity_transport` read of ``derivation`` (its ``inputs``,
-    ``builder``, ``model.quaternion_joints`` and ``model.dof``), in the independent
-    coordinates: ``derivation`` itself without couplings; with couplings a view whose
-    quaternion joints are numbered in the independent ``q`` and ``v`` (a quaternion joint is
-    never coupled: its velocity rows of ``T`` are unit rows, and every follower before it is a
-    one-entry coordinate in both ``q`` and ``v``)."""
-    T = derivation.coupling
-    if T is None:
-        return derivation
-    joints = []
-    for joint in derivation.model.quaternion_joints:
-        v = next(k for k in range(T.cols) if T[joint.v_index, k] != 0)
-        joints.append(replace(joint, v_index=v, q_index=joint.q_index - joint.v_index + v))
-    return SimpleNamespace(inputs=derivation.inputs, builder=derivation.builder,
-                           model=SimpleNamespace(quaternion_joints=tuple(joints), dof=T.cols))
+    :func:`~eomgen.symbolic.tangent.velocity_transport` read of ``derivation``, in the
+    independent coordinates: ``derivation`` itself without couplings; with couplings a view
+    whose joints with a chart are numbered in the independent ``q`` and ``v``
+    (:func:`eomgen.symbolic.charts.independent_view`)."""
+    return derivation if derivation.coupling is None else independent_view(derivation)
 
 
 __all__ = ["COMBINED", "PROJECTIONS", "coupled_inputs", "independent", "project", "refused",

@@ -28,7 +28,7 @@ from ..errors import UnsupportedError
 from ..outputs import BY_SYMBOL, INPUTS
 from .builders import builder_of, input_size, sizes
 from .couplings import coupled_inputs, project, refused
-from .quaternion_joints import chart_accelerations, coordinates, placements
+from .charts import chart_accelerations, coordinates, placements
 from .program import Program, ProgramBuilder
 
 # ``q`` is NQ long: the configuration, an entry more than the velocity per quaternion joint.
@@ -62,7 +62,7 @@ class Derivation:
     #: The joint coordinates the algorithms index by ``RigidBody.q_index`` (NV entries), when
     #: they are not ``inputs["q"]``: the virtual joints of a free flyer or a ball joint are
     #: held at zero, the pose from its quaternion placed above them
-    #: (:mod:`eomgen.symbolic.quaternion_joints`).
+    #: (:mod:`eomgen.symbolic.charts`).
     coordinates: tuple | None = None
     #: For a model with coupled joints (:mod:`eomgen.symbolic.couplings`): ``T`` of
     #: ``q_full = T q + c`` and the full velocities ``T q̇``; :attr:`model` is then the
@@ -86,7 +86,7 @@ class Derivation:
     @property
     def qdd(self) -> tuple:
         """The accelerations the algorithms take: the ``qdd`` input, with quaternion joints
-        turned into the chart's (:func:`eomgen.symbolic.quaternion_joints.chart_accelerations`)."""
+        turned into the chart's (:func:`eomgen.symbolic.charts.chart_accelerations`)."""
         return self.accelerations(self.inputs["qdd"])
 
     def accelerations(self, qdd) -> tuple:
@@ -96,9 +96,9 @@ class Derivation:
         ``T q̈``."""
         if self.coupling is not None and len(qdd) == self.coupling.cols:
             qdd = tuple(self.coupling * sp.Matrix(qdd))
-        if not self.model.quaternion_joints:
+        if self.model.nq == self.model.dof:  # no chart
             return tuple(qdd)
-        return chart_accelerations(self.model.quaternion_joints, self.qd, qdd)
+        return chart_accelerations(self.model, self.qd, qdd)
 
     def tangent(self, vector) -> tuple:
         """A velocity-like input vector (``qd_r``, ``qdd_r``) as the algorithms take it: itself,
@@ -190,7 +190,7 @@ def new_derivation(model: RobotModel, inputs: Iterable[str] | None = None) -> De
                           velocities=qd_full)
     tree, coords = _placed(model, ordered["q"], builder)
     return Derivation(model, tree, ordered, builder,
-                      coordinates=coords if model.quaternion_joints else None)
+                      coordinates=coords if model.nq > model.dof else None)
 
 
 def _placed(model: RobotModel, q, builder: ProgramBuilder) -> tuple[BodyTree, tuple]:
@@ -198,14 +198,14 @@ def _placed(model: RobotModel, q, builder: ProgramBuilder) -> tuple[BodyTree, tu
     entries) before its chain, and the joint coordinates the algorithms index (NV). A model
     with floats is placed with its irrational constants as floats (:func:`~eomgen.model.
     float_constants`), so that they fold with the floats."""
-    tree, joints = body_tree(float_constants(model)), model.quaternion_joints
-    if not joints:
+    tree = body_tree(float_constants(model))
+    if model.nq == model.dof:  # every configuration entry is a coordinate
         return tree, tuple(q)
-    placed = placements(joints, q, builder)
+    placed = placements(model, q, builder)
     tree = replace(tree, bodies=tuple(
         replace(body, placement=body.placement @ placed[body.q_index])
         if body.q_index in placed else body for body in tree.bodies))
-    return tree, coordinates(joints, q, model.dof)
+    return tree, coordinates(model, q, model.dof)
 
 
 __all__ = ["Derivation", "joint_symbols", "new_derivation", "vector_symbols"]

@@ -145,17 +145,9 @@ def configuration_rates(model, q, v) -> dict:
     (R of the normalised quaternion, as the program places it). Along these rates the
     quaternion's norm is constant, so the forward-mode derivatives of the program, which
     normalises it, are exact."""
-    rates, starts = {}, {j.v_index: j for j in model.quaternion_joints}
-    k = iq = 0
-    while k < len(v):
-        joint = starts.get(k)
-        if joint is None:
-            rates[q[iq]] = v[k]
-            k, iq = k + 1, iq + 1
-            continue
-        rates.update(joint.kind.symbolic_rate(tuple(q[joint.q_slice]),
-                                              tuple(v[joint.v_slice])))
-        k, iq = k + joint.nv, iq + joint.nq
+    rates = {}
+    for place in model.joint_places:  # each joint's kind's rate
+        rates.update(place.kind.symbolic_rate(tuple(q[place.q_slice]), tuple(v[place.v_slice])))
     return rates
 
 

@@ -40,7 +40,7 @@ from .builders import builds, provides
 from .composite import forward_kinematics
 from .derivation import new_derivation
 from .evaluate import compile_program
-from .quaternion_joints import chart_offset
+from .charts import chart_offset
 from .program import Program, ProgramBuilder
 from .spatial import cross, matmul, matvec, motion_cross, transpose
 
@@ -202,7 +202,7 @@ def frame_kinematics(model: RobotModel, tree, q, qd, b: ProgramBuilder,
                         Jw[half + r, col] = b.define(rotated[r], f"Jw{k}_{half + r}_{col + 1}")
             J = Jw
             dJqd = b.define_all(matvec(R0, dJqd[:3]) + matvec(R0, dJqd[3:]), f"dJw{k}_")
-        if model.quaternion_joints:  # the chart's J̇ q̇ less J n(v)
+        if model.nq > model.dof:  # a chart: its J̇ q̇ less J n(v)
             dJqd = corrected_bias(model, J, dJqd, qd, b, f"dJff{k}_")
             dJbqd = corrected_bias(model, Jb, dJbqd, qd, b, f"dJbff{k}_")
         result.append({
@@ -218,9 +218,9 @@ def frame_kinematics(model: RobotModel, tree, q, qd, b: ProgramBuilder,
 
 def corrected_bias(model: RobotModel, J: sp.Matrix, bias, qd, b: ProgramBuilder,
                    hint: str) -> tuple:
-    """``J̇ v`` of a model with quaternion joints from the chart's: ``bias − J n(v)``
-    (:func:`eomgen.symbolic.quaternion_joints.chart_offset`), named with ``hint``."""
-    n = chart_offset(model.quaternion_joints, qd)
+    """``J̇ v`` of a model whose configuration is not its coordinates from the chart's:
+    ``bias − J n(v)`` (:func:`eomgen.symbolic.charts.chart_offset`), named with ``hint``."""
+    n = chart_offset(model, qd)
     return b.define_all(tuple(bias[r] - sp.Add(*[J[r, c] * n[c] for c in range(len(n))
                                                  if n[c] != 0])
                               for r in range(J.rows)), hint)

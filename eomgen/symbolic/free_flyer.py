@@ -1,6 +1,6 @@
 """The free flyer's symbolic pieces, as they were named before ball joints joined it: the root
 pose from ``q[0:7]`` and the chart corrections for a model whose only quaternion joint is a
-free flyer at ``v[0:6]``. Every function is :mod:`eomgen.symbolic.quaternion_joints` (which
+free flyer at ``v[0:6]``. Every function is :mod:`eomgen.symbolic.charts` (which
 holds the mechanism and its derivation, for the free flyer and ball joints alike) with that
 layout bound; new code calls that module with the model's
 :attr:`~eomgen.model.RobotModel.quaternion_joints`.
@@ -12,8 +12,8 @@ import sympy as sp
 
 from ..model import QuaternionJoint, Transform
 from ..model.quaternion import FREE_FLYER
-from . import quaternion_joints as _quaternion
-from .quaternion_joints import quaternion_rotation
+from . import charts as _quaternion
+from .charts import quaternion_rotation
 
 #: The free flyer as the first joint of a model (velocity and configuration both at 0).
 FREE_FLYER_JOINT = QuaternionJoint(FREE_FLYER, "base", 0, 0)

@@ -31,7 +31,7 @@ from .composite import (christoffel_coriolis_program, composite_gravity_program,
                         composite_M_program, coriolis_program, forward_kinematics,
                         potential_energy)
 from .crba import M_program
-from .quaternion_joints import corrected_coriolis
+from .charts import corrected_coriolis
 from .newton_euler import inverse_dynamics_program
 from .program import Program, ProgramBuilder, rough_operation_count
 
@@ -135,15 +135,15 @@ def build_lagrangian(derivation, wanted) -> dict:
     derivation's body tree for the ``wanted`` ones, with the potential energy ``P`` [J] when g is
     among them."""
     wanted = set(wanted)
-    joints = derivation.model.quaternion_joints
-    if joints and "C" in wanted:
-        wanted.add("M")  # a quaternion joint's C is the chart's corrected with M
+    chart = derivation.model.nq > derivation.model.dof
+    if chart and "C" in wanted:
+        wanted.add("M")  # with a chart, C is the chart's corrected with M
     result = derive_program(derivation.tree, derivation.q, derivation.qd,
                             derivation.model.gravity, wanted, derivation.builder,
-                            christoffel=not joints)
-    if joints and "C" in result:
+                            christoffel=not chart)
+    if chart and "C" in result:
         b = derivation.builder
-        C = corrected_coriolis(joints, result["C"], result["M"], derivation.qd)
+        C = corrected_coriolis(derivation, result["C"], result["M"], derivation.qd)
         result["C"] = C.applyfunc(lambda e: e if e.is_Atom else b.define(e, "Cff", ("C",)))
     return {name: result[name] for name in ("M", "C", "g", "P") if name in result}
 

@@ -9,7 +9,7 @@ tangent: column ``i`` of ∂f/∂q is ``d/dε f(q ⊕ ε eᵢ)`` at ``ε = 0``, 
 body twist of the free flyer, the child-frame angular velocity of a ball joint).
 
 The derivation's programs are functions of the configuration entries themselves (the chart of
-:mod:`eomgen.symbolic.quaternion_joints` is re-centred at each ``q``), so the tangent
+:mod:`eomgen.symbolic.charts` is re-centred at each ``q``), so the tangent
 derivative is the chain rule through ``∂(q ⊕ δ)/∂δ`` at ``δ = 0`` (:func:`tangent_seeds`):
 
 * a one-axis joint's entry: 1 along its own direction;
@@ -23,50 +23,13 @@ derivative is the chain rule through ``∂(q ⊕ δ)/∂δ`` at ``δ = 0`` (:fun
 In the same chart ``δ ↦ q ⊕ δ`` the state equation's position rows are
 ``δ̇ = J_r(δ)⁻¹ v`` (``J_r`` the right Jacobian of the joint's group), whose derivative at
 ``δ = 0`` is :func:`velocity_transport`: ``−½ ad_v`` for the free flyer (SE(3)),
-``−½ [ω]×`` for a ball joint (SO(3)), 0 for one-axis joints.
+``−½ [ω]×`` for a ball joint (SO(3)), 0 for one-axis joints. Both walk the joints with a
+chart, so they live with the chart's other maps (:mod:`eomgen.symbolic.charts`); this module
+names them for the derivatives.
 """
 
 from __future__ import annotations
 
-import sympy as sp
-
-from .quaternion_joints import placements
-
-
-def tangent_seeds(derivation, prefix: str = "q") -> dict:
-    """``{configuration symbol: {(prefix, i): ∂q/∂δᵢ}}`` at ``δ = 0`` (module docstring), for
-    :func:`eomgen.symbolic.derivatives.forward_mode`: the seeds of a derivative with respect
-    to q in tangent coordinates (NV directions). For a model without quaternion joints each
-    ``q`` entry is its own direction."""
-    q = derivation.inputs["q"]
-    joints = derivation.model.quaternion_joints
-    if not joints:
-        return {s: {(prefix, k): sp.Integer(1)} for k, s in enumerate(q)}
-    placed = placements(joints, q, derivation.builder)  # the derivation's own names again
-    starts = {j.v_index: j for j in joints}
-    seeds: dict = {}
-    k, iq, nv = 0, 0, derivation.model.dof
-    while k < nv:
-        joint = starts.get(k)
-        if joint is None:
-            seeds[q[iq]] = {(prefix, k): sp.Integer(1)}
-            k, iq = k + 1, iq + 1
-            continue
-        seeds.update(joint.kind.tangent_seeds(tuple(q[joint.q_slice]),
-                                              placed[joint.v_index].rotation, k, prefix))
-        k, iq = k + joint.nv, iq + joint.nq
-    return seeds
-
-
-def velocity_transport(derivation) -> sp.Matrix:
-    """∂δ̇/∂δ at ``δ = 0`` of ``δ̇ = J_r(δ)⁻¹ v`` (NV × NV, module docstring): the block of the
-    state matrix A that the positions' rows take in tangent coordinates; zero without
-    quaternion joints."""
-    nv, v = derivation.model.dof, derivation.inputs["qd"]
-    out = sp.zeros(nv, nv)
-    for joint in derivation.model.quaternion_joints:
-        out[joint.v_slice, joint.v_slice] = joint.kind.velocity_transport(tuple(v[joint.v_slice]))
-    return out
-
+from .charts import tangent_seeds, velocity_transport
 
 __all__ = ["tangent_seeds", "velocity_transport"]

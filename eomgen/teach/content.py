@@ -104,7 +104,7 @@ def _robot_section(model: RobotModel, w: Writer, sketch_caption: tuple,
         "gives.")))
     blocks.append(Figure("sketch", sketch_caption))
     rows = []
-    variable = "v" if model.quaternion_joints else "q"
+    variable = "v" if model.nq > model.dof else "q"
     for joint in model.joints:
         if joint.origin.rotation == IDENTITY3:
             rpy = prose("$0$")
@@ -119,7 +119,7 @@ def _robot_section(model: RobotModel, w: Writer, sketch_caption: tuple,
             (vector_span(w, joint.origin.translation),), rpy))
     blocks.append(Paragraph(prose(
         ("Joints, in the order of the velocity vector $v$ (a quaternion joint's rows are its "
-         "velocity coordinates, see the next section). " if model.quaternion_joints else
+         "velocity coordinates, see the next section). " if model.nq > model.dof else
          "Joints, in the order of the joint vector $q$. ")
         + "A joint's origin is the pose of its "
         "frame in the parent link's frame (translation in m; roll, pitch, yaw in rad); the "
@@ -169,7 +169,7 @@ def _robot_section(model: RobotModel, w: Writer, sketch_caption: tuple,
 
 
 def _method_section(model: RobotModel, teaching: bool) -> Section:
-    if model.quaternion_joints:
+    if model.nq > model.dof:
         return chart_method_section(model)
     n = model.dof
     q = ("(" + ", ".join(f"q_{{{k}}}" for k in range(1, n + 1)) + ")" if n <= 3
@@ -388,7 +388,7 @@ def _verification_section(dyn: Dynamics, report: VerificationReport | None,
     if report is None:
         return Section("Verified properties", (Paragraph(prose(
             "Not checked numerically: ", plain(missing or ""), ". " + hint)),))
-    quaternion = bool(dyn.model.quaternion_joints)  # velocities v, not q̇: say it in v
+    quaternion = dyn.model.nq > dyn.model.dof  # velocities v, not q̇: say it in v
     names, rate = _check_names(quaternion), "v" if quaternion else "\\dot{q}"
     rows = []
     for c in report.checks:
@@ -463,9 +463,9 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
     progress(f"deriving the equations of motion of {model.name} ({plural(model.dof, 'joint')})")
     dyn = derive(model, outputs=("M", "C", "g"), simplify=False)
     # the textbook form takes every joint as a coordinate: not a quaternion joint's chart
-    book = None if model.quaternion_joints else nt.textbook_for(dyn, HANDOUT_CONFIG)
+    book = None if model.nq > model.dof else nt.textbook_for(dyn, HANDOUT_CONFIG)
     extra_names = {HALF: r"\tfrac{1}{2}"}
-    if model.quaternion_joints:  # qd, qdd are v and v̇, not the rates of q
+    if model.nq > model.dof:  # qd, qdd are v and v̇, not the rates of q
         extra_names.update(velocity_names(dyn))
     w = Writer(nt.printing(dyn, HANDOUT_CONFIG, compact_trig=book is not None,
                             extra_names=extra_names))
@@ -481,7 +481,7 @@ def build_handout(model: RobotModel, progress: Callable[[str], None] = lambda me
     geometry = sketch_geometry(model)
     pose = ", ".join(f"{v:.3g}" for v in geometry.q)
     where = (f" with its velocity coordinates' chart (virtual joints) at $({pose})$ (rad, m)"
-             if model.quaternion_joints else f" at the pose $q = ({pose})$ (rad, m)")
+             if model.nq > model.dof else f" at the pose $q = ({pose})$ (rad, m)")
     caption = prose("Kinematic sketch of ", code(model.name), where + ": links as grey "
                     "lines, joints as circles (revolute) or squares (prismatic), centres of "
                     "mass $c_{k}$, gravity $g$.")

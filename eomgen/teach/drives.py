@@ -101,7 +101,7 @@ def drive_equations(spong: SpongDynamics, book: TextbookDerivation | None, corio
 def _velocities(model, tex: str) -> str:
     """eomgen's own equation ``tex`` with ``q̈``, ``q̇`` read as ``v̇``, ``v`` for a model with
     quaternion joints (its velocity is not the rate of q: :mod:`eomgen.teach.quaternion`)."""
-    if not model.quaternion_joints:
+    if model.nq == model.dof:  # v is the rate of q
         return tex
     return tex.replace(r"\ddot{q}", r"\dot{v}").replace(r"\dot{q}", "v")
 

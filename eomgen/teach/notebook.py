@@ -33,6 +33,7 @@ from ..model import RobotModel
 from ..present.notation import teaching_sized
 from ..symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS
 from .embedded import EmbeddedSource, embedded_source, text_literal
+from .quaternion import chart_joint_names
 from ..common.templating import render_block
 
 
@@ -71,12 +72,12 @@ def build_notebook(model: RobotModel, description: Path | None = None,
         raise ParameterError(model.source, "parameters",
                              "the notebook's numeric cells need a value for "
                              + ", ".join(missing))
-    chart = bool(model.quaternion_joints)  # q (NQ) and v (NV) differ: no textbook form
+    chart = model.nq > model.dof  # q (NQ) and v (NV) differ: no textbook form
     small = not chart and model.dof <= TEXTBOOK_MAX_DOF and _teaching_sized(model)
     source = embedded_source(description, scene, at)
     context = {
         "name": model.name, "nq": model.nq, "dof": model.dof, "chart": chart, "check": check,
-        "quaternion_joints": [joint.name for joint in model.quaternion_joints],
+        "chart_joints": chart_joint_names(model),
         "textbook_max_dof": TEXTBOOK_MAX_DOF, "textbook_max_operations": TEXTBOOK_MAX_OPERATIONS,
         "source": source,
     }

@@ -21,9 +21,15 @@ def velocity_names(dyn) -> dict:
     return names
 
 
+def chart_joint_names(model) -> list[str]:
+    """The names of the joints of ``model`` whose configuration is not their coordinates (the
+    free flyer's is ``base``), in velocity order."""
+    return [place.name for place in model.joint_places if place.nq != place.nv]
+
+
 def _layout_rows(model) -> tuple:
     rows = []
-    for joint in model.quaternion_joints:
+    for joint in (place for place in model.joint_places if place.nq != place.nv):
         q = f"$q_{{{joint.q_index + 1}}} \\dots q_{{{joint.q_index + joint.nq}}}$"
         v = f"$v_{{{joint.v_index + 1}}} \\dots v_{{{joint.v_index + joint.nv}}}$"
         word, what_q, what_v = joint.kind.describe()
@@ -80,4 +86,4 @@ def chart_method_section(model) -> Section:
     return Section("Method and notation", tuple(blocks))
 
 
-__all__ = ["chart_method_section", "velocity_names"]
+__all__ = ["chart_joint_names", "chart_method_section", "velocity_names"]

@@ -35,7 +35,7 @@ LAYERS: tuple[tuple[int, tuple[str, ...]], ...] = (
          "numeric.quaternion_chart", "numeric.loop_checks")),
     (3, ("symbolic.monomials", "symbolic.spatial", "symbolic.program", "symbolic.transforms",
          "symbolic.printing", "symbolic.evaluate", "symbolic.derivation", "symbolic.builders",
-         "symbolic.quaternion_joints", "symbolic.couplings")),
+         "symbolic.charts", "symbolic.couplings")),
     (4, ("symbolic",)),
     (5, ("dynamics", "regressor")),
     (6, ("numeric", "verify")),

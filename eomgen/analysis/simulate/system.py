@@ -21,7 +21,7 @@ import numpy as np
 from ...dynamics import derive
 from ...model import RobotModel
 from ...numeric import kinetic_energy, numeric_model, potential_energy
-from ...model.configuration import configuration_rate, integrate
+from ...model.configuration import configuration_rate, integrate, quaternion_indices
 from ..conditioning import EXACT_FROM
 from ..routes import compile_scalar, numeric_only
 
@@ -33,11 +33,10 @@ def advance(model: RobotModel, q: np.ndarray, v: np.ndarray, h: float) -> np.nda
     quaternion of the result is the one of ``±`` nearest ``q``'s (both are the same rotation):
     a trajectory stepped with it is continuous, as the reference it is compared with."""
     out = integrate(q, v, h, model)
-    for joint in model.quaternion_joints:
-        if joint.quaternion is not None:
-            k = slice(joint.quaternion, joint.quaternion + 4)
-            if out[k] @ q[k] < 0.0:
-                out[k] = -out[k]
+    for start in quaternion_indices(model):
+        k = slice(start, start + 4)
+        if out[k] @ q[k] < 0.0:
+            out[k] = -out[k]
     return out
 
 
@@ -76,7 +75,7 @@ class System:
         self._Cg = compile_scalar(dyn.program, dyn.q + dyn.qd, ["C", "g"])
         #: True when the configuration is not a vector (a free flyer, ball or planar joints:
         #: NQ ≠ NV): the integrators step it along its manifold (:meth:`integrate`).
-        self.quaternion = bool(self.model.quaternion_joints)
+        self.quaternion = self.model.nq > self.model.dof
         self._nm = numeric_model(self.model)
         self._shape = (n, n)
         self.evaluations = 0

@@ -24,7 +24,7 @@ there). When its configuration is the chain's coordinates (a universal joint), t
 joints are joints of the tree like any other. When it is not (:class:`ChartKind`: the free
 flyer, a ball joint, a planar joint), the chain is held at zero, with the pose from ``q`` placed
 before it (:meth:`ChainKind.pose`, :meth:`ChartKind.placement`);
-:mod:`eomgen.symbolic.quaternion_joints` has the argument.
+:mod:`eomgen.symbolic.charts` has the argument.
 """
 
 from __future__ import annotations
@@ -50,9 +50,15 @@ class JointKind:
     #: True when a description writes it as a joint's type (a :class:`eomgen.model.JointType`
     #: member); the free flyer is put under a robot instead.
     described: bool = True
+    #: True for a virtual base joint: the joint a scene or a parser puts between the world and
+    #: a robot's root (Pinocchio's ``root_joint``; named ``base``), whose velocity is the root's
+    #: twist in the root frame (the free flyer).
+    base: bool = False
     #: True when the kind rotates its child about its axis, or translates it along its axis.
     rotates: bool = False
     translates: bool = False
+    #: Where the kind's quaternion starts in its configuration entries (None: it has none).
+    quaternion_offset: int | None = None
 
     def lead(self, pitch=0):
         """The translation along the axis per unit of the coordinate: 1 for a prismatic joint
@@ -101,6 +107,11 @@ class JointKind:
     def configuration_rate(self, q, v) -> np.ndarray:
         """``q̇`` (NQ,) at velocity ``v`` (NV,)."""
         return np.asarray(v, dtype=float).copy()
+
+    def symbolic_rate(self, q, v) -> dict:
+        """``{symbol: q̇}`` of the NQ configuration symbols ``q`` at velocity ``v`` (NV): ``v``
+        itself for a kind whose configuration is its coordinates."""
+        return dict(zip(q, v))
 
     def random_configuration(self, coordinates, rng) -> np.ndarray:
         """A configuration (NQ,) for tests and verification from ``coordinates`` (NV values
@@ -159,6 +170,13 @@ class ChainKind(JointKind):
         messages."""
         raise NotImplementedError
 
+    def refused_as(self, joint: str) -> tuple[str, str, str]:
+        """``(what, where, hint)`` for a one-line refusal of something not derived for the
+        joint ``joint`` of this kind: what it is, the element of the description that made it,
+        and a way out (empty when there is none)."""
+        name = self.describe()[0]
+        return f"a {name} joint", f"{name} joint '{joint}'", ""
+
 
 class ChartKind(ChainKind):
     """A kind whose configuration is not its coordinates (NQ > NV): in the tree a chain of
@@ -167,8 +185,6 @@ class ChartKind(ChainKind):
 
     #: Suffixes of the configuration entries' names (``<joint>_<suffix>``).
     configuration_suffixes: tuple[str, ...] = ()
-    #: Where the kind's quaternion starts in its configuration entries (None: it has none).
-    quaternion_offset: int | None = None
     #: The entries of the configuration (NQ,) that stand for their normalised value (a
     #: quaternion; a planar joint's ``(cos θ, sin θ)``), and their name for messages; None
     #: when the kind has none. Zero length stands for no configuration at all.

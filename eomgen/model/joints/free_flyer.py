@@ -38,6 +38,7 @@ VELOCITY = ("base_vx", "base_vy", "base_vz", "base_wx", "base_wy", "base_wz")
 class FreeFlyer(ChartKind):
     name = "free_flyer"
     described = False  # put under a robot (eomgen.model.floating.add_free_flyer), not written
+    base = True
     nq, nv = 7, 6
     pinocchio = "JointModelFreeFlyer"
     motions = (0, 1, 2, 3, 4, 5)
@@ -140,6 +141,10 @@ class FreeFlyer(ChartKind):
                 "root's orientation $R$",
                 "the root's twist in the root frame: linear velocity $R^{T} \\dot{p}$ (m/s), "
                 "then angular velocity $\\omega$ (rad/s)")
+
+
+    def refused_as(self, joint: str) -> tuple[str, str, str]:
+        return "a quaternion free flyer", "floating_base: quaternion", "; use floating_base: euler"
 
 
 FREE_FLYER = FreeFlyer()

@@ -1,6 +1,14 @@
-"""Quaternion joints in the derivation: the rotation placed from ``q`` and the chart corrections.
+"""Charts in the derivation: the pose of each joint whose configuration is not its coordinates,
+placed from ``q``, and the chart corrections.
 
-A quaternion joint (the free flyer, a ball joint: :mod:`eomgen.model.quaternion`) is a chain of
+Every function takes the joints from their model: ``source`` is a
+:class:`~eomgen.model.RobotModel`, a derivation (its ``model``) or the joints themselves
+(:class:`~eomgen.model.QuaternionJoint`); a model without such joints gives the identity
+(no placement, no offset, no correction), so an algorithm calls them for every model without
+asking which kinds it has.
+
+A joint of a :class:`~eomgen.model.joints.ChartKind` (the free flyer, a ball joint, a planar
+joint: :mod:`eomgen.model.quaternion`) is a chain of
 virtual one-axis joints in the model. The derivation holds them at zero and places the joint's
 pose from ``q`` before them (:func:`placements`: ``(R(quaternion), p)`` for the free flyer,
 ``(R(quaternion), 0)`` for a ball joint): at the current configuration the chain is then a chart
@@ -29,12 +37,24 @@ gives it, NV entries, zero outside the quaternion joints; then
 
 from __future__ import annotations
 
+from dataclasses import replace
+from types import SimpleNamespace
+
 import sympy as sp
 
 from ..model import QuaternionJoint, Transform
 from ..model.joints.lie import quaternion_rotation_symbolic as quaternion_rotation
 
 _ZERO = sp.S.Zero
+
+
+def _joints(source) -> tuple[QuaternionJoint, ...]:
+    """The joints with a chart of ``source`` (module docstring): the places of a model (a
+    derivation's model) whose configuration is not their coordinates (NQ ≠ NV), or
+    ``source`` itself when it is the joints."""
+    model = getattr(source, "model", source)
+    return tuple(place for place in getattr(model, "joint_places", model)
+                 if place.nq != place.nv)
 
 
 def placement(joint: QuaternionJoint, q, b, number: int = 0) -> Transform:
@@ -47,22 +67,22 @@ def placement(joint: QuaternionJoint, q, b, number: int = 0) -> Transform:
     return Transform(R, origin)
 
 
-def placements(joints, q, b) -> dict[int, Transform]:
+def placements(source, q, b) -> dict[int, Transform]:
     """:func:`placement` of each of ``joints`` (the joints of each kind numbered from 1 in
     velocity order), by the index of its first velocity (the ``q_index`` of the body whose
     joint starts its chain)."""
     out, numbers = {}, {}
-    for joint in joints:
+    for joint in _joints(source):
         numbers[joint.kind.name] = numbers.get(joint.kind.name, 0) + 1
         out[joint.v_index] = placement(joint, q, b, numbers[joint.kind.name])
     return out
 
 
-def coordinates(joints, q, nv: int) -> tuple:
+def coordinates(source, q, nv: int) -> tuple:
     """The joint coordinates the algorithms index (NV entries): ``q``'s entries of the other
     joints, zero for the virtual joints of ``joints``."""
     out, k, iq = [], 0, 0
-    starts = {j.v_index: j for j in joints}
+    starts = {j.v_index: j for j in _joints(source)}
     while k < nv:
         joint = starts.get(k)
         if joint is None:
@@ -93,10 +113,10 @@ def _motion(joint: QuaternionJoint, qd, chain) -> tuple:
     return tuple(out)
 
 
-def chart_offset(joints, qd) -> tuple:
+def chart_offset(source, qd) -> tuple:
     """``n(v)`` (module docstring) in velocity coordinates: ``len(qd)`` entries."""
     out = [_ZERO] * len(qd)
-    for joint in joints:
+    for joint in _joints(source):
         total = [_ZERO] * 6
         for i in range(joint.nv):
             term = _motion_cross(_motion(joint, qd, (i,)), _motion(joint, qd, range(i + 1, joint.nv)))
@@ -106,16 +126,16 @@ def chart_offset(joints, qd) -> tuple:
     return tuple(out)
 
 
-def chart_accelerations(joints, qd, qdd) -> tuple:
+def chart_accelerations(source, qd, qdd) -> tuple:
     """The chart accelerations of the true accelerations ``qdd`` at velocity ``qd``:
     ``qdd − n(v)``."""
-    n = chart_offset(joints, qd)
+    n = chart_offset(source, qd)
     return tuple(a - o for a, o in zip(qdd, n))
 
 
-def true_accelerations(joints, qd, chart) -> tuple:
+def true_accelerations(source, qd, chart) -> tuple:
     """The inverse of :func:`chart_accelerations`: ``chart + n(v)``."""
-    n = chart_offset(joints, qd)
+    n = chart_offset(source, qd)
     return tuple(a + o for a, o in zip(chart, n))
 
 
@@ -131,11 +151,11 @@ def coriolis_correction(joint: QuaternionJoint, qd) -> sp.Matrix:
     return K
 
 
-def corrected_coriolis(joints, C: sp.Matrix, M: sp.Matrix, qd) -> sp.Matrix:
+def corrected_coriolis(source, C: sp.Matrix, M: sp.Matrix, qd) -> sp.Matrix:
     """The quaternion joints' C from the chart's: ``C + M[:, cols] K(v)`` in each joint's
     columns ``cols``."""
     out = sp.Matrix(C)
-    for joint in joints:
+    for joint in _joints(source):
         K, cols = coriolis_correction(joint, qd), range(joint.v_index, joint.v_index + joint.nv)
         for r in range(C.rows):
             for i, col in enumerate(cols):
@@ -144,6 +164,74 @@ def corrected_coriolis(joints, C: sp.Matrix, M: sp.Matrix, qd) -> sp.Matrix:
     return out
 
 
-__all__ = ["chart_accelerations", "chart_offset", "coordinates", "coriolis_correction",
-           "corrected_coriolis", "placement", "placements", "quaternion_rotation",
-           "true_accelerations"]
+def chart_reference_accelerations(source, qd, qd_r, qdd_r) -> tuple:
+    """The reference accelerations the chart's program takes
+    (:mod:`eomgen.regressor.slotine_li`): ``q̈_r + K(v) q̇_r`` in the velocity entries of each
+    joint with a chart of ``source`` (``K`` of :func:`coriolis_correction` at ``v = qd``),
+    ``q̈_r`` elsewhere (all of it when it has none)."""
+    out = list(qdd_r)
+    for joint in _joints(source):
+        K, k = coriolis_correction(joint, qd), joint.v_index
+        for r in range(joint.nv):
+            out[k + r] += sum((K[r, c] * qd_r[k + c] for c in range(joint.nv)), sp.Integer(0))
+    return tuple(out)
+
+
+def tangent_seeds(derivation, prefix: str = "q") -> dict:
+    """``{configuration symbol: {(prefix, i): ∂q/∂δᵢ}}`` at ``δ = 0``
+    (:mod:`eomgen.symbolic.tangent`), for :func:`eomgen.symbolic.derivatives.forward_mode`:
+    the seeds of a derivative with respect to q in tangent coordinates (NV directions). For a
+    model without a chart each ``q`` entry is its own direction."""
+    q = derivation.inputs["q"]
+    joints = _joints(derivation)
+    if not joints:
+        return {s: {(prefix, k): sp.Integer(1)} for k, s in enumerate(q)}
+    placed = placements(joints, q, derivation.builder)  # the derivation's own names again
+    starts = {j.v_index: j for j in joints}
+    seeds: dict = {}
+    k, iq, nv = 0, 0, derivation.model.dof
+    while k < nv:
+        joint = starts.get(k)
+        if joint is None:
+            seeds[q[iq]] = {(prefix, k): sp.Integer(1)}
+            k, iq = k + 1, iq + 1
+            continue
+        seeds.update(joint.kind.tangent_seeds(tuple(q[joint.q_slice]),
+                                              placed[joint.v_index].rotation, k, prefix))
+        k, iq = k + joint.nv, iq + joint.nq
+    return seeds
+
+
+def velocity_transport(derivation) -> sp.Matrix:
+    """∂δ̇/∂δ at ``δ = 0`` of ``δ̇ = J_r(δ)⁻¹ v`` (NV × NV, :mod:`eomgen.symbolic.tangent`):
+    the block of the state matrix A that the positions' rows take in tangent coordinates;
+    zero without a chart."""
+    nv, v = derivation.model.dof, derivation.inputs["qd"]
+    out = sp.zeros(nv, nv)
+    for joint in _joints(derivation):
+        out[joint.v_slice, joint.v_slice] = joint.kind.velocity_transport(tuple(v[joint.v_slice]))
+    return out
+
+
+def independent_view(derivation):
+    """What :func:`tangent_seeds` and :func:`velocity_transport` read of ``derivation`` (its
+    ``inputs``, ``builder``, its model's joints with a chart and ``dof``), in the independent
+    coordinates (:mod:`eomgen.symbolic.couplings`): ``derivation`` itself without couplings;
+    with couplings a view whose joints with a chart are numbered in the independent ``q`` and
+    ``v`` (such a joint is never coupled: its velocity rows of ``T`` are unit rows, and every
+    follower before it is a one-entry coordinate in both ``q`` and ``v``)."""
+    T = derivation.coupling
+    if T is None:
+        return derivation
+    joints = []
+    for joint in _joints(derivation):
+        v = next(k for k in range(T.cols) if T[joint.v_index, k] != 0)
+        joints.append(replace(joint, v_index=v, q_index=joint.q_index - joint.v_index + v))
+    return SimpleNamespace(inputs=derivation.inputs, builder=derivation.builder,
+                           model=SimpleNamespace(joint_places=tuple(joints), dof=T.cols))
+
+
+__all__ = ["chart_accelerations", "chart_offset", "chart_reference_accelerations",
+           "coordinates", "coriolis_correction", "corrected_coriolis", "independent_view",
+           "placement", "placements", "quaternion_rotation", "tangent_seeds",
+           "true_accelerations", "velocity_transport"]
