@@ -532,6 +532,21 @@ FORWARD_CTRL_DERIVATIVE = _listed(Output(
     "forward_dynamics_ctrl: (M + diag(a))^-1 dtau_act/dctrl (zero where a clamp holds).",
     ("q", "qd", "ctrl"), False, "rad/s^2 (revolute rows), m/s^2 (prismatic) per unit of ctrl",
     ("dqdd_dctrl",), default=False, constants=_ACTUATOR_NAMES))
+FORWARD_CTRL_DQ = _listed(Output(
+    "forward_dynamics_ctrl_derivative_q", "dqdd_ctrl_dq", "dqdd/dq (nv, nv) of "
+    "forward_dynamics_ctrl: -(M + diag(a))^-1 (dtau/dq - d(actuator_forces + "
+    "passive_forces)/dq), dtau/dq of Newton-Euler at qdd held fixed.", ("q", "qd", "ctrl"),
+    False, "1/s^2", ("dqdd_ctrl_dq",), default=False, constants=_ACTUATOR_NAMES))
+FORWARD_CTRL_DQD = _listed(Output(
+    "forward_dynamics_ctrl_derivative_qd", "dqdd_ctrl_dqd", "dqdd/dqd (nv, nv) of "
+    "forward_dynamics_ctrl (the servos' and the passive forces' damping included).",
+    ("q", "qd", "ctrl"), False, "1/s", ("dqdd_ctrl_dqd",), default=False,
+    constants=_ACTUATOR_NAMES))
+FORWARD_CTRL_DERIVATIVES = _listed(Output(
+    "forward_dynamics_ctrl_derivatives", "dqdd_ctrl_dx", "(dqdd/dq, dqdd/dqd) of "
+    "forward_dynamics_ctrl in one call.", ("q", "qd", "ctrl"), False,
+    "the units of forward_dynamics_ctrl_derivative_q and _qd", ("dqdd_ctrl_dx",),
+    default=False, constants=_ACTUATOR_NAMES, returns=("dqdd_ctrl_dq", "dqdd_ctrl_dqd")))
 
 #: Every output, in module order (:mod:`eomgen.outputs` indexes them).
 CATALOGUE: tuple[Output, ...] = tuple(_ENTRIES)

@@ -13,7 +13,13 @@ functions of ``(q, q̇, ctrl)`` (:class:`~eomgen.model.Control`, docs/formats.md
   viscous damping, fixed tendons): MuJoCo's ``qacc_smooth``. Coulomb friction (MuJoCo's
   ``frictionloss``, a constraint there) is left out;
 * ``dqdd_dctrl``: ``∂q̈/∂ctrl = (M + diag(a))⁻¹ ∂τ_act/∂ctrl`` (nv × nu), zero in the columns
-  whose clamp holds.
+  whose clamp holds;
+* ``dqdd_ctrl_dq``, ``dqdd_ctrl_dqd`` (nv × nv; ``dqdd_ctrl_dx`` both side by side):
+  ``∂q̈/∂x = −(M + diag(a))⁻¹ (∂τ/∂x − ∂(τ_act + τ_p)/∂x)`` for x = q (along the tangent of a
+  quaternion joint, as :mod:`eomgen.symbolic.derivatives`) and x = q̇, the Newton–Euler
+  ``∂τ`` taken at q̈ held fixed (the implicit function theorem,
+  :func:`~eomgen.symbolic.derivatives.applied_forward_dynamics_jacobians`): what MPC
+  linearizes. A clamp that holds contributes 0 to them; a tendon's dead band too.
 
 A clamp is the piecewise-linear ``clamp(x, lo, hi) = (lo + hi + |x − lo| − |x − hi|) / 2``:
 exact inside the range (up to rounding of order ``ulp(max(|lo|, |hi|))``), ``lo`` below and
@@ -32,7 +38,7 @@ from ..errors import GenerationError
 from ..model import RobotModel, joint_actuators
 from .aba import forward_dynamics_program, true_accelerations
 from .builders import builds, provides, sizes
-from .derivatives import symmetric_inverse
+from .derivatives import applied_forward_dynamics_jacobians, symmetric_inverse
 from .passive import passive_forces
 from .program import name_expr
 
@@ -90,10 +96,11 @@ def actuator_forces(derivation, forces) -> sp.Matrix:
     return sp.Matrix(tau)
 
 
-@builds("tau_act", "qdd_ctrl", "dqdd_dctrl")
+@builds("tau_act", "qdd_ctrl", "dqdd_dctrl", "dqdd_ctrl_dq", "dqdd_ctrl_dqd", "dqdd_ctrl_dx")
 def build_controls(derivation, wanted) -> dict:
-    """The builder of ``tau_act``, ``qdd_ctrl`` and ``dqdd_dctrl`` in :mod:`eomgen.outputs`
-    (see the module docstring).
+    """The builder of ``tau_act``, ``qdd_ctrl``, ``dqdd_dctrl``, ``dqdd_ctrl_dq``,
+    ``dqdd_ctrl_dqd`` and ``dqdd_ctrl_dx`` in :mod:`eomgen.outputs` (see the module
+    docstring).
 
     Raises
     ------
@@ -115,11 +122,16 @@ def build_controls(derivation, wanted) -> dict:
                                        list(effort), derivation.model.gravity,
                                        derivation.builder, armature=armature)
         out["qdd_ctrl"] = true_accelerations(derivation, qdd)
+    Minv = None
+    if wanted & {"dqdd_ctrl_dq", "dqdd_ctrl_dqd", "dqdd_ctrl_dx"}:
+        Minv, _, dq, dqd = applied_forward_dynamics_jacobians(
+            derivation, tau + passive_forces(derivation), armature, "u")
+        out.update(dqdd_ctrl_dq=dq, dqdd_ctrl_dqd=dqd, dqdd_ctrl_dx=sp.Matrix.hstack(dq, dqd))
     if "dqdd_dctrl" in wanted:
         b = derivation.builder
         ctrl = derivation.inputs["ctrl"]
-        M = derivation.output("M") + sp.diag(*armature)
-        Minv = symmetric_inverse(b, M, "Minv_u")
+        if Minv is None:
+            Minv = symmetric_inverse(b, derivation.output("M") + sp.diag(*armature), "Minv_u")
         B = sp.zeros(len(tau), len(ctrl))
         for i, found in enumerate(forces):
             if found is not None:
