@@ -514,8 +514,8 @@ PASSIVE = _listed(Output(
     "joint springs, the drives' viscous damping and the fixed tendons (MuJoCo's qfrc_passive), "
     "added to tau: M qdd + C qd + g = tau + tau_p.", ("q", "qd"), True, _REVOLUTE_EFFORT,
     ("tau_p",), default=False))
-# --- issue 41: MuJoCo's actuators on joints (eomgen.symbolic.controls, docs/formats.md): the
-# joint forces of the controls and the forward dynamics they drive, exported when asked for.
+# --- issue 41: MuJoCo's actuators on joints and fixed tendons (eomgen.symbolic.controls,
+# docs/formats.md): the joint forces of the controls and the forward dynamics they drive.
 _ACTUATOR_NAMES = ("ACTUATOR_NAMES",)
 ACTUATOR_FORCES = _listed(Output(
     "actuator_forces", "tau_act", "Joint forces of the actuators sum gear clamp(gain(q, qd) "

@@ -1,12 +1,13 @@
-"""Builders of the control outputs (issue 41): MuJoCo's actuators on joints as generated
-functions of ``(q, q̇, ctrl)`` (:class:`~eomgen.model.Control`, docs/formats.md).
+"""Builders of the control outputs (issue 41): MuJoCo's actuators on joints and fixed tendons
+as generated functions of ``(q, q̇, ctrl)`` (:class:`~eomgen.model.Control`, docs/formats.md).
 
-* ``tau_act`` (``actuator_forces``): ``τ_act = Σ_i gear_i · clamp(gain_i · clamp(ctrl_i) +
-  bias_i)`` on each control's joint, with ``gain = g0 + g1 l + g2 v``, ``bias = b0 + b1 l + b2
-  v`` on the joint's length ``l = gear · q`` and velocity ``v = gear · q̇`` (MuJoCo's
-  ``qfrc_actuator`` of a joint transmission: ``force = gain · ctrl + bias``, the control
-  clamped to ``ctrlrange`` and the force to ``forcerange``, then ``Jᵀ force`` with ``J =
-  gear``);
+* ``tau_act`` (``actuator_forces``): ``τ_act = Σ_i J_iᵀ clamp(gain_i · clamp(ctrl_i) +
+  bias_i)`` with ``gain = g0 + g1 l + g2 v``, ``bias = b0 + b1 l + b2 v`` on the actuator's
+  length ``l = gear · L`` and velocity ``v = gear · L̇``, ``L = Σ c_j q_j + L_0`` its
+  transmission (the joint itself, or a fixed tendon's coefficients), ``J_i = gear · ∂L/∂q``
+  (MuJoCo's ``qfrc_actuator`` of a joint or tendon transmission: ``force = gain · ctrl +
+  bias``, the control clamped to ``ctrlrange`` and the force to ``forcerange``, then the
+  moment ``Jᵀ force``);
 * ``qdd_ctrl`` (``forward_dynamics_ctrl``): ``q̈ = (M + diag(a))⁻¹ (τ_act + τ_p − C q̇ − g)``
   by the Articulated-Body Algorithm with the drives' armature ``a`` (MuJoCo's ``armature``)
   and the passive forces ``τ_p`` of :mod:`eomgen.symbolic.passive` (joint springs, the drives'
@@ -27,7 +28,8 @@ exact inside the range (up to rounding of order ``ulp(max(|lo|, |hi|))``), ``lo`
 (½ on the bound itself). Every backend prints ``Abs`` and ``sign``.
 
 A control on a joint the model no longer moves (locked by a scene or an equality) gives no
-force; its ``ctrl`` entry stays.
+force; its ``ctrl`` entry stays (a tendon's held joints are in its length, :meth:`~eomgen.
+model.Control.locked`).
 """
 
 from __future__ import annotations
@@ -64,24 +66,26 @@ def clamp(x, bounds):
     return (lo + hi + sp.Abs(x - lo) - sp.Abs(x - hi)) / 2
 
 
-def control_forces(derivation) -> list[tuple[int, sp.Expr, sp.Expr]]:
-    """``(joint index, gear, force)`` of each control of the derivation's model (``None`` for
-    a control on a joint it does not move), the force an expression of ``q``, ``q̇`` and
-    ``ctrl`` (module docstring)."""
+def control_forces(derivation) -> list:
+    """``(moments, force)`` of each control of the derivation's model, ``moments`` the
+    ``(joint index, gear · c_i)`` of its transmission's joints the model moves (``None`` for
+    a control on none of them), the force an expression of ``q``, ``q̇`` and ``ctrl``
+    (module docstring)."""
     model = derivation.model
-    names = list(model.joint_names)
+    index = {name: k for k, name in enumerate(model.joint_names)}
     q, qd, ctrl = derivation.q, derivation.qd, derivation.inputs["ctrl"]
     out = []
     for i, control in enumerate(model.controls):
-        if control.joint not in names:
+        terms = [(index[n], c) for n, c in control.transmission if n in index]
+        if not terms:
             out.append(None)
             continue
-        k = names.index(control.joint)
-        length, velocity = control.gear * q[k], control.gear * qd[k]
+        length = control.gear * (sp.Add(*[c * q[k] for k, c in terms]) + control.offset)
+        velocity = control.gear * sp.Add(*[c * qd[k] for k, c in terms])
         gain = control.gain[0] + control.gain[1] * length + control.gain[2] * velocity
         bias = control.bias[0] + control.bias[1] * length + control.bias[2] * velocity
         force = clamp(gain * clamp(ctrl[i], control.ctrlrange) + bias, control.forcerange)
-        out.append((k, control.gear, force))
+        out.append(([(k, control.gear * c) for k, c in terms], force))
     return out
 
 
@@ -90,9 +94,10 @@ def actuator_forces(derivation, forces) -> sp.Matrix:
     tau = [sp.Integer(0)] * len(derivation.model.joint_names)
     for i, found in enumerate(forces):
         if found is not None:
-            k, gear, force = found
-            tau[k] += gear * name_expr(derivation.builder, force, f"f_act{i + 1}",
-                                       ("f_act", i + 1))
+            moments, force = found
+            named = name_expr(derivation.builder, force, f"f_act{i + 1}", ("f_act", i + 1))
+            for k, moment in moments:
+                tau[k] += moment * named
     return sp.Matrix(tau)
 
 
@@ -110,8 +115,8 @@ def build_controls(derivation, wanted) -> dict:
     model = derivation.model
     if not model.controls:
         raise GenerationError(f"{model.source}: {', '.join(sorted(wanted))} need controls "
-                              "(MJCF actuators on joints, YAML controls:), but the model has "
-                              "none (docs/formats.md)")
+                              "(MJCF actuators on joints and fixed tendons, YAML controls:), "
+                              "but the model has none (docs/formats.md)")
     out = {}
     forces = control_forces(derivation)
     tau = out["tau_act"] = actuator_forces(derivation, forces)
@@ -135,9 +140,11 @@ def build_controls(derivation, wanted) -> dict:
         B = sp.zeros(len(tau), len(ctrl))
         for i, found in enumerate(forces):
             if found is not None:
-                k, gear, force = found
-                B[k, i] += name_expr(b, gear * sp.diff(force, ctrl[i]), f"dtau_act{i + 1}",
-                                     ("dtau_act", i + 1))
+                moments, force = found
+                slope = name_expr(b, sp.diff(force, ctrl[i]), f"dtau_act{i + 1}",
+                                  ("dtau_act", i + 1))
+                for k, moment in moments:
+                    B[k, i] += moment * slope
         out["dqdd_dctrl"] = Minv * B
     return out
 

@@ -43,7 +43,8 @@ What is read
   rest lengths ``springlength``, a dead band since MuJoCo 3). With the joints' damping they
   are the output ``tau_p`` (MuJoCo's ``qfrc_passive``, :mod:`eomgen.symbolic.passive`).
 * ``<option gravity>`` (zero when the ``gravity`` flag is disabled).
-* Actuators with a joint transmission on hinge and slide joints and no activation dynamics
+* Actuators with a joint transmission on hinge and slide joints or a transmission on a fixed
+  tendon (the moment ``gear`` times the tendon's coefficients), and no activation dynamics
   (``<motor>``, ``<position>`` and ``<velocity>`` without ``timeconst``, ``<general>`` with a
   fixed or affine gain and bias): the model's :attr:`~eomgen.model.RobotModel.controls`
   (:class:`~eomgen.model.Control`), entries of the input ``ctrl`` in MuJoCo's actuator order
@@ -74,8 +75,8 @@ a name that is taken gets ``_2``, ``_3``, … appended.
 Warned about (:class:`~eomgen.errors.UnsupportedFeatureWarning`, refused under ``strict``),
 by name: ball joints' springs, spatial tendons (and a fixed tendon's armature and
 frictionloss), the actuators not read (one line per kind, with their count and first names:
-activation dynamics ``dyntype`` filter, integrator, DC motor; tendon, site, slider-crank or
-body transmissions; muscles; free and ball joints; user-defined gains), equalities that are
+activation dynamics ``dyntype`` filter, integrator, DC motor; spatial tendon, site,
+slider-crank or body transmissions; muscles; free and ball joints; user-defined gains), equalities that are
 inactive (``active="false"``),
 ``tendon`` and flex equalities, an equality joining a dropped free body, fluid forces
 (``density``, ``viscosity``), gravity compensation (``gravcomp``). Refused
@@ -240,7 +241,8 @@ def model_from_mujoco(m, source: str = "<mujoco>", strict: bool = False,
     notices = tuple(n for n in model_notices(m, source)
                     if not n.joints or any(j in present for j in n.joints))
     model = replace(model, notices=tuple(model.notices) + notices,
-                    controls=tuple(c for c in controls(m) if c.joint in present),
+                    controls=tuple(c for c in controls(m)
+                                   if all(n in present for n, _ in c.transmission)),
                     info=model.info + (("mujoco_motors", tuple(
                         motor for motor in motors(m) if motor[1] in present)),))
     if not defer_notices:
