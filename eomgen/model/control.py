@@ -15,6 +15,16 @@ actuator's length ``l = gear · L`` and velocity ``v = gear · L̇``::
     force  = clamp(gain · c + bias, forcerange)     (when forcerange is given)
     τ_i   += gear · c_i · force                      (MuJoCo's moment gear · ∂L/∂q_i)
 
+An actuator with activation dynamics (MuJoCo's ``dyntype``, :attr:`Control.dynamics`) has a
+state ``act`` of its own that replaces ``c`` in the force (``gain · act + bias``), with the
+rate (``c`` the clamped control, ``T`` the :attr:`~Control.timeconst`)::
+
+    integrator               act_dot = c
+    filter, filterexact      act_dot = (c − act) / T
+
+(``filterexact`` differs from ``filter`` only in how MuJoCo integrates ``act`` over a step;
+``actrange`` clamps ``act`` there too, not in the force or the rate.)
+
 so a motor is ``gain = (1, 0, 0)``, a position servo ``gain = (kp, 0, 0), bias = (0, −kp,
 −kv)``, a velocity servo ``gain = (kv, 0, 0), bias = (0, 0, −kv)``.
 """
@@ -51,6 +61,11 @@ class Control:
         For a tendon transmission, ``((joint, c_i), …)``: the tendon's length ``Σ c_i q_i``.
     offset:
         ``L_0``, the length of the tendon's joints a scene holds still (:meth:`locked`).
+    dynamics:
+        None (the force follows ``ctrl``), or ``"integrator"``, ``"filter"`` or
+        ``"filterexact"``: the activation dynamics of the module docstring.
+    timeconst:
+        ``T`` [s] of a filter (MuJoCo's ``dynprm[0]``).
     """
 
     __repr__ = reprs.field_repr
@@ -65,6 +80,8 @@ class Control:
     tendon: str | None = None
     coefficients: tuple[tuple[str, Scalar], ...] = ()
     offset: Scalar = scalar(0)
+    dynamics: str | None = None
+    timeconst: Scalar = scalar(1)
 
     @property
     def transmission(self) -> tuple[tuple[str, Scalar], ...]:
@@ -85,16 +102,18 @@ class Control:
 
 
 def make_control(name: str, joint: str | None, gear=1, gain=(1, 0, 0), bias=(0, 0, 0),
-                 ctrlrange=None, forcerange=None, tendon=None, coefficients=()) -> Control:
+                 ctrlrange=None, forcerange=None, tendon=None, coefficients=(), dynamics=None,
+                 timeconst=1) -> Control:
     """A :class:`Control` from plain numbers (each made a model scalar); a tendon
     transmission when ``tendon`` (its name) and ``coefficients`` ``((joint, c_i), …)`` are
-    given, ``joint`` then None."""
+    given, ``joint`` then None; activation ``dynamics`` with its ``timeconst``."""
     def pair(values):
         return None if values is None else tuple(scalar(v) for v in values)
 
     return Control(name, joint, scalar(gear), tuple(scalar(v) for v in gain),
                    tuple(scalar(v) for v in bias), pair(ctrlrange), pair(forcerange), tendon,
-                   tuple((n, scalar(c)) for n, c in coefficients))
+                   tuple((n, scalar(c)) for n, c in coefficients), scalar(0), dynamics,
+                   scalar(timeconst))
 
 
 __all__ = ["Control", "make_control"]

@@ -39,6 +39,8 @@ INPUTS: dict[str, str] = {
     "qd_r": "reference joint velocities of the Slotine-Li controller [rad/s or m/s]",
     "qdd_r": "reference joint accelerations of the Slotine-Li controller [rad/s^2 or m/s^2]",
     "ctrl": "controls of the actuators, in ACTUATOR_NAMES order (MuJoCo's ctrl)",
+    "act": "activations of the actuators with activation dynamics, in ACTIVATION_NAMES order "
+           "(MuJoCo's act)",
 }
 
 #: The inputs whose length is not the number of joints, with what their length is; the function
@@ -48,6 +50,7 @@ INPUT_SIZES: dict[str, str] = {
     "q": "NQ, the configuration size (NV + 1 per quaternion joint)",
     "F_c": "m, the constraint rows: the contacts' (CONTACT_ROWS), then the loops'",
     "ctrl": "nu, the model's controls (ACTUATOR_NAMES)",
+    "act": "na, the controls with activation dynamics (ACTIVATION_NAMES)",
 }
 
 
@@ -547,6 +550,12 @@ FORWARD_CTRL_DERIVATIVES = _listed(Output(
     "forward_dynamics_ctrl in one call.", ("q", "qd", "ctrl"), False,
     "the units of forward_dynamics_ctrl_derivative_q and _qd", ("dqdd_ctrl_dx",),
     default=False, constants=_ACTUATOR_NAMES, returns=("dqdd_ctrl_dq", "dqdd_ctrl_dqd")))
+FORWARD_ACT = _listed(Output(
+    "forward_dynamics_act", "xd_act", "(qdd, act_dot) stacked (nv + na,) of a model whose "
+    "actuators have activation dynamics (integrator: act_dot = ctrl; filter, filterexact: "
+    "(ctrl - act) / timeconst), their forces gain act + bias (MuJoCo's qacc_smooth, act_dot).",
+    ("q", "qd", "ctrl", "act"), True, "rad/s^2 or m/s^2 (qdd), activation units/s (act_dot)",
+    ("xd_act",), default=False, constants=("ACTUATOR_NAMES", "ACTIVATION_NAMES")))
 
 #: Every output, in module order (:mod:`eomgen.outputs` indexes them).
 CATALOGUE: tuple[Output, ...] = tuple(_ENTRIES)

@@ -22,6 +22,13 @@ as generated functions of ``(q, q̇, ctrl)`` (:class:`~eomgen.model.Control`, do
   :func:`~eomgen.symbolic.derivatives.applied_forward_dynamics_jacobians`): what MPC
   linearizes. A clamp that holds contributes 0 to them; a tendon's dead band too.
 
+* ``xd_act`` (``forward_dynamics_act``): for a model whose controls include activation
+  dynamics (MuJoCo's ``dyntype`` integrator, filter, filterexact; :mod:`eomgen.model.control`),
+  ``(q̈, act_dot)`` stacked (nv + na), a function of ``(q, q̇, ctrl, act)``: the forces of
+  those controls follow their activations ``act`` (MuJoCo's ``act``, ``ACTIVATION_NAMES``
+  order), ``q̈`` is ``qdd_ctrl``'s at those forces (MuJoCo's ``qacc_smooth``) and
+  ``act_dot`` is MuJoCo's. The outputs above, without ``act``, refuse such a model.
+
 A clamp is the piecewise-linear ``clamp(x, lo, hi) = (lo + hi + |x − lo| − |x − hi|) / 2``:
 exact inside the range (up to rounding of order ``ulp(max(|lo|, |hi|))``), ``lo`` below and
 ``hi`` above, and its derivative ``(sign(x − lo) − sign(x − hi)) / 2`` is 1 inside, 0 outside
@@ -51,10 +58,25 @@ def control_count(model: RobotModel) -> int:
     return len(model.controls)
 
 
+@sizes("act")
+def activation_count(model: RobotModel) -> int:
+    """The length of ``act``: the controls with activation dynamics."""
+    return sum(1 for c in model.controls if c.dynamics is not None)
+
+
 @provides("ACTUATOR_NAMES")
 def actuator_names(dynamics) -> dict[str, tuple[str, ...]]:
     """``ACTUATOR_NAMES``: the controls' names, the entries of ``ctrl`` in order."""
     return {"ACTUATOR_NAMES": tuple(c.name for c in dynamics.model.controls)}
+
+
+@provides("ACTUATOR_NAMES", "ACTIVATION_NAMES")
+def activation_names(dynamics) -> dict[str, tuple[str, ...]]:
+    """``ACTUATOR_NAMES`` and ``ACTIVATION_NAMES``: the names of the controls with activation
+    dynamics, the entries of ``act`` (MuJoCo's ``act``) in order."""
+    controls = dynamics.model.controls
+    return {**actuator_names(dynamics),
+            "ACTIVATION_NAMES": tuple(c.name for c in controls if c.dynamics is not None)}
 
 
 def clamp(x, bounds):
@@ -66,16 +88,30 @@ def clamp(x, bounds):
     return (lo + hi + sp.Abs(x - lo) - sp.Abs(x - hi)) / 2
 
 
-def control_forces(derivation) -> list:
+def control_forces(derivation, act=None) -> list:
     """``(moments, force)`` of each control of the derivation's model, ``moments`` the
     ``(joint index, gear · c_i)`` of its transmission's joints the model moves (``None`` for
-    a control on none of them), the force an expression of ``q``, ``q̇`` and ``ctrl``
-    (module docstring)."""
+    a control on none of them), the force an expression of ``q``, ``q̇``, ``ctrl`` and, for
+    the controls with activation dynamics, their activations ``act`` (module docstring).
+
+    Raises
+    ------
+    GenerationError
+        For a control with activation dynamics when ``act`` is None (an output without the
+        input ``act``)."""
     model = derivation.model
     index = {name: k for k, name in enumerate(model.joint_names)}
     q, qd, ctrl = derivation.q, derivation.qd, derivation.inputs["ctrl"]
-    out = []
+    out, j = [], 0
     for i, control in enumerate(model.controls):
+        driven = clamp(ctrl[i], control.ctrlrange)
+        if control.dynamics is not None:
+            if act is None:
+                raise GenerationError(
+                    f"{model.source}: actuator '{control.name}' has {control.dynamics} "
+                    "activation dynamics: its force follows its activation act, an input of "
+                    "forward_dynamics_act only (docs/formats.md)")
+            driven, j = act[j], j + 1
         terms = [(index[n], c) for n, c in control.transmission if n in index]
         if not terms:
             out.append(None)
@@ -84,7 +120,7 @@ def control_forces(derivation) -> list:
         velocity = control.gear * sp.Add(*[c * qd[k] for k, c in terms])
         gain = control.gain[0] + control.gain[1] * length + control.gain[2] * velocity
         bias = control.bias[0] + control.bias[1] * length + control.bias[2] * velocity
-        force = clamp(gain * clamp(ctrl[i], control.ctrlrange) + bias, control.forcerange)
+        force = clamp(gain * driven + bias, control.forcerange)
         out.append(([(k, control.gear * c) for k, c in terms], force))
     return out
 
@@ -101,7 +137,40 @@ def actuator_forces(derivation, forces) -> sp.Matrix:
     return sp.Matrix(tau)
 
 
-@builds("tau_act", "qdd_ctrl", "dqdd_dctrl", "dqdd_ctrl_dq", "dqdd_ctrl_dqd", "dqdd_ctrl_dx")
+def _accelerations(derivation, tau, armature) -> sp.Matrix:
+    """``q̈ = (M + diag(a))⁻¹ (τ_act + τ_p − C q̇ − g)`` by the ABA (module docstring)."""
+    effort = tau + passive_forces(derivation)
+    qdd = forward_dynamics_program(derivation.tree, derivation.q, derivation.qd, list(effort),
+                                   derivation.model.gravity, derivation.builder,
+                                   armature=armature)
+    return true_accelerations(derivation, qdd)
+
+
+def activation_rates(derivation) -> list:
+    """``act_dot`` of each control with activation dynamics, in ``act`` order: ``c`` for an
+    integrator, ``(c − act) / T`` for a filter (:mod:`eomgen.model.control`), ``c`` the
+    control clamped to its ``ctrlrange``."""
+    ctrl, act = derivation.inputs["ctrl"], derivation.inputs["act"]
+    out = []
+    for i, control in enumerate(derivation.model.controls):
+        if control.dynamics is None:
+            continue
+        driven = clamp(ctrl[i], control.ctrlrange)
+        out.append(driven if control.dynamics == "integrator"
+                   else (driven - act[len(out)]) / control.timeconst)
+    return out
+
+
+def _activated(derivation) -> sp.Matrix:
+    """``xd_act``: ``(q̈, act_dot)`` stacked, the forces at the activations ``act``."""
+    armature = [a.armature for a in joint_actuators(derivation.model)]
+    tau = actuator_forces(derivation, control_forces(derivation, derivation.inputs["act"]))
+    qdd = _accelerations(derivation, tau, armature)
+    return sp.Matrix(list(qdd) + activation_rates(derivation))
+
+
+@builds("tau_act", "qdd_ctrl", "dqdd_dctrl", "dqdd_ctrl_dq", "dqdd_ctrl_dqd", "dqdd_ctrl_dx",
+        "xd_act")
 def build_controls(derivation, wanted) -> dict:
     """The builder of ``tau_act``, ``qdd_ctrl``, ``dqdd_dctrl``, ``dqdd_ctrl_dq``,
     ``dqdd_ctrl_dqd`` and ``dqdd_ctrl_dx`` in :mod:`eomgen.outputs` (see the module
@@ -118,15 +187,15 @@ def build_controls(derivation, wanted) -> dict:
                               "(MJCF actuators on joints and fixed tendons, YAML controls:), "
                               "but the model has none (docs/formats.md)")
     out = {}
+    if "xd_act" in wanted:
+        out["xd_act"] = _activated(derivation)
+        if not wanted - {"xd_act"}:
+            return out
     forces = control_forces(derivation)
     tau = out["tau_act"] = actuator_forces(derivation, forces)
     armature = [a.armature for a in joint_actuators(derivation.model)]
     if "qdd_ctrl" in wanted:
-        effort = tau + passive_forces(derivation)
-        qdd = forward_dynamics_program(derivation.tree, derivation.q, derivation.qd,
-                                       list(effort), derivation.model.gravity,
-                                       derivation.builder, armature=armature)
-        out["qdd_ctrl"] = true_accelerations(derivation, qdd)
+        out["qdd_ctrl"] = _accelerations(derivation, tau, armature)
     Minv = None
     if wanted & {"dqdd_ctrl_dq", "dqdd_ctrl_dqd", "dqdd_ctrl_dx"}:
         Minv, _, dq, dqd = applied_forward_dynamics_jacobians(
@@ -149,5 +218,6 @@ def build_controls(derivation, wanted) -> dict:
     return out
 
 
-__all__ = ["actuator_forces", "actuator_names", "build_controls", "clamp", "control_count",
+__all__ = ["activation_count", "activation_names", "activation_rates", "actuator_forces",
+           "actuator_names", "build_controls", "clamp", "control_count",
            "control_forces"]

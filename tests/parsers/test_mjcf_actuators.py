@@ -5,7 +5,7 @@ actuator_forces against MuJoCo's qfrc_actuator and forward_dynamics_ctrl against
 (mj_forward, contacts disabled, no joint limits: no constraint forces); their derivative in ctrl
 against central differences of forward_dynamics_ctrl. The models: tests/data/mjcf/actuated.xml
 (a motor, position and velocity servos, general affine gain and bias, ctrl and force ranges,
-damping and armature; a filter actuator left out) and gymnasium's hopper and ant (motors with
+damping and armature; one with user-defined activation dynamics left out) and gymnasium's hopper and ant (motors with
 gear and ctrlrange; the ant flies: its qvel and forces mapped by eomgen.parsers.mjcf.convert).
 """
 
@@ -55,12 +55,12 @@ def arm(tmp_path_factory):
 
 def test_the_actuators_read_are_mujocos(arm):
     model, m, _, module = arm
-    assert module["ACTUATOR_NAMES"] == ("m1", "p2", "v3", "g1", "m3")  # 'filt' is left out
+    assert module["ACTUATOR_NAMES"] == ("m1", "p2", "v3", "g1", "m3")  # 'own' is left out
     servo = {c.name: c for c in model.controls}["p2"]
     assert (servo.joint, float(servo.gear), [float(x) for x in servo.bias]) == \
         ("j2", 1.5, [0, -30, -2])
-    with pytest.warns(UnsupportedFeatureWarning, match="actuator 'filt': an actuator with "
-                      "filter dynamics"):
+    with pytest.warns(UnsupportedFeatureWarning, match="actuator 'own': an actuator with "
+                      "its own dynamics"):
         eomgen.load(DATA / "actuated.xml")
 
 
@@ -72,7 +72,7 @@ def test_forces_and_accelerations_are_mujocos(arm):
         q, qd = rng.uniform(-1.5, 1.5, 3), rng.uniform(-3, 3, 3)
         ctrl = rng.uniform(-2, 2, m.nu)  # beyond ctrlrange and forcerange at times
         force, acc = mujoco_at(m, q, qd, ctrl)
-        u = ctrl[:5]  # MuJoCo's 'filt' has no activation yet: no force
+        u = ctrl[:5]  # MuJoCo's 'own' has no activation (act = 0): no force
         ours = call("actuator_forces", q, qd, u)
         worst_force = max(worst_force, np.abs(ours - force).max() / np.abs(force).max())
         ours = call("forward_dynamics_ctrl", q, qd, u)
