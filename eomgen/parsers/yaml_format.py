@@ -41,6 +41,8 @@
         bias: [0, -kp, -kv]        # optional, default 0; gain optional, default 1
         ctrlrange: [-1, 1]         # optional: ctrl clamped to it
         forcerange: [-10, 10]      # optional: force clamped to it
+        dynamics: filter           # optional: integrator, filter or filterexact: the force
+        timeconst: 0.05            # follows the state act (forward_dynamics_act) [s]
 
 Frames and units follow :mod:`eomgen.model` (URDF's conventions). Values are numbers or
 expressions read by :func:`eomgen.model.expressions.parse_scalar`; every symbol must be declared under
@@ -68,7 +70,10 @@ from .registry import register
 from ._yaml import Reader, read_document, top_level_key
 
 TOP_KEYS = ("name", "description", "gravity", "parameters", "links", "joints", "controls")
-CONTROL_KEYS = ("name", "joint", "tendon", "gear", "gain", "bias", "ctrlrange", "forcerange")
+CONTROL_KEYS = ("name", "joint", "tendon", "gear", "gain", "bias", "ctrlrange", "forcerange",
+                "dynamics", "timeconst")
+#: The activation dynamics a control may have (:attr:`eomgen.model.Control.dynamics`).
+CONTROL_DYNAMICS = ("integrator", "filter", "filterexact")
 LINK_KEYS = ("name", "mass", "com", "inertia")
 JOINT_KEYS = ("name", "type", "parent", "child", "origin", "axis", "pitch", "actuator", "spring")
 SPRING_KEYS = ("stiffness", "reference")
@@ -205,6 +210,13 @@ def _controls(r: Reader, value, joints: list[Joint]) -> tuple[Control, ...]:
             coefficients = tuple((one_axis(j, f"{where} tendon"),
                                   r.scalar(c, f"{where} tendon {j}"))
                                  for j, c in entry["tendon"].items())
+        dynamics = entry.get("dynamics")
+        if dynamics is not None and dynamics not in CONTROL_DYNAMICS:
+            raise r.error(f"{where} dynamics", f"expected one of {', '.join(CONTROL_DYNAMICS)}")
+        if "timeconst" in entry and dynamics not in ("filter", "filterexact"):
+            raise r.error(f"{where} timeconst", "a time constant needs dynamics: filter or "
+                          "filterexact")
+        timeconst = r.scalar(entry.get("timeconst", 1), f"{where} timeconst")
         gain = entry.get("gain", 1)
         gain = [gain, 0, 0] if not isinstance(gain, list) else gain
         out.append(Control(
@@ -212,7 +224,8 @@ def _controls(r: Reader, value, joints: list[Joint]) -> tuple[Control, ...]:
             _triple(r, gain, f"{where} gain"), _triple(r, entry.get("bias", [0, 0, 0]),
                                                        f"{where} bias"),
             _range(r, entry.get("ctrlrange"), f"{where} ctrlrange"),
-            _range(r, entry.get("forcerange"), f"{where} forcerange"), tendon, coefficients))
+            _range(r, entry.get("forcerange"), f"{where} forcerange"), tendon, coefficients,
+            scalar(0), dynamics, timeconst))
     return tuple(out)
 
 

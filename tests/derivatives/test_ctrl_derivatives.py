@@ -5,7 +5,8 @@ References: central differences of the generated forward_dynamics_ctrl (along eo
 (mj_forward, contacts off) on a model of hinges and a slide: joint springs, damping, armature,
 a fixed tendon with a dead band and damping, a position servo, a velocity servo, a motor with
 a ctrlrange and a general actuator with an affine gain and a forcerange. The combined function
-returns the two Jacobians of the single ones.
+returns the two Jacobians of the single ones; (slow) every code backend gives the NumPy
+module's.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import pytest
 import eomgen
 from eomgen.errors import UnsupportedFeatureWarning
 from eomgen.model.configuration import integrate
+from support.derivatives import results
 from support.extras import need
 from support.generated import generated
 
@@ -145,3 +147,16 @@ def test_a_free_flyer_is_differentiated_along_the_tangent(tmp_path):
     assert relative(call("forward_dynamics_ctrl_derivative_q", q, qd, u), along) <= 1e-6
     assert relative(call("forward_dynamics_ctrl_derivative_qd", q, qd, u),
                     differences(lambda x: call("forward_dynamics_ctrl", q, x, u), qd)) <= 1e-6
+
+
+@pytest.mark.slow
+def test_every_code_backend_gives_the_numpy_derivatives(tmp_path):
+    model, _ = load(tmp_path, ARM, "arm")
+    _, modules = generated(model, OUTPUTS[1:], tmp_path)
+    q, qd, u = next(states(np.random.default_rng(21), 1))
+    reference = {f: results("numpy", modules["numpy"], f, q, qd, u) for f in OUTPUTS[1:]}
+    for backend, module in modules.items():
+        for f in OUTPUTS[1:]:
+            for ours, theirs in zip(results(backend, module, f, q, qd, u), reference[f]):
+                assert np.allclose(np.reshape(ours, theirs.shape), theirs, rtol=1e-12,
+                                   atol=1e-12), (backend, f)

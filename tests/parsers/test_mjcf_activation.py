@@ -92,3 +92,18 @@ def test_outputs_without_act_refuse_a_model_with_activations(activated):
     with pytest.raises(GenerationError, match="actuator 'pf' has filterexact activation "
                        "dynamics: its force follows its activation act"):
         eomgen.derive(model, ["qdd_ctrl"])
+
+
+@pytest.mark.slow
+def test_every_code_backend_gives_mujocos_activation_rates(activated, tmp_path):
+    model, m, _, _ = activated
+    calls, _ = generated(model, ["forward_dynamics_act"], tmp_path)
+    d = mujoco.MjData(m)
+    q, qd = np.array([0.3, -0.6, 0.1]), np.array([0.8, -0.2, 1.1])
+    ctrl, act = np.array([0.4, 1.7, -0.3, 0.9, 0.2, 0.0]), np.array([0.1, -0.8, 0.7, -0.3, 0.0])
+    d.qpos[:], d.qvel[:], d.ctrl[:], d.act[:] = q, qd, ctrl, act
+    mujoco.mj_forward(m, d)
+    expected = np.r_[d.qacc_smooth, d.act_dot[:4]]
+    for name, call in calls.items():
+        assert np.allclose(call("forward_dynamics_act", q, qd, ctrl[:5], act[:4]), expected,
+                           rtol=1e-11, atol=1e-11), name

@@ -60,6 +60,25 @@ def test_forces_are_the_clamped_affine_laws(two):
                            call("forward_dynamics", q, qd, tau), rtol=1e-12, atol=1e-12)
 
 
+def test_activation_dynamics_are_mujocos_laws(tmp_path):
+    """A filter and an integrator: forward_dynamics_act's act_dot is (clamp(ctrl) − act) / T
+    and clamp(ctrl), and its q̈ forward_dynamics at the forces gain · act (+ the servo's
+    bias, the prismatic joint's damping)."""
+    text = ROBOT[:ROBOT.index("controls:")] + (
+        "controls:\n  - {name: lag, joint: a, gain: 4, bias: [0, -2, 0], dynamics: filter, "
+        "timeconst: 0.2, ctrlrange: [-1, 1]}\n  - {name: ramp, joint: b, dynamics: integrator}\n")
+    (tmp_path / "two.yaml").write_text(text, encoding="utf-8")
+    model = eomgen.load(tmp_path / "two.yaml")
+    call = generated(model, ["forward_dynamics_act", "forward_dynamics"], tmp_path,
+                     ("numpy",))[0]["numpy"]
+    q, qd, u, act = np.array([0.3, -0.1]), np.array([0.5, 0.8]), np.array([1.6, -0.4]), \
+        np.array([0.7, 0.2])
+    tau = np.array([4 * act[0] - 2 * q[0], act[1] - 0.4 * qd[1]])
+    expected = np.r_[call("forward_dynamics", q, qd, tau), (1 - act[0]) / 0.2, -0.4]
+    assert np.allclose(call("forward_dynamics_act", q, qd, u, act), expected, rtol=1e-12,
+                       atol=1e-12)
+
+
 @pytest.mark.parametrize("entry, where", [
     ("{name: c, joint: nowhere}", "controls[0] 'c' joint"),
     ("{name: c, joint: a, ctrlrange: [1, -1]}", "controls[0] 'c' ctrlrange"),
@@ -69,6 +88,8 @@ def test_forces_are_the_clamped_affine_laws(two):
     ("{name: c, joint: a, tendon: {b: 1}}", "controls[0] 'c': expected either 'joint'"),
     ("{name: c, tendon: [a, b]}", "controls[0] 'c' tendon"),
     ("{name: c, tendon: {a: 1, nowhere: 2}}", "controls[0] 'c' tendon"),
+    ("{name: c, joint: a, dynamics: muscle}", "controls[0] 'c' dynamics"),
+    ("{name: c, joint: a, timeconst: 0.1}", "controls[0] 'c' timeconst"),
 ])
 def test_a_wrong_control_is_refused_in_one_line(tmp_path, entry, where):
     text = ROBOT[:ROBOT.index("controls:")] + f"controls:\n  - {entry}\n"
