@@ -47,7 +47,8 @@ What is read
   tendon (the moment ``gear`` times the tendon's coefficients), with no activation dynamics
   or an integrator or filter one (``dyntype``, :attr:`~eomgen.model.Control.dynamics`: the
   state ``act`` of ``forward_dynamics_act``), a fixed or affine gain and bias (``<motor>``,
-  ``<position>``, ``<velocity>``, ``<intvelocity>``, ``<general>`` of those kinds): the model's :attr:`~eomgen.model.RobotModel.controls`
+  ``<position>``, ``<velocity>``, ``<intvelocity>``, ``<general>`` of those kinds): the
+  model's :attr:`~eomgen.model.RobotModel.controls`
   (:class:`~eomgen.model.Control`), entries of the input ``ctrl`` in MuJoCo's actuator order
   (``ACTUATOR_NAMES``), with MuJoCo's ``gear`` (first component), ``gainprm``, ``biasprm``,
   ``ctrlrange`` (when ``ctrllimited``) and ``forcerange`` (when ``forcelimited``); the
@@ -77,8 +78,8 @@ Warned about (:class:`~eomgen.errors.UnsupportedFeatureWarning`, refused under `
 by name: ball joints' springs, spatial tendons (and a fixed tendon's armature and
 frictionloss), the actuators not read (one line per kind, with their count and first names:
 activation dynamics ``dyntype`` DC motor, PID, user, or ``actearly``; spatial tendon, site,
-slider-crank or body transmissions; muscles; free and ball joints; user-defined gains), equalities that are
-inactive (``active="false"``),
+slider-crank or body transmissions; muscles; free and ball joints; user-defined gains),
+equalities that are inactive (``active="false"``),
 ``tendon`` and flex equalities, an equality joining a dropped free body, fluid forces
 (``density``, ``viscosity``), gravity compensation (``gravcomp``). Refused
 (:class:`~eomgen.errors.UnsupportedError`), by name: ``joint`` equalities of order above
