@@ -4,9 +4,9 @@ References: central differences of the generated forward_dynamics_ctrl (along eo
 ``integrate``, Pinocchio's tangent, for the free flyer) and of MuJoCo's own ``qacc_smooth``
 (mj_forward, contacts off) on a model of hinges and a slide: joint springs, damping, armature,
 a fixed tendon with a dead band and damping, a position servo, a velocity servo, a motor with
-a ctrlrange and a general actuator with an affine gain and a forcerange. The combined function
-returns the two Jacobians of the single ones; (slow) every code backend gives the NumPy
-module's.
+a ctrlrange, a general actuator with an affine gain and a forcerange, and a position servo on
+the fixed tendon. The combined function returns the two Jacobians of the single ones; (slow)
+every code backend gives the NumPy module's.
 """
 
 from __future__ import annotations
@@ -44,7 +44,8 @@ ARM = """<mujoco model="servoarm"><option gravity="0.2 -0.1 -9.81"/><worldbody>
     <motor name="m" joint="j3" gear="2" ctrlrange="-1 1" ctrllimited="true"/>
     <velocity name="v" joint="j1" kv="3"/>
     <general name="g" joint="j4" gainprm="2 0.5 0.3" gaintype="affine" biastype="affine"
-      biasprm="0.1 -1 -0.2" forcerange="-3 3" forcelimited="true"/></actuator>
+      biasprm="0.1 -1 -0.2" forcerange="-3 3" forcelimited="true"/>
+    <position name="pt" tendon="t" kp="6" kv="0.4" gear="1.5"/></actuator>
 </mujoco>"""
 
 FLYER = """<mujoco model="flyer"><worldbody>
@@ -87,7 +88,7 @@ def relative(a, b):
 
 def states(rng, count):
     for _ in range(count):  # some controls beyond ctrlrange, some forces beyond forcerange
-        yield rng.uniform(-1, 1, 4), rng.uniform(-2, 2, 4), rng.uniform(-2, 2, 4)
+        yield rng.uniform(-1, 1, 4), rng.uniform(-2, 2, 4), rng.uniform(-2, 2, 5)
 
 
 def test_the_derivatives_are_central_differences_of_forward_dynamics_ctrl(arm):
