@@ -1,15 +1,29 @@
-"""The control inputs of a model (:class:`Control`): MuJoCo's actuators with a joint
-transmission, each a scalar ``ctrl`` turned into a joint force (docs/formats.md, ``controls:``).
+"""The control inputs of a model (:class:`Control`): MuJoCo's actuators with a joint or a
+fixed-tendon transmission, each a scalar ``ctrl`` turned into joint forces (docs/formats.md,
+``controls:``).
 
 Not the drive of a joint (:class:`~eomgen.model.Actuator`: armature, friction, a flexible
-transmission): a control is what a controller commands. Its force, MuJoCo's ``force = gain ·
-ctrl + bias`` on the joint's length ``l = gear · q`` and velocity ``v = gear · q̇``::
+transmission): a control is what a controller commands. Its transmission is a linear length
+``L = Σ c_i q_i + L_0`` over joints (:attr:`Control.transmission`: the joint itself with
+``c = 1`` for a joint transmission; a fixed tendon's coefficients, as MuJoCo's ``fixed``
+tendon, for a tendon transmission). Its force, MuJoCo's ``force = gain · ctrl + bias`` on the
+actuator's length ``l = gear · L`` and velocity ``v = gear · L̇``::
 
     c      = clamp(ctrl, ctrlrange)                (when ctrlrange is given)
     gain   = gain[0] + gain[1] l + gain[2] v        (fixed: gain[1] = gain[2] = 0)
     bias   = bias[0] + bias[1] l + bias[2] v        (none: all zero)
     force  = clamp(gain · c + bias, forcerange)     (when forcerange is given)
-    τ_joint += gear · force
+    τ_i   += gear · c_i · force                      (MuJoCo's moment gear · ∂L/∂q_i)
+
+An actuator with activation dynamics (MuJoCo's ``dyntype``, :attr:`Control.dynamics`) has a
+state ``act`` of its own that replaces ``c`` in the force (``gain · act + bias``), with the
+rate (``c`` the clamped control, ``T`` the :attr:`~Control.timeconst`)::
+
+    integrator               act_dot = c
+    filter, filterexact      act_dot = (c − act) / T
+
+(``filterexact`` differs from ``filter`` only in how MuJoCo integrates ``act`` over a step;
+``actrange`` clamps ``act`` there too, not in the force or the rate.)
 
 so a motor is ``gain = (1, 0, 0)``, a position servo ``gain = (kp, 0, 0), bias = (0, −kp,
 −kv)``, a velocity servo ``gain = (kv, 0, 0), bias = (0, 0, −kv)``.
@@ -17,7 +31,7 @@ so a motor is ``gain = (1, 0, 0)``, a position servo ``gain = (kp, 0, 0), bias =
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..common import reprs
 from .scalars import Scalar, scalar
@@ -25,41 +39,81 @@ from .scalars import Scalar, scalar
 
 @dataclass(frozen=True)
 class Control:
-    """One control input on a one-coordinate joint (see the module docstring).
+    """One control input on a one-coordinate joint or a fixed tendon (see the module
+    docstring).
 
     Attributes
     ----------
     name:
         Its name (MuJoCo's actuator name), an entry of ``ACTUATOR_NAMES``.
     joint:
-        The joint it drives (a revolute, prismatic or helical joint of the model).
+        The joint it drives (a revolute, prismatic or helical joint of the model); None for a
+        tendon transmission.
     gear:
-        The transmission ratio: length ``gear · q``, joint force ``gear · force``.
+        The transmission ratio: length ``gear · L``, joint forces ``gear · c_i · force``.
     gain, bias:
         The affine coefficients ``(c0, c_length, c_velocity)`` of the gain and the bias.
     ctrlrange, forcerange:
         ``(low, high)`` the control and the force are clamped to; None: not clamped.
+    tendon:
+        For a tendon transmission, the tendon's name (None for a joint transmission).
+    coefficients:
+        For a tendon transmission, ``((joint, c_i), …)``: the tendon's length ``Σ c_i q_i``.
+    offset:
+        ``L_0``, the length of the tendon's joints a scene holds still (:meth:`locked`).
+    dynamics:
+        None (the force follows ``ctrl``), or ``"integrator"``, ``"filter"`` or
+        ``"filterexact"``: the activation dynamics of the module docstring.
+    timeconst:
+        ``T`` [s] of a filter (MuJoCo's ``dynprm[0]``).
     """
 
     __repr__ = reprs.field_repr
 
     name: str
-    joint: str
+    joint: str | None
     gear: Scalar = scalar(1)
     gain: tuple[Scalar, Scalar, Scalar] = (scalar(1), scalar(0), scalar(0))
     bias: tuple[Scalar, Scalar, Scalar] = (scalar(0), scalar(0), scalar(0))
     ctrlrange: tuple[Scalar, Scalar] | None = None
     forcerange: tuple[Scalar, Scalar] | None = None
+    tendon: str | None = None
+    coefficients: tuple[tuple[str, Scalar], ...] = ()
+    offset: Scalar = scalar(0)
+    dynamics: str | None = None
+    timeconst: Scalar = scalar(1)
+
+    @property
+    def transmission(self) -> tuple[tuple[str, Scalar], ...]:
+        """``((joint, c_i), …)`` of the length ``L = Σ c_i q_i + offset``: ``((joint, 1),)``
+        for a joint transmission, the tendon's coefficients otherwise."""
+        return self.coefficients if self.tendon is not None else ((self.joint, scalar(1)),)
+
+    def locked(self, positions) -> "Control":
+        """The control with the joints of ``positions`` (``{joint: value}``) held there: a
+        tendon's terms on them move into :attr:`offset` (a joint transmission is unchanged:
+        on a held joint it gives no force)."""
+        if self.tendon is None or not any(n in positions for n, _ in self.coefficients):
+            return self
+        held = sum((c * scalar(positions[n]) for n, c in self.coefficients if n in positions),
+                   self.offset)
+        return replace(self, coefficients=tuple((n, c) for n, c in self.coefficients
+                                                if n not in positions), offset=held)
 
 
-def make_control(name: str, joint: str, gear=1, gain=(1, 0, 0), bias=(0, 0, 0),
-                 ctrlrange=None, forcerange=None) -> Control:
-    """A :class:`Control` from plain numbers (each made a model scalar)."""
+def make_control(name: str, joint: str | None, gear=1, gain=(1, 0, 0), bias=(0, 0, 0),
+                 ctrlrange=None, forcerange=None, tendon=None, coefficients=(), dynamics=None,
+                 timeconst=1) -> Control:
+    """A :class:`Control` from plain numbers (each made a model scalar); a tendon
+    transmission when ``tendon`` (its name) and ``coefficients`` ``((joint, c_i), …)`` are
+    given, ``joint`` then None; activation ``dynamics`` with its ``timeconst``."""
     def pair(values):
         return None if values is None else tuple(scalar(v) for v in values)
 
     return Control(name, joint, scalar(gear), tuple(scalar(v) for v in gain),
-                   tuple(scalar(v) for v in bias), pair(ctrlrange), pair(forcerange))
+                   tuple(scalar(v) for v in bias), pair(ctrlrange), pair(forcerange), tendon,
+                   tuple((n, scalar(c)) for n, c in coefficients), scalar(0), dynamics,
+                   scalar(timeconst))
 
 
 __all__ = ["Control", "make_control"]

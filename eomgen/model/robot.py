@@ -80,8 +80,9 @@ class RobotModel:
     #: Fixed tendons (:class:`~eomgen.model.passive.Tendon`): springs and dampers on linear
     #: combinations of joint coordinates, in the passive forces (``tau_p``).
     tendons: tuple[Tendon, ...] = ()
-    #: The control inputs (:class:`~eomgen.model.Control`: MuJoCo's actuators on joints, YAML's
-    #: ``controls:``), entries of ``ctrl`` in this order; empty: the input is the joint effort.
+    #: The control inputs (:class:`~eomgen.model.Control`: MuJoCo's actuators on joints and
+    #: fixed tendons, YAML's ``controls:``), entries of ``ctrl`` in this order; empty: the input
+    #: is the joint effort.
     controls: tuple[Control, ...] = ()
 
     @cached_property
@@ -431,5 +432,6 @@ def lock_joints(model: RobotModel, positions: Mapping[str, object]) -> RobotMode
     locked = {name for name in compound if any(v in fixed_origins for v in compound[name][1])}
     return replace(model, joints=joints, couplings=couplings,
                    tendons=tuple(t.locked(positions) for t in model.tendons),
+                   controls=tuple(c.locked(positions) for c in model.controls),
                    compound_joints=tuple((k, n) for k, n in model.compound_joints
                                          if n not in locked))

@@ -39,6 +39,8 @@ INPUTS: dict[str, str] = {
     "qd_r": "reference joint velocities of the Slotine-Li controller [rad/s or m/s]",
     "qdd_r": "reference joint accelerations of the Slotine-Li controller [rad/s^2 or m/s^2]",
     "ctrl": "controls of the actuators, in ACTUATOR_NAMES order (MuJoCo's ctrl)",
+    "act": "activations of the actuators with activation dynamics, in ACTIVATION_NAMES order "
+           "(MuJoCo's act)",
 }
 
 #: The inputs whose length is not the number of joints, with what their length is; the function
@@ -48,6 +50,7 @@ INPUT_SIZES: dict[str, str] = {
     "q": "NQ, the configuration size (NV + 1 per quaternion joint)",
     "F_c": "m, the constraint rows: the contacts' (CONTACT_ROWS), then the loops'",
     "ctrl": "nu, the model's controls (ACTUATOR_NAMES)",
+    "act": "na, the controls with activation dynamics (ACTIVATION_NAMES)",
 }
 
 
@@ -520,8 +523,8 @@ PASSIVE = _listed(Output(
     "joint springs, the drives' viscous damping and the fixed tendons (MuJoCo's qfrc_passive), "
     "added to tau: M qdd + C qd + g = tau + tau_p.", ("q", "qd"), True, _REVOLUTE_EFFORT,
     ("tau_p",), default=False))
-# --- issue 41: MuJoCo's actuators on joints (eomgen.symbolic.controls, docs/formats.md): the
-# joint forces of the controls and the forward dynamics they drive, exported when asked for.
+# --- issue 41: MuJoCo's actuators on joints and fixed tendons (eomgen.symbolic.controls,
+# docs/formats.md): the joint forces of the controls and the forward dynamics they drive.
 _ACTUATOR_NAMES = ("ACTUATOR_NAMES",)
 ACTUATOR_FORCES = _listed(Output(
     "actuator_forces", "tau_act", "Joint forces of the actuators sum gear clamp(gain(q, qd) "
@@ -538,6 +541,27 @@ FORWARD_CTRL_DERIVATIVE = _listed(Output(
     "forward_dynamics_ctrl: (M + diag(a))^-1 dtau_act/dctrl (zero where a clamp holds).",
     ("q", "qd", "ctrl"), False, "rad/s^2 (revolute rows), m/s^2 (prismatic) per unit of ctrl",
     ("dqdd_dctrl",), default=False, constants=_ACTUATOR_NAMES))
+FORWARD_CTRL_DQ = _listed(Output(
+    "forward_dynamics_ctrl_derivative_q", "dqdd_ctrl_dq", "dqdd/dq (nv, nv) of "
+    "forward_dynamics_ctrl: -(M + diag(a))^-1 (dtau/dq - d(actuator_forces + "
+    "passive_forces)/dq), dtau/dq of Newton-Euler at qdd held fixed.", ("q", "qd", "ctrl"),
+    False, "1/s^2", ("dqdd_ctrl_dq",), default=False, constants=_ACTUATOR_NAMES))
+FORWARD_CTRL_DQD = _listed(Output(
+    "forward_dynamics_ctrl_derivative_qd", "dqdd_ctrl_dqd", "dqdd/dqd (nv, nv) of "
+    "forward_dynamics_ctrl (the servos' and the passive forces' damping included).",
+    ("q", "qd", "ctrl"), False, "1/s", ("dqdd_ctrl_dqd",), default=False,
+    constants=_ACTUATOR_NAMES))
+FORWARD_CTRL_DERIVATIVES = _listed(Output(
+    "forward_dynamics_ctrl_derivatives", "dqdd_ctrl_dx", "(dqdd/dq, dqdd/dqd) of "
+    "forward_dynamics_ctrl in one call.", ("q", "qd", "ctrl"), False,
+    "the units of forward_dynamics_ctrl_derivative_q and _qd", ("dqdd_ctrl_dx",),
+    default=False, constants=_ACTUATOR_NAMES, returns=("dqdd_ctrl_dq", "dqdd_ctrl_dqd")))
+FORWARD_ACT = _listed(Output(
+    "forward_dynamics_act", "xd_act", "(qdd, act_dot) stacked (nv + na,) of a model whose "
+    "actuators have activation dynamics (integrator: act_dot = ctrl; filter, filterexact: "
+    "(ctrl - act) / timeconst), their forces gain act + bias (MuJoCo's qacc_smooth, act_dot).",
+    ("q", "qd", "ctrl", "act"), True, "rad/s^2 or m/s^2 (qdd), activation units/s (act_dot)",
+    ("xd_act",), default=False, constants=("ACTUATOR_NAMES", "ACTIVATION_NAMES")))
 
 #: Every output, in module order (:mod:`eomgen.outputs` indexes them).
 CATALOGUE: tuple[Output, ...] = tuple(_ENTRIES)

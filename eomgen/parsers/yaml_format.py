@@ -31,14 +31,18 @@
           stiffness: K1            # [N m/rad]: a flexible joint (Spong's model)
         spring: {stiffness: 2.0, reference: 0.1}   # optional: -k (q - q_ref) on the joint
                                                    # (passive_forces; one-axis joints only)
-    controls:                      # optional: MuJoCo's actuators on joints, entries of ctrl
+    controls:                      # optional: MuJoCo's actuators, entries of ctrl
       - name: shoulder_servo
-        joint: joint1              # a revolute, prismatic or helical joint
+        joint: joint1              # a revolute, prismatic or helical joint, or instead
+                                   # tendon: {joint1: 1, joint2: -0.5}: a fixed tendon's
+                                   # length sum c_i q_i (MuJoCo's tendon transmission)
         gear: 1                    # optional, default 1: force on the joint gear * force
         gain: [kp, 0, 0]           # force = gain * ctrl + bias, each c0 + c1 gear q + c2 gear qd
         bias: [0, -kp, -kv]        # optional, default 0; gain optional, default 1
         ctrlrange: [-1, 1]         # optional: ctrl clamped to it
         forcerange: [-10, 10]      # optional: force clamped to it
+        dynamics: filter           # optional: integrator, filter or filterexact: the force
+        timeconst: 0.05            # follows the state act (forward_dynamics_act) [s]
 
 Frames and units follow :mod:`eomgen.model` (URDF's conventions). Values are numbers or
 expressions read by :func:`eomgen.model.expressions.parse_scalar`; every symbol must be declared under
@@ -66,7 +70,10 @@ from .registry import register
 from ._yaml import Reader, read_document, top_level_key
 
 TOP_KEYS = ("name", "description", "gravity", "parameters", "links", "joints", "controls")
-CONTROL_KEYS = ("name", "joint", "gear", "gain", "bias", "ctrlrange", "forcerange")
+CONTROL_KEYS = ("name", "joint", "tendon", "gear", "gain", "bias", "ctrlrange", "forcerange",
+                "dynamics", "timeconst")
+#: The activation dynamics a control may have (:attr:`eomgen.model.Control.dynamics`).
+CONTROL_DYNAMICS = ("integrator", "filter", "filterexact")
 LINK_KEYS = ("name", "mass", "com", "inertia")
 JOINT_KEYS = ("name", "type", "parent", "child", "origin", "axis", "pitch", "actuator", "spring")
 SPRING_KEYS = ("stiffness", "reference")
@@ -167,22 +174,49 @@ def parse(data: dict, source: str, strict: bool = False, default_name: str = "ro
 
 
 def _controls(r: Reader, value, joints: list[Joint]) -> tuple[Control, ...]:
-    """The ``controls:`` entries (module docstring), each on a one-coordinate joint."""
+    """The ``controls:`` entries (module docstring), each on a one-coordinate joint or on a
+    fixed tendon of such joints (``tendon: {joint: coefficient, …}``, named after the
+    control)."""
     kinds = {joint.name: joint.type for joint in joints}
     one = (JointType.REVOLUTE, JointType.CONTINUOUS, JointType.PRISMATIC, JointType.HELICAL)
     out, seen = [], set()
+
+    def one_axis(joint: str, where: str) -> str:
+        joint = r.name(joint, where)
+        if kinds.get(joint) not in one:
+            raise r.error(where, f"'{joint}' is not a revolute, prismatic or helical joint of "
+                          "the robot")
+        return joint
+
     for i, entry in enumerate(r.sequence(value, "controls")):
-        r.mapping(entry, r.named(entry, f"controls[{i}]"), required=("name", "joint"),
+        r.mapping(entry, r.named(entry, f"controls[{i}]"), required=("name",),
                   optional=CONTROL_KEYS)
         name = r.name(entry["name"], f"controls[{i}] name")
         where = f"controls[{i}] '{name}'"
         if name in seen:
             raise r.error(f"{where} name", "a second control of this name")
         seen.add(name)
-        joint = r.name(entry["joint"], f"{where} joint")
-        if kinds.get(joint) not in one:
-            raise r.error(f"{where} joint", f"'{joint}' is not a revolute, prismatic or "
-                          "helical joint of the robot")
+        if ("joint" in entry) == ("tendon" in entry):
+            raise r.error(where, "expected either 'joint' (a joint transmission) or 'tendon' "
+                          "(a fixed tendon: {joint: coefficient, ...})")
+        joint, tendon, coefficients = None, None, ()
+        if "joint" in entry:
+            joint = one_axis(entry["joint"], f"{where} joint")
+        else:
+            if not isinstance(entry["tendon"], dict) or not entry["tendon"]:
+                raise r.error(f"{where} tendon", "expected a mapping {joint: coefficient, ...} "
+                              "of one joint or more")
+            tendon = name
+            coefficients = tuple((one_axis(j, f"{where} tendon"),
+                                  r.scalar(c, f"{where} tendon {j}"))
+                                 for j, c in entry["tendon"].items())
+        dynamics = entry.get("dynamics")
+        if dynamics is not None and dynamics not in CONTROL_DYNAMICS:
+            raise r.error(f"{where} dynamics", f"expected one of {', '.join(CONTROL_DYNAMICS)}")
+        if "timeconst" in entry and dynamics not in ("filter", "filterexact"):
+            raise r.error(f"{where} timeconst", "a time constant needs dynamics: filter or "
+                          "filterexact")
+        timeconst = r.scalar(entry.get("timeconst", 1), f"{where} timeconst")
         gain = entry.get("gain", 1)
         gain = [gain, 0, 0] if not isinstance(gain, list) else gain
         out.append(Control(
@@ -190,7 +224,8 @@ def _controls(r: Reader, value, joints: list[Joint]) -> tuple[Control, ...]:
             _triple(r, gain, f"{where} gain"), _triple(r, entry.get("bias", [0, 0, 0]),
                                                        f"{where} bias"),
             _range(r, entry.get("ctrlrange"), f"{where} ctrlrange"),
-            _range(r, entry.get("forcerange"), f"{where} forcerange")))
+            _range(r, entry.get("forcerange"), f"{where} forcerange"), tendon, coefficients,
+            scalar(0), dynamics, timeconst))
     return tuple(out)
 
 

@@ -1,19 +1,33 @@
-"""Builders of the control outputs (issue 41): MuJoCo's actuators on joints as generated
-functions of ``(q, q̇, ctrl)`` (:class:`~eomgen.model.Control`, docs/formats.md).
+"""Builders of the control outputs (issue 41): MuJoCo's actuators on joints and fixed tendons
+as generated functions of ``(q, q̇, ctrl)`` (:class:`~eomgen.model.Control`, docs/formats.md).
 
-* ``tau_act`` (``actuator_forces``): ``τ_act = Σ_i gear_i · clamp(gain_i · clamp(ctrl_i) +
-  bias_i)`` on each control's joint, with ``gain = g0 + g1 l + g2 v``, ``bias = b0 + b1 l + b2
-  v`` on the joint's length ``l = gear · q`` and velocity ``v = gear · q̇`` (MuJoCo's
-  ``qfrc_actuator`` of a joint transmission: ``force = gain · ctrl + bias``, the control
-  clamped to ``ctrlrange`` and the force to ``forcerange``, then ``Jᵀ force`` with ``J =
-  gear``);
+* ``tau_act`` (``actuator_forces``): ``τ_act = Σ_i J_iᵀ clamp(gain_i · clamp(ctrl_i) +
+  bias_i)`` with ``gain = g0 + g1 l + g2 v``, ``bias = b0 + b1 l + b2 v`` on the actuator's
+  length ``l = gear · L`` and velocity ``v = gear · L̇``, ``L = Σ c_j q_j + L_0`` its
+  transmission (the joint itself, or a fixed tendon's coefficients), ``J_i = gear · ∂L/∂q``
+  (MuJoCo's ``qfrc_actuator`` of a joint or tendon transmission: ``force = gain · ctrl +
+  bias``, the control clamped to ``ctrlrange`` and the force to ``forcerange``, then the
+  moment ``Jᵀ force``);
 * ``qdd_ctrl`` (``forward_dynamics_ctrl``): ``q̈ = (M + diag(a))⁻¹ (τ_act + τ_p − C q̇ − g)``
   by the Articulated-Body Algorithm with the drives' armature ``a`` (MuJoCo's ``armature``)
   and the passive forces ``τ_p`` of :mod:`eomgen.symbolic.passive` (joint springs, the drives'
   viscous damping, fixed tendons): MuJoCo's ``qacc_smooth``. Coulomb friction (MuJoCo's
   ``frictionloss``, a constraint there) is left out;
 * ``dqdd_dctrl``: ``∂q̈/∂ctrl = (M + diag(a))⁻¹ ∂τ_act/∂ctrl`` (nv × nu), zero in the columns
-  whose clamp holds.
+  whose clamp holds;
+* ``dqdd_ctrl_dq``, ``dqdd_ctrl_dqd`` (nv × nv; ``dqdd_ctrl_dx`` both side by side):
+  ``∂q̈/∂x = −(M + diag(a))⁻¹ (∂τ/∂x − ∂(τ_act + τ_p)/∂x)`` for x = q (along the tangent of a
+  quaternion joint, as :mod:`eomgen.symbolic.derivatives`) and x = q̇, the Newton–Euler
+  ``∂τ`` taken at q̈ held fixed (the implicit function theorem,
+  :func:`~eomgen.symbolic.derivatives.applied_forward_dynamics_jacobians`): what MPC
+  linearizes. A clamp that holds contributes 0 to them; a tendon's dead band too.
+
+* ``xd_act`` (``forward_dynamics_act``): for a model whose controls include activation
+  dynamics (MuJoCo's ``dyntype`` integrator, filter, filterexact; :mod:`eomgen.model.control`),
+  ``(q̈, act_dot)`` stacked (nv + na), a function of ``(q, q̇, ctrl, act)``: the forces of
+  those controls follow their activations ``act`` (MuJoCo's ``act``, ``ACTIVATION_NAMES``
+  order), ``q̈`` is ``qdd_ctrl``'s at those forces (MuJoCo's ``qacc_smooth``) and
+  ``act_dot`` is MuJoCo's. The outputs above, without ``act``, refuse such a model.
 
 A clamp is the piecewise-linear ``clamp(x, lo, hi) = (lo + hi + |x − lo| − |x − hi|) / 2``:
 exact inside the range (up to rounding of order ``ulp(max(|lo|, |hi|))``), ``lo`` below and
@@ -21,7 +35,8 @@ exact inside the range (up to rounding of order ``ulp(max(|lo|, |hi|))``), ``lo`
 (½ on the bound itself). Every backend prints ``Abs`` and ``sign``.
 
 A control on a joint the model no longer moves (locked by a scene or an equality) gives no
-force; its ``ctrl`` entry stays.
+force; its ``ctrl`` entry stays (a tendon's held joints are in its length, :meth:`~eomgen.
+model.Control.locked`).
 """
 
 from __future__ import annotations
@@ -32,7 +47,7 @@ from ..errors import GenerationError
 from ..model import RobotModel, joint_actuators
 from .aba import forward_dynamics_program, true_accelerations
 from .builders import builds, provides, sizes
-from .derivatives import symmetric_inverse
+from .derivatives import applied_forward_dynamics_jacobians, symmetric_inverse
 from .passive import passive_forces
 from .program import name_expr
 
@@ -43,10 +58,25 @@ def control_count(model: RobotModel) -> int:
     return len(model.controls)
 
 
+@sizes("act")
+def activation_count(model: RobotModel) -> int:
+    """The length of ``act``: the controls with activation dynamics."""
+    return sum(1 for c in model.controls if c.dynamics is not None)
+
+
 @provides("ACTUATOR_NAMES")
 def actuator_names(dynamics) -> dict[str, tuple[str, ...]]:
     """``ACTUATOR_NAMES``: the controls' names, the entries of ``ctrl`` in order."""
     return {"ACTUATOR_NAMES": tuple(c.name for c in dynamics.model.controls)}
+
+
+@provides("ACTUATOR_NAMES", "ACTIVATION_NAMES")
+def activation_names(dynamics) -> dict[str, tuple[str, ...]]:
+    """``ACTUATOR_NAMES`` and ``ACTIVATION_NAMES``: the names of the controls with activation
+    dynamics, the entries of ``act`` (MuJoCo's ``act``) in order."""
+    controls = dynamics.model.controls
+    return {**actuator_names(dynamics),
+            "ACTIVATION_NAMES": tuple(c.name for c in controls if c.dynamics is not None)}
 
 
 def clamp(x, bounds):
@@ -58,24 +88,40 @@ def clamp(x, bounds):
     return (lo + hi + sp.Abs(x - lo) - sp.Abs(x - hi)) / 2
 
 
-def control_forces(derivation) -> list[tuple[int, sp.Expr, sp.Expr]]:
-    """``(joint index, gear, force)`` of each control of the derivation's model (``None`` for
-    a control on a joint it does not move), the force an expression of ``q``, ``q̇`` and
-    ``ctrl`` (module docstring)."""
+def control_forces(derivation, act=None) -> list:
+    """``(moments, force)`` of each control of the derivation's model, ``moments`` the
+    ``(joint index, gear · c_i)`` of its transmission's joints the model moves (``None`` for
+    a control on none of them), the force an expression of ``q``, ``q̇``, ``ctrl`` and, for
+    the controls with activation dynamics, their activations ``act`` (module docstring).
+
+    Raises
+    ------
+    GenerationError
+        For a control with activation dynamics when ``act`` is None (an output without the
+        input ``act``)."""
     model = derivation.model
-    names = list(model.joint_names)
+    index = {name: k for k, name in enumerate(model.joint_names)}
     q, qd, ctrl = derivation.q, derivation.qd, derivation.inputs["ctrl"]
-    out = []
+    out, j = [], 0
     for i, control in enumerate(model.controls):
-        if control.joint not in names:
+        driven = clamp(ctrl[i], control.ctrlrange)
+        if control.dynamics is not None:
+            if act is None:
+                raise GenerationError(
+                    f"{model.source}: actuator '{control.name}' has {control.dynamics} "
+                    "activation dynamics: its force follows its activation act, an input of "
+                    "forward_dynamics_act only (docs/formats.md)")
+            driven, j = act[j], j + 1
+        terms = [(index[n], c) for n, c in control.transmission if n in index]
+        if not terms:
             out.append(None)
             continue
-        k = names.index(control.joint)
-        length, velocity = control.gear * q[k], control.gear * qd[k]
+        length = control.gear * (sp.Add(*[c * q[k] for k, c in terms]) + control.offset)
+        velocity = control.gear * sp.Add(*[c * qd[k] for k, c in terms])
         gain = control.gain[0] + control.gain[1] * length + control.gain[2] * velocity
         bias = control.bias[0] + control.bias[1] * length + control.bias[2] * velocity
-        force = clamp(gain * clamp(ctrl[i], control.ctrlrange) + bias, control.forcerange)
-        out.append((k, control.gear, force))
+        force = clamp(gain * driven + bias, control.forcerange)
+        out.append(([(k, control.gear * c) for k, c in terms], force))
     return out
 
 
@@ -84,16 +130,51 @@ def actuator_forces(derivation, forces) -> sp.Matrix:
     tau = [sp.Integer(0)] * len(derivation.model.joint_names)
     for i, found in enumerate(forces):
         if found is not None:
-            k, gear, force = found
-            tau[k] += gear * name_expr(derivation.builder, force, f"f_act{i + 1}",
-                                       ("f_act", i + 1))
+            moments, force = found
+            named = name_expr(derivation.builder, force, f"f_act{i + 1}", ("f_act", i + 1))
+            for k, moment in moments:
+                tau[k] += moment * named
     return sp.Matrix(tau)
 
 
-@builds("tau_act", "qdd_ctrl", "dqdd_dctrl")
+def _accelerations(derivation, tau, armature) -> sp.Matrix:
+    """``q̈ = (M + diag(a))⁻¹ (τ_act + τ_p − C q̇ − g)`` by the ABA (module docstring)."""
+    effort = tau + passive_forces(derivation)
+    qdd = forward_dynamics_program(derivation.tree, derivation.q, derivation.qd, list(effort),
+                                   derivation.model.gravity, derivation.builder,
+                                   armature=armature)
+    return true_accelerations(derivation, qdd)
+
+
+def activation_rates(derivation) -> list:
+    """``act_dot`` of each control with activation dynamics, in ``act`` order: ``c`` for an
+    integrator, ``(c − act) / T`` for a filter (:mod:`eomgen.model.control`), ``c`` the
+    control clamped to its ``ctrlrange``."""
+    ctrl, act = derivation.inputs["ctrl"], derivation.inputs["act"]
+    out = []
+    for i, control in enumerate(derivation.model.controls):
+        if control.dynamics is None:
+            continue
+        driven = clamp(ctrl[i], control.ctrlrange)
+        out.append(driven if control.dynamics == "integrator"
+                   else (driven - act[len(out)]) / control.timeconst)
+    return out
+
+
+def _activated(derivation) -> sp.Matrix:
+    """``xd_act``: ``(q̈, act_dot)`` stacked, the forces at the activations ``act``."""
+    armature = [a.armature for a in joint_actuators(derivation.model)]
+    tau = actuator_forces(derivation, control_forces(derivation, derivation.inputs["act"]))
+    qdd = _accelerations(derivation, tau, armature)
+    return sp.Matrix(list(qdd) + activation_rates(derivation))
+
+
+@builds("tau_act", "qdd_ctrl", "dqdd_dctrl", "dqdd_ctrl_dq", "dqdd_ctrl_dqd", "dqdd_ctrl_dx",
+        "xd_act")
 def build_controls(derivation, wanted) -> dict:
-    """The builder of ``tau_act``, ``qdd_ctrl`` and ``dqdd_dctrl`` in :mod:`eomgen.outputs`
-    (see the module docstring).
+    """The builder of ``tau_act``, ``qdd_ctrl``, ``dqdd_dctrl``, ``dqdd_ctrl_dq``,
+    ``dqdd_ctrl_dqd`` and ``dqdd_ctrl_dx`` in :mod:`eomgen.outputs` (see the module
+    docstring).
 
     Raises
     ------
@@ -103,32 +184,40 @@ def build_controls(derivation, wanted) -> dict:
     model = derivation.model
     if not model.controls:
         raise GenerationError(f"{model.source}: {', '.join(sorted(wanted))} need controls "
-                              "(MJCF actuators on joints, YAML controls:), but the model has "
-                              "none (docs/formats.md)")
+                              "(MJCF actuators on joints and fixed tendons, YAML controls:), "
+                              "but the model has none (docs/formats.md)")
     out = {}
+    if "xd_act" in wanted:
+        out["xd_act"] = _activated(derivation)
+        if not wanted - {"xd_act"}:
+            return out
     forces = control_forces(derivation)
     tau = out["tau_act"] = actuator_forces(derivation, forces)
     armature = [a.armature for a in joint_actuators(derivation.model)]
     if "qdd_ctrl" in wanted:
-        effort = tau + passive_forces(derivation)
-        qdd = forward_dynamics_program(derivation.tree, derivation.q, derivation.qd,
-                                       list(effort), derivation.model.gravity,
-                                       derivation.builder, armature=armature)
-        out["qdd_ctrl"] = true_accelerations(derivation, qdd)
+        out["qdd_ctrl"] = _accelerations(derivation, tau, armature)
+    Minv = None
+    if wanted & {"dqdd_ctrl_dq", "dqdd_ctrl_dqd", "dqdd_ctrl_dx"}:
+        Minv, _, dq, dqd = applied_forward_dynamics_jacobians(
+            derivation, tau + passive_forces(derivation), armature, "u")
+        out.update(dqdd_ctrl_dq=dq, dqdd_ctrl_dqd=dqd, dqdd_ctrl_dx=sp.Matrix.hstack(dq, dqd))
     if "dqdd_dctrl" in wanted:
         b = derivation.builder
         ctrl = derivation.inputs["ctrl"]
-        M = derivation.output("M") + sp.diag(*armature)
-        Minv = symmetric_inverse(b, M, "Minv_u")
+        if Minv is None:
+            Minv = symmetric_inverse(b, derivation.output("M") + sp.diag(*armature), "Minv_u")
         B = sp.zeros(len(tau), len(ctrl))
         for i, found in enumerate(forces):
             if found is not None:
-                k, gear, force = found
-                B[k, i] += name_expr(b, gear * sp.diff(force, ctrl[i]), f"dtau_act{i + 1}",
-                                     ("dtau_act", i + 1))
+                moments, force = found
+                slope = name_expr(b, sp.diff(force, ctrl[i]), f"dtau_act{i + 1}",
+                                  ("dtau_act", i + 1))
+                for k, moment in moments:
+                    B[k, i] += moment * slope
         out["dqdd_dctrl"] = Minv * B
     return out
 
 
-__all__ = ["actuator_forces", "actuator_names", "build_controls", "clamp", "control_count",
+__all__ = ["activation_count", "activation_names", "activation_rates", "actuator_forces",
+           "actuator_names", "build_controls", "clamp", "control_count",
            "control_forces"]

@@ -255,11 +255,12 @@ def symmetric_inverse(b: ProgramBuilder, M: sp.Matrix, hint: str) -> sp.Matrix:
     return out.extract(last, last)
 
 
-def _solved_dynamics(derivation, armature=None, friction=None, hint: str = "s"):
+def _solved_dynamics(derivation, armature=None, friction=None, hint: str = "s", efforts=None):
     """``(M⁻¹, q̈)`` of the model in its own coordinates: ``M_r = Tᵀ (M + diag(armature)) T``
     (``M + diag(armature)`` without couplings) inverted by :func:`symmetric_inverse` (leaves
     first: no fill-in on a branched tree), and
-    ``q̈ = M_r⁻¹ (τ_r − Tᵀ (τ(q, q̇, 0) + friction))``, each acceleration named."""
+    ``q̈ = M_r⁻¹ (τ_r − Tᵀ (τ(q, q̇, 0) + friction))``, each acceleration named; ``τ_r`` the
+    input τ, or ``efforts`` (expressions, in the model's own coordinates) when given."""
     b, T, n = derivation.builder, derivation.coupling, _nv(derivation)
     M = derivation.output("M")
     if armature is not None:
@@ -273,7 +274,8 @@ def _solved_dynamics(derivation, armature=None, friction=None, hint: str = "s"):
                                     derivation.model.gravity, b, hint=f"h_{hint}")
     if friction is not None:
         bias = bias + friction
-    rhs = [t - e for t, e in zip(derivation.tau, _efforts(derivation, bias))]
+    tau = derivation.tau if efforts is None else efforts
+    rhs = [t - e for t, e in zip(tau, _efforts(derivation, bias))]
     qdd = [b.define(sp.Add(*[Minv[i, k] * rhs[k] for k in range(n)]), f"qdd_{hint}{i + 1}")
            for i in range(n)]
     return Minv, sp.Matrix(qdd)
@@ -382,6 +384,30 @@ def drive_forward_dynamics_jacobians(derivation) -> tuple[sp.Matrix, sp.Matrix, 
     return work["dqdd_a"]
 
 
+def applied_forward_dynamics_jacobians(derivation, forces, armature, hint: str):
+    """``(M_a⁻¹, q̈, ∂q̈/∂q, ∂q̈/∂q̇)`` of the forward dynamics under joint forces given as
+    expressions ``forces`` = f(q, q̇) (NV entries in the derivation's joints, e.g. the
+    actuators' and the springs' of :mod:`eomgen.symbolic.controls`) instead of the input τ::
+
+        q̈ = M_a⁻¹ Tᵀ (f(q, q̇) − τ(q, q̇, 0)),     M_a = Tᵀ (M + diag(armature)) T
+        ∂q̈/∂x = −M_a⁻¹ Tᵀ (∂τ/∂x − ∂f/∂x)          (x = q along the tangent, or q̇)
+
+    with the Newton–Euler ∂τ taken at that q̈ held fixed (the implicit function theorem on
+    τ(q, q̇, q̈) + a q̈ = f(q, q̇), as :func:`drive_forward_dynamics_jacobians`) and ∂f by
+    :func:`forward_mode` through the builder's intermediates. Each n × n (n = NV, the
+    independent NV with couplings; T the identity without), the intermediates' names
+    starting with ``hint``."""
+    b, n = derivation.builder, _nv(derivation)
+    f = _efforts(derivation, forces)
+    Minv, qdd = _solved_dynamics(derivation, armature, None, hint, efforts=f)
+    dq, dqd = _efforts_at(derivation, qdd, f"tau_{hint}")
+    rows = forward_mode(b, f, _tangent_seeds(derivation))
+    dq = dq - _jacobian(rows, "q", n)
+    dqd = dqd - _jacobian(rows, "qd", n)
+    return (Minv, qdd, _product(b, Minv, dq, f"dqdd_{hint}_dq"),
+            _product(b, Minv, dqd, f"dqdd_{hint}_dqd"))
+
+
 def linearization(derivation) -> tuple[sp.Matrix, sp.Matrix]:
     """A (2n × 2n) and B (2n × n) of ẋ = f(x, τ), x = (q, q̇), n = NV: with quaternion
     joints x = (δ, v) in the chart δ ↦ q ⊕ δ at δ = 0, whose position rows are
@@ -421,7 +447,7 @@ def build_derivatives(derivation, wanted) -> dict:
     return result
 
 
-__all__ = ["build_derivatives", "drive_forward_dynamics_jacobians",
+__all__ = ["applied_forward_dynamics_jacobians", "build_derivatives", "drive_forward_dynamics_jacobians",
            "drive_inverse_dynamics_jacobians", "forward_dynamics_jacobians", "forward_mode",
            "gravity_jacobian", "inverse_dynamics_jacobians", "inverse_mass_matrix",
            "linearization", "symmetric_inverse"]

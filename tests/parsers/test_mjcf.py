@@ -229,19 +229,20 @@ def test_equalities_are_warned_by_name_and_dropped(tmp_path, case):
 
 def test_tendons_and_other_actuators_are_warned_by_name(tmp_path):
     path = tmp_path / "t.xml"
-    path.write_text(WORLD.format(extra_bodies="", extra=(
+    path.write_text(WORLD.format(extra_bodies="<site name='ws'/>", extra=(
         "<tendon><fixed name='pull'><joint joint='j1' coef='1'/><joint joint='j2' coef='-1'/>"
         "</fixed></tendon><actuator><motor name='m1' joint='j1' gear='3'/>"
         "<motor name='on_tendon' tendon='pull'/><velocity name='damped' joint='j3' kv='2'/>"
-        "<motor name='on_tendon2' tendon='pull'/></actuator>")), encoding="utf-8")
+        "<motor name='on_site' site='ws'/><motor name='on_site2' site='ws'/></actuator>")),
+        encoding="utf-8")
     with pytest.warns(UnsupportedFeatureWarning) as caught:
         model = eomgen.load(path)
     messages = " | ".join(str(w.message) for w in caught)
-    assert len(caught) == 1, messages  # the fixed tendon pulls only through its actuators
-    for part in ("2 actuators 'on_tendon', 'on_tendon2': actuators on a tendon are not "
-                 "modelled",):
+    assert len(caught) == 1, messages  # the fixed tendon pulls only through its actuator
+    for part in ("2 actuators 'on_site', 'on_site2': actuators on a site are not modelled",):
         assert part in messages
-    assert [c.name for c in model.controls] == ["m1", "damped"]  # the velocity servo is read
+    # the velocity servo and the fixed tendon's motor are read; only m1 is a joint's motor
+    assert [c.name for c in model.controls] == ["m1", "on_tendon", "damped"]
     assert dict(model.info)["mujoco_motors"] == (("m1", "j1", 3.0),)
 
 

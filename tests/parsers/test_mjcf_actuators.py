@@ -5,7 +5,7 @@ actuator_forces against MuJoCo's qfrc_actuator and forward_dynamics_ctrl against
 (mj_forward, contacts disabled, no joint limits: no constraint forces); their derivative in ctrl
 against central differences of forward_dynamics_ctrl. The models: tests/data/mjcf/actuated.xml
 (a motor, position and velocity servos, general affine gain and bias, ctrl and force ranges,
-damping and armature; a filter actuator left out) and gymnasium's hopper and ant (motors with
+damping and armature; one with user-defined activation dynamics left out) and gymnasium's hopper and ant (motors with
 gear and ctrlrange; the ant flies: its qvel and forces mapped by eomgen.parsers.mjcf.convert).
 """
 
@@ -55,12 +55,12 @@ def arm(tmp_path_factory):
 
 def test_the_actuators_read_are_mujocos(arm):
     model, m, _, module = arm
-    assert module["ACTUATOR_NAMES"] == ("m1", "p2", "v3", "g1", "m3")  # 'filt' is left out
+    assert module["ACTUATOR_NAMES"] == ("m1", "p2", "v3", "g1", "m3")  # 'own' is left out
     servo = {c.name: c for c in model.controls}["p2"]
     assert (servo.joint, float(servo.gear), [float(x) for x in servo.bias]) == \
         ("j2", 1.5, [0, -30, -2])
-    with pytest.warns(UnsupportedFeatureWarning, match="actuator 'filt': an actuator with "
-                      "filter dynamics"):
+    with pytest.warns(UnsupportedFeatureWarning, match="actuator 'own': an actuator with "
+                      "its own dynamics"):
         eomgen.load(DATA / "actuated.xml")
 
 
@@ -72,7 +72,7 @@ def test_forces_and_accelerations_are_mujocos(arm):
         q, qd = rng.uniform(-1.5, 1.5, 3), rng.uniform(-3, 3, 3)
         ctrl = rng.uniform(-2, 2, m.nu)  # beyond ctrlrange and forcerange at times
         force, acc = mujoco_at(m, q, qd, ctrl)
-        u = ctrl[:5]  # MuJoCo's 'filt' has no activation yet: no force
+        u = ctrl[:5]  # MuJoCo's 'own' has no activation (act = 0): no force
         ours = call("actuator_forces", q, qd, u)
         worst_force = max(worst_force, np.abs(ours - force).max() / np.abs(force).max())
         ours = call("forward_dynamics_ctrl", q, qd, u)
@@ -180,3 +180,81 @@ def test_springs_and_tendons_are_in_the_forward_dynamics_of_the_controls(tmp_pat
         mujoco.mj_forward(m, d)
         assert np.abs(call("passive_forces", q, qd) - d.qfrc_passive).max() \
             <= 1e-10 * np.abs(d.qfrc_passive).max()
+
+
+#: Actuators on two fixed tendons (a position servo with a forcerange, a motor with a
+#: ctrlrange; the second tendon has a spring too), a joint actuator beside them, and an
+#: actuator on a spatial tendon, which stays warned about and left out.
+TENDONS = """<mujoco model="tendons"><worldbody>
+  <body name="a"><joint name="j1" axis="0 0 1" damping="0.2"/>
+    <geom type="capsule" size="0.04" fromto="0 0 0 0.4 0 0" mass="1.2"/><site name="s1"/>
+    <body name="b" pos="0.4 0 0"><joint name="j2" axis="0 1 0" armature="0.02"/>
+      <geom type="capsule" size="0.03" fromto="0 0 0 0.3 0 0.1" mass="0.7"/>
+      <body name="c" pos="0.3 0 0.1"><joint name="j3" type="slide" axis="1 0 0"/>
+        <geom type="box" size="0.03 0.03 0.03" mass="0.3"/><site name="s2"/></body>
+    </body></body></worldbody>
+  <tendon><fixed name="t"><joint joint="j1" coef="1"/><joint joint="j2" coef="-0.5"/></fixed>
+    <fixed name="u" stiffness="4" springlength="0.1"><joint joint="j2" coef="0.7"/>
+      <joint joint="j3" coef="2"/></fixed>
+    <spatial name="rope"><site site="s1"/><site site="s2"/></spatial></tendon>
+  <actuator><position name="pt" tendon="t" kp="20" kv="1" gear="1.5" forcerange="-4 4"/>
+    <motor name="mu" tendon="u" gear="2" ctrlrange="-1 1"/>
+    <general name="gj" joint="j3" gainprm="2 0.5 0.3" gaintype="affine" biastype="affine"
+      biasprm="0.1 -1 -0.2"/>
+    <motor name="spatial" tendon="rope"/></actuator>
+</mujoco>"""
+
+
+@pytest.fixture(scope="module")
+def tendons(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("tendons")
+    path = folder / "tendons.xml"
+    path.write_text(TENDONS, encoding="utf-8")
+    with pytest.warns(UnsupportedFeatureWarning) as caught:
+        model = eomgen.load(path)
+    calls, _ = generated(model, ["actuator_forces", "forward_dynamics_ctrl"], folder,
+                         ("numpy",))
+    return model, mujoco.MjModel.from_xml_path(str(path)), calls["numpy"], \
+        [str(w.message) for w in caught]
+
+
+def test_actuators_on_fixed_tendons_are_read_and_the_spatial_one_is_warned(tendons):
+    model, _, _, warned = tendons
+    assert [(c.name, c.joint, c.tendon) for c in model.controls] == [
+        ("pt", None, "t"), ("mu", None, "u"), ("gj", "j3", None)]
+    assert [(n, float(c)) for n, c in model.controls[1].transmission] == [("j2", 0.7),
+                                                                         ("j3", 2.0)]
+    actuators = [w for w in warned if ": actuator" in w or "actuators" in w.split(":")[1]]
+    assert len(actuators) == 1 and "actuator 'spatial': an actuator on a spatial tendon" \
+        in actuators[0], warned
+
+
+def test_tendon_actuators_give_mujocos_forces_and_accelerations(tendons):
+    model, m, call, _ = tendons
+    rng = np.random.default_rng(13)
+    worst_force = worst_acc = 0.0
+    for _ in range(8):
+        q, qd = rng.uniform(-1, 1, 3), rng.uniform(-2, 2, 3)
+        ctrl = rng.uniform(-2, 2, m.nu)  # beyond ctrlrange and forcerange at times
+        ctrl[3] = 0.0  # the spatial tendon's motor, left out
+        force, acc = mujoco_at(m, q, qd, ctrl)
+        worst_force = max(worst_force, np.abs(call("actuator_forces", q, qd, ctrl[:3]) - force)
+                          .max() / np.abs(force).max())
+        worst_acc = max(worst_acc, np.abs(call("forward_dynamics_ctrl", q, qd, ctrl[:3]) - acc)
+                        .max() / np.abs(acc).max())
+    assert worst_force < 1e-12 and worst_acc < 1e-11, (worst_force, worst_acc)
+
+
+def test_a_locked_joint_of_a_tendon_stays_in_its_length(tendons):
+    """A scene holding j1 at 0.3: the tendon servo's length keeps j1's share (its position
+    bias), so the forces on j2 and j3 are the whole model's at q1 = 0.3."""
+    from eomgen.model.robot import lock_joints
+
+    model, _, call, _ = tendons
+    held = lock_joints(model, {"j1": 0.3})
+    assert [float(c) for c in (held.controls[0].offset,)] == [0.3]
+    module = eomgen.derive(held, outputs=("tau_act",)).lambdify().module
+    q, qd, u = np.array([-0.4, 0.2]), np.array([0.7, -1.1]), np.array([0.5, 0.3, -0.2])
+    whole = call("actuator_forces", np.r_[0.3, q], np.r_[0.0, qd], u)
+    assert np.allclose(np.ravel(module.actuator_forces(q, qd, u)), whole[1:], rtol=1e-14,
+                       atol=1e-14)

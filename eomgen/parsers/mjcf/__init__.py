@@ -43,9 +43,12 @@ What is read
   rest lengths ``springlength``, a dead band since MuJoCo 3). With the joints' damping they
   are the output ``tau_p`` (MuJoCo's ``qfrc_passive``, :mod:`eomgen.symbolic.passive`).
 * ``<option gravity>`` (zero when the ``gravity`` flag is disabled).
-* Actuators with a joint transmission on hinge and slide joints and no activation dynamics
-  (``<motor>``, ``<position>`` and ``<velocity>`` without ``timeconst``, ``<general>`` with a
-  fixed or affine gain and bias): the model's :attr:`~eomgen.model.RobotModel.controls`
+* Actuators with a joint transmission on hinge and slide joints or a transmission on a fixed
+  tendon (the moment ``gear`` times the tendon's coefficients), with no activation dynamics
+  or an integrator or filter one (``dyntype``, :attr:`~eomgen.model.Control.dynamics`: the
+  state ``act`` of ``forward_dynamics_act``), a fixed or affine gain and bias (``<motor>``,
+  ``<position>``, ``<velocity>``, ``<intvelocity>``, ``<general>`` of those kinds): the
+  model's :attr:`~eomgen.model.RobotModel.controls`
   (:class:`~eomgen.model.Control`), entries of the input ``ctrl`` in MuJoCo's actuator order
   (``ACTUATOR_NAMES``), with MuJoCo's ``gear`` (first component), ``gainprm``, ``biasprm``,
   ``ctrlrange`` (when ``ctrllimited``) and ``forcerange`` (when ``forcelimited``); the
@@ -74,9 +77,9 @@ a name that is taken gets ``_2``, ``_3``, … appended.
 Warned about (:class:`~eomgen.errors.UnsupportedFeatureWarning`, refused under ``strict``),
 by name: ball joints' springs, spatial tendons (and a fixed tendon's armature and
 frictionloss), the actuators not read (one line per kind, with their count and first names:
-activation dynamics ``dyntype`` filter, integrator, DC motor; tendon, site, slider-crank or
-body transmissions; muscles; free and ball joints; user-defined gains), equalities that are
-inactive (``active="false"``),
+activation dynamics ``dyntype`` DC motor, PID, user, or ``actearly``; spatial tendon, site,
+slider-crank or body transmissions; muscles; free and ball joints; user-defined gains),
+equalities that are inactive (``active="false"``),
 ``tendon`` and flex equalities, an equality joining a dropped free body, fluid forces
 (``density``, ``viscosity``), gravity compensation (``gravcomp``). Refused
 (:class:`~eomgen.errors.UnsupportedError`), by name: ``joint`` equalities of order above
@@ -240,7 +243,8 @@ def model_from_mujoco(m, source: str = "<mujoco>", strict: bool = False,
     notices = tuple(n for n in model_notices(m, source)
                     if not n.joints or any(j in present for j in n.joints))
     model = replace(model, notices=tuple(model.notices) + notices,
-                    controls=tuple(c for c in controls(m) if c.joint in present),
+                    controls=tuple(c for c in controls(m)
+                                   if all(n in present for n, _ in c.transmission)),
                     info=model.info + (("mujoco_motors", tuple(
                         motor for motor in motors(m) if motor[1] in present)),))
     if not defer_notices:

@@ -41,9 +41,12 @@ from .tree import BALL, FREE, HINGE, SLIDE, body_names, disabled, joint_names, r
 
 #: MuJoCo's transmission, dynamics, gain and bias types of a plain motor (``mjTRN_JOINT``,
 #: ``mjDYN_NONE``, ``mjGAIN_FIXED``, ``mjBIAS_NONE``) and of ``mjTRN_JOINTINPARENT``.
-_TRN_JOINT, _TRN_JOINT_IN_PARENT = 0, 1
+_TRN_JOINT, _TRN_JOINT_IN_PARENT, _TRN_TENDON = 0, 1, 3
 _TRN_NAMES = {2: "slider-crank", 3: "tendon", 4: "site", 5: "body"}
-_DYN_NAMES = {1: "integrator", 2: "filter", 3: "filter", 4: "muscle", 5: "DC motor", 6: "PID"}
+_DYN_NAMES = {1: "integrator", 2: "filter", 3: "filterexact", 4: "muscle", 5: "DC motor",
+              6: "PID"}
+#: The activation dynamics eomgen reads (:attr:`eomgen.model.Control.dynamics`).
+_DYN_READ = {1: "integrator", 2: "filter", 3: "filterexact"}
 _GAIN_FIXED, _GAIN_AFFINE, _GAIN_MUSCLE = 0, 1, 2
 _BIAS_NONE, _BIAS_AFFINE = 0, 1
 #: MuJoCo's equality types (``mjtEq``) and wrap type of a joint in a fixed tendon.
@@ -74,22 +77,40 @@ def motors(m) -> tuple[tuple[str, str, float], ...]:
 
 
 def is_motor(m, i: int) -> bool:
-    """Whether actuator ``i`` is a plain motor (fixed gain, no bias) eomgen reads."""
-    return (is_control(m, i) and int(m.actuator_gaintype[i]) == _GAIN_FIXED
+    """Whether actuator ``i`` is a plain motor (fixed gain, no bias) on a joint eomgen reads."""
+    return (is_control(m, i) and int(m.actuator_trntype[i]) != _TRN_TENDON
+            and int(m.actuator_dyntype[i]) == 0
+            and int(m.actuator_gaintype[i]) == _GAIN_FIXED
             and int(m.actuator_biastype[i]) == _BIAS_NONE)
 
 
 def is_control(m, i: int) -> bool:
     """Whether actuator ``i`` is one eomgen reads as a :class:`~eomgen.model.Control`: a joint
-    transmission on a hinge or slide joint, no activation dynamics, a fixed or affine gain and
-    no or an affine bias (``<motor>``, ``<position>`` and ``<velocity>`` without a time
-    constant, ``<general>`` of those types)."""
-    if int(m.actuator_trntype[i]) not in (_TRN_JOINT, _TRN_JOINT_IN_PARENT):
+    transmission on a hinge or slide joint or a transmission on a fixed tendon, no activation
+    dynamics, a fixed or affine gain and no or an affine bias (``<motor>``, ``<position>`` and
+    ``<velocity>`` without a time constant, ``<general>`` of those types)."""
+    trn = int(m.actuator_trntype[i])
+    if trn in (_TRN_JOINT, _TRN_JOINT_IN_PARENT):
+        if int(m.jnt_type[int(m.actuator_trnid[i, 0])]) not in (HINGE, SLIDE):
+            return False
+    elif trn != _TRN_TENDON or not is_fixed(m, int(m.actuator_trnid[i, 0])):
         return False
-    joint = int(m.actuator_trnid[i, 0])
-    return (int(m.jnt_type[joint]) in (HINGE, SLIDE) and int(m.actuator_dyntype[i]) == 0
+    return (_dynamics_read(m, i)
             and int(m.actuator_gaintype[i]) in (_GAIN_FIXED, _GAIN_AFFINE)
             and int(m.actuator_biastype[i]) in (_BIAS_NONE, _BIAS_AFFINE))
+
+
+def _early(m, i: int) -> bool:
+    """Whether actuator ``i`` has ``actearly`` (its force uses the next step's activation)."""
+    return bool(getattr(m, "actuator_actearly", np.zeros(m.nu))[i])
+
+
+def _dynamics_read(m, i: int) -> bool:
+    """Whether eomgen reads actuator ``i``'s activation dynamics: none, or an integrator or a
+    filter of one activation whose force uses the activation itself (no ``actearly``)."""
+    dyntype = int(m.actuator_dyntype[i])
+    return dyntype == 0 or (dyntype in _DYN_READ and int(m.actuator_actnum[i]) == 1
+                            and not _early(m, i))
 
 
 def controls(m) -> tuple[Control, ...]:
@@ -97,7 +118,8 @@ def controls(m) -> tuple[Control, ...]:
     MuJoCo's actuator order: ``gear`` its first component, the gain and bias the first three
     of ``gainprm``/``biasprm`` (a fixed gain keeps only the first, no bias is zero), the
     control clamped to ``ctrlrange`` when ``ctrllimited`` (and clamping is not disabled), the
-    force to ``forcerange`` when ``forcelimited``."""
+    force to ``forcerange`` when ``forcelimited``; on a fixed tendon, the tendon's name and
+    coefficients (``wrap_prm``: MuJoCo's moment is ``gear`` times them)."""
     jnames = joint_names(m)
     clamp_ctrl = not disabled(m, "CLAMPCTRL")
     out = []
@@ -110,21 +132,36 @@ def controls(m) -> tuple[Control, ...]:
         ctrl = (m.actuator_ctrlrange[i].tolist()
                 if clamp_ctrl and bool(m.actuator_ctrllimited[i]) else None)
         force = m.actuator_forcerange[i].tolist() if bool(m.actuator_forcelimited[i]) else None
-        out.append(make_control(_name(m, "actuator", i), jnames[int(m.actuator_trnid[i, 0])],
-                                float(m.actuator_gear[i, 0]), gain, bias, ctrl, force))
+        target = int(m.actuator_trnid[i, 0])
+        if int(m.actuator_trntype[i]) == _TRN_TENDON:
+            where = {"joint": None, "tendon": _name(m, "tendon", target), "coefficients": tuple(
+                (jnames[j], c) for j, c in _tendon_joints(m, target))}
+        else:
+            where = {"joint": jnames[target]}
+        dyntype = int(m.actuator_dyntype[i])
+        out.append(make_control(_name(m, "actuator", i), gear=float(m.actuator_gear[i, 0]),
+                                gain=gain, bias=bias, ctrlrange=ctrl, forcerange=force,
+                                dynamics=_DYN_READ.get(dyntype),
+                                timeconst=float(m.actuator_dynprm[i, 0]) if dyntype > 1 else 1,
+                                **where))
     return tuple(out)
 
 
 def _actuator_kind(m, i: int) -> tuple[str, str]:
     """What actuator ``i`` (one :func:`is_control` does not read) is: ``(one, several)``."""
     trn = int(m.actuator_trntype[i])
-    if trn in _TRN_NAMES:
+    if trn == _TRN_TENDON and not is_fixed(m, int(m.actuator_trnid[i, 0])):
+        return "an actuator on a spatial tendon is", "actuators on spatial tendons are"
+    if trn in _TRN_NAMES and trn != _TRN_TENDON:
         kind = f"on a {_TRN_NAMES[trn]}"
         return f"an actuator {kind} is", f"actuators {kind} are"
     if int(m.actuator_gaintype[i]) == _GAIN_MUSCLE or int(m.actuator_dyntype[i]) == 4:
         return "a muscle is", "muscles are"
-    if int(m.jnt_type[int(m.actuator_trnid[i, 0])]) not in (HINGE, SLIDE):
+    if trn != _TRN_TENDON and int(m.jnt_type[int(m.actuator_trnid[i, 0])]) not in (HINGE, SLIDE):
         return "an actuator on a free or ball joint is", "actuators on free or ball joints are"
+    if int(m.actuator_dyntype[i]) in _DYN_READ and _early(m, i):
+        return ("an actuator with actearly (its force at the next step's activation) is",
+                "actuators with actearly (their force at the next step's activation) are")
     if int(m.actuator_dyntype[i]):
         dynamics = _DYN_NAMES.get(int(m.actuator_dyntype[i]), "its own")
         return (f"an actuator with {dynamics} dynamics (activation) is",
