@@ -16,7 +16,13 @@
 #define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
 #include <numpy/arrayobject.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
+#if defined(__unix__) || defined(__APPLE__)
+#include <pthread.h>
+#include <sched.h>
+#include <unistd.h>
+#endif
 
 /* eomgen: the generated module holds the text below this line. */
 typedef void (*kernel_t)(const double *const *, const double *, double *);
@@ -42,6 +48,7 @@ typedef struct {
     kernel_t kernel;
     int sizes[MAX_IN];  /* length of each input (0: NV) */
     lanes_kernel_t lanes;  /* NULL: the batch goes state by state */
+    long operations;  /* arithmetic operations per state (0: unknown, a batch stays on one thread) */
 } function_t;
 
 static PyObject *ill_conditioned_warning = NULL;  /* IllConditionedWarning */
@@ -104,6 +111,181 @@ static npy_intp in_lanes(const function_t *f, const double *const *in, const dou
     free(work);
     return k;
 }
+
+/* The states [begin, end) of a batch: EOM_LANES at a time through f's lanes kernel where it has
+ * one (in_lanes), the rest one by one through its one-state kernel. */
+static void in_range(const function_t *f, const double *const *in, const double *p,
+                     double *out, npy_intp begin, npy_intp end)
+{
+    const npy_intp size = (npy_intp)f->rows * (f->cols ? f->cols : 1);
+    const double *at[MAX_IN] = {NULL};
+    npy_intp k = begin;
+    int j;
+    if (f->lanes != NULL && EOM_LANES > 1) {
+        for (j = 0; j < f->n_in; ++j)
+            at[j] = in[j] + begin * (f->sizes[j] ? f->sizes[j] : NV);
+        k += in_lanes(f, at, p, out + begin * size, end - begin);
+    }
+    for (; k < end; ++k) {
+        for (j = 0; j < f->n_in; ++j)
+            at[j] = in[j] + k * (f->sizes[j] ? f->sizes[j] : NV);
+        f->kernel(at, p, out + k * size);
+    }
+}
+
+/* Threads of a batch (docs/backends.md, "Batches on several cores"). A batch is cut into as
+ * many contiguous parts as threads, each a whole number of EOM_LANES blocks but the last (which
+ * also takes the remainder): state k goes through the same kernel (lanes or one-state) whatever
+ * the thread count, so that results are bitwise the same. A batch stays on one thread below
+ * EOM_WORK_PER_THREAD arithmetic operations per thread (starting and joining a thread costs
+ * tens of microseconds; benchmarks/batch_speed.py measured where a second one pays). The
+ * count: set_threads(n), else $EOMGEN_THREADS read at import, else the CPUs this process may
+ * run on. Without POSIX threads every batch runs on the calling thread. */
+#define EOM_WORK_PER_THREAD 400000L
+#define EOM_MAX_THREADS 256
+static int eom_threads = 0;  /* 0: the default, eom_default_threads() */
+static int eom_threads_at_import = 0;  /* $EOMGEN_THREADS (0: not set) */
+
+static int eom_default_threads(void)
+{
+#if defined(__linux__) && defined(CPU_COUNT)
+    cpu_set_t set;
+    if (sched_getaffinity(0, sizeof(set), &set) == 0 && CPU_COUNT(&set) > 0)
+        return CPU_COUNT(&set) < EOM_MAX_THREADS ? CPU_COUNT(&set) : EOM_MAX_THREADS;
+#endif
+#if defined(__unix__) || defined(__APPLE__)
+    {
+        long online = sysconf(_SC_NPROCESSORS_ONLN);
+        if (online > 0)
+            return online < EOM_MAX_THREADS ? (int)online : EOM_MAX_THREADS;
+    }
+#endif
+    return 1;
+}
+
+/* The threads a batch of `states` of f runs on (the GIL held: reads the setting). */
+static int batch_threads(const function_t *f, npy_intp states)
+{
+    const int wanted = eom_threads > 0 ? eom_threads : eom_default_threads();
+    const double work = (double)states * (double)f->operations;
+    const npy_intp blocks = states / EOM_LANES;
+    npy_intp most = (npy_intp)(work / (double)EOM_WORK_PER_THREAD);
+    if (most > blocks)
+        most = blocks;
+    return most < 2 ? 1 : (npy_intp)wanted < most ? wanted : (int)most;
+}
+
+typedef struct {
+    const function_t *f;
+    const double *const *in;
+    const double *p;
+    double *out;
+    npy_intp begin, end;
+} part_t;
+
+#if defined(__unix__) || defined(__APPLE__)
+static void *run_part(void *argument)
+{
+    const part_t *part = (const part_t *)argument;
+    in_range(part->f, part->in, part->p, part->out, part->begin, part->end);
+    return NULL;
+}
+#endif
+
+/* The batch on `threads` threads (the calling one and threads - 1 started here); a thread that
+ * cannot be started leaves its part to the calling thread, which computes it the same way. */
+static void in_parts(const function_t *f, const double *const *in, const double *p,
+                     double *out, npy_intp states, int threads)
+{
+#if defined(__unix__) || defined(__APPLE__)
+    part_t parts[EOM_MAX_THREADS];
+    pthread_t ids[EOM_MAX_THREADS];
+    int started[EOM_MAX_THREADS] = {0};
+    const npy_intp blocks = states / EOM_LANES;
+    int t;
+    if (threads > 1) {
+        for (t = 0; t < threads; ++t) {
+            parts[t].f = f;
+            parts[t].in = in;
+            parts[t].p = p;
+            parts[t].out = out;
+            parts[t].begin = blocks * t / threads * EOM_LANES;
+            parts[t].end = t + 1 < threads ? blocks * (t + 1) / threads * EOM_LANES : states;
+        }
+        for (t = 1; t < threads; ++t)
+            started[t] = pthread_create(&ids[t], NULL, run_part, &parts[t]) == 0;
+        run_part(&parts[0]);
+        for (t = 1; t < threads; ++t) {
+            if (started[t])
+                pthread_join(ids[t], NULL);
+            else
+                run_part(&parts[t]);
+        }
+        return;
+    }
+#else
+    (void)threads;
+#endif
+    in_range(f, in, p, out, 0, states);
+}
+
+/* Module functions set_threads(n) and threads(). */
+static PyObject *set_threads(PyObject *self, PyObject *value)
+{
+    long n;
+    (void)self;
+    if (value == Py_None) {
+        eom_threads = eom_threads_at_import;
+        Py_RETURN_NONE;
+    }
+    n = PyLong_Check(value) ? PyLong_AsLong(value) : -1;
+    if (n == -1 && PyErr_Occurred())
+        PyErr_Clear();
+    if (!PyLong_Check(value) || PyBool_Check(value) || n < 1 || n > EOM_MAX_THREADS) {
+        PyErr_Format(PyLong_Check(value) && !PyBool_Check(value) ? PyExc_ValueError
+                                                                 : PyExc_TypeError,
+                     "set_threads(): n must be an integer from 1 to %d or None (the CPUs this "
+                     "process may use), got %R", EOM_MAX_THREADS, value);
+        return NULL;
+    }
+    eom_threads = (int)n;
+    Py_RETURN_NONE;
+}
+
+static PyObject *threads(PyObject *self, PyObject *unused)
+{
+    (void)self;
+    (void)unused;
+    return PyLong_FromLong(eom_threads > 0 ? eom_threads : eom_default_threads());
+}
+
+/* At import: $EOMGEN_THREADS, when set, is the thread count; -1 with a ValueError when it is
+ * not an integer from 1 to EOM_MAX_THREADS. */
+static int read_threads_variable(void)
+{
+    const char *text = getenv("EOMGEN_THREADS");
+    char *end = NULL;
+    long n;
+    if (text == NULL || *text == '\0')
+        return 0;
+    n = strtol(text, &end, 10);
+    if (*end != '\0' || n < 1 || n > EOM_MAX_THREADS) {
+        PyErr_Format(PyExc_ValueError, "EOMGEN_THREADS must be an integer from 1 to %d, got "
+                     "'%s'", EOM_MAX_THREADS, text);
+        return -1;
+    }
+    eom_threads = eom_threads_at_import = (int)n;
+    return 0;
+}
+
+#define THREAD_METHODS \
+    {"set_threads", (PyCFunction)set_threads, METH_O, \
+     "set_threads(n)\n--\n\nRun this module's batches on n threads (n from 1 to 256; None: the " \
+     "CPUs this process may use, or $EOMGEN_THREADS when set at import). Batches of little " \
+     "work stay on one thread; results are bitwise the same for every n."}, \
+    {"threads", (PyCFunction)threads, METH_NOARGS, \
+     "threads()\n--\n\nThe number of threads this module's batches may run on."}
+
 /* The keywords a composed function takes besides its inputs and parameters (parse()). */
 #define TAKES_RETURN_CONDITION 1
 #define TAKES_DAMPING 2
@@ -340,8 +522,7 @@ static PyObject *evaluate(const function_t *f, PyObject *const *args, Py_ssize_t
     call_t call;
     npy_intp dims[3];
     int nd = 0, j;
-    npy_intp k, size = (npy_intp)f->rows * (f->cols ? f->cols : 1);
-    const double *in[MAX_IN] = {NULL}, *at[MAX_IN] = {NULL};
+    const double *in[MAX_IN] = {NULL};
     double *out;
     PyArrayObject *result;
     if (parse(f, args, nargs, kwnames, &call, 0) < 0)
@@ -362,13 +543,9 @@ static PyObject *evaluate(const function_t *f, PyObject *const *args, Py_ssize_t
     if (call.states == 1) {
         f->kernel(in, call.p, out);
     } else {
+        const int threads = batch_threads(f, call.states);
         Py_BEGIN_ALLOW_THREADS
-        k = f->lanes != NULL && EOM_LANES > 1 ? in_lanes(f, in, call.p, out, call.states) : 0;
-        for (; k < call.states; ++k) {
-            for (j = 0; j < f->n_in; ++j)
-                at[j] = in[j] + k * (f->sizes[j] ? f->sizes[j] : NV);
-            f->kernel(at, call.p, out + k * size);
-        }
+        in_parts(f, in, call.p, out, call.states, threads);
         Py_END_ALLOW_THREADS
     }
     release(&call);
