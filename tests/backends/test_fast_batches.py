@@ -45,7 +45,8 @@ def arm(tmp_path_factory):
     model = eomgen.load(eomgen.example_path("planar_2link"))
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(fast_backend, "LANES_OPERATIONS", 0)
-        files = render_files(model, ["fast"], functions=select_functions(FUNCTIONS))
+        files = render_files(model, ["fast"],
+                             functions=select_functions([*FUNCTIONS, "forward_dynamics"]))
     folder = tmp_path_factory.mktemp("fast_batches")
     for f in files:
         path = folder / f.name
@@ -143,6 +144,33 @@ def test_errors_are_the_same_on_any_thread_count(arm):
     module.set_threads(None)
     assert messages[0] == messages[1] == (
         f"inverse_dynamics: qd is not finite at state {BIG // 2 + 1}: entry 0 is -inf")
+
+
+def test_forward_dynamics_on_threads_solves_and_fails_as_on_one(arm):
+    """The composed forward dynamics (Cholesky per state) on 1 and 2 threads: the same bits
+    and condition estimates; a batch with states whose C qd overflows names the first of them,
+    whichever part (thread) it falls in."""
+    module, _, _ = arm
+    rng = np.random.default_rng(5)
+    q, qd, tau = _inputs("forward_dynamics", rng, BIG)
+    results = []
+    for threads in (1, 2):
+        module.set_threads(threads)
+        qdd, condition = module.forward_dynamics(q, qd, tau, return_condition=True)
+        results.append(qdd.tobytes() + condition.tobytes())
+    assert results[0] == results[1]
+    for bad in ((40_000, 90_000), (60_000, 90_000), (BIG - 1,)):
+        fast = qd.copy()
+        fast[list(bad), 0] = 1e200  # C qd overflows to inf
+        messages = []
+        for threads in (1, 2):
+            module.set_threads(threads)
+            with pytest.raises(FloatingPointError) as error:
+                module.forward_dynamics(q, fast, tau)
+            messages.append(str(error.value))
+        assert messages[0] == messages[1], messages
+        assert f"at state {bad[0]} " in messages[0], messages
+    module.set_threads(None)
 
 
 def test_set_threads_and_threads(arm):

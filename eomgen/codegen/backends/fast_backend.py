@@ -309,6 +309,7 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
         forward_doc=forward_doc,
         forward_dynamics=FORWARD.function in job.functions,
         fd=composition_names(FORWARD),
+        fd_operations=_forward_operations(functions, n),
         constrained_forward_dynamics=constrained,
         cfd=cfd,
         nc=nc,
@@ -325,6 +326,14 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
         **task,
         **extra,
     )
+
+
+def _forward_operations(functions: list[dict], n: int) -> int:
+    """Operations per state of the composed forward dynamics (M, its bias, a Cholesky solve of
+    about n³/3 + 2n²): what the batch's threads are counted by (runtime ``call.c``)."""
+    names = composition_names(FORWARD)
+    return (sum(f["operation_count"] for f in functions if f["name"] in
+                (names["mass"], names["bias"])) + n ** 3 // 3 + 2 * n * n)
 
 
 def render_source(job: Job, config, **extra) -> str:

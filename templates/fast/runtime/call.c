@@ -163,11 +163,12 @@ static int eom_default_threads(void)
     return 1;
 }
 
-/* The threads a batch of `states` of f runs on (the GIL held: reads the setting). */
-static int batch_threads(const function_t *f, npy_intp states)
+/* The threads a batch of `states` runs on, `operations` each (the GIL held: reads the
+ * setting); never more than the batch's blocks of EOM_LANES states. */
+static int batch_threads(long operations, npy_intp states)
 {
     const int wanted = eom_threads > 0 ? eom_threads : eom_default_threads();
-    const double work = (double)states * (double)f->operations;
+    const double work = (double)states * (double)operations;
     const npy_intp blocks = states / EOM_LANES;
     npy_intp most = (npy_intp)(work / (double)EOM_WORK_PER_THREAD);
     if (most > blocks)
@@ -175,58 +176,74 @@ static int batch_threads(const function_t *f, npy_intp states)
     return most < 2 ? 1 : (npy_intp)wanted < most ? wanted : (int)most;
 }
 
+/* The work of part `part` of a batch: its states [begin, end). */
+typedef void (*range_t)(void *job, int part, npy_intp begin, npy_intp end);
+
+typedef struct {
+    range_t run;
+    void *job;
+    int part;
+    npy_intp begin, end;
+} part_t;
+
+static void *run_part(void *argument)
+{
+    const part_t *part = (const part_t *)argument;
+    part->run(part->job, part->part, part->begin, part->end);
+    return NULL;
+}
+
+/* run(job, t, ...) on `threads` contiguous parts of the batch's states, part t from state
+ * blocks * t / threads * EOM_LANES (blocks: whole blocks of EOM_LANES states), the last taking
+ * the remainder; part 0 on the calling thread, the others on threads started here (one that
+ * cannot be started leaves its part to the calling thread, which computes it the same way). */
+static void in_parts(range_t run, void *job, npy_intp states, int threads)
+{
+    part_t parts[EOM_MAX_THREADS];
+    const npy_intp blocks = states / EOM_LANES;
+    int t;
+#if defined(__unix__) || defined(__APPLE__)
+    pthread_t ids[EOM_MAX_THREADS];
+    int started[EOM_MAX_THREADS] = {0};
+#endif
+    if (threads < 1)
+        threads = 1;
+    for (t = 0; t < threads; ++t) {
+        parts[t].run = run;
+        parts[t].job = job;
+        parts[t].part = t;
+        parts[t].begin = blocks * t / threads * EOM_LANES;
+        parts[t].end = t + 1 < threads ? blocks * (t + 1) / threads * EOM_LANES : states;
+    }
+#if defined(__unix__) || defined(__APPLE__)
+    for (t = 1; t < threads; ++t)
+        started[t] = pthread_create(&ids[t], NULL, run_part, &parts[t]) == 0;
+    run_part(&parts[0]);
+    for (t = 1; t < threads; ++t) {
+        if (started[t])
+            pthread_join(ids[t], NULL);
+        else
+            run_part(&parts[t]);
+    }
+#else
+    for (t = 0; t < threads; ++t)
+        run_part(&parts[t]);
+#endif
+}
+
+/* evaluate()'s batch: f on inputs `in`, parameters p, results `out`. */
 typedef struct {
     const function_t *f;
     const double *const *in;
     const double *p;
     double *out;
-    npy_intp begin, end;
-} part_t;
+} evaluation_t;
 
-#if defined(__unix__) || defined(__APPLE__)
-static void *run_part(void *argument)
+static void evaluate_range(void *job, int part, npy_intp begin, npy_intp end)
 {
-    const part_t *part = (const part_t *)argument;
-    in_range(part->f, part->in, part->p, part->out, part->begin, part->end);
-    return NULL;
-}
-#endif
-
-/* The batch on `threads` threads (the calling one and threads - 1 started here); a thread that
- * cannot be started leaves its part to the calling thread, which computes it the same way. */
-static void in_parts(const function_t *f, const double *const *in, const double *p,
-                     double *out, npy_intp states, int threads)
-{
-#if defined(__unix__) || defined(__APPLE__)
-    part_t parts[EOM_MAX_THREADS];
-    pthread_t ids[EOM_MAX_THREADS];
-    int started[EOM_MAX_THREADS] = {0};
-    const npy_intp blocks = states / EOM_LANES;
-    int t;
-    if (threads > 1) {
-        for (t = 0; t < threads; ++t) {
-            parts[t].f = f;
-            parts[t].in = in;
-            parts[t].p = p;
-            parts[t].out = out;
-            parts[t].begin = blocks * t / threads * EOM_LANES;
-            parts[t].end = t + 1 < threads ? blocks * (t + 1) / threads * EOM_LANES : states;
-        }
-        for (t = 1; t < threads; ++t)
-            started[t] = pthread_create(&ids[t], NULL, run_part, &parts[t]) == 0;
-        run_part(&parts[0]);
-        for (t = 1; t < threads; ++t) {
-            if (started[t])
-                pthread_join(ids[t], NULL);
-            else
-                run_part(&parts[t]);
-        }
-        return;
-    }
-#else
-    (void)threads;
-#endif
-    in_range(f, in, p, out, 0, states);
+    const evaluation_t *e = (const evaluation_t *)job;
+    (void)part;
+    in_range(e->f, e->in, e->p, e->out, begin, end);
 }
 
 /* Module functions set_threads(n) and threads(). */
@@ -543,9 +560,10 @@ static PyObject *evaluate(const function_t *f, PyObject *const *args, Py_ssize_t
     if (call.states == 1) {
         f->kernel(in, call.p, out);
     } else {
-        const int threads = batch_threads(f, call.states);
+        evaluation_t job = {f, in, call.p, out};
+        const int threads = batch_threads(f->operations, call.states);
         Py_BEGIN_ALLOW_THREADS
-        in_parts(f, in, call.p, out, call.states, threads);
+        in_parts(evaluate_range, &job, call.states, threads);
         Py_END_ALLOW_THREADS
     }
     release(&call);
