@@ -214,3 +214,21 @@ def test_the_environment_variable_is_read_at_import(arm, value, expected):
                             timeout=120, env={**os.environ, "EOMGEN_THREADS": value})
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == expected
+
+
+def test_a_forked_child_runs_batches_on_threads_too(arm):
+    """The module's worker threads do not survive fork(): a child process (multiprocessing's
+    fork start) gets a fresh pool, and its batches on 2 threads give the parent's bits."""
+    import multiprocessing
+
+    if "fork" not in multiprocessing.get_all_start_methods():
+        pytest.skip("no fork() on this platform")
+    module, _, _ = arm
+    rng = np.random.default_rng(6)
+    inputs = _inputs("inverse_dynamics", rng, BIG)
+    module.set_threads(2)
+    expected = module.inverse_dynamics(*inputs)  # the parent's pool is running
+    with multiprocessing.get_context("fork").Pool(1) as pool:
+        got = pool.apply(module.inverse_dynamics, inputs)
+    module.set_threads(None)
+    assert got.tobytes() == expected.tobytes()

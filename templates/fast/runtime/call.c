@@ -137,8 +137,9 @@ static void in_range(const function_t *f, const double *const *in, const double 
  * many contiguous parts as threads, each a whole number of EOM_LANES blocks but the last (which
  * also takes the remainder): state k goes through the same kernel (lanes or one-state) whatever
  * the thread count, so that results are bitwise the same. A batch stays on one thread below
- * EOM_WORK_PER_THREAD arithmetic operations per thread (starting and joining a thread costs
- * tens of microseconds; benchmarks/batch_speed.py measured where a second one pays). The
+ * EOM_WORK_PER_THREAD arithmetic operations per thread (waking a worker and handing it a part
+ * costs microseconds, more on a loaded machine; benchmarks/batch_speed.py times where a second
+ * thread pays). The
  * count: set_threads(n), else $EOMGEN_THREADS read at import, else the CPUs this process may
  * run on. Without POSIX threads every batch runs on the calling thread. */
 #define EOM_WORK_PER_THREAD 400000L
@@ -193,42 +194,133 @@ static void *run_part(void *argument)
     return NULL;
 }
 
+#if defined(__unix__) || defined(__APPLE__)
+/* The module's pool of worker threads, started when a batch first wants them and kept waiting
+ * on `wake` between batches. A batch publishes its parts (part 0 is the caller's), each FREE;
+ * a worker or the caller takes one by turning it TAKEN (atomically: each part is run once),
+ * and marks it DONE. The caller takes the parts no worker has taken, so it never waits for a
+ * worker that has not started (a loaded machine, a forked child) but only for the parts being
+ * computed; a worker that wakes late finds nothing FREE. One batch at a time (`busy`): another
+ * thread's batch meanwhile runs on its own thread. */
+enum { PART_FREE, PART_TAKEN, PART_DONE };
+static struct {
+    pthread_mutex_t busy, lock;
+    pthread_cond_t wake;
+    unsigned long generation;  /* of the batch published last (lock) */
+    int workers, forks_handled;
+    part_t parts[EOM_MAX_THREADS];
+    int state[EOM_MAX_THREADS];  /* PART_*: atomic */
+    int count;                   /* parts of the batch published last (lock) */
+} eom_pool = {.busy = PTHREAD_MUTEX_INITIALIZER, .lock = PTHREAD_MUTEX_INITIALIZER,
+              .wake = PTHREAD_COND_INITIALIZER};
+
+/* Take and run the FREE parts among 1 .. count - 1, from the first (workers) or the last
+ * (the caller). */
+static void take_parts(int count, int from_last)
+{
+    int i;
+    for (i = 1; i < count; ++i) {
+        const int t = from_last ? count - i : i;
+        int expected = PART_FREE;
+        if (__atomic_compare_exchange_n(&eom_pool.state[t], &expected, PART_TAKEN, 0,
+                                        __ATOMIC_ACQ_REL, __ATOMIC_ACQUIRE)) {
+            run_part(&eom_pool.parts[t]);
+            __atomic_store_n(&eom_pool.state[t], PART_DONE, __ATOMIC_RELEASE);
+        }
+    }
+}
+
+static void *pool_worker(void *unused)
+{
+    unsigned long seen;
+    (void)unused;
+    pthread_mutex_lock(&eom_pool.lock);
+    seen = eom_pool.generation;
+    for (;;) {
+        int count;
+        while (eom_pool.generation == seen)
+            pthread_cond_wait(&eom_pool.wake, &eom_pool.lock);
+        seen = eom_pool.generation;
+        count = eom_pool.count;
+        pthread_mutex_unlock(&eom_pool.lock);
+        take_parts(count, 0);
+        pthread_mutex_lock(&eom_pool.lock);
+    }
+    return NULL;
+}
+
+/* In a child process after fork(): no worker exists there; a fresh pool. */
+static void pool_after_fork(void)
+{
+    pthread_mutex_init(&eom_pool.busy, NULL);
+    pthread_mutex_init(&eom_pool.lock, NULL);
+    pthread_cond_init(&eom_pool.wake, NULL);
+    eom_pool.workers = 0;
+}
+
+/* Start workers until there are `wanted` (fewer when a thread cannot be started). */
+static void pool_start(int wanted)
+{
+    pthread_attr_t attributes;
+    if (!eom_pool.forks_handled)
+        eom_pool.forks_handled = pthread_atfork(NULL, NULL, pool_after_fork) == 0;
+    if (eom_pool.workers >= wanted || pthread_attr_init(&attributes) != 0)
+        return;
+    pthread_attr_setdetachstate(&attributes, PTHREAD_CREATE_DETACHED);
+    while (eom_pool.workers < wanted) {
+        pthread_t id;
+        if (pthread_create(&id, &attributes, pool_worker, NULL) != 0)
+            break;
+        ++eom_pool.workers;
+    }
+    pthread_attr_destroy(&attributes);
+}
+#endif
+
 /* run(job, t, ...) on `threads` contiguous parts of the batch's states, part t from state
  * blocks * t / threads * EOM_LANES (blocks: whole blocks of EOM_LANES states), the last taking
- * the remainder; part 0 on the calling thread, the others on threads started here (one that
- * cannot be started leaves its part to the calling thread, which computes it the same way). */
-static void in_parts(range_t run, void *job, npy_intp states, int threads)
+ * the remainder; part 0 on the calling thread, the others on the pool's workers or, those no
+ * worker took, on the calling thread too: the parts are the same whoever computes them.
+ * Returns the number of parts: `threads`, or 1 (the whole batch as part 0) when the pool is
+ * busy with another batch or there are no POSIX threads. */
+static int in_parts(range_t run, void *job, npy_intp states, int threads)
 {
-    part_t parts[EOM_MAX_THREADS];
-    const npy_intp blocks = states / EOM_LANES;
-    int t;
+    part_t whole;
 #if defined(__unix__) || defined(__APPLE__)
-    pthread_t ids[EOM_MAX_THREADS];
-    int started[EOM_MAX_THREADS] = {0};
-#endif
-    if (threads < 1)
-        threads = 1;
-    for (t = 0; t < threads; ++t) {
-        parts[t].run = run;
-        parts[t].job = job;
-        parts[t].part = t;
-        parts[t].begin = blocks * t / threads * EOM_LANES;
-        parts[t].end = t + 1 < threads ? blocks * (t + 1) / threads * EOM_LANES : states;
+    if (threads > 1 && pthread_mutex_trylock(&eom_pool.busy) == 0) {
+        const npy_intp blocks = states / EOM_LANES;
+        part_t *parts = eom_pool.parts;
+        int t;
+        pool_start(threads - 1);
+        for (t = 0; t < threads; ++t) {
+            parts[t].run = run;
+            parts[t].job = job;
+            parts[t].part = t;
+            parts[t].begin = blocks * t / threads * EOM_LANES;
+            parts[t].end = t + 1 < threads ? blocks * (t + 1) / threads * EOM_LANES : states;
+            __atomic_store_n(&eom_pool.state[t], t ? PART_FREE : PART_TAKEN, __ATOMIC_RELEASE);
+        }
+        pthread_mutex_lock(&eom_pool.lock);
+        eom_pool.count = threads;
+        ++eom_pool.generation;
+        pthread_cond_broadcast(&eom_pool.wake);
+        pthread_mutex_unlock(&eom_pool.lock);
+        run_part(&parts[0]);
+        take_parts(threads, 1);
+        for (t = 1; t < threads; ++t)
+            while (__atomic_load_n(&eom_pool.state[t], __ATOMIC_ACQUIRE) != PART_DONE)
+                sched_yield();
+        pthread_mutex_unlock(&eom_pool.busy);
+        return threads;
     }
-#if defined(__unix__) || defined(__APPLE__)
-    for (t = 1; t < threads; ++t)
-        started[t] = pthread_create(&ids[t], NULL, run_part, &parts[t]) == 0;
-    run_part(&parts[0]);
-    for (t = 1; t < threads; ++t) {
-        if (started[t])
-            pthread_join(ids[t], NULL);
-        else
-            run_part(&parts[t]);
-    }
-#else
-    for (t = 0; t < threads; ++t)
-        run_part(&parts[t]);
 #endif
+    whole.run = run;
+    whole.job = job;
+    whole.part = 0;
+    whole.begin = 0;
+    whole.end = states;
+    run_part(&whole);
+    return 1;
 }
 
 /* evaluate()'s batch: f on inputs `in`, parameters p, results `out`. */
