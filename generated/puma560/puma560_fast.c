@@ -1024,8 +1024,7 @@ static struct {
 } eom_pool = {.busy = PTHREAD_MUTEX_INITIALIZER, .lock = PTHREAD_MUTEX_INITIALIZER,
               .wake = PTHREAD_COND_INITIALIZER};
 
-/* Take and run the FREE parts among 1 .. count - 1, from the first (workers) or the last
- * (the caller). */
+/* Take and run the FREE parts among 1 .. count - 1, from the first or from the last. */
 static void take_parts(int count, int from_last)
 {
     int i;
@@ -1087,12 +1086,15 @@ static void pool_start(int wanted)
 }
 #endif
 
-/* run(job, t, ...) on `threads` contiguous parts of the batch's states, part t from state
- * blocks * t / threads * EOM_LANES (blocks: whole blocks of EOM_LANES states), the last taking
- * the remainder; part 0 on the calling thread, the others on the pool's workers or, those no
- * worker took, on the calling thread too: the parts are the same whoever computes them.
- * Returns the number of parts: `threads`, or 1 (the whole batch as part 0) when the pool is
- * busy with another batch or there are no POSIX threads. */
+/* run(job, t, ...) on the batch's states in `parts` contiguous parts on `threads` threads:
+ * EOM_PARTS_PER_THREAD parts a thread (at most EOM_MAX_THREADS, at least a block each), part t
+ * from state blocks * t / parts * EOM_LANES (blocks: whole blocks of EOM_LANES states), the last
+ * taking the remainder. Part 0 on the calling thread, the others on the pool's workers or, those
+ * no worker took, on the calling thread too: the parts are the same whoever computes them, and
+ * a worker that loses its core holds up the batch by one small part at most. Returns the number
+ * of parts, 1 (the whole batch as part 0) when the pool is busy with another batch or there are
+ * no POSIX threads. */
+#define EOM_PARTS_PER_THREAD 8
 static int in_parts(range_t run, void *job, npy_intp states, int threads)
 {
     part_t whole;
@@ -1100,28 +1102,32 @@ static int in_parts(range_t run, void *job, npy_intp states, int threads)
     if (threads > 1 && pthread_mutex_trylock(&eom_pool.busy) == 0) {
         const npy_intp blocks = states / EOM_LANES;
         part_t *parts = eom_pool.parts;
-        int t;
+        npy_intp most = (npy_intp)threads * EOM_PARTS_PER_THREAD;
+        int count, t;
+        if (most > EOM_MAX_THREADS)
+            most = EOM_MAX_THREADS;
+        count = (int)(most < blocks ? most : blocks);
         pool_start(threads - 1);
-        for (t = 0; t < threads; ++t) {
+        for (t = 0; t < count; ++t) {
             parts[t].run = run;
             parts[t].job = job;
             parts[t].part = t;
-            parts[t].begin = blocks * t / threads * EOM_LANES;
-            parts[t].end = t + 1 < threads ? blocks * (t + 1) / threads * EOM_LANES : states;
+            parts[t].begin = blocks * t / count * EOM_LANES;
+            parts[t].end = t + 1 < count ? blocks * (t + 1) / count * EOM_LANES : states;
             __atomic_store_n(&eom_pool.state[t], t ? PART_FREE : PART_TAKEN, __ATOMIC_RELEASE);
         }
         pthread_mutex_lock(&eom_pool.lock);
-        eom_pool.count = threads;
+        eom_pool.count = count;
         ++eom_pool.generation;
         pthread_cond_broadcast(&eom_pool.wake);
         pthread_mutex_unlock(&eom_pool.lock);
         run_part(&parts[0]);
-        take_parts(threads, 1);
-        for (t = 1; t < threads; ++t)
+        take_parts(count, 0);
+        for (t = 1; t < count; ++t)
             while (__atomic_load_n(&eom_pool.state[t], __ATOMIC_ACQUIRE) != PART_DONE)
                 sched_yield();
         pthread_mutex_unlock(&eom_pool.busy);
-        return threads;
+        return count;
     }
 #endif
     whole.run = run;
@@ -1982,7 +1988,7 @@ static const function_t forward_dynamics_function = {
     "forward_dynamics", 3, {"q", "qd", "tau"}, NV, 0, NULL, {NQ}, NULL, 765};
 
 /* A batch of forward_dynamics on threads (in_parts): each part's first failing state and status,
- * and its state of largest condition estimate. */
+ * and its first state of largest condition estimate. */
 typedef struct {
     const double *q, *qd, *tau, *p;
     double *qdd, *condition;
@@ -2015,7 +2021,7 @@ static PyObject *forward_dynamics(PyObject *self, PyObject *const *args, Py_ssiz
 {
     call_t call;
     npy_intp dims[2], failed = -1, worst = 0;
-    int status = 0, threads, t;
+    int status = 0, threads, parts = 1, t;
     double *condition;
     PyArrayObject *result, *conditions;
     forward_dynamics_job_t job;
@@ -2042,14 +2048,14 @@ static PyObject *forward_dynamics(PyObject *self, PyObject *const *args, Py_ssiz
     threads = batch_threads(forward_dynamics_function.operations, call.states);
     if (call.states > 1) {
         Py_BEGIN_ALLOW_THREADS
-        threads = in_parts(forward_dynamics_range, &job, call.states, threads);
+        parts = in_parts(forward_dynamics_range, &job, call.states, threads);
         Py_END_ALLOW_THREADS
     } else {
-        threads = in_parts(forward_dynamics_range, &job, call.states, threads);
+        parts = in_parts(forward_dynamics_range, &job, call.states, threads);
     }
     /* the first failing state (parts in order), else the first state of largest estimate */
     worst = job.worst[0];
-    for (t = 0; t < threads; ++t) {
+    for (t = 0; t < parts; ++t) {
         if (job.failed[t] >= 0) {
             failed = job.failed[t];
             status = job.status[t];
