@@ -20,7 +20,13 @@
 #include <numpy/arrayobject.h>
 #include <math.h>
 #include <float.h>
+#include <stdlib.h>
 #include <string.h>
+#if defined(__unix__) || defined(__APPLE__)
+#include <pthread.h>  /* a batch's threads (runtime call.c) */
+#include <sched.h>
+#include <unistd.h>
+#endif
 
 #define NQ 6  /* entries of q (configuration) */
 #define NV 6  /* entries of qd, qdd, tau (velocity): JOINT_NAMES */
@@ -57,6 +63,17 @@ static const char *const renamed_parameters[][2] = {
 /* ---------------------------------------------------------------------------------------- */
 /* The functions of one state: inputs x[j] (NV,) each (F_c: the contact rows), parameters p
  * (NP,), output row-major. */
+/* The kernels marked FMA_CLONES (the longest: their arithmetic, not the call, is the time) are
+ * compiled twice, with and without fused multiply-add instructions, and the loader picks the
+ * version this CPU runs (target_clones; x86-64 Linux with glibc, else one plain version). */
+#if defined(__x86_64__) && defined(__linux__) && defined(__GLIBC__) && defined(__has_attribute)
+#if __has_attribute(target_clones)
+#define FMA_CLONES __attribute__((target_clones("fma", "default")))
+#endif
+#endif
+#ifndef FMA_CLONES
+#define FMA_CLONES
+#endif
 
 /* Mass matrix M(q), symmetric positive definite.
  * Output 6x6, in kg m^2 (revolute rows/columns), kg (prismatic); 259 operations. */
@@ -815,6 +832,7 @@ typedef struct {
     kernel_t kernel;
     int sizes[MAX_IN];  /* length of each input (0: NV) */
     lanes_kernel_t lanes;  /* NULL: the batch goes state by state */
+    long operations;  /* arithmetic operations per state (0: unknown, a batch stays on one thread) */
 } function_t;
 
 static PyObject *ill_conditioned_warning = NULL;  /* IllConditionedWarning */
@@ -877,6 +895,296 @@ static npy_intp in_lanes(const function_t *f, const double *const *in, const dou
     free(work);
     return k;
 }
+
+/* The states [begin, end) of a batch: EOM_LANES at a time through f's lanes kernel where it has
+ * one (in_lanes), the rest one by one through its one-state kernel. */
+static void in_range(const function_t *f, const double *const *in, const double *p,
+                     double *out, npy_intp begin, npy_intp end)
+{
+    const npy_intp size = (npy_intp)f->rows * (f->cols ? f->cols : 1);
+    const double *at[MAX_IN] = {NULL};
+    npy_intp k = begin;
+    int j;
+    if (f->lanes != NULL && EOM_LANES > 1) {
+        for (j = 0; j < f->n_in; ++j)
+            at[j] = in[j] + begin * (f->sizes[j] ? f->sizes[j] : NV);
+        k += in_lanes(f, at, p, out + begin * size, end - begin);
+    }
+    for (; k < end; ++k) {
+        for (j = 0; j < f->n_in; ++j)
+            at[j] = in[j] + k * (f->sizes[j] ? f->sizes[j] : NV);
+        f->kernel(at, p, out + k * size);
+    }
+}
+
+/* Threads of a batch (docs/backends.md, "Batches on several cores"). A batch is cut into as
+ * many contiguous parts as threads, each a whole number of EOM_LANES blocks but the last (which
+ * also takes the remainder): state k goes through the same kernel (lanes or one-state) whatever
+ * the thread count, so that results are bitwise the same. A batch stays on one thread below
+ * EOM_WORK_PER_THREAD arithmetic operations per thread (waking a worker and handing it a part
+ * costs microseconds, more on a loaded machine; benchmarks/batch_speed.py times where a second
+ * thread pays). The
+ * count: set_threads(n), else $EOMGEN_THREADS read at import, else the CPUs this process may
+ * run on. Without POSIX threads every batch runs on the calling thread. */
+#define EOM_WORK_PER_THREAD 400000L
+#define EOM_MAX_THREADS 256
+static int eom_threads = 0;  /* 0: the default, eom_default_threads() */
+static int eom_threads_at_import = 0;  /* $EOMGEN_THREADS (0: not set) */
+
+static int eom_default_threads(void)
+{
+#if defined(__linux__) && defined(CPU_COUNT)
+    cpu_set_t set;
+    if (sched_getaffinity(0, sizeof(set), &set) == 0 && CPU_COUNT(&set) > 0)
+        return CPU_COUNT(&set) < EOM_MAX_THREADS ? CPU_COUNT(&set) : EOM_MAX_THREADS;
+#endif
+#if defined(__unix__) || defined(__APPLE__)
+    {
+        long online = sysconf(_SC_NPROCESSORS_ONLN);
+        if (online > 0)
+            return online < EOM_MAX_THREADS ? (int)online : EOM_MAX_THREADS;
+    }
+#endif
+    return 1;
+}
+
+/* The threads a batch of `states` runs on, `operations` each (the GIL held: reads the
+ * setting); never more than the batch's blocks of EOM_LANES states. */
+static int batch_threads(long operations, npy_intp states)
+{
+    const int wanted = eom_threads > 0 ? eom_threads : eom_default_threads();
+    const double work = (double)states * (double)operations;
+    const npy_intp blocks = states / EOM_LANES;
+    npy_intp most = (npy_intp)(work / (double)EOM_WORK_PER_THREAD);
+    if (most > blocks)
+        most = blocks;
+    return most < 2 ? 1 : (npy_intp)wanted < most ? wanted : (int)most;
+}
+
+/* The work of part `part` of a batch: its states [begin, end). */
+typedef void (*range_t)(void *job, int part, npy_intp begin, npy_intp end);
+
+typedef struct {
+    range_t run;
+    void *job;
+    int part;
+    npy_intp begin, end;
+} part_t;
+
+static void *run_part(void *argument)
+{
+    const part_t *part = (const part_t *)argument;
+    part->run(part->job, part->part, part->begin, part->end);
+    return NULL;
+}
+
+#if defined(__unix__) || defined(__APPLE__)
+/* The module's pool of worker threads, started when a batch first wants them and kept waiting
+ * on `wake` between batches. A batch publishes its parts (part 0 is the caller's), each FREE;
+ * a worker or the caller takes one by turning it TAKEN (atomically: each part is run once),
+ * and marks it DONE. The caller takes the parts no worker has taken, so it never waits for a
+ * worker that has not started (a loaded machine, a forked child) but only for the parts being
+ * computed; a worker that wakes late finds nothing FREE. One batch at a time (`busy`): another
+ * thread's batch meanwhile runs on its own thread. */
+enum { PART_FREE, PART_TAKEN, PART_DONE };
+static struct {
+    pthread_mutex_t busy, lock;
+    pthread_cond_t wake;
+    unsigned long generation;  /* of the batch published last (lock) */
+    int workers, forks_handled;
+    part_t parts[EOM_MAX_THREADS];
+    int state[EOM_MAX_THREADS];  /* PART_*: atomic */
+    int count;                   /* parts of the batch published last (lock) */
+} eom_pool = {.busy = PTHREAD_MUTEX_INITIALIZER, .lock = PTHREAD_MUTEX_INITIALIZER,
+              .wake = PTHREAD_COND_INITIALIZER};
+
+/* Take and run the FREE parts among 1 .. count - 1, from the first or from the last. */
+static void take_parts(int count, int from_last)
+{
+    int i;
+    for (i = 1; i < count; ++i) {
+        const int t = from_last ? count - i : i;
+        int expected = PART_FREE;
+        if (__atomic_compare_exchange_n(&eom_pool.state[t], &expected, PART_TAKEN, 0,
+                                        __ATOMIC_ACQ_REL, __ATOMIC_ACQUIRE)) {
+            run_part(&eom_pool.parts[t]);
+            __atomic_store_n(&eom_pool.state[t], PART_DONE, __ATOMIC_RELEASE);
+        }
+    }
+}
+
+static void *pool_worker(void *unused)
+{
+    unsigned long seen;
+    (void)unused;
+    pthread_mutex_lock(&eom_pool.lock);
+    seen = eom_pool.generation;
+    for (;;) {
+        int count;
+        while (eom_pool.generation == seen)
+            pthread_cond_wait(&eom_pool.wake, &eom_pool.lock);
+        seen = eom_pool.generation;
+        count = eom_pool.count;
+        pthread_mutex_unlock(&eom_pool.lock);
+        take_parts(count, 0);
+        pthread_mutex_lock(&eom_pool.lock);
+    }
+    return NULL;
+}
+
+/* In a child process after fork(): no worker exists there; a fresh pool. */
+static void pool_after_fork(void)
+{
+    pthread_mutex_init(&eom_pool.busy, NULL);
+    pthread_mutex_init(&eom_pool.lock, NULL);
+    pthread_cond_init(&eom_pool.wake, NULL);
+    eom_pool.workers = 0;
+}
+
+/* Start workers until there are `wanted` (fewer when a thread cannot be started). */
+static void pool_start(int wanted)
+{
+    pthread_attr_t attributes;
+    if (!eom_pool.forks_handled)
+        eom_pool.forks_handled = pthread_atfork(NULL, NULL, pool_after_fork) == 0;
+    if (eom_pool.workers >= wanted || pthread_attr_init(&attributes) != 0)
+        return;
+    pthread_attr_setdetachstate(&attributes, PTHREAD_CREATE_DETACHED);
+    while (eom_pool.workers < wanted) {
+        pthread_t id;
+        if (pthread_create(&id, &attributes, pool_worker, NULL) != 0)
+            break;
+        ++eom_pool.workers;
+    }
+    pthread_attr_destroy(&attributes);
+}
+#endif
+
+/* run(job, t, ...) on the batch's states in `parts` contiguous parts on `threads` threads:
+ * EOM_PARTS_PER_THREAD parts a thread (at most EOM_MAX_THREADS, at least a block each), part t
+ * from state blocks * t / parts * EOM_LANES (blocks: whole blocks of EOM_LANES states), the last
+ * taking the remainder. Part 0 on the calling thread, the others on the pool's workers or, those
+ * no worker took, on the calling thread too: the parts are the same whoever computes them, and
+ * a worker that loses its core holds up the batch by one small part at most. Returns the number
+ * of parts, 1 (the whole batch as part 0) when the pool is busy with another batch or there are
+ * no POSIX threads. */
+#define EOM_PARTS_PER_THREAD 8
+static int in_parts(range_t run, void *job, npy_intp states, int threads)
+{
+    part_t whole;
+#if defined(__unix__) || defined(__APPLE__)
+    if (threads > 1 && pthread_mutex_trylock(&eom_pool.busy) == 0) {
+        const npy_intp blocks = states / EOM_LANES;
+        part_t *parts = eom_pool.parts;
+        npy_intp most = (npy_intp)threads * EOM_PARTS_PER_THREAD;
+        int count, t;
+        if (most > EOM_MAX_THREADS)
+            most = EOM_MAX_THREADS;
+        count = (int)(most < blocks ? most : blocks);
+        pool_start(threads - 1);
+        for (t = 0; t < count; ++t) {
+            parts[t].run = run;
+            parts[t].job = job;
+            parts[t].part = t;
+            parts[t].begin = blocks * t / count * EOM_LANES;
+            parts[t].end = t + 1 < count ? blocks * (t + 1) / count * EOM_LANES : states;
+            __atomic_store_n(&eom_pool.state[t], t ? PART_FREE : PART_TAKEN, __ATOMIC_RELEASE);
+        }
+        pthread_mutex_lock(&eom_pool.lock);
+        eom_pool.count = count;
+        ++eom_pool.generation;
+        pthread_cond_broadcast(&eom_pool.wake);
+        pthread_mutex_unlock(&eom_pool.lock);
+        run_part(&parts[0]);
+        take_parts(count, 0);
+        for (t = 1; t < count; ++t)
+            while (__atomic_load_n(&eom_pool.state[t], __ATOMIC_ACQUIRE) != PART_DONE)
+                sched_yield();
+        pthread_mutex_unlock(&eom_pool.busy);
+        return count;
+    }
+#endif
+    whole.run = run;
+    whole.job = job;
+    whole.part = 0;
+    whole.begin = 0;
+    whole.end = states;
+    run_part(&whole);
+    return 1;
+}
+
+/* evaluate()'s batch: f on inputs `in`, parameters p, results `out`. */
+typedef struct {
+    const function_t *f;
+    const double *const *in;
+    const double *p;
+    double *out;
+} evaluation_t;
+
+static void evaluate_range(void *job, int part, npy_intp begin, npy_intp end)
+{
+    const evaluation_t *e = (const evaluation_t *)job;
+    (void)part;
+    in_range(e->f, e->in, e->p, e->out, begin, end);
+}
+
+/* Module functions set_threads(n) and threads(). */
+static PyObject *set_threads(PyObject *self, PyObject *value)
+{
+    long n;
+    (void)self;
+    if (value == Py_None) {
+        eom_threads = eom_threads_at_import;
+        Py_RETURN_NONE;
+    }
+    n = PyLong_Check(value) ? PyLong_AsLong(value) : -1;
+    if (n == -1 && PyErr_Occurred())
+        PyErr_Clear();
+    if (!PyLong_Check(value) || PyBool_Check(value) || n < 1 || n > EOM_MAX_THREADS) {
+        PyErr_Format(PyLong_Check(value) && !PyBool_Check(value) ? PyExc_ValueError
+                                                                 : PyExc_TypeError,
+                     "set_threads(): n must be an integer from 1 to %d or None (the CPUs this "
+                     "process may use), got %R", EOM_MAX_THREADS, value);
+        return NULL;
+    }
+    eom_threads = (int)n;
+    Py_RETURN_NONE;
+}
+
+static PyObject *threads(PyObject *self, PyObject *unused)
+{
+    (void)self;
+    (void)unused;
+    return PyLong_FromLong(eom_threads > 0 ? eom_threads : eom_default_threads());
+}
+
+/* At import: $EOMGEN_THREADS, when set, is the thread count; -1 with a ValueError when it is
+ * not an integer from 1 to EOM_MAX_THREADS. */
+static int read_threads_variable(void)
+{
+    const char *text = getenv("EOMGEN_THREADS");
+    char *end = NULL;
+    long n;
+    if (text == NULL || *text == '\0')
+        return 0;
+    n = strtol(text, &end, 10);
+    if (*end != '\0' || n < 1 || n > EOM_MAX_THREADS) {
+        PyErr_Format(PyExc_ValueError, "EOMGEN_THREADS must be an integer from 1 to %d, got "
+                     "'%s'", EOM_MAX_THREADS, text);
+        return -1;
+    }
+    eom_threads = eom_threads_at_import = (int)n;
+    return 0;
+}
+
+#define THREAD_METHODS \
+    {"set_threads", (PyCFunction)set_threads, METH_O, \
+     "set_threads(n)\n--\n\nRun this module's batches on n threads (n from 1 to 256; None: the " \
+     "CPUs this process may use, or $EOMGEN_THREADS when set at import). Batches of little " \
+     "work stay on one thread; results are bitwise the same for every n."}, \
+    {"threads", (PyCFunction)threads, METH_NOARGS, \
+     "threads()\n--\n\nThe number of threads this module's batches may run on."}
+
 /* The keywords a composed function takes besides its inputs and parameters (parse()). */
 #define TAKES_RETURN_CONDITION 1
 #define TAKES_DAMPING 2
@@ -1113,8 +1421,7 @@ static PyObject *evaluate(const function_t *f, PyObject *const *args, Py_ssize_t
     call_t call;
     npy_intp dims[3];
     int nd = 0, j;
-    npy_intp k, size = (npy_intp)f->rows * (f->cols ? f->cols : 1);
-    const double *in[MAX_IN] = {NULL}, *at[MAX_IN] = {NULL};
+    const double *in[MAX_IN] = {NULL};
     double *out;
     PyArrayObject *result;
     if (parse(f, args, nargs, kwnames, &call, 0) < 0)
@@ -1135,23 +1442,472 @@ static PyObject *evaluate(const function_t *f, PyObject *const *args, Py_ssize_t
     if (call.states == 1) {
         f->kernel(in, call.p, out);
     } else {
+        evaluation_t job = {f, in, call.p, out};
+        const int threads = batch_threads(f->operations, call.states);
         Py_BEGIN_ALLOW_THREADS
-        k = f->lanes != NULL && EOM_LANES > 1 ? in_lanes(f, in, call.p, out, call.states) : 0;
-        for (; k < call.states; ++k) {
-            for (j = 0; j < f->n_in; ++j)
-                at[j] = in[j] + k * (f->sizes[j] ? f->sizes[j] : NV);
-            f->kernel(at, call.p, out + k * size);
-        }
+        in_parts(evaluate_range, &job, call.states, threads);
         Py_END_ALLOW_THREADS
     }
     release(&call);
     return (PyObject *)result;
 }
 
+#if EOM_LANES > 1
+/* The lanes kernels of a batch (in_lanes): the one-state kernels' arithmetic on vectors of
+ * EOM_LANES states, sin and cos by the vector routine below, sqrt lane by lane (a statement
+ * expression: no vector crosses a function call); a constant is broadcast to every lane. Every
+ * kernel of at least LANES_OPERATIONS operations (eomgen's fast backend) whose arithmetic is
+ * +, -, *, / and those functions has one, compiled with and without FMA (FMA_CLONES). */
+typedef unsigned long long eom_lane_bits __attribute__((vector_size(8 * EOM_LANES)));
+typedef long long eom_lane_ints __attribute__((vector_size(8 * EOM_LANES)));
+
+#define EOM_PIO2_1 0x1.921fb544p+0           /* pi/2 = EOM_PIO2_1 + EOM_PIO2_2 + EOM_PIO2_3 + */
+#define EOM_PIO2_2 0x1.0b4611a6p-34          /* O(2^-122): two parts of 33 bits, one of 53 */
+#define EOM_PIO2_3 0x1.3198a2e037073p-69
+#define EOM_2_OVER_PI 0x1.45f306dc9c883p-1
+#define EOM_ROUND 0x1.8p52                    /* (y + EOM_ROUND) - EOM_ROUND: y rounded */
+#define EOM_REDUCE_LIMIT 1e5                  /* beyond: libm, lane by lane */
+#define EOM_INLINE inline __attribute__((always_inline))
+
+/* sin and cos of every lane of *at (vectors by pointer: none crosses a call by value, whose
+ * ABI depends on the instruction set). */
+static EOM_INLINE void eom_sincos_lanes(const eom_lanes *at, eom_lanes *sine, eom_lanes *cosine)
+{
+    const eom_lanes x = *at;
+    const eom_lanes k = (x * EOM_2_OVER_PI + EOM_ROUND) - EOM_ROUND;
+    const eom_lane_bits n = (eom_lane_bits)__builtin_convertvector(k, eom_lane_ints);
+    /* |x| > EOM_REDUCE_LIMIT, nan or +-inf: the bits without the sign, compared unsigned */
+    const eom_lane_ints far = ((eom_lane_bits)x << 1)
+        > ((eom_lane_bits)((eom_lanes){0} + EOM_REDUCE_LIMIT) << 1);
+    /* r_hi + r_lo = x - k pi/2: a exact, w exact, (a - r1) - w the rounding error of r1 */
+    const eom_lanes a = x - k * EOM_PIO2_1;
+    const eom_lanes w = k * EOM_PIO2_2;
+    const eom_lanes r1 = a - w;
+    const eom_lanes t = ((a - r1) - w) - k * EOM_PIO2_3;
+    const eom_lanes r = r1 + t;
+    const eom_lanes r_lo = (r1 - r) + t;
+    const eom_lanes z = r * r;
+    /* sin(r + r_lo) = r + r z S(z) + r_lo (1 - z/2); cos(r + r_lo) = 1 - z/2 + z^2 C(z) - r r_lo,
+     * 1 - z/2 as w_c plus its rounding error */
+    const eom_lanes s_poly = -0x1.5555555555555p-3 + z * (0x1.1111111110babp-7 + z * (
+        -0x1.a01a019e820aep-13 + z * (0x1.71de37946ed6dp-19 + z * (-0x1.ae6008d114485p-26
+        + z * 0x1.5e0a4fc16be59p-33))));
+    const eom_lanes c_poly = 0x1.5555555555555p-5 + z * (-0x1.6c16c16c16963p-10 + z * (
+        0x1.a01a019f4ddfdp-16 + z * (-0x1.27e4fa16cc2d1p-22 + z * (0x1.1eeb67d026ec6p-29
+        + z * -0x1.907cd8ff5ede7p-37))));
+    const eom_lanes half_z = 0.5 * z;
+    const eom_lanes w_c = 1.0 - half_z;
+    const eom_lanes s = r + ((r * z) * s_poly + r_lo * w_c);
+    const eom_lanes c = w_c + (((1.0 - w_c) - half_z) + ((z * z) * c_poly - r * r_lo));
+    /* quadrant n mod 4: sin x = s, c, -s, -c; cos x = c, -s, -c, s */
+    const eom_lane_bits swap = -(n & 1);
+    const eom_lane_bits sin_bits = (((eom_lane_bits)s & ~swap) | ((eom_lane_bits)c & swap))
+        ^ ((n & 2) << 62);
+    const eom_lane_bits cos_bits = (((eom_lane_bits)c & ~swap) | ((eom_lane_bits)s & swap))
+        ^ (((n + 1) & 2) << 62);
+    long long any = 0;
+    int l;
+    *sine = (eom_lanes)sin_bits;
+    *cosine = (eom_lanes)cos_bits;
+    for (l = 0; l < EOM_LANES; ++l)
+        any |= far[l];
+    if (__builtin_expect(any != 0, 0))
+        for (l = 0; l < EOM_LANES; ++l) {
+            (*sine)[l] = sin(x[l]);
+            (*cosine)[l] = cos(x[l]);
+        }
+}
+
+/* sin(value) and cos(value) of a lanes kernel (GNU statement expressions). */
+#define EOM_SIN_LANES(value) ({ \
+    eom_lanes eom_x = (value), eom_sine, eom_cosine; \
+    eom_sincos_lanes(&eom_x, &eom_sine, &eom_cosine); \
+    eom_sine; })
+#define EOM_COS_LANES(value) ({ \
+    eom_lanes eom_x = (value), eom_sine, eom_cosine; \
+    eom_sincos_lanes(&eom_x, &eom_sine, &eom_cosine); \
+    eom_cosine; })
+
+#define EOM_BROADCAST(value) ((value) - (eom_lanes){0})
+#define EOM_LANES_KERNEL(kernel) kernel
+#define EOM_EACH_LANE(function, value) ({ \
+    eom_lanes eom_each = (value); \
+    for (int eom_l = 0; eom_l < EOM_LANES; ++eom_l) \
+        eom_each[eom_l] = function(eom_each[eom_l]); \
+    eom_each; })
+#define sin(value) EOM_SIN_LANES(value)
+#define cos(value) EOM_COS_LANES(value)
+#define sqrt(value) EOM_EACH_LANE(sqrt, value)
+
+FMA_CLONES static void coriolis_matrix_lanes(const eom_lanes *const *x, const eom_lanes *p, eom_lanes *out)
+{
+    const eom_lanes *q = x[0];
+    const eom_lanes *qd = x[1];
+    (void)x; (void)p; (void)q; (void)qd;
+    const eom_lanes t_s1 = sin(q[0]);
+    const eom_lanes t_c1 = cos(q[0]);
+    const eom_lanes t_s2 = sin(q[1]);
+    const eom_lanes t_c2 = cos(q[1]);
+    const eom_lanes t_s3 = sin(q[2]);
+    const eom_lanes t_c3 = cos(q[2]);
+    const eom_lanes t_s4 = sin(q[3]);
+    const eom_lanes t_c4 = cos(q[3]);
+    const eom_lanes t_s5 = sin(q[4]);
+    const eom_lanes t_c5 = cos(q[4]);
+    const eom_lanes t_s6 = sin(q[5]);
+    const eom_lanes t_c6 = cos(q[5]);
+    const eom_lanes t_R2_00 = -t_c1*t_s2;
+    const eom_lanes t_R2_02 = t_c1*t_c2;
+    const eom_lanes t_R2_10 = -t_s1*t_s2;
+    const eom_lanes t_R2_12 = t_c2*t_s1;
+    const eom_lanes t_o3_0 = 0.425*t_R2_02 - 0.016149999999999998*t_s1;
+    const eom_lanes t_o3_1 = 0.425*t_R2_12 + 0.016149999999999998*t_c1;
+    const eom_lanes t_R3_00 = t_R2_00*t_c3 - t_R2_02*t_s3;
+    const eom_lanes t_R3_02 = t_R2_00*t_s3 + t_R2_02*t_c3;
+    const eom_lanes t_R3_10 = t_R2_10*t_c3 - t_R2_12*t_s3;
+    const eom_lanes t_R3_12 = t_R2_10*t_s3 + t_R2_12*t_c3;
+    const eom_lanes t_R3_20 = t_s2*t_s3 - t_c2*t_c3;
+    const eom_lanes t_R3_22 = -t_c2*t_s3 - t_c3*t_s2;
+    const eom_lanes t_v3_0 = 0.425*t_c1*t_s2;
+    const eom_lanes t_v3_1 = 0.425*t_s1*t_s2;
+    const eom_lanes t_v3_2 = t_c1*t_o3_0 + t_o3_1*t_s1;
+    const eom_lanes t_o4_0 = 0.39225*t_R3_02 + t_o3_0;
+    const eom_lanes t_o4_1 = 0.39225*t_R3_12 + t_o3_1;
+    const eom_lanes t_o4_2 = 0.39225*t_R3_22 - 0.425*t_s2;
+    const eom_lanes t_R4_00 = -t_R3_00*t_s4 - t_R3_02*t_c4;
+    const eom_lanes t_R4_02 = t_R3_00*t_c4 - t_R3_02*t_s4;
+    const eom_lanes t_R4_10 = -t_R3_10*t_s4 - t_R3_12*t_c4;
+    const eom_lanes t_R4_12 = t_R3_10*t_c4 - t_R3_12*t_s4;
+    const eom_lanes t_R4_20 = -t_R3_20*t_s4 - t_R3_22*t_c4;
+    const eom_lanes t_R4_22 = t_R3_20*t_c4 - t_R3_22*t_s4;
+    const eom_lanes t_v4_0 = -t_c1*t_o4_2;
+    const eom_lanes t_v4_1 = -t_o4_2*t_s1;
+    const eom_lanes t_v4_2 = t_c1*t_o4_0 + t_o4_1*t_s1;
+    const eom_lanes t_o5_0 = t_o4_0 - 0.093*t_s1;
+    const eom_lanes t_o5_1 = 0.093*t_c1 + t_o4_1;
+    const eom_lanes t_R5_00 = t_R4_00*t_c5 - t_s1*t_s5;
+    const eom_lanes t_R5_01 = -t_R4_00*t_s5 - t_c5*t_s1;
+    const eom_lanes t_R5_10 = t_R4_10*t_c5 + t_c1*t_s5;
+    const eom_lanes t_R5_11 = t_c1*t_c5 - t_R4_10*t_s5;
+    const eom_lanes t_R5_20 = t_R4_20*t_c5;
+    const eom_lanes t_R5_21 = -t_R4_20*t_s5;
+    const eom_lanes t_v5_0 = t_R4_22*t_o5_1 - t_R4_12*t_o4_2;
+    const eom_lanes t_v5_1 = t_R4_02*t_o4_2 - t_R4_22*t_o5_0;
+    const eom_lanes t_v5_2 = t_R4_12*t_o5_0 - t_R4_02*t_o5_1;
+    const eom_lanes t_o6_0 = 0.09465*t_R4_02 + t_o5_0;
+    const eom_lanes t_o6_1 = 0.09465*t_R4_12 + t_o5_1;
+    const eom_lanes t_o6_2 = 0.09465*t_R4_22 + t_o4_2;
+    const eom_lanes t_R6_00 = t_R5_00*t_c6 - t_R4_02*t_s6;
+    const eom_lanes t_R6_02 = t_R4_02*t_c6 + t_R5_00*t_s6;
+    const eom_lanes t_R6_10 = t_R5_10*t_c6 - t_R4_12*t_s6;
+    const eom_lanes t_R6_12 = t_R4_12*t_c6 + t_R5_10*t_s6;
+    const eom_lanes t_R6_20 = t_R5_20*t_c6 - t_R4_22*t_s6;
+    const eom_lanes t_R6_22 = t_R4_22*t_c6 + t_R5_20*t_s6;
+    const eom_lanes t_v6_0 = t_R5_21*t_o6_1 - t_R5_11*t_o6_2;
+    const eom_lanes t_v6_1 = t_R5_01*t_o6_2 - t_R5_21*t_o6_0;
+    const eom_lanes t_v6_2 = t_R5_11*t_o6_0 - t_R5_01*t_o6_1;
+    const eom_lanes t_Iw2_00 = 0.8849018759100001*t_R2_00*t_R2_00 + 0.0151074*t_R2_02*t_R2_02 + 0.6385058680000001*t_R2_12*t_c1 + 0.15489468244250001*t_c1*t_c1 + 0.8849018759100001*t_s1*t_s1;
+    const eom_lanes t_Iw2_01 = 0.8849018759100001*t_R2_00*t_R2_10 + 0.0151074*t_R2_02*t_R2_12 - 0.31925293400000004*t_R2_02*t_c1 + 0.31925293400000004*t_R2_12*t_s1 - 0.7300071934675002*t_c1*t_s1;
+    const eom_lanes t_Iw2_02 = -0.8849018759100001*t_R2_00*t_c2 - 0.0151074*t_R2_02*t_s2 - 0.31925293400000004*t_s1*t_s2;
+    const eom_lanes t_Iw2_11 = 0.8849018759100001*t_R2_10*t_R2_10 - 0.6385058680000001*t_R2_02*t_s1 + 0.0151074*t_R2_12*t_R2_12 + 0.8849018759100001*t_c1*t_c1 + 0.15489468244250001*t_s1*t_s1;
+    const eom_lanes t_Iw2_12 = 0.31925293400000004*t_c1*t_s2 - 0.8849018759100001*t_R2_10*t_c2 - 0.0151074*t_R2_12*t_s2;
+    const eom_lanes t_Iw2_22 = 0.6385058680000001*t_R2_12*t_c1 - 0.6385058680000001*t_R2_02*t_s1 + 0.15489468244250001*t_c1*t_c1 + 0.8849018759100001*t_c2*t_c2 + 0.15489468244250001*t_s1*t_s1 + 0.0151074*t_s2*t_s2;
+    const eom_lanes t_Iw3_00 = 0.19163081355599998*t_R3_00*t_R3_00 + 0.004095*t_R3_02*t_R3_02 + 1.1375*t_R3_12*t_o3_1 - 0.48343749999999996*t_R3_22*t_s2 + 2.275*t_o3_1*t_o3_1 + 0.19163081355599998*t_s1*t_s1 + 0.41092187499999994*t_s2*t_s2;
+    const eom_lanes t_Iw3_01 = 0.19163081355599998*t_R3_00*t_R3_10 + 0.004095*t_R3_02*t_R3_12 - 0.56875*t_R3_02*t_o3_1 - 0.56875*t_R3_12*t_o3_0 - 0.19163081355599998*t_c1*t_s1 - 2.275*t_o3_0*t_o3_1;
+    const eom_lanes t_Iw3_02 = 0.19163081355599998*t_R3_00*t_R3_20 + 0.004095*t_R3_02*t_R3_22 + 0.24171874999999998*t_R3_02*t_s2 - 0.56875*t_R3_22*t_o3_0 + 0.9668749999999999*t_o3_0*t_s2;
+    const eom_lanes t_Iw3_11 = 1.1375*t_R3_02*t_o3_0 + 0.19163081355599998*t_R3_10*t_R3_10 + 0.004095*t_R3_12*t_R3_12 - 0.48343749999999996*t_R3_22*t_s2 + 0.19163081355599998*t_c1*t_c1 + 2.275*t_o3_0*t_o3_0 + 0.41092187499999994*t_s2*t_s2;
+    const eom_lanes t_Iw3_12 = 0.19163081355599998*t_R3_10*t_R3_20 + 0.004095*t_R3_12*t_R3_22 + 0.24171874999999998*t_R3_12*t_s2 - 0.56875*t_R3_22*t_o3_1 + 0.9668749999999999*t_o3_1*t_s2;
+    const eom_lanes t_Iw3_22 = 1.1375*t_R3_02*t_o3_0 + 1.1375*t_R3_12*t_o3_1 + 0.19163081355599998*t_R3_20*t_R3_20 + 0.004095*t_R3_22*t_R3_22 + 2.275*t_o3_0*t_o3_0 + 2.275*t_o3_1*t_o3_1;
+    const eom_lanes t_hw3_0 = 0.56875*t_R3_02 + 2.275*t_o3_0;
+    const eom_lanes t_hw3_1 = 0.56875*t_R3_12 + 2.275*t_o3_1;
+    const eom_lanes t_hw3_2 = 0.56875*t_R3_22 - 0.9668749999999999*t_s2;
+    const eom_lanes t_Iw4_00 = 0.111172755531*t_R4_00*t_R4_00 + 0.21942*t_R4_02*t_R4_02 + 1.219*t_o4_1*t_o4_1 + 1.219*t_o4_2*t_o4_2 + 0.111172755531*t_s1*t_s1;
+    const eom_lanes t_Iw4_01 = 0.111172755531*t_R4_00*t_R4_10 + 0.21942*t_R4_02*t_R4_12 - 0.111172755531*t_c1*t_s1 - 1.219*t_o4_0*t_o4_1;
+    const eom_lanes t_Iw4_02 = 0.111172755531*t_R4_00*t_R4_20 + 0.21942*t_R4_02*t_R4_22 - 1.219*t_o4_0*t_o4_2;
+    const eom_lanes t_Iw4_11 = 0.111172755531*t_R4_10*t_R4_10 + 0.21942*t_R4_12*t_R4_12 + 0.111172755531*t_c1*t_c1 + 1.219*t_o4_0*t_o4_0 + 1.219*t_o4_2*t_o4_2;
+    const eom_lanes t_Iw4_12 = 0.111172755531*t_R4_10*t_R4_20 + 0.21942*t_R4_12*t_R4_22 - 1.219*t_o4_1*t_o4_2;
+    const eom_lanes t_Iw4_22 = 0.111172755531*t_R4_20*t_R4_20 + 0.21942*t_R4_22*t_R4_22 + 1.219*t_o4_0*t_o4_0 + 1.219*t_o4_1*t_o4_1;
+    const eom_lanes t_Iw5_00 = 0.21942*t_R4_02*t_R4_02 + 0.111172755531*t_R5_00*t_R5_00 + 0.111172755531*t_R5_01*t_R5_01 + 1.219*t_o4_2*t_o4_2 + 1.219*t_o5_1*t_o5_1;
+    const eom_lanes t_Iw5_01 = 0.21942*t_R4_02*t_R4_12 + 0.111172755531*t_R5_00*t_R5_10 + 0.111172755531*t_R5_01*t_R5_11 - 1.219*t_o5_0*t_o5_1;
+    const eom_lanes t_Iw5_02 = 0.21942*t_R4_02*t_R4_22 + 0.111172755531*t_R5_00*t_R5_20 + 0.111172755531*t_R5_01*t_R5_21 - 1.219*t_o4_2*t_o5_0;
+    const eom_lanes t_Iw5_11 = 0.21942*t_R4_12*t_R4_12 + 0.111172755531*t_R5_10*t_R5_10 + 0.111172755531*t_R5_11*t_R5_11 + 1.219*t_o4_2*t_o4_2 + 1.219*t_o5_0*t_o5_0;
+    const eom_lanes t_Iw5_12 = 0.21942*t_R4_12*t_R4_22 + 0.111172755531*t_R5_10*t_R5_20 + 0.111172755531*t_R5_11*t_R5_21 - 1.219*t_o4_2*t_o5_1;
+    const eom_lanes t_Iw5_22 = 0.21942*t_R4_22*t_R4_22 + 0.111172755531*t_R5_20*t_R5_20 + 0.111172755531*t_R5_21*t_R5_21 + 1.219*t_o5_0*t_o5_0 + 1.219*t_o5_1*t_o5_1;
+    const eom_lanes t_Iw6_00 = 0.0171364731454*t_R5_01*t_R5_01 + 0.0171364731454*t_R6_00*t_R6_00 + 0.033822*t_R6_02*t_R6_02 + 0.1879*t_o6_1*t_o6_1 + 0.1879*t_o6_2*t_o6_2;
+    const eom_lanes t_Iw6_01 = 0.0171364731454*t_R5_01*t_R5_11 + 0.0171364731454*t_R6_00*t_R6_10 + 0.033822*t_R6_02*t_R6_12 - 0.1879*t_o6_0*t_o6_1;
+    const eom_lanes t_Iw6_02 = 0.0171364731454*t_R5_01*t_R5_21 + 0.0171364731454*t_R6_00*t_R6_20 + 0.033822*t_R6_02*t_R6_22 - 0.1879*t_o6_0*t_o6_2;
+    const eom_lanes t_Iw6_11 = 0.0171364731454*t_R5_11*t_R5_11 + 0.0171364731454*t_R6_10*t_R6_10 + 0.033822*t_R6_12*t_R6_12 + 0.1879*t_o6_0*t_o6_0 + 0.1879*t_o6_2*t_o6_2;
+    const eom_lanes t_Iw6_12 = 0.0171364731454*t_R5_11*t_R5_21 + 0.0171364731454*t_R6_10*t_R6_20 + 0.033822*t_R6_12*t_R6_22 - 0.1879*t_o6_1*t_o6_2;
+    const eom_lanes t_Iw6_22 = 0.0171364731454*t_R5_21*t_R5_21 + 0.0171364731454*t_R6_20*t_R6_20 + 0.033822*t_R6_22*t_R6_22 + 0.1879*t_o6_0*t_o6_0 + 0.1879*t_o6_1*t_o6_1;
+    const eom_lanes t_hc5_0 = 1.219*t_o5_0 + 0.1879*t_o6_0;
+    const eom_lanes t_hc5_1 = 1.219*t_o5_1 + 0.1879*t_o6_1;
+    const eom_lanes t_hc5_2 = 1.219*t_o4_2 + 0.1879*t_o6_2;
+    const eom_lanes t_Ic5_00 = t_Iw5_00 + t_Iw6_00;
+    const eom_lanes t_Ic5_01 = t_Iw5_01 + t_Iw6_01;
+    const eom_lanes t_Ic5_02 = t_Iw5_02 + t_Iw6_02;
+    const eom_lanes t_Ic5_11 = t_Iw5_11 + t_Iw6_11;
+    const eom_lanes t_Ic5_12 = t_Iw5_12 + t_Iw6_12;
+    const eom_lanes t_Ic5_22 = t_Iw5_22 + t_Iw6_22;
+    const eom_lanes t_hc4_0 = t_hc5_0 + 1.219*t_o4_0;
+    const eom_lanes t_hc4_1 = t_hc5_1 + 1.219*t_o4_1;
+    const eom_lanes t_hc4_2 = t_hc5_2 + 1.219*t_o4_2;
+    const eom_lanes t_Ic4_00 = t_Ic5_00 + t_Iw4_00;
+    const eom_lanes t_Ic4_01 = t_Ic5_01 + t_Iw4_01;
+    const eom_lanes t_Ic4_02 = t_Ic5_02 + t_Iw4_02;
+    const eom_lanes t_Ic4_11 = t_Ic5_11 + t_Iw4_11;
+    const eom_lanes t_Ic4_12 = t_Ic5_12 + t_Iw4_12;
+    const eom_lanes t_Ic4_22 = t_Ic5_22 + t_Iw4_22;
+    const eom_lanes t_hc3_0 = t_hc4_0 + t_hw3_0;
+    const eom_lanes t_hc3_1 = t_hc4_1 + t_hw3_1;
+    const eom_lanes t_hc3_2 = t_hc4_2 + t_hw3_2;
+    const eom_lanes t_Ic3_00 = t_Ic4_00 + t_Iw3_00;
+    const eom_lanes t_Ic3_01 = t_Ic4_01 + t_Iw3_01;
+    const eom_lanes t_Ic3_02 = t_Ic4_02 + t_Iw3_02;
+    const eom_lanes t_Ic3_11 = t_Ic4_11 + t_Iw3_11;
+    const eom_lanes t_Ic3_12 = t_Ic4_12 + t_Iw3_12;
+    const eom_lanes t_Ic3_22 = t_Ic4_22 + t_Iw3_22;
+    const eom_lanes t_Ic2_00 = t_Ic3_00 + t_Iw2_00;
+    const eom_lanes t_Ic2_01 = t_Ic3_01 + t_Iw2_01;
+    const eom_lanes t_Ic2_02 = t_Ic3_02 + t_Iw2_02;
+    const eom_lanes t_Ic2_11 = t_Ic3_11 + t_Iw2_11;
+    const eom_lanes t_Ic2_12 = t_Ic3_12 + t_Iw2_12;
+    const eom_lanes t_F3_0 = t_Ic3_01*t_c1 - t_Ic3_00*t_s1 + t_hc3_1*t_v3_2 - t_hc3_2*t_v3_1;
+    const eom_lanes t_F3_1 = t_Ic3_11*t_c1 - t_Ic3_01*t_s1 - t_hc3_0*t_v3_2 + t_hc3_2*t_v3_0;
+    const eom_lanes t_F4_0 = t_Ic4_01*t_c1 - t_Ic4_00*t_s1 + t_hc4_1*t_v4_2 - t_hc4_2*t_v4_1;
+    const eom_lanes t_F4_1 = t_Ic4_11*t_c1 - t_Ic4_01*t_s1 - t_hc4_0*t_v4_2 + t_hc4_2*t_v4_0;
+    const eom_lanes t_F4_2 = t_Ic4_12*t_c1 - t_Ic4_02*t_s1 + t_hc4_0*t_v4_1 - t_hc4_1*t_v4_0;
+    const eom_lanes t_F4_3 = t_c1*t_hc4_2 + 2.6259*t_v4_0;
+    const eom_lanes t_F4_4 = t_hc4_2*t_s1 + 2.6259*t_v4_1;
+    const eom_lanes t_F4_5 = 2.6259*t_v4_2 - t_c1*t_hc4_0 - t_hc4_1*t_s1;
+    const eom_lanes t_F5_0 = t_Ic5_00*t_R4_02 + t_Ic5_01*t_R4_12 + t_Ic5_02*t_R4_22 + t_hc5_1*t_v5_2 - t_hc5_2*t_v5_1;
+    const eom_lanes t_F5_1 = t_Ic5_01*t_R4_02 + t_Ic5_11*t_R4_12 + t_Ic5_12*t_R4_22 - t_hc5_0*t_v5_2 + t_hc5_2*t_v5_0;
+    const eom_lanes t_F5_2 = t_Ic5_02*t_R4_02 + t_Ic5_12*t_R4_12 + t_Ic5_22*t_R4_22 + t_hc5_0*t_v5_1 - t_hc5_1*t_v5_0;
+    const eom_lanes t_F5_3 = t_R4_12*t_hc5_2 - t_R4_22*t_hc5_1 + 1.4069*t_v5_0;
+    const eom_lanes t_F5_4 = t_R4_22*t_hc5_0 - t_R4_02*t_hc5_2 + 1.4069*t_v5_1;
+    const eom_lanes t_F5_5 = t_R4_02*t_hc5_1 - t_R4_12*t_hc5_0 + 1.4069*t_v5_2;
+    const eom_lanes t_F6_0 = t_Iw6_00*t_R5_01 + t_Iw6_01*t_R5_11 + t_Iw6_02*t_R5_21 + 0.1879*t_o6_1*t_v6_2 - 0.1879*t_o6_2*t_v6_1;
+    const eom_lanes t_F6_1 = t_Iw6_01*t_R5_01 + t_Iw6_11*t_R5_11 + t_Iw6_12*t_R5_21 - 0.1879*t_o6_0*t_v6_2 + 0.1879*t_o6_2*t_v6_0;
+    const eom_lanes t_F6_2 = t_Iw6_02*t_R5_01 + t_Iw6_12*t_R5_11 + t_Iw6_22*t_R5_21 + 0.1879*t_o6_0*t_v6_1 - 0.1879*t_o6_1*t_v6_0;
+    const eom_lanes t_F6_3 = 0.1879*t_R5_11*t_o6_2 - 0.1879*t_R5_21*t_o6_1 + 0.1879*t_v6_0;
+    const eom_lanes t_F6_4 = 0.1879*t_R5_21*t_o6_0 - 0.1879*t_R5_01*t_o6_2 + 0.1879*t_v6_1;
+    const eom_lanes t_F6_5 = 0.1879*t_R5_01*t_o6_1 - 0.1879*t_R5_11*t_o6_0 + 0.1879*t_v6_2;
+    const eom_lanes t_Sd2_0 = -qd[0]*t_c1;
+    const eom_lanes t_Sd2_1 = -qd[0]*t_s1;
+    const eom_lanes t_V2_0 = -qd[1]*t_s1;
+    const eom_lanes t_V2_1 = qd[1]*t_c1;
+    const eom_lanes t_Sd3_2 = t_V2_0*t_c1 + t_V2_1*t_s1;
+    const eom_lanes t_Sd3_3 = t_V2_1*t_v3_2 - qd[0]*t_v3_1;
+    const eom_lanes t_Sd3_4 = qd[0]*t_v3_0 - t_V2_0*t_v3_2;
+    const eom_lanes t_Sd3_5 = t_V2_0*t_v3_1 - t_V2_1*t_v3_0;
+    const eom_lanes t_V3_0 = t_V2_0 - qd[2]*t_s1;
+    const eom_lanes t_V3_1 = qd[2]*t_c1 + t_V2_1;
+    const eom_lanes t_V3_3 = qd[2]*t_v3_0;
+    const eom_lanes t_V3_4 = qd[2]*t_v3_1;
+    const eom_lanes t_V3_5 = qd[2]*t_v3_2;
+    const eom_lanes t_Sd4_2 = t_V3_0*t_c1 + t_V3_1*t_s1;
+    const eom_lanes t_Sd4_3 = t_V3_1*t_v4_2 - qd[0]*t_v4_1 - t_V3_5*t_c1;
+    const eom_lanes t_Sd4_4 = qd[0]*t_v4_0 - t_V3_0*t_v4_2 - t_V3_5*t_s1;
+    const eom_lanes t_Sd4_5 = t_V3_0*t_v4_1 - t_V3_1*t_v4_0 + t_V3_3*t_c1 + t_V3_4*t_s1;
+    const eom_lanes t_V4_0 = t_V3_0 - qd[3]*t_s1;
+    const eom_lanes t_V4_1 = qd[3]*t_c1 + t_V3_1;
+    const eom_lanes t_V4_3 = qd[3]*t_v4_0 + t_V3_3;
+    const eom_lanes t_V4_4 = qd[3]*t_v4_1 + t_V3_4;
+    const eom_lanes t_V4_5 = qd[3]*t_v4_2 + t_V3_5;
+    const eom_lanes t_Sd5_0 = t_R4_22*t_V4_1 - qd[0]*t_R4_12;
+    const eom_lanes t_Sd5_1 = qd[0]*t_R4_02 - t_R4_22*t_V4_0;
+    const eom_lanes t_Sd5_2 = t_R4_12*t_V4_0 - t_R4_02*t_V4_1;
+    const eom_lanes t_Sd5_3 = t_R4_22*t_V4_4 - qd[0]*t_v5_1 - t_R4_12*t_V4_5 + t_V4_1*t_v5_2;
+    const eom_lanes t_Sd5_4 = qd[0]*t_v5_0 + t_R4_02*t_V4_5 - t_R4_22*t_V4_3 - t_V4_0*t_v5_2;
+    const eom_lanes t_Sd5_5 = t_R4_12*t_V4_3 - t_R4_02*t_V4_4 + t_V4_0*t_v5_1 - t_V4_1*t_v5_0;
+    const eom_lanes t_V5_0 = qd[4]*t_R4_02 + t_V4_0;
+    const eom_lanes t_V5_1 = qd[4]*t_R4_12 + t_V4_1;
+    const eom_lanes t_V5_2 = qd[0] + qd[4]*t_R4_22;
+    const eom_lanes t_V5_3 = qd[4]*t_v5_0 + t_V4_3;
+    const eom_lanes t_V5_4 = qd[4]*t_v5_1 + t_V4_4;
+    const eom_lanes t_V5_5 = qd[4]*t_v5_2 + t_V4_5;
+    const eom_lanes t_Sd6_0 = t_R5_21*t_V5_1 - t_R5_11*t_V5_2;
+    const eom_lanes t_Sd6_1 = t_R5_01*t_V5_2 - t_R5_21*t_V5_0;
+    const eom_lanes t_Sd6_2 = t_R5_11*t_V5_0 - t_R5_01*t_V5_1;
+    const eom_lanes t_Sd6_3 = t_R5_21*t_V5_4 - t_R5_11*t_V5_5 + t_V5_1*t_v6_2 - t_V5_2*t_v6_1;
+    const eom_lanes t_Sd6_4 = t_R5_01*t_V5_5 - t_R5_21*t_V5_3 - t_V5_0*t_v6_2 + t_V5_2*t_v6_0;
+    const eom_lanes t_Sd6_5 = t_R5_11*t_V5_3 - t_R5_01*t_V5_4 + t_V5_0*t_v6_1 - t_V5_1*t_v6_0;
+    const eom_lanes t_V6_0 = qd[5]*t_R5_01 + t_V5_0;
+    const eom_lanes t_V6_1 = qd[5]*t_R5_11 + t_V5_1;
+    const eom_lanes t_V6_2 = qd[5]*t_R5_21 + t_V5_2;
+    const eom_lanes t_V6_3 = qd[5]*t_v6_0 + t_V5_3;
+    const eom_lanes t_V6_4 = qd[5]*t_v6_1 + t_V5_4;
+    const eom_lanes t_V6_5 = qd[5]*t_v6_2 + t_V5_5;
+    const eom_lanes t_hV6_0 = t_Iw6_00*t_V6_0 + t_Iw6_01*t_V6_1 + t_Iw6_02*t_V6_2 - 0.1879*t_V6_4*t_o6_2 + 0.1879*t_V6_5*t_o6_1;
+    const eom_lanes t_hV6_1 = t_Iw6_01*t_V6_0 + t_Iw6_11*t_V6_1 + t_Iw6_12*t_V6_2 + 0.1879*t_V6_3*t_o6_2 - 0.1879*t_V6_5*t_o6_0;
+    const eom_lanes t_hV6_2 = t_Iw6_02*t_V6_0 + t_Iw6_12*t_V6_1 + t_Iw6_22*t_V6_2 - 0.1879*t_V6_3*t_o6_1 + 0.1879*t_V6_4*t_o6_0;
+    const eom_lanes t_hV6_3 = 0.1879*t_V6_1*t_o6_2 - 0.1879*t_V6_2*t_o6_1 + 0.1879*t_V6_3;
+    const eom_lanes t_hV6_4 = 0.1879*t_V6_2*t_o6_0 - 0.1879*t_V6_0*t_o6_2 + 0.1879*t_V6_4;
+    const eom_lanes t_hV6_5 = 0.1879*t_V6_0*t_o6_1 - 0.1879*t_V6_1*t_o6_0 + 0.1879*t_V6_5;
+    const eom_lanes t_Id6_00 = 2.0*t_Iw6_02*t_V6_1 - 2.0*t_Iw6_01*t_V6_2 + 0.3758*t_V6_4*t_o6_1 + 0.3758*t_V6_5*t_o6_2;
+    const eom_lanes t_Id6_01 = t_Iw6_00*t_V6_2 - t_Iw6_02*t_V6_0 - t_Iw6_11*t_V6_2 + t_Iw6_12*t_V6_1 - 0.1879*t_V6_3*t_o6_1 - 0.1879*t_V6_4*t_o6_0;
+    const eom_lanes t_Id6_02 = t_Iw6_01*t_V6_0 - t_Iw6_00*t_V6_1 - t_Iw6_12*t_V6_2 + t_Iw6_22*t_V6_1 - 0.1879*t_V6_3*t_o6_2 - 0.1879*t_V6_5*t_o6_0;
+    const eom_lanes t_Id6_11 = 2.0*t_Iw6_01*t_V6_2 - 2.0*t_Iw6_12*t_V6_0 + 0.3758*t_V6_3*t_o6_0 + 0.3758*t_V6_5*t_o6_2;
+    const eom_lanes t_Id6_12 = t_Iw6_02*t_V6_2 - t_Iw6_01*t_V6_1 + t_Iw6_11*t_V6_0 - t_Iw6_22*t_V6_0 - 0.1879*t_V6_4*t_o6_2 - 0.1879*t_V6_5*t_o6_1;
+    const eom_lanes t_Id6_22 = 2.0*t_Iw6_12*t_V6_0 - 2.0*t_Iw6_02*t_V6_1 + 0.3758*t_V6_3*t_o6_0 + 0.3758*t_V6_4*t_o6_1;
+    const eom_lanes t_hV5_0 = t_Iw5_00*t_V5_0 + t_Iw5_01*t_V5_1 + t_Iw5_02*t_V5_2 - 1.219*t_V5_4*t_o4_2 + 1.219*t_V5_5*t_o5_1 + t_hV6_0;
+    const eom_lanes t_hV5_1 = t_Iw5_01*t_V5_0 + t_Iw5_11*t_V5_1 + t_Iw5_12*t_V5_2 + 1.219*t_V5_3*t_o4_2 - 1.219*t_V5_5*t_o5_0 + t_hV6_1;
+    const eom_lanes t_hV5_2 = t_Iw5_02*t_V5_0 + t_Iw5_12*t_V5_1 + t_Iw5_22*t_V5_2 - 1.219*t_V5_3*t_o5_1 + 1.219*t_V5_4*t_o5_0 + t_hV6_2;
+    const eom_lanes t_hV5_3 = 1.219*t_V5_1*t_o4_2 - 1.219*t_V5_2*t_o5_1 + 1.219*t_V5_3 + t_hV6_3;
+    const eom_lanes t_hV5_4 = 1.219*t_V5_2*t_o5_0 - 1.219*t_V5_0*t_o4_2 + 1.219*t_V5_4 + t_hV6_4;
+    const eom_lanes t_hV5_5 = 1.219*t_V5_0*t_o5_1 - 1.219*t_V5_1*t_o5_0 + 1.219*t_V5_5 + t_hV6_5;
+    const eom_lanes t_Id5_00 = t_Id6_00 - 2.0*t_Iw5_01*t_V5_2 + 2.0*t_Iw5_02*t_V5_1 + 2.438*t_V5_4*t_o5_1 + 2.438*t_V5_5*t_o4_2;
+    const eom_lanes t_Id5_01 = t_Id6_01 + t_Iw5_00*t_V5_2 - t_Iw5_02*t_V5_0 - t_Iw5_11*t_V5_2 + t_Iw5_12*t_V5_1 - 1.219*t_V5_3*t_o5_1 - 1.219*t_V5_4*t_o5_0;
+    const eom_lanes t_Id5_02 = t_Id6_02 - t_Iw5_00*t_V5_1 + t_Iw5_01*t_V5_0 - t_Iw5_12*t_V5_2 + t_Iw5_22*t_V5_1 - 1.219*t_V5_3*t_o4_2 - 1.219*t_V5_5*t_o5_0;
+    const eom_lanes t_Id5_11 = t_Id6_11 + 2.0*t_Iw5_01*t_V5_2 - 2.0*t_Iw5_12*t_V5_0 + 2.438*t_V5_3*t_o5_0 + 2.438*t_V5_5*t_o4_2;
+    const eom_lanes t_Id5_12 = t_Id6_12 - t_Iw5_01*t_V5_1 + t_Iw5_02*t_V5_2 + t_Iw5_11*t_V5_0 - t_Iw5_22*t_V5_0 - 1.219*t_V5_4*t_o4_2 - 1.219*t_V5_5*t_o5_1;
+    const eom_lanes t_Id5_22 = t_Id6_22 - 2.0*t_Iw5_02*t_V5_1 + 2.0*t_Iw5_12*t_V5_0 + 2.438*t_V5_3*t_o5_0 + 2.438*t_V5_4*t_o5_1;
+    const eom_lanes t_hV4_0 = qd[0]*t_Iw4_02 + t_Iw4_00*t_V4_0 + t_Iw4_01*t_V4_1 - 1.219*t_V4_4*t_o4_2 + 1.219*t_V4_5*t_o4_1 + t_hV5_0;
+    const eom_lanes t_hV4_1 = qd[0]*t_Iw4_12 + t_Iw4_01*t_V4_0 + t_Iw4_11*t_V4_1 + 1.219*t_V4_3*t_o4_2 - 1.219*t_V4_5*t_o4_0 + t_hV5_1;
+    const eom_lanes t_hV4_2 = qd[0]*t_Iw4_22 + t_Iw4_02*t_V4_0 + t_Iw4_12*t_V4_1 - 1.219*t_V4_3*t_o4_1 + 1.219*t_V4_4*t_o4_0 + t_hV5_2;
+    const eom_lanes t_hV4_3 = 1.219*t_V4_1*t_o4_2 - 1.219*qd[0]*t_o4_1 + 1.219*t_V4_3 + t_hV5_3;
+    const eom_lanes t_hV4_4 = 1.219*qd[0]*t_o4_0 - 1.219*t_V4_0*t_o4_2 + 1.219*t_V4_4 + t_hV5_4;
+    const eom_lanes t_hV4_5 = 1.219*t_V4_0*t_o4_1 - 1.219*t_V4_1*t_o4_0 + 1.219*t_V4_5 + t_hV5_5;
+    const eom_lanes t_Id4_00 = t_Id5_00 - 2.0*qd[0]*t_Iw4_01 + 2.0*t_Iw4_02*t_V4_1 + 2.438*t_V4_4*t_o4_1 + 2.438*t_V4_5*t_o4_2;
+    const eom_lanes t_Id4_01 = qd[0]*t_Iw4_00 - qd[0]*t_Iw4_11 + t_Id5_01 - t_Iw4_02*t_V4_0 + t_Iw4_12*t_V4_1 - 1.219*t_V4_3*t_o4_1 - 1.219*t_V4_4*t_o4_0;
+    const eom_lanes t_Id4_02 = t_Id5_02 - qd[0]*t_Iw4_12 - t_Iw4_00*t_V4_1 + t_Iw4_01*t_V4_0 + t_Iw4_22*t_V4_1 - 1.219*t_V4_3*t_o4_2 - 1.219*t_V4_5*t_o4_0;
+    const eom_lanes t_Id4_11 = 2.0*qd[0]*t_Iw4_01 + t_Id5_11 - 2.0*t_Iw4_12*t_V4_0 + 2.438*t_V4_3*t_o4_0 + 2.438*t_V4_5*t_o4_2;
+    const eom_lanes t_Id4_12 = qd[0]*t_Iw4_02 + t_Id5_12 - t_Iw4_01*t_V4_1 + t_Iw4_11*t_V4_0 - t_Iw4_22*t_V4_0 - 1.219*t_V4_4*t_o4_2 - 1.219*t_V4_5*t_o4_1;
+    const eom_lanes t_Id4_22 = t_Id5_22 - 2.0*t_Iw4_02*t_V4_1 + 2.0*t_Iw4_12*t_V4_0 + 2.438*t_V4_3*t_o4_0 + 2.438*t_V4_4*t_o4_1;
+    const eom_lanes t_hV3_0 = qd[0]*t_Iw3_02 + t_Iw3_00*t_V3_0 + t_Iw3_01*t_V3_1 - t_V3_4*t_hw3_2 + t_V3_5*t_hw3_1 + t_hV4_0;
+    const eom_lanes t_hV3_1 = qd[0]*t_Iw3_12 + t_Iw3_01*t_V3_0 + t_Iw3_11*t_V3_1 + t_V3_3*t_hw3_2 - t_V3_5*t_hw3_0 + t_hV4_1;
+    const eom_lanes t_hV3_2 = qd[0]*t_Iw3_22 + t_Iw3_02*t_V3_0 + t_Iw3_12*t_V3_1 - t_V3_3*t_hw3_1 + t_V3_4*t_hw3_0 + t_hV4_2;
+    const eom_lanes t_hV3_3 = t_V3_1*t_hw3_2 - qd[0]*t_hw3_1 + 2.275*t_V3_3 + t_hV4_3;
+    const eom_lanes t_hV3_4 = qd[0]*t_hw3_0 - t_V3_0*t_hw3_2 + 2.275*t_V3_4 + t_hV4_4;
+    const eom_lanes t_hV3_5 = t_V3_0*t_hw3_1 - t_V3_1*t_hw3_0 + 2.275*t_V3_5 + t_hV4_5;
+    const eom_lanes t_Id3_00 = t_Id4_00 - 2.0*qd[0]*t_Iw3_01 + 2.0*t_Iw3_02*t_V3_1 + 2.0*t_V3_4*t_hw3_1 + 2.0*t_V3_5*t_hw3_2;
+    const eom_lanes t_Id3_01 = qd[0]*t_Iw3_00 - qd[0]*t_Iw3_11 + t_Id4_01 - t_Iw3_02*t_V3_0 + t_Iw3_12*t_V3_1 - t_V3_3*t_hw3_1 - t_V3_4*t_hw3_0;
+    const eom_lanes t_Id3_02 = t_Id4_02 - qd[0]*t_Iw3_12 - t_Iw3_00*t_V3_1 + t_Iw3_01*t_V3_0 + t_Iw3_22*t_V3_1 - t_V3_3*t_hw3_2 - t_V3_5*t_hw3_0;
+    const eom_lanes t_Id3_11 = 2.0*qd[0]*t_Iw3_01 + t_Id4_11 - 2.0*t_Iw3_12*t_V3_0 + 2.0*t_V3_3*t_hw3_0 + 2.0*t_V3_5*t_hw3_2;
+    const eom_lanes t_Id3_12 = qd[0]*t_Iw3_02 + t_Id4_12 - t_Iw3_01*t_V3_1 + t_Iw3_11*t_V3_0 - t_Iw3_22*t_V3_0 - t_V3_4*t_hw3_2 - t_V3_5*t_hw3_1;
+    const eom_lanes t_Id3_22 = t_Id4_22 - 2.0*t_Iw3_02*t_V3_1 + 2.0*t_Iw3_12*t_V3_0 + 2.0*t_V3_3*t_hw3_0 + 2.0*t_V3_4*t_hw3_1;
+    const eom_lanes t_hV2_0 = qd[0]*t_Iw2_02 + t_Iw2_00*t_V2_0 + t_Iw2_01*t_V2_1 + t_hV3_0;
+    const eom_lanes t_hV2_1 = qd[0]*t_Iw2_12 + t_Iw2_01*t_V2_0 + t_Iw2_11*t_V2_1 + t_hV3_1;
+    const eom_lanes t_hV2_2 = qd[0]*t_Iw2_22 + t_Iw2_02*t_V2_0 + t_Iw2_12*t_V2_1 + t_hV3_2;
+    const eom_lanes t_Id2_00 = t_Id3_00 - 2.0*qd[0]*t_Iw2_01 + 2.0*t_Iw2_02*t_V2_1;
+    const eom_lanes t_Id2_01 = qd[0]*t_Iw2_00 - qd[0]*t_Iw2_11 + t_Id3_01 - t_Iw2_02*t_V2_0 + t_Iw2_12*t_V2_1;
+    const eom_lanes t_Id2_02 = t_Id3_02 - qd[0]*t_Iw2_12 - t_Iw2_00*t_V2_1 + t_Iw2_01*t_V2_0 + t_Iw2_22*t_V2_1;
+    const eom_lanes t_Id2_11 = 2.0*qd[0]*t_Iw2_01 + t_Id3_11 - 2.0*t_Iw2_12*t_V2_0;
+    const eom_lanes t_Id2_12 = qd[0]*t_Iw2_02 + t_Id3_12 - t_Iw2_01*t_V2_1 + t_Iw2_11*t_V2_0 - t_Iw2_22*t_V2_0;
+    const eom_lanes t_Id2_22 = t_Id3_22 - 2.0*t_Iw2_02*t_V2_1 + 2.0*t_Iw2_12*t_V2_0;
+    const eom_lanes t_Fa2_0 = t_Ic2_00*t_Sd2_0 + t_Ic2_01*t_Sd2_1 - 0.5*t_Id2_00*t_s1 + 0.5*t_Id2_01*t_c1 + 0.5*t_c1*t_hV2_2;
+    const eom_lanes t_Fa2_1 = t_Ic2_01*t_Sd2_0 + t_Ic2_11*t_Sd2_1 - 0.5*t_Id2_01*t_s1 + 0.5*t_Id2_11*t_c1 + 0.5*t_hV2_2*t_s1;
+    const eom_lanes t_Fa2_2 = t_Ic2_02*t_Sd2_0 + t_Ic2_12*t_Sd2_1 - 0.5*t_Id2_02*t_s1 + 0.5*t_Id2_12*t_c1 - 0.5*t_c1*t_hV2_0 - 0.5*t_hV2_1*t_s1;
+    const eom_lanes t_C2_2 = t_Fa2_1*t_c1 - t_Fa2_0*t_s1;
+    const eom_lanes t_Fb2_2 = 0.5*t_Id2_12*t_c1 - 0.5*t_Id2_02*t_s1 + 0.5*t_c1*t_hV2_0 + 0.5*t_hV2_1*t_s1;
+    const eom_lanes t_Fa3_0 = t_Ic3_00*t_Sd2_0 + t_Ic3_01*t_Sd2_1 + t_Ic3_02*t_Sd3_2 - 0.5*t_Id3_00*t_s1 + 0.5*t_Id3_01*t_c1 - t_Sd3_4*t_hc3_2 + t_Sd3_5*t_hc3_1 + 0.5*t_c1*t_hV3_2;
+    const eom_lanes t_Fa3_1 = t_Ic3_01*t_Sd2_0 + t_Ic3_11*t_Sd2_1 + t_Ic3_12*t_Sd3_2 - 0.5*t_Id3_01*t_s1 + 0.5*t_Id3_11*t_c1 + t_Sd3_3*t_hc3_2 - t_Sd3_5*t_hc3_0 + 0.5*t_hV3_2*t_s1;
+    const eom_lanes t_Fa3_2 = t_Ic3_02*t_Sd2_0 + t_Ic3_12*t_Sd2_1 + t_Ic3_22*t_Sd3_2 - 0.5*t_Id3_02*t_s1 + 0.5*t_Id3_12*t_c1 - t_Sd3_3*t_hc3_1 + t_Sd3_4*t_hc3_0 - 0.5*t_c1*t_hV3_0 - 0.5*t_hV3_1*t_s1;
+    const eom_lanes t_Fa3_3 = t_Sd2_1*t_hc3_2 - t_Sd3_2*t_hc3_1 + 4.9009*t_Sd3_3 + t_c1*t_hV3_5;
+    const eom_lanes t_Fa3_4 = t_Sd3_2*t_hc3_0 - t_Sd2_0*t_hc3_2 + 4.9009*t_Sd3_4 + t_hV3_5*t_s1;
+    const eom_lanes t_Fa3_5 = t_Sd2_0*t_hc3_1 - t_Sd2_1*t_hc3_0 + 4.9009*t_Sd3_5 - t_c1*t_hV3_3 - t_hV3_4*t_s1;
+    const eom_lanes t_C3_3 = t_Fa3_1*t_c1 - t_Fa3_0*t_s1 + t_Fa3_3*t_v3_0 + t_Fa3_4*t_v3_1 + t_Fa3_5*t_v3_2;
+    const eom_lanes t_Fb3_0 = 0.5*t_Id3_01*t_c1 - 0.5*t_Id3_00*t_s1 - 0.5*t_c1*t_hV3_2 + t_hV3_4*t_v3_2 - t_hV3_5*t_v3_1;
+    const eom_lanes t_Fb3_1 = 0.5*t_Id3_11*t_c1 - 0.5*t_Id3_01*t_s1 - 0.5*t_hV3_2*t_s1 - t_hV3_3*t_v3_2 + t_hV3_5*t_v3_0;
+    const eom_lanes t_Fb3_2 = 0.5*t_Id3_12*t_c1 - 0.5*t_Id3_02*t_s1 + 0.5*t_c1*t_hV3_0 + 0.5*t_hV3_1*t_s1 + t_hV3_3*t_v3_1 - t_hV3_4*t_v3_0;
+    const eom_lanes t_C2_3 = t_Fa3_1*t_c1 - t_Fa3_0*t_s1;
+    const eom_lanes t_C3_2 = t_F3_0*t_Sd2_0 + t_F3_1*t_Sd2_1 - t_Fb3_0*t_s1 + t_Fb3_1*t_c1;
+    const eom_lanes t_Fa4_0 = t_Ic4_00*t_Sd2_0 + t_Ic4_01*t_Sd2_1 + t_Ic4_02*t_Sd4_2 - 0.5*t_Id4_00*t_s1 + 0.5*t_Id4_01*t_c1 - t_Sd4_4*t_hc4_2 + t_Sd4_5*t_hc4_1 + 0.5*t_c1*t_hV4_2;
+    const eom_lanes t_Fa4_1 = t_Ic4_01*t_Sd2_0 + t_Ic4_11*t_Sd2_1 + t_Ic4_12*t_Sd4_2 - 0.5*t_Id4_01*t_s1 + 0.5*t_Id4_11*t_c1 + t_Sd4_3*t_hc4_2 - t_Sd4_5*t_hc4_0 + 0.5*t_hV4_2*t_s1;
+    const eom_lanes t_Fa4_2 = t_Ic4_02*t_Sd2_0 + t_Ic4_12*t_Sd2_1 + t_Ic4_22*t_Sd4_2 - 0.5*t_Id4_02*t_s1 + 0.5*t_Id4_12*t_c1 - t_Sd4_3*t_hc4_1 + t_Sd4_4*t_hc4_0 - 0.5*t_c1*t_hV4_0 - 0.5*t_hV4_1*t_s1;
+    const eom_lanes t_Fa4_3 = t_Sd2_1*t_hc4_2 - t_Sd4_2*t_hc4_1 + 2.6259*t_Sd4_3 + t_c1*t_hV4_5;
+    const eom_lanes t_Fa4_4 = t_Sd4_2*t_hc4_0 - t_Sd2_0*t_hc4_2 + 2.6259*t_Sd4_4 + t_hV4_5*t_s1;
+    const eom_lanes t_Fa4_5 = t_Sd2_0*t_hc4_1 - t_Sd2_1*t_hc4_0 + 2.6259*t_Sd4_5 - t_c1*t_hV4_3 - t_hV4_4*t_s1;
+    const eom_lanes t_C4_4 = t_Fa4_1*t_c1 - t_Fa4_0*t_s1 + t_Fa4_3*t_v4_0 + t_Fa4_4*t_v4_1 + t_Fa4_5*t_v4_2;
+    const eom_lanes t_Fb4_0 = 0.5*t_Id4_01*t_c1 - 0.5*t_Id4_00*t_s1 - 0.5*t_c1*t_hV4_2 + t_hV4_4*t_v4_2 - t_hV4_5*t_v4_1;
+    const eom_lanes t_Fb4_1 = 0.5*t_Id4_11*t_c1 - 0.5*t_Id4_01*t_s1 - 0.5*t_hV4_2*t_s1 - t_hV4_3*t_v4_2 + t_hV4_5*t_v4_0;
+    const eom_lanes t_Fb4_2 = 0.5*t_Id4_12*t_c1 - 0.5*t_Id4_02*t_s1 + 0.5*t_c1*t_hV4_0 + 0.5*t_hV4_1*t_s1 + t_hV4_3*t_v4_1 - t_hV4_4*t_v4_0;
+    const eom_lanes t_C3_4 = t_Fa4_1*t_c1 - t_Fa4_0*t_s1 + t_Fa4_3*t_v3_0 + t_Fa4_4*t_v3_1 + t_Fa4_5*t_v3_2;
+    const eom_lanes t_C4_3 = t_F4_0*t_Sd2_0 + t_F4_1*t_Sd2_1 + t_F4_2*t_Sd3_2 + t_F4_3*t_Sd3_3 + t_F4_4*t_Sd3_4 + t_F4_5*t_Sd3_5 - t_Fb4_0*t_s1 + t_Fb4_1*t_c1;
+    const eom_lanes t_C2_4 = t_Fa4_1*t_c1 - t_Fa4_0*t_s1;
+    const eom_lanes t_C4_2 = t_F4_0*t_Sd2_0 + t_F4_1*t_Sd2_1 - t_Fb4_0*t_s1 + t_Fb4_1*t_c1;
+    const eom_lanes t_Fa5_0 = t_Ic5_00*t_Sd5_0 + t_Ic5_01*t_Sd5_1 + t_Ic5_02*t_Sd5_2 + 0.5*t_Id5_00*t_R4_02 + 0.5*t_Id5_01*t_R4_12 + 0.5*t_Id5_02*t_R4_22 + 0.5*t_R4_12*t_hV5_2 - 0.5*t_R4_22*t_hV5_1 - t_Sd5_4*t_hc5_2 + t_Sd5_5*t_hc5_1;
+    const eom_lanes t_Fa5_1 = t_Ic5_01*t_Sd5_0 + t_Ic5_11*t_Sd5_1 + t_Ic5_12*t_Sd5_2 + 0.5*t_Id5_01*t_R4_02 + 0.5*t_Id5_11*t_R4_12 + 0.5*t_Id5_12*t_R4_22 - 0.5*t_R4_02*t_hV5_2 + 0.5*t_R4_22*t_hV5_0 + t_Sd5_3*t_hc5_2 - t_Sd5_5*t_hc5_0;
+    const eom_lanes t_Fa5_2 = t_Ic5_02*t_Sd5_0 + t_Ic5_12*t_Sd5_1 + t_Ic5_22*t_Sd5_2 + 0.5*t_Id5_02*t_R4_02 + 0.5*t_Id5_12*t_R4_12 + 0.5*t_Id5_22*t_R4_22 + 0.5*t_R4_02*t_hV5_1 - 0.5*t_R4_12*t_hV5_0 - t_Sd5_3*t_hc5_1 + t_Sd5_4*t_hc5_0;
+    const eom_lanes t_Fa5_3 = t_R4_12*t_hV5_5 - t_R4_22*t_hV5_4 + t_Sd5_1*t_hc5_2 - t_Sd5_2*t_hc5_1 + 1.4069*t_Sd5_3;
+    const eom_lanes t_Fa5_4 = t_R4_22*t_hV5_3 - t_R4_02*t_hV5_5 - t_Sd5_0*t_hc5_2 + t_Sd5_2*t_hc5_0 + 1.4069*t_Sd5_4;
+    const eom_lanes t_Fa5_5 = t_R4_02*t_hV5_4 - t_R4_12*t_hV5_3 + t_Sd5_0*t_hc5_1 - t_Sd5_1*t_hc5_0 + 1.4069*t_Sd5_5;
+    const eom_lanes t_C5_5 = t_Fa5_0*t_R4_02 + t_Fa5_1*t_R4_12 + t_Fa5_2*t_R4_22 + t_Fa5_3*t_v5_0 + t_Fa5_4*t_v5_1 + t_Fa5_5*t_v5_2;
+    const eom_lanes t_Fb5_0 = 0.5*t_Id5_00*t_R4_02 + 0.5*t_Id5_01*t_R4_12 + 0.5*t_Id5_02*t_R4_22 - 0.5*t_R4_12*t_hV5_2 + 0.5*t_R4_22*t_hV5_1 + t_hV5_4*t_v5_2 - t_hV5_5*t_v5_1;
+    const eom_lanes t_Fb5_1 = 0.5*t_Id5_01*t_R4_02 + 0.5*t_Id5_11*t_R4_12 + 0.5*t_Id5_12*t_R4_22 + 0.5*t_R4_02*t_hV5_2 - 0.5*t_R4_22*t_hV5_0 - t_hV5_3*t_v5_2 + t_hV5_5*t_v5_0;
+    const eom_lanes t_Fb5_2 = 0.5*t_Id5_02*t_R4_02 + 0.5*t_Id5_12*t_R4_12 + 0.5*t_Id5_22*t_R4_22 - 0.5*t_R4_02*t_hV5_1 + 0.5*t_R4_12*t_hV5_0 + t_hV5_3*t_v5_1 - t_hV5_4*t_v5_0;
+    const eom_lanes t_C4_5 = t_Fa5_1*t_c1 - t_Fa5_0*t_s1 + t_Fa5_3*t_v4_0 + t_Fa5_4*t_v4_1 + t_Fa5_5*t_v4_2;
+    const eom_lanes t_C5_4 = t_F5_0*t_Sd2_0 + t_F5_1*t_Sd2_1 + t_F5_2*t_Sd4_2 + t_F5_3*t_Sd4_3 + t_F5_4*t_Sd4_4 + t_F5_5*t_Sd4_5 - t_Fb5_0*t_s1 + t_Fb5_1*t_c1;
+    const eom_lanes t_C3_5 = t_Fa5_1*t_c1 - t_Fa5_0*t_s1 + t_Fa5_3*t_v3_0 + t_Fa5_4*t_v3_1 + t_Fa5_5*t_v3_2;
+    const eom_lanes t_C5_3 = t_F5_0*t_Sd2_0 + t_F5_1*t_Sd2_1 + t_F5_2*t_Sd3_2 + t_F5_3*t_Sd3_3 + t_F5_4*t_Sd3_4 + t_F5_5*t_Sd3_5 - t_Fb5_0*t_s1 + t_Fb5_1*t_c1;
+    const eom_lanes t_C2_5 = t_Fa5_1*t_c1 - t_Fa5_0*t_s1;
+    const eom_lanes t_C5_2 = t_F5_0*t_Sd2_0 + t_F5_1*t_Sd2_1 - t_Fb5_0*t_s1 + t_Fb5_1*t_c1;
+    const eom_lanes t_Fa6_0 = 0.5*t_Id6_00*t_R5_01 + 0.5*t_Id6_01*t_R5_11 + 0.5*t_Id6_02*t_R5_21 + t_Iw6_00*t_Sd6_0 + t_Iw6_01*t_Sd6_1 + t_Iw6_02*t_Sd6_2 + 0.5*t_R5_11*t_hV6_2 - 0.5*t_R5_21*t_hV6_1 - 0.1879*t_Sd6_4*t_o6_2 + 0.1879*t_Sd6_5*t_o6_1;
+    const eom_lanes t_Fa6_1 = 0.5*t_Id6_01*t_R5_01 + 0.5*t_Id6_11*t_R5_11 + 0.5*t_Id6_12*t_R5_21 + t_Iw6_01*t_Sd6_0 + t_Iw6_11*t_Sd6_1 + t_Iw6_12*t_Sd6_2 - 0.5*t_R5_01*t_hV6_2 + 0.5*t_R5_21*t_hV6_0 + 0.1879*t_Sd6_3*t_o6_2 - 0.1879*t_Sd6_5*t_o6_0;
+    const eom_lanes t_Fa6_2 = 0.5*t_Id6_02*t_R5_01 + 0.5*t_Id6_12*t_R5_11 + 0.5*t_Id6_22*t_R5_21 + t_Iw6_02*t_Sd6_0 + t_Iw6_12*t_Sd6_1 + t_Iw6_22*t_Sd6_2 + 0.5*t_R5_01*t_hV6_1 - 0.5*t_R5_11*t_hV6_0 - 0.1879*t_Sd6_3*t_o6_1 + 0.1879*t_Sd6_4*t_o6_0;
+    const eom_lanes t_Fa6_3 = t_R5_11*t_hV6_5 - t_R5_21*t_hV6_4 + 0.1879*t_Sd6_1*t_o6_2 - 0.1879*t_Sd6_2*t_o6_1 + 0.1879*t_Sd6_3;
+    const eom_lanes t_Fa6_4 = t_R5_21*t_hV6_3 - t_R5_01*t_hV6_5 - 0.1879*t_Sd6_0*t_o6_2 + 0.1879*t_Sd6_2*t_o6_0 + 0.1879*t_Sd6_4;
+    const eom_lanes t_Fa6_5 = t_R5_01*t_hV6_4 - t_R5_11*t_hV6_3 + 0.1879*t_Sd6_0*t_o6_1 - 0.1879*t_Sd6_1*t_o6_0 + 0.1879*t_Sd6_5;
+    const eom_lanes t_C6_6 = t_Fa6_0*t_R5_01 + t_Fa6_1*t_R5_11 + t_Fa6_2*t_R5_21 + t_Fa6_3*t_v6_0 + t_Fa6_4*t_v6_1 + t_Fa6_5*t_v6_2;
+    const eom_lanes t_Fb6_0 = 0.5*t_Id6_00*t_R5_01 + 0.5*t_Id6_01*t_R5_11 + 0.5*t_Id6_02*t_R5_21 - 0.5*t_R5_11*t_hV6_2 + 0.5*t_R5_21*t_hV6_1 + t_hV6_4*t_v6_2 - t_hV6_5*t_v6_1;
+    const eom_lanes t_Fb6_1 = 0.5*t_Id6_01*t_R5_01 + 0.5*t_Id6_11*t_R5_11 + 0.5*t_Id6_12*t_R5_21 + 0.5*t_R5_01*t_hV6_2 - 0.5*t_R5_21*t_hV6_0 - t_hV6_3*t_v6_2 + t_hV6_5*t_v6_0;
+    const eom_lanes t_Fb6_2 = 0.5*t_Id6_02*t_R5_01 + 0.5*t_Id6_12*t_R5_11 + 0.5*t_Id6_22*t_R5_21 - 0.5*t_R5_01*t_hV6_1 + 0.5*t_R5_11*t_hV6_0 + t_hV6_3*t_v6_1 - t_hV6_4*t_v6_0;
+    const eom_lanes t_C5_6 = t_Fa6_0*t_R4_02 + t_Fa6_1*t_R4_12 + t_Fa6_2*t_R4_22 + t_Fa6_3*t_v5_0 + t_Fa6_4*t_v5_1 + t_Fa6_5*t_v5_2;
+    const eom_lanes t_C6_5 = t_F6_0*t_Sd5_0 + t_F6_1*t_Sd5_1 + t_F6_2*t_Sd5_2 + t_F6_3*t_Sd5_3 + t_F6_4*t_Sd5_4 + t_F6_5*t_Sd5_5 + t_Fb6_0*t_R4_02 + t_Fb6_1*t_R4_12 + t_Fb6_2*t_R4_22;
+    const eom_lanes t_C4_6 = t_Fa6_1*t_c1 - t_Fa6_0*t_s1 + t_Fa6_3*t_v4_0 + t_Fa6_4*t_v4_1 + t_Fa6_5*t_v4_2;
+    const eom_lanes t_C6_4 = t_F6_0*t_Sd2_0 + t_F6_1*t_Sd2_1 + t_F6_2*t_Sd4_2 + t_F6_3*t_Sd4_3 + t_F6_4*t_Sd4_4 + t_F6_5*t_Sd4_5 - t_Fb6_0*t_s1 + t_Fb6_1*t_c1;
+    const eom_lanes t_C3_6 = t_Fa6_1*t_c1 - t_Fa6_0*t_s1 + t_Fa6_3*t_v3_0 + t_Fa6_4*t_v3_1 + t_Fa6_5*t_v3_2;
+    const eom_lanes t_C6_3 = t_F6_0*t_Sd2_0 + t_F6_1*t_Sd2_1 + t_F6_2*t_Sd3_2 + t_F6_3*t_Sd3_3 + t_F6_4*t_Sd3_4 + t_F6_5*t_Sd3_5 - t_Fb6_0*t_s1 + t_Fb6_1*t_c1;
+    const eom_lanes t_C2_6 = t_Fa6_1*t_c1 - t_Fa6_0*t_s1;
+    const eom_lanes t_C6_2 = t_F6_0*t_Sd2_0 + t_F6_1*t_Sd2_1 - t_Fb6_0*t_s1 + t_Fb6_1*t_c1;
+    memset(out, 0, sizeof(eom_lanes) * 36);
+    out[0] = 0.5*t_Id2_22;
+    out[1] = t_Fa2_2;
+    out[2] = t_Fa3_2;
+    out[3] = t_Fa4_2;
+    out[4] = t_Fa5_2;
+    out[5] = t_Fa6_2;
+    out[6] = t_Fb2_2;
+    out[7] = t_C2_2;
+    out[8] = t_C2_3;
+    out[9] = t_C2_4;
+    out[10] = t_C2_5;
+    out[11] = t_C2_6;
+    out[12] = t_Fb3_2;
+    out[13] = t_C3_2;
+    out[14] = t_C3_3;
+    out[15] = t_C3_4;
+    out[16] = t_C3_5;
+    out[17] = t_C3_6;
+    out[18] = t_Fb4_2;
+    out[19] = t_C4_2;
+    out[20] = t_C4_3;
+    out[21] = t_C4_4;
+    out[22] = t_C4_5;
+    out[23] = t_C4_6;
+    out[24] = t_Fb5_2;
+    out[25] = t_C5_2;
+    out[26] = t_C5_3;
+    out[27] = t_C5_4;
+    out[28] = t_C5_5;
+    out[29] = t_C5_6;
+    out[30] = t_Fb6_2;
+    out[31] = t_C6_2;
+    out[32] = t_C6_3;
+    out[33] = t_C6_4;
+    out[34] = t_C6_5;
+    out[35] = t_C6_6;
+}
+#undef sin
+#undef cos
+#undef sqrt
+#else
+#define EOM_LANES_KERNEL(kernel) NULL
+#endif
+
 static const function_t mass_matrix_function = {
     "mass_matrix", 1, {"q", NULL, NULL},
     6, 6, mass_matrix_one, {NQ, 0, 0},
-    NULL};
+    NULL, 259};
 
 static PyObject *mass_matrix(PyObject *self, PyObject *const *args, Py_ssize_t nargs,
                               PyObject *kwnames)
@@ -1163,7 +1919,7 @@ static PyObject *mass_matrix(PyObject *self, PyObject *const *args, Py_ssize_t n
 static const function_t coriolis_matrix_function = {
     "coriolis_matrix", 2, {"q", "qd", NULL},
     6, 6, coriolis_matrix_one, {NQ, NV, 0},
-    NULL};
+    EOM_LANES_KERNEL(coriolis_matrix_lanes), 2293};
 
 static PyObject *coriolis_matrix(PyObject *self, PyObject *const *args, Py_ssize_t nargs,
                               PyObject *kwnames)
@@ -1175,7 +1931,7 @@ static PyObject *coriolis_matrix(PyObject *self, PyObject *const *args, Py_ssize
 static const function_t gravity_vector_function = {
     "gravity_vector", 1, {"q", NULL, NULL},
     6, 0, gravity_vector_one, {NQ, 0, 0},
-    NULL};
+    NULL, 22};
 
 static PyObject *gravity_vector(PyObject *self, PyObject *const *args, Py_ssize_t nargs,
                               PyObject *kwnames)
@@ -1187,7 +1943,7 @@ static PyObject *gravity_vector(PyObject *self, PyObject *const *args, Py_ssize_
 static const function_t inverse_dynamics_function = {
     "inverse_dynamics", 3, {"q", "qd", "qdd"},
     6, 0, inverse_dynamics_one, {NQ, NV, NV},
-    NULL};
+    NULL, 306};
 
 static PyObject *inverse_dynamics(PyObject *self, PyObject *const *args, Py_ssize_t nargs,
                               PyObject *kwnames)
@@ -1197,17 +1953,46 @@ static PyObject *inverse_dynamics(PyObject *self, PyObject *const *args, Py_ssiz
 }
 
 static const function_t forward_dynamics_function = {
-    "forward_dynamics", 3, {"q", "qd", "tau"}, NV, 0, NULL, {NQ}};
+    "forward_dynamics", 3, {"q", "qd", "tau"}, NV, 0, NULL, {NQ}, NULL, 709};
+
+/* A batch of forward_dynamics on threads (in_parts): each part's first failing state and status,
+ * and its first state of largest condition estimate. */
+typedef struct {
+    const double *q, *qd, *tau, *p;
+    double *qdd, *condition;
+    npy_intp failed[EOM_MAX_THREADS], worst[EOM_MAX_THREADS];
+    int status[EOM_MAX_THREADS];
+} forward_dynamics_job_t;
+
+static void forward_dynamics_range(void *job, int part, npy_intp begin, npy_intp end)
+{
+    forward_dynamics_job_t *j = (forward_dynamics_job_t *)job;
+    npy_intp k;
+    j->failed[part] = -1;
+    j->status[part] = 0;
+    j->worst[part] = begin;
+    for (k = begin; k < end; ++k) {
+        const int status = forward_dynamics_one(j->q + k * NQ, j->qd + k * NV, j->tau + k * NV,
+                                                j->p, j->qdd + k * NV, j->condition + k);
+        if (status) {
+            j->failed[part] = k;
+            j->status[part] = status;
+            return;
+        }
+        if (j->condition[k] > j->condition[j->worst[part]])
+            j->worst[part] = k;
+    }
+}
 
 static PyObject *forward_dynamics(PyObject *self, PyObject *const *args, Py_ssize_t nargs,
                                   PyObject *kwnames)
 {
     call_t call;
-    npy_intp dims[2], k, failed = -1, worst = 0;
-    int status = 0;
-    const double *q, *qd, *tau;
-    double *qdd, *condition;
+    npy_intp dims[2], failed = -1, worst = 0;
+    int status = 0, threads, parts = 1, t;
+    double *condition;
     PyArrayObject *result, *conditions;
+    forward_dynamics_job_t job;
     (void)self;
     if (parse(&forward_dynamics_function, args, nargs, kwnames, &call, TAKES_RETURN_CONDITION) < 0)
         return NULL;
@@ -1222,20 +2007,30 @@ static PyObject *forward_dynamics(PyObject *self, PyObject *const *args, Py_ssiz
         release(&call);
         return NULL;
     }
-    q = (const double *)PyArray_DATA(call.arrays[0]);
-    qd = (const double *)PyArray_DATA(call.arrays[1]);
-    tau = (const double *)PyArray_DATA(call.arrays[2]);
-    qdd = (double *)PyArray_DATA(result);
-    condition = (double *)PyArray_DATA(conditions);
-    for (k = 0; k < call.states; ++k) {
-        status = forward_dynamics_one(q + k * NQ, qd + k * NV, tau + k * NV, call.p,
-                                      qdd + k * NV, condition + k);
-        if (status) {
-            failed = k;
+    job.q = (const double *)PyArray_DATA(call.arrays[0]);
+    job.qd = (const double *)PyArray_DATA(call.arrays[1]);
+    job.tau = (const double *)PyArray_DATA(call.arrays[2]);
+    job.p = call.p;
+    job.qdd = (double *)PyArray_DATA(result);
+    job.condition = condition = (double *)PyArray_DATA(conditions);
+    threads = batch_threads(forward_dynamics_function.operations, call.states);
+    if (call.states > 1) {
+        Py_BEGIN_ALLOW_THREADS
+        parts = in_parts(forward_dynamics_range, &job, call.states, threads);
+        Py_END_ALLOW_THREADS
+    } else {
+        parts = in_parts(forward_dynamics_range, &job, call.states, threads);
+    }
+    /* the first failing state (parts in order), else the first state of largest estimate */
+    worst = job.worst[0];
+    for (t = 0; t < parts; ++t) {
+        if (job.failed[t] >= 0) {
+            failed = job.failed[t];
+            status = job.status[t];
             break;
         }
-        if (condition[k] > condition[worst])
-            worst = k;
+        if (call.states && condition[job.worst[t]] > condition[worst])
+            worst = job.worst[t];
     }
     release(&call);
     if (failed >= 0) {
@@ -1279,6 +2074,7 @@ static PyObject *forward_dynamics(PyObject *self, PyObject *const *args, Py_ssiz
 
 
 static PyMethodDef methods[] = {
+    THREAD_METHODS,
     {"mass_matrix", (PyCFunction)(void (*)(void))mass_matrix, METH_FASTCALL | METH_KEYWORDS,
      "mass_matrix(q)\012--\012\012Mass matrix M(q), symmetric positive definite.\012\012Inputs of shape (NV,) or (N, NV) in JOINT_NAMES order, q of shape (NQ,) or (N, NQ); returns shape (6, 6) or (N,) + that, in kg m^2 (revolute rows/columns), kg (prismatic). 259 arithmetic operations per state."},
     {"coriolis_matrix", (PyCFunction)(void (*)(void))coriolis_matrix, METH_FASTCALL | METH_KEYWORDS,
@@ -1302,6 +2098,8 @@ PyMODINIT_FUNC PyInit_ur5_fast(void)
     PyObject *module, *names, *configuration, *parameters, *exports, *linalg;
     int i;
     import_array();
+    if (read_threads_variable() < 0)
+        return NULL;
     module = PyModule_Create(&module_definition);
     if (module == NULL)
         return NULL;

@@ -212,12 +212,14 @@ def test_derivatives_agree_with_pinocchio(make, tmp_path):
 @pytest.mark.slow
 def test_panda_derivatives_agree_with_pinocchio_in_numpy_and_the_fast_module(tmp_path,
                                                                               monkeypatch):
-    """The kernels compiled once, without their fused multiply-add clones (half the compile;
-    the clones are the same code, checked against NumPy below on the planar arm)."""
+    """The kernels compiled once, without their fused multiply-add clones and lanes kernels
+    (half the compile; the clones are the same code, checked against NumPy below on the planar
+    arm)."""
     from eomgen.codegen.backends import fast_backend
 
     need("pinocchio")
     monkeypatch.setattr(fast_backend, "FMA_CLONE_OPERATIONS", float("inf"))
+    monkeypatch.setattr(fast_backend, "LANES_OPERATIONS", float("inf"))  # no lanes kernels
     worst = _pinocchio_agreement(robots.panda(), tmp_path, backends=("numpy", "fast"))
     assert len(worst) == 18 and max(worst.values()) <= 1e-10, worst
 
@@ -245,6 +247,7 @@ def test_fma_clones_of_the_fast_kernels_give_the_numpy_modules_derivatives(plana
     if "fast" not in modules:
         pytest.skip("no C compiler: the fast module was not built")
     monkeypatch.setattr(fast_backend, "FMA_CLONE_OPERATIONS", 0)
+    monkeypatch.setattr(fast_backend, "LANES_OPERATIONS", 0)
     _, cloned = generated(model, FUNCTIONS, tmp_path, backends=("fast",))
     source = (tmp_path / "planar_2link_fast.c").read_text(encoding="utf-8")
     for function in FUNCTIONS:  # the one-state kernel, and the batch's lanes kernel

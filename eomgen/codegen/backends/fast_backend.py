@@ -46,7 +46,7 @@ from .common import (import_file, parallel_indices, positional, printed_once,
 #: gives their text (``runtime.cholesky`` ...).
 RUNTIME_DIR = TEMPLATES_DIR / "fast" / "runtime"
 RUNTIME_FILES = ("cholesky", "kkt", "call", "split_columns", "contact_call", "task_space",
-                 "task_call")
+                 "task_call", "lanes_math")
 #: The line of a runtime file below which its text goes into the generated module (above it:
 #: the file's own comment and the #includes that let it compile alone).
 RUNTIME_MARKER = "/* eomgen: the generated module holds the text below this line. */\n"
@@ -111,10 +111,15 @@ def c_comment(text: str) -> str:
 #: fused multiply-add instructions, the loader picking the one the CPU runs (``target_clones``,
 #: x86-64 Linux): for such kernels the arithmetic, not the Python call, is the time, and FMA
 #: cuts it by about a third (the Panda's derivatives: 1.34 -> 0.97 µs per state in a batch);
-#: smaller kernels keep one version (cloning doubles their compile time for little). The same
-#: kernels get a lanes version for batches (:func:`in_lanes`: four states per SIMD vector; the
-#: Panda's ∂q̈ 1.43 -> 0.62 µs per state, its module's compile time 7 -> 17 s).
+#: smaller kernels keep one version (cloning doubles their compile time for little).
 FMA_CLONE_OPERATIONS = 4000
+
+#: Kernels of at least this many operations whose arithmetic a lanes kernel has
+#: (:func:`in_lanes`) get one for batches: four states per SIMD vector, always compiled with and
+#: without FMA (the FMA version is the AVX2 one), sin and cos by the runtime's vector routine
+#: (runtime ``lanes_math.c``). Below this, a batch's time is mostly the loop and the
+#: transposes, and the lanes version's compile time buys little.
+LANES_OPERATIONS = 500
 
 
 @dataclass(frozen=True)
@@ -193,7 +198,7 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
         doprint = printers.setdefault(layout, printed_once(text))
 
         rows, cols = spec.output.shape
-        lanes = spec.operation_count >= FMA_CLONE_OPERATIONS and in_lanes(spec)
+        lanes = spec.operation_count >= LANES_OPERATIONS and in_lanes(spec)
         entries = [(r * cols + c, doprint(spec.output[r, c]))
                    for r in range(rows) for c in range(cols) if spec.output[r, c] != 0]
         functions.append(dict(
@@ -296,7 +301,7 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
         renamed=[(c_string_literal(p.name), c_string_literal(p.keyword))
                  for p in job.parameters if p.renamed],
         functions=functions,
-        fma_clones=any(f["fma_clone"] for f in functions),
+        fma_clones=any(f["fma_clone"] or f["lanes"] for f in functions),
         constants=[(name, [c_string_literal(v) for v in values])
                    for name, values in job.constants],
         exports=[name for name, _ in job.constants] + list(exported(job.functions, "fast"))
@@ -304,6 +309,7 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
         forward_doc=forward_doc,
         forward_dynamics=FORWARD.function in job.functions,
         fd=composition_names(FORWARD),
+        fd_operations=_forward_operations(functions, n),
         constrained_forward_dynamics=constrained,
         cfd=cfd,
         nc=nc,
@@ -320,6 +326,14 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
         **task,
         **extra,
     )
+
+
+def _forward_operations(functions: list[dict], n: int) -> int:
+    """Operations per state of the composed forward dynamics (M, its bias, a Cholesky solve of
+    about n³/3 + 2n²): what the batch's threads are counted by (runtime ``call.c``)."""
+    names = composition_names(FORWARD)
+    return (sum(f["operation_count"] for f in functions if f["name"] in
+                (names["mass"], names["bias"])) + n ** 3 // 3 + 2 * n * n)
 
 
 def render_source(job: Job, config, **extra) -> str:

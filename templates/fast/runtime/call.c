@@ -16,7 +16,13 @@
 #define NPY_NO_DEPRECATED_API NPY_1_7_API_VERSION
 #include <numpy/arrayobject.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
+#if defined(__unix__) || defined(__APPLE__)
+#include <pthread.h>
+#include <sched.h>
+#include <unistd.h>
+#endif
 
 /* eomgen: the generated module holds the text below this line. */
 typedef void (*kernel_t)(const double *const *, const double *, double *);
@@ -42,6 +48,7 @@ typedef struct {
     kernel_t kernel;
     int sizes[MAX_IN];  /* length of each input (0: NV) */
     lanes_kernel_t lanes;  /* NULL: the batch goes state by state */
+    long operations;  /* arithmetic operations per state (0: unknown, a batch stays on one thread) */
 } function_t;
 
 static PyObject *ill_conditioned_warning = NULL;  /* IllConditionedWarning */
@@ -104,6 +111,296 @@ static npy_intp in_lanes(const function_t *f, const double *const *in, const dou
     free(work);
     return k;
 }
+
+/* The states [begin, end) of a batch: EOM_LANES at a time through f's lanes kernel where it has
+ * one (in_lanes), the rest one by one through its one-state kernel. */
+static void in_range(const function_t *f, const double *const *in, const double *p,
+                     double *out, npy_intp begin, npy_intp end)
+{
+    const npy_intp size = (npy_intp)f->rows * (f->cols ? f->cols : 1);
+    const double *at[MAX_IN] = {NULL};
+    npy_intp k = begin;
+    int j;
+    if (f->lanes != NULL && EOM_LANES > 1) {
+        for (j = 0; j < f->n_in; ++j)
+            at[j] = in[j] + begin * (f->sizes[j] ? f->sizes[j] : NV);
+        k += in_lanes(f, at, p, out + begin * size, end - begin);
+    }
+    for (; k < end; ++k) {
+        for (j = 0; j < f->n_in; ++j)
+            at[j] = in[j] + k * (f->sizes[j] ? f->sizes[j] : NV);
+        f->kernel(at, p, out + k * size);
+    }
+}
+
+/* Threads of a batch (docs/backends.md, "Batches on several cores"). A batch is cut into as
+ * many contiguous parts as threads, each a whole number of EOM_LANES blocks but the last (which
+ * also takes the remainder): state k goes through the same kernel (lanes or one-state) whatever
+ * the thread count, so that results are bitwise the same. A batch stays on one thread below
+ * EOM_WORK_PER_THREAD arithmetic operations per thread (waking a worker and handing it a part
+ * costs microseconds, more on a loaded machine; benchmarks/batch_speed.py times where a second
+ * thread pays). The
+ * count: set_threads(n), else $EOMGEN_THREADS read at import, else the CPUs this process may
+ * run on. Without POSIX threads every batch runs on the calling thread. */
+#define EOM_WORK_PER_THREAD 400000L
+#define EOM_MAX_THREADS 256
+static int eom_threads = 0;  /* 0: the default, eom_default_threads() */
+static int eom_threads_at_import = 0;  /* $EOMGEN_THREADS (0: not set) */
+
+static int eom_default_threads(void)
+{
+#if defined(__linux__) && defined(CPU_COUNT)
+    cpu_set_t set;
+    if (sched_getaffinity(0, sizeof(set), &set) == 0 && CPU_COUNT(&set) > 0)
+        return CPU_COUNT(&set) < EOM_MAX_THREADS ? CPU_COUNT(&set) : EOM_MAX_THREADS;
+#endif
+#if defined(__unix__) || defined(__APPLE__)
+    {
+        long online = sysconf(_SC_NPROCESSORS_ONLN);
+        if (online > 0)
+            return online < EOM_MAX_THREADS ? (int)online : EOM_MAX_THREADS;
+    }
+#endif
+    return 1;
+}
+
+/* The threads a batch of `states` runs on, `operations` each (the GIL held: reads the
+ * setting); never more than the batch's blocks of EOM_LANES states. */
+static int batch_threads(long operations, npy_intp states)
+{
+    const int wanted = eom_threads > 0 ? eom_threads : eom_default_threads();
+    const double work = (double)states * (double)operations;
+    const npy_intp blocks = states / EOM_LANES;
+    npy_intp most = (npy_intp)(work / (double)EOM_WORK_PER_THREAD);
+    if (most > blocks)
+        most = blocks;
+    return most < 2 ? 1 : (npy_intp)wanted < most ? wanted : (int)most;
+}
+
+/* The work of part `part` of a batch: its states [begin, end). */
+typedef void (*range_t)(void *job, int part, npy_intp begin, npy_intp end);
+
+typedef struct {
+    range_t run;
+    void *job;
+    int part;
+    npy_intp begin, end;
+} part_t;
+
+static void *run_part(void *argument)
+{
+    const part_t *part = (const part_t *)argument;
+    part->run(part->job, part->part, part->begin, part->end);
+    return NULL;
+}
+
+#if defined(__unix__) || defined(__APPLE__)
+/* The module's pool of worker threads, started when a batch first wants them and kept waiting
+ * on `wake` between batches. A batch publishes its parts (part 0 is the caller's), each FREE;
+ * a worker or the caller takes one by turning it TAKEN (atomically: each part is run once),
+ * and marks it DONE. The caller takes the parts no worker has taken, so it never waits for a
+ * worker that has not started (a loaded machine, a forked child) but only for the parts being
+ * computed; a worker that wakes late finds nothing FREE. One batch at a time (`busy`): another
+ * thread's batch meanwhile runs on its own thread. */
+enum { PART_FREE, PART_TAKEN, PART_DONE };
+static struct {
+    pthread_mutex_t busy, lock;
+    pthread_cond_t wake;
+    unsigned long generation;  /* of the batch published last (lock) */
+    int workers, forks_handled;
+    part_t parts[EOM_MAX_THREADS];
+    int state[EOM_MAX_THREADS];  /* PART_*: atomic */
+    int count;                   /* parts of the batch published last (lock) */
+} eom_pool = {.busy = PTHREAD_MUTEX_INITIALIZER, .lock = PTHREAD_MUTEX_INITIALIZER,
+              .wake = PTHREAD_COND_INITIALIZER};
+
+/* Take and run the FREE parts among 1 .. count - 1, from the first or from the last. */
+static void take_parts(int count, int from_last)
+{
+    int i;
+    for (i = 1; i < count; ++i) {
+        const int t = from_last ? count - i : i;
+        int expected = PART_FREE;
+        if (__atomic_compare_exchange_n(&eom_pool.state[t], &expected, PART_TAKEN, 0,
+                                        __ATOMIC_ACQ_REL, __ATOMIC_ACQUIRE)) {
+            run_part(&eom_pool.parts[t]);
+            __atomic_store_n(&eom_pool.state[t], PART_DONE, __ATOMIC_RELEASE);
+        }
+    }
+}
+
+static void *pool_worker(void *unused)
+{
+    unsigned long seen;
+    (void)unused;
+    pthread_mutex_lock(&eom_pool.lock);
+    seen = eom_pool.generation;
+    for (;;) {
+        int count;
+        while (eom_pool.generation == seen)
+            pthread_cond_wait(&eom_pool.wake, &eom_pool.lock);
+        seen = eom_pool.generation;
+        count = eom_pool.count;
+        pthread_mutex_unlock(&eom_pool.lock);
+        take_parts(count, 0);
+        pthread_mutex_lock(&eom_pool.lock);
+    }
+    return NULL;
+}
+
+/* In a child process after fork(): no worker exists there; a fresh pool. */
+static void pool_after_fork(void)
+{
+    pthread_mutex_init(&eom_pool.busy, NULL);
+    pthread_mutex_init(&eom_pool.lock, NULL);
+    pthread_cond_init(&eom_pool.wake, NULL);
+    eom_pool.workers = 0;
+}
+
+/* Start workers until there are `wanted` (fewer when a thread cannot be started). */
+static void pool_start(int wanted)
+{
+    pthread_attr_t attributes;
+    if (!eom_pool.forks_handled)
+        eom_pool.forks_handled = pthread_atfork(NULL, NULL, pool_after_fork) == 0;
+    if (eom_pool.workers >= wanted || pthread_attr_init(&attributes) != 0)
+        return;
+    pthread_attr_setdetachstate(&attributes, PTHREAD_CREATE_DETACHED);
+    while (eom_pool.workers < wanted) {
+        pthread_t id;
+        if (pthread_create(&id, &attributes, pool_worker, NULL) != 0)
+            break;
+        ++eom_pool.workers;
+    }
+    pthread_attr_destroy(&attributes);
+}
+#endif
+
+/* run(job, t, ...) on the batch's states in `parts` contiguous parts on `threads` threads:
+ * EOM_PARTS_PER_THREAD parts a thread (at most EOM_MAX_THREADS, at least a block each), part t
+ * from state blocks * t / parts * EOM_LANES (blocks: whole blocks of EOM_LANES states), the last
+ * taking the remainder. Part 0 on the calling thread, the others on the pool's workers or, those
+ * no worker took, on the calling thread too: the parts are the same whoever computes them, and
+ * a worker that loses its core holds up the batch by one small part at most. Returns the number
+ * of parts, 1 (the whole batch as part 0) when the pool is busy with another batch or there are
+ * no POSIX threads. */
+#define EOM_PARTS_PER_THREAD 8
+static int in_parts(range_t run, void *job, npy_intp states, int threads)
+{
+    part_t whole;
+#if defined(__unix__) || defined(__APPLE__)
+    if (threads > 1 && pthread_mutex_trylock(&eom_pool.busy) == 0) {
+        const npy_intp blocks = states / EOM_LANES;
+        part_t *parts = eom_pool.parts;
+        npy_intp most = (npy_intp)threads * EOM_PARTS_PER_THREAD;
+        int count, t;
+        if (most > EOM_MAX_THREADS)
+            most = EOM_MAX_THREADS;
+        count = (int)(most < blocks ? most : blocks);
+        pool_start(threads - 1);
+        for (t = 0; t < count; ++t) {
+            parts[t].run = run;
+            parts[t].job = job;
+            parts[t].part = t;
+            parts[t].begin = blocks * t / count * EOM_LANES;
+            parts[t].end = t + 1 < count ? blocks * (t + 1) / count * EOM_LANES : states;
+            __atomic_store_n(&eom_pool.state[t], t ? PART_FREE : PART_TAKEN, __ATOMIC_RELEASE);
+        }
+        pthread_mutex_lock(&eom_pool.lock);
+        eom_pool.count = count;
+        ++eom_pool.generation;
+        pthread_cond_broadcast(&eom_pool.wake);
+        pthread_mutex_unlock(&eom_pool.lock);
+        run_part(&parts[0]);
+        take_parts(count, 0);
+        for (t = 1; t < count; ++t)
+            while (__atomic_load_n(&eom_pool.state[t], __ATOMIC_ACQUIRE) != PART_DONE)
+                sched_yield();
+        pthread_mutex_unlock(&eom_pool.busy);
+        return count;
+    }
+#endif
+    whole.run = run;
+    whole.job = job;
+    whole.part = 0;
+    whole.begin = 0;
+    whole.end = states;
+    run_part(&whole);
+    return 1;
+}
+
+/* evaluate()'s batch: f on inputs `in`, parameters p, results `out`. */
+typedef struct {
+    const function_t *f;
+    const double *const *in;
+    const double *p;
+    double *out;
+} evaluation_t;
+
+static void evaluate_range(void *job, int part, npy_intp begin, npy_intp end)
+{
+    const evaluation_t *e = (const evaluation_t *)job;
+    (void)part;
+    in_range(e->f, e->in, e->p, e->out, begin, end);
+}
+
+/* Module functions set_threads(n) and threads(). */
+static PyObject *set_threads(PyObject *self, PyObject *value)
+{
+    long n;
+    (void)self;
+    if (value == Py_None) {
+        eom_threads = eom_threads_at_import;
+        Py_RETURN_NONE;
+    }
+    n = PyLong_Check(value) ? PyLong_AsLong(value) : -1;
+    if (n == -1 && PyErr_Occurred())
+        PyErr_Clear();
+    if (!PyLong_Check(value) || PyBool_Check(value) || n < 1 || n > EOM_MAX_THREADS) {
+        PyErr_Format(PyLong_Check(value) && !PyBool_Check(value) ? PyExc_ValueError
+                                                                 : PyExc_TypeError,
+                     "set_threads(): n must be an integer from 1 to %d or None (the CPUs this "
+                     "process may use), got %R", EOM_MAX_THREADS, value);
+        return NULL;
+    }
+    eom_threads = (int)n;
+    Py_RETURN_NONE;
+}
+
+static PyObject *threads(PyObject *self, PyObject *unused)
+{
+    (void)self;
+    (void)unused;
+    return PyLong_FromLong(eom_threads > 0 ? eom_threads : eom_default_threads());
+}
+
+/* At import: $EOMGEN_THREADS, when set, is the thread count; -1 with a ValueError when it is
+ * not an integer from 1 to EOM_MAX_THREADS. */
+static int read_threads_variable(void)
+{
+    const char *text = getenv("EOMGEN_THREADS");
+    char *end = NULL;
+    long n;
+    if (text == NULL || *text == '\0')
+        return 0;
+    n = strtol(text, &end, 10);
+    if (*end != '\0' || n < 1 || n > EOM_MAX_THREADS) {
+        PyErr_Format(PyExc_ValueError, "EOMGEN_THREADS must be an integer from 1 to %d, got "
+                     "'%s'", EOM_MAX_THREADS, text);
+        return -1;
+    }
+    eom_threads = eom_threads_at_import = (int)n;
+    return 0;
+}
+
+#define THREAD_METHODS \
+    {"set_threads", (PyCFunction)set_threads, METH_O, \
+     "set_threads(n)\n--\n\nRun this module's batches on n threads (n from 1 to 256; None: the " \
+     "CPUs this process may use, or $EOMGEN_THREADS when set at import). Batches of little " \
+     "work stay on one thread; results are bitwise the same for every n."}, \
+    {"threads", (PyCFunction)threads, METH_NOARGS, \
+     "threads()\n--\n\nThe number of threads this module's batches may run on."}
+
 /* The keywords a composed function takes besides its inputs and parameters (parse()). */
 #define TAKES_RETURN_CONDITION 1
 #define TAKES_DAMPING 2
@@ -340,8 +637,7 @@ static PyObject *evaluate(const function_t *f, PyObject *const *args, Py_ssize_t
     call_t call;
     npy_intp dims[3];
     int nd = 0, j;
-    npy_intp k, size = (npy_intp)f->rows * (f->cols ? f->cols : 1);
-    const double *in[MAX_IN] = {NULL}, *at[MAX_IN] = {NULL};
+    const double *in[MAX_IN] = {NULL};
     double *out;
     PyArrayObject *result;
     if (parse(f, args, nargs, kwnames, &call, 0) < 0)
@@ -362,13 +658,10 @@ static PyObject *evaluate(const function_t *f, PyObject *const *args, Py_ssize_t
     if (call.states == 1) {
         f->kernel(in, call.p, out);
     } else {
+        evaluation_t job = {f, in, call.p, out};
+        const int threads = batch_threads(f->operations, call.states);
         Py_BEGIN_ALLOW_THREADS
-        k = f->lanes != NULL && EOM_LANES > 1 ? in_lanes(f, in, call.p, out, call.states) : 0;
-        for (; k < call.states; ++k) {
-            for (j = 0; j < f->n_in; ++j)
-                at[j] = in[j] + k * (f->sizes[j] ? f->sizes[j] : NV);
-            f->kernel(at, call.p, out + k * size);
-        }
+        in_parts(evaluate_range, &job, call.states, threads);
         Py_END_ALLOW_THREADS
     }
     release(&call);
