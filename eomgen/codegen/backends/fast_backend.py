@@ -28,7 +28,8 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.precedence import PRECEDENCE
 
-from ...common.compiler import c_compiler, shared_library
+from ...common.compiler import c_compiler, compile_jobs, linked_library, shared_library
+from ...common import progress as progress_lines
 from ...common.output import GeneratedFile
 from ..job import Job
 from ..registry import Loaded, register
@@ -40,13 +41,14 @@ from ...symbolic.printing import FloatLiteralMixin, renamed
 from ...common.templating import TEMPLATES_DIR, render
 from .common import (import_file, parallel_indices, positional, printed_once,
                      warning_exports)
+from .fast_units import kernel_signature, split_source
 
 #: The fixed C runtime every generated module includes parts of: real C files (compiled and
 #: warning-checked on their own by tests/backends/test_fast_runtime_c.py), by the name the template
 #: gives their text (``runtime.cholesky`` ...).
 RUNTIME_DIR = TEMPLATES_DIR / "fast" / "runtime"
 RUNTIME_FILES = ("cholesky", "kkt", "call", "split_columns", "contact_call", "task_space",
-                 "task_call")
+                 "task_call", "fma_clones", "lanes")
 #: The line of a runtime file below which its text goes into the generated module (above it:
 #: the file's own comment and the #includes that let it compile alone).
 RUNTIME_MARKER = "/* eomgen: the generated module holds the text below this line. */\n"
@@ -198,6 +200,8 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
                    for r in range(rows) for c in range(cols) if spec.output[r, c] != 0]
         functions.append(dict(
             name=spec.name, summary=spec.summary, inputs=[a.name for a in spec.arguments],
+            one_signature=kernel_signature(spec.name),
+            lanes_signature=kernel_signature(spec.name, lanes=True),
             slots=[f'"{a.name}"' for a in spec.arguments]
             + ["NULL"] * (max_inputs - len(spec.arguments)),
             # lengths of the inputs (NV for the joint vectors; F_c has the contact rows)
@@ -373,10 +377,16 @@ def python_headers() -> tuple[str, ...] | None:
     return include, numpy.get_include()
 
 
-def compile_module(source: str, module: str, config: FastConfig = FastConfig()
-                   ) -> bytes | str:
+def compile_module(source: str, module: str, config: FastConfig = FastConfig(),
+                   kernels: list[tuple[str, int]] = ()) -> bytes | str:
     """Compile the extension ``module`` from ``source``: the shared library's bytes, or a
-    one-line reason why it was not built (no C compiler, no Python headers)."""
+    one-line reason why it was not built (no C compiler, no Python headers).
+
+    With ``kernels`` (the module's kernels, ``(name, operations)``), the long ones are cut out
+    into translation units (:func:`~.fast_units.split_source`) compiled in parallel
+    (:func:`~eomgen.common.compiler.compile_jobs` at a time) and cached by content in the
+    cache folder's ``objects`` (:class:`ObjectStore`), then linked into the one extension; its
+    progress goes to :func:`eomgen.common.progress.current`."""
     compiler = c_compiler()
     if compiler is None:
         return "no C compiler found (set CC)"
@@ -384,8 +394,45 @@ def compile_module(source: str, module: str, config: FastConfig = FastConfig()
     if headers is None:
         return "Python's C headers (Python.h) are not installed"
     suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
-    return shared_library(compiler, source, module, [*config.flags, *(f"-I{h}" for h in headers)],
-                          suffix)
+    flags = [*config.flags, *(f"-I{h}" for h in headers)]
+    units = split_source(source, module, list(kernels),
+                         {name: runtime_source(name) for name in ("fma_clones", "lanes", "call")}
+                         ) if kernels else None
+    if units is None:
+        return shared_library(compiler, source, module, flags, suffix)
+    return linked_library(compiler, [(u.name, u.text, u.weight) for u in units], module,
+                          [f for f in flags if f != "-shared"],
+                          [f for f in config.flags if f in ("-shared", "-fPIC")], suffix,
+                          jobs=compile_jobs(), cache=ObjectStore(),
+                          progress=progress_lines.current())
+
+
+class ObjectStore:
+    """Compiled objects of the fast module's translation units, kept in the derivation cache's
+    folder (:func:`eomgen.cache.default_cache_dir`), in ``objects/``: entries signed as the
+    derivation cache's are (:class:`eomgen.cache.store.Cache`; the least recently used beyond
+    its limit deleted). A cache that cannot be read or written costs a compile, never the
+    build."""
+
+    def __init__(self, directory: Path | None = None):
+        from ...cache.store import Cache, default_cache_dir  # only a split build needs it
+
+        self._cache = Cache((directory or default_cache_dir()) / "objects")
+
+    def get(self, key: str) -> bytes | None:
+        try:
+            entry = self._cache.get(key)
+        except Exception:  # noqa: BLE001 - a broken cache must not fail the build
+            return None
+        if entry is None or len(entry.files) != 1 or not isinstance(entry.files[0].content, bytes):
+            return None
+        return entry.files[0].content
+
+    def put(self, key: str, data: bytes) -> None:
+        try:
+            self._cache.put(key, [GeneratedFile("unit.o", data, golden=False)])
+        except Exception:  # noqa: BLE001 - as in get
+            pass
 
 
 def load_fast(folder: Path, stem: str) -> Loaded:
@@ -411,7 +458,8 @@ def build_fast(job: Job, emitted: list[GeneratedFile], config: FastConfig = Fast
     RuntimeWarning saying why) when no C compiler or no Python headers are found."""
     module = job.stem + config.suffix
     (source,) = [f.content for f in emitted if f.name == module + ".c"]
-    built = compile_module(source, module, config)
+    built = compile_module(source, module, config,
+                           [(spec.name, spec.operation_count) for spec in job.specs])
     if isinstance(built, bytes):
         suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
         return [GeneratedFile(module + suffix, built, golden=False)]
