@@ -134,3 +134,27 @@ def test_jobs_come_from_the_block_else_the_environment(monkeypatch):
     with pytest.raises(ValueError, match="jobs must be"):
         with compiler.jobs_set(0):
             pass
+
+
+def test_generate_jobs_reaches_the_build_and_the_compile_is_reported(tmp_path, monkeypatch):
+    """``eomgen generate --jobs 1``: the split build runs one compiler at a time and its
+    progress lines name the units; ``--jobs 0`` is refused (exit 2) before any work."""
+    from support import run_cli
+
+    monkeypatch.setattr(fast_units, "UNIT_OPERATIONS", 1)
+    seen = []
+    real = compiler.linked_library
+
+    def spy(*args, **kwargs):
+        seen.append(kwargs["jobs"])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(fast_backend, "linked_library", spy)
+    result = run_cli("generate", eomgen.example_path("planar_2link"), "--backend", "fast",
+                     "--no-cache", "--jobs", "1", "-o", tmp_path / "out")
+    assert result.exit_code == 0, result.output
+    assert seen == [1]
+    assert "compiling planar_2link_fast: unit 1 of " in result.stderr
+    refused = run_cli("generate", "--backend", "fast", "--jobs", "0", "-o", tmp_path / "no")
+    assert refused.exit_code == 2 and "--jobs" in refused.stderr
+    assert not (tmp_path / "no").exists()
