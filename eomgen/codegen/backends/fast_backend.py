@@ -13,6 +13,9 @@ routine on stack arrays (docs/contact.md has the constrained solve and its error
 
 Printer: SymPy's :class:`~sympy.printing.c.C99CodePrinter` with exact float literals and
 small integer powers written as products. Template: ``templates/fast/module.c.jinja``.
+
+Build: the long kernels are cut out of the source into translation units of their own
+(:mod:`.fast_units`), compiled in parallel and cached by content (:func:`compile_module`).
 """
 
 from __future__ import annotations
