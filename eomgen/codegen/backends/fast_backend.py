@@ -119,6 +119,16 @@ def c_comment(text: str) -> str:
 #: smaller kernels keep one version (cloning doubles their compile time for little). The same
 #: kernels get a lanes version for batches (:func:`in_lanes`: four states per SIMD vector; the
 #: Panda's ∂q̈ 1.43 -> 0.62 µs per state, its module's compile time 7 -> 17 s).
+#:
+#: The rule, a clone only where it pays, measured kernel by kernel (issue 42,
+#: benchmarks/fma_clones.py: the Panda's module built with the clones and with one plain
+#: version, calls timed alternately, load 7–9 on 2 cores): clones / plain 0.75 for ∂τ (5,147
+#: operations) and 0.85 for ∂q̈ (7,957) per one-state call (1,719 / 2,296 ns and 3,504 / 4,073
+#: ns, the Python call included), 0.53 and 0.50 per state in a batch of 64: every clone above
+#: this threshold pays. Below it, the ABA (1,747 operations) measured 0.76 one state and batch
+#: alike (895 / 1,194 ns): a lower threshold would pay at run time too, for twice the compile
+#: time of those kernels (the clones build of that module 140 s against 67 s plain) and new
+#: golden files; it is left at 4000 until measured on more kernels between.
 FMA_CLONE_OPERATIONS = 4000
 
 
