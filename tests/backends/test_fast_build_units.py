@@ -158,3 +158,11 @@ def test_generate_jobs_reaches_the_build_and_the_compile_is_reported(tmp_path, m
     refused = run_cli("generate", "--backend", "fast", "--jobs", "0", "-o", tmp_path / "no")
     assert refused.exit_code == 2 and "--jobs" in refused.stderr
     assert not (tmp_path / "no").exists()
+
+
+def test_jobs_leave_the_command_cache_key_alone():
+    from eomgen.cache import command_request
+
+    arm = eomgen.example_path("planar_2link")
+    keys = {command_request(arm, {"backends": "fast", "jobs": jobs}).key for jobs in (None, 1, 2)}
+    assert len(keys) == 1
