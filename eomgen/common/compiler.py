@@ -21,6 +21,8 @@ from contextvars import ContextVar
 from pathlib import Path
 from typing import Callable, Iterator, Protocol, Sequence
 
+from ..errors import GenerationError
+
 #: Tried in this order after ``$CC``.
 CANDIDATES = ("cc", "gcc", "clang")
 
@@ -87,7 +89,8 @@ def jobs_set(jobs: int | None) -> Iterator[None]:
 
 def compile_jobs() -> int:
     """How many compilers a build runs at a time: what :func:`jobs_set` set, else
-    ``$EOMGEN_JOBS``, else the number of cores this process may use."""
+    ``$EOMGEN_JOBS``, else the number of cores this process may use. A GenerationError (exit 2
+    from the command line) for an ``$EOMGEN_JOBS`` that is not a whole number >= 1."""
     jobs = _jobs.get()
     if jobs is not None:
         return jobs
@@ -98,7 +101,7 @@ def compile_jobs() -> int:
         except ValueError:
             value = 0
         if value < 1:
-            raise ValueError(f"{JOBS_VARIABLE}={text!r}: not a whole number >= 1")
+            raise GenerationError(f"{JOBS_VARIABLE}={text!r}: not a whole number >= 1")
         return value
     try:
         return max(1, len(os.sched_getaffinity(0)))

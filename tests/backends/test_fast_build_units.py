@@ -19,6 +19,7 @@ from eomgen.codegen.backends.fast_backend import build_fast, emit_fast, python_h
 from eomgen.common import compiler
 from eomgen.common.progress import reporting
 from eomgen.dynamics import derive
+from eomgen.errors import GenerationError
 from support import load_module
 
 pytestmark = pytest.mark.skipif(compiler.c_compiler() is None or python_headers() is None,
@@ -127,7 +128,7 @@ def test_jobs_come_from_the_block_else_the_environment(monkeypatch):
     with compiler.jobs_set(1):
         assert compiler.compile_jobs() == 1
     monkeypatch.setenv(compiler.JOBS_VARIABLE, "zero")
-    with pytest.raises(ValueError, match="EOMGEN_JOBS='zero'"):
+    with pytest.raises(GenerationError, match="EOMGEN_JOBS='zero'"):
         compiler.compile_jobs()
     monkeypatch.delenv(compiler.JOBS_VARIABLE)
     assert compiler.compile_jobs() >= 1
