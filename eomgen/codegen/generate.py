@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Callable, Iterable, Sequence
 
 from ..dynamics import derive
-from ..cache import CacheRequest, render_cached
+from ..cache import CacheRequest, cache_folder, render_cached
 from ..errors import GenerationError
 from ..model import RobotModel, snap_summary
 from ..common.output import checked_stem, import_collisions, write_atomically  # noqa: F401
@@ -203,6 +203,7 @@ def generate(model: RobotModel, outdir: Path, backends: str | Sequence[str] = "a
     options = {} if build else {"build": False}
     if stem is not None:  # likewise: part of the key only when given
         options["stem"] = stem
-    files = render_cached(render_files, model, chosen, progress, cache=cache,
-                          cache_dir=cache_dir, functions=functions, **options)
+    with cache_folder(cache_dir):  # the fast module's compiled objects go there too
+        files = render_cached(render_files, model, chosen, progress, cache=cache,
+                              cache_dir=cache_dir, functions=functions, **options)
     return write_atomically(files, Path(outdir))

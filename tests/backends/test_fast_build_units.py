@@ -167,3 +167,17 @@ def test_jobs_leave_the_command_cache_key_alone():
     arm = eomgen.example_path("planar_2link")
     keys = {command_request(arm, {"backends": "fast", "jobs": jobs}).key for jobs in (None, 1, 2)}
     assert len(keys) == 1
+
+
+def test_the_objects_go_to_generates_cache_folder(tmp_path, monkeypatch):
+    """``generate(..., cache_dir=D)`` (``--cache-dir``) keeps the compiled objects in D too,
+    not in $EOMGEN_CACHE_DIR."""
+    from eomgen.codegen.generate import generate
+
+    monkeypatch.setenv("EOMGEN_CACHE_DIR", str(tmp_path / "environment"))
+    monkeypatch.setattr(fast_units, "UNIT_OPERATIONS", 1)
+    model = eomgen.load(eomgen.example_path("planar_2link"))
+    generate(model, tmp_path / "out", ["fast"], functions=["M"], cache=False,
+             cache_dir=tmp_path / "given")
+    assert len(list((tmp_path / "given" / "objects" / "entries").glob("*.entry"))) == 2
+    assert not (tmp_path / "environment").exists()

@@ -422,7 +422,8 @@ def compile_module(source: str, module: str, config: FastConfig = FastConfig(),
 
 class ObjectStore:
     """Compiled objects of the fast module's translation units, kept in the derivation cache's
-    folder (:func:`eomgen.cache.default_cache_dir`), in ``objects/``: entries signed as the
+    folder (:func:`eomgen.cache.default_cache_dir`: ``generate``'s ``cache_dir`` when given,
+    :func:`eomgen.cache.store.cache_folder`), in ``objects/``: entries signed as the
     derivation cache's are (:class:`eomgen.cache.store.Cache`; the least recently used beyond
     its limit deleted). A cache that cannot be read or written costs a compile, never the
     build."""
