@@ -16,7 +16,8 @@ import subprocess
 import tempfile
 import threading
 import time
-from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor
+from concurrent.futures import wait as wait_for
 from contextvars import ContextVar
 from pathlib import Path
 from typing import Callable, Iterator, Protocol, Sequence
@@ -191,7 +192,7 @@ def linked_library(compiler: str, units: Sequence[tuple[str, str, int]], name: s
         try:
             pending = {pool.submit(compile_one, k): k for k in todo}
             while pending:
-                finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+                finished, _ = wait_for(pending, return_when=FIRST_COMPLETED)
                 for future in finished:
                     k = pending.pop(future)
                     returncode, stderr = future.result()
