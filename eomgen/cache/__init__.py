@@ -21,9 +21,10 @@ from .generation import CachedNotice, render_cached
 from .keys import (COMMAND_IGNORED, COMMAND_KEYED, FORMAT, MAX_KEYED_BYTES, CacheRequest,
                    cache_key, canonical, code_version, command_request, generation_key,
                    model_fingerprint, toolchain)
-from .store import MAX_ENTRIES, Cache, Entry, Notify, default_cache_dir
+from .store import MAX_ENTRIES, Cache, Entry, Notify, cache_folder, default_cache_dir
 
 __all__ = ["COMMAND_IGNORED", "COMMAND_KEYED", "FORMAT", "MAX_ENTRIES", "MAX_KEYED_BYTES",
-           "Cache", "CacheRequest", "CachedNotice", "Entry", "Notify", "cache_key", "canonical",
+           "Cache", "CacheRequest", "CachedNotice", "Entry", "Notify", "cache_folder", "cache_key",
+           "canonical",
            "code_version", "command_request", "default_cache_dir", "generation_key",
            "model_fingerprint", "render_cached", "toolchain"]

@@ -44,7 +44,8 @@ MAX_KEYED_BYTES = 50 * 1024 * 1024
 #: The package's folder (eomgen/), whose sources and templates the code version covers.
 _PACKAGE = Path(__file__).resolve().parents[1]
 #: ``eomgen generate`` parameters that do not change what is written.
-COMMAND_IGNORED = frozenset({"description", "outdir", "quiet", "debug", "no_cache", "cache_dir"})
+COMMAND_IGNORED = frozenset({"description", "outdir", "quiet", "debug", "no_cache", "cache_dir",
+                             "jobs"})
 #: ``eomgen generate`` parameters that enter the key (and ``scene_path``, keyed by the scene
 #: file's bytes and name). A parameter in none of these, given with a value other than None or
 #: False (``--explain``), turns the command-level cache off for that run: it may print more

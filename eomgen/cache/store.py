@@ -23,6 +23,7 @@ The folder is ``--cache-dir``, else ``$EOMGEN_CACHE_DIR``, else ``$XDG_CACHE_HOM
 from __future__ import annotations
 
 import base64
+import contextlib
 import hashlib
 import hmac
 import json
@@ -31,9 +32,10 @@ import re
 import secrets
 import stat
 import sys
+from contextvars import ContextVar
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import Callable, Iterator, Sequence
 
 from ..common.output import GeneratedFile
 from .keys import FORMAT, code_version
@@ -52,8 +54,26 @@ def _stderr_notice(text: str) -> None:
     print(f"eomgen: notice: {text}", file=sys.stderr, flush=True)
 
 
+_folder: ContextVar[Path | None] = ContextVar("eomgen_cache_folder", default=None)
+
+
+@contextlib.contextmanager
+def cache_folder(directory: Path | str | None) -> Iterator[None]:
+    """Within the block, :func:`default_cache_dir` is ``directory`` (None: unchanged):
+    ``generate(..., cache_dir=...)`` sets it, so that what its build steps keep (the fast
+    module's compiled objects) goes where the derivation cache does."""
+    token = _folder.set(Path(directory) if directory is not None else _folder.get())
+    try:
+        yield
+    finally:
+        _folder.reset(token)
+
+
 def default_cache_dir() -> Path:
-    """``$EOMGEN_CACHE_DIR``, else ``$XDG_CACHE_HOME/eomgen``, else ``~/.cache/eomgen``."""
+    """The folder :func:`cache_folder` set, else ``$EOMGEN_CACHE_DIR``, else
+    ``$XDG_CACHE_HOME/eomgen``, else ``~/.cache/eomgen``."""
+    if _folder.get() is not None:
+        return _folder.get()
     explicit = os.environ.get("EOMGEN_CACHE_DIR")
     if explicit:
         return Path(explicit)
@@ -338,4 +358,4 @@ def _decode_file(data: dict) -> GeneratedFile:
     raise ValueError("bad file entry")
 
 
-__all__ = ["MAX_ENTRIES", "Cache", "Entry", "Notify", "default_cache_dir"]
+__all__ = ["MAX_ENTRIES", "Cache", "Entry", "Notify", "cache_folder", "default_cache_dir"]

@@ -172,10 +172,13 @@ def answer_from_cache(request, outdir: Path, quiet: bool, cache_dir: Path | None
               help="Comma-separated functions to export, by name or symbol (default: M, C, g, "
                    "tau and forward dynamics; docs/outputs.md lists the others, e.g. Y). "
                    "Replaces a scene's outputs.")
+@click.option("--jobs", default=None, type=click.IntRange(min=1), metavar="N",
+              help="Compilers run at a time when building the fast module, whose long kernels "
+                   "compile as units of their own (default: $EOMGEN_JOBS, else the cores).")
 @strict_option
 @handle_errors
 def generate(description, backends, outdir, symbolic, quiet, scene_path, explain, no_cache,
-             cache_dir, name, no_snap, outputs, strict):
+             cache_dir, name, no_snap, outputs, jobs, strict):
     """Generate code and a derivation for DESCRIPTION (default: the bundled planar 2-link arm).
 
     Writes the files of each backend (listed below) into OUTPUT, named <robot>_<backend>
@@ -205,6 +208,7 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
             return
     # SymPy and the code generators: only when the cache did not answer
     from ..codegen.generate import generate as run_generate
+    from ..common.compiler import jobs_set
 
     with recorded_warnings() as notices:
         scene = None
@@ -223,14 +227,17 @@ def generate(description, backends, outdir, symbolic, quiet, scene_path, explain
     if scene_path is not None or explain:
         from ..codegen.scene_generate import generate_scene  # SymPy, as above
 
-        paths, produced = generate_scene(model, scene, outdir, backends, names, progress,
-                                         explain, cache=cache, cache_dir=cache_dir, stem=name)
+        with jobs_set(jobs):
+            paths, produced = generate_scene(model, scene, outdir, backends, names, progress,
+                                             explain, cache=cache, cache_dir=cache_dir,
+                                             stem=name)
         progress.clear()
         if explain:
             click.echo(produced.markdown)
     else:
-        paths = run_generate(model, outdir, backends, names, progress, functions, cache=cache,
-                             cache_dir=cache_dir, stem=name)
+        with jobs_set(jobs):
+            paths = run_generate(model, outdir, backends, names, progress, functions,
+                                 cache=cache, cache_dir=cache_dir, stem=name)
         progress.clear()
     for path in paths:
         click.echo(str(path))

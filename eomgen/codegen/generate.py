@@ -12,11 +12,11 @@ from pathlib import Path
 from typing import Callable, Iterable, Sequence
 
 from ..dynamics import derive
-from ..cache import CacheRequest, render_cached
+from ..cache import CacheRequest, cache_folder, render_cached
 from ..errors import GenerationError
 from ..model import RobotModel, snap_summary
 from ..common.output import checked_stem, import_collisions, write_atomically  # noqa: F401
-from ..common.progress import plural
+from ..common.progress import plural, reporting
 from ..outputs import OUTPUTS
 from ..common.output import GeneratedFile
 from .job import make_job
@@ -133,7 +133,8 @@ def render_job(job, backends: Sequence[str], progress: Progress = lambda _: None
     for name in backends:
         start = time.perf_counter()
         progress(f"{name}: generating")  # the C backend compiles: a stage of its own in a log
-        produced = registry[name].files(job, build)
+        with reporting(progress):  # a build step reports its compile (the fast backend's units)
+            produced = registry[name].files(job, build)
         progress(f"{name}: {', '.join(f.name for f in produced)} "
                  f"({time.perf_counter() - start:.2f} s)")
         files.extend(produced)
@@ -202,6 +203,7 @@ def generate(model: RobotModel, outdir: Path, backends: str | Sequence[str] = "a
     options = {} if build else {"build": False}
     if stem is not None:  # likewise: part of the key only when given
         options["stem"] = stem
-    files = render_cached(render_files, model, chosen, progress, cache=cache,
-                          cache_dir=cache_dir, functions=functions, **options)
+    with cache_folder(cache_dir):  # the fast module's compiled objects go there too
+        files = render_cached(render_files, model, chosen, progress, cache=cache,
+                              cache_dir=cache_dir, functions=functions, **options)
     return write_atomically(files, Path(outdir))

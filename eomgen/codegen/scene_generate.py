@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterable, Sequence
 
-from ..cache import Cache, CacheRequest
+from ..cache import Cache, CacheRequest, cache_folder
 from ..dynamics import derive
 from ..model import RobotModel
 from ..common.output import checked_stem
@@ -142,8 +142,9 @@ def generate_scene(model: RobotModel, scene: Scene | None, outdir: Path,
         chosen, skipped = usable_backends(chosen, outputs)
         for name in skipped:
             progress(f"{name}: skipped (needs {', '.join(available_backends()[name].needs)})")
-    produced = render_scene_files(model, scene, chosen, symbolic, progress, explain, timeout,
-                                  build, stem)
+    with cache_folder(cache_dir):  # the fast module's compiled objects go there
+        produced = render_scene_files(model, scene, chosen, symbolic, progress, explain,
+                                      timeout, build, stem)
     if isinstance(cache, CacheRequest) and build:  # the key says nothing of build=False
         Cache(cache_dir).put(cache.key, produced.files, tuple(cache.notices))
     return write_atomically(produced.files, Path(outdir)), produced

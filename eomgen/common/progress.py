@@ -27,7 +27,26 @@ import contextlib
 import sys
 import threading
 import time
+from contextvars import ContextVar
 from typing import Callable, Iterator, TextIO
+
+_current: ContextVar[Callable[[str], None] | None] = ContextVar("eomgen_progress", default=None)
+
+
+@contextlib.contextmanager
+def reporting(progress: Callable[[str], None]) -> Iterator[None]:
+    """Within the block, :func:`current` is ``progress``."""
+    token = _current.set(progress)
+    try:
+        yield
+    finally:
+        _current.reset(token)
+
+
+def current() -> Callable[[str], None]:
+    """The progress callable :func:`reporting` set, else one that prints nothing."""
+    progress = _current.get()
+    return progress if progress is not None else (lambda _: None)
 
 
 #: The Progress whose terminal line is open (not ended by a newline), if any.

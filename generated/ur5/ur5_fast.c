@@ -1453,11 +1453,6 @@ static PyObject *evaluate(const function_t *f, PyObject *const *args, Py_ssize_t
 }
 
 #if EOM_LANES > 1
-/* The lanes kernels of a batch (in_lanes): the one-state kernels' arithmetic on vectors of
- * EOM_LANES states, sin and cos by the vector routine below, sqrt lane by lane (a statement
- * expression: no vector crosses a function call); a constant is broadcast to every lane. Every
- * kernel of at least LANES_OPERATIONS operations (eomgen's fast backend) whose arithmetic is
- * +, -, *, / and those functions has one, compiled with and without FMA (FMA_CLONES). */
 typedef unsigned long long eom_lane_bits __attribute__((vector_size(8 * EOM_LANES)));
 typedef long long eom_lane_ints __attribute__((vector_size(8 * EOM_LANES)));
 
@@ -1528,6 +1523,11 @@ static EOM_INLINE void eom_sincos_lanes(const eom_lanes *at, eom_lanes *sine, eo
     eom_sincos_lanes(&eom_x, &eom_sine, &eom_cosine); \
     eom_cosine; })
 
+/* The lanes kernels of a batch (in_lanes): the one-state kernels' arithmetic on vectors of
+ * EOM_LANES states, sin and cos by the vector routine above, sqrt lane by lane (a statement
+ * expression: no vector crosses a function call); a constant is broadcast to every lane. Every
+ * kernel of at least LANES_OPERATIONS operations (eomgen's fast backend) whose arithmetic is
+ * +, -, *, / and those functions has one, compiled with and without FMA (FMA_CLONES). */
 #define EOM_BROADCAST(value) ((value) - (eom_lanes){0})
 #define EOM_LANES_KERNEL(kernel) kernel
 #define EOM_EACH_LANE(function, value) ({ \

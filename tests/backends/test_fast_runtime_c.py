@@ -55,6 +55,20 @@ def _toolchain() -> tuple[str, tuple[str, ...]]:
     return compiler, headers
 
 
+#: What uses the macros of a runtime file that defines no static (the files the head of a split
+#: build's kernel unit is made of, issue 42): a cloned kernel; a lanes kernel taking sin, cos
+#: and sqrt lane by lane, behind the call runtime's eom_lanes.
+MACRO_USES = {
+    "fma_clones": "\nFMA_CLONES double runtime_use(double x);\n"
+                  "FMA_CLONES double runtime_use(double x) { return x * x + 1.0; }\n",
+    "lanes": "\nvoid runtime_use(const eom_lanes *x, eom_lanes *out);\n"
+             "void runtime_use(const eom_lanes *x, eom_lanes *out)\n"
+             "{ *out = sin(*x) * cos(*x) + sqrt(*x) + EOM_BROADCAST(1.0); }\n#endif\n",
+}
+#: What goes before a macro file: the lanes macros need eom_lanes and the vector sin/cos
+#: (lanes_math.c, which defines eom_lanes above its marker), inside #if EOM_LANES > 1.
+MACRO_PRELUDES = {"lanes": f'#include "{RUNTIME_DIR / "lanes_math.c"}"\n#if EOM_LANES > 1\n'}
+
 #: A runtime file that another includes to compile alone (kkt.c the Cholesky runtime).
 INCLUDE = re.compile(r'^#include "(\w+)\.c"', re.M)
 
@@ -65,6 +79,10 @@ def _unit(name: str) -> str:
     text = (RUNTIME_DIR / f"{name}.c").read_text(encoding="utf-8")
     included = INCLUDE.findall(text.partition(RUNTIME_MARKER)[0])
     statics = [s for part in (name, *included) for s in STATIC.findall(runtime_source(part))]
+    if name in MACRO_USES:
+        assert not statics, name
+        return (MACRO_PRELUDES.get(name, "") + f'#include "{RUNTIME_DIR / (name + ".c")}"\n'
+                + MACRO_USES[name])
     assert statics, name
     used = ", ".join(f"(const void *)&{symbol}" for symbol in statics)
     return (PRELUDES.get(name, "") + f'#include "{RUNTIME_DIR / (name + ".c")}"\n'

@@ -13,6 +13,9 @@ routine on stack arrays (docs/contact.md has the constrained solve and its error
 
 Printer: SymPy's :class:`~sympy.printing.c.C99CodePrinter` with exact float literals and
 small integer powers written as products. Template: ``templates/fast/module.c.jinja``.
+
+Build: the long kernels are cut out of the source into translation units of their own
+(:mod:`.fast_units`), compiled in parallel and cached by content (:func:`compile_module`).
 """
 
 from __future__ import annotations
@@ -28,7 +31,8 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.precedence import PRECEDENCE
 
-from ...common.compiler import c_compiler, shared_library
+from ...common.compiler import c_compiler, compile_jobs, linked_library, shared_library
+from ...common import progress as progress_lines
 from ...common.output import GeneratedFile
 from ..job import Job
 from ..registry import Loaded, register
@@ -40,13 +44,14 @@ from ...symbolic.printing import FloatLiteralMixin, renamed
 from ...common.templating import TEMPLATES_DIR, render
 from .common import (import_file, parallel_indices, positional, printed_once,
                      warning_exports)
+from .fast_units import UNIT_RUNTIME, kernel_signature, split_source
 
 #: The fixed C runtime every generated module includes parts of: real C files (compiled and
 #: warning-checked on their own by tests/backends/test_fast_runtime_c.py), by the name the template
 #: gives their text (``runtime.cholesky`` ...).
 RUNTIME_DIR = TEMPLATES_DIR / "fast" / "runtime"
 RUNTIME_FILES = ("cholesky", "kkt", "call", "split_columns", "contact_call", "task_space",
-                 "task_call", "lanes_math")
+                 "task_call", "fma_clones", "lanes_math", "lanes")
 #: The line of a runtime file below which its text goes into the generated module (above it:
 #: the file's own comment and the #includes that let it compile alone).
 RUNTIME_MARKER = "/* eomgen: the generated module holds the text below this line. */\n"
@@ -111,7 +116,18 @@ def c_comment(text: str) -> str:
 #: fused multiply-add instructions, the loader picking the one the CPU runs (``target_clones``,
 #: x86-64 Linux): for such kernels the arithmetic, not the Python call, is the time, and FMA
 #: cuts it by about a third (the Panda's derivatives: 1.34 -> 0.97 µs per state in a batch);
-#: smaller kernels keep one version (cloning doubles their compile time for little).
+#: smaller kernels keep one version (cloning doubles their compile time for little); the lanes
+#: versions of batches are cloned whatever their size (:data:`LANES_OPERATIONS`).
+#:
+#: The rule, a clone only where it pays, measured kernel by kernel (issue 42,
+#: benchmarks/fma_clones.py: the Panda's module built with the clones and with one plain
+#: version, calls timed alternately, load 7–9 on 2 cores): clones / plain 0.75 for ∂τ (5,147
+#: operations) and 0.85 for ∂q̈ (7,957) per one-state call (1,719 / 2,296 ns and 3,504 / 4,073
+#: ns, the Python call included), 0.53 and 0.50 per state in a batch of 64: every clone above
+#: this threshold pays. Below it, the ABA (1,747 operations) measured 0.76 one state and batch
+#: alike (895 / 1,194 ns): a lower threshold would pay at run time too, for twice the compile
+#: time of those kernels (the clones build of that module 140 s against 67 s plain) and new
+#: golden files; it is left at 4000 until measured on more kernels between.
 FMA_CLONE_OPERATIONS = 4000
 
 #: Kernels of at least this many operations whose arithmetic a lanes kernel has
@@ -203,6 +219,8 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
                    for r in range(rows) for c in range(cols) if spec.output[r, c] != 0]
         functions.append(dict(
             name=spec.name, summary=spec.summary, inputs=[a.name for a in spec.arguments],
+            one_signature=kernel_signature(spec.name),
+            lanes_signature=kernel_signature(spec.name, lanes=True),
             slots=[f'"{a.name}"' for a in spec.arguments]
             + ["NULL"] * (max_inputs - len(spec.arguments)),
             # lengths of the inputs (NV for the joint vectors; F_c has the contact rows)
@@ -387,10 +405,16 @@ def python_headers() -> tuple[str, ...] | None:
     return include, numpy.get_include()
 
 
-def compile_module(source: str, module: str, config: FastConfig = FastConfig()
-                   ) -> bytes | str:
+def compile_module(source: str, module: str, config: FastConfig = FastConfig(),
+                   kernels: list[tuple[str, int]] = ()) -> bytes | str:
     """Compile the extension ``module`` from ``source``: the shared library's bytes, or a
-    one-line reason why it was not built (no C compiler, no Python headers)."""
+    one-line reason why it was not built (no C compiler, no Python headers).
+
+    With ``kernels`` (the module's kernels, ``(name, operations)``), the long ones are cut out
+    into translation units (:func:`~.fast_units.split_source`) compiled in parallel
+    (:func:`~eomgen.common.compiler.compile_jobs` at a time) and cached by content in the
+    cache folder's ``objects`` (:class:`ObjectStore`), then linked into the one extension; its
+    progress goes to :func:`eomgen.common.progress.current`."""
     compiler = c_compiler()
     if compiler is None:
         return "no C compiler found (set CC)"
@@ -398,8 +422,46 @@ def compile_module(source: str, module: str, config: FastConfig = FastConfig()
     if headers is None:
         return "Python's C headers (Python.h) are not installed"
     suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
-    return shared_library(compiler, source, module, [*config.flags, *(f"-I{h}" for h in headers)],
-                          suffix)
+    flags = [*config.flags, *(f"-I{h}" for h in headers)]
+    units = split_source(source, module, list(kernels),
+                         {name: runtime_source(name) for name in UNIT_RUNTIME}
+                         ) if kernels else None
+    if units is None:
+        return shared_library(compiler, source, module, flags, suffix)
+    return linked_library(compiler, [(u.name, u.text, u.weight) for u in units], module,
+                          [f for f in flags if f != "-shared"],
+                          [f for f in config.flags if f in ("-shared", "-fPIC")], suffix,
+                          jobs=compile_jobs(), cache=ObjectStore(),
+                          progress=progress_lines.current())
+
+
+class ObjectStore:
+    """Compiled objects of the fast module's translation units, kept in the derivation cache's
+    folder (:func:`eomgen.cache.default_cache_dir`: ``generate``'s ``cache_dir`` when given,
+    :func:`eomgen.cache.store.cache_folder`), in ``objects/``: entries signed as the
+    derivation cache's are (:class:`eomgen.cache.store.Cache`; the least recently used beyond
+    its limit deleted). A cache that cannot be read or written costs a compile, never the
+    build."""
+
+    def __init__(self, directory: Path | None = None):
+        from ...cache.store import Cache, default_cache_dir  # only a split build needs it
+
+        self._cache = Cache((directory or default_cache_dir()) / "objects")
+
+    def get(self, key: str) -> bytes | None:
+        try:
+            entry = self._cache.get(key)
+        except Exception:  # noqa: BLE001 - a broken cache must not fail the build
+            return None
+        if entry is None or len(entry.files) != 1 or not isinstance(entry.files[0].content, bytes):
+            return None
+        return entry.files[0].content
+
+    def put(self, key: str, data: bytes) -> None:
+        try:
+            self._cache.put(key, [GeneratedFile("unit.o", data, golden=False)])
+        except Exception:  # noqa: BLE001 - as in get
+            pass
 
 
 def load_fast(folder: Path, stem: str) -> Loaded:
@@ -425,7 +487,8 @@ def build_fast(job: Job, emitted: list[GeneratedFile], config: FastConfig = Fast
     RuntimeWarning saying why) when no C compiler or no Python headers are found."""
     module = job.stem + config.suffix
     (source,) = [f.content for f in emitted if f.name == module + ".c"]
-    built = compile_module(source, module, config)
+    built = compile_module(source, module, config,
+                           [(spec.name, spec.operation_count) for spec in job.specs])
     if isinstance(built, bytes):
         suffix = sysconfig.get_config_var("EXT_SUFFIX") or ".so"
         return [GeneratedFile(module + suffix, built, golden=False)]
