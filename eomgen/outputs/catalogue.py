@@ -488,8 +488,8 @@ D2TAU_DVDV = _listed(Output(
     quaternion_joints=False, tensor=True))
 DTAU_DQDV = _listed(Output(
     "inverse_dynamics_second_derivative_q_qd", "dtau_dqdv", "d(dtau/dq)/dqd of tau(q, qd, "
-    "qdd): dtau_dqdv[i, j, k] = d2tau_i/dqd_j dq_k, " + _TENSOR, ("q", "qd", "qdd"), False,
-    "of the joint efforts per rad (revolute pages) and rad/s (revolute columns)", ("dtau_dqdv",),
+    "qdd): dtau_dqdv[i, j, k] = d2tau_i/dq_j dqd_k, " + _TENSOR, ("q", "qd", "qdd"), False,
+    "of the joint efforts per rad (revolute j) and rad/s (revolute k)", ("dtau_dqdv",),
     default=False, quaternion_joints=False, tensor=True))
 DTAU_DADQ = _listed(Output(
     "mass_matrix_derivative_q", "dtau_dadq", "dM/dq = d(dtau/dqdd)/dq: dtau_dadq[i, j, k] = "

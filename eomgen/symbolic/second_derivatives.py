@@ -19,7 +19,8 @@ of ``ComputeRNEASecondOrderDerivatives`` (``algorithm/rnea-second-order-derivati
 
 * ``d2tau_dqdq[i, j, k] = ∂²τ_i/∂q_j∂q_k`` (symmetric in j, k);
 * ``d2tau_dvdv[i, j, k] = ∂²τ_i/∂q̇_j∂q̇_k`` (symmetric in j, k);
-* ``dtau_dqdv[i, j, k] = ∂²τ_i/∂q̇_j∂q_k``: ∂(∂τ/∂q)/∂q̇, q̇ along the columns, q along the pages;
+* ``dtau_dqdv[i, j, k] = ∂²τ_i/∂q_j∂q̇_k``: ∂(∂τ/∂q)/∂q̇, as Pinocchio's ``data.d2tau_dqdv(i, j,
+  k)`` holds it (checked against it: q along the second index, q̇ along the third);
 * ``dtau_dadq[i, j, k] = ∂²τ_i/∂q̈_j∂q_k = ∂M_ij/∂q_k``;
 * ``d2tau``: the four side by side (one program, one call).
 
@@ -39,10 +40,13 @@ from .tangent import tangent_seeds
 #: the key of this module's work in ``Derivation.shared``
 _SHARED = __name__
 
-#: Per output symbol: the first and the second direction's input of ``[i, j, k]`` (j, k).
+#: Per output symbol: the inputs of the second and the third index of ``T[i, j, k]``.
 TENSORS: dict[str, tuple[str, str]] = {
-    "d2tau_dqdq": ("q", "q"), "d2tau_dvdv": ("qd", "qd"), "dtau_dqdv": ("qd", "q"),
+    "d2tau_dqdq": ("q", "q"), "d2tau_dvdv": ("qd", "qd"), "dtau_dqdv": ("q", "qd"),
     "dtau_dadq": ("qdd", "q")}
+#: The input differentiated along first (the other one second), where it is not ``j``'s: the
+#: first derivatives along q̇ are fewer than those along q.
+_FIRST: dict[str, str] = {"dtau_dqdv": "qd"}
 
 
 def second_order(b: ProgramBuilder, outputs, seeds: dict, pairs) -> list[dict]:
@@ -139,13 +143,15 @@ def second_order(b: ProgramBuilder, outputs, seeds: dict, pairs) -> list[dict]:
     return result
 
 
-def _pairs(symbol: str, n: int) -> list:
-    """The direction pairs ``(d, e)`` output ``symbol`` needs: the upper triangle ``k ≥ j`` of
-    the symmetric ones."""
+def _key(symbol: str, j: int, k: int) -> tuple:
+    """The direction pair ``(d, e)`` whose second derivative is ``T[i, j, k]`` of output
+    ``symbol``: the upper triangle ``k ≥ j`` of the symmetric ones."""
     first, second = TENSORS[symbol]
-    symmetric = first == second
-    return [((first, j), (second, k)) for j in range(n) for k in range(n)
-            if not symmetric or k >= j]
+    if first == second and k < j:
+        j, k = k, j
+    if _FIRST.get(symbol, first) != first:
+        return (second, k), (first, j)
+    return (first, j), (second, k)
 
 
 def inverse_dynamics_second_derivatives(derivation, symbols) -> dict:
@@ -160,19 +166,16 @@ def inverse_dynamics_second_derivatives(derivation, symbols) -> dict:
         for name in ("qd", "qdd"):
             if name in inputs:
                 seeds.update({s: (name, k) for k, s in enumerate(derivation.inputs[name])})
-        pairs = [p for s in missing for p in _pairs(s, n)]
+        pairs = sorted({_key(s, j, k) for s in missing for j in range(n) for k in range(n)})
         b = derivation.builder
         rows = second_order(b, list(derivation.output("tau")), seeds, pairs)
         zero = sp.Integer(0)
         for s in missing:
-            first, second = TENSORS[s]
             T = sp.zeros(n, n * n)
             for i, row in enumerate(rows):
                 for j in range(n):
                     for k in range(n):
-                        key = ((first, j), (second, k)) if first != second or k >= j else \
-                            ((first, k), (second, j))
-                        T[i, j * n + k] = row.get(key, zero)
+                        T[i, j * n + k] = row.get(_key(s, j, k), zero)
             work[s] = T
     return {s: work[s] for s in symbols}
 

@@ -88,7 +88,7 @@ def test_second_derivatives_are_central_differences_of_the_first(scara):
         assert relative(vv, central_difference(
             lambda x: m[FIRST[0]](q, x, qdd)[1], qd)) < 1e-6
         assert relative(qv, central_difference(
-            lambda x: m[FIRST[0]](x, qd, qdd)[1], q)) < 1e-6
+            lambda x: m[FIRST[0]](q, x, qdd)[0], qd)) < 1e-6
         assert relative(aq, central_difference(lambda x: m["mass_matrix"](x), q)) < 1e-6
         np.testing.assert_array_equal(qq, qq.transpose(0, 2, 1))  # mirrored, exactly
         np.testing.assert_array_equal(vv, vv.transpose(0, 2, 1))
@@ -233,7 +233,7 @@ def test_second_derivatives_equal_pinocchios_cpp(which, pinocchio_second_order, 
     if which == "panda":
         model = robots.panda()
     else:
-        model = random_robot(np.random.default_rng(42), 5, tree=True, prismatic=True)
+        model = random_robot(np.random.default_rng(13), 5, tree=True, prismatic=True)
         assert any(not j.type.is_revolute for j in model.joints if j.type.is_movable)
     _, modules = generated(model, [COMBINED], tmp_path, backends=("numpy",))
     pm = to_pinocchio(model)
