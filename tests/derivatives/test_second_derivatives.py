@@ -19,10 +19,14 @@ import numpy as np
 import pytest
 
 import eomgen
+from eomgen.codegen.backends.casadi_backend import c_compiler, library_name
+from eomgen.codegen.functions import module_name
+from eomgen.codegen.generate import render_files
 from eomgen.errors import UnsupportedError
 from eomgen.outputs import OUTPUTS
 from support import robots
 from support.generated import generated
+from support.extras import need
 from support.reference import pin_q_order, random_robot, to_pinocchio
 
 COMBINED = "inverse_dynamics_second_derivatives"
@@ -249,3 +253,23 @@ def test_second_derivatives_equal_pinocchios_cpp(which, pinocchio_second_order, 
                               expected):
             b = b[np.ix_(inv, inv, inv)]
             assert relative(a, b) < 1e-9, (which, what, relative(a, b))
+
+
+def test_the_c_backends_library_gives_the_numpy_modules_tensors(scara, tmp_path):
+    """The ``c`` backend (CasADi's C, a shared library) through ``casadi.external``."""
+    casadi = need("casadi")
+    if c_compiler() is None:
+        pytest.skip("needs a C compiler")
+    model, modules = scara
+    n = model.dof
+    for f in render_files(model, ["c"], functions=[COMBINED]):
+        path = tmp_path / f.name
+        path.write_bytes(f.content) if isinstance(f.content, bytes) else path.write_text(
+            f.content, encoding="utf-8")
+    function = casadi.external(COMBINED, str(tmp_path / library_name(module_name(model.name))))
+    q, qd, qdd = _state(7, n)
+    out = function.call({"q": q, "qd": qd, "qdd": qdd})
+    for symbol, b in zip(OUTPUTS[COMBINED].returns, tensors("numpy", modules["numpy"], q, qd,
+                                                            qdd)):
+        np.testing.assert_allclose(np.array(out[symbol]).reshape(n, n, n), b, rtol=1e-12,
+                                   atol=1e-12, err_msg=symbol)
