@@ -132,6 +132,17 @@ def test_a_quaternion_free_flyer_is_refused_in_one_line():
     assert "\n" not in message and "d2tau not derived for a quaternion free flyer" in message
 
 
+def test_coupled_joints_are_refused_in_one_line():
+    from eomgen.model import couple
+
+    arm = eomgen.load(eomgen.example_path("elbow_rrr"))
+    geared = couple(arm, "elbow", "shoulder", ratio=-1, offset=0.2)
+    with pytest.raises(UnsupportedError) as error:
+        eomgen.derive(geared, outputs=["tau", "d2tau_dqdq"])
+    message = str(error.value)
+    assert "\n" not in message and "d2tau_dqdq not derived for a model with coupled" in message
+
+
 # --- Pinocchio's C++ ComputeRNEASecondOrderDerivatives ---------------------------------------
 
 #: The program: reads a model of revolute and prismatic joints (any axis) and states from stdin,
