@@ -224,7 +224,8 @@ def main() -> None:
     lines = [f"{model.name}, {model.dof} joints; Pinocchio {pin.__version__} header-only, "
              f"{cxx} {' '.join(FLAGS)}; eomgen derivation and printing {derive_seconds:.0f} s, "
              f"compile (both at once): ours {ours_seconds:.0f} s, the benchmark with "
-             f"Pinocchio {pin_seconds:.0f} s; load average {load:.1f} on {os.cpu_count()} cores.", ""]
+             f"Pinocchio {pin_seconds:.0f} s; load average {load:.1f} on {os.cpu_count()} "
+             "cores.", ""]
     for line in run.splitlines():
         parts = line.split()
         if parts[0] == "agreement":
@@ -247,7 +248,8 @@ def main() -> None:
               "|---|---:|---:|---:|---:|---|",
               f"| ∂²τ (4 tensors) | {spread(ours)} | {spread(theirs)} "
               f"(`ComputeRNEASecondOrderDerivatives`) | {ratio:.2f} | "
-              + (f"≤ {target:.2f} × | {met} |" if kind == "ratio" else f"≤ {target:.0f} µs | {met} |")]
+              + (f"≤ {target:.2f} × | {met} |" if kind == "ratio"
+                 else f"≤ {target:.0f} µs | {met} |")]
     print("\n".join(lines))
     if args.markdown:
         args.markdown.write_text("\n".join(lines) + "\n", encoding="utf-8")
