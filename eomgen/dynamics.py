@@ -35,7 +35,8 @@ from .symbolic.textbook import TEXTBOOK_MAX_DOF, TEXTBOOK_MAX_OPERATIONS, textbo
 from . import regressor  # noqa: F401  (the regressor outputs: eomgen.regressor.generated)
 from .regressor import slotine_li  # noqa: F401
 from .symbolic import (aba, centroidal, combined, contact_derivatives, controls,  # noqa: F401
-                       derivatives, drives, flat, frames, loops, newton_euler, passive, routes)
+                       derivatives, drives, flat, frames, loops, newton_euler, passive, routes,
+                       second_derivatives)
 
 #: What generated modules export by default: the mass matrix, Coriolis matrix, gravity vector
 #: and the inverse dynamics τ(q, q̇, q̈) (by a symbolic Newton–Euler pass; cheaper to evaluate).

@@ -114,7 +114,8 @@ def splits(output: Output, n: int) -> tuple[tuple[str, int, int | None], ...]:
             out.append((symbol, column, None))
             column += 1
         else:
-            width = n * BY_SYMBOL[symbol].width
+            declared = BY_SYMBOL[symbol]
+            width = n * (n if declared.tensor else declared.width)
             out.append((symbol, column, column + width))
             column += width
     return tuple(out)

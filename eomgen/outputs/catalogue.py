@@ -98,6 +98,9 @@ class Output:
     width:
         The columns of a matrix result in units of n (2 for the 2n × 2n state matrix of
         ``linearize``), for :func:`eomgen.outputs.splits`.
+    tensor:
+        Whether the result is a 3-index tensor ``T[i, j, k]`` (n, nv, nv), returned as the
+        matrix (n, nv·nv) with entry ``[i, j·nv + k]`` (``reshape(n, nv, nv)`` in C order).
     """
 
     function: str
@@ -114,6 +117,7 @@ class Output:
     quaternion_joints: bool = True
     returns: tuple[str, ...] = ()
     width: int = 1
+    tensor: bool = False
 
     @property
     def composed(self) -> bool:
@@ -129,7 +133,7 @@ class Output:
     def shape(self, n: int) -> tuple[int, ...]:
         """Its result's shape for ``n`` joints, for the outputs whose rows and columns are the
         joints (the printed shape of any output is that of the matrix its builder returns)."""
-        return (n,) if self.is_vector else (n, n)
+        return (n,) if self.is_vector else (n, n * n) if self.tensor else (n, n)
 
 
 _ENTRIES: list[Output] = []
@@ -476,6 +480,36 @@ DRIVE_FORWARD_DERIVATIVES = _listed(Output(
     "the units of drive_forward_dynamics_derivative_q, _qd and drive_inverse_mass_matrix",
     ("dqdd_a",), default=False,
     returns=("dqdd_a_dq", "dqdd_a_dqd", "Minv_a")))
+
+# Issue 42: second derivatives of the inverse dynamics (eomgen.symbolic.second_derivatives), in
+# the layout of Pinocchio's ComputeRNEASecondOrderDerivatives; no quaternion joints yet.
+_TENSOR = ("a tensor T[i, j, k] returned as (n, nv*nv), entry [i, j*nv + k]: reshape(n, nv, "
+           "nv) gives T.")
+D2TAU_DQDQ = _listed(Output(
+    "inverse_dynamics_second_derivative_q", "d2tau_dqdq", "d2tau/dq2 of tau(q, qd, qdd): "
+    "d2tau_dqdq[i, j, k] = d2tau_i/dq_j dq_k, " + _TENSOR, ("q", "qd", "qdd"), False,
+    "of the joint efforts per rad^2 (revolute columns) or m^2", ("d2tau_dqdq",), default=False,
+    quaternion_joints=False, tensor=True))
+D2TAU_DVDV = _listed(Output(
+    "inverse_dynamics_second_derivative_qd", "d2tau_dvdv", "d2tau/dqd2 of tau(q, qd, qdd): "
+    "d2tau_dvdv[i, j, k] = d2tau_i/dqd_j dqd_k, " + _TENSOR, ("q", "qd", "qdd"), False,
+    "of the joint efforts per (rad/s)^2 or (m/s)^2", ("d2tau_dvdv",), default=False,
+    quaternion_joints=False, tensor=True))
+DTAU_DQDV = _listed(Output(
+    "inverse_dynamics_second_derivative_q_qd", "dtau_dqdv", "d(dtau/dq)/dqd of tau(q, qd, "
+    "qdd): dtau_dqdv[i, j, k] = d2tau_i/dq_j dqd_k, " + _TENSOR, ("q", "qd", "qdd"), False,
+    "of the joint efforts per rad (revolute j) and rad/s (revolute k)", ("dtau_dqdv",),
+    default=False, quaternion_joints=False, tensor=True))
+DTAU_DADQ = _listed(Output(
+    "mass_matrix_derivative_q", "dtau_dadq", "dM/dq = d(dtau/dqdd)/dq: dtau_dadq[i, j, k] = "
+    "dM_ij/dq_k, " + _TENSOR, ("q",), False, "kg m^2 per rad (revolute)", ("dtau_dadq",),
+    default=False, quaternion_joints=False, tensor=True))
+SECOND_DERIVATIVES = _listed(Output(
+    "inverse_dynamics_second_derivatives", "d2tau", "(d2tau_dqdq, d2tau_dvdv, dtau_dqdv, "
+    "dtau_dadq) of tau(q, qd, qdd) in one call, each (n, nv*nv) as in Pinocchio's "
+    "ComputeRNEASecondOrderDerivatives.", ("q", "qd", "qdd"), False,
+    "the units of the four tensors", ("d2tau",), default=False, quaternion_joints=False,
+    returns=("d2tau_dqdq", "d2tau_dvdv", "dtau_dqdv", "dtau_dadq")))
 
 CONSTRAINED_PARTIALS = _listed(Output(
     "constrained_dynamics_partials", "dKKT", "[[dr/dq, dr/dqd], [da/dq, da/dqd]] (nv + m, 2 nv) "

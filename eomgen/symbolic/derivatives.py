@@ -92,7 +92,7 @@ def _relevant(assignments, outputs, seeds, frozen) -> list:
     return kept[::-1]
 
 
-def _differentiate(b: ProgramBuilder, expr, free, D, hint: str, name: bool, partials: dict):
+def differentiate(b: ProgramBuilder, expr, free, D, hint: str, name: bool, partials: dict):
     """``{direction: d expr}`` of ``expr`` given the derivatives ``D`` of its free symbols,
     zeros left out; each derivative named in ``b`` (with ``name``) with the hint
     ``<hint>_<direction>``."""
@@ -157,15 +157,23 @@ def forward_mode(b: ProgramBuilder, outputs, seeds: dict, frozen=frozenset()) ->
     >>> b.assignments[1:]
     [(ps, y*cos(x)), (ps_, sin(x)), (p, 2*s), (d_x1, p*ps), (d_y1, p*ps_)]
     """
+    return forward_mode_map(b, outputs, seeds, frozen)[0]
+
+
+def forward_mode_map(b: ProgramBuilder, outputs, seeds: dict, frozen=frozenset()) \
+        -> tuple[list[dict], dict]:
+    """:func:`forward_mode`'s result and the map ``{symbol: {direction: derivative}}`` of every
+    intermediate it differentiated (the seeds included), which a second pass
+    (:mod:`eomgen.symbolic.second_derivatives`) reuses."""
     D: dict = {s: dict(d) if isinstance(d, dict) else {d: sp.Integer(1)}
                for s, d in seeds.items()}
     outputs = [sp.sympify(e) for e in outputs]
     partials: dict = {}
     for symbol, expr, free in _relevant(list(b.assignments), outputs, seeds, frozen):
-        derivative = _differentiate(b, expr, free, D, symbol.name, True, partials)
+        derivative = differentiate(b, expr, free, D, symbol.name, True, partials)
         if derivative:
             D[symbol] = derivative
-    return [_differentiate(b, e, e.free_symbols, D, "", True, partials) for e in outputs]
+    return [differentiate(b, e, e.free_symbols, D, "", True, partials) for e in outputs], D
 
 
 def _jacobian(rows: list[dict], prefix: str, n: int) -> sp.Matrix:
@@ -449,5 +457,6 @@ def build_derivatives(derivation, wanted) -> dict:
 
 __all__ = ["applied_forward_dynamics_jacobians", "build_derivatives", "drive_forward_dynamics_jacobians",
            "drive_inverse_dynamics_jacobians", "forward_dynamics_jacobians", "forward_mode",
+           "forward_mode_map",
            "gravity_jacobian", "inverse_dynamics_jacobians", "inverse_mass_matrix",
            "linearization", "symmetric_inverse"]
