@@ -24,8 +24,9 @@ of ``ComputeRNEASecondOrderDerivatives`` (``algorithm/rnea-second-order-derivati
 * ``dtau_dadq[i, j, k] = ∂²τ_i/∂q̈_j∂q_k = ∂M_ij/∂q_k``;
 * ``d2tau``: the four side by side (one program, one call).
 
-Models with quaternion joints are refused (the catalogue's ``quaternion_joints=False``), and
-so are coupled joints (:data:`eomgen.symbolic.couplings.PROJECTIONS` does not list them).
+Models whose configuration has more entries than their velocity (quaternion joints: nq > nv)
+are refused (the catalogue marks these outputs as not derived on the chart), and so are
+coupled joints (:data:`eomgen.symbolic.couplings.PROJECTIONS` does not list them).
 """
 
 from __future__ import annotations

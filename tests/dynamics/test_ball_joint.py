@@ -328,13 +328,13 @@ def test_yaml_spherical_joint_errors(tmp_path, text, message):
 
 def test_outputs_not_derived_for_the_chart_are_refused(monkeypatch):
     """The loop rows are derived for ball joints (tests/loops/test_quaternion_loops.py);
-    an output the catalogue marked quaternion_joints=False would be refused naming the
+    an output the catalogue marked on_charts=False would be refused naming the
     joint."""
     from eomgen import derive
     from eomgen.errors import UnsupportedError
     from eomgen.outputs import BY_SYMBOL
     model, _ = robots(CHAIN[:2], seed=19)
-    monkeypatch.setitem(BY_SYMBOL, "Phi_l", replace(BY_SYMBOL["Phi_l"], quaternion_joints=False))
+    monkeypatch.setitem(BY_SYMBOL, "Phi_l", replace(BY_SYMBOL["Phi_l"], on_charts=False))
     with pytest.raises(UnsupportedError, match="Phi_l not derived for a ball joint yet"):
         derive(model, outputs=("M", "Phi_l"))
 

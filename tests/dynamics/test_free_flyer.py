@@ -180,16 +180,16 @@ def test_scene_quaternion_base_equals_pinocchio(robot, tips, tmp_path):
 
 
 def test_outputs_not_derived_for_the_chart_are_refused(monkeypatch):
-    """Every output is derived on the chart now (the loop rows too: without loops they ask
-    for some); one the catalogue marked quaternion_joints=False would be refused in one
-    line."""
+    """An output the catalogue marks on_charts=False (the second derivatives today) is
+    refused in one line; the loop rows are derived on the chart (without loops they ask for
+    some)."""
     from eomgen import derive
     from eomgen.errors import GenerationError, UnsupportedError
     from eomgen.outputs import BY_SYMBOL
     model = add_free_flyer(floating_tree(5, 2))
     with pytest.raises(GenerationError, match="need loops"):
         derive(model, outputs=("M", "Phi_l"))
-    monkeypatch.setitem(BY_SYMBOL, "Phi_l", replace(BY_SYMBOL["Phi_l"], quaternion_joints=False))
+    monkeypatch.setitem(BY_SYMBOL, "Phi_l", replace(BY_SYMBOL["Phi_l"], on_charts=False))
     with pytest.raises(UnsupportedError,
                        match="Phi_l not derived for a quaternion free flyer yet"):
         derive(model, outputs=("M", "Phi_l"))
