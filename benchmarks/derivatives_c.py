@@ -83,6 +83,51 @@ def model_source(model) -> str:
     return "\n    ".join(lines)
 
 
+#: C++ shared by the C-level benchmarks (here and pinocchio_codegen.py): the process's CPU time,
+#: the largest entry of a difference relative to the reference's, a block of a row-major result.
+CPP_HELPERS = r"""/* the process's CPU time [ns]: waiting for a CPU on a shared machine does not count */
+static double cpu_ns(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return t.tv_sec * 1e9 + t.tv_nsec;
+}
+
+static double relative(const Eigen::MatrixXd &ours, const Eigen::MatrixXd &theirs)
+{
+    return (ours - theirs).cwiseAbs().maxCoeff() / theirs.cwiseAbs().maxCoeff();
+}
+
+static Eigen::MatrixXd block(const double *out, int rows, int cols, int start, int width)
+{
+    Eigen::Map<const RowMajor> full(out, rows, cols);
+    return full.block(0, start, rows, width);
+}"""
+
+#: C++ statements drawing the S random states (q, v, a in [-1.5, 1.5], tau = rnea) both as Eigen
+#: vectors (Q, V, A, T) and as plain arrays (q, v, a, t), for the benchmarks' programs.
+CPP_STATES = r"""std::mt19937 rng(0);
+    std::uniform_real_distribution<double> U(-1.5, 1.5);
+    std::vector<Eigen::VectorXd> Q(S), V(S), A(S), T(S);
+    std::vector<double> q(S * n), v(S * n), a(S * n), t(S * n);
+    for (int s = 0; s < S; ++s) {
+        Q[s].resize(n); V[s].resize(n); A[s].resize(n);
+        for (int k = 0; k < n; ++k) {
+            q[s * n + k] = Q[s][k] = U(rng); v[s * n + k] = V[s][k] = U(rng);
+            a[s * n + k] = A[s][k] = U(rng);
+        }
+        T[s] = pinocchio::rnea(model, data, Q[s], V[s], A[s]);
+        for (int k = 0; k < n; ++k) t[s * n + k] = T[s][k];
+    }"""
+
+
+def program(main: str, model) -> str:
+    """The C++ program ``main`` with its placeholders filled: the model's statements, the
+    helpers and the states."""
+    return (main.replace("@HELPERS@", CPP_HELPERS).replace("@STATES@", CPP_STATES)
+            .replace("@MODEL@", model_source(model)))
+
+
 MAIN = r"""
 #include <pinocchio/multibody.hpp>
 #include <pinocchio/algorithm/rnea.hpp>
@@ -105,43 +150,14 @@ static const int S = 64;  /* states */
 static const int n = PANDA_NQ;
 typedef Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> RowMajor;
 
-/* the process's CPU time [ns]: waiting for a CPU on a shared machine does not count */
-static double cpu_ns(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return t.tv_sec * 1e9 + t.tv_nsec;
-}
-
-static double relative(const Eigen::MatrixXd &ours, const Eigen::MatrixXd &theirs)
-{
-    return (ours - theirs).cwiseAbs().maxCoeff() / theirs.cwiseAbs().maxCoeff();
-}
-
-static Eigen::MatrixXd block(const double *out, int rows, int cols, int start, int width)
-{
-    Eigen::Map<const RowMajor> full(out, rows, cols);
-    return full.block(0, start, rows, width);
-}
+@HELPERS@
 
 int main(int argc, char **argv)
 {
     int repeats = argc > 1 ? atoi(argv[1]) : 15;
     @MODEL@
     pinocchio::Data data(model);
-    std::mt19937 rng(0);
-    std::uniform_real_distribution<double> U(-1.5, 1.5);
-    std::vector<Eigen::VectorXd> Q(S), V(S), A(S), T(S);
-    std::vector<double> q(S * n), v(S * n), a(S * n), t(S * n);
-    for (int s = 0; s < S; ++s) {
-        Q[s].resize(n); V[s].resize(n); A[s].resize(n);
-        for (int k = 0; k < n; ++k) {
-            q[s * n + k] = Q[s][k] = U(rng); v[s * n + k] = V[s][k] = U(rng);
-            a[s * n + k] = A[s][k] = U(rng);
-        }
-        T[s] = pinocchio::rnea(model, data, Q[s], V[s], A[s]);
-        for (int k = 0; k < n; ++k) t[s * n + k] = T[s][k];
-    }
+    @STATES@
     const double *p = panda_parameter_defaults;
     double out[3 * PANDA_NQ * PANDA_NQ];
     double worst = 0.0;
@@ -252,7 +268,7 @@ def main() -> None:
         for f in render_files(model, ["kernels"], functions=FUNCTIONS):
             (folder / f.name).write_text(f.content, encoding="utf-8")
         pin, pmodel, _ = pinocchio_panda(path, model.joint_names)
-        (folder / "bench.cpp").write_text(MAIN.replace("@MODEL@", model_source(pmodel)),
+        (folder / "bench.cpp").write_text(program(MAIN, pmodel),
                                           encoding="utf-8")
         cc, cxx = os.environ.get("CC", "gcc"), os.environ.get("CXX", "g++")
         start = time.perf_counter()

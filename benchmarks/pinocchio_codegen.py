@@ -53,7 +53,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import eomgen  # noqa: E402
 from codegen_speed import erd_robots_dir  # noqa: E402
-from derivatives_c import DEFINES, FLAGS, model_source  # noqa: E402
+from derivatives_c import DEFINES, FLAGS, program  # noqa: E402
 from eomgen.codegen.generate import render_files  # noqa: E402
 from eomgen.model import lock_joints  # noqa: E402
 from fair_speed import LOCKED, pinocchio_panda  # noqa: E402
@@ -113,27 +113,11 @@ struct ABADerivatives : pinocchio::CodeGenABADerivatives<double> {
     const Eigen::MatrixXd &dtau() const { return dddq_dtau; }
 };
 
-static double cpu_ns(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return t.tv_sec * 1e9 + t.tv_nsec;
-}
-
-static double relative(const Eigen::MatrixXd &ours, const Eigen::MatrixXd &theirs)
-{
-    return (ours - theirs).cwiseAbs().maxCoeff() / theirs.cwiseAbs().maxCoeff();
-}
+@HELPERS@
 
 static Eigen::MatrixXd upper(const Eigen::MatrixXd &m)
 {
     return m.triangularView<Eigen::Upper>().toDenseMatrix();
-}
-
-static Eigen::MatrixXd block(const double *out, int rows, int cols, int start, int width)
-{
-    Eigen::Map<const RowMajor> full(out, rows, cols);
-    return full.block(0, start, rows, width);
 }
 
 int main(int argc, char **argv)
@@ -157,19 +141,7 @@ int main(int argc, char **argv)
     printf("build aba_derivatives %.2f\n", cg_daba.build(cc, flags));
     fflush(stdout);
 
-    std::mt19937 rng(0);
-    std::uniform_real_distribution<double> U(-1.5, 1.5);
-    std::vector<Eigen::VectorXd> Q(S), V(S), A(S), T(S);
-    std::vector<double> q(S * n), v(S * n), a(S * n), t(S * n);
-    for (int s = 0; s < S; ++s) {
-        Q[s].resize(n); V[s].resize(n); A[s].resize(n);
-        for (int k = 0; k < n; ++k) {
-            q[s * n + k] = Q[s][k] = U(rng); v[s * n + k] = V[s][k] = U(rng);
-            a[s * n + k] = A[s][k] = U(rng);
-        }
-        T[s] = pinocchio::rnea(model, data, Q[s], V[s], A[s]);
-        for (int k = 0; k < n; ++k) t[s * n + k] = T[s][k];
-    }
+    @STATES@
     const double *p = panda_parameter_defaults;
     double out[3 * PANDA_NQ * PANDA_NQ];
     double ours = 0.0, generated = 0.0;
@@ -294,7 +266,7 @@ def main() -> None:
         pin, pmodel, _ = pinocchio_panda(path, model.joint_names)
         sources = {f.name: f.content for f in render_files(model, ["kernels"],
                                                            functions=FUNCTIONS)}
-        sources["bench.cpp"] = MAIN.replace("@MODEL@", model_source(pmodel))
+        sources["bench.cpp"] = program(MAIN, pmodel)
         # a kept folder whose sources are the same is not compiled again (it takes minutes)
         reuse = (folder / "bench").is_file() and all(
             (folder / name).is_file() and (folder / name).read_text(encoding="utf-8") == text
@@ -346,7 +318,7 @@ def main() -> None:
         f"ns per call: median (min–max) over {args.repeats} repeats, the three in turns; "
         "ratio = median of per-repeat ratios.", "",
         "| output | eomgen C kernel | Pinocchio code-generated | Pinocchio C++ | eomgen / code-generated "
-        f"| target | met | eomgen / C++ |",
+        "| target | met | eomgen / C++ |",
         "|---|---:|---:|---:|---:|---:|---|---:|"]
 
     def spread(values):
