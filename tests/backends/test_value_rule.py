@@ -157,3 +157,27 @@ def test_the_backends_that_cannot_raise_return_nan(arm):
         assert np.isnan(tau).any(), backend
         g = call("gravity_vector", STATE, g=np.nan)
         assert np.isnan(g).all(), backend
+
+
+TASK_SPACE = ["operational_space_inertia", "operational_space_bias",
+              "dynamically_consistent_inverse"]
+
+
+def test_an_empty_batch_of_the_task_space_functions_in_every_python_backend(tmp_path):
+    """JAX and PyTorch give the task-space functions' empty batch the shapes NumPy gives,
+    (0,) + one state's (the frame count is the module's, not inferred from the batch; damping
+    because the planar arm's tip moves in 3 of the 6 directions)."""
+    model = apply_scene(eomgen.load(eomgen.example_path("planar_2link")),
+                        load_scene(WALL)).model
+    have = [b for b in ("numpy", "jax", "torch") if b in BACKENDS]
+    if have == ["numpy"]:
+        pytest.skip("neither jax nor torch is installed (the jax and torch extras)")
+    _, modules = generated(model, TASK_SPACE, tmp_path, tuple(have))
+    for name in TASK_SPACE:
+        count = len(OUTPUTS[name].inputs)
+        single = outcome(modules["numpy"][name], *[STATE] * count, damping=1e-3)
+        assert single[0] == "ok", (name, single)
+        empty = [np.zeros((0, 2))] * count
+        for backend in have:
+            got = outcome(modules[backend][name], *empty, damping=1e-3)
+            assert got == ("ok", [(0, *shape) for shape in single[1]]), (backend, name, got)
