@@ -210,7 +210,7 @@ def pinocchio_second_order(tmp_path_factory) -> Path:
     if shutil.which("g++") is None:
         pytest.skip("needs a C++ compiler (g++)")
     if not (include / "eigen3").is_dir() or not (include / "pinocchio").is_dir():
-        pytest.skip("needs Pinocchio's headers (pin) and Eigen's (pip install cmeel-eigen)")
+        pytest.skip("needs Pinocchio's headers (pin) and Eigen's (pip install -e '.[bench]' brings cmeel-eigen)")
     folder = tmp_path_factory.mktemp("pinocchio_second_order")
     (folder / "second.cpp").write_text(SECOND_ORDER_CPP, encoding="utf-8")
     subprocess.run(["g++", "-O1", "-std=c++17", *DEFINES, f"-I{include}",
