@@ -23,6 +23,7 @@ new place (docs/architecture.md lays the layers out).
  ``eomgen.reduction.cost``                :mod:`eomgen.codegen.derivation_cost`
  ``eomgen.reprs``                         :mod:`eomgen.common.reprs`
  ``eomgen.symbolic.quaternion_joints``    :mod:`eomgen.symbolic.charts`
+ ``eomgen.symbolic.free_flyer``           :mod:`eomgen.symbolic.charts` (see below)
  ``eomgen.templating``                    :mod:`eomgen.common.templating`
 ========================================  =====================================
 
@@ -31,6 +32,12 @@ emits one :class:`DeprecationWarning` naming the new path and :data:`REMOVED_IN`
 new module under the old name: its functions and classes are the same objects. The new module
 offers every public name of the old one (``eomgen.numeric.floating_base`` offers
 ``add_floating_base``, ``EULER_JOINTS`` and ``WORLD`` of the model layer with its own maps).
+The one exception is ``eomgen.symbolic.free_flyer``, whose functions had the free flyer at the
+start of ``v`` bound in: :mod:`eomgen.symbolic.charts` takes the joints (or the model) first, so
+``chart_offset(v)`` is ``charts.chart_offset(base, v)`` with ``base =
+eomgen.model.configuration.layout(None)`` (the free flyer at ``v[0:6]``), and
+``root_placement(q, b)`` is ``charts.placement(base[0], q, b)``; a call in the old form fails
+loudly (a missing argument or name), never silently.
 
 Names that left a module which stays (:data:`MOVED_NAMES`) are looked up by that module's
 ``__getattr__`` through :func:`moved_name`, with the same warning:
@@ -38,8 +45,8 @@ Names that left a module which stays (:data:`MOVED_NAMES`) are looked up by that
 ================================================  =====================================
  old name                                           new place
 ================================================  =====================================
- ``eomgen.model.FREE_FLYER_CONFIGURATION``          :mod:`eomgen.model.quaternion`
- ``eomgen.model.FREE_FLYER_VELOCITY``               :mod:`eomgen.model.quaternion`
+ ``eomgen.model.FREE_FLYER_CONFIGURATION``          :mod:`eomgen.model.floating`
+ ``eomgen.model.FREE_FLYER_VELOCITY``               :mod:`eomgen.model.floating`
  ``eomgen.reduction.derivation_cost``               :mod:`eomgen.codegen.derivation_cost`
  ``eomgen.reduction.measure_derivation``            :mod:`eomgen.codegen.derivation_cost`
  ``eomgen.reduction.MEASURE_TIMEOUT``               :mod:`eomgen.codegen.derivation_cost`
@@ -78,14 +85,15 @@ MOVED: dict[str, str] = {
     "eomgen.reduction.cost": "eomgen.codegen.derivation_cost",
     "eomgen.reprs": "eomgen.common.reprs",
     "eomgen.symbolic.quaternion_joints": "eomgen.symbolic.charts",
+    "eomgen.symbolic.free_flyer": "eomgen.symbolic.charts",
     "eomgen.templating": "eomgen.common.templating",
 }
 
 #: Module that stays → {name that left it: the module it went to}.
 MOVED_NAMES: dict[str, dict[str, str]] = {
     "eomgen.model": {
-        "FREE_FLYER_CONFIGURATION": "eomgen.model.quaternion",
-        "FREE_FLYER_VELOCITY": "eomgen.model.quaternion",
+        "FREE_FLYER_CONFIGURATION": "eomgen.model.floating",
+        "FREE_FLYER_VELOCITY": "eomgen.model.floating",
     },
     "eomgen.reduction": {
         "derivation_cost": "eomgen.codegen.derivation_cost",

@@ -92,7 +92,9 @@ from .joints.lie import matrix_quaternion, quaternion_matrix  # noqa: F401
 from .notices import NoticeKind
 from .parts import Joint, JointType, Link
 from .joints import FREE_FLYER
-from .quaternion import FREE_FLYER_CONFIGURATION, FREE_FLYER_VELOCITY, check_entry_names
+from .joints.free_flyer import CONFIGURATION as FREE_FLYER_CONFIGURATION
+from .joints.free_flyer import VELOCITY as FREE_FLYER_VELOCITY
+from .quaternion import check_entry_names
 from .robot import RobotModel, joint_motion
 from .scalars import vec3
 from .transforms import Transform

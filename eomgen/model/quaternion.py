@@ -19,8 +19,8 @@ the joint comes in the joint order):
 
 Within a model a quaternion joint is a chain of virtual one-axis joints (six for the free
 flyer, three rotations about the child frame's x, y, z axes for a ball joint) between massless
-links: the model's joints are its velocity coordinates. :attr:`RobotModel.free_flyer
-<eomgen.model.RobotModel.free_flyer>` and :attr:`RobotModel.ball_joints
+links: the model's joints are its velocity coordinates. :attr:`RobotModel.base_kind
+<eomgen.model.RobotModel.base_kind>` and :attr:`RobotModel.ball_joints
 <eomgen.model.RobotModel.ball_joints>` say which joints they are, and
 :func:`quaternion_layout` lists them with their positions in ``q`` and ``v``; the derivation
 (:mod:`eomgen.symbolic.charts`) holds the virtual joints at zero and places the
@@ -42,9 +42,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from ..errors import KinematicTreeError, UnsupportedError
-from .joints import FREE_FLYER, KINDS, SPHERICAL, ChainKind, ChartKind, JointKind
-from .joints.free_flyer import CONFIGURATION as FREE_FLYER_CONFIGURATION
-from .joints.free_flyer import VELOCITY as FREE_FLYER_VELOCITY
+from .joints import KINDS, SPHERICAL, ChainKind, ChartKind, JointKind
 from .parts import Joint, JointType, Link
 from .scalars import vec3
 from .transforms import Transform
@@ -258,6 +256,5 @@ def quaternion_layout(model: "RobotModel") -> tuple[QuaternionJoint, ...]:
     return tuple(layout)
 
 
-__all__ = ["BALL_CONFIGURATION", "BALL_VELOCITY", "FREE_FLYER", "FREE_FLYER_CONFIGURATION",
-           "FREE_FLYER_VELOCITY", "JointKind", "QuaternionJoint", "SPHERICAL",
+__all__ = ["BALL_CONFIGURATION", "BALL_VELOCITY", "JointKind", "QuaternionJoint", "SPHERICAL",
            "ball_velocity_names", "expand_ball_joints", "expand_joints", "quaternion_layout"]

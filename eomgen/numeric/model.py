@@ -152,11 +152,15 @@ class NumericModel:
     numbers : Numbers
         The number type of the arrays above (not of the index arrays) and of every result of
         the algorithms: :data:`FLOAT64` unless built for another one.
-    quaternion_joints : tuple of QuaternionJoint
-        The free flyer and ball joints with their places in ``q`` and ``v``
-        (:attr:`eomgen.model.RobotModel.quaternion_joints`); empty without them.
+    joint_places : tuple of QuaternionJoint
+        Every joint of the tree in velocity order, with its kind and its first index in ``v``
+        and in ``q`` (:attr:`eomgen.model.RobotModel.joint_places` of the uncoupled tree);
+        the algorithms ask a place's kind (``nq != nv``: a joint with a chart), never its name.
+    chart_places : tuple of QuaternionJoint
+        The places whose configuration is not their coordinates (``nq != nv``: a free flyer, a
+        ball joint, a planar joint), in velocity order; empty without them.
     quaternion_bodies : tuple of int
-        For each of ``quaternion_joints``, the body whose joint starts its chain (where its pose
+        For each of ``chart_places``, the body whose joint starts its chain (where its pose
         from ``q`` is placed).
     tree_joint_names : tuple of str
         Every movable joint in description order (followers of couplings included): the
@@ -190,7 +194,7 @@ class NumericModel:
     inertia: np.ndarray
     gravity: np.ndarray
     numbers: Numbers = FLOAT64
-    quaternion_joints: tuple[QuaternionJoint, ...] = ()
+    joint_places: tuple[QuaternionJoint, ...] = ()
     quaternion_bodies: tuple[int, ...] = ()
     tree_joint_names: tuple[str, ...] = ()
     coupling: np.ndarray | None = None
@@ -211,7 +215,13 @@ class NumericModel:
     @property
     def nq(self) -> int:
         """Length of the configuration ``q`` (NQ): :attr:`n`, plus one per quaternion joint."""
-        return self.n + sum(j.nq - j.nv for j in self.quaternion_joints)
+        return self.n + sum(j.nq - j.nv for j in self.joint_places)
+
+    @property
+    def chart_places(self) -> tuple[QuaternionJoint, ...]:
+        """The joints whose configuration is not their coordinates (``nq != nv``), with their
+        places in ``q`` and ``v``, in velocity order; empty without them."""
+        return tuple(place for place in self.joint_places if place.nq != place.nv)
 
     @property
     def nb(self) -> int:
@@ -325,7 +335,8 @@ def numeric_model(model: RobotModel, values: Mapping | None = None,
             raise ValueError(f"model '{model.name}' has a non-finite quantity")
         a.flags.writeable = False
     tree = uncoupled(model)
-    joints = tree.quaternion_joints
+    places = tree.joint_places
+    charts = [place for place in places if place.nq != place.nv]
     coupling = {}
     if model.couplings:
         T = _mat(numbers, coupling_map(model)[0].tolist(), "coupling gain")
@@ -339,8 +350,8 @@ def numeric_model(model: RobotModel, values: Mapping | None = None,
         joint_of_body=("",) + tuple(j.name for j in order),
         joint_names=model.joint_names,
         numbers=numbers,
-        quaternion_joints=joints,
-        quaternion_bodies=tuple(int(np.flatnonzero(q_index == j.v_index)[0]) for j in joints),
+        joint_places=places,
+        quaternion_bodies=tuple(int(np.flatnonzero(q_index == j.v_index)[0]) for j in charts),
         tree_joint_names=tuple(j.name for j in model.movable_joints),
         **coupling,
         **arrays,

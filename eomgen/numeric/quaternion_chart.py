@@ -32,7 +32,7 @@ def chart_coordinates(nm, q: np.ndarray) -> np.ndarray:
     chart, zero for the virtual joints of the others (``q`` itself when none has one)."""
     nv, numbers = nm.n_tree, nm.numbers
     out = numbers.zeros(nv)
-    starts = {j.v_index: j for j in nm.quaternion_joints}
+    starts = {j.v_index: j for j in nm.chart_places}
     k = iq = 0
     while k < nv:
         joint = starts.get(k)
@@ -51,7 +51,7 @@ def placements(nm, q: np.ndarray) -> dict[int, tuple[np.ndarray, np.ndarray]]:
     :meth:`~eomgen.model.joints.ChartKind.pose` (the rotation of a quaternion, and a free
     flyer's origin ``q[0:3]`` [m]; a planar joint's rotation about z and origin)."""
     return {joint.v_index: joint.kind.pose(q[joint.q_slice], nm.numbers)
-            for joint in nm.quaternion_joints}
+            for joint in nm.chart_places}
 
 
 def chart_offset(nm, qd: np.ndarray) -> np.ndarray:
@@ -59,7 +59,7 @@ def chart_offset(nm, qd: np.ndarray) -> np.ndarray:
     ``len(qd)`` entries, zero outside the joints with a chart (all zero without them)."""
     numbers = nm.numbers
     out = numbers.zeros(len(qd))
-    for joint in nm.quaternion_joints:
+    for joint in nm.chart_places:
         motions = []
         for i, axis in enumerate(joint.motions):
             m = numbers.zeros(6)

@@ -25,11 +25,6 @@ NAMING_TODAY: dict[str, str] = {
     "eomgen/model/robot.py": "RobotModel.free_flyer and .quaternion_joints, public properties",
     "eomgen/model/floating.py": "add_free_flyer: the free flyer put under a robot",
     "eomgen/numeric/floating_base.py": "to_free_flyer, from_free_flyer: the Euler chart's maps",
-    "eomgen/symbolic/free_flyer.py": "the free flyer's symbolic pieces, as first named",
-    # the homes of the charts at their layer, which take the model
-    "eomgen/model/quaternion.py": "where each joint with a chart sits in q and v",
-    "eomgen/numeric/model.py": "NumericModel.quaternion_joints, the numeric model's layout",
-    "eomgen/numeric/quaternion_chart.py": "the numeric chart: placements, offset",
 }
 
 
