@@ -4,6 +4,7 @@
 /*
  * C kernels of robot planar_2link (declared in planar_2link_kernels.h): plain C99, no Python.
  *   cc -O2 -fno-math-errno -c planar_2link_kernels.c
+ * (add -march=native for the batches' SIMD lanes: four states per AVX2 vector).
  */
 #include <math.h>
 #include <string.h>
@@ -107,4 +108,44 @@ void planar_2link_inverse_dynamics(const double *q, const double *qd, const doub
     memset(out, 0, sizeof(double) * 2);
     out[0] = t_n1_2_;
     out[1] = t_n2_2_;
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Batches: n states, state k's vectors at q + k * NQ, qd + k * NV, ... and its result at
+ * out + k * (the one-state size). With GCC or Clang, a function with a lanes kernel takes the
+ * states EOM_LANES at a time (one per lane of a SIMD vector, the inputs transposed once per
+ * block), the rest one by one; elsewhere every state goes through the one-state function. */
+#if defined(__GNUC__) && !defined(PLANAR_2LINK_NO_LANES)
+#define EOM_LANES 4
+typedef double eom_lanes __attribute__((vector_size(8 * EOM_LANES)));
+#else
+#define EOM_LANES 1
+#endif
+
+void planar_2link_mass_matrix_batch(long n, const double *q, const double *p, double *out)
+{
+    long k = 0;
+    for (; k < n; ++k)
+        planar_2link_mass_matrix(q + k * PLANAR_2LINK_NQ, p, out + k * 4);
+}
+
+void planar_2link_coriolis_matrix_batch(long n, const double *q, const double *qd, const double *p, double *out)
+{
+    long k = 0;
+    for (; k < n; ++k)
+        planar_2link_coriolis_matrix(q + k * PLANAR_2LINK_NQ, qd + k * PLANAR_2LINK_NV, p, out + k * 4);
+}
+
+void planar_2link_gravity_vector_batch(long n, const double *q, const double *p, double *out)
+{
+    long k = 0;
+    for (; k < n; ++k)
+        planar_2link_gravity_vector(q + k * PLANAR_2LINK_NQ, p, out + k * 2);
+}
+
+void planar_2link_inverse_dynamics_batch(long n, const double *q, const double *qd, const double *qdd, const double *p, double *out)
+{
+    long k = 0;
+    for (; k < n; ++k)
+        planar_2link_inverse_dynamics(q + k * PLANAR_2LINK_NQ, qd + k * PLANAR_2LINK_NV, qdd + k * PLANAR_2LINK_NV, p, out + k * 2);
 }

@@ -4,6 +4,7 @@
 /*
  * C kernels of robot puma560 (declared in puma560_kernels.h): plain C99, no Python.
  *   cc -O2 -fno-math-errno -c puma560_kernels.c
+ * (add -march=native for the batches' SIMD lanes: four states per AVX2 vector).
  */
 #include <math.h>
 #include <string.h>
@@ -671,4 +672,524 @@ void puma560_inverse_dynamics(const double *q, const double *qd, const double *q
     out[3] = t_n4_2_;
     out[4] = t_n5_2_;
     out[5] = t_n6_2;
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Batches: n states, state k's vectors at q + k * NQ, qd + k * NV, ... and its result at
+ * out + k * (the one-state size). With GCC or Clang, a function with a lanes kernel takes the
+ * states EOM_LANES at a time (one per lane of a SIMD vector, the inputs transposed once per
+ * block), the rest one by one; elsewhere every state goes through the one-state function. */
+#if defined(__GNUC__) && !defined(PUMA560_NO_LANES)
+#define EOM_LANES 4
+typedef double eom_lanes __attribute__((vector_size(8 * EOM_LANES)));
+#else
+#define EOM_LANES 1
+#endif
+#if EOM_LANES > 1
+typedef unsigned long long eom_lane_bits __attribute__((vector_size(8 * EOM_LANES)));
+typedef long long eom_lane_ints __attribute__((vector_size(8 * EOM_LANES)));
+
+#define EOM_PIO2_1 0x1.921fb544p+0           /* pi/2 = EOM_PIO2_1 + EOM_PIO2_2 + EOM_PIO2_3 + */
+#define EOM_PIO2_2 0x1.0b4611a6p-34          /* O(2^-122): two parts of 33 bits, one of 53 */
+#define EOM_PIO2_3 0x1.3198a2e037073p-69
+#define EOM_2_OVER_PI 0x1.45f306dc9c883p-1
+#define EOM_ROUND 0x1.8p52                    /* (y + EOM_ROUND) - EOM_ROUND: y rounded */
+#define EOM_REDUCE_LIMIT 1e5                  /* beyond: libm, lane by lane */
+#define EOM_INLINE inline __attribute__((always_inline))
+
+/* sin and cos of every lane of *at (vectors by pointer: none crosses a call by value, whose
+ * ABI depends on the instruction set). */
+static EOM_INLINE void eom_sincos_lanes(const eom_lanes *at, eom_lanes *sine, eom_lanes *cosine)
+{
+    const eom_lanes x = *at;
+    const eom_lanes k = (x * EOM_2_OVER_PI + EOM_ROUND) - EOM_ROUND;
+    const eom_lane_bits n = (eom_lane_bits)__builtin_convertvector(k, eom_lane_ints);
+    /* |x| > EOM_REDUCE_LIMIT, nan or +-inf: the bits without the sign, compared unsigned */
+    const eom_lane_ints far = ((eom_lane_bits)x << 1)
+        > ((eom_lane_bits)((eom_lanes){0} + EOM_REDUCE_LIMIT) << 1);
+    /* r_hi + r_lo = x - k pi/2: a exact, w exact, (a - r1) - w the rounding error of r1 */
+    const eom_lanes a = x - k * EOM_PIO2_1;
+    const eom_lanes w = k * EOM_PIO2_2;
+    const eom_lanes r1 = a - w;
+    const eom_lanes t = ((a - r1) - w) - k * EOM_PIO2_3;
+    const eom_lanes r = r1 + t;
+    const eom_lanes r_lo = (r1 - r) + t;
+    const eom_lanes z = r * r;
+    /* sin(r + r_lo) = r + r z S(z) + r_lo (1 - z/2); cos(r + r_lo) = 1 - z/2 + z^2 C(z) - r r_lo,
+     * 1 - z/2 as w_c plus its rounding error */
+    const eom_lanes s_poly = -0x1.5555555555555p-3 + z * (0x1.1111111110babp-7 + z * (
+        -0x1.a01a019e820aep-13 + z * (0x1.71de37946ed6dp-19 + z * (-0x1.ae6008d114485p-26
+        + z * 0x1.5e0a4fc16be59p-33))));
+    const eom_lanes c_poly = 0x1.5555555555555p-5 + z * (-0x1.6c16c16c16963p-10 + z * (
+        0x1.a01a019f4ddfdp-16 + z * (-0x1.27e4fa16cc2d1p-22 + z * (0x1.1eeb67d026ec6p-29
+        + z * -0x1.907cd8ff5ede7p-37))));
+    const eom_lanes half_z = 0.5 * z;
+    const eom_lanes w_c = 1.0 - half_z;
+    const eom_lanes s = r + ((r * z) * s_poly + r_lo * w_c);
+    const eom_lanes c = w_c + (((1.0 - w_c) - half_z) + ((z * z) * c_poly - r * r_lo));
+    /* quadrant n mod 4: sin x = s, c, -s, -c; cos x = c, -s, -c, s */
+    const eom_lane_bits swap = -(n & 1);
+    const eom_lane_bits sin_bits = (((eom_lane_bits)s & ~swap) | ((eom_lane_bits)c & swap))
+        ^ ((n & 2) << 62);
+    const eom_lane_bits cos_bits = (((eom_lane_bits)c & ~swap) | ((eom_lane_bits)s & swap))
+        ^ (((n + 1) & 2) << 62);
+    long long any = 0;
+    int l;
+    *sine = (eom_lanes)sin_bits;
+    *cosine = (eom_lanes)cos_bits;
+    for (l = 0; l < EOM_LANES; ++l)
+        any |= far[l];
+    if (__builtin_expect(any != 0, 0))
+        for (l = 0; l < EOM_LANES; ++l) {
+            (*sine)[l] = sin(x[l]);
+            (*cosine)[l] = cos(x[l]);
+        }
+}
+
+/* sin(value) and cos(value) of a lanes kernel (GNU statement expressions). */
+#define EOM_SIN_LANES(value) ({ \
+    eom_lanes eom_x = (value), eom_sine, eom_cosine; \
+    eom_sincos_lanes(&eom_x, &eom_sine, &eom_cosine); \
+    eom_sine; })
+#define EOM_COS_LANES(value) ({ \
+    eom_lanes eom_x = (value), eom_sine, eom_cosine; \
+    eom_sincos_lanes(&eom_x, &eom_sine, &eom_cosine); \
+    eom_cosine; })
+
+/* The lanes kernels of a batch (in_lanes): the one-state kernels' arithmetic on vectors of
+ * EOM_LANES states, sin and cos by the vector routine above, sqrt lane by lane (a statement
+ * expression: no vector crosses a function call); a constant is broadcast to every lane. Every
+ * kernel of at least LANES_OPERATIONS operations (eomgen's fast backend) whose arithmetic is
+ * +, -, *, / and those functions has one, compiled with and without FMA (FMA_CLONES). */
+#define EOM_BROADCAST(value) ((value) - (eom_lanes){0})
+#define EOM_LANES_KERNEL(kernel) kernel
+#define EOM_EACH_LANE(function, value) ({ \
+    eom_lanes eom_each = (value); \
+    for (int eom_l = 0; eom_l < EOM_LANES; ++eom_l) \
+        eom_each[eom_l] = function(eom_each[eom_l]); \
+    eom_each; })
+#define sin(value) EOM_SIN_LANES(value)
+#define cos(value) EOM_COS_LANES(value)
+#define sqrt(value) EOM_EACH_LANE(sqrt, value)
+
+static void coriolis_matrix_lanes(const eom_lanes *const *x, const eom_lanes *p, eom_lanes *out)
+{
+    const eom_lanes *q = x[0];
+    const eom_lanes *qd = x[1];
+    (void)x; (void)p; (void)q; (void)qd;
+    const eom_lanes t_s1 = sin(q[0]);
+    const eom_lanes t_c1 = cos(q[0]);
+    const eom_lanes t_s2 = sin(q[1]);
+    const eom_lanes t_c2 = cos(q[1]);
+    const eom_lanes t_s3 = sin(q[2]);
+    const eom_lanes t_c3 = cos(q[2]);
+    const eom_lanes t_s4 = sin(q[3]);
+    const eom_lanes t_c4 = cos(q[3]);
+    const eom_lanes t_s5 = sin(q[4]);
+    const eom_lanes t_c5 = cos(q[4]);
+    const eom_lanes t_s6 = sin(q[5]);
+    const eom_lanes t_c6 = cos(q[5]);
+    const eom_lanes t_R2_00 = t_c1*t_c2;
+    const eom_lanes t_R2_01 = -t_c1*t_s2;
+    const eom_lanes t_R2_10 = t_c2*t_s1;
+    const eom_lanes t_R2_11 = -t_s1*t_s2;
+    const eom_lanes t_o3_0 = 0.4318*t_R2_00 + 0.15005*t_s1;
+    const eom_lanes t_o3_1 = 0.4318*t_R2_10 - 0.15005*t_c1;
+    const eom_lanes t_R3_00 = t_R2_00*t_c3 + t_R2_01*t_s3;
+    const eom_lanes t_R3_01 = t_R2_01*t_c3 - t_R2_00*t_s3;
+    const eom_lanes t_R3_10 = t_R2_10*t_c3 + t_R2_11*t_s3;
+    const eom_lanes t_R3_11 = t_R2_11*t_c3 - t_R2_10*t_s3;
+    const eom_lanes t_R3_20 = t_c2*t_s3 + t_c3*t_s2;
+    const eom_lanes t_R3_21 = t_c2*t_c3 - t_s2*t_s3;
+    const eom_lanes t_v3_0 = 0.4318*t_c1*t_s2;
+    const eom_lanes t_v3_1 = 0.4318*t_s1*t_s2;
+    const eom_lanes t_v3_2 = -t_c1*t_o3_0 - t_o3_1*t_s1;
+    const eom_lanes t_o4_0 = 0.0203*t_R3_00 + 0.4318*t_R3_01 + t_o3_0;
+    const eom_lanes t_o4_1 = 0.0203*t_R3_10 + 0.4318*t_R3_11 + t_o3_1;
+    const eom_lanes t_o4_2 = 0.0203*t_R3_20 + 0.4318*t_R3_21 + 0.4318*t_s2;
+    const eom_lanes t_R4_00 = t_R3_00*t_c4 - t_s1*t_s4;
+    const eom_lanes t_R4_01 = -t_R3_00*t_s4 - t_c4*t_s1;
+    const eom_lanes t_R4_10 = t_R3_10*t_c4 + t_c1*t_s4;
+    const eom_lanes t_R4_11 = t_c1*t_c4 - t_R3_10*t_s4;
+    const eom_lanes t_R4_20 = t_R3_20*t_c4;
+    const eom_lanes t_R4_21 = -t_R3_20*t_s4;
+    const eom_lanes t_v4_0 = t_R3_21*t_o4_1 - t_R3_11*t_o4_2;
+    const eom_lanes t_v4_1 = t_R3_01*t_o4_2 - t_R3_21*t_o4_0;
+    const eom_lanes t_v4_2 = t_R3_11*t_o4_0 - t_R3_01*t_o4_1;
+    const eom_lanes t_R5_00 = t_R3_01*t_s5 + t_R4_00*t_c5;
+    const eom_lanes t_R5_01 = t_R3_01*t_c5 - t_R4_00*t_s5;
+    const eom_lanes t_R5_10 = t_R3_11*t_s5 + t_R4_10*t_c5;
+    const eom_lanes t_R5_11 = t_R3_11*t_c5 - t_R4_10*t_s5;
+    const eom_lanes t_R5_20 = t_R3_21*t_s5 + t_R4_20*t_c5;
+    const eom_lanes t_R5_21 = t_R3_21*t_c5 - t_R4_20*t_s5;
+    const eom_lanes t_v5_0 = t_R4_11*t_o4_2 - t_R4_21*t_o4_1;
+    const eom_lanes t_v5_1 = t_R4_21*t_o4_0 - t_R4_01*t_o4_2;
+    const eom_lanes t_v5_2 = t_R4_01*t_o4_1 - t_R4_11*t_o4_0;
+    const eom_lanes t_R6_00 = t_R4_01*t_s6 + t_R5_00*t_c6;
+    const eom_lanes t_R6_01 = t_R4_01*t_c6 - t_R5_00*t_s6;
+    const eom_lanes t_R6_10 = t_R4_11*t_s6 + t_R5_10*t_c6;
+    const eom_lanes t_R6_11 = t_R4_11*t_c6 - t_R5_10*t_s6;
+    const eom_lanes t_R6_20 = t_R4_21*t_s6 + t_R5_20*t_c6;
+    const eom_lanes t_R6_21 = t_R4_21*t_c6 - t_R5_20*t_s6;
+    const eom_lanes t_v6_0 = t_R5_21*t_o4_1 - t_R5_11*t_o4_2;
+    const eom_lanes t_v6_1 = t_R5_01*t_o4_2 - t_R5_21*t_o4_0;
+    const eom_lanes t_v6_2 = t_R5_11*t_o4_0 - t_R5_01*t_o4_1;
+    const eom_lanes t_Iw2_00 = t_R2_00*(1.03118515*t_R2_00 - 0.0070992*t_R2_01 - 0.26917800000000003*t_s1) + t_R2_01*(1.50501635*t_R2_01 - 0.0070992*t_R2_00 - 0.023750999999999998*t_s1) + t_s1*(0.6200840000000001*t_s1 - 0.26917800000000003*t_R2_00 - 0.023750999999999998*t_R2_01);
+    const eom_lanes t_Iw2_01 = t_R2_10*(1.03118515*t_R2_00 - 0.0070992*t_R2_01 - 0.26917800000000003*t_s1) + t_R2_11*(1.50501635*t_R2_01 - 0.0070992*t_R2_00 - 0.023750999999999998*t_s1) - t_c1*(0.6200840000000001*t_s1 - 0.26917800000000003*t_R2_00 - 0.023750999999999998*t_R2_01);
+    const eom_lanes t_Iw2_02 = t_c2*(1.50501635*t_R2_01 - 0.0070992*t_R2_00 - 0.023750999999999998*t_s1) + t_s2*(1.03118515*t_R2_00 - 0.0070992*t_R2_01 - 0.26917800000000003*t_s1);
+    const eom_lanes t_Iw2_11 = t_R2_10*(1.03118515*t_R2_10 - 0.0070992*t_R2_11 + 0.26917800000000003*t_c1) + t_R2_11*(1.50501635*t_R2_11 - 0.0070992*t_R2_10 + 0.023750999999999998*t_c1) - t_c1*(-0.26917800000000003*t_R2_10 - 0.023750999999999998*t_R2_11 - 0.6200840000000001*t_c1);
+    const eom_lanes t_Iw2_12 = t_c2*(1.50501635*t_R2_11 - 0.0070992*t_R2_10 + 0.023750999999999998*t_c1) + t_s2*(1.03118515*t_R2_10 - 0.0070992*t_R2_11 + 0.26917800000000003*t_c1);
+    const eom_lanes t_Iw2_22 = t_c2*(1.50501635*t_c2 - 0.0070992*t_s2) + t_s2*(1.03118515*t_s2 - 0.0070992*t_c2);
+    const eom_lanes t_Rh3_0 = 0.336*t_R3_01 + 0.06767999999999999*t_s1;
+    const eom_lanes t_Rh3_1 = 0.336*t_R3_11 - 0.06767999999999999*t_c1;
+    const eom_lanes t_Iw3_00 = 0.090474288*t_R3_00*t_R3_00 + t_R3_01*(0.013454288*t_R3_01 - 0.0047376*t_s1) + 0.2901696*t_R3_21*t_s2 + 2.0*t_Rh3_1*t_o3_1 + 4.8*t_o3_1*t_o3_1 + t_s1*(0.10951999999999999*t_s1 - 0.0047376*t_R3_01) + 0.8949659520000001*t_s2*t_s2;
+    const eom_lanes t_Iw3_01 = 0.090474288*t_R3_00*t_R3_10 + t_R3_11*(0.013454288*t_R3_01 - 0.0047376*t_s1) - t_Rh3_0*t_o3_1 - t_Rh3_1*t_o3_0 - t_c1*(0.10951999999999999*t_s1 - 0.0047376*t_R3_01) - 4.8*t_o3_0*t_o3_1;
+    const eom_lanes t_Iw3_02 = 0.090474288*t_R3_00*t_R3_20 - 0.336*t_R3_21*t_o3_0 + t_R3_21*(0.013454288*t_R3_01 - 0.0047376*t_s1) - 0.4318*t_Rh3_0*t_s2 - 2.07264*t_o3_0*t_s2;
+    const eom_lanes t_Iw3_11 = 0.090474288*t_R3_10*t_R3_10 + t_R3_11*(0.013454288*t_R3_11 + 0.0047376*t_c1) + 0.2901696*t_R3_21*t_s2 + 2.0*t_Rh3_0*t_o3_0 - t_c1*(-0.0047376*t_R3_11 - 0.10951999999999999*t_c1) + 4.8*t_o3_0*t_o3_0 + 0.8949659520000001*t_s2*t_s2;
+    const eom_lanes t_Iw3_12 = 0.090474288*t_R3_10*t_R3_20 - 0.336*t_R3_21*t_o3_1 + t_R3_21*(0.013454288*t_R3_11 + 0.0047376*t_c1) - 0.4318*t_Rh3_1*t_s2 - 2.07264*t_o3_1*t_s2;
+    const eom_lanes t_Iw3_22 = 0.090474288*t_R3_20*t_R3_20 + 0.013454288*t_R3_21*t_R3_21 + 2.0*t_Rh3_0*t_o3_0 + 2.0*t_Rh3_1*t_o3_1 + 4.8*t_o3_0*t_o3_0 + 4.8*t_o3_1*t_o3_1;
+    const eom_lanes t_hw3_0 = t_Rh3_0 + 4.8*t_o3_0;
+    const eom_lanes t_hw3_1 = t_Rh3_1 + 4.8*t_o3_1;
+    const eom_lanes t_hw3_2 = 0.336*t_R3_21 + 2.07264*t_s2;
+    const eom_lanes t_Iw4_00 = 0.0013*t_R3_01*t_R3_01 + 0.031159999999999997*t_R3_11*t_o4_1 + 0.031159999999999997*t_R3_21*t_o4_2 + 0.00209602*t_R4_00*t_R4_00 + 0.00209602*t_R4_01*t_R4_01 + 0.82*t_o4_1*t_o4_1 + 0.82*t_o4_2*t_o4_2;
+    const eom_lanes t_Iw4_01 = 0.0013*t_R3_01*t_R3_11 - 0.015579999999999998*t_R3_01*t_o4_1 - 0.015579999999999998*t_R3_11*t_o4_0 + 0.00209602*t_R4_00*t_R4_10 + 0.00209602*t_R4_01*t_R4_11 - 0.82*t_o4_0*t_o4_1;
+    const eom_lanes t_Iw4_02 = 0.0013*t_R3_01*t_R3_21 - 0.015579999999999998*t_R3_01*t_o4_2 - 0.015579999999999998*t_R3_21*t_o4_0 + 0.00209602*t_R4_00*t_R4_20 + 0.00209602*t_R4_01*t_R4_21 - 0.82*t_o4_0*t_o4_2;
+    const eom_lanes t_Iw4_11 = 0.031159999999999997*t_R3_01*t_o4_0 + 0.0013*t_R3_11*t_R3_11 + 0.031159999999999997*t_R3_21*t_o4_2 + 0.00209602*t_R4_10*t_R4_10 + 0.00209602*t_R4_11*t_R4_11 + 0.82*t_o4_0*t_o4_0 + 0.82*t_o4_2*t_o4_2;
+    const eom_lanes t_Iw4_12 = 0.0013*t_R3_11*t_R3_21 - 0.015579999999999998*t_R3_11*t_o4_2 - 0.015579999999999998*t_R3_21*t_o4_1 + 0.00209602*t_R4_10*t_R4_20 + 0.00209602*t_R4_11*t_R4_21 - 0.82*t_o4_1*t_o4_2;
+    const eom_lanes t_Iw4_22 = 0.031159999999999997*t_R3_01*t_o4_0 + 0.031159999999999997*t_R3_11*t_o4_1 + 0.0013*t_R3_21*t_R3_21 + 0.00209602*t_R4_20*t_R4_20 + 0.00209602*t_R4_21*t_R4_21 + 0.82*t_o4_0*t_o4_0 + 0.82*t_o4_1*t_o4_1;
+    const eom_lanes t_hw4_0 = 0.015579999999999998*t_R3_01 + 0.82*t_o4_0;
+    const eom_lanes t_hw4_1 = 0.015579999999999998*t_R3_11 + 0.82*t_o4_1;
+    const eom_lanes t_hw4_2 = 0.015579999999999998*t_R3_21 + 0.82*t_o4_2;
+    const eom_lanes t_Iw5_00 = 0.0004*t_R4_01*t_R4_01 + 0.0003*t_R5_00*t_R5_00 + 0.0003*t_R5_01*t_R5_01 + 0.34*t_o4_1*t_o4_1 + 0.34*t_o4_2*t_o4_2;
+    const eom_lanes t_Iw5_01 = 0.0004*t_R4_01*t_R4_11 + 0.0003*t_R5_00*t_R5_10 + 0.0003*t_R5_01*t_R5_11 - 0.34*t_o4_0*t_o4_1;
+    const eom_lanes t_Iw5_02 = 0.0004*t_R4_01*t_R4_21 + 0.0003*t_R5_00*t_R5_20 + 0.0003*t_R5_01*t_R5_21 - 0.34*t_o4_0*t_o4_2;
+    const eom_lanes t_Iw5_11 = 0.0004*t_R4_11*t_R4_11 + 0.0003*t_R5_10*t_R5_10 + 0.0003*t_R5_11*t_R5_11 + 0.34*t_o4_0*t_o4_0 + 0.34*t_o4_2*t_o4_2;
+    const eom_lanes t_Iw5_12 = 0.0004*t_R4_11*t_R4_21 + 0.0003*t_R5_10*t_R5_20 + 0.0003*t_R5_11*t_R5_21 - 0.34*t_o4_1*t_o4_2;
+    const eom_lanes t_Iw5_22 = 0.0004*t_R4_21*t_R4_21 + 0.0003*t_R5_20*t_R5_20 + 0.0003*t_R5_21*t_R5_21 + 0.34*t_o4_0*t_o4_0 + 0.34*t_o4_1*t_o4_1;
+    const eom_lanes t_Iw6_00 = 4e-05*t_R5_01*t_R5_01 + 0.0057599999999999995*t_R5_11*t_o4_1 + 0.0057599999999999995*t_R5_21*t_o4_2 + 0.00024216*t_R6_00*t_R6_00 + 0.00024216*t_R6_01*t_R6_01 + 0.09*t_o4_1*t_o4_1 + 0.09*t_o4_2*t_o4_2;
+    const eom_lanes t_Iw6_01 = 4e-05*t_R5_01*t_R5_11 - 0.0028799999999999997*t_R5_01*t_o4_1 - 0.0028799999999999997*t_R5_11*t_o4_0 + 0.00024216*t_R6_00*t_R6_10 + 0.00024216*t_R6_01*t_R6_11 - 0.09*t_o4_0*t_o4_1;
+    const eom_lanes t_Iw6_02 = 4e-05*t_R5_01*t_R5_21 - 0.0028799999999999997*t_R5_01*t_o4_2 - 0.0028799999999999997*t_R5_21*t_o4_0 + 0.00024216*t_R6_00*t_R6_20 + 0.00024216*t_R6_01*t_R6_21 - 0.09*t_o4_0*t_o4_2;
+    const eom_lanes t_Iw6_11 = 0.0057599999999999995*t_R5_01*t_o4_0 + 4e-05*t_R5_11*t_R5_11 + 0.0057599999999999995*t_R5_21*t_o4_2 + 0.00024216*t_R6_10*t_R6_10 + 0.00024216*t_R6_11*t_R6_11 + 0.09*t_o4_0*t_o4_0 + 0.09*t_o4_2*t_o4_2;
+    const eom_lanes t_Iw6_12 = 4e-05*t_R5_11*t_R5_21 - 0.0028799999999999997*t_R5_11*t_o4_2 - 0.0028799999999999997*t_R5_21*t_o4_1 + 0.00024216*t_R6_10*t_R6_20 + 0.00024216*t_R6_11*t_R6_21 - 0.09*t_o4_1*t_o4_2;
+    const eom_lanes t_Iw6_22 = 0.0057599999999999995*t_R5_01*t_o4_0 + 0.0057599999999999995*t_R5_11*t_o4_1 + 4e-05*t_R5_21*t_R5_21 + 0.00024216*t_R6_20*t_R6_20 + 0.00024216*t_R6_21*t_R6_21 + 0.09*t_o4_0*t_o4_0 + 0.09*t_o4_1*t_o4_1;
+    const eom_lanes t_hw6_0 = 0.0028799999999999997*t_R5_01 + 0.09*t_o4_0;
+    const eom_lanes t_hw6_1 = 0.0028799999999999997*t_R5_11 + 0.09*t_o4_1;
+    const eom_lanes t_hw6_2 = 0.0028799999999999997*t_R5_21 + 0.09*t_o4_2;
+    const eom_lanes t_hc5_0 = t_hw6_0 + 0.34*t_o4_0;
+    const eom_lanes t_hc5_1 = t_hw6_1 + 0.34*t_o4_1;
+    const eom_lanes t_hc5_2 = t_hw6_2 + 0.34*t_o4_2;
+    const eom_lanes t_Ic5_00 = t_Iw5_00 + t_Iw6_00;
+    const eom_lanes t_Ic5_01 = t_Iw5_01 + t_Iw6_01;
+    const eom_lanes t_Ic5_02 = t_Iw5_02 + t_Iw6_02;
+    const eom_lanes t_Ic5_11 = t_Iw5_11 + t_Iw6_11;
+    const eom_lanes t_Ic5_12 = t_Iw5_12 + t_Iw6_12;
+    const eom_lanes t_Ic5_22 = t_Iw5_22 + t_Iw6_22;
+    const eom_lanes t_hc4_0 = t_hc5_0 + t_hw4_0;
+    const eom_lanes t_hc4_1 = t_hc5_1 + t_hw4_1;
+    const eom_lanes t_hc4_2 = t_hc5_2 + t_hw4_2;
+    const eom_lanes t_Ic4_00 = t_Ic5_00 + t_Iw4_00;
+    const eom_lanes t_Ic4_01 = t_Ic5_01 + t_Iw4_01;
+    const eom_lanes t_Ic4_02 = t_Ic5_02 + t_Iw4_02;
+    const eom_lanes t_Ic4_11 = t_Ic5_11 + t_Iw4_11;
+    const eom_lanes t_Ic4_12 = t_Ic5_12 + t_Iw4_12;
+    const eom_lanes t_Ic4_22 = t_Ic5_22 + t_Iw4_22;
+    const eom_lanes t_hc3_0 = t_hc4_0 + t_hw3_0;
+    const eom_lanes t_hc3_1 = t_hc4_1 + t_hw3_1;
+    const eom_lanes t_hc3_2 = t_hc4_2 + t_hw3_2;
+    const eom_lanes t_Ic3_00 = t_Ic4_00 + t_Iw3_00;
+    const eom_lanes t_Ic3_01 = t_Ic4_01 + t_Iw3_01;
+    const eom_lanes t_Ic3_02 = t_Ic4_02 + t_Iw3_02;
+    const eom_lanes t_Ic3_11 = t_Ic4_11 + t_Iw3_11;
+    const eom_lanes t_Ic3_12 = t_Ic4_12 + t_Iw3_12;
+    const eom_lanes t_Ic3_22 = t_Ic4_22 + t_Iw3_22;
+    const eom_lanes t_Ic2_00 = t_Ic3_00 + t_Iw2_00;
+    const eom_lanes t_Ic2_01 = t_Ic3_01 + t_Iw2_01;
+    const eom_lanes t_Ic2_02 = t_Ic3_02 + t_Iw2_02;
+    const eom_lanes t_Ic2_11 = t_Ic3_11 + t_Iw2_11;
+    const eom_lanes t_Ic2_12 = t_Ic3_12 + t_Iw2_12;
+    const eom_lanes t_F3_0 = t_Ic3_00*t_s1 - t_Ic3_01*t_c1 + t_hc3_1*t_v3_2 - t_hc3_2*t_v3_1;
+    const eom_lanes t_F3_1 = t_Ic3_01*t_s1 - t_Ic3_11*t_c1 - t_hc3_0*t_v3_2 + t_hc3_2*t_v3_0;
+    const eom_lanes t_F4_0 = t_Ic4_00*t_R3_01 + t_Ic4_01*t_R3_11 + t_Ic4_02*t_R3_21 + t_hc4_1*t_v4_2 - t_hc4_2*t_v4_1;
+    const eom_lanes t_F4_1 = t_Ic4_01*t_R3_01 + t_Ic4_11*t_R3_11 + t_Ic4_12*t_R3_21 - t_hc4_0*t_v4_2 + t_hc4_2*t_v4_0;
+    const eom_lanes t_F4_2 = t_Ic4_02*t_R3_01 + t_Ic4_12*t_R3_11 + t_Ic4_22*t_R3_21 + t_hc4_0*t_v4_1 - t_hc4_1*t_v4_0;
+    const eom_lanes t_F4_3 = t_R3_11*t_hc4_2 - t_R3_21*t_hc4_1 + 1.25*t_v4_0;
+    const eom_lanes t_F4_4 = t_R3_21*t_hc4_0 - t_R3_01*t_hc4_2 + 1.25*t_v4_1;
+    const eom_lanes t_F4_5 = t_R3_01*t_hc4_1 - t_R3_11*t_hc4_0 + 1.25*t_v4_2;
+    const eom_lanes t_F5_0 = t_hc5_1*t_v5_2 - t_Ic5_00*t_R4_01 - t_Ic5_01*t_R4_11 - t_Ic5_02*t_R4_21 - t_hc5_2*t_v5_1;
+    const eom_lanes t_F5_1 = t_hc5_2*t_v5_0 - t_Ic5_01*t_R4_01 - t_Ic5_11*t_R4_11 - t_Ic5_12*t_R4_21 - t_hc5_0*t_v5_2;
+    const eom_lanes t_F5_2 = t_hc5_0*t_v5_1 - t_Ic5_02*t_R4_01 - t_Ic5_12*t_R4_11 - t_Ic5_22*t_R4_21 - t_hc5_1*t_v5_0;
+    const eom_lanes t_F5_3 = t_R4_21*t_hc5_1 - t_R4_11*t_hc5_2 + 0.43000000000000005*t_v5_0;
+    const eom_lanes t_F5_4 = t_R4_01*t_hc5_2 - t_R4_21*t_hc5_0 + 0.43000000000000005*t_v5_1;
+    const eom_lanes t_F5_5 = t_R4_11*t_hc5_0 - t_R4_01*t_hc5_1 + 0.43000000000000005*t_v5_2;
+    const eom_lanes t_F6_0 = t_Iw6_00*t_R5_01 + t_Iw6_01*t_R5_11 + t_Iw6_02*t_R5_21 + t_hw6_1*t_v6_2 - t_hw6_2*t_v6_1;
+    const eom_lanes t_F6_1 = t_Iw6_01*t_R5_01 + t_Iw6_11*t_R5_11 + t_Iw6_12*t_R5_21 - t_hw6_0*t_v6_2 + t_hw6_2*t_v6_0;
+    const eom_lanes t_F6_2 = t_Iw6_02*t_R5_01 + t_Iw6_12*t_R5_11 + t_Iw6_22*t_R5_21 + t_hw6_0*t_v6_1 - t_hw6_1*t_v6_0;
+    const eom_lanes t_F6_3 = t_R5_11*t_hw6_2 - t_R5_21*t_hw6_1 + 0.09*t_v6_0;
+    const eom_lanes t_F6_4 = t_R5_21*t_hw6_0 - t_R5_01*t_hw6_2 + 0.09*t_v6_1;
+    const eom_lanes t_F6_5 = t_R5_01*t_hw6_1 - t_R5_11*t_hw6_0 + 0.09*t_v6_2;
+    const eom_lanes t_Sd2_0 = qd[0]*t_c1;
+    const eom_lanes t_Sd2_1 = qd[0]*t_s1;
+    const eom_lanes t_V2_0 = qd[1]*t_s1;
+    const eom_lanes t_V2_1 = -qd[1]*t_c1;
+    const eom_lanes t_Sd3_2 = -t_V2_0*t_c1 - t_V2_1*t_s1;
+    const eom_lanes t_Sd3_3 = t_V2_1*t_v3_2 - qd[0]*t_v3_1;
+    const eom_lanes t_Sd3_4 = qd[0]*t_v3_0 - t_V2_0*t_v3_2;
+    const eom_lanes t_Sd3_5 = t_V2_0*t_v3_1 - t_V2_1*t_v3_0;
+    const eom_lanes t_V3_0 = qd[2]*t_s1 + t_V2_0;
+    const eom_lanes t_V3_1 = t_V2_1 - qd[2]*t_c1;
+    const eom_lanes t_V3_3 = qd[2]*t_v3_0;
+    const eom_lanes t_V3_4 = qd[2]*t_v3_1;
+    const eom_lanes t_V3_5 = qd[2]*t_v3_2;
+    const eom_lanes t_Sd4_0 = t_R3_21*t_V3_1 - qd[0]*t_R3_11;
+    const eom_lanes t_Sd4_1 = qd[0]*t_R3_01 - t_R3_21*t_V3_0;
+    const eom_lanes t_Sd4_2 = t_R3_11*t_V3_0 - t_R3_01*t_V3_1;
+    const eom_lanes t_Sd4_3 = t_R3_21*t_V3_4 - qd[0]*t_v4_1 - t_R3_11*t_V3_5 + t_V3_1*t_v4_2;
+    const eom_lanes t_Sd4_4 = qd[0]*t_v4_0 + t_R3_01*t_V3_5 - t_R3_21*t_V3_3 - t_V3_0*t_v4_2;
+    const eom_lanes t_Sd4_5 = t_R3_11*t_V3_3 - t_R3_01*t_V3_4 + t_V3_0*t_v4_1 - t_V3_1*t_v4_0;
+    const eom_lanes t_V4_0 = qd[3]*t_R3_01 + t_V3_0;
+    const eom_lanes t_V4_1 = qd[3]*t_R3_11 + t_V3_1;
+    const eom_lanes t_V4_2 = qd[0] + qd[3]*t_R3_21;
+    const eom_lanes t_V4_3 = qd[3]*t_v4_0 + t_V3_3;
+    const eom_lanes t_V4_4 = qd[3]*t_v4_1 + t_V3_4;
+    const eom_lanes t_V4_5 = qd[3]*t_v4_2 + t_V3_5;
+    const eom_lanes t_Sd5_0 = t_R4_11*t_V4_2 - t_R4_21*t_V4_1;
+    const eom_lanes t_Sd5_1 = t_R4_21*t_V4_0 - t_R4_01*t_V4_2;
+    const eom_lanes t_Sd5_2 = t_R4_01*t_V4_1 - t_R4_11*t_V4_0;
+    const eom_lanes t_Sd5_3 = t_R4_11*t_V4_5 - t_R4_21*t_V4_4 + t_V4_1*t_v5_2 - t_V4_2*t_v5_1;
+    const eom_lanes t_Sd5_4 = t_R4_21*t_V4_3 - t_R4_01*t_V4_5 - t_V4_0*t_v5_2 + t_V4_2*t_v5_0;
+    const eom_lanes t_Sd5_5 = t_R4_01*t_V4_4 - t_R4_11*t_V4_3 + t_V4_0*t_v5_1 - t_V4_1*t_v5_0;
+    const eom_lanes t_V5_0 = t_V4_0 - qd[4]*t_R4_01;
+    const eom_lanes t_V5_1 = t_V4_1 - qd[4]*t_R4_11;
+    const eom_lanes t_V5_2 = t_V4_2 - qd[4]*t_R4_21;
+    const eom_lanes t_V5_3 = qd[4]*t_v5_0 + t_V4_3;
+    const eom_lanes t_V5_4 = qd[4]*t_v5_1 + t_V4_4;
+    const eom_lanes t_V5_5 = qd[4]*t_v5_2 + t_V4_5;
+    const eom_lanes t_Sd6_0 = t_R5_21*t_V5_1 - t_R5_11*t_V5_2;
+    const eom_lanes t_Sd6_1 = t_R5_01*t_V5_2 - t_R5_21*t_V5_0;
+    const eom_lanes t_Sd6_2 = t_R5_11*t_V5_0 - t_R5_01*t_V5_1;
+    const eom_lanes t_Sd6_3 = t_R5_21*t_V5_4 - t_R5_11*t_V5_5 + t_V5_1*t_v6_2 - t_V5_2*t_v6_1;
+    const eom_lanes t_Sd6_4 = t_R5_01*t_V5_5 - t_R5_21*t_V5_3 - t_V5_0*t_v6_2 + t_V5_2*t_v6_0;
+    const eom_lanes t_Sd6_5 = t_R5_11*t_V5_3 - t_R5_01*t_V5_4 + t_V5_0*t_v6_1 - t_V5_1*t_v6_0;
+    const eom_lanes t_V6_0 = qd[5]*t_R5_01 + t_V5_0;
+    const eom_lanes t_V6_1 = qd[5]*t_R5_11 + t_V5_1;
+    const eom_lanes t_V6_2 = qd[5]*t_R5_21 + t_V5_2;
+    const eom_lanes t_V6_3 = qd[5]*t_v6_0 + t_V5_3;
+    const eom_lanes t_V6_4 = qd[5]*t_v6_1 + t_V5_4;
+    const eom_lanes t_V6_5 = qd[5]*t_v6_2 + t_V5_5;
+    const eom_lanes t_hV6_0 = t_Iw6_00*t_V6_0 + t_Iw6_01*t_V6_1 + t_Iw6_02*t_V6_2 - t_V6_4*t_hw6_2 + t_V6_5*t_hw6_1;
+    const eom_lanes t_hV6_1 = t_Iw6_01*t_V6_0 + t_Iw6_11*t_V6_1 + t_Iw6_12*t_V6_2 + t_V6_3*t_hw6_2 - t_V6_5*t_hw6_0;
+    const eom_lanes t_hV6_2 = t_Iw6_02*t_V6_0 + t_Iw6_12*t_V6_1 + t_Iw6_22*t_V6_2 - t_V6_3*t_hw6_1 + t_V6_4*t_hw6_0;
+    const eom_lanes t_hV6_3 = t_V6_1*t_hw6_2 - t_V6_2*t_hw6_1 + 0.09*t_V6_3;
+    const eom_lanes t_hV6_4 = t_V6_2*t_hw6_0 - t_V6_0*t_hw6_2 + 0.09*t_V6_4;
+    const eom_lanes t_hV6_5 = t_V6_0*t_hw6_1 - t_V6_1*t_hw6_0 + 0.09*t_V6_5;
+    const eom_lanes t_Id6_00 = 2.0*t_Iw6_02*t_V6_1 - 2.0*t_Iw6_01*t_V6_2 + 2.0*t_V6_4*t_hw6_1 + 2.0*t_V6_5*t_hw6_2;
+    const eom_lanes t_Id6_01 = t_Iw6_00*t_V6_2 - t_Iw6_02*t_V6_0 - t_Iw6_11*t_V6_2 + t_Iw6_12*t_V6_1 - t_V6_3*t_hw6_1 - t_V6_4*t_hw6_0;
+    const eom_lanes t_Id6_02 = t_Iw6_01*t_V6_0 - t_Iw6_00*t_V6_1 - t_Iw6_12*t_V6_2 + t_Iw6_22*t_V6_1 - t_V6_3*t_hw6_2 - t_V6_5*t_hw6_0;
+    const eom_lanes t_Id6_11 = 2.0*t_Iw6_01*t_V6_2 - 2.0*t_Iw6_12*t_V6_0 + 2.0*t_V6_3*t_hw6_0 + 2.0*t_V6_5*t_hw6_2;
+    const eom_lanes t_Id6_12 = t_Iw6_02*t_V6_2 - t_Iw6_01*t_V6_1 + t_Iw6_11*t_V6_0 - t_Iw6_22*t_V6_0 - t_V6_4*t_hw6_2 - t_V6_5*t_hw6_1;
+    const eom_lanes t_Id6_22 = 2.0*t_Iw6_12*t_V6_0 - 2.0*t_Iw6_02*t_V6_1 + 2.0*t_V6_3*t_hw6_0 + 2.0*t_V6_4*t_hw6_1;
+    const eom_lanes t_hV5_0 = t_Iw5_00*t_V5_0 + t_Iw5_01*t_V5_1 + t_Iw5_02*t_V5_2 - 0.34*t_V5_4*t_o4_2 + 0.34*t_V5_5*t_o4_1 + t_hV6_0;
+    const eom_lanes t_hV5_1 = t_Iw5_01*t_V5_0 + t_Iw5_11*t_V5_1 + t_Iw5_12*t_V5_2 + 0.34*t_V5_3*t_o4_2 - 0.34*t_V5_5*t_o4_0 + t_hV6_1;
+    const eom_lanes t_hV5_2 = t_Iw5_02*t_V5_0 + t_Iw5_12*t_V5_1 + t_Iw5_22*t_V5_2 - 0.34*t_V5_3*t_o4_1 + 0.34*t_V5_4*t_o4_0 + t_hV6_2;
+    const eom_lanes t_hV5_3 = 0.34*t_V5_1*t_o4_2 - 0.34*t_V5_2*t_o4_1 + 0.34*t_V5_3 + t_hV6_3;
+    const eom_lanes t_hV5_4 = 0.34*t_V5_2*t_o4_0 - 0.34*t_V5_0*t_o4_2 + 0.34*t_V5_4 + t_hV6_4;
+    const eom_lanes t_hV5_5 = 0.34*t_V5_0*t_o4_1 - 0.34*t_V5_1*t_o4_0 + 0.34*t_V5_5 + t_hV6_5;
+    const eom_lanes t_Id5_00 = t_Id6_00 - 2.0*t_Iw5_01*t_V5_2 + 2.0*t_Iw5_02*t_V5_1 + 0.68*t_V5_4*t_o4_1 + 0.68*t_V5_5*t_o4_2;
+    const eom_lanes t_Id5_01 = t_Id6_01 + t_Iw5_00*t_V5_2 - t_Iw5_02*t_V5_0 - t_Iw5_11*t_V5_2 + t_Iw5_12*t_V5_1 - 0.34*t_V5_3*t_o4_1 - 0.34*t_V5_4*t_o4_0;
+    const eom_lanes t_Id5_02 = t_Id6_02 - t_Iw5_00*t_V5_1 + t_Iw5_01*t_V5_0 - t_Iw5_12*t_V5_2 + t_Iw5_22*t_V5_1 - 0.34*t_V5_3*t_o4_2 - 0.34*t_V5_5*t_o4_0;
+    const eom_lanes t_Id5_11 = t_Id6_11 + 2.0*t_Iw5_01*t_V5_2 - 2.0*t_Iw5_12*t_V5_0 + 0.68*t_V5_3*t_o4_0 + 0.68*t_V5_5*t_o4_2;
+    const eom_lanes t_Id5_12 = t_Id6_12 - t_Iw5_01*t_V5_1 + t_Iw5_02*t_V5_2 + t_Iw5_11*t_V5_0 - t_Iw5_22*t_V5_0 - 0.34*t_V5_4*t_o4_2 - 0.34*t_V5_5*t_o4_1;
+    const eom_lanes t_Id5_22 = t_Id6_22 - 2.0*t_Iw5_02*t_V5_1 + 2.0*t_Iw5_12*t_V5_0 + 0.68*t_V5_3*t_o4_0 + 0.68*t_V5_4*t_o4_1;
+    const eom_lanes t_hV4_0 = t_Iw4_00*t_V4_0 + t_Iw4_01*t_V4_1 + t_Iw4_02*t_V4_2 - t_V4_4*t_hw4_2 + t_V4_5*t_hw4_1 + t_hV5_0;
+    const eom_lanes t_hV4_1 = t_Iw4_01*t_V4_0 + t_Iw4_11*t_V4_1 + t_Iw4_12*t_V4_2 + t_V4_3*t_hw4_2 - t_V4_5*t_hw4_0 + t_hV5_1;
+    const eom_lanes t_hV4_2 = t_Iw4_02*t_V4_0 + t_Iw4_12*t_V4_1 + t_Iw4_22*t_V4_2 - t_V4_3*t_hw4_1 + t_V4_4*t_hw4_0 + t_hV5_2;
+    const eom_lanes t_hV4_3 = t_V4_1*t_hw4_2 - t_V4_2*t_hw4_1 + 0.82*t_V4_3 + t_hV5_3;
+    const eom_lanes t_hV4_4 = t_V4_2*t_hw4_0 - t_V4_0*t_hw4_2 + 0.82*t_V4_4 + t_hV5_4;
+    const eom_lanes t_hV4_5 = t_V4_0*t_hw4_1 - t_V4_1*t_hw4_0 + 0.82*t_V4_5 + t_hV5_5;
+    const eom_lanes t_Id4_00 = t_Id5_00 - 2.0*t_Iw4_01*t_V4_2 + 2.0*t_Iw4_02*t_V4_1 + 2.0*t_V4_4*t_hw4_1 + 2.0*t_V4_5*t_hw4_2;
+    const eom_lanes t_Id4_01 = t_Id5_01 + t_Iw4_00*t_V4_2 - t_Iw4_02*t_V4_0 - t_Iw4_11*t_V4_2 + t_Iw4_12*t_V4_1 - t_V4_3*t_hw4_1 - t_V4_4*t_hw4_0;
+    const eom_lanes t_Id4_02 = t_Id5_02 - t_Iw4_00*t_V4_1 + t_Iw4_01*t_V4_0 - t_Iw4_12*t_V4_2 + t_Iw4_22*t_V4_1 - t_V4_3*t_hw4_2 - t_V4_5*t_hw4_0;
+    const eom_lanes t_Id4_11 = t_Id5_11 + 2.0*t_Iw4_01*t_V4_2 - 2.0*t_Iw4_12*t_V4_0 + 2.0*t_V4_3*t_hw4_0 + 2.0*t_V4_5*t_hw4_2;
+    const eom_lanes t_Id4_12 = t_Id5_12 - t_Iw4_01*t_V4_1 + t_Iw4_02*t_V4_2 + t_Iw4_11*t_V4_0 - t_Iw4_22*t_V4_0 - t_V4_4*t_hw4_2 - t_V4_5*t_hw4_1;
+    const eom_lanes t_Id4_22 = t_Id5_22 - 2.0*t_Iw4_02*t_V4_1 + 2.0*t_Iw4_12*t_V4_0 + 2.0*t_V4_3*t_hw4_0 + 2.0*t_V4_4*t_hw4_1;
+    const eom_lanes t_hV3_0 = qd[0]*t_Iw3_02 + t_Iw3_00*t_V3_0 + t_Iw3_01*t_V3_1 - t_V3_4*t_hw3_2 + t_V3_5*t_hw3_1 + t_hV4_0;
+    const eom_lanes t_hV3_1 = qd[0]*t_Iw3_12 + t_Iw3_01*t_V3_0 + t_Iw3_11*t_V3_1 + t_V3_3*t_hw3_2 - t_V3_5*t_hw3_0 + t_hV4_1;
+    const eom_lanes t_hV3_2 = qd[0]*t_Iw3_22 + t_Iw3_02*t_V3_0 + t_Iw3_12*t_V3_1 - t_V3_3*t_hw3_1 + t_V3_4*t_hw3_0 + t_hV4_2;
+    const eom_lanes t_hV3_3 = t_V3_1*t_hw3_2 - qd[0]*t_hw3_1 + 4.8*t_V3_3 + t_hV4_3;
+    const eom_lanes t_hV3_4 = qd[0]*t_hw3_0 - t_V3_0*t_hw3_2 + 4.8*t_V3_4 + t_hV4_4;
+    const eom_lanes t_hV3_5 = t_V3_0*t_hw3_1 - t_V3_1*t_hw3_0 + 4.8*t_V3_5 + t_hV4_5;
+    const eom_lanes t_Id3_00 = t_Id4_00 - 2.0*qd[0]*t_Iw3_01 + 2.0*t_Iw3_02*t_V3_1 + 2.0*t_V3_4*t_hw3_1 + 2.0*t_V3_5*t_hw3_2;
+    const eom_lanes t_Id3_01 = qd[0]*t_Iw3_00 - qd[0]*t_Iw3_11 + t_Id4_01 - t_Iw3_02*t_V3_0 + t_Iw3_12*t_V3_1 - t_V3_3*t_hw3_1 - t_V3_4*t_hw3_0;
+    const eom_lanes t_Id3_02 = t_Id4_02 - qd[0]*t_Iw3_12 - t_Iw3_00*t_V3_1 + t_Iw3_01*t_V3_0 + t_Iw3_22*t_V3_1 - t_V3_3*t_hw3_2 - t_V3_5*t_hw3_0;
+    const eom_lanes t_Id3_11 = 2.0*qd[0]*t_Iw3_01 + t_Id4_11 - 2.0*t_Iw3_12*t_V3_0 + 2.0*t_V3_3*t_hw3_0 + 2.0*t_V3_5*t_hw3_2;
+    const eom_lanes t_Id3_12 = qd[0]*t_Iw3_02 + t_Id4_12 - t_Iw3_01*t_V3_1 + t_Iw3_11*t_V3_0 - t_Iw3_22*t_V3_0 - t_V3_4*t_hw3_2 - t_V3_5*t_hw3_1;
+    const eom_lanes t_Id3_22 = t_Id4_22 - 2.0*t_Iw3_02*t_V3_1 + 2.0*t_Iw3_12*t_V3_0 + 2.0*t_V3_3*t_hw3_0 + 2.0*t_V3_4*t_hw3_1;
+    const eom_lanes t_hV2_0 = qd[0]*t_Iw2_02 + t_Iw2_00*t_V2_0 + t_Iw2_01*t_V2_1 + t_hV3_0;
+    const eom_lanes t_hV2_1 = qd[0]*t_Iw2_12 + t_Iw2_01*t_V2_0 + t_Iw2_11*t_V2_1 + t_hV3_1;
+    const eom_lanes t_hV2_2 = qd[0]*t_Iw2_22 + t_Iw2_02*t_V2_0 + t_Iw2_12*t_V2_1 + t_hV3_2;
+    const eom_lanes t_Id2_00 = t_Id3_00 - 2.0*qd[0]*t_Iw2_01 + 2.0*t_Iw2_02*t_V2_1;
+    const eom_lanes t_Id2_01 = qd[0]*t_Iw2_00 - qd[0]*t_Iw2_11 + t_Id3_01 - t_Iw2_02*t_V2_0 + t_Iw2_12*t_V2_1;
+    const eom_lanes t_Id2_02 = t_Id3_02 - qd[0]*t_Iw2_12 - t_Iw2_00*t_V2_1 + t_Iw2_01*t_V2_0 + t_Iw2_22*t_V2_1;
+    const eom_lanes t_Id2_11 = 2.0*qd[0]*t_Iw2_01 + t_Id3_11 - 2.0*t_Iw2_12*t_V2_0;
+    const eom_lanes t_Id2_12 = qd[0]*t_Iw2_02 + t_Id3_12 - t_Iw2_01*t_V2_1 + t_Iw2_11*t_V2_0 - t_Iw2_22*t_V2_0;
+    const eom_lanes t_Id2_22 = t_Id3_22 - 2.0*t_Iw2_02*t_V2_1 + 2.0*t_Iw2_12*t_V2_0;
+    const eom_lanes t_Fa2_0 = t_Ic2_00*t_Sd2_0 + t_Ic2_01*t_Sd2_1 + 0.5*t_Id2_00*t_s1 - 0.5*t_Id2_01*t_c1 - 0.5*t_c1*t_hV2_2;
+    const eom_lanes t_Fa2_1 = t_Ic2_01*t_Sd2_0 + t_Ic2_11*t_Sd2_1 + 0.5*t_Id2_01*t_s1 - 0.5*t_Id2_11*t_c1 - 0.5*t_hV2_2*t_s1;
+    const eom_lanes t_Fa2_2 = t_Ic2_02*t_Sd2_0 + t_Ic2_12*t_Sd2_1 + 0.5*t_Id2_02*t_s1 - 0.5*t_Id2_12*t_c1 + 0.5*t_c1*t_hV2_0 + 0.5*t_hV2_1*t_s1;
+    const eom_lanes t_C2_2 = t_Fa2_0*t_s1 - t_Fa2_1*t_c1;
+    const eom_lanes t_Fb2_2 = 0.5*t_Id2_02*t_s1 - 0.5*t_Id2_12*t_c1 - 0.5*t_c1*t_hV2_0 - 0.5*t_hV2_1*t_s1;
+    const eom_lanes t_Fa3_0 = t_Ic3_00*t_Sd2_0 + t_Ic3_01*t_Sd2_1 + t_Ic3_02*t_Sd3_2 + 0.5*t_Id3_00*t_s1 - 0.5*t_Id3_01*t_c1 - t_Sd3_4*t_hc3_2 + t_Sd3_5*t_hc3_1 - 0.5*t_c1*t_hV3_2;
+    const eom_lanes t_Fa3_1 = t_Ic3_01*t_Sd2_0 + t_Ic3_11*t_Sd2_1 + t_Ic3_12*t_Sd3_2 + 0.5*t_Id3_01*t_s1 - 0.5*t_Id3_11*t_c1 + t_Sd3_3*t_hc3_2 - t_Sd3_5*t_hc3_0 - 0.5*t_hV3_2*t_s1;
+    const eom_lanes t_Fa3_2 = t_Ic3_02*t_Sd2_0 + t_Ic3_12*t_Sd2_1 + t_Ic3_22*t_Sd3_2 + 0.5*t_Id3_02*t_s1 - 0.5*t_Id3_12*t_c1 - t_Sd3_3*t_hc3_1 + t_Sd3_4*t_hc3_0 + 0.5*t_c1*t_hV3_0 + 0.5*t_hV3_1*t_s1;
+    const eom_lanes t_Fa3_3 = t_Sd2_1*t_hc3_2 - t_Sd3_2*t_hc3_1 + 6.05*t_Sd3_3 - t_c1*t_hV3_5;
+    const eom_lanes t_Fa3_4 = t_Sd3_2*t_hc3_0 - t_Sd2_0*t_hc3_2 + 6.05*t_Sd3_4 - t_hV3_5*t_s1;
+    const eom_lanes t_Fa3_5 = t_Sd2_0*t_hc3_1 - t_Sd2_1*t_hc3_0 + 6.05*t_Sd3_5 + t_c1*t_hV3_3 + t_hV3_4*t_s1;
+    const eom_lanes t_C3_3 = t_Fa3_0*t_s1 - t_Fa3_1*t_c1 + t_Fa3_3*t_v3_0 + t_Fa3_4*t_v3_1 + t_Fa3_5*t_v3_2;
+    const eom_lanes t_Fb3_0 = 0.5*t_Id3_00*t_s1 - 0.5*t_Id3_01*t_c1 + 0.5*t_c1*t_hV3_2 + t_hV3_4*t_v3_2 - t_hV3_5*t_v3_1;
+    const eom_lanes t_Fb3_1 = 0.5*t_Id3_01*t_s1 - 0.5*t_Id3_11*t_c1 + 0.5*t_hV3_2*t_s1 - t_hV3_3*t_v3_2 + t_hV3_5*t_v3_0;
+    const eom_lanes t_Fb3_2 = 0.5*t_Id3_02*t_s1 - 0.5*t_Id3_12*t_c1 - 0.5*t_c1*t_hV3_0 - 0.5*t_hV3_1*t_s1 + t_hV3_3*t_v3_1 - t_hV3_4*t_v3_0;
+    const eom_lanes t_C2_3 = t_Fa3_0*t_s1 - t_Fa3_1*t_c1;
+    const eom_lanes t_C3_2 = t_F3_0*t_Sd2_0 + t_F3_1*t_Sd2_1 + t_Fb3_0*t_s1 - t_Fb3_1*t_c1;
+    const eom_lanes t_Fa4_0 = t_Ic4_00*t_Sd4_0 + t_Ic4_01*t_Sd4_1 + t_Ic4_02*t_Sd4_2 + 0.5*t_Id4_00*t_R3_01 + 0.5*t_Id4_01*t_R3_11 + 0.5*t_Id4_02*t_R3_21 + 0.5*t_R3_11*t_hV4_2 - 0.5*t_R3_21*t_hV4_1 - t_Sd4_4*t_hc4_2 + t_Sd4_5*t_hc4_1;
+    const eom_lanes t_Fa4_1 = t_Ic4_01*t_Sd4_0 + t_Ic4_11*t_Sd4_1 + t_Ic4_12*t_Sd4_2 + 0.5*t_Id4_01*t_R3_01 + 0.5*t_Id4_11*t_R3_11 + 0.5*t_Id4_12*t_R3_21 - 0.5*t_R3_01*t_hV4_2 + 0.5*t_R3_21*t_hV4_0 + t_Sd4_3*t_hc4_2 - t_Sd4_5*t_hc4_0;
+    const eom_lanes t_Fa4_2 = t_Ic4_02*t_Sd4_0 + t_Ic4_12*t_Sd4_1 + t_Ic4_22*t_Sd4_2 + 0.5*t_Id4_02*t_R3_01 + 0.5*t_Id4_12*t_R3_11 + 0.5*t_Id4_22*t_R3_21 + 0.5*t_R3_01*t_hV4_1 - 0.5*t_R3_11*t_hV4_0 - t_Sd4_3*t_hc4_1 + t_Sd4_4*t_hc4_0;
+    const eom_lanes t_Fa4_3 = t_R3_11*t_hV4_5 - t_R3_21*t_hV4_4 + t_Sd4_1*t_hc4_2 - t_Sd4_2*t_hc4_1 + 1.25*t_Sd4_3;
+    const eom_lanes t_Fa4_4 = t_R3_21*t_hV4_3 - t_R3_01*t_hV4_5 - t_Sd4_0*t_hc4_2 + t_Sd4_2*t_hc4_0 + 1.25*t_Sd4_4;
+    const eom_lanes t_Fa4_5 = t_R3_01*t_hV4_4 - t_R3_11*t_hV4_3 + t_Sd4_0*t_hc4_1 - t_Sd4_1*t_hc4_0 + 1.25*t_Sd4_5;
+    const eom_lanes t_C4_4 = t_Fa4_0*t_R3_01 + t_Fa4_1*t_R3_11 + t_Fa4_2*t_R3_21 + t_Fa4_3*t_v4_0 + t_Fa4_4*t_v4_1 + t_Fa4_5*t_v4_2;
+    const eom_lanes t_Fb4_0 = 0.5*t_Id4_00*t_R3_01 + 0.5*t_Id4_01*t_R3_11 + 0.5*t_Id4_02*t_R3_21 - 0.5*t_R3_11*t_hV4_2 + 0.5*t_R3_21*t_hV4_1 + t_hV4_4*t_v4_2 - t_hV4_5*t_v4_1;
+    const eom_lanes t_Fb4_1 = 0.5*t_Id4_01*t_R3_01 + 0.5*t_Id4_11*t_R3_11 + 0.5*t_Id4_12*t_R3_21 + 0.5*t_R3_01*t_hV4_2 - 0.5*t_R3_21*t_hV4_0 - t_hV4_3*t_v4_2 + t_hV4_5*t_v4_0;
+    const eom_lanes t_Fb4_2 = 0.5*t_Id4_02*t_R3_01 + 0.5*t_Id4_12*t_R3_11 + 0.5*t_Id4_22*t_R3_21 - 0.5*t_R3_01*t_hV4_1 + 0.5*t_R3_11*t_hV4_0 + t_hV4_3*t_v4_1 - t_hV4_4*t_v4_0;
+    const eom_lanes t_C3_4 = t_Fa4_0*t_s1 - t_Fa4_1*t_c1 + t_Fa4_3*t_v3_0 + t_Fa4_4*t_v3_1 + t_Fa4_5*t_v3_2;
+    const eom_lanes t_C4_3 = t_F4_0*t_Sd2_0 + t_F4_1*t_Sd2_1 + t_F4_2*t_Sd3_2 + t_F4_3*t_Sd3_3 + t_F4_4*t_Sd3_4 + t_F4_5*t_Sd3_5 + t_Fb4_0*t_s1 - t_Fb4_1*t_c1;
+    const eom_lanes t_C2_4 = t_Fa4_0*t_s1 - t_Fa4_1*t_c1;
+    const eom_lanes t_C4_2 = t_F4_0*t_Sd2_0 + t_F4_1*t_Sd2_1 + t_Fb4_0*t_s1 - t_Fb4_1*t_c1;
+    const eom_lanes t_Fa5_0 = t_Ic5_00*t_Sd5_0 + t_Ic5_01*t_Sd5_1 + t_Ic5_02*t_Sd5_2 - 0.5*t_Id5_00*t_R4_01 - 0.5*t_Id5_01*t_R4_11 - 0.5*t_Id5_02*t_R4_21 - 0.5*t_R4_11*t_hV5_2 + 0.5*t_R4_21*t_hV5_1 - t_Sd5_4*t_hc5_2 + t_Sd5_5*t_hc5_1;
+    const eom_lanes t_Fa5_1 = t_Ic5_01*t_Sd5_0 + t_Ic5_11*t_Sd5_1 + t_Ic5_12*t_Sd5_2 - 0.5*t_Id5_01*t_R4_01 - 0.5*t_Id5_11*t_R4_11 - 0.5*t_Id5_12*t_R4_21 + 0.5*t_R4_01*t_hV5_2 - 0.5*t_R4_21*t_hV5_0 + t_Sd5_3*t_hc5_2 - t_Sd5_5*t_hc5_0;
+    const eom_lanes t_Fa5_2 = t_Ic5_02*t_Sd5_0 + t_Ic5_12*t_Sd5_1 + t_Ic5_22*t_Sd5_2 - 0.5*t_Id5_02*t_R4_01 - 0.5*t_Id5_12*t_R4_11 - 0.5*t_Id5_22*t_R4_21 - 0.5*t_R4_01*t_hV5_1 + 0.5*t_R4_11*t_hV5_0 - t_Sd5_3*t_hc5_1 + t_Sd5_4*t_hc5_0;
+    const eom_lanes t_Fa5_3 = t_R4_21*t_hV5_4 - t_R4_11*t_hV5_5 + t_Sd5_1*t_hc5_2 - t_Sd5_2*t_hc5_1 + 0.43000000000000005*t_Sd5_3;
+    const eom_lanes t_Fa5_4 = t_R4_01*t_hV5_5 - t_R4_21*t_hV5_3 - t_Sd5_0*t_hc5_2 + t_Sd5_2*t_hc5_0 + 0.43000000000000005*t_Sd5_4;
+    const eom_lanes t_Fa5_5 = t_R4_11*t_hV5_3 - t_R4_01*t_hV5_4 + t_Sd5_0*t_hc5_1 - t_Sd5_1*t_hc5_0 + 0.43000000000000005*t_Sd5_5;
+    const eom_lanes t_C5_5 = t_Fa5_3*t_v5_0 - t_Fa5_0*t_R4_01 - t_Fa5_1*t_R4_11 - t_Fa5_2*t_R4_21 + t_Fa5_4*t_v5_1 + t_Fa5_5*t_v5_2;
+    const eom_lanes t_Fb5_0 = 0.5*t_R4_11*t_hV5_2 - 0.5*t_Id5_00*t_R4_01 - 0.5*t_Id5_01*t_R4_11 - 0.5*t_Id5_02*t_R4_21 - 0.5*t_R4_21*t_hV5_1 + t_hV5_4*t_v5_2 - t_hV5_5*t_v5_1;
+    const eom_lanes t_Fb5_1 = 0.5*t_R4_21*t_hV5_0 - 0.5*t_Id5_01*t_R4_01 - 0.5*t_Id5_11*t_R4_11 - 0.5*t_Id5_12*t_R4_21 - 0.5*t_R4_01*t_hV5_2 - t_hV5_3*t_v5_2 + t_hV5_5*t_v5_0;
+    const eom_lanes t_Fb5_2 = 0.5*t_R4_01*t_hV5_1 - 0.5*t_Id5_02*t_R4_01 - 0.5*t_Id5_12*t_R4_11 - 0.5*t_Id5_22*t_R4_21 - 0.5*t_R4_11*t_hV5_0 + t_hV5_3*t_v5_1 - t_hV5_4*t_v5_0;
+    const eom_lanes t_C4_5 = t_Fa5_0*t_R3_01 + t_Fa5_1*t_R3_11 + t_Fa5_2*t_R3_21 + t_Fa5_3*t_v4_0 + t_Fa5_4*t_v4_1 + t_Fa5_5*t_v4_2;
+    const eom_lanes t_C5_4 = t_F5_0*t_Sd4_0 + t_F5_1*t_Sd4_1 + t_F5_2*t_Sd4_2 + t_F5_3*t_Sd4_3 + t_F5_4*t_Sd4_4 + t_F5_5*t_Sd4_5 + t_Fb5_0*t_R3_01 + t_Fb5_1*t_R3_11 + t_Fb5_2*t_R3_21;
+    const eom_lanes t_C3_5 = t_Fa5_0*t_s1 - t_Fa5_1*t_c1 + t_Fa5_3*t_v3_0 + t_Fa5_4*t_v3_1 + t_Fa5_5*t_v3_2;
+    const eom_lanes t_C5_3 = t_F5_0*t_Sd2_0 + t_F5_1*t_Sd2_1 + t_F5_2*t_Sd3_2 + t_F5_3*t_Sd3_3 + t_F5_4*t_Sd3_4 + t_F5_5*t_Sd3_5 + t_Fb5_0*t_s1 - t_Fb5_1*t_c1;
+    const eom_lanes t_C2_5 = t_Fa5_0*t_s1 - t_Fa5_1*t_c1;
+    const eom_lanes t_C5_2 = t_F5_0*t_Sd2_0 + t_F5_1*t_Sd2_1 + t_Fb5_0*t_s1 - t_Fb5_1*t_c1;
+    const eom_lanes t_Fa6_0 = 0.5*t_Id6_00*t_R5_01 + 0.5*t_Id6_01*t_R5_11 + 0.5*t_Id6_02*t_R5_21 + t_Iw6_00*t_Sd6_0 + t_Iw6_01*t_Sd6_1 + t_Iw6_02*t_Sd6_2 + 0.5*t_R5_11*t_hV6_2 - 0.5*t_R5_21*t_hV6_1 - t_Sd6_4*t_hw6_2 + t_Sd6_5*t_hw6_1;
+    const eom_lanes t_Fa6_1 = 0.5*t_Id6_01*t_R5_01 + 0.5*t_Id6_11*t_R5_11 + 0.5*t_Id6_12*t_R5_21 + t_Iw6_01*t_Sd6_0 + t_Iw6_11*t_Sd6_1 + t_Iw6_12*t_Sd6_2 - 0.5*t_R5_01*t_hV6_2 + 0.5*t_R5_21*t_hV6_0 + t_Sd6_3*t_hw6_2 - t_Sd6_5*t_hw6_0;
+    const eom_lanes t_Fa6_2 = 0.5*t_Id6_02*t_R5_01 + 0.5*t_Id6_12*t_R5_11 + 0.5*t_Id6_22*t_R5_21 + t_Iw6_02*t_Sd6_0 + t_Iw6_12*t_Sd6_1 + t_Iw6_22*t_Sd6_2 + 0.5*t_R5_01*t_hV6_1 - 0.5*t_R5_11*t_hV6_0 - t_Sd6_3*t_hw6_1 + t_Sd6_4*t_hw6_0;
+    const eom_lanes t_Fa6_3 = t_R5_11*t_hV6_5 - t_R5_21*t_hV6_4 + t_Sd6_1*t_hw6_2 - t_Sd6_2*t_hw6_1 + 0.09*t_Sd6_3;
+    const eom_lanes t_Fa6_4 = t_R5_21*t_hV6_3 - t_R5_01*t_hV6_5 - t_Sd6_0*t_hw6_2 + t_Sd6_2*t_hw6_0 + 0.09*t_Sd6_4;
+    const eom_lanes t_Fa6_5 = t_R5_01*t_hV6_4 - t_R5_11*t_hV6_3 + t_Sd6_0*t_hw6_1 - t_Sd6_1*t_hw6_0 + 0.09*t_Sd6_5;
+    const eom_lanes t_C6_6 = t_Fa6_0*t_R5_01 + t_Fa6_1*t_R5_11 + t_Fa6_2*t_R5_21 + t_Fa6_3*t_v6_0 + t_Fa6_4*t_v6_1 + t_Fa6_5*t_v6_2;
+    const eom_lanes t_Fb6_0 = 0.5*t_Id6_00*t_R5_01 + 0.5*t_Id6_01*t_R5_11 + 0.5*t_Id6_02*t_R5_21 - 0.5*t_R5_11*t_hV6_2 + 0.5*t_R5_21*t_hV6_1 + t_hV6_4*t_v6_2 - t_hV6_5*t_v6_1;
+    const eom_lanes t_Fb6_1 = 0.5*t_Id6_01*t_R5_01 + 0.5*t_Id6_11*t_R5_11 + 0.5*t_Id6_12*t_R5_21 + 0.5*t_R5_01*t_hV6_2 - 0.5*t_R5_21*t_hV6_0 - t_hV6_3*t_v6_2 + t_hV6_5*t_v6_0;
+    const eom_lanes t_Fb6_2 = 0.5*t_Id6_02*t_R5_01 + 0.5*t_Id6_12*t_R5_11 + 0.5*t_Id6_22*t_R5_21 - 0.5*t_R5_01*t_hV6_1 + 0.5*t_R5_11*t_hV6_0 + t_hV6_3*t_v6_1 - t_hV6_4*t_v6_0;
+    const eom_lanes t_C5_6 = t_Fa6_3*t_v5_0 - t_Fa6_0*t_R4_01 - t_Fa6_1*t_R4_11 - t_Fa6_2*t_R4_21 + t_Fa6_4*t_v5_1 + t_Fa6_5*t_v5_2;
+    const eom_lanes t_C6_5 = t_F6_0*t_Sd5_0 + t_F6_1*t_Sd5_1 + t_F6_2*t_Sd5_2 + t_F6_3*t_Sd5_3 + t_F6_4*t_Sd5_4 + t_F6_5*t_Sd5_5 - t_Fb6_0*t_R4_01 - t_Fb6_1*t_R4_11 - t_Fb6_2*t_R4_21;
+    const eom_lanes t_C4_6 = t_Fa6_0*t_R3_01 + t_Fa6_1*t_R3_11 + t_Fa6_2*t_R3_21 + t_Fa6_3*t_v4_0 + t_Fa6_4*t_v4_1 + t_Fa6_5*t_v4_2;
+    const eom_lanes t_C6_4 = t_F6_0*t_Sd4_0 + t_F6_1*t_Sd4_1 + t_F6_2*t_Sd4_2 + t_F6_3*t_Sd4_3 + t_F6_4*t_Sd4_4 + t_F6_5*t_Sd4_5 + t_Fb6_0*t_R3_01 + t_Fb6_1*t_R3_11 + t_Fb6_2*t_R3_21;
+    const eom_lanes t_C3_6 = t_Fa6_0*t_s1 - t_Fa6_1*t_c1 + t_Fa6_3*t_v3_0 + t_Fa6_4*t_v3_1 + t_Fa6_5*t_v3_2;
+    const eom_lanes t_C6_3 = t_F6_0*t_Sd2_0 + t_F6_1*t_Sd2_1 + t_F6_2*t_Sd3_2 + t_F6_3*t_Sd3_3 + t_F6_4*t_Sd3_4 + t_F6_5*t_Sd3_5 + t_Fb6_0*t_s1 - t_Fb6_1*t_c1;
+    const eom_lanes t_C2_6 = t_Fa6_0*t_s1 - t_Fa6_1*t_c1;
+    const eom_lanes t_C6_2 = t_F6_0*t_Sd2_0 + t_F6_1*t_Sd2_1 + t_Fb6_0*t_s1 - t_Fb6_1*t_c1;
+    memset(out, 0, sizeof(eom_lanes) * 36);
+    out[0] = 0.5*t_Id2_22;
+    out[1] = t_Fa2_2;
+    out[2] = t_Fa3_2;
+    out[3] = t_Fa4_2;
+    out[4] = t_Fa5_2;
+    out[5] = t_Fa6_2;
+    out[6] = t_Fb2_2;
+    out[7] = t_C2_2;
+    out[8] = t_C2_3;
+    out[9] = t_C2_4;
+    out[10] = t_C2_5;
+    out[11] = t_C2_6;
+    out[12] = t_Fb3_2;
+    out[13] = t_C3_2;
+    out[14] = t_C3_3;
+    out[15] = t_C3_4;
+    out[16] = t_C3_5;
+    out[17] = t_C3_6;
+    out[18] = t_Fb4_2;
+    out[19] = t_C4_2;
+    out[20] = t_C4_3;
+    out[21] = t_C4_4;
+    out[22] = t_C4_5;
+    out[23] = t_C4_6;
+    out[24] = t_Fb5_2;
+    out[25] = t_C5_2;
+    out[26] = t_C5_3;
+    out[27] = t_C5_4;
+    out[28] = t_C5_5;
+    out[29] = t_C5_6;
+    out[30] = t_Fb6_2;
+    out[31] = t_C6_2;
+    out[32] = t_C6_3;
+    out[33] = t_C6_4;
+    out[34] = t_C6_5;
+    out[35] = t_C6_6;
+}
+
+#undef sin
+#undef cos
+#undef sqrt
+#endif
+
+void puma560_mass_matrix_batch(long n, const double *q, const double *p, double *out)
+{
+    long k = 0;
+    for (; k < n; ++k)
+        puma560_mass_matrix(q + k * PUMA560_NQ, p, out + k * 36);
+}
+
+void puma560_coriolis_matrix_batch(long n, const double *q, const double *qd, const double *p, double *out)
+{
+    long k = 0;
+#if EOM_LANES > 1
+    eom_lanes lanes_p[PUMA560_NP + 1];
+    eom_lanes q_lanes[PUMA560_NQ];
+    eom_lanes qd_lanes[PUMA560_NV];
+    const eom_lanes *const x[] = {q_lanes, qd_lanes};
+    eom_lanes result[36];
+    for (int i = 0; i < PUMA560_NP; ++i)
+        for (int l = 0; l < EOM_LANES; ++l)
+            lanes_p[i][l] = p[i];
+    for (int l = 0; l < EOM_LANES; ++l)
+        lanes_p[PUMA560_NP][l] = 0.0;
+    for (; k + EOM_LANES <= n; k += EOM_LANES) {
+        for (int l = 0; l < EOM_LANES; ++l) {
+            for (int i = 0; i < PUMA560_NQ; ++i)
+                q_lanes[i][l] = q[(k + l) * PUMA560_NQ + i];
+            for (int i = 0; i < PUMA560_NV; ++i)
+                qd_lanes[i][l] = qd[(k + l) * PUMA560_NV + i];
+        }
+        coriolis_matrix_lanes(x, lanes_p, result);
+        for (int l = 0; l < EOM_LANES; ++l)
+            for (int i = 0; i < 36; ++i)
+                out[(k + l) * 36 + i] = result[i][l];
+    }
+#endif
+    for (; k < n; ++k)
+        puma560_coriolis_matrix(q + k * PUMA560_NQ, qd + k * PUMA560_NV, p, out + k * 36);
+}
+
+void puma560_gravity_vector_batch(long n, const double *q, const double *p, double *out)
+{
+    long k = 0;
+    for (; k < n; ++k)
+        puma560_gravity_vector(q + k * PUMA560_NQ, p, out + k * 6);
+}
+
+void puma560_inverse_dynamics_batch(long n, const double *q, const double *qd, const double *qdd, const double *p, double *out)
+{
+    long k = 0;
+    for (; k < n; ++k)
+        puma560_inverse_dynamics(q + k * PUMA560_NQ, qd + k * PUMA560_NV, qdd + k * PUMA560_NV, p, out + k * 6);
 }

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import eomgen
+from eomgen.codegen.backends import fast_backend
 from eomgen.codegen.backends.casadi_backend import c_compiler, library_name
 from eomgen.codegen.generate import render_files
 from support import load_module
@@ -89,3 +90,77 @@ def test_casadi_c_library_linearize_equals_the_numpy_module(tmp_path):
     np.testing.assert_allclose(np.array(out["A_lin"]), A, rtol=1e-13, atol=1e-13)
     np.testing.assert_allclose(np.array(out["B_lin"]), B, rtol=1e-13, atol=1e-13)
     assert not np.allclose(B, numpy_module.linearize(q, qd, tau)[1])  # m2 was passed on
+
+
+BATCH_MAIN = r"""
+#include <stdio.h>
+#include "planar_2link_kernels.h"
+#define N 7
+static const double states[N][3][PLANAR_2LINK_NV] = {%(states)s};
+int main(void)
+{
+    double q[N * PLANAR_2LINK_NV], qd[N * PLANAR_2LINK_NV], x[N * PLANAR_2LINK_NV];
+    double tau[N * PLANAR_2LINK_NV], d[N * PLANAR_2LINK_NV * 2 * PLANAR_2LINK_NV];
+    double qdd[N * PLANAR_2LINK_NV];
+    const double *p = planar_2link_parameter_defaults;
+    int k, i;
+    for (k = 0; k < N; ++k)
+        for (i = 0; i < PLANAR_2LINK_NV; ++i) {
+            q[k * PLANAR_2LINK_NV + i] = states[k][0][i];
+            qd[k * PLANAR_2LINK_NV + i] = states[k][1][i];
+            x[k * PLANAR_2LINK_NV + i] = states[k][2][i];
+        }
+    planar_2link_inverse_dynamics_batch(N, q, qd, x, p, tau);
+    planar_2link_inverse_dynamics_derivatives_batch(N, q, qd, x, p, d);
+    planar_2link_forward_dynamics_aba_batch(N, q, qd, x, p, qdd);
+    for (k = 0; k < N; ++k) {
+        for (i = 0; i < PLANAR_2LINK_NV; ++i) printf("%%.17g ", tau[k * PLANAR_2LINK_NV + i]);
+        for (i = 0; i < 4 * PLANAR_2LINK_NV; ++i) printf("%%.17g ", d[k * 4 * PLANAR_2LINK_NV + i]);
+        for (i = 0; i < PLANAR_2LINK_NV; ++i) printf("%%.17g ", qdd[k * PLANAR_2LINK_NV + i]);
+        printf("\n");
+    }
+    return 0;
+}
+"""
+
+
+@pytest.mark.skipif(c_compiler() is None, reason="needs a C compiler")
+def test_kernel_batches_equal_the_numpy_module_state_by_state(tmp_path, monkeypatch):
+    """``<robot>_<function>_batch`` over 7 states (one block of four through the lanes kernels,
+    three one by one) equals the NumPy module at each state: with the SIMD lanes (-march=native
+    where the compiler takes it), without them (``<ROBOT>_NO_LANES``) and at plain -O2. The
+    planar arm's kernels are below the size that gets lanes; the bound is lowered here so that
+    every one of them has a lanes version."""
+    monkeypatch.setattr(fast_backend, "LANES_OPERATIONS", 1)
+    model = eomgen.load(eomgen.example_path("planar_2link"))
+    for f in render_files(model, ["kernels", "numpy"], functions=FUNCTIONS):
+        (tmp_path / f.name).write_text(f.content, encoding="utf-8")
+    source = (tmp_path / "planar_2link_kernels.c").read_text(encoding="utf-8")
+    for name in FUNCTIONS:  # every batch on lanes
+        assert f"{name}_lanes(x, lanes_p, result)" in source
+    numpy_module = load_module(tmp_path / "planar_2link_numpy.py", "planar_2link_numpy_b")
+    rng = np.random.default_rng(7)
+    states = rng.uniform(-2.0, 2.0, (7, 3, 2))
+    expected = []
+    for q, qd, x in states:
+        dq, dqd = numpy_module.inverse_dynamics_derivatives(q, qd, x)
+        expected.append(np.concatenate([numpy_module.inverse_dynamics(q, qd, x),
+                                        np.hstack([dq, dqd]).ravel(),
+                                        numpy_module.forward_dynamics_aba(q, qd, x)]))
+    literal = ", ".join("{" + ", ".join("{" + ", ".join(repr(float(v)) for v in vector) + "}"
+                                        for vector in state) + "}" for state in states)
+    (tmp_path / "batch.c").write_text(BATCH_MAIN % {"states": literal}, encoding="utf-8")
+    native = subprocess.run([c_compiler(), "-march=native", "-E", "-x", "c", "/dev/null"],
+                            capture_output=True).returncode == 0
+    builds = [["-O2"], ["-O2", "-DPLANAR_2LINK_NO_LANES"]] + ([["-O2", "-march=native"]]
+                                                               if native else [])
+    for flags in builds:
+        exe = tmp_path / "batch.out"
+        subprocess.run([c_compiler(), "-std=c99", *flags, "-fno-math-errno", "-Wall", "-Werror",
+                        "-I", str(tmp_path), str(tmp_path / "batch.c"),
+                        str(tmp_path / "planar_2link_kernels.c"), "-o", str(exe), "-lm"],
+                       check=True)
+        out = subprocess.run([str(exe)], check=True, capture_output=True, text=True).stdout
+        got = np.array([[float(v) for v in line.split()] for line in out.splitlines()])
+        np.testing.assert_allclose(got, np.array(expected), rtol=1e-13, atol=1e-13,
+                                   err_msg=" ".join(flags))
