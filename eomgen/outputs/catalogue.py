@@ -437,7 +437,8 @@ TASK_SPACE = (OPERATIONAL_SPACE_INERTIA, OPERATIONAL_SPACE_BIAS, DYNAMICALLY_CON
 # eomgen.symbolic.passive, docs/formats.md), exported when asked for.
 PASSIVE = _listed(Output(
     "passive_forces", "tau_p", "Passive joint forces -k (q - q_ref) - d qd + J_t^T f_t of the "
-    "joint springs, the drives' viscous damping and the fixed tendons (MuJoCo's qfrc_passive), "
+    "joint springs, the drives' viscous damping, the fixed tendons and gravity compensation "
+    "(MuJoCo's qfrc_passive), "
     "added to tau: M qdd + C qd + g = tau + tau_p.", ("q", "qd"), True, _REVOLUTE_EFFORT,
     ("tau_p",), default=False))
 # --- issue 41: MuJoCo's actuators on joints and fixed tendons (eomgen.symbolic.controls,

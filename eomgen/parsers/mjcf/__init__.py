@@ -42,6 +42,8 @@ What is read
   or a damping: a :class:`~eomgen.model.Tendon` of ``model.tendons`` (``L = Σ cᵢ qᵢ``, the
   rest lengths ``springlength``, a dead band since MuJoCo 3). With the joints' damping they
   are the output ``tau_p`` (MuJoCo's ``qfrc_passive``, :mod:`eomgen.symbolic.passive`).
+* Each body's ``gravcomp``: :attr:`~eomgen.model.RobotModel.gravcomp`, its weight times the
+  factor pushed back up at its centre of mass, in ``tau_p`` (MuJoCo's ``qfrc_gravcomp``).
 * ``<option gravity>`` (zero when the ``gravity`` flag is disabled).
 * Actuators with a joint transmission on hinge and slide joints or a transmission on a fixed
   tendon (the moment ``gear`` times the tendon's coefficients), with no activation dynamics
@@ -81,7 +83,8 @@ activation dynamics ``dyntype`` DC motor, PID, user, or ``actearly``; spatial te
 slider-crank or body transmissions; muscles; free and ball joints; user-defined gains),
 equalities that are inactive (``active="false"``),
 ``tendon`` and flex equalities, an equality joining a dropped free body, fluid forces
-(``density``, ``viscosity``), gravity compensation (``gravcomp``). Refused
+(``density``, ``viscosity``), a joint's ``actuatorgravcomp`` (its compensation stays in
+``tau_p``). Refused
 (:class:`~eomgen.errors.UnsupportedError`), by name: ``joint`` equalities of order above
 one; two ``joint`` equalities on one joint or a cycle of them
 (:class:`~eomgen.errors.KinematicTreeError`); a ``connect`` or ``weld`` that fails the checks
@@ -114,7 +117,8 @@ from ...errors import (DescriptionError, ForbiddenXMLError, InvalidLoopError,
 from ...model import RobotModel, emit_notices, settled
 from ...numeric.loop_checks import LoopProblem, check_loops
 from ..registry import register
-from .extras import controls, model_notices, motors, with_equalities, with_tendons
+from .extras import (controls, gravity_compensation, model_notices, motors, with_equalities,
+                     with_tendons)
 from .numbers import check_compiled
 from .tree import build_tree
 
@@ -239,6 +243,9 @@ def model_from_mujoco(m, source: str = "<mujoco>", strict: bool = False,
             raise InvalidLoopError(source, f"equality '{model.loops[exc.index].name}'",
                                    exc.problem) from None
     present = {joint.name for joint in model.joints}
+    links = {link.name for link in model.links}
+    model = replace(model, gravcomp=tuple((body, factor) for body, factor
+                                          in gravity_compensation(m) if body in links))
     # what concerns only the joints of a dropped free body goes with it
     notices = tuple(n for n in model_notices(m, source)
                     if not n.joints or any(j in present for j in n.joints))

@@ -1,6 +1,6 @@
 """What a compiled MuJoCo model holds besides its tree: the motors eomgen maps to joint torques, the fixed tendons,
-and the findings warned about (or refused) by name: ball joints' springs, spatial tendons, other actuators,
-equality constraints, fluid forces, gravity compensation (:mod:`eomgen.parsers.mjcf`).
+the gravity compensation, and the findings warned about (or refused) by name: ball joints' springs,
+spatial tendons, other actuators, equality constraints, fluid forces (:mod:`eomgen.parsers.mjcf`).
 
 Each equality kind has its reader in :data:`EQUALITY_READERS`: a first-order ``joint``
 equality is a coupling (:class:`~eomgen.model.Coupling`) or, without a second joint, a locked
@@ -198,7 +198,7 @@ def _actuator_notices(m, source: str) -> list[Notice]:
 def model_notices(m, source: str) -> tuple[Notice, ...]:
     """The findings about ``m`` eomgen warns about (or refuses under ``strict``), in this
     order: ball joints' springs, spatial tendons, actuators other than motors, equalities, fluid forces,
-    gravity compensation.
+    gravity compensation routed through the actuators (``actuatorgravcomp``).
 
     Raises
     ------
@@ -240,11 +240,28 @@ def model_notices(m, source: str) -> tuple[Notice, ...]:
     if m.opt.density or m.opt.viscosity:
         notices.append(_notice(source, "option density, viscosity",
                                "fluid forces are not modelled", "left out"))
-    for b in range(1, m.nbody):
-        if float(m.body_gravcomp[b]):
-            notices.append(_notice(source, f"body '{_name(m, 'body', b)}' gravcomp",
-                                   "gravity compensation is not modelled", "left out"))
+    if gravity_compensation(m):
+        for j in range(m.njnt):
+            if bool(m.jnt_actgravcomp[j]):
+                notices.append(_notice(
+                    source, f"joint '{jnames[j]}' actuatorgravcomp", "its gravity "
+                    "compensation is in tau_p, not in the actuator forces (MuJoCo's "
+                    "qfrc_actuator, where the joint's actuatorfrcrange would clamp it; MuJoCo 4.0 "
+                    "drops it in a model without actuators)",
+                    "added to the passive forces", joints=(jnames[j],)))
     return tuple(notices)
+
+
+def gravity_compensation(m) -> tuple[tuple[str, float], ...]:
+    """``(body, gravcomp)`` of each body of ``m`` with gravity compensation (MuJoCo's
+    ``qfrc_gravcomp``, :attr:`~eomgen.model.RobotModel.gravcomp`); none when gravity is
+    disabled or the ``spring`` and ``damper`` flags both are (MuJoCo then skips every
+    passive force)."""
+    if disabled(m, "GRAVITY") or (disabled(m, "SPRING") and disabled(m, "DAMPER")):
+        return ()
+    names = body_names(m)
+    return tuple((names[b], float(m.body_gravcomp[b])) for b in range(1, m.nbody)
+                 if float(m.body_gravcomp[b]))
 
 
 def _tendon_joints(m, t: int) -> tuple[tuple[int, float], ...]:
