@@ -15,8 +15,9 @@ the gravity vector of the tree whose links weigh ``γ_b m_b`` (Newton–Euler at
 
 in ``JOINT_NAMES`` order (NV entries): the generalised force the springs and dampers put on
 the joints, to be *added* to the joint efforts (``M q̈ + C q̇ + g = τ + τ_p``). Coulomb
-friction (``frictionloss``) is not in it: it is :data:`tau_f`'s. A quaternion joint's entries
-hold their drives' damping only (their springs are not modelled).
+friction (``frictionloss``) is not in it: it is :data:`tau_f`'s. A ball joint's spring
+(:class:`~eomgen.model.BallSpring`) puts MuJoCo's ``−k · subQuat(q, q_ref)`` on its three
+entries (:func:`~eomgen.model.ball_spring_torque`); a free joint has no spring.
 """
 
 from __future__ import annotations
@@ -25,7 +26,8 @@ from dataclasses import replace
 
 import sympy as sp
 
-from ..model import Inertial, float_constants, joint_actuators, tendon_force
+from ..model import (BallSpring, Inertial, Spring, ball_spring_torque, float_constants,
+                     joint_actuators, quaternion_layout, tendon_force)
 from ..model.bodies import body_tree
 from .builders import builds
 from .newton_euler import inverse_dynamics_program
@@ -45,10 +47,17 @@ def passive_forces(derivation) -> sp.Matrix:
     q, qd = derivation.q, derivation.qd
     out = [sp.Integer(0)] * len(qd)
     for k, (joint, drive) in enumerate(zip(model.movable_joints, joint_actuators(model))):
-        if joint.spring is not None and joint.spring.stiffness != 0:
-            out[k] -= joint.spring.stiffness * (q[k] - joint.spring.reference)
+        spring = joint.spring  # a ball's (on its first virtual joint) is added below
+        if isinstance(spring, Spring) and spring.stiffness != 0:
+            out[k] -= spring.stiffness * (q[k] - spring.reference)
         if drive.damping != 0:
             out[k] -= drive.damping * qd[k]
+    for ball in quaternion_layout(model):
+        spring = model.movable_joints[ball.v_index].spring
+        if isinstance(spring, BallSpring) and spring.stiffness != 0:
+            quaternion = derivation.configuration[ball.q_index:ball.q_index + 4]
+            for axis, torque in enumerate(ball_spring_torque(spring, quaternion)):
+                out[ball.v_index + axis] += torque
     index = {name: k for k, name in enumerate(model.joint_names)}
     for tendon in model.tendons:
         if not tendon.coefficients:  # every joint locked

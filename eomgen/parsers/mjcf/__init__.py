@@ -38,7 +38,8 @@ What is read
   docs/actuators.md); those of the free joint go to the six free-flyer coordinates (equal on
   all six, so they map exactly).
 * Each hinge or slide joint's ``stiffness`` and ``springref``: its
-  :class:`~eomgen.model.Spring` ``−k (q − qpos_spring)``; each fixed tendon with a stiffness
+  :class:`~eomgen.model.Spring` ``−k (q − qpos_spring)``; a ball joint's ``stiffness``: its
+  :class:`~eomgen.model.BallSpring`, MuJoCo's ``−k · subQuat(q, qpos_spring)``; each fixed tendon with a stiffness
   or a damping: a :class:`~eomgen.model.Tendon` of ``model.tendons`` (``L = Σ cᵢ qᵢ``, the
   rest lengths ``springlength``, a dead band since MuJoCo 3). With the joints' damping they
   are the output ``tau_p`` (MuJoCo's ``qfrc_passive``, :mod:`eomgen.symbolic.passive`).
@@ -77,7 +78,7 @@ Unnamed bodies and joints are named ``body<i>`` and ``joint<i>`` with MuJoCo's i
 a name that is taken gets ``_2``, ``_3``, … appended.
 
 Warned about (:class:`~eomgen.errors.UnsupportedFeatureWarning`, refused under ``strict``),
-by name: ball joints' springs, spatial tendons (and a fixed tendon's armature and
+by name: free joints' springs, spatial tendons (and a fixed tendon's armature and
 frictionloss), the actuators not read (one line per kind, with their count and first names:
 activation dynamics ``dyntype`` DC motor, PID, user, or ``actearly``; spatial tendon, site,
 slider-crank or body transmissions; muscles; free and ball joints; user-defined gains),

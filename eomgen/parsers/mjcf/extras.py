@@ -1,5 +1,5 @@
 """What a compiled MuJoCo model holds besides its tree: the motors eomgen maps to joint torques, the fixed tendons,
-the gravity compensation, and the findings warned about (or refused) by name: ball joints' springs,
+the gravity compensation, and the findings warned about (or refused) by name: free joints' springs,
 spatial tendons, other actuators, equality constraints, fluid forces (:mod:`eomgen.parsers.mjcf`).
 
 Each equality kind has its reader in :data:`EQUALITY_READERS`: a first-order ``joint``
@@ -197,7 +197,7 @@ def _actuator_notices(m, source: str) -> list[Notice]:
 
 def model_notices(m, source: str) -> tuple[Notice, ...]:
     """The findings about ``m`` eomgen warns about (or refuses under ``strict``), in this
-    order: ball joints' springs, spatial tendons, actuators other than motors, equalities, fluid forces,
+    order: free joints' springs, spatial tendons, actuators other than motors, equalities, fluid forces,
     gravity compensation routed through the actuators (``actuatorgravcomp``).
 
     Raises
@@ -210,9 +210,9 @@ def model_notices(m, source: str) -> tuple[Notice, ...]:
     if not disabled(m, "SPRING"):
         for j in range(m.njnt):
             k = float(m.jnt_stiffness[j])
-            if k and int(m.jnt_type[j]) == BALL:
+            if k and int(m.jnt_type[j]) == FREE:
                 notices.append(_notice(source, f"joint '{jnames[j]}' stiffness",
-                                       f"the spring {k:g} of a ball joint is not modelled",
+                                       f"the spring {k:g} of a free joint is not modelled",
                                        "left out", joints=(jnames[j],)))
     for j in range(m.njnt):
         if int(m.jnt_type[j]) == FREE and float(m.dof_armature[int(m.jnt_dofadr[j])]):

@@ -20,6 +20,7 @@ from ...errors import KinematicTreeError, UnsupportedError
 from ...model.floating import add_free_flyer, quaternion_matrix
 from ...model import (
     Actuator,
+    BallSpring,
     Spring,
     Notice,
     NoticeKind,
@@ -132,13 +133,20 @@ def _actuator(m, joint: int) -> Actuator | None:
     return Actuator(**values)
 
 
-def _spring(m, joint: int) -> Spring | None:
-    """The spring of a hinge or slide joint: ``−stiffness (q − qpos_spring)`` (none when the
-    ``spring`` flag is disabled)."""
+def _spring(m, joint: int) -> Spring | BallSpring | None:
+    """The spring of a hinge or slide joint: ``−stiffness (q − qpos_spring)``; of a ball
+    joint, MuJoCo's ``−stiffness · subQuat(q, qpos_spring)`` (:class:`~eomgen.model.
+    BallSpring`, the reference in eomgen's ``(x, y, z, w)`` order); none when the ``spring``
+    flag is disabled."""
     k = float(m.jnt_stiffness[joint])
-    if not k or disabled(m, "SPRING") or int(m.jnt_type[joint]) not in (HINGE, SLIDE):
+    kind = int(m.jnt_type[joint])
+    if not k or disabled(m, "SPRING") or kind not in (HINGE, SLIDE, BALL):
         return None
-    return Spring(k, float(m.qpos_spring[int(m.jnt_qposadr[joint])]))
+    adr = int(m.jnt_qposadr[joint])
+    if kind == BALL:
+        w, x, y, z = (float(v) for v in m.qpos_spring[adr:adr + 4])
+        return BallSpring(k, (x, y, z, w))
+    return Spring(k, float(m.qpos_spring[adr]))
 
 
 def build_tree(m, source: str) -> RobotModel:
