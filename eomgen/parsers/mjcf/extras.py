@@ -49,6 +49,11 @@ _DYN_NAMES = {1: "integrator", 2: "filter", 3: "filterexact", 4: "muscle", 5: "D
 _DYN_READ = {1: "integrator", 2: "filter", 3: "filterexact"}
 _GAIN_FIXED, _GAIN_AFFINE, _GAIN_MUSCLE = 0, 1, 2
 _BIAS_NONE, _BIAS_AFFINE = 0, 1
+#: A DC motor's dynamics, gain and bias types (``mjDYN_DCMOTOR``, ``mjGAIN_DCMOTOR``,
+#: ``mjBIAS_DCMOTOR``) and its plain voltage input (``mjINPUT_VOLTAGE``, ``actuator_ctrlspec``).
+_DYN_DCMOTOR, _GAIN_DCMOTOR, _BIAS_DCMOTOR, _INPUT_VOLTAGE = 5, 3, 3, 8
+#: MuJoCo's ``mjMINVAL``: the smallest time constant and resistance it divides by.
+_MINVAL = 1e-15
 #: MuJoCo's equality types (``mjtEq``) and wrap type of a joint in a fixed tendon.
 CONNECT, WELD, JOINT, TENDON = 0, 1, 2, 3
 _WRAP_JOINT = 1
@@ -87,14 +92,20 @@ def is_motor(m, i: int) -> bool:
 def is_control(m, i: int) -> bool:
     """Whether actuator ``i`` is one eomgen reads as a :class:`~eomgen.model.Control`: a joint
     transmission on a hinge or slide joint or a transmission on a fixed tendon, no activation
-    dynamics, a fixed or affine gain and no or an affine bias (``<motor>``, ``<position>`` and
-    ``<velocity>`` without a time constant, ``<general>`` of those types)."""
+    dynamics or an integrator or filter one (:func:`_dynamics_read`), a fixed or affine gain and
+    no or an affine bias (``<motor>``, ``<position>``, ``<velocity>``, ``<intvelocity>``,
+    ``<general>`` of those types), or a ``<dcmotor>`` on its voltage input whose every feature
+    eomgen models (:func:`dcmotor_left_out`)."""
     trn = int(m.actuator_trntype[i])
     if trn in (_TRN_JOINT, _TRN_JOINT_IN_PARENT):
         if int(m.jnt_type[int(m.actuator_trnid[i, 0])]) not in (HINGE, SLIDE):
             return False
     elif trn != _TRN_TENDON or not is_fixed(m, int(m.actuator_trnid[i, 0])):
         return False
+    if int(m.actuator_dyntype[i]) == _DYN_DCMOTOR:
+        return (int(m.actuator_gaintype[i]) == _GAIN_DCMOTOR
+                and int(m.actuator_biastype[i]) == _BIAS_DCMOTOR
+                and dcmotor_left_out(m, i) is None)
     return (_dynamics_read(m, i)
             and int(m.actuator_gaintype[i]) in (_GAIN_FIXED, _GAIN_AFFINE)
             and int(m.actuator_biastype[i]) in (_BIAS_NONE, _BIAS_AFFINE))
@@ -107,10 +118,41 @@ def _early(m, i: int) -> bool:
 
 def _dynamics_read(m, i: int) -> bool:
     """Whether eomgen reads actuator ``i``'s activation dynamics: none, or an integrator or a
-    filter of one activation whose force uses the activation itself (no ``actearly``)."""
+    filter of one activation (its force at the activation, or with ``actearly`` one step
+    ahead)."""
     dyntype = int(m.actuator_dyntype[i])
-    return dyntype == 0 or (dyntype in _DYN_READ and int(m.actuator_actnum[i]) == 1
-                            and not _early(m, i))
+    return dyntype == 0 or (dyntype in _DYN_READ and int(m.actuator_actnum[i]) == 1)
+
+
+def dcmotor_left_out(m, i: int) -> str | None:
+    """The first feature of DC motor ``i`` eomgen does not model, as its MJCF attribute with
+    what it adds; None when every one is modelled (the voltage input, ``resistance``,
+    ``motorconst``, ``nominal``, ``inductance``, ``saturation``, ``cogging``)."""
+    dyn, gain = m.actuator_dynprm[i], m.actuator_gainprm[i]
+    if int(m.actuator_ctrlspec[i]) != _INPUT_VOLTAGE or int(m.actuator_ctrlnum[i]) != 1:
+        return "input (an on-board controller's setpoints, or none)"
+    if any(float(x) for x in gain[4:8]) or float(dyn[7]) > 0 or float(dyn[8]) > 0:
+        return "controller (PID gains, slew, integral and voltage limits)"
+    if float(dyn[2]) > 0:
+        return "thermal (a winding temperature state)"
+    if float(dyn[5]) > 0:
+        return "lugre (a bristle state)"
+    return None
+
+
+def _early_step(m, i: int) -> float | None:
+    """``α`` of actuator ``i``'s ``actearly`` (:attr:`eomgen.model.Control.early`): its force
+    at ``act + α act_dot``, MuJoCo's ``mj_nextActivation`` one time step ``h`` ahead: ``h``
+    (Euler) for an integrator or a filter, ``T (1 − exp(−h / T))`` for ``filterexact`` and a DC
+    motor's current; None without ``actearly`` or activation."""
+    dyntype = int(m.actuator_dyntype[i])
+    if not _early(m, i) or not int(m.actuator_actnum[i]):
+        return None
+    h = float(m.opt.timestep)
+    if dyntype in (3, _DYN_DCMOTOR):
+        T = max(_MINVAL, float(m.actuator_dynprm[i, 0]))
+        return T * (1 - float(np.exp(-h / T)))
+    return h
 
 
 def controls(m) -> tuple[Control, ...]:
@@ -139,12 +181,36 @@ def controls(m) -> tuple[Control, ...]:
         else:
             where = {"joint": jnames[target]}
         dyntype = int(m.actuator_dyntype[i])
+        early = _early_step(m, i)
+        actrange = (m.actuator_actrange[i].tolist() if early is not None
+                    and dyntype != _DYN_DCMOTOR and bool(m.actuator_actlimited[i]) else None)
+        motor: dict = {"dynamics": _DYN_READ.get(dyntype)}
+        if dyntype == _DYN_DCMOTOR:
+            motor, gain, bias = _dcmotor(m, i)
+        timeconst = float(m.actuator_dynprm[i, 0]) if motor.get("dynamics") not in (
+            None, "integrator") else 1
         out.append(make_control(_name(m, "actuator", i), gear=float(m.actuator_gear[i, 0]),
                                 gain=gain, bias=bias, ctrlrange=ctrl, forcerange=force,
-                                dynamics=_DYN_READ.get(dyntype),
-                                timeconst=float(m.actuator_dynprm[i, 0]) if dyntype > 1 else 1,
+                                timeconst=timeconst, early=early, actrange=actrange, **motor,
                                 **where))
     return tuple(out)
+
+
+def _dcmotor(m, i: int) -> tuple[dict, list, list]:
+    """``(fields, gain, bias)`` of DC motor ``i`` as a :class:`~eomgen.model.Control` (its
+    module docstring): with a current state (``inductance``, ``dynprm[0] = T > 0``) the
+    dynamics ``"dcmotor"``, ``motor = (R, K)`` (``gainprm[0:2]``), the current rate limit
+    ``dynprm[1]`` and the force ``K · act``; without, the affine force ``K/R (V − K v)``.
+    The cogging torque ``biasprm[0:3]`` either way."""
+    R, K = (float(x) for x in m.actuator_gainprm[i, :2])
+    dyn, cog = m.actuator_dynprm[i], [float(x) for x in m.actuator_biasprm[i, :3]]
+    fields: dict = {"dynamics": None, "cogging": cog if cog[0] else None}
+    if float(dyn[0]) > 0:
+        fields.update(dynamics="dcmotor", motor=(R, K),
+                      rate_limit=float(dyn[1]) if float(dyn[1]) > 0 else None)
+        return fields, [K, 0.0, 0.0], [0.0, 0.0, 0.0]
+    gain = K / max(_MINVAL, R)
+    return fields, [gain, 0.0, 0.0], [0.0, 0.0, -gain * K]
 
 
 def _actuator_kind(m, i: int) -> tuple[str, str]:
@@ -159,9 +225,9 @@ def _actuator_kind(m, i: int) -> tuple[str, str]:
         return "a muscle is", "muscles are"
     if trn != _TRN_TENDON and int(m.jnt_type[int(m.actuator_trnid[i, 0])]) not in (HINGE, SLIDE):
         return "an actuator on a free or ball joint is", "actuators on free or ball joints are"
-    if int(m.actuator_dyntype[i]) in _DYN_READ and _early(m, i):
-        return ("an actuator with actearly (its force at the next step's activation) is",
-                "actuators with actearly (their force at the next step's activation) are")
+    if int(m.actuator_dyntype[i]) == _DYN_DCMOTOR and dcmotor_left_out(m, i):
+        feature = dcmotor_left_out(m, i)
+        return (f"a DC motor's {feature} is", f"DC motors' {feature} are")
     if int(m.actuator_dyntype[i]):
         dynamics = _DYN_NAMES.get(int(m.actuator_dyntype[i]), "its own")
         return (f"an actuator with {dynamics} dynamics (activation) is",
