@@ -477,7 +477,8 @@ FORWARD_CTRL_DERIVATIVES = _listed(Output(
 FORWARD_ACT = _listed(Output(
     "forward_dynamics_act", "xd_act", "(qdd, act_dot) stacked (nv + na,) of a model whose "
     "actuators have activation dynamics (integrator: act_dot = ctrl; filter, filterexact: "
-    "(ctrl - act) / timeconst), their forces gain act + bias (MuJoCo's qacc_smooth, act_dot).",
+    "(ctrl - act) / timeconst; a DC motor's current), their forces gain act + bias (MuJoCo's "
+    "qacc_smooth, act_dot).",
     ("q", "qd", "ctrl", "act"), True, "rad/s^2 or m/s^2 (qdd), activation units/s (act_dot)",
     ("xd_act",), default=False, constants=("ACTUATOR_NAMES", "ACTIVATION_NAMES")))
 
