@@ -2,7 +2,8 @@
 ``inductance`` the affine force ``K/R (V − K v)``, with it the armature current as a state
 ``act`` (``act_dot = clamp(((V − K v)/R − i)/T, ±di_max)``, the force ``K i`` taken one step
 ahead, MuJoCo's ``actearly``), ``saturation`` (the force range and the current rate limit),
-``cogging`` (``A sin(N l + φ)``), on joints and a fixed tendon, with ``gear``.
+``cogging`` (``A sin(N l + φ)``), on joints and a fixed tendon, with ``gear``; an actuator's
+``armature`` and ``damping`` (MuJoCo 4: times ``gear²`` on its joint or tendon).
 
 References, MuJoCo's own at random states, voltages (some beyond ``ctrlrange``) and currents
 (some within the rate limit, some beyond): ``qfrc_actuator`` against ``actuator_forces`` for
@@ -38,10 +39,11 @@ BODIES = """<option timestep="0.004"><flag contact="disable"/></option><worldbod
 </tendon>"""
 
 STATELESS = f"""<mujoco model="stateless">{BODIES}<actuator>
- <dcmotor name="a" joint="j1" resistance="2" motorconst="0.05" gear="3"/>
+ <dcmotor name="a" joint="j1" resistance="2" motorconst="0.05" gear="3" armature="0.003"
+   damping="0.001"/>
  <dcmotor name="b" joint="j2" nominal="12 0.8 300" cogging="0.02 4 0.3" ctrlrange="-12 12"
    ctrllimited="true" saturation="0.3"/>
- <dcmotor name="c" tendon="t" resistance="1.2" motorconst="0.04 0.06" gear="2"/>
+ <dcmotor name="c" tendon="t" resistance="1.2" motorconst="0.04 0.06" gear="2" damping="0.02"/>
 </actuator></mujoco>"""
 
 CURRENT = f"""<mujoco model="current">{BODIES}<actuator>
@@ -89,6 +91,9 @@ def test_the_motors_are_read(stateless, current):
         ("a", None), ("b", None), ("c", None)]
     a = stateless[1].controls[0]
     assert [float(x) for x in a.gain + a.bias] == [0.025, 0, 0, 0, 0, -0.025 * 0.05]
+    drive = stateless[1].joints[0].actuator  # j1's own damping 0.01, the motor's times 3²
+    assert (float(drive.armature), float(drive.damping)) == pytest.approx((0.027, 0.019))
+    assert float(stateless[1].tendons[0].damping) == pytest.approx(0.08)
     controls = {c.name: c for c in current[1].controls}
     assert [c.dynamics for c in controls.values()] == [
         "dcmotor", "dcmotor", "dcmotor", "filterexact", "filter", "integrator"]

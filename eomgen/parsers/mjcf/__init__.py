@@ -86,7 +86,8 @@ on-board controller; spatial tendon, site,
 slider-crank or body transmissions; muscles; free and ball joints; user-defined gains),
 equalities that are inactive (``active="false"``),
 ``tendon`` and flex equalities, an equality joining a dropped free body, fluid forces
-(``density``, ``viscosity``), a joint's ``actuatorgravcomp`` (its compensation stays in
+(``density``, ``viscosity``), MuJoCo 4's polynomial springs and dampers (``stiffnesspoly``,
+``dampingpoly``) and control ``delay``, a joint's ``actuatorgravcomp`` (its compensation stays in
 ``tau_p``). Refused
 (:class:`~eomgen.errors.UnsupportedError`), by name: ``joint`` equalities of order above
 one; two ``joint`` equalities on one joint or a cycle of them

@@ -37,7 +37,8 @@ from ...model import (
     vec3,
     with_couplings,
 )
-from .tree import BALL, FREE, HINGE, SLIDE, body_names, disabled, joint_names, rotation_of_quaternion
+from .tree import (BALL, FREE, HINGE, SLIDE, actuator_inertia, body_names, disabled, joint_names,
+                   rotation_of_quaternion)
 
 #: MuJoCo's transmission, dynamics, gain and bias types of a plain motor (``mjTRN_JOINT``,
 #: ``mjDYN_NONE``, ``mjGAIN_FIXED``, ``mjBIAS_NONE``) and of ``mjTRN_JOINTINPARENT``.
@@ -295,13 +296,15 @@ def model_notices(m, source: str) -> tuple[Notice, ...]:
                                    "spring, damping and the actuators on it)", "left out",
                                    joints=tuple(jnames[j] for j, _ in joints)))
             continue
-        for attribute, values in (("armature", getattr(m, "tendon_armature", None)),
-                                  ("frictionloss", m.tendon_frictionloss)):
-            if values is not None and float(values[t]):
+        armature = getattr(m, "tendon_armature", np.zeros(m.ntendon))[t]
+        for attribute, value in (("armature", armature + actuator_inertia(m, t, (_TRN_TENDON,))[0]),
+                                 ("frictionloss", m.tendon_frictionloss[t])):
+            if float(value):
                 notices.append(_notice(source, f"{where} {attribute}", f"a tendon's "
                                        f"{attribute} is not modelled", "left out",
                                        joints=tuple(jnames[j] for j, _ in joints)))
     notices += _actuator_notices(m, source)
+    notices += _array_notices(m, source)
     notices += [found for found in equalities(m, source) if isinstance(found, Notice)]
     if m.opt.density or m.opt.viscosity:
         notices.append(_notice(source, "option density, viscosity",
@@ -330,6 +333,34 @@ def gravity_compensation(m) -> tuple[tuple[str, float], ...]:
                  if float(m.body_gravcomp[b]))
 
 
+#: MuJoCo 4's per-element arrays eomgen does not model: ``(array, element, what it adds)``.
+_NOT_MODELLED = (("jnt_stiffnesspoly", "joint", "a nonlinear (polynomial) spring"),
+                 ("dof_dampingpoly", "dof", "nonlinear (polynomial) damping"),
+                 ("tendon_stiffnesspoly", "tendon", "a nonlinear (polynomial) spring"),
+                 ("tendon_dampingpoly", "tendon", "nonlinear (polynomial) damping"),
+                 ("actuator_dampingpoly", "actuator", "nonlinear (polynomial) damping"),
+                 ("actuator_delay", "actuator", "a control delay"))
+
+
+def _array_notices(m, source: str) -> list[Notice]:
+    """One notice per array of :data:`_NOT_MODELLED` with a nonzero entry, naming the first
+    three elements (a dof by its joint)."""
+    out = []
+    for array, kind, what in _NOT_MODELLED:
+        values = getattr(m, array, None)
+        found = [] if values is None else [i for i in range(len(values)) if np.any(values[i])]
+        if not found:
+            continue
+        element = "joint" if kind == "dof" else kind
+        names = list(dict.fromkeys(
+            _name(m, "joint", int(m.dof_jntid[i])) if kind == "dof" else _name(m, kind, i)
+            for i in found))
+        shown = ", ".join(f"'{n}'" for n in names[:3]) + (", ..." if len(names) > 3 else "")
+        out.append(_notice(source, f"{element} {shown} {array.split('_', 1)[1]}",
+                           f"{what} is not modelled", "left out"))
+    return out
+
+
 def _tendon_joints(m, t: int) -> tuple[tuple[int, float], ...]:
     """``(joint, coefficient)`` of each joint wrap of tendon ``t``."""
     start, count = int(m.tendon_adr[t]), int(m.tendon_num[t])
@@ -347,12 +378,14 @@ def fixed_tendons(m) -> tuple[Tendon, ...]:
     """The fixed tendons of ``m`` that pull (a stiffness or a damping): ``L = Σ c_i q_i``
     (``wrap_prm`` the coefficients), the rest lengths ``tendon_lengthspring`` (a dead band
     since MuJoCo 3; both ends the one length otherwise), ``tendon_stiffness`` (0 when the
-    ``spring`` flag is disabled) and ``tendon_damping`` (0 when ``damper`` is)."""
+    ``spring`` flag is disabled) and ``tendon_damping`` with the ``damping`` of the actuators
+    on the tendon times ``gear²`` (0 when ``damper`` is)."""
     jnames = joint_names(m)
     out = []
     for t in range(m.ntendon):
         k = 0.0 if disabled(m, "SPRING") else float(m.tendon_stiffness[t])
-        b = 0.0 if disabled(m, "DAMPER") else float(m.tendon_damping[t])
+        b = 0.0 if disabled(m, "DAMPER") else (float(m.tendon_damping[t])
+                                               + actuator_inertia(m, t, (_TRN_TENDON,))[1])
         if not is_fixed(m, t) or not (k or b):
             continue
         rest = np.atleast_1d(np.asarray(m.tendon_lengthspring[t], dtype=float))

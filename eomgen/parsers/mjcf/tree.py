@@ -123,14 +123,31 @@ def _inertial(m, body: int) -> Inertial | None:
 def _actuator(m, joint: int) -> Actuator | None:
     """The drive of a joint from its first dof's armature, damping and frictionloss (a free
     joint's are the same on its six dofs, a ball joint's on its three: eomgen gives the drive
-    to each of the ball joint's velocity coordinates)."""
+    to each of the ball joint's velocity coordinates), with the
+    ``armature`` and ``damping`` of the actuators on it times ``gear²`` (MuJoCo 4's
+    ``mj_actuatorArmature``, ``mj_actuatorDamping``)."""
     dof = int(m.jnt_dofadr[joint])
-    values = {"armature": float(m.dof_armature[dof]),
-              "damping": 0.0 if disabled(m, "DAMPER") else float(m.dof_damping[dof]),
+    armature, damping = actuator_inertia(m, joint, (0, 1))
+    values = {"armature": float(m.dof_armature[dof]) + armature,
+              "damping": 0.0 if disabled(m, "DAMPER") else float(m.dof_damping[dof]) + damping,
               "friction": 0.0 if disabled(m, "FRICTIONLOSS") else float(m.dof_frictionloss[dof])}
     if not any(values.values()):
         return None
     return Actuator(**values)
+
+
+def actuator_inertia(m, target: int, transmissions) -> tuple[float, float]:
+    """``(Σ gear² armature, Σ gear² damping)`` of the actuators whose transmission is one of
+    ``transmissions`` (MuJoCo's ``mjTRN_*`` codes) on ``target`` (a joint or a tendon id):
+    what MuJoCo adds to its armature and damping (``actuator_armature``, ``actuator_damping``,
+    MuJoCo 4; zero before)."""
+    armature = damping = 0.0
+    for k in range(m.nu):
+        if int(m.actuator_trntype[k]) in transmissions and int(m.actuator_trnid[k, 0]) == target:
+            gear2 = float(m.actuator_gear[k, 0]) ** 2
+            armature += gear2 * float(getattr(m, "actuator_armature", np.zeros(m.nu))[k])
+            damping += gear2 * float(getattr(m, "actuator_damping", np.zeros(m.nu))[k])
+    return armature, damping
 
 
 def _spring(m, joint: int) -> Spring | BallSpring | None:
