@@ -36,6 +36,12 @@ is the armature current ``act = i``, the force ``K · i`` (``gain = (K, 0, 0)``)
 clamped). A DC motor's cogging torque ``A sin(N l + φ)`` (:attr:`~Control.cogging`) is added to
 its force after the ``forcerange`` clamp.
 
+A PID (MuJoCo's ``<pid>`` on its position input, ``c`` the setpoint) is a position servo,
+``gain = (kp, 0, 0)``, ``bias = (0, −kp, −kv)``; with an integral gain ``ki``
+(:attr:`~Control.integral`) its state is the integral of the position error, ``act = z``::
+
+    pid                      act_dot = c − l,    force = kp c + ki z + bias
+
 ``actearly`` (MuJoCo's; always on for a DC motor): the force takes the activation one time step
 ``h`` ahead, ``act + α act_dot`` (:attr:`~Control.early` ``= α``: ``h`` for an integrator or a
 filter, ``T (1 − exp(−h / T))`` for ``filterexact`` and a DC motor's current, as MuJoCo
@@ -79,7 +85,8 @@ class Control:
         ``L_0``, the length of the tendon's joints a scene holds still (:meth:`locked`).
     dynamics:
         None (the force follows ``ctrl``), or ``"integrator"``, ``"filter"``,
-        ``"filterexact"`` or ``"dcmotor"``: the activation dynamics of the module docstring.
+        ``"filterexact"``, ``"dcmotor"`` or ``"pid"``: the activation dynamics of the module
+        docstring.
     timeconst:
         ``T`` [s] of a filter or of a DC motor's current (MuJoCo's ``dynprm[0]``).
     motor:
@@ -89,6 +96,8 @@ class Control:
         ``di_max`` [A/s] of a DC motor's current; None: not limited.
     cogging:
         ``(A, N, φ)`` of a DC motor's cogging torque ``A sin(N l + φ)``; None: none.
+    integral:
+        ``ki`` of a PID with an integral state (``dynamics="pid"``); None otherwise.
     early:
         ``α`` of ``actearly`` (the force at ``act + α act_dot``); None: the force at ``act``.
     actrange:
@@ -114,6 +123,7 @@ class Control:
     cogging: tuple[Scalar, Scalar, Scalar] | None = None
     early: Scalar | None = None
     actrange: tuple[Scalar, Scalar] | None = None
+    integral: Scalar | None = None
 
     @property
     def transmission(self) -> tuple[tuple[str, Scalar], ...]:
@@ -136,11 +146,12 @@ class Control:
 def make_control(name: str, joint: str | None, gear=1, gain=(1, 0, 0), bias=(0, 0, 0),
                  ctrlrange=None, forcerange=None, tendon=None, coefficients=(), dynamics=None,
                  timeconst=1, motor=None, rate_limit=None, cogging=None, early=None,
-                 actrange=None) -> Control:
+                 actrange=None, integral=None) -> Control:
     """A :class:`Control` from plain numbers (each made a model scalar); a tendon
     transmission when ``tendon`` (its name) and ``coefficients`` ``((joint, c_i), …)`` are
     given, ``joint`` then None; activation ``dynamics`` with its ``timeconst``; a DC motor's
-    ``motor``, ``rate_limit`` and ``cogging``; ``actearly``'s ``early`` and ``actrange``."""
+    ``motor``, ``rate_limit`` and ``cogging``; ``actearly``'s ``early`` and ``actrange``; a
+    PID's ``integral`` gain."""
     def several(values):
         return None if values is None else tuple(scalar(v) for v in values)
 
@@ -149,7 +160,8 @@ def make_control(name: str, joint: str | None, gear=1, gain=(1, 0, 0), bias=(0, 
                    tendon, tuple((n, scalar(c)) for n, c in coefficients), scalar(0), dynamics,
                    scalar(timeconst), several(motor),
                    None if rate_limit is None else scalar(rate_limit), several(cogging),
-                   None if early is None else scalar(early), several(actrange))
+                   None if early is None else scalar(early), several(actrange),
+                   None if integral is None else scalar(integral))
 
 
 __all__ = ["Control", "make_control"]

@@ -106,16 +106,19 @@ def control_forces(derivation, act=None) -> list:
     out, j = [], 0
     for i, control in enumerate(model.controls):
         driven = clamp(ctrl[i], control.ctrlrange)
+        state = None
         if control.dynamics is not None:
             if act is None:
                 raise GenerationError(
                     f"{model.source}: actuator '{control.name}' has {control.dynamics} "
                     "activation dynamics: its force follows its activation act, an input of "
                     "forward_dynamics_act only (docs/formats.md)")
-            driven = act[j]
+            state = act[j]
             if control.early is not None:  # actearly: one step ahead
                 rates = activation_rates(derivation) if rates is None else rates
-                driven = clamp(driven + control.early * rates[j], control.actrange)
+                state = clamp(state + control.early * rates[j], control.actrange)
+            if control.integral is None:  # a PID's integral adds to the setpoint's force
+                driven = state
             j += 1
         terms, length, velocity = _transmission(derivation, control)
         if not terms:
@@ -123,7 +126,10 @@ def control_forces(derivation, act=None) -> list:
             continue
         gain = control.gain[0] + control.gain[1] * length + control.gain[2] * velocity
         bias = control.bias[0] + control.bias[1] * length + control.bias[2] * velocity
-        force = clamp(gain * driven + bias, control.forcerange)
+        if control.integral is not None:
+            force = clamp(gain * driven + control.integral * state + bias, control.forcerange)
+        else:
+            force = clamp(gain * driven + bias, control.forcerange)
         if control.cogging is not None:
             amplitude, poles, phase = control.cogging
             force += amplitude * sp.sin(poles * length + phase)
@@ -166,7 +172,7 @@ def _accelerations(derivation, tau, armature) -> sp.Matrix:
 
 def activation_rates(derivation) -> list:
     """``act_dot`` of each control with activation dynamics, in ``act`` order: ``c`` for an
-    integrator, ``(c − act) / T`` for a filter, ``clamp(((c − K v) / R − act) / T, ±di_max)``
+    integrator, ``c − l`` for a PID's integral, ``(c − act) / T`` for a filter, ``clamp(((c − K v) / R − act) / T, ±di_max)``
     for a DC motor's current (:mod:`eomgen.model.control`), ``c`` the control clamped to its
     ``ctrlrange``, ``v`` the actuator's velocity."""
     ctrl, act = derivation.inputs["ctrl"], derivation.inputs["act"]
@@ -178,6 +184,8 @@ def activation_rates(derivation) -> list:
         state = act[len(out)]
         if control.dynamics == "integrator":
             out.append(driven)
+        elif control.dynamics == "pid":  # the position error's integral
+            out.append(driven - _transmission(derivation, control)[1])
         elif control.dynamics == "dcmotor":
             resistance, constant = control.motor
             velocity = _transmission(derivation, control)[2]

@@ -51,8 +51,9 @@ What is read
   or an integrator or filter one (``dyntype``, :attr:`~eomgen.model.Control.dynamics`: the
   state ``act`` of ``forward_dynamics_act``; with ``actearly``, the force one step ahead), a
   fixed or affine gain and bias (``<motor>``, ``<position>``, ``<velocity>``,
-  ``<intvelocity>``, ``<general>`` of those kinds), and ``<dcmotor>`` on its voltage input
-  (its current a state with ``inductance``; ``saturation``, ``cogging``): the model's :attr:`~eomgen.model.RobotModel.controls`
+  ``<intvelocity>``, ``<general>`` of those kinds), ``<dcmotor>`` on its voltage input
+  (its current a state with ``inductance``; ``saturation``, ``cogging``) and ``<pid>`` on its
+  position input (its integral a state with ``ki``): the model's :attr:`~eomgen.model.RobotModel.controls`
   (:class:`~eomgen.model.Control`), entries of the input ``ctrl`` in MuJoCo's actuator order
   (``ACTUATOR_NAMES``), with MuJoCo's ``gear`` (first component), ``gainprm``, ``biasprm``,
   ``ctrlrange`` (when ``ctrllimited``) and ``forcerange`` (when ``forcelimited``); the
@@ -81,8 +82,8 @@ a name that is taken gets ``_2``, ``_3``, … appended.
 Warned about (:class:`~eomgen.errors.UnsupportedFeatureWarning`, refused under ``strict``),
 by name: free joints' springs, spatial tendons (and a fixed tendon's armature and
 frictionloss), the actuators not read (one line per kind, with their count and first names:
-activation dynamics ``dyntype`` PID or user, a DC motor's thermal model, LuGre friction or
-on-board controller; spatial tendon, site,
+activation dynamics ``dyntype`` user, a DC motor's thermal model, LuGre friction or
+on-board controller, a PID's inputs other than ``pos``, ``slewmax`` or ``imax``; spatial tendon, site,
 slider-crank or body transmissions; muscles; free and ball joints; user-defined gains),
 equalities that are inactive (``active="false"``),
 ``tendon`` and flex equalities, an equality joining a dropped free body, fluid forces

@@ -37,8 +37,8 @@ from ...model import (
     vec3,
     with_couplings,
 )
-from .tree import (BALL, FREE, HINGE, SLIDE, actuator_inertia, body_names, disabled, joint_names,
-                   rotation_of_quaternion)
+from .tree import (BALL, FREE, HINGE, SLIDE, actuator_count, actuator_inertia, body_names,
+                   disabled, joint_names, rotation_of_quaternion)
 
 #: MuJoCo's transmission, dynamics, gain and bias types of a plain motor (``mjTRN_JOINT``,
 #: ``mjDYN_NONE``, ``mjGAIN_FIXED``, ``mjBIAS_NONE``) and of ``mjTRN_JOINTINPARENT``.
@@ -53,6 +53,8 @@ _BIAS_NONE, _BIAS_AFFINE = 0, 1
 #: A DC motor's dynamics, gain and bias types (``mjDYN_DCMOTOR``, ``mjGAIN_DCMOTOR``,
 #: ``mjBIAS_DCMOTOR``) and its plain voltage input (``mjINPUT_VOLTAGE``, ``actuator_ctrlspec``).
 _DYN_DCMOTOR, _GAIN_DCMOTOR, _BIAS_DCMOTOR, _INPUT_VOLTAGE = 5, 3, 3, 8
+#: A PID's dynamics and gain types (``mjDYN_PID``, ``mjGAIN_PID``) and its position input.
+_DYN_PID, _GAIN_PID, _INPUT_POS = 6, 5, 1
 #: MuJoCo's ``mjMINVAL``: the smallest time constant and resistance it divides by.
 _MINVAL = 1e-15
 #: MuJoCo's equality types (``mjtEq``) and wrap type of a joint in a fixed tendon.
@@ -79,7 +81,7 @@ def motors(m) -> tuple[tuple[str, str, float], ...]:
     jnames = joint_names(m)
     return tuple((_name(m, "actuator", i), jnames[int(m.actuator_trnid[i, 0])],
                   float(m.actuator_gear[i, 0] * m.actuator_gainprm[i, 0]))
-                 for i in range(m.nu) if is_motor(m, i))
+                 for i in range(actuator_count(m)) if is_motor(m, i))
 
 
 def is_motor(m, i: int) -> bool:
@@ -107,14 +109,17 @@ def is_control(m, i: int) -> bool:
         return (int(m.actuator_gaintype[i]) == _GAIN_DCMOTOR
                 and int(m.actuator_biastype[i]) == _BIAS_DCMOTOR
                 and dcmotor_left_out(m, i) is None)
-    return (_dynamics_read(m, i)
+    if int(m.actuator_gaintype[i]) == _GAIN_PID:
+        return pid_left_out(m, i) is None
+    return (int(getattr(m, "actuator_ctrlnum", np.ones(actuator_count(m)))[i]) == 1
+            and _dynamics_read(m, i)
             and int(m.actuator_gaintype[i]) in (_GAIN_FIXED, _GAIN_AFFINE)
             and int(m.actuator_biastype[i]) in (_BIAS_NONE, _BIAS_AFFINE))
 
 
 def _early(m, i: int) -> bool:
     """Whether actuator ``i`` has ``actearly`` (its force uses the next step's activation)."""
-    return bool(getattr(m, "actuator_actearly", np.zeros(m.nu))[i])
+    return bool(getattr(m, "actuator_actearly", np.zeros(actuator_count(m)))[i])
 
 
 def _dynamics_read(m, i: int) -> bool:
@@ -138,6 +143,23 @@ def dcmotor_left_out(m, i: int) -> str | None:
         return "thermal (a winding temperature state)"
     if float(dyn[5]) > 0:
         return "lugre (a bristle state)"
+    return None
+
+
+def pid_left_out(m, i: int) -> str | None:
+    """The first feature of PID ``i`` eomgen does not model, as its MJCF attribute; None when
+    it is a PID on its position input alone (``input="pos"``) with no ``slewmax`` and, with
+    an integral gain ``ki``, no ``imax``."""
+    dyn = m.actuator_dynprm[i]
+    if int(m.actuator_biastype[i]) != _BIAS_AFFINE or int(m.actuator_dyntype[i]) not in (
+            0, _DYN_PID):
+        return "gain and bias types"
+    if int(m.actuator_ctrlspec[i]) != _INPUT_POS or int(m.actuator_ctrlnum[i]) != 1:
+        return "input (vel or ff inputs: several controls per actuator)"
+    if float(dyn[1]) > 0:
+        return "slewmax (a setpoint state)"
+    if float(m.actuator_gainprm[i, 0]) > 0 and float(dyn[0]) > 0:
+        return "imax (the integral's anti-windup)"
     return None
 
 
@@ -166,7 +188,7 @@ def controls(m) -> tuple[Control, ...]:
     jnames = joint_names(m)
     clamp_ctrl = not disabled(m, "CLAMPCTRL")
     out = []
-    for i in (i for i in range(m.nu) if is_control(m, i)):
+    for i in (i for i in range(actuator_count(m)) if is_control(m, i)):
         gain = [float(x) for x in m.actuator_gainprm[i, :3]]
         if int(m.actuator_gaintype[i]) == _GAIN_FIXED:
             gain[1:] = [0.0, 0.0]
@@ -188,8 +210,13 @@ def controls(m) -> tuple[Control, ...]:
         motor: dict = {"dynamics": _DYN_READ.get(dyntype)}
         if dyntype == _DYN_DCMOTOR:
             motor, gain, bias = _dcmotor(m, i)
+        elif int(m.actuator_gaintype[i]) == _GAIN_PID:  # kp on ctrl, ki on the integral
+            gain = [-float(m.actuator_biasprm[i, 1]), 0.0, 0.0]
+            ki = float(m.actuator_gainprm[i, 0])
+            if ki > 0:
+                motor = {"dynamics": "pid", "integral": ki}
         timeconst = float(m.actuator_dynprm[i, 0]) if motor.get("dynamics") not in (
-            None, "integrator") else 1
+            None, "integrator", "pid") else 1
         out.append(make_control(_name(m, "actuator", i), gear=float(m.actuator_gear[i, 0]),
                                 gain=gain, bias=bias, ctrlrange=ctrl, forcerange=force,
                                 timeconst=timeconst, early=early, actrange=actrange, **motor,
@@ -229,6 +256,9 @@ def _actuator_kind(m, i: int) -> tuple[str, str]:
     if int(m.actuator_dyntype[i]) == _DYN_DCMOTOR and dcmotor_left_out(m, i):
         feature = dcmotor_left_out(m, i)
         return (f"a DC motor's {feature} is", f"DC motors' {feature} are")
+    if int(m.actuator_gaintype[i]) == _GAIN_PID:
+        feature = pid_left_out(m, i)
+        return (f"a PID's {feature} is", f"PIDs' {feature} are")
     if int(m.actuator_dyntype[i]):
         dynamics = _DYN_NAMES.get(int(m.actuator_dyntype[i]), "its own")
         return (f"an actuator with {dynamics} dynamics (activation) is",
@@ -242,7 +272,7 @@ def _actuator_notices(m, source: str) -> list[Notice]:
     their count and first three names."""
     jnames = joint_names(m)
     kinds: dict[tuple[str, str], list[tuple[str, tuple[str, ...]]]] = {}
-    for i in range(m.nu):
+    for i in range(actuator_count(m)):
         if is_control(m, i):
             continue
         on_joint = int(m.actuator_trntype[i]) in (_TRN_JOINT, _TRN_JOINT_IN_PARENT)

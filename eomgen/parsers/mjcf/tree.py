@@ -136,17 +136,24 @@ def _actuator(m, joint: int) -> Actuator | None:
     return Actuator(**values)
 
 
+def actuator_count(m) -> int:
+    """The number of actuators of ``m``: MuJoCo 4's ``nactuator`` (its ``nu`` counts the
+    controls, several for an actuator with several inputs: a PID's ``pos vel``), ``nu``
+    before."""
+    return int(getattr(m, "nactuator", m.nu))
+
+
 def actuator_inertia(m, target: int, transmissions) -> tuple[float, float]:
     """``(Σ gear² armature, Σ gear² damping)`` of the actuators whose transmission is one of
     ``transmissions`` (MuJoCo's ``mjTRN_*`` codes) on ``target`` (a joint or a tendon id):
     what MuJoCo adds to its armature and damping (``actuator_armature``, ``actuator_damping``,
     MuJoCo 4; zero before)."""
     armature = damping = 0.0
-    for k in range(m.nu):
+    for k in range(actuator_count(m)):
         if int(m.actuator_trntype[k]) in transmissions and int(m.actuator_trnid[k, 0]) == target:
             gear2 = float(m.actuator_gear[k, 0]) ** 2
-            armature += gear2 * float(getattr(m, "actuator_armature", np.zeros(m.nu))[k])
-            damping += gear2 * float(getattr(m, "actuator_damping", np.zeros(m.nu))[k])
+            armature += gear2 * float(getattr(m, "actuator_armature", np.zeros(actuator_count(m)))[k])
+            damping += gear2 * float(getattr(m, "actuator_damping", np.zeros(actuator_count(m)))[k])
     return armature, damping
 
 
