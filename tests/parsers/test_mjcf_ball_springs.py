@@ -113,3 +113,19 @@ def test_the_state_derivative_holds_the_springs():
     q = np.zeros(model.nq)
     q[[3, 8]] = 1.0
     assert np.all(np.isfinite(module.forward_dynamics_ctrl_derivative_q(q, rest, ctrl)))
+
+
+@pytest.mark.slow
+def test_every_code_backend_gives_mujocos_spring_torques(balls, tmp_path):
+    from support.generated import generated
+
+    model, m, _ = balls["moved"]
+    calls, _ = generated(model, ["passive_forces"], tmp_path)
+    lay = layout(m, model)
+    data = mujoco.MjData(m)
+    q, v = next(iter(model_states(model, count=1, seed=9)))
+    data.qpos[:], data.qvel[:] = to_mujoco(lay, q, v)
+    mujoco.mj_forward(m, data)
+    expected = velocity_map(lay, data.qpos).T @ data.qfrc_passive
+    for name, call in calls.items():
+        assert relative(np.asarray(call("passive_forces", q, v)).ravel(), expected) < 1e-12, name

@@ -151,3 +151,19 @@ def test_features_left_out_are_warned_by_attribute():
     for name, feature in (("hot", "thermal"), ("sticky", "lugre"), ("servo", "input")):
         assert f"actuator '{name}': a DC motor's {feature}" in said
     assert [c.name for c in model.controls] == ["plain"]
+
+
+@pytest.mark.slow
+def test_every_code_backend_gives_mujocos_currents(current, tmp_path):
+    from support.generated import generated
+
+    m, model, _ = current
+    calls, _ = generated(model, ["forward_dynamics_act"], tmp_path)
+    d = mujoco.MjData(m)
+    q, qd, ctrl, act = next(states(m, np.random.default_rng(7), 1))
+    d.qpos[:], d.qvel[:], d.ctrl[:], d.act[:] = q, qd, ctrl, act
+    mujoco.mj_forward(m, d)
+    for name, call in calls.items():
+        ours = np.asarray(call("forward_dynamics_act", q, qd, ctrl, act)).ravel()
+        assert relative(ours[:3], d.qacc_smooth) < 1e-11, name
+        assert relative(ours[3:], d.act_dot) < 1e-11, name
