@@ -5,7 +5,8 @@ MuJoCo's own compiler reads the file (the ``simulators`` extra: ``pip install
 'eomgen[simulators]'``): default classes, ``childclass``, ``<include>``, angle units, Euler
 sequences, ``inertiafromgeom`` and the other compiler options are MuJoCo's to resolve. eomgen's
 model is built from the compiled ``mujoco.MjModel`` (:mod:`eomgen.parsers.mjcf.tree` for the
-bodies and joints, :mod:`eomgen.parsers.mjcf.extras` for what is warned about or refused). A
+bodies and joints, :mod:`eomgen.parsers.mjcf.actuators` for the actuators,
+:mod:`eomgen.parsers.mjcf.extras` for tendons, equalities and what is warned about or refused). A
 file the compiler rejects is a :class:`MujocoCompileError` carrying the compiler's message on
 one line.
 
@@ -122,8 +123,8 @@ from ...errors import (DescriptionError, ForbiddenXMLError, InvalidLoopError,
 from ...model import RobotModel, emit_notices, settled
 from ...numeric.loop_checks import LoopProblem, check_loops
 from ..registry import register
-from .extras import (controls, gravity_compensation, model_notices, motors, with_equalities,
-                     with_tendons)
+from .actuators import controls, motors
+from .extras import gravity_compensation, model_notices, with_equalities, with_tendons
 from .numbers import check_compiled
 from .tree import build_tree
 

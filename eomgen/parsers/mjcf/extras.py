@@ -1,6 +1,7 @@
-"""What a compiled MuJoCo model holds besides its tree: the motors eomgen maps to joint torques, the fixed tendons,
-the gravity compensation, and the findings warned about (or refused) by name: free joints' springs,
-spatial tendons, other actuators, equality constraints, fluid forces (:mod:`eomgen.parsers.mjcf`).
+"""What a compiled MuJoCo model holds besides its tree and its actuators
+(:mod:`eomgen.parsers.mjcf.actuators`): the fixed tendons, the gravity compensation, the
+equalities, and the findings warned about (or refused) by name: free joints' springs, spatial
+tendons, the actuators not read, equality constraints, fluid forces (:mod:`eomgen.parsers.mjcf`).
 
 Each equality kind has its reader in :data:`EQUALITY_READERS`: a first-order ``joint``
 equality is a coupling (:class:`~eomgen.model.Coupling`) or, without a second joint, a locked
@@ -21,42 +22,23 @@ from ...errors import UnsupportedError
 from ...model import (
     POINT_LOOP,
     WELD as WELD_LOOP,
-    Control,
     Coupling,
     Loop,
     LoopFrame,
     Notice,
-    NoticeKind,
     RobotModel,
     Tendon,
     Transform,
     lock_joints,
-    make_control,
     make_coupling,
     scalar,
     vec3,
     with_couplings,
 )
-from .tree import (BALL, FREE, HINGE, SLIDE, actuator_count, actuator_inertia, body_names,
-                   disabled, joint_names, rotation_of_quaternion)
+from .actuators import TRN_TENDON, actuator_notices
+from .tree import (FREE, HINGE, SLIDE, actuator_inertia, body_names, disabled, element_name,
+                   is_fixed, joint_names, not_modelled, rotation_of_quaternion, tendon_joints)
 
-#: MuJoCo's transmission, dynamics, gain and bias types of a plain motor (``mjTRN_JOINT``,
-#: ``mjDYN_NONE``, ``mjGAIN_FIXED``, ``mjBIAS_NONE``) and of ``mjTRN_JOINTINPARENT``.
-_TRN_JOINT, _TRN_JOINT_IN_PARENT, _TRN_TENDON = 0, 1, 3
-_TRN_NAMES = {2: "slider-crank", 3: "tendon", 4: "site", 5: "body"}
-_DYN_NAMES = {1: "integrator", 2: "filter", 3: "filterexact", 4: "muscle", 5: "DC motor",
-              6: "PID"}
-#: The activation dynamics eomgen reads (:attr:`eomgen.model.Control.dynamics`).
-_DYN_READ = {1: "integrator", 2: "filter", 3: "filterexact"}
-_GAIN_FIXED, _GAIN_AFFINE, _GAIN_MUSCLE = 0, 1, 2
-_BIAS_NONE, _BIAS_AFFINE = 0, 1
-#: A DC motor's dynamics, gain and bias types (``mjDYN_DCMOTOR``, ``mjGAIN_DCMOTOR``,
-#: ``mjBIAS_DCMOTOR``) and its plain voltage input (``mjINPUT_VOLTAGE``, ``actuator_ctrlspec``).
-_DYN_DCMOTOR, _GAIN_DCMOTOR, _BIAS_DCMOTOR, _INPUT_VOLTAGE = 5, 3, 3, 8
-#: A PID's dynamics and gain types (``mjDYN_PID``, ``mjGAIN_PID``) and its position input.
-_DYN_PID, _GAIN_PID, _INPUT_POS = 6, 5, 1
-#: MuJoCo's ``mjMINVAL``: the smallest time constant and resistance it divides by.
-_MINVAL = 1e-15
 #: MuJoCo's equality types (``mjtEq``) and wrap type of a joint in a fixed tendon.
 CONNECT, WELD, JOINT, TENDON = 0, 1, 2, 3
 _WRAP_JOINT = 1
@@ -64,232 +46,6 @@ _WRAP_JOINT = 1
 _OBJ_SITE = 6
 
 _NOT_READ = "not read yet: the model is the tree without it"
-
-
-def _name(m, kind: str, i: int) -> str:
-    return getattr(m, kind)(i).name or f"{kind}{i}"
-
-
-def _notice(source: str, element: str, problem: str, fallback: str = "",
-            joints: tuple[str, ...] = (), links: tuple[str, ...] = ()) -> Notice:
-    return Notice(NoticeKind.NOT_MODELLED, source, element, problem, fallback, links, joints)
-
-
-def motors(m) -> tuple[tuple[str, str, float], ...]:
-    """``(actuator, joint, gear)`` of each plain motor on a hinge or slide joint: MuJoCo applies
-    the joint torque ``gear · ctrl`` [N m or N] (``gear`` includes a ``<general>``'s gain)."""
-    jnames = joint_names(m)
-    return tuple((_name(m, "actuator", i), jnames[int(m.actuator_trnid[i, 0])],
-                  float(m.actuator_gear[i, 0] * m.actuator_gainprm[i, 0]))
-                 for i in range(actuator_count(m)) if is_motor(m, i))
-
-
-def is_motor(m, i: int) -> bool:
-    """Whether actuator ``i`` is a plain motor (fixed gain, no bias) on a joint eomgen reads."""
-    return (is_control(m, i) and int(m.actuator_trntype[i]) != _TRN_TENDON
-            and int(m.actuator_dyntype[i]) == 0
-            and int(m.actuator_gaintype[i]) == _GAIN_FIXED
-            and int(m.actuator_biastype[i]) == _BIAS_NONE)
-
-
-def is_control(m, i: int) -> bool:
-    """Whether actuator ``i`` is one eomgen reads as a :class:`~eomgen.model.Control`: a joint
-    transmission on a hinge or slide joint or a transmission on a fixed tendon, no activation
-    dynamics or an integrator or filter one (:func:`_dynamics_read`), a fixed or affine gain and
-    no or an affine bias (``<motor>``, ``<position>``, ``<velocity>``, ``<intvelocity>``,
-    ``<general>`` of those types), or a ``<dcmotor>`` on its voltage input whose every feature
-    eomgen models (:func:`dcmotor_left_out`)."""
-    trn = int(m.actuator_trntype[i])
-    if trn in (_TRN_JOINT, _TRN_JOINT_IN_PARENT):
-        if int(m.jnt_type[int(m.actuator_trnid[i, 0])]) not in (HINGE, SLIDE):
-            return False
-    elif trn != _TRN_TENDON or not is_fixed(m, int(m.actuator_trnid[i, 0])):
-        return False
-    if int(m.actuator_dyntype[i]) == _DYN_DCMOTOR:
-        return (int(m.actuator_gaintype[i]) == _GAIN_DCMOTOR
-                and int(m.actuator_biastype[i]) == _BIAS_DCMOTOR
-                and dcmotor_left_out(m, i) is None)
-    if int(m.actuator_gaintype[i]) == _GAIN_PID:
-        return pid_left_out(m, i) is None
-    return (int(getattr(m, "actuator_ctrlnum", np.ones(actuator_count(m)))[i]) == 1
-            and _dynamics_read(m, i)
-            and int(m.actuator_gaintype[i]) in (_GAIN_FIXED, _GAIN_AFFINE)
-            and int(m.actuator_biastype[i]) in (_BIAS_NONE, _BIAS_AFFINE))
-
-
-def _early(m, i: int) -> bool:
-    """Whether actuator ``i`` has ``actearly`` (its force uses the next step's activation)."""
-    return bool(getattr(m, "actuator_actearly", np.zeros(actuator_count(m)))[i])
-
-
-def _dynamics_read(m, i: int) -> bool:
-    """Whether eomgen reads actuator ``i``'s activation dynamics: none, or an integrator or a
-    filter of one activation (its force at the activation, or with ``actearly`` one step
-    ahead)."""
-    dyntype = int(m.actuator_dyntype[i])
-    return dyntype == 0 or (dyntype in _DYN_READ and int(m.actuator_actnum[i]) == 1)
-
-
-def dcmotor_left_out(m, i: int) -> str | None:
-    """The first feature of DC motor ``i`` eomgen does not model, as its MJCF attribute with
-    what it adds; None when every one is modelled (the voltage input, ``resistance``,
-    ``motorconst``, ``nominal``, ``inductance``, ``saturation``, ``cogging``)."""
-    dyn, gain = m.actuator_dynprm[i], m.actuator_gainprm[i]
-    if int(m.actuator_ctrlspec[i]) != _INPUT_VOLTAGE or int(m.actuator_ctrlnum[i]) != 1:
-        return "input (an on-board controller's setpoints, or none)"
-    if any(float(x) for x in gain[4:8]) or float(dyn[7]) > 0 or float(dyn[8]) > 0:
-        return "controller (PID gains, slew, integral and voltage limits)"
-    if float(dyn[2]) > 0:
-        return "thermal (a winding temperature state)"
-    if float(dyn[5]) > 0:
-        return "lugre (a bristle state)"
-    return None
-
-
-def pid_left_out(m, i: int) -> str | None:
-    """The first feature of PID ``i`` eomgen does not model, as its MJCF attribute; None when
-    it is a PID on its position input alone (``input="pos"``) with no ``slewmax`` and, with
-    an integral gain ``ki``, no ``imax``."""
-    dyn = m.actuator_dynprm[i]
-    if int(m.actuator_biastype[i]) != _BIAS_AFFINE or int(m.actuator_dyntype[i]) not in (
-            0, _DYN_PID):
-        return "gain and bias types"
-    if int(m.actuator_ctrlspec[i]) != _INPUT_POS or int(m.actuator_ctrlnum[i]) != 1:
-        return "input (vel or ff inputs: several controls per actuator)"
-    if float(dyn[1]) > 0:
-        return "slewmax (a setpoint state)"
-    if float(m.actuator_gainprm[i, 0]) > 0 and float(dyn[0]) > 0:
-        return "imax (the integral's anti-windup)"
-    return None
-
-
-def _early_step(m, i: int) -> float | None:
-    """``α`` of actuator ``i``'s ``actearly`` (:attr:`eomgen.model.Control.early`): its force
-    at ``act + α act_dot``, MuJoCo's ``mj_nextActivation`` one time step ``h`` ahead: ``h``
-    (Euler) for an integrator or a filter, ``T (1 − exp(−h / T))`` for ``filterexact`` and a DC
-    motor's current; None without ``actearly`` or activation."""
-    dyntype = int(m.actuator_dyntype[i])
-    if not _early(m, i) or not int(m.actuator_actnum[i]):
-        return None
-    h = float(m.opt.timestep)
-    if dyntype in (3, _DYN_DCMOTOR):
-        T = max(_MINVAL, float(m.actuator_dynprm[i, 0]))
-        return T * (1 - float(np.exp(-h / T)))
-    return h
-
-
-def controls(m) -> tuple[Control, ...]:
-    """The :class:`~eomgen.model.Control` of each actuator :func:`is_control` reads, in
-    MuJoCo's actuator order: ``gear`` its first component, the gain and bias the first three
-    of ``gainprm``/``biasprm`` (a fixed gain keeps only the first, no bias is zero), the
-    control clamped to ``ctrlrange`` when ``ctrllimited`` (and clamping is not disabled), the
-    force to ``forcerange`` when ``forcelimited``; on a fixed tendon, the tendon's name and
-    coefficients (``wrap_prm``: MuJoCo's moment is ``gear`` times them)."""
-    jnames = joint_names(m)
-    clamp_ctrl = not disabled(m, "CLAMPCTRL")
-    out = []
-    for i in (i for i in range(actuator_count(m)) if is_control(m, i)):
-        gain = [float(x) for x in m.actuator_gainprm[i, :3]]
-        if int(m.actuator_gaintype[i]) == _GAIN_FIXED:
-            gain[1:] = [0.0, 0.0]
-        bias = ([float(x) for x in m.actuator_biasprm[i, :3]]
-                if int(m.actuator_biastype[i]) == _BIAS_AFFINE else [0.0, 0.0, 0.0])
-        ctrl = (m.actuator_ctrlrange[i].tolist()
-                if clamp_ctrl and bool(m.actuator_ctrllimited[i]) else None)
-        force = m.actuator_forcerange[i].tolist() if bool(m.actuator_forcelimited[i]) else None
-        target = int(m.actuator_trnid[i, 0])
-        if int(m.actuator_trntype[i]) == _TRN_TENDON:
-            where = {"joint": None, "tendon": _name(m, "tendon", target), "coefficients": tuple(
-                (jnames[j], c) for j, c in _tendon_joints(m, target))}
-        else:
-            where = {"joint": jnames[target]}
-        dyntype = int(m.actuator_dyntype[i])
-        early = _early_step(m, i)
-        actrange = (m.actuator_actrange[i].tolist() if early is not None
-                    and dyntype != _DYN_DCMOTOR and bool(m.actuator_actlimited[i]) else None)
-        motor: dict = {"dynamics": _DYN_READ.get(dyntype)}
-        if dyntype == _DYN_DCMOTOR:
-            motor, gain, bias = _dcmotor(m, i)
-        elif int(m.actuator_gaintype[i]) == _GAIN_PID:  # kp on ctrl, ki on the integral
-            gain = [-float(m.actuator_biasprm[i, 1]), 0.0, 0.0]
-            ki = float(m.actuator_gainprm[i, 0])
-            if ki > 0:
-                motor = {"dynamics": "pid", "integral": ki}
-        timeconst = float(m.actuator_dynprm[i, 0]) if motor.get("dynamics") not in (
-            None, "integrator", "pid") else 1
-        out.append(make_control(_name(m, "actuator", i), gear=float(m.actuator_gear[i, 0]),
-                                gain=gain, bias=bias, ctrlrange=ctrl, forcerange=force,
-                                timeconst=timeconst, early=early, actrange=actrange, **motor,
-                                **where))
-    return tuple(out)
-
-
-def _dcmotor(m, i: int) -> tuple[dict, list, list]:
-    """``(fields, gain, bias)`` of DC motor ``i`` as a :class:`~eomgen.model.Control` (its
-    module docstring): with a current state (``inductance``, ``dynprm[0] = T > 0``) the
-    dynamics ``"dcmotor"``, ``motor = (R, K)`` (``gainprm[0:2]``), the current rate limit
-    ``dynprm[1]`` and the force ``K · act``; without, the affine force ``K/R (V − K v)``.
-    The cogging torque ``biasprm[0:3]`` either way."""
-    R, K = (float(x) for x in m.actuator_gainprm[i, :2])
-    dyn, cog = m.actuator_dynprm[i], [float(x) for x in m.actuator_biasprm[i, :3]]
-    fields: dict = {"dynamics": None, "cogging": cog if cog[0] else None}
-    if float(dyn[0]) > 0:
-        fields.update(dynamics="dcmotor", motor=(R, K),
-                      rate_limit=float(dyn[1]) if float(dyn[1]) > 0 else None)
-        return fields, [K, 0.0, 0.0], [0.0, 0.0, 0.0]
-    gain = K / max(_MINVAL, R)
-    return fields, [gain, 0.0, 0.0], [0.0, 0.0, -gain * K]
-
-
-def _actuator_kind(m, i: int) -> tuple[str, str]:
-    """What actuator ``i`` (one :func:`is_control` does not read) is: ``(one, several)``."""
-    trn = int(m.actuator_trntype[i])
-    if trn == _TRN_TENDON and not is_fixed(m, int(m.actuator_trnid[i, 0])):
-        return "an actuator on a spatial tendon is", "actuators on spatial tendons are"
-    if trn in _TRN_NAMES and trn != _TRN_TENDON:
-        kind = f"on a {_TRN_NAMES[trn]}"
-        return f"an actuator {kind} is", f"actuators {kind} are"
-    if int(m.actuator_gaintype[i]) == _GAIN_MUSCLE or int(m.actuator_dyntype[i]) == 4:
-        return "a muscle is", "muscles are"
-    if trn != _TRN_TENDON and int(m.jnt_type[int(m.actuator_trnid[i, 0])]) not in (HINGE, SLIDE):
-        return "an actuator on a free or ball joint is", "actuators on free or ball joints are"
-    if int(m.actuator_dyntype[i]) == _DYN_DCMOTOR and dcmotor_left_out(m, i):
-        feature = dcmotor_left_out(m, i)
-        return (f"a DC motor's {feature} is", f"DC motors' {feature} are")
-    if int(m.actuator_gaintype[i]) == _GAIN_PID:
-        feature = pid_left_out(m, i)
-        return (f"a PID's {feature} is", f"PIDs' {feature} are")
-    if int(m.actuator_dyntype[i]):
-        dynamics = _DYN_NAMES.get(int(m.actuator_dyntype[i]), "its own")
-        return (f"an actuator with {dynamics} dynamics (activation) is",
-                f"actuators with {dynamics} dynamics (activation) are")
-    return ("an actuator with a user-defined gain or bias is",
-            "actuators with a user-defined gain or bias are")
-
-
-def _actuator_notices(m, source: str) -> list[Notice]:
-    """One notice per kind of actuator eomgen does not read (:func:`_actuator_kind`), with
-    their count and first three names."""
-    jnames = joint_names(m)
-    kinds: dict[tuple[str, str], list[tuple[str, tuple[str, ...]]]] = {}
-    for i in range(actuator_count(m)):
-        if is_control(m, i):
-            continue
-        on_joint = int(m.actuator_trntype[i]) in (_TRN_JOINT, _TRN_JOINT_IN_PARENT)
-        joints = (jnames[int(m.actuator_trnid[i, 0])],) if on_joint else ()
-        kinds.setdefault(_actuator_kind(m, i), []).append((_name(m, "actuator", i), joints))
-    notices = []
-    for kind, found in kinds.items():
-        names = [f"'{name}'" for name, _ in found]
-        shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
-        joints = tuple(j for _, js in found for j in js)
-        every_on_joint = all(js for _, js in found)
-        notices.append(_notice(source, f"actuator {shown}" if len(found) == 1 else
-                               f"{len(found)} actuators {shown}",
-                               f"{kind[0] if len(found) == 1 else kind[1]} not modelled",
-                               "left out of ctrl (docs/formats.md, "
-                               "MJCF actuators)", joints=joints if every_on_joint else ()))
-    return notices
 
 
 def model_notices(m, source: str) -> tuple[Notice, ...]:
@@ -308,41 +64,41 @@ def model_notices(m, source: str) -> tuple[Notice, ...]:
         for j in range(m.njnt):
             k = float(m.jnt_stiffness[j])
             if k and int(m.jnt_type[j]) == FREE:
-                notices.append(_notice(source, f"joint '{jnames[j]}' stiffness",
+                notices.append(not_modelled(source, f"joint '{jnames[j]}' stiffness",
                                        f"the spring {k:g} of a free joint is not modelled",
                                        "left out", joints=(jnames[j],)))
     for j in range(m.njnt):
         if int(m.jnt_type[j]) == FREE and float(m.dof_armature[int(m.jnt_dofadr[j])]):
-            notices.append(_notice(source, f"joint '{jnames[j]}' (free) armature",
+            notices.append(not_modelled(source, f"joint '{jnames[j]}' (free) armature",
                                    "MuJoCo's armature acts on the world-frame linear velocity "
                                    "of a free joint, eomgen's on the body-frame one (the same "
                                    "M + a I, a bias a (omega x v) apart)",
                                    "read on eomgen's coordinates", joints=(jnames[j],)))
     for t in range(m.ntendon):
-        joints = _tendon_joints(m, t)
-        where = f"tendon '{_name(m, 'tendon', t)}'"
+        joints = tendon_joints(m, t)
+        where = f"tendon '{element_name(m, 'tendon', t)}'"
         if not is_fixed(m, t):
-            notices.append(_notice(source, where, "a spatial tendon is not modelled (its "
+            notices.append(not_modelled(source, where, "a spatial tendon is not modelled (its "
                                    "spring, damping and the actuators on it)", "left out",
                                    joints=tuple(jnames[j] for j, _ in joints)))
             continue
         armature = getattr(m, "tendon_armature", np.zeros(m.ntendon))[t]
-        for attribute, value in (("armature", armature + actuator_inertia(m, t, (_TRN_TENDON,))[0]),
+        for attribute, value in (("armature", armature + actuator_inertia(m, t, (TRN_TENDON,))[0]),
                                  ("frictionloss", m.tendon_frictionloss[t])):
             if float(value):
-                notices.append(_notice(source, f"{where} {attribute}", f"a tendon's "
+                notices.append(not_modelled(source, f"{where} {attribute}", f"a tendon's "
                                        f"{attribute} is not modelled", "left out",
                                        joints=tuple(jnames[j] for j, _ in joints)))
-    notices += _actuator_notices(m, source)
+    notices += actuator_notices(m, source)
     notices += _array_notices(m, source)
     notices += [found for found in equalities(m, source) if isinstance(found, Notice)]
     if m.opt.density or m.opt.viscosity:
-        notices.append(_notice(source, "option density, viscosity",
+        notices.append(not_modelled(source, "option density, viscosity",
                                "fluid forces are not modelled", "left out"))
     if gravity_compensation(m):
         for j in range(m.njnt):
             if bool(m.jnt_actgravcomp[j]):
-                notices.append(_notice(
+                notices.append(not_modelled(
                     source, f"joint '{jnames[j]}' actuatorgravcomp", "its gravity "
                     "compensation is in tau_p, not in the actuator forces (MuJoCo's "
                     "qfrc_actuator, where the joint's actuatorfrcrange would clamp it; MuJoCo 4.0 "
@@ -383,25 +139,13 @@ def _array_notices(m, source: str) -> list[Notice]:
             continue
         element = "joint" if kind == "dof" else kind
         names = list(dict.fromkeys(
-            _name(m, "joint", int(m.dof_jntid[i])) if kind == "dof" else _name(m, kind, i)
+            element_name(m, "joint", int(m.dof_jntid[i])) if kind == "dof"
+            else element_name(m, kind, i)
             for i in found))
         shown = ", ".join(f"'{n}'" for n in names[:3]) + (", ..." if len(names) > 3 else "")
-        out.append(_notice(source, f"{element} {shown} {array.split('_', 1)[1]}",
+        out.append(not_modelled(source, f"{element} {shown} {array.split('_', 1)[1]}",
                            f"{what} is not modelled", "left out"))
     return out
-
-
-def _tendon_joints(m, t: int) -> tuple[tuple[int, float], ...]:
-    """``(joint, coefficient)`` of each joint wrap of tendon ``t``."""
-    start, count = int(m.tendon_adr[t]), int(m.tendon_num[t])
-    return tuple((int(m.wrap_objid[w]), float(m.wrap_prm[w])) for w in range(start, start + count)
-                 if int(m.wrap_type[w]) == _WRAP_JOINT)
-
-
-def is_fixed(m, t: int) -> bool:
-    """Whether tendon ``t`` is a fixed tendon (every wrap a joint)."""
-    start, count = int(m.tendon_adr[t]), int(m.tendon_num[t])
-    return all(int(m.wrap_type[w]) == _WRAP_JOINT for w in range(start, start + count))
 
 
 def fixed_tendons(m) -> tuple[Tendon, ...]:
@@ -415,12 +159,12 @@ def fixed_tendons(m) -> tuple[Tendon, ...]:
     for t in range(m.ntendon):
         k = 0.0 if disabled(m, "SPRING") else float(m.tendon_stiffness[t])
         b = 0.0 if disabled(m, "DAMPER") else (float(m.tendon_damping[t])
-                                               + actuator_inertia(m, t, (_TRN_TENDON,))[1])
+                                               + actuator_inertia(m, t, (TRN_TENDON,))[1])
         if not is_fixed(m, t) or not (k or b):
             continue
         rest = np.atleast_1d(np.asarray(m.tendon_lengthspring[t], dtype=float))
-        out.append(Tendon(_name(m, "tendon", t), tuple((jnames[j], c) for j, c in
-                                                       _tendon_joints(m, t)),
+        out.append(Tendon(element_name(m, "tendon", t), tuple((jnames[j], c) for j, c in
+                                                       tendon_joints(m, t)),
                           k, (float(rest[0]), float(rest[-1])), b))
     return tuple(out)
 
@@ -437,18 +181,18 @@ def with_tendons(model: RobotModel, m, source: str) -> RobotModel:
         if len(kept) == len(names):
             tendons.append(tendon)
         elif kept:
-            notices.append(_notice(source, f"tendon '{tendon.name}'", "it joins a dropped free "
+            notices.append(not_modelled(source, f"tendon '{tendon.name}'", "it joins a dropped free "
                                    "body", "left out", joints=kept))
     return replace(model, tendons=tuple(tendons), notices=tuple(model.notices) + tuple(notices))
 
 
 def _equality_where(m, e: int, kind: str) -> str:
     inactive = "" if bool(m.eq_active0[e]) else ", inactive"
-    return f"equality '{_name(m, 'eq', e)}' ({kind}{inactive})"
+    return f"equality '{element_name(m, 'eq', e)}' ({kind}{inactive})"
 
 
 def _equality_bodies(m, e: int) -> tuple[str, ...]:
-    return tuple(_name(m, "body", int(b)) for b in m.eq_obj1id[e:e + 1].tolist()
+    return tuple(element_name(m, "body", int(b)) for b in m.eq_obj1id[e:e + 1].tolist()
                  + m.eq_obj2id[e:e + 1].tolist() if int(b) > 0)
 
 
@@ -464,7 +208,7 @@ def equality_connect(m, e: int, source: str) -> Union[Loop, Notice]:
     data = m.eq_data[e]
     one, two = (_site_frame(m, e, k) if int(m.eq_objtype[e]) == _OBJ_SITE
                 else _body_frame(m, e, k, data[3 * k:3 * k + 3]) for k in (0, 1))
-    return Loop(_name(m, "eq", e), POINT_LOOP, two, one)
+    return Loop(element_name(m, "eq", e), POINT_LOOP, two, one)
 
 
 def equality_weld(m, e: int, source: str) -> Union[Loop, Notice]:
@@ -483,11 +227,11 @@ def equality_weld(m, e: int, source: str) -> Union[Loop, Notice]:
         one = _body_frame(m, e, 0, data[3:6], rotation_of_quaternion(data[6:10]))
         two = _body_frame(m, e, 1, data[0:3])
     kind = WELD_LOOP if float(data[10]) else POINT_LOOP
-    return Loop(_name(m, "eq", e), kind, two, one)
+    return Loop(element_name(m, "eq", e), kind, two, one)
 
 
 def _inactive(m, e: int, source: str, where: str) -> Notice:
-    return _notice(source, where, "an inactive equality is not modelled (MuJoCo enforces it "
+    return not_modelled(source, where, "an inactive equality is not modelled (MuJoCo enforces it "
                    "only once switched on)", "left out", links=_equality_bodies(m, e))
 
 
@@ -567,25 +311,25 @@ def equality_tendon(m, e: int, source: str) -> Union[Coupling, JointLock, Notice
     ids = [int(m.eq_obj1id[e])] + ([int(m.eq_obj2id[e])] if int(m.eq_obj2id[e]) >= 0 else [])
     coefficients = [float(c) for c in m.eq_data[e, :5]]
     order = max((k for k, c in enumerate(coefficients) if c), default=0)
-    joints = tuple(jnames[j] for t in ids for j, _ in _tendon_joints(m, t))
+    joints = tuple(jnames[j] for t in ids for j, _ in tendon_joints(m, t))
     if not all(is_fixed(m, t) for t in ids) or order > 1:
         why = "a spatial tendon's" if order <= 1 else f"an order {order}"
-        return _notice(source, where, f"{why} equality is not modelled: the model is the tree "
+        return not_modelled(source, where, f"{why} equality is not modelled: the model is the tree "
                        "without it", joints=joints)
     if not bool(m.eq_active0[e]):
         return replace(_inactive(m, e, source, where), links=(), joints=joints)
     c0, c1 = coefficients[:2]
     gains: dict[int, float] = {}
-    for j, a in _tendon_joints(m, ids[0]):
+    for j, a in tendon_joints(m, ids[0]):
         gains[j] = gains.get(j, 0.0) + a
     rhs = float(m.tendon_length0[ids[0]]) + c0
     if len(ids) > 1 and c1:
         rhs -= c1 * float(m.tendon_length0[ids[1]])
-        for j, b in _tendon_joints(m, ids[1]):
+        for j, b in tendon_joints(m, ids[1]):
             gains[j] = gains.get(j, 0.0) - c1 * b
-    follower = next((j for j, _ in _tendon_joints(m, ids[0]) if gains[j]), None)
+    follower = next((j for j, _ in tendon_joints(m, ids[0]) if gains[j]), None)
     if follower is None:
-        return _notice(source, where, "the equality moves no joint of tendon1", joints=joints)
+        return not_modelled(source, where, "the equality moves no joint of tendon1", joints=joints)
     a_f = gains.pop(follower)
     leaders = {jnames[j]: -g / a_f for j, g in gains.items() if g}
     if not leaders:
@@ -596,7 +340,7 @@ def equality_tendon(m, e: int, source: str) -> Union[Coupling, JointLock, Notice
 def other_equality(m, e: int, source: str) -> Notice:
     """A flex or distance equality: not modelled."""
     kinds = {TENDON: "tendon", 4: "flex", 5: "flexvert", 6: "flexstrain", 7: "distance"}
-    return _notice(source, _equality_where(m, e, kinds.get(int(m.eq_type[e]), "other")),
+    return not_modelled(source, _equality_where(m, e, kinds.get(int(m.eq_type[e]), "other")),
                    "this equality is not modelled: the model is the tree without it")
 
 
@@ -644,7 +388,7 @@ def with_equalities(model: RobotModel, m, source: str) -> RobotModel:
             continue
         if not all(name in present for name in names):
             kept = tuple(n for n in names if n in present)
-            notices.append(_notice(source, element, "it joins a dropped free body", "left out",
+            notices.append(not_modelled(source, element, "it joins a dropped free body", "left out",
                                    **({"links": kept} if isinstance(found, Loop)
                                       else {"joints": kept})))
         elif isinstance(found, Loop):

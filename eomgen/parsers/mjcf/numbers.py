@@ -15,7 +15,7 @@ from typing import Iterator
 
 from ...errors import InvalidNumberError
 from ...model.numbers import number_problem
-from .extras import is_control
+from .actuators import is_control
 from .tree import BALL, FREE, HINGE, SLIDE, actuator_count, body_names, joint_names
 
 #: MuJoCo's equality types read by eomgen (``mjtEq``) and the ``eq_data`` entries each uses.

@@ -41,6 +41,8 @@ from ...model import (
 FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3
 #: The world body's link (MuJoCo's body 0, always named ``world``).
 WORLD = "world"
+#: MuJoCo's wrap type of a joint in a fixed tendon (``mjWRAP_JOINT``).
+_WRAP_JOINT = 1
 
 
 def disabled(m, flag: str) -> bool:
@@ -348,3 +350,28 @@ def _with_free_flyer(model: RobotModel, m, body: str, joint: str, index: int,
     check_tree(source, (l.name for l in links), joints)
     return replace(flying, links=links, joints=joints,
                    info=flying.info + (("mujoco_free_joint", joint),))
+
+
+def element_name(m, kind: str, i: int) -> str:
+    """MuJoCo's name of element ``i`` of ``kind`` (``"actuator"``, ``"tendon"``, …), or
+    ``<kind><i>`` when it has none."""
+    return getattr(m, kind)(i).name or f"{kind}{i}"
+
+
+def not_modelled(source: str, element: str, problem: str, fallback: str = "",
+                 joints: tuple[str, ...] = (), links: tuple[str, ...] = ()) -> Notice:
+    """A notice that ``element`` of ``source`` is not modelled: ``problem``, ``fallback``."""
+    return Notice(NoticeKind.NOT_MODELLED, source, element, problem, fallback, links, joints)
+
+
+def tendon_joints(m, t: int) -> tuple[tuple[int, float], ...]:
+    """``(joint, coefficient)`` of each joint wrap of tendon ``t``."""
+    start, count = int(m.tendon_adr[t]), int(m.tendon_num[t])
+    return tuple((int(m.wrap_objid[w]), float(m.wrap_prm[w])) for w in range(start, start + count)
+                 if int(m.wrap_type[w]) == _WRAP_JOINT)
+
+
+def is_fixed(m, t: int) -> bool:
+    """Whether tendon ``t`` is a fixed tendon (every wrap a joint)."""
+    start, count = int(m.tendon_adr[t]), int(m.tendon_num[t])
+    return all(int(m.wrap_type[w]) == _WRAP_JOINT for w in range(start, start + count))
