@@ -53,7 +53,7 @@ from .loop import HINGE, LOOP_KINDS, POINT_LOOP, WELD, Loop, LoopFrame
 from .notices import Notice, NoticeKind, emit_notices
 from .numbers import MAX_MAGNITUDE, check_model_numbers, check_number
 from .moving_mass import massless_joints, massless_notices, settled
-from .passive import Spring, Tendon, tendon_force
+from .passive import BallSpring, Spring, Tendon, ball_spring_torque, tendon_force
 from .parts import Inertial, Joint, JointType, Link, Parameter
 from .quaternion import (
     QuaternionJoint,
@@ -84,7 +84,7 @@ def __getattr__(name: str):
 
 
 __all__ = [
-    "Spring", "Tendon", "tendon_force",
+    "BallSpring", "Spring", "Tendon", "ball_spring_torque", "tendon_force",
     "HINGE", "LOOP_KINDS", "POINT_LOOP", "WELD", "Loop", "LoopFrame",
     "MAX_MAGNITUDE", "check_model_numbers", "check_number",
     "ANGLE_SNAP_TOLERANCE", "DEFAULT_FRICTION_WIDTH", "IDENTITY3", "MAX_JOINTS", "POINT",

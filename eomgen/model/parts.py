@@ -10,7 +10,7 @@ import sympy as sp
 from ..common import reprs
 from .actuator import Actuator
 from .joints import KINDS, JointKind
-from .passive import Spring
+from .passive import BallSpring, Spring  # noqa: F401 (the annotation of Joint.spring)
 from .scalars import ZERO3, Mat3, Scalar, Vec3, mat3, scalar, vec3
 from .transforms import Transform
 
@@ -90,8 +90,10 @@ class Joint:
     #: A helical joint's pitch [m/rad]: its translation along ``axis`` per radian turned.
     pitch: Scalar = 0
     #: A spring pulling the joint back to its reference (:class:`~eomgen.model.passive.Spring`,
-    #: MuJoCo's ``stiffness`` and ``springref``); None for none.
-    spring: "Spring | None" = None
+    #: MuJoCo's ``stiffness`` and ``springref``; on a ball joint a
+    #: :class:`~eomgen.model.passive.BallSpring`, which its expansion gives to its first virtual
+    #: joint ``<name>_wx``); None for none.
+    spring: "Spring | BallSpring | None" = None
 
     def __post_init__(self):  # accept plain numbers from Python callers
         object.__setattr__(self, "axis", vec3(self.axis))

@@ -1,4 +1,5 @@
-"""Passive elements: a joint's spring (:class:`Spring`) and fixed tendons (:class:`Tendon`),
+"""Passive elements: a joint's spring (:class:`Spring`, on a ball joint :class:`BallSpring`)
+and fixed tendons (:class:`Tendon`),
 the springs and dampers MuJoCo puts in ``qfrc_passive`` (docs/formats.md).
 
 Sign conventions (MuJoCo's): a joint spring pushes its joint back to the reference,
@@ -43,6 +44,62 @@ class Spring:
 
     def substitute(self, subs: Mapping[sp.Symbol, sp.Expr]) -> "Spring":
         return Spring(self.stiffness.xreplace(subs), self.reference.xreplace(subs))
+
+
+@dataclass(frozen=True)
+class BallSpring:
+    """A spring on a ball joint (MuJoCo's ``stiffness`` on a ball joint): the torque
+    ``τ = −stiffness · log(q_ref⁻¹ ⊗ q)`` on its angular velocity coordinates, the rotation
+    vector (axis times angle in ``(−π, π]``, in the child frame) that turns the reference
+    quaternion into the joint's, MuJoCo's ``mju_subQuat(q, qpos_spring)``
+    (:func:`ball_spring_torque`).
+
+    Attributes
+    ----------
+    stiffness:
+        ``k`` [N m/rad], ``≥ 0``.
+    reference:
+        ``q_ref = (x, y, z, w)``, the quaternion where the spring is at rest (MuJoCo's
+        ``qpos_spring``, eomgen's order).
+    """
+
+    __repr__ = reprs.field_repr
+
+    stiffness: Scalar = sp.Integer(0)
+    reference: tuple[Scalar, Scalar, Scalar, Scalar] = (sp.Integer(0), sp.Integer(0),
+                                                        sp.Integer(0), sp.Integer(1))
+
+    def __post_init__(self):
+        object.__setattr__(self, "stiffness", scalar(self.stiffness))
+        object.__setattr__(self, "reference", tuple(scalar(v) for v in self.reference))
+
+    def substitute(self, subs: Mapping[sp.Symbol, sp.Expr]) -> "BallSpring":
+        return BallSpring(self.stiffness.xreplace(subs),
+                          tuple(v.xreplace(subs) for v in self.reference))
+
+
+#: Added under the square root of ``|v|²`` in :func:`ball_spring_torque` so that the torque and
+#: its derivatives (up to the fifth power of ``1/|v|``, 1e-150, above the doubles' underflow)
+#: are finite at the reference itself (``v = 0``). The factor ``atan(n / w) / n`` is even in
+#: ``n`` with a zero slope at 0, so it moves the torque by a relative 1e-60 at most.
+_TINY = sp.Float("1e-60")
+
+
+def ball_spring_torque(spring: BallSpring, quaternion) -> list:
+    """``τ = −k · 2 atan(|v| / w) / |v| · v`` (3 entries) of ``spring`` at the joint's
+    ``quaternion`` ``(x, y, z, w)`` (SymPy expressions; any norm: the rotation vector does not
+    depend on it), where ``(v, w) = q_ref⁻¹ ⊗ q``: ``2 atan(|v| / w)`` is MuJoCo's angle
+    ``2 atan2(|v|, w)`` taken into ``(−π, π]`` as ``mju_quat2Vel`` does (the shorter way
+    round), with a derivative everywhere (no sign function)."""
+    rx, ry, rz, rw = spring.reference
+    qx, qy, qz, qw = quaternion
+    w = rw * qw + rx * qx + ry * qy + rz * qz
+    v = (rw * qx - qw * rx - (ry * qz - rz * qy),
+         rw * qy - qw * ry - (rz * qx - rx * qz),
+         rw * qz - qw * rz - (rx * qy - ry * qx))
+    norm = sp.sqrt(v[0] ** 2 + v[1] ** 2 + v[2] ** 2 + _TINY)
+    scale = -spring.stiffness * 2 * sp.atan(norm / w) / norm
+    return [scale * x for x in v]
 
 
 @dataclass(frozen=True)

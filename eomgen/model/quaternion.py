@@ -132,7 +132,8 @@ def _chain(model, joint: Joint, kind: ChainKind, taken: set) -> tuple[list, list
         taken.add(name)
     chain = [joint.parent, *links, joint.child]
     joints = [Joint(names[k], JointType(step[1]), chain[k], chain[k + 1],
-                    joint.origin if k == 0 else Transform(), vec3(step[2]), joint.actuator)
+                    joint.origin if k == 0 else Transform(), vec3(step[2]), joint.actuator,
+                    spring=joint.spring if k == 0 else None)
               for k, step in enumerate(steps)]
     return joints, [Link(name) for name in links]
 
@@ -153,7 +154,8 @@ def expand_joints(model: "RobotModel") -> "RobotModel":
         A ball or planar joint's actuator has a stiffness (a flexible joint): not modelled
         yet. Its armature, damping and friction act on each of its velocity coordinates (as
         MuJoCo's act on each dof of a ball joint): the actuator is given to every virtual
-        joint of the chain.
+        joint of the chain; a ball joint's spring (:class:`~eomgen.model.BallSpring`) to
+        its first.
     """
     expanded = [j for j in model.joints if isinstance(j.type.kind, ChainKind)]
     if not expanded:

@@ -24,7 +24,7 @@ from .joints import KINDS
 from .parts import Inertial, Joint, JointType, Link, Parameter
 from .quaternion import (QuaternionJoint,
                          quaternion_layout)
-from .scalars import IDENTITY3, ZERO3, Vec3, scalar, vec3
+from .scalars import IDENTITY3, ZERO3, Scalar, Vec3, scalar, vec3
 from .transforms import Transform, rotation_about_axis
 
 
@@ -84,6 +84,10 @@ class RobotModel:
     #: fixed tendons, YAML's ``controls:``), entries of ``ctrl`` in this order; empty: the input
     #: is the joint effort.
     controls: tuple[Control, ...] = ()
+    #: Gravity compensation (MuJoCo's body ``gravcomp``): ``(link, factor)`` pairs, each link
+    #: pushed up by ``factor`` times its weight at its centre of mass, a passive force
+    #: (``tau_p``, :func:`~eomgen.model.passive.compensated`); empty: none.
+    gravcomp: tuple[tuple[str, Scalar], ...] = ()
 
     @cached_property
     def link_by_name(self) -> dict[str, Link]:

@@ -437,7 +437,8 @@ TASK_SPACE = (OPERATIONAL_SPACE_INERTIA, OPERATIONAL_SPACE_BIAS, DYNAMICALLY_CON
 # eomgen.symbolic.passive, docs/formats.md), exported when asked for.
 PASSIVE = _listed(Output(
     "passive_forces", "tau_p", "Passive joint forces -k (q - q_ref) - d qd + J_t^T f_t of the "
-    "joint springs, the drives' viscous damping and the fixed tendons (MuJoCo's qfrc_passive), "
+    "joint springs, the drives' viscous damping, the fixed tendons and gravity compensation "
+    "(MuJoCo's qfrc_passive), "
     "added to tau: M qdd + C qd + g = tau + tau_p.", ("q", "qd"), True, _REVOLUTE_EFFORT,
     ("tau_p",), default=False))
 # --- issue 41: MuJoCo's actuators on joints and fixed tendons (eomgen.symbolic.controls,
@@ -476,7 +477,8 @@ FORWARD_CTRL_DERIVATIVES = _listed(Output(
 FORWARD_ACT = _listed(Output(
     "forward_dynamics_act", "xd_act", "(qdd, act_dot) stacked (nv + na,) of a model whose "
     "actuators have activation dynamics (integrator: act_dot = ctrl; filter, filterexact: "
-    "(ctrl - act) / timeconst), their forces gain act + bias (MuJoCo's qacc_smooth, act_dot).",
+    "(ctrl - act) / timeconst; a DC motor's current), their forces gain act + bias (MuJoCo's "
+    "qacc_smooth, act_dot).",
     ("q", "qd", "ctrl", "act"), True, "rad/s^2 or m/s^2 (qdd), activation units/s (act_dot)",
     ("xd_act",), default=False, constants=("ACTUATOR_NAMES", "ACTIVATION_NAMES")))
 

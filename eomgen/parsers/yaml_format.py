@@ -43,6 +43,10 @@
         forcerange: [-10, 10]      # optional: force clamped to it
         dynamics: filter           # optional: integrator, filter or filterexact: the force
         timeconst: 0.05            # follows the state act (forward_dynamics_act) [s]
+      - name: wheel                # a DC motor (MuJoCo's dcmotor; ctrl its voltage [V]),
+        joint: joint2              # instead of gain, bias and dynamics:
+        dcmotor: {resistance: 2, motorconst: 0.05, timeconst: 0.01, rate_limit: 30,
+                  cogging: [0.02, 4, 0.3]}   # the last three optional
 
 Frames and units follow :mod:`eomgen.model` (URDF's conventions). Values are numbers or
 expressions read by :func:`eomgen.model.expressions.parse_scalar`; every symbol must be declared under
@@ -71,7 +75,10 @@ from ._yaml import Reader, read_document, top_level_key
 
 TOP_KEYS = ("name", "description", "gravity", "parameters", "links", "joints", "controls")
 CONTROL_KEYS = ("name", "joint", "tendon", "gear", "gain", "bias", "ctrlrange", "forcerange",
-                "dynamics", "timeconst")
+                "dynamics", "timeconst", "dcmotor")
+#: A DC motor's keys (MuJoCo's ``<dcmotor>``, ctrl its voltage): ``timeconst`` gives it a
+#: current state, ``rate_limit`` clamps the current's rate, ``cogging`` is ``[A, N, phase]``.
+DCMOTOR_KEYS = ("resistance", "motorconst", "timeconst", "rate_limit", "cogging")
 #: The activation dynamics a control may have (:attr:`eomgen.model.Control.dynamics`).
 CONTROL_DYNAMICS = ("integrator", "filter", "filterexact")
 LINK_KEYS = ("name", "mass", "com", "inertia")
@@ -219,14 +226,44 @@ def _controls(r: Reader, value, joints: list[Joint]) -> tuple[Control, ...]:
         timeconst = r.scalar(entry.get("timeconst", 1), f"{where} timeconst")
         gain = entry.get("gain", 1)
         gain = [gain, 0, 0] if not isinstance(gain, list) else gain
-        out.append(Control(
+        control = Control(
             name, joint, r.scalar(entry.get("gear", 1), f"{where} gear"),
             _triple(r, gain, f"{where} gain"), _triple(r, entry.get("bias", [0, 0, 0]),
                                                        f"{where} bias"),
             _range(r, entry.get("ctrlrange"), f"{where} ctrlrange"),
             _range(r, entry.get("forcerange"), f"{where} forcerange"), tendon, coefficients,
-            scalar(0), dynamics, timeconst))
+            scalar(0), dynamics, timeconst)
+        if "dcmotor" in entry:
+            control = _dcmotor(r, entry, control, f"{where} dcmotor")
+        out.append(control)
     return tuple(out)
+
+
+def _dcmotor(r: Reader, entry: dict, control: Control, where: str) -> Control:
+    """``control`` as the DC motor of ``entry["dcmotor"]`` (:mod:`eomgen.model.control`):
+    without ``timeconst`` the affine ``K/R (V − K v)``, with it the current state."""
+    clash = [key for key in ("gain", "bias", "dynamics", "timeconst") if key in entry]
+    if clash:
+        raise r.error(where, f"a DC motor's force is its own: drop {', '.join(clash)}")
+    motor = entry["dcmotor"]
+    r.mapping(motor, where, required=("resistance", "motorconst"), optional=DCMOTOR_KEYS)
+    R, K = (r.scalar(motor[key], f"{where} {key}") for key in ("resistance", "motorconst"))
+    cogging = motor.get("cogging")
+    if cogging is not None:
+        if not isinstance(cogging, list) or len(cogging) != 3:
+            raise r.error(f"{where} cogging", "expected [amplitude, poles, phase]")
+        cogging = tuple(r.scalar(v, f"{where} cogging[{k}]") for k, v in enumerate(cogging))
+    if "timeconst" not in motor:
+        if "rate_limit" in motor:
+            raise r.error(f"{where} rate_limit", "a current rate limit needs the current "
+                          "state: give timeconst")
+        return replace(control, gain=(K / R, scalar(0), scalar(0)),
+                       bias=(scalar(0), scalar(0), -K * K / R), cogging=cogging)
+    limit = motor.get("rate_limit")
+    return replace(control, gain=(K, scalar(0), scalar(0)), dynamics="dcmotor",
+                   timeconst=r.scalar(motor["timeconst"], f"{where} timeconst"), motor=(R, K),
+                   rate_limit=None if limit is None else r.scalar(limit, f"{where} rate_limit"),
+                   cogging=cogging)
 
 
 def _triple(r: Reader, value, where: str) -> tuple:

@@ -23,7 +23,8 @@ as generated functions of ``(q, q̇, ctrl)`` (:class:`~eomgen.model.Control`, do
   linearizes. A clamp that holds contributes 0 to them; a tendon's dead band too.
 
 * ``xd_act`` (``forward_dynamics_act``): for a model whose controls include activation
-  dynamics (MuJoCo's ``dyntype`` integrator, filter, filterexact; :mod:`eomgen.model.control`),
+  dynamics (MuJoCo's ``dyntype`` integrator, filter, filterexact, a DC motor's current, with
+  or without ``actearly``; :mod:`eomgen.model.control`),
   ``(q̈, act_dot)`` stacked (nv + na), a function of ``(q, q̇, ctrl, act)``: the forces of
   those controls follow their activations ``act`` (MuJoCo's ``act``, ``ACTIVATION_NAMES``
   order), ``q̈`` is ``qdd_ctrl``'s at those forces (MuJoCo's ``qacc_smooth``) and
@@ -100,29 +101,52 @@ def control_forces(derivation, act=None) -> list:
         For a control with activation dynamics when ``act`` is None (an output without the
         input ``act``)."""
     model = derivation.model
-    index = {name: k for k, name in enumerate(model.joint_names)}
-    q, qd, ctrl = derivation.q, derivation.qd, derivation.inputs["ctrl"]
+    ctrl = derivation.inputs["ctrl"]
+    rates = None
     out, j = [], 0
     for i, control in enumerate(model.controls):
         driven = clamp(ctrl[i], control.ctrlrange)
+        state = None
         if control.dynamics is not None:
             if act is None:
                 raise GenerationError(
                     f"{model.source}: actuator '{control.name}' has {control.dynamics} "
                     "activation dynamics: its force follows its activation act, an input of "
                     "forward_dynamics_act only (docs/formats.md)")
-            driven, j = act[j], j + 1
-        terms = [(index[n], c) for n, c in control.transmission if n in index]
+            state = act[j]
+            if control.early is not None:  # actearly: one step ahead
+                rates = activation_rates(derivation) if rates is None else rates
+                state = clamp(state + control.early * rates[j], control.actrange)
+            if control.integral is None:  # a PID's integral adds to the setpoint's force
+                driven = state
+            j += 1
+        terms, length, velocity = _transmission(derivation, control)
         if not terms:
             out.append(None)
             continue
-        length = control.gear * (sp.Add(*[c * q[k] for k, c in terms]) + control.offset)
-        velocity = control.gear * sp.Add(*[c * qd[k] for k, c in terms])
         gain = control.gain[0] + control.gain[1] * length + control.gain[2] * velocity
         bias = control.bias[0] + control.bias[1] * length + control.bias[2] * velocity
-        force = clamp(gain * driven + bias, control.forcerange)
+        if control.integral is not None:
+            force = clamp(gain * driven + control.integral * state + bias, control.forcerange)
+        else:
+            force = clamp(gain * driven + bias, control.forcerange)
+        if control.cogging is not None:
+            amplitude, poles, phase = control.cogging
+            force += amplitude * sp.sin(poles * length + phase)
         out.append(([(k, control.gear * c) for k, c in terms], force))
     return out
+
+
+def _transmission(derivation, control) -> tuple[list, object, object]:
+    """``(terms, l, v)`` of ``control``: the ``(joint index, c_i)`` of its transmission's
+    joints the model moves, its length ``l = gear · (Σ c_i q_i + L_0)`` and velocity
+    ``v = gear · Σ c_i q̇_i`` (zero without terms)."""
+    index = {name: k for k, name in enumerate(derivation.model.joint_names)}
+    q, qd = derivation.q, derivation.qd
+    terms = [(index[n], c) for n, c in control.transmission if n in index]
+    length = control.gear * (sp.Add(*[c * q[k] for k, c in terms]) + control.offset)
+    velocity = control.gear * sp.Add(*[c * qd[k] for k, c in terms])
+    return terms, length, velocity
 
 
 def actuator_forces(derivation, forces) -> sp.Matrix:
@@ -148,16 +172,28 @@ def _accelerations(derivation, tau, armature) -> sp.Matrix:
 
 def activation_rates(derivation) -> list:
     """``act_dot`` of each control with activation dynamics, in ``act`` order: ``c`` for an
-    integrator, ``(c − act) / T`` for a filter (:mod:`eomgen.model.control`), ``c`` the
-    control clamped to its ``ctrlrange``."""
+    integrator, ``c − l`` for a PID's integral, ``(c − act) / T`` for a filter, ``clamp(((c − K v) / R − act) / T, ±di_max)``
+    for a DC motor's current (:mod:`eomgen.model.control`), ``c`` the control clamped to its
+    ``ctrlrange``, ``v`` the actuator's velocity."""
     ctrl, act = derivation.inputs["ctrl"], derivation.inputs["act"]
     out = []
     for i, control in enumerate(derivation.model.controls):
         if control.dynamics is None:
             continue
         driven = clamp(ctrl[i], control.ctrlrange)
-        out.append(driven if control.dynamics == "integrator"
-                   else (driven - act[len(out)]) / control.timeconst)
+        state = act[len(out)]
+        if control.dynamics == "integrator":
+            out.append(driven)
+        elif control.dynamics == "pid":  # the position error's integral
+            out.append(driven - _transmission(derivation, control)[1])
+        elif control.dynamics == "dcmotor":
+            resistance, constant = control.motor
+            velocity = _transmission(derivation, control)[2]
+            rate = ((driven - constant * velocity) / resistance - state) / control.timeconst
+            limit = control.rate_limit
+            out.append(rate if limit is None else clamp(rate, (-limit, limit)))
+        else:
+            out.append((driven - state) / control.timeconst)
     return out
 
 

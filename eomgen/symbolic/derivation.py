@@ -70,6 +70,15 @@ class Derivation:
     #: to the independent coordinates.
     coupling: sp.Matrix | None = None
     velocities: tuple | None = None
+    #: With coupled joints, the whole tree's configuration (NQ_full entries of
+    #: :attr:`model`'s, a quaternion's block copied from ``q``, :attr:`configuration`).
+    full_configuration: tuple | None = None
+
+    @property
+    def configuration(self) -> tuple:
+        """The configuration of :attr:`model` (NQ entries, a quaternion joint's four among
+        them): the ``q`` input, or with coupled joints the whole tree's."""
+        return self.inputs["q"] if self.full_configuration is None else self.full_configuration
 
     @property
     def q(self) -> tuple:
@@ -187,7 +196,7 @@ def new_derivation(model: RobotModel, inputs: Iterable[str] | None = None) -> De
         full, T, q_full, qd_full = coupled_inputs(model, ordered["q"], ordered["qd"])
         tree, coords = _placed(full, q_full, builder)
         return Derivation(full, tree, ordered, builder, coordinates=coords, coupling=T,
-                          velocities=qd_full)
+                          velocities=qd_full, full_configuration=tuple(q_full))
     tree, coords = _placed(model, ordered["q"], builder)
     return Derivation(model, tree, ordered, builder,
                       coordinates=coords if model.nq > model.dof else None)

@@ -6,11 +6,13 @@ References, MuJoCo's: ``qacc_smooth`` and ``act_dot`` of ``mj_forward`` (contact
 random states, controls (some beyond ctrlrange) and activations (some beyond actrange, which
 MuJoCo applies only when it integrates act). The model: a position servo with a timeconst
 (filterexact), a general filter with a ctrlrange, an intvelocity (integrator, actrange), a
-general integrator on a fixed tendon with an affine bias; an ``actearly`` filter stays warned
-about and left out.
+general integrator on a fixed tendon with an affine bias, an ``actearly`` filter (its force at
+the activation one step ahead, ``act + h act_dot``) with an ``actrange`` that clamps it.
 """
 
 from __future__ import annotations
+
+import warnings
 
 import numpy as np
 import pytest
@@ -39,7 +41,8 @@ ACTIVATED = """<mujoco model="activated"><worldbody>
     <motor name="m" joint="j2" gear="2"/>
     <general name="it" tendon="t" dyntype="integrator" gainprm="2" biastype="affine"
       biasprm="0.3 -1 -0.5"/>
-    <general name="early" joint="j1" dyntype="filter" dynprm="0.2" actearly="true"/>
+    <general name="early" joint="j1" dyntype="filter" dynprm="0.2" actearly="true"
+      actlimited="true" actrange="-0.6 0.6"/>
   </actuator>
 </mujoco>"""
 
@@ -49,8 +52,8 @@ def activated(tmp_path_factory):
     folder = tmp_path_factory.mktemp("activated")
     path = folder / "activated.xml"
     path.write_text(ACTIVATED, encoding="utf-8")
-    with pytest.warns(UnsupportedFeatureWarning, match="actuator 'early': an actuator with "
-                      "actearly"):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UnsupportedFeatureWarning)
         model = eomgen.load(path)
     calls, modules = generated(model, ["forward_dynamics_act"], folder, ("numpy",))
     m = mujoco.MjModel.from_xml_path(str(path))
@@ -62,9 +65,10 @@ def test_the_activation_dynamics_are_read(activated):
     model, _, _, module = activated
     assert [(c.name, c.dynamics) for c in model.controls] == [
         ("pf", "filterexact"), ("f", "filter"), ("iv", "integrator"), ("m", None),
-        ("it", "integrator")]
-    assert module["ACTIVATION_NAMES"] == ("pf", "f", "iv", "it")
+        ("it", "integrator"), ("early", "filter")]
+    assert module["ACTIVATION_NAMES"] == ("pf", "f", "iv", "it", "early")
     assert [float(c.timeconst) for c in model.controls[:2]] == [0.1, 0.05]
+    assert float(model.controls[-1].early) == 0.002  # MuJoCo's default timestep
 
 
 def test_accelerations_and_activation_rates_are_mujocos(activated):
@@ -75,15 +79,14 @@ def test_accelerations_and_activation_rates_are_mujocos(activated):
     for _ in range(10):
         q, qd = rng.uniform(-1, 1, 3), rng.uniform(-2, 2, 3)
         ctrl, act = rng.uniform(-2, 2, m.nu), rng.uniform(-1, 1, m.na)
-        ctrl[5] = act[4] = 0.0  # 'early' (left out) at rest: no force in MuJoCo either
         d.qpos[:], d.qvel[:], d.ctrl[:], d.act[:] = q, qd, ctrl, act
         mujoco.mj_forward(m, d)
-        ours = call("forward_dynamics_act", q, qd, ctrl[:5], act[:4])
-        assert ours.shape == (3 + 4,)
+        ours = call("forward_dynamics_act", q, qd, ctrl, act)
+        assert ours.shape == (3 + 5,)
         worst_acc = max(worst_acc, np.abs(ours[:3] - d.qacc_smooth).max()
                         / np.abs(d.qacc_smooth).max())
-        worst_rate = max(worst_rate, np.abs(ours[3:] - d.act_dot[:4]).max()
-                         / np.abs(d.act_dot[:4]).max())
+        worst_rate = max(worst_rate, np.abs(ours[3:] - d.act_dot).max()
+                         / np.abs(d.act_dot).max())
     assert worst_acc < 1e-11 and worst_rate < 1e-14, (worst_acc, worst_rate)
 
 
@@ -100,10 +103,10 @@ def test_every_code_backend_gives_mujocos_activation_rates(activated, tmp_path):
     calls, _ = generated(model, ["forward_dynamics_act"], tmp_path)
     d = mujoco.MjData(m)
     q, qd = np.array([0.3, -0.6, 0.1]), np.array([0.8, -0.2, 1.1])
-    ctrl, act = np.array([0.4, 1.7, -0.3, 0.9, 0.2, 0.0]), np.array([0.1, -0.8, 0.7, -0.3, 0.0])
+    ctrl, act = np.array([0.4, 1.7, -0.3, 0.9, 0.2, 0.5]), np.array([0.1, -0.8, 0.7, -0.3, 0.4])
     d.qpos[:], d.qvel[:], d.ctrl[:], d.act[:] = q, qd, ctrl, act
     mujoco.mj_forward(m, d)
-    expected = np.r_[d.qacc_smooth, d.act_dot[:4]]
+    expected = np.r_[d.qacc_smooth, d.act_dot]
     for name, call in calls.items():
-        assert np.allclose(call("forward_dynamics_act", q, qd, ctrl[:5], act[:4]), expected,
+        assert np.allclose(call("forward_dynamics_act", q, qd, ctrl, act), expected,
                            rtol=1e-11, atol=1e-11), name

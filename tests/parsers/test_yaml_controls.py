@@ -79,6 +79,32 @@ def test_activation_dynamics_are_mujocos_laws(tmp_path):
                        atol=1e-12)
 
 
+def test_dc_motors_are_mujocos_laws(tmp_path):
+    """A DC motor with a current state (rate-limited, with cogging) on a and one without on b:
+    act_dot = clamp(((V − K v)/R − i)/T, ±30), forces K i + A sin(N l + φ) and K/R (V − K v)
+    (the prismatic joint's damping besides), q̈ forward_dynamics at those forces."""
+    text = ROBOT[:ROBOT.index("controls:")].replace("{kp: 20, kv: 1.5}", "{K: 0.05}") + (
+        "controls:\n  - {name: m1, joint: a, gear: 2, dcmotor: {resistance: 2, motorconst: K, "
+        "timeconst: 0.01, rate_limit: 30, cogging: [0.02, 4, 0.3]}}\n"
+        "  - {name: m2, joint: b, ctrlrange: [-12, 12], dcmotor: {resistance: 1.5, "
+        "motorconst: 0.04}}\n")
+    (tmp_path / "two.yaml").write_text(text, encoding="utf-8")
+    model = eomgen.load(tmp_path / "two.yaml")
+    assert [c.dynamics for c in model.controls] == ["dcmotor", None]
+    call = generated(model, ["forward_dynamics_act", "forward_dynamics"], tmp_path,
+                     ("numpy",))[0]["numpy"]
+    q, qd = np.array([0.3, -0.1]), np.array([0.5, 0.8])
+    for u, i in ((np.array([6.0, 15.0]), 0.4), (np.array([6.0, -3.0]), 2.9)):
+        rate = np.clip(((u[0] - 0.05 * 2 * qd[0]) / 2 - i) / 0.01, -30, 30)
+        voltage = np.clip(u[1], -12, 12)
+        tau = np.array([2 * (0.05 * i + 0.02 * np.sin(4 * 2 * q[0] + 0.3)),
+                        0.04 / 1.5 * (voltage - 0.04 * qd[1]) - 0.4 * qd[1]])
+        expected = np.r_[call("forward_dynamics", q, qd, tau), rate]
+        assert np.allclose(call("forward_dynamics_act", q, qd, u, [i]), expected, rtol=1e-12,
+                           atol=1e-12)
+    assert abs(rate) < 30  # the second current is within the rate limit, the first is not
+
+
 @pytest.mark.parametrize("entry, where", [
     ("{name: c, joint: nowhere}", "controls[0] 'c' joint"),
     ("{name: c, joint: a, ctrlrange: [1, -1]}", "controls[0] 'c' ctrlrange"),
@@ -90,6 +116,11 @@ def test_activation_dynamics_are_mujocos_laws(tmp_path):
     ("{name: c, tendon: {a: 1, nowhere: 2}}", "controls[0] 'c' tendon"),
     ("{name: c, joint: a, dynamics: muscle}", "controls[0] 'c' dynamics"),
     ("{name: c, joint: a, timeconst: 0.1}", "controls[0] 'c' timeconst"),
+    ("{name: c, joint: a, gain: 2, dcmotor: {resistance: 1, motorconst: 1}}",
+     "controls[0] 'c' dcmotor: a DC motor's force is its own: drop gain"),
+    ("{name: c, joint: a, dcmotor: {resistance: 1}}", "controls[0] 'c' dcmotor"),
+    ("{name: c, joint: a, dcmotor: {resistance: 1, motorconst: 1, rate_limit: 3}}",
+     "controls[0] 'c' dcmotor rate_limit"),
 ])
 def test_a_wrong_control_is_refused_in_one_line(tmp_path, entry, where):
     text = ROBOT[:ROBOT.index("controls:")] + f"controls:\n  - {entry}\n"

@@ -42,8 +42,10 @@ class CasADiPrinter(TermOrderShared, FloatLiteralMixin, PythonCodePrinter):
         raise ValueError(f"the CasADi backend cannot print function {name}")
 
     # sign: Coulomb friction (regressor columns, drive friction); PythonCodePrinter would print
-    # math.copysign, which fails on CasADi symbols
+    # math.copysign, which fails on CasADi symbols (and math.atan etc.: a ball joint's spring)
     _print_sin = _print_cos = _print_tan = _print_tanh = _print_sign = _print_Function
+    _print_atan = _print_atan2 = _print_asin = _print_acos = _print_Function
+    _print_exp = _print_log = _print_Function
 
     def _print_Pow(self, expr, rational=False):
         # x**(1/2) and x**(-1/2) through ca.sqrt (PythonCodePrinter's math.sqrt fails on

@@ -5,7 +5,8 @@ MuJoCo's own compiler reads the file (the ``simulators`` extra: ``pip install
 'eomgen[simulators]'``): default classes, ``childclass``, ``<include>``, angle units, Euler
 sequences, ``inertiafromgeom`` and the other compiler options are MuJoCo's to resolve. eomgen's
 model is built from the compiled ``mujoco.MjModel`` (:mod:`eomgen.parsers.mjcf.tree` for the
-bodies and joints, :mod:`eomgen.parsers.mjcf.extras` for what is warned about or refused). A
+bodies and joints, :mod:`eomgen.parsers.mjcf.actuators` for the actuators,
+:mod:`eomgen.parsers.mjcf.extras` for tendons, equalities and what is warned about or refused). A
 file the compiler rejects is a :class:`MujocoCompileError` carrying the compiler's message on
 one line.
 
@@ -38,17 +39,22 @@ What is read
   docs/actuators.md); those of the free joint go to the six free-flyer coordinates (equal on
   all six, so they map exactly).
 * Each hinge or slide joint's ``stiffness`` and ``springref``: its
-  :class:`~eomgen.model.Spring` ``−k (q − qpos_spring)``; each fixed tendon with a stiffness
+  :class:`~eomgen.model.Spring` ``−k (q − qpos_spring)``; a ball joint's ``stiffness``: its
+  :class:`~eomgen.model.BallSpring`, MuJoCo's ``−k · subQuat(q, qpos_spring)``; each fixed tendon with a stiffness
   or a damping: a :class:`~eomgen.model.Tendon` of ``model.tendons`` (``L = Σ cᵢ qᵢ``, the
   rest lengths ``springlength``, a dead band since MuJoCo 3). With the joints' damping they
   are the output ``tau_p`` (MuJoCo's ``qfrc_passive``, :mod:`eomgen.symbolic.passive`).
+* Each body's ``gravcomp``: :attr:`~eomgen.model.RobotModel.gravcomp`, its weight times the
+  factor pushed back up at its centre of mass, in ``tau_p`` (MuJoCo's ``qfrc_gravcomp``).
 * ``<option gravity>`` (zero when the ``gravity`` flag is disabled).
 * Actuators with a joint transmission on hinge and slide joints or a transmission on a fixed
   tendon (the moment ``gear`` times the tendon's coefficients), with no activation dynamics
   or an integrator or filter one (``dyntype``, :attr:`~eomgen.model.Control.dynamics`: the
-  state ``act`` of ``forward_dynamics_act``), a fixed or affine gain and bias (``<motor>``,
-  ``<position>``, ``<velocity>``, ``<intvelocity>``, ``<general>`` of those kinds): the
-  model's :attr:`~eomgen.model.RobotModel.controls`
+  state ``act`` of ``forward_dynamics_act``; with ``actearly``, the force one step ahead), a
+  fixed or affine gain and bias (``<motor>``, ``<position>``, ``<velocity>``,
+  ``<intvelocity>``, ``<general>`` of those kinds), ``<dcmotor>`` on its voltage input
+  (its current a state with ``inductance``; ``saturation``, ``cogging``) and ``<pid>`` on its
+  position input (its integral a state with ``ki``): the model's :attr:`~eomgen.model.RobotModel.controls`
   (:class:`~eomgen.model.Control`), entries of the input ``ctrl`` in MuJoCo's actuator order
   (``ACTUATOR_NAMES``), with MuJoCo's ``gear`` (first component), ``gainprm``, ``biasprm``,
   ``ctrlrange`` (when ``ctrllimited``) and ``forcerange`` (when ``forcelimited``); the
@@ -75,13 +81,16 @@ Unnamed bodies and joints are named ``body<i>`` and ``joint<i>`` with MuJoCo's i
 a name that is taken gets ``_2``, ``_3``, … appended.
 
 Warned about (:class:`~eomgen.errors.UnsupportedFeatureWarning`, refused under ``strict``),
-by name: ball joints' springs, spatial tendons (and a fixed tendon's armature and
+by name: free joints' springs, spatial tendons (and a fixed tendon's armature and
 frictionloss), the actuators not read (one line per kind, with their count and first names:
-activation dynamics ``dyntype`` DC motor, PID, user, or ``actearly``; spatial tendon, site,
+activation dynamics ``dyntype`` user, a DC motor's thermal model, LuGre friction or
+on-board controller, a PID's inputs other than ``pos``, ``slewmax`` or ``imax``; spatial tendon, site,
 slider-crank or body transmissions; muscles; free and ball joints; user-defined gains),
 equalities that are inactive (``active="false"``),
 ``tendon`` and flex equalities, an equality joining a dropped free body, fluid forces
-(``density``, ``viscosity``), gravity compensation (``gravcomp``). Refused
+(``density``, ``viscosity``), MuJoCo 4's polynomial springs and dampers (``stiffnesspoly``,
+``dampingpoly``) and control ``delay``, a joint's ``actuatorgravcomp`` (its compensation stays in
+``tau_p``). Refused
 (:class:`~eomgen.errors.UnsupportedError`), by name: ``joint`` equalities of order above
 one; two ``joint`` equalities on one joint or a cycle of them
 (:class:`~eomgen.errors.KinematicTreeError`); a ``connect`` or ``weld`` that fails the checks
@@ -114,7 +123,8 @@ from ...errors import (DescriptionError, ForbiddenXMLError, InvalidLoopError,
 from ...model import RobotModel, emit_notices, settled
 from ...numeric.loop_checks import LoopProblem, check_loops
 from ..registry import register
-from .extras import controls, model_notices, motors, with_equalities, with_tendons
+from .actuators import controls, motors
+from .extras import gravity_compensation, model_notices, with_equalities, with_tendons
 from .numbers import check_compiled
 from .tree import build_tree
 
@@ -239,6 +249,9 @@ def model_from_mujoco(m, source: str = "<mujoco>", strict: bool = False,
             raise InvalidLoopError(source, f"equality '{model.loops[exc.index].name}'",
                                    exc.problem) from None
     present = {joint.name for joint in model.joints}
+    links = {link.name for link in model.links}
+    model = replace(model, gravcomp=tuple((body, factor) for body, factor
+                                          in gravity_compensation(m) if body in links))
     # what concerns only the joints of a dropped free body goes with it
     notices = tuple(n for n in model_notices(m, source)
                     if not n.joints or any(j in present for j in n.joints))

@@ -1,6 +1,7 @@
-"""What a compiled MuJoCo model holds besides its tree: the motors eomgen maps to joint torques, the fixed tendons,
-and the findings warned about (or refused) by name: ball joints' springs, spatial tendons, other actuators,
-equality constraints, fluid forces, gravity compensation (:mod:`eomgen.parsers.mjcf`).
+"""What a compiled MuJoCo model holds besides its tree and its actuators
+(:mod:`eomgen.parsers.mjcf.actuators`): the fixed tendons, the gravity compensation, the
+equalities, and the findings warned about (or refused) by name: free joints' springs, spatial
+tendons, the actuators not read, equality constraints, fluid forces (:mod:`eomgen.parsers.mjcf`).
 
 Each equality kind has its reader in :data:`EQUALITY_READERS`: a first-order ``joint``
 equality is a coupling (:class:`~eomgen.model.Coupling`) or, without a second joint, a locked
@@ -21,34 +22,23 @@ from ...errors import UnsupportedError
 from ...model import (
     POINT_LOOP,
     WELD as WELD_LOOP,
-    Control,
     Coupling,
     Loop,
     LoopFrame,
     Notice,
-    NoticeKind,
     RobotModel,
     Tendon,
     Transform,
     lock_joints,
-    make_control,
     make_coupling,
     scalar,
     vec3,
     with_couplings,
 )
-from .tree import BALL, FREE, HINGE, SLIDE, body_names, disabled, joint_names, rotation_of_quaternion
+from .actuators import TRN_TENDON, actuator_notices
+from .tree import (FREE, HINGE, SLIDE, actuator_inertia, body_names, disabled, element_name,
+                   is_fixed, joint_names, not_modelled, rotation_of_quaternion, tendon_joints)
 
-#: MuJoCo's transmission, dynamics, gain and bias types of a plain motor (``mjTRN_JOINT``,
-#: ``mjDYN_NONE``, ``mjGAIN_FIXED``, ``mjBIAS_NONE``) and of ``mjTRN_JOINTINPARENT``.
-_TRN_JOINT, _TRN_JOINT_IN_PARENT, _TRN_TENDON = 0, 1, 3
-_TRN_NAMES = {2: "slider-crank", 3: "tendon", 4: "site", 5: "body"}
-_DYN_NAMES = {1: "integrator", 2: "filter", 3: "filterexact", 4: "muscle", 5: "DC motor",
-              6: "PID"}
-#: The activation dynamics eomgen reads (:attr:`eomgen.model.Control.dynamics`).
-_DYN_READ = {1: "integrator", 2: "filter", 3: "filterexact"}
-_GAIN_FIXED, _GAIN_AFFINE, _GAIN_MUSCLE = 0, 1, 2
-_BIAS_NONE, _BIAS_AFFINE = 0, 1
 #: MuJoCo's equality types (``mjtEq``) and wrap type of a joint in a fixed tendon.
 CONNECT, WELD, JOINT, TENDON = 0, 1, 2, 3
 _WRAP_JOINT = 1
@@ -58,147 +48,10 @@ _OBJ_SITE = 6
 _NOT_READ = "not read yet: the model is the tree without it"
 
 
-def _name(m, kind: str, i: int) -> str:
-    return getattr(m, kind)(i).name or f"{kind}{i}"
-
-
-def _notice(source: str, element: str, problem: str, fallback: str = "",
-            joints: tuple[str, ...] = (), links: tuple[str, ...] = ()) -> Notice:
-    return Notice(NoticeKind.NOT_MODELLED, source, element, problem, fallback, links, joints)
-
-
-def motors(m) -> tuple[tuple[str, str, float], ...]:
-    """``(actuator, joint, gear)`` of each plain motor on a hinge or slide joint: MuJoCo applies
-    the joint torque ``gear · ctrl`` [N m or N] (``gear`` includes a ``<general>``'s gain)."""
-    jnames = joint_names(m)
-    return tuple((_name(m, "actuator", i), jnames[int(m.actuator_trnid[i, 0])],
-                  float(m.actuator_gear[i, 0] * m.actuator_gainprm[i, 0]))
-                 for i in range(m.nu) if is_motor(m, i))
-
-
-def is_motor(m, i: int) -> bool:
-    """Whether actuator ``i`` is a plain motor (fixed gain, no bias) on a joint eomgen reads."""
-    return (is_control(m, i) and int(m.actuator_trntype[i]) != _TRN_TENDON
-            and int(m.actuator_dyntype[i]) == 0
-            and int(m.actuator_gaintype[i]) == _GAIN_FIXED
-            and int(m.actuator_biastype[i]) == _BIAS_NONE)
-
-
-def is_control(m, i: int) -> bool:
-    """Whether actuator ``i`` is one eomgen reads as a :class:`~eomgen.model.Control`: a joint
-    transmission on a hinge or slide joint or a transmission on a fixed tendon, no activation
-    dynamics, a fixed or affine gain and no or an affine bias (``<motor>``, ``<position>`` and
-    ``<velocity>`` without a time constant, ``<general>`` of those types)."""
-    trn = int(m.actuator_trntype[i])
-    if trn in (_TRN_JOINT, _TRN_JOINT_IN_PARENT):
-        if int(m.jnt_type[int(m.actuator_trnid[i, 0])]) not in (HINGE, SLIDE):
-            return False
-    elif trn != _TRN_TENDON or not is_fixed(m, int(m.actuator_trnid[i, 0])):
-        return False
-    return (_dynamics_read(m, i)
-            and int(m.actuator_gaintype[i]) in (_GAIN_FIXED, _GAIN_AFFINE)
-            and int(m.actuator_biastype[i]) in (_BIAS_NONE, _BIAS_AFFINE))
-
-
-def _early(m, i: int) -> bool:
-    """Whether actuator ``i`` has ``actearly`` (its force uses the next step's activation)."""
-    return bool(getattr(m, "actuator_actearly", np.zeros(m.nu))[i])
-
-
-def _dynamics_read(m, i: int) -> bool:
-    """Whether eomgen reads actuator ``i``'s activation dynamics: none, or an integrator or a
-    filter of one activation whose force uses the activation itself (no ``actearly``)."""
-    dyntype = int(m.actuator_dyntype[i])
-    return dyntype == 0 or (dyntype in _DYN_READ and int(m.actuator_actnum[i]) == 1
-                            and not _early(m, i))
-
-
-def controls(m) -> tuple[Control, ...]:
-    """The :class:`~eomgen.model.Control` of each actuator :func:`is_control` reads, in
-    MuJoCo's actuator order: ``gear`` its first component, the gain and bias the first three
-    of ``gainprm``/``biasprm`` (a fixed gain keeps only the first, no bias is zero), the
-    control clamped to ``ctrlrange`` when ``ctrllimited`` (and clamping is not disabled), the
-    force to ``forcerange`` when ``forcelimited``; on a fixed tendon, the tendon's name and
-    coefficients (``wrap_prm``: MuJoCo's moment is ``gear`` times them)."""
-    jnames = joint_names(m)
-    clamp_ctrl = not disabled(m, "CLAMPCTRL")
-    out = []
-    for i in (i for i in range(m.nu) if is_control(m, i)):
-        gain = [float(x) for x in m.actuator_gainprm[i, :3]]
-        if int(m.actuator_gaintype[i]) == _GAIN_FIXED:
-            gain[1:] = [0.0, 0.0]
-        bias = ([float(x) for x in m.actuator_biasprm[i, :3]]
-                if int(m.actuator_biastype[i]) == _BIAS_AFFINE else [0.0, 0.0, 0.0])
-        ctrl = (m.actuator_ctrlrange[i].tolist()
-                if clamp_ctrl and bool(m.actuator_ctrllimited[i]) else None)
-        force = m.actuator_forcerange[i].tolist() if bool(m.actuator_forcelimited[i]) else None
-        target = int(m.actuator_trnid[i, 0])
-        if int(m.actuator_trntype[i]) == _TRN_TENDON:
-            where = {"joint": None, "tendon": _name(m, "tendon", target), "coefficients": tuple(
-                (jnames[j], c) for j, c in _tendon_joints(m, target))}
-        else:
-            where = {"joint": jnames[target]}
-        dyntype = int(m.actuator_dyntype[i])
-        out.append(make_control(_name(m, "actuator", i), gear=float(m.actuator_gear[i, 0]),
-                                gain=gain, bias=bias, ctrlrange=ctrl, forcerange=force,
-                                dynamics=_DYN_READ.get(dyntype),
-                                timeconst=float(m.actuator_dynprm[i, 0]) if dyntype > 1 else 1,
-                                **where))
-    return tuple(out)
-
-
-def _actuator_kind(m, i: int) -> tuple[str, str]:
-    """What actuator ``i`` (one :func:`is_control` does not read) is: ``(one, several)``."""
-    trn = int(m.actuator_trntype[i])
-    if trn == _TRN_TENDON and not is_fixed(m, int(m.actuator_trnid[i, 0])):
-        return "an actuator on a spatial tendon is", "actuators on spatial tendons are"
-    if trn in _TRN_NAMES and trn != _TRN_TENDON:
-        kind = f"on a {_TRN_NAMES[trn]}"
-        return f"an actuator {kind} is", f"actuators {kind} are"
-    if int(m.actuator_gaintype[i]) == _GAIN_MUSCLE or int(m.actuator_dyntype[i]) == 4:
-        return "a muscle is", "muscles are"
-    if trn != _TRN_TENDON and int(m.jnt_type[int(m.actuator_trnid[i, 0])]) not in (HINGE, SLIDE):
-        return "an actuator on a free or ball joint is", "actuators on free or ball joints are"
-    if int(m.actuator_dyntype[i]) in _DYN_READ and _early(m, i):
-        return ("an actuator with actearly (its force at the next step's activation) is",
-                "actuators with actearly (their force at the next step's activation) are")
-    if int(m.actuator_dyntype[i]):
-        dynamics = _DYN_NAMES.get(int(m.actuator_dyntype[i]), "its own")
-        return (f"an actuator with {dynamics} dynamics (activation) is",
-                f"actuators with {dynamics} dynamics (activation) are")
-    return ("an actuator with a user-defined gain or bias is",
-            "actuators with a user-defined gain or bias are")
-
-
-def _actuator_notices(m, source: str) -> list[Notice]:
-    """One notice per kind of actuator eomgen does not read (:func:`_actuator_kind`), with
-    their count and first three names."""
-    jnames = joint_names(m)
-    kinds: dict[tuple[str, str], list[tuple[str, tuple[str, ...]]]] = {}
-    for i in range(m.nu):
-        if is_control(m, i):
-            continue
-        on_joint = int(m.actuator_trntype[i]) in (_TRN_JOINT, _TRN_JOINT_IN_PARENT)
-        joints = (jnames[int(m.actuator_trnid[i, 0])],) if on_joint else ()
-        kinds.setdefault(_actuator_kind(m, i), []).append((_name(m, "actuator", i), joints))
-    notices = []
-    for kind, found in kinds.items():
-        names = [f"'{name}'" for name, _ in found]
-        shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
-        joints = tuple(j for _, js in found for j in js)
-        every_on_joint = all(js for _, js in found)
-        notices.append(_notice(source, f"actuator {shown}" if len(found) == 1 else
-                               f"{len(found)} actuators {shown}",
-                               f"{kind[0] if len(found) == 1 else kind[1]} not modelled",
-                               "left out of ctrl (docs/formats.md, "
-                               "MJCF actuators)", joints=joints if every_on_joint else ()))
-    return notices
-
-
 def model_notices(m, source: str) -> tuple[Notice, ...]:
     """The findings about ``m`` eomgen warns about (or refuses under ``strict``), in this
-    order: ball joints' springs, spatial tendons, actuators other than motors, equalities, fluid forces,
-    gravity compensation.
+    order: free joints' springs, spatial tendons, actuators other than motors, equalities, fluid forces,
+    gravity compensation routed through the actuators (``actuatorgravcomp``).
 
     Raises
     ------
@@ -210,71 +63,108 @@ def model_notices(m, source: str) -> tuple[Notice, ...]:
     if not disabled(m, "SPRING"):
         for j in range(m.njnt):
             k = float(m.jnt_stiffness[j])
-            if k and int(m.jnt_type[j]) == BALL:
-                notices.append(_notice(source, f"joint '{jnames[j]}' stiffness",
-                                       f"the spring {k:g} of a ball joint is not modelled",
+            if k and int(m.jnt_type[j]) == FREE:
+                notices.append(not_modelled(source, f"joint '{jnames[j]}' stiffness",
+                                       f"the spring {k:g} of a free joint is not modelled",
                                        "left out", joints=(jnames[j],)))
     for j in range(m.njnt):
         if int(m.jnt_type[j]) == FREE and float(m.dof_armature[int(m.jnt_dofadr[j])]):
-            notices.append(_notice(source, f"joint '{jnames[j]}' (free) armature",
+            notices.append(not_modelled(source, f"joint '{jnames[j]}' (free) armature",
                                    "MuJoCo's armature acts on the world-frame linear velocity "
                                    "of a free joint, eomgen's on the body-frame one (the same "
                                    "M + a I, a bias a (omega x v) apart)",
                                    "read on eomgen's coordinates", joints=(jnames[j],)))
     for t in range(m.ntendon):
-        joints = _tendon_joints(m, t)
-        where = f"tendon '{_name(m, 'tendon', t)}'"
+        joints = tendon_joints(m, t)
+        where = f"tendon '{element_name(m, 'tendon', t)}'"
         if not is_fixed(m, t):
-            notices.append(_notice(source, where, "a spatial tendon is not modelled (its "
+            notices.append(not_modelled(source, where, "a spatial tendon is not modelled (its "
                                    "spring, damping and the actuators on it)", "left out",
                                    joints=tuple(jnames[j] for j, _ in joints)))
             continue
-        for attribute, values in (("armature", getattr(m, "tendon_armature", None)),
-                                  ("frictionloss", m.tendon_frictionloss)):
-            if values is not None and float(values[t]):
-                notices.append(_notice(source, f"{where} {attribute}", f"a tendon's "
+        armature = getattr(m, "tendon_armature", np.zeros(m.ntendon))[t]
+        for attribute, value in (("armature", armature + actuator_inertia(m, t, (TRN_TENDON,))[0]),
+                                 ("frictionloss", m.tendon_frictionloss[t])):
+            if float(value):
+                notices.append(not_modelled(source, f"{where} {attribute}", f"a tendon's "
                                        f"{attribute} is not modelled", "left out",
                                        joints=tuple(jnames[j] for j, _ in joints)))
-    notices += _actuator_notices(m, source)
+    notices += actuator_notices(m, source)
+    notices += _array_notices(m, source)
     notices += [found for found in equalities(m, source) if isinstance(found, Notice)]
     if m.opt.density or m.opt.viscosity:
-        notices.append(_notice(source, "option density, viscosity",
+        notices.append(not_modelled(source, "option density, viscosity",
                                "fluid forces are not modelled", "left out"))
-    for b in range(1, m.nbody):
-        if float(m.body_gravcomp[b]):
-            notices.append(_notice(source, f"body '{_name(m, 'body', b)}' gravcomp",
-                                   "gravity compensation is not modelled", "left out"))
+    if gravity_compensation(m):
+        for j in range(m.njnt):
+            if bool(m.jnt_actgravcomp[j]):
+                notices.append(not_modelled(
+                    source, f"joint '{jnames[j]}' actuatorgravcomp", "its gravity "
+                    "compensation is in tau_p, not in the actuator forces (MuJoCo's "
+                    "qfrc_actuator, where the joint's actuatorfrcrange would clamp it; MuJoCo 4.0 "
+                    "drops it in a model without actuators)",
+                    "added to the passive forces", joints=(jnames[j],)))
     return tuple(notices)
 
 
-def _tendon_joints(m, t: int) -> tuple[tuple[int, float], ...]:
-    """``(joint, coefficient)`` of each joint wrap of tendon ``t``."""
-    start, count = int(m.tendon_adr[t]), int(m.tendon_num[t])
-    return tuple((int(m.wrap_objid[w]), float(m.wrap_prm[w])) for w in range(start, start + count)
-                 if int(m.wrap_type[w]) == _WRAP_JOINT)
+def gravity_compensation(m) -> tuple[tuple[str, float], ...]:
+    """``(body, gravcomp)`` of each body of ``m`` with gravity compensation (MuJoCo's
+    ``qfrc_gravcomp``, :attr:`~eomgen.model.RobotModel.gravcomp`); none when gravity is
+    disabled or the ``spring`` and ``damper`` flags both are (MuJoCo then skips every
+    passive force)."""
+    if disabled(m, "GRAVITY") or (disabled(m, "SPRING") and disabled(m, "DAMPER")):
+        return ()
+    names = body_names(m)
+    return tuple((names[b], float(m.body_gravcomp[b])) for b in range(1, m.nbody)
+                 if float(m.body_gravcomp[b]))
 
 
-def is_fixed(m, t: int) -> bool:
-    """Whether tendon ``t`` is a fixed tendon (every wrap a joint)."""
-    start, count = int(m.tendon_adr[t]), int(m.tendon_num[t])
-    return all(int(m.wrap_type[w]) == _WRAP_JOINT for w in range(start, start + count))
+#: MuJoCo 4's per-element arrays eomgen does not model: ``(array, element, what it adds)``.
+_NOT_MODELLED = (("jnt_stiffnesspoly", "joint", "a nonlinear (polynomial) spring"),
+                 ("dof_dampingpoly", "dof", "nonlinear (polynomial) damping"),
+                 ("tendon_stiffnesspoly", "tendon", "a nonlinear (polynomial) spring"),
+                 ("tendon_dampingpoly", "tendon", "nonlinear (polynomial) damping"),
+                 ("actuator_dampingpoly", "actuator", "nonlinear (polynomial) damping"),
+                 ("actuator_delay", "actuator", "a control delay"))
+
+
+def _array_notices(m, source: str) -> list[Notice]:
+    """One notice per array of :data:`_NOT_MODELLED` with a nonzero entry, naming the first
+    three elements (a dof by its joint)."""
+    out = []
+    for array, kind, what in _NOT_MODELLED:
+        values = getattr(m, array, None)
+        found = [] if values is None else [i for i in range(len(values)) if np.any(values[i])]
+        if not found:
+            continue
+        element = "joint" if kind == "dof" else kind
+        names = list(dict.fromkeys(
+            element_name(m, "joint", int(m.dof_jntid[i])) if kind == "dof"
+            else element_name(m, kind, i)
+            for i in found))
+        shown = ", ".join(f"'{n}'" for n in names[:3]) + (", ..." if len(names) > 3 else "")
+        out.append(not_modelled(source, f"{element} {shown} {array.split('_', 1)[1]}",
+                           f"{what} is not modelled", "left out"))
+    return out
 
 
 def fixed_tendons(m) -> tuple[Tendon, ...]:
     """The fixed tendons of ``m`` that pull (a stiffness or a damping): ``L = Σ c_i q_i``
     (``wrap_prm`` the coefficients), the rest lengths ``tendon_lengthspring`` (a dead band
     since MuJoCo 3; both ends the one length otherwise), ``tendon_stiffness`` (0 when the
-    ``spring`` flag is disabled) and ``tendon_damping`` (0 when ``damper`` is)."""
+    ``spring`` flag is disabled) and ``tendon_damping`` with the ``damping`` of the actuators
+    on the tendon times ``gear²`` (0 when ``damper`` is)."""
     jnames = joint_names(m)
     out = []
     for t in range(m.ntendon):
         k = 0.0 if disabled(m, "SPRING") else float(m.tendon_stiffness[t])
-        b = 0.0 if disabled(m, "DAMPER") else float(m.tendon_damping[t])
+        b = 0.0 if disabled(m, "DAMPER") else (float(m.tendon_damping[t])
+                                               + actuator_inertia(m, t, (TRN_TENDON,))[1])
         if not is_fixed(m, t) or not (k or b):
             continue
         rest = np.atleast_1d(np.asarray(m.tendon_lengthspring[t], dtype=float))
-        out.append(Tendon(_name(m, "tendon", t), tuple((jnames[j], c) for j, c in
-                                                       _tendon_joints(m, t)),
+        out.append(Tendon(element_name(m, "tendon", t), tuple((jnames[j], c) for j, c in
+                                                       tendon_joints(m, t)),
                           k, (float(rest[0]), float(rest[-1])), b))
     return tuple(out)
 
@@ -291,18 +181,18 @@ def with_tendons(model: RobotModel, m, source: str) -> RobotModel:
         if len(kept) == len(names):
             tendons.append(tendon)
         elif kept:
-            notices.append(_notice(source, f"tendon '{tendon.name}'", "it joins a dropped free "
+            notices.append(not_modelled(source, f"tendon '{tendon.name}'", "it joins a dropped free "
                                    "body", "left out", joints=kept))
     return replace(model, tendons=tuple(tendons), notices=tuple(model.notices) + tuple(notices))
 
 
 def _equality_where(m, e: int, kind: str) -> str:
     inactive = "" if bool(m.eq_active0[e]) else ", inactive"
-    return f"equality '{_name(m, 'eq', e)}' ({kind}{inactive})"
+    return f"equality '{element_name(m, 'eq', e)}' ({kind}{inactive})"
 
 
 def _equality_bodies(m, e: int) -> tuple[str, ...]:
-    return tuple(_name(m, "body", int(b)) for b in m.eq_obj1id[e:e + 1].tolist()
+    return tuple(element_name(m, "body", int(b)) for b in m.eq_obj1id[e:e + 1].tolist()
                  + m.eq_obj2id[e:e + 1].tolist() if int(b) > 0)
 
 
@@ -318,7 +208,7 @@ def equality_connect(m, e: int, source: str) -> Union[Loop, Notice]:
     data = m.eq_data[e]
     one, two = (_site_frame(m, e, k) if int(m.eq_objtype[e]) == _OBJ_SITE
                 else _body_frame(m, e, k, data[3 * k:3 * k + 3]) for k in (0, 1))
-    return Loop(_name(m, "eq", e), POINT_LOOP, two, one)
+    return Loop(element_name(m, "eq", e), POINT_LOOP, two, one)
 
 
 def equality_weld(m, e: int, source: str) -> Union[Loop, Notice]:
@@ -337,11 +227,11 @@ def equality_weld(m, e: int, source: str) -> Union[Loop, Notice]:
         one = _body_frame(m, e, 0, data[3:6], rotation_of_quaternion(data[6:10]))
         two = _body_frame(m, e, 1, data[0:3])
     kind = WELD_LOOP if float(data[10]) else POINT_LOOP
-    return Loop(_name(m, "eq", e), kind, two, one)
+    return Loop(element_name(m, "eq", e), kind, two, one)
 
 
 def _inactive(m, e: int, source: str, where: str) -> Notice:
-    return _notice(source, where, "an inactive equality is not modelled (MuJoCo enforces it "
+    return not_modelled(source, where, "an inactive equality is not modelled (MuJoCo enforces it "
                    "only once switched on)", "left out", links=_equality_bodies(m, e))
 
 
@@ -421,25 +311,25 @@ def equality_tendon(m, e: int, source: str) -> Union[Coupling, JointLock, Notice
     ids = [int(m.eq_obj1id[e])] + ([int(m.eq_obj2id[e])] if int(m.eq_obj2id[e]) >= 0 else [])
     coefficients = [float(c) for c in m.eq_data[e, :5]]
     order = max((k for k, c in enumerate(coefficients) if c), default=0)
-    joints = tuple(jnames[j] for t in ids for j, _ in _tendon_joints(m, t))
+    joints = tuple(jnames[j] for t in ids for j, _ in tendon_joints(m, t))
     if not all(is_fixed(m, t) for t in ids) or order > 1:
         why = "a spatial tendon's" if order <= 1 else f"an order {order}"
-        return _notice(source, where, f"{why} equality is not modelled: the model is the tree "
+        return not_modelled(source, where, f"{why} equality is not modelled: the model is the tree "
                        "without it", joints=joints)
     if not bool(m.eq_active0[e]):
         return replace(_inactive(m, e, source, where), links=(), joints=joints)
     c0, c1 = coefficients[:2]
     gains: dict[int, float] = {}
-    for j, a in _tendon_joints(m, ids[0]):
+    for j, a in tendon_joints(m, ids[0]):
         gains[j] = gains.get(j, 0.0) + a
     rhs = float(m.tendon_length0[ids[0]]) + c0
     if len(ids) > 1 and c1:
         rhs -= c1 * float(m.tendon_length0[ids[1]])
-        for j, b in _tendon_joints(m, ids[1]):
+        for j, b in tendon_joints(m, ids[1]):
             gains[j] = gains.get(j, 0.0) - c1 * b
-    follower = next((j for j, _ in _tendon_joints(m, ids[0]) if gains[j]), None)
+    follower = next((j for j, _ in tendon_joints(m, ids[0]) if gains[j]), None)
     if follower is None:
-        return _notice(source, where, "the equality moves no joint of tendon1", joints=joints)
+        return not_modelled(source, where, "the equality moves no joint of tendon1", joints=joints)
     a_f = gains.pop(follower)
     leaders = {jnames[j]: -g / a_f for j, g in gains.items() if g}
     if not leaders:
@@ -450,7 +340,7 @@ def equality_tendon(m, e: int, source: str) -> Union[Coupling, JointLock, Notice
 def other_equality(m, e: int, source: str) -> Notice:
     """A flex or distance equality: not modelled."""
     kinds = {TENDON: "tendon", 4: "flex", 5: "flexvert", 6: "flexstrain", 7: "distance"}
-    return _notice(source, _equality_where(m, e, kinds.get(int(m.eq_type[e]), "other")),
+    return not_modelled(source, _equality_where(m, e, kinds.get(int(m.eq_type[e]), "other")),
                    "this equality is not modelled: the model is the tree without it")
 
 
@@ -498,7 +388,7 @@ def with_equalities(model: RobotModel, m, source: str) -> RobotModel:
             continue
         if not all(name in present for name in names):
             kept = tuple(n for n in names if n in present)
-            notices.append(_notice(source, element, "it joins a dropped free body", "left out",
+            notices.append(not_modelled(source, element, "it joins a dropped free body", "left out",
                                    **({"links": kept} if isinstance(found, Loop)
                                       else {"joints": kept})))
         elif isinstance(found, Loop):

@@ -15,8 +15,8 @@ from typing import Iterator
 
 from ...errors import InvalidNumberError
 from ...model.numbers import number_problem
-from .extras import is_control
-from .tree import BALL, FREE, HINGE, SLIDE, body_names, joint_names
+from .actuators import is_control
+from .tree import BALL, FREE, HINGE, SLIDE, actuator_count, body_names, joint_names
 
 #: MuJoCo's equality types read by eomgen (``mjtEq``) and the ``eq_data`` entries each uses.
 _EQUALITY_DATA = {0: (6, "connect", "anchor"), 1: (11, "weld", "anchor, relpose or torquescale"),
@@ -70,13 +70,14 @@ def compiled_numbers(m) -> Iterator[tuple[str, str, object]]:
             for site in (int(m.eq_obj1id[e]), int(m.eq_obj2id[e])):
                 yield f"site '{_name(m, 'site', site)}'", "pos", m.site_pos[site]
                 yield f"site '{_name(m, 'site', site)}'", "orientation", m.site_quat[site]
-    for i in (i for i in range(m.nu) if is_control(m, i)):  # the others are not read
+    for i in (i for i in range(actuator_count(m)) if is_control(m, i)):  # the others are not read
         where = f"actuator '{_name(m, 'actuator', i)}'"
         yield where, "gear", m.actuator_gear[i, 0]
         yield where, "gainprm", m.actuator_gainprm[i, :3]
         yield where, "biasprm", m.actuator_biasprm[i, :3]
         yield where, "ctrlrange", m.actuator_ctrlrange[i]
         yield where, "forcerange", m.actuator_forcerange[i]
+        yield where, "dynprm", m.actuator_dynprm[i, :2]
 
 
 def check_compiled(m, source: str) -> None:

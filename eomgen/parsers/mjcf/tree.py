@@ -20,6 +20,7 @@ from ...errors import KinematicTreeError, UnsupportedError
 from ...model.floating import add_free_flyer, quaternion_matrix
 from ...model import (
     Actuator,
+    BallSpring,
     Spring,
     Notice,
     NoticeKind,
@@ -40,6 +41,8 @@ from ...model import (
 FREE, BALL, SLIDE, HINGE = 0, 1, 2, 3
 #: The world body's link (MuJoCo's body 0, always named ``world``).
 WORLD = "world"
+#: MuJoCo's wrap type of a joint in a fixed tendon (``mjWRAP_JOINT``).
+_WRAP_JOINT = 1
 
 
 def disabled(m, flag: str) -> bool:
@@ -122,23 +125,54 @@ def _inertial(m, body: int) -> Inertial | None:
 def _actuator(m, joint: int) -> Actuator | None:
     """The drive of a joint from its first dof's armature, damping and frictionloss (a free
     joint's are the same on its six dofs, a ball joint's on its three: eomgen gives the drive
-    to each of the ball joint's velocity coordinates)."""
+    to each of the ball joint's velocity coordinates), with the
+    ``armature`` and ``damping`` of the actuators on it times ``gear²`` (MuJoCo 4's
+    ``mj_actuatorArmature``, ``mj_actuatorDamping``)."""
     dof = int(m.jnt_dofadr[joint])
-    values = {"armature": float(m.dof_armature[dof]),
-              "damping": 0.0 if disabled(m, "DAMPER") else float(m.dof_damping[dof]),
+    armature, damping = actuator_inertia(m, joint, (0, 1))
+    values = {"armature": float(m.dof_armature[dof]) + armature,
+              "damping": 0.0 if disabled(m, "DAMPER") else float(m.dof_damping[dof]) + damping,
               "friction": 0.0 if disabled(m, "FRICTIONLOSS") else float(m.dof_frictionloss[dof])}
     if not any(values.values()):
         return None
     return Actuator(**values)
 
 
-def _spring(m, joint: int) -> Spring | None:
-    """The spring of a hinge or slide joint: ``−stiffness (q − qpos_spring)`` (none when the
-    ``spring`` flag is disabled)."""
+def actuator_count(m) -> int:
+    """The number of actuators of ``m``: MuJoCo 4's ``nactuator`` (its ``nu`` counts the
+    controls, several for an actuator with several inputs: a PID's ``pos vel``), ``nu``
+    before."""
+    return int(getattr(m, "nactuator", m.nu))
+
+
+def actuator_inertia(m, target: int, transmissions) -> tuple[float, float]:
+    """``(Σ gear² armature, Σ gear² damping)`` of the actuators whose transmission is one of
+    ``transmissions`` (MuJoCo's ``mjTRN_*`` codes) on ``target`` (a joint or a tendon id):
+    what MuJoCo adds to its armature and damping (``actuator_armature``, ``actuator_damping``,
+    MuJoCo 4; zero before)."""
+    armature = damping = 0.0
+    for k in range(actuator_count(m)):
+        if int(m.actuator_trntype[k]) in transmissions and int(m.actuator_trnid[k, 0]) == target:
+            gear2 = float(m.actuator_gear[k, 0]) ** 2
+            armature += gear2 * float(getattr(m, "actuator_armature", np.zeros(actuator_count(m)))[k])
+            damping += gear2 * float(getattr(m, "actuator_damping", np.zeros(actuator_count(m)))[k])
+    return armature, damping
+
+
+def _spring(m, joint: int) -> Spring | BallSpring | None:
+    """The spring of a hinge or slide joint: ``−stiffness (q − qpos_spring)``; of a ball
+    joint, MuJoCo's ``−stiffness · subQuat(q, qpos_spring)`` (:class:`~eomgen.model.
+    BallSpring`, the reference in eomgen's ``(x, y, z, w)`` order); none when the ``spring``
+    flag is disabled."""
     k = float(m.jnt_stiffness[joint])
-    if not k or disabled(m, "SPRING") or int(m.jnt_type[joint]) not in (HINGE, SLIDE):
+    kind = int(m.jnt_type[joint])
+    if not k or disabled(m, "SPRING") or kind not in (HINGE, SLIDE, BALL):
         return None
-    return Spring(k, float(m.qpos_spring[int(m.jnt_qposadr[joint])]))
+    adr = int(m.jnt_qposadr[joint])
+    if kind == BALL:
+        w, x, y, z = (float(v) for v in m.qpos_spring[adr:adr + 4])
+        return BallSpring(k, (x, y, z, w))
+    return Spring(k, float(m.qpos_spring[adr]))
 
 
 def build_tree(m, source: str) -> RobotModel:
@@ -316,3 +350,28 @@ def _with_free_flyer(model: RobotModel, m, body: str, joint: str, index: int,
     check_tree(source, (l.name for l in links), joints)
     return replace(flying, links=links, joints=joints,
                    info=flying.info + (("mujoco_free_joint", joint),))
+
+
+def element_name(m, kind: str, i: int) -> str:
+    """MuJoCo's name of element ``i`` of ``kind`` (``"actuator"``, ``"tendon"``, …), or
+    ``<kind><i>`` when it has none."""
+    return getattr(m, kind)(i).name or f"{kind}{i}"
+
+
+def not_modelled(source: str, element: str, problem: str, fallback: str = "",
+                 joints: tuple[str, ...] = (), links: tuple[str, ...] = ()) -> Notice:
+    """A notice that ``element`` of ``source`` is not modelled: ``problem``, ``fallback``."""
+    return Notice(NoticeKind.NOT_MODELLED, source, element, problem, fallback, links, joints)
+
+
+def tendon_joints(m, t: int) -> tuple[tuple[int, float], ...]:
+    """``(joint, coefficient)`` of each joint wrap of tendon ``t``."""
+    start, count = int(m.tendon_adr[t]), int(m.tendon_num[t])
+    return tuple((int(m.wrap_objid[w]), float(m.wrap_prm[w])) for w in range(start, start + count)
+                 if int(m.wrap_type[w]) == _WRAP_JOINT)
+
+
+def is_fixed(m, t: int) -> bool:
+    """Whether tendon ``t`` is a fixed tendon (every wrap a joint)."""
+    start, count = int(m.tendon_adr[t]), int(m.tendon_num[t])
+    return all(int(m.wrap_type[w]) == _WRAP_JOINT for w in range(start, start + count))
