@@ -48,6 +48,7 @@ from ..errors import GenerationError
 from ..model import RobotModel, joint_actuators
 from .aba import forward_dynamics_program, true_accelerations
 from .builders import builds, provides, sizes
+from .charts import chart_offset
 from .derivatives import applied_forward_dynamics_jacobians, symmetric_inverse
 from .passive import passive_forces
 from .program import name_expr
@@ -162,8 +163,15 @@ def actuator_forces(derivation, forces) -> sp.Matrix:
 
 
 def _accelerations(derivation, tau, armature) -> sp.Matrix:
-    """``q̈ = (M + diag(a))⁻¹ (τ_act + τ_p − C q̇ − g)`` by the ABA (module docstring)."""
+    """``q̈ = (M + diag(a))⁻¹ (τ_act + τ_p − C q̇ − g)`` by the ABA (module docstring).
+
+    The ABA's armature multiplies its own accelerations, which on a free flyer or a ball joint
+    are the chart's ``ξ̈ = v̇ − n(v)`` (:mod:`eomgen.symbolic.charts`), where MuJoCo's
+    armature (and ``M + diag(a)``) multiplies the joint's ``v̇``: the difference ``a n(v)``
+    moves to the efforts."""
     effort = tau + passive_forces(derivation)
+    offset = chart_offset(derivation, derivation.qd)
+    effort = effort - sp.Matrix([a * n for a, n in zip(armature, offset)])
     qdd = forward_dynamics_program(derivation.tree, derivation.q, derivation.qd, list(effort),
                                    derivation.model.gravity, derivation.builder,
                                    armature=armature)
