@@ -49,7 +49,8 @@ from ..model import RobotModel, joint_actuators
 from .aba import forward_dynamics_program, true_accelerations
 from .builders import builds, provides, sizes
 from .charts import chart_offset
-from .derivatives import applied_forward_dynamics_jacobians, symmetric_inverse
+from .derivatives import (applied_forward_dynamics, applied_forward_dynamics_jacobians,
+                          symmetric_inverse)
 from .passive import passive_forces
 from .program import name_expr
 
@@ -162,14 +163,20 @@ def actuator_forces(derivation, forces) -> sp.Matrix:
     return sp.Matrix(tau)
 
 
-def _accelerations(derivation, tau, armature) -> sp.Matrix:
-    """``q̈ = (M + diag(a))⁻¹ (τ_act + τ_p − C q̇ − g)`` by the ABA (module docstring).
+def _accelerations(derivation, tau, armature, hint: str = "u") -> sp.Matrix:
+    """``q̈ = (M + diag(a))⁻¹ (τ_act + τ_p − C q̇ − g)`` by the ABA (module docstring); with
+    coupled joints ``q̈ = M_a⁻¹ Tᵀ (τ_act + τ_p − h)``, ``M_a = Tᵀ (M + diag(a)) T``, in the
+    independent coordinates (the ABA solves the unconstrained tree), from the LDLᵀ factors
+    of :func:`~eomgen.symbolic.derivatives.applied_forward_dynamics` (``hint`` names its
+    intermediates).
 
     The ABA's armature multiplies its own accelerations, which on a free flyer or a ball joint
     are the chart's ``ξ̈ = v̇ − n(v)`` (:mod:`eomgen.symbolic.charts`), where MuJoCo's
     armature (and ``M + diag(a)``) multiplies the joint's ``v̇``: the difference ``a n(v)``
     moves to the efforts."""
     effort = tau + passive_forces(derivation)
+    if derivation.coupling is not None:
+        return applied_forward_dynamics(derivation, effort, armature, hint)[1]
     offset = chart_offset(derivation, derivation.qd)
     effort = effort - sp.Matrix([a * n for a, n in zip(armature, offset)])
     qdd = forward_dynamics_program(derivation.tree, derivation.q, derivation.qd, list(effort),
@@ -209,7 +216,7 @@ def _activated(derivation) -> sp.Matrix:
     """``xd_act``: ``(q̈, act_dot)`` stacked, the forces at the activations ``act``."""
     armature = [a.armature for a in joint_actuators(derivation.model)]
     tau = actuator_forces(derivation, control_forces(derivation, derivation.inputs["act"]))
-    qdd = _accelerations(derivation, tau, armature)
+    qdd = _accelerations(derivation, tau, armature, "act")
     return sp.Matrix(list(qdd) + activation_rates(derivation))
 
 
@@ -248,7 +255,11 @@ def build_controls(derivation, wanted) -> dict:
     if "dqdd_dctrl" in wanted:
         b = derivation.builder
         ctrl = derivation.inputs["ctrl"]
-        if Minv is None:
+        T = derivation.coupling
+        if Minv is None and T is not None:
+            Minv = applied_forward_dynamics(derivation, tau + passive_forces(derivation),
+                                            armature, "u")[0]
+        elif Minv is None:
             Minv = symmetric_inverse(b, derivation.output("M") + sp.diag(*armature), "Minv_u")
         B = sp.zeros(len(tau), len(ctrl))
         for i, found in enumerate(forces):
@@ -258,7 +269,7 @@ def build_controls(derivation, wanted) -> dict:
                                   ("dtau_act", i + 1))
                 for k, moment in moments:
                     B[k, i] += moment * slope
-        out["dqdd_dctrl"] = Minv * B
+        out["dqdd_dctrl"] = Minv * (B if T is None else T.T * B)
     return out
 
 

@@ -55,10 +55,14 @@ PROJECTIONS: dict[str, tuple[bool, bool]] = {
     "dqdd_dq": (False, False), "dqdd_dqd": (False, False), "Minv": (False, False),
     "A_lin": (False, False), "B_lin": (False, False), "dtau_a_dqd": (False, False),
     "dqdd_a_dq": (False, False), "dqdd_a_dqd": (False, False), "Minv_a": (False, False),
+    # the controls' forward dynamics, built in the independent coordinates too
+    # (eomgen.symbolic.controls: M_a⁻¹ Tᵀ (τ_act + τ_p − h) from the LDLᵀ factors)
+    "qdd_ctrl": (False, False), "dqdd_dctrl": (False, False), "dqdd_ctrl_dq": (False, False),
+    "dqdd_ctrl_dqd": (False, False), "xd_act": (False, False),
 }
 
 #: Several-result outputs (:attr:`eomgen.outputs.Output.returns`) projected block by block.
-COMBINED = ("MCg", "Mh", "dtau", "dqdd", "AB", "dtau_a", "dqdd_a")
+COMBINED = ("MCg", "Mh", "dtau", "dqdd", "AB", "dtau_a", "dqdd_a", "dqdd_ctrl_dx")
 
 
 def supported(symbol: str) -> bool:

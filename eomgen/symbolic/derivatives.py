@@ -392,6 +392,20 @@ def drive_forward_dynamics_jacobians(derivation) -> tuple[sp.Matrix, sp.Matrix, 
     return work["dqdd_a"]
 
 
+def applied_forward_dynamics(derivation, forces, armature, hint: str):
+    """``(M_a⁻¹, q̈)`` of the forward dynamics under the joint forces ``forces`` (expressions
+    f(q, q̇, …), NV entries in the derivation's joints) with the drives' ``armature``:
+    ``q̈ = M_a⁻¹ Tᵀ (f − τ(q, q̇, 0))``, ``M_a = Tᵀ (M + diag(armature)) T``, from the
+    straight-line LDLᵀ factors (:func:`_solved_dynamics`), in the model's own coordinates (the
+    independent ones with couplings; T the identity without). Built once per ``hint`` (one
+    hint names one set of forces), the intermediates' names starting with it."""
+    work = _work(derivation).setdefault("applied", {})
+    if hint not in work:
+        work[hint] = _solved_dynamics(derivation, armature, None, hint,
+                                      efforts=_efforts(derivation, forces))
+    return work[hint]
+
+
 def applied_forward_dynamics_jacobians(derivation, forces, armature, hint: str):
     """``(M_a⁻¹, q̈, ∂q̈/∂q, ∂q̈/∂q̇)`` of the forward dynamics under joint forces given as
     expressions ``forces`` = f(q, q̇) (NV entries in the derivation's joints, e.g. the
@@ -407,7 +421,7 @@ def applied_forward_dynamics_jacobians(derivation, forces, armature, hint: str):
     starting with ``hint``."""
     b, n = derivation.builder, _nv(derivation)
     f = _efforts(derivation, forces)
-    Minv, qdd = _solved_dynamics(derivation, armature, None, hint, efforts=f)
+    Minv, qdd = applied_forward_dynamics(derivation, forces, armature, hint)
     dq, dqd = _efforts_at(derivation, qdd, f"tau_{hint}")
     rows = forward_mode(b, f, _tangent_seeds(derivation))
     dq = dq - _jacobian(rows, "q", n)
@@ -455,7 +469,7 @@ def build_derivatives(derivation, wanted) -> dict:
     return result
 
 
-__all__ = ["applied_forward_dynamics_jacobians", "build_derivatives", "drive_forward_dynamics_jacobians",
+__all__ = ["applied_forward_dynamics", "applied_forward_dynamics_jacobians", "build_derivatives", "drive_forward_dynamics_jacobians",
            "drive_inverse_dynamics_jacobians", "forward_dynamics_jacobians", "forward_mode",
            "forward_mode_map",
            "gravity_jacobian", "inverse_dynamics_jacobians", "inverse_mass_matrix",
