@@ -22,6 +22,11 @@ with ``--folder``), contacts disabled:
   error (max |ours − MuJoCo| / max |MuJoCo|) against ``qacc_smooth`` (MuJoCo's acceleration
   without constraints), ``qfrc_actuator`` and ``qfrc_passive``, mapped to eomgen's coordinates
   (a free joint: ``v̇ = T⁻¹ (qacc − Ṫ v)``, forces ``Tᵀ f``; docs/formats.md). Target: ≤ 1e-9.
+  A model whose actuators have activation dynamics (dm_control's quadruped: filters) is
+  checked by ``forward_dynamics_act`` at random activations, ``act_dot`` against MuJoCo's; a
+  model with couplings (joint and fixed-tendon equalities) against the KKT system of MuJoCo's
+  arrays with its equality rows held exactly (MuJoCo's equalities are soft), as
+  tests/parsers/test_mjcf_coupled_controls.py.
 * **speed** (unless ``--no-speed``): the fast module of ``forward_dynamics_ctrl`` is generated
   and compiled (its build time shown), then one-state calls from Python and ``mj_forward`` on
   the same state are timed alternately (``--repeats`` repeats of 200 calls, the order swapped
@@ -72,9 +77,18 @@ def assets() -> Path:
     return Path(gymnasium.__file__).parent / "envs" / "mujoco" / "assets"
 
 
+def activated(model) -> bool:
+    """Whether some control of ``model`` has activation dynamics (then ``forward_dynamics_act``
+    gives q̈, at random activations, and ``act_dot`` is compared too)."""
+    return any(c.dynamics is not None for c in model.controls)
+
+
 def numpy_module(model) -> dict:
-    dyn = eomgen.derive(model, outputs=("qdd_ctrl", "tau_act", "tau_p"), simplify=False)
-    job = make_job(dyn, FUNCTIONS, count_operations=False)
+    symbols, functions = ("qdd_ctrl", "tau_act", "tau_p"), FUNCTIONS
+    if activated(model):
+        symbols, functions = ("xd_act", "tau_p"), ["forward_dynamics_act", "passive_forces"]
+    dyn = eomgen.derive(model, outputs=symbols, simplify=False)
+    job = make_job(dyn, functions, count_operations=False)
     printer = NumPyModulePrinter({"fully_qualified_modules": True, "standard": "python3",
                                   "order": "none"})
     namespace: dict = {}
@@ -87,32 +101,66 @@ def state(model, m, rng):
     return q, rng.normal(size=model.dof), rng.uniform(-1, 1, m.nu)
 
 
-def mujoco_at(m, lay, q, v, ctrl):
+def mujoco_at(m, lay, q, v, ctrl, act=None):
     data = mujoco.MjData(m)
-    data.qpos[:], data.qvel[:] = to_mujoco(lay, q, v)
+    qpos, data.qvel[:] = to_mujoco(lay, q, v)
+    absent = np.ones(m.nq, dtype=bool)  # a dropped free body's entries: at qpos0
+    absent[lay.qpos_index] = False
+    qpos[absent] = m.qpos0[absent]
+    data.qpos[:] = qpos
     data.ctrl[:] = ctrl
+    if act is not None:
+        data.act[:] = act
     mujoco.mj_forward(m, data)
     return data
 
 
+def constrained(m, data) -> np.ndarray:
+    """The accelerations of MuJoCo's tree under its equality rows held exactly: the KKT system
+    ``[[M, Jᵀ], [J, 0]] (q̈, λ) = (qfrc_smooth, 0)`` of MuJoCo's arrays (``mj_fullM`` with the
+    armature, ``efc_J``; ``J̇ = 0`` for joint and fixed-tendon equalities), what eomgen's
+    couplings give (MuJoCo's own equalities are soft: its ``qacc_smooth`` is without them)."""
+    full = np.zeros((m.nv, m.nv))
+    if hasattr(data, "qM"):  # MuJoCo before 3.3: mj_fullM(m, dst, qM)
+        mujoco.mj_fullM(m, full, data.qM)
+    else:
+        mujoco.mj_fullM(m, data, full)
+    rows = np.asarray(data.efc_type) == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+    J = np.asarray(data.efc_J).reshape(data.nefc, m.nv)[rows]
+    K = np.block([[full, J.T], [J, np.zeros((len(J), len(J)))]])
+    return np.linalg.solve(K, np.r_[data.qfrc_smooth, np.zeros(len(J))])[:m.nv]
+
+
 def accuracy(model, m, namespace, samples: int) -> dict[str, float]:
     lay, rng = layout(m, model), np.random.default_rng(0)
-    worst = {"qacc_smooth": 0.0, "qfrc_actuator": 0.0, "qfrc_passive": 0.0}
+    reference = "qacc (KKT)" if model.couplings else "qacc_smooth"
+    worst = {reference: 0.0, "qfrc_actuator": 0.0, "qfrc_passive": 0.0}
+    if activated(model):
+        worst = {reference: 0.0, "act_dot": 0.0, "qfrc_passive": 0.0}
+    kept = lay.dof_index  # a dropped free body's rows are not eomgen's
     for _ in range(samples):
         q, v, ctrl = state(model, m, rng)
-        data = mujoco_at(m, lay, q, v, ctrl)
+        act = rng.uniform(-1, 1, m.na) if activated(model) else None
+        data = mujoco_at(m, lay, q, v, ctrl, act)
         T = velocity_map(lay, data.qpos)
         drift = np.zeros(m.nv)  # Ṫ v on the free joint's linear block
         if lay.free is not None:
             qa, da = lay.free
             R = rotation_of_quaternion(data.qpos[qa + 3:qa + 7])
             drift[da:da + 3] = R @ np.cross(v[3:6], v[0:3])
-        pairs = {"qacc_smooth": (namespace["forward_dynamics_ctrl"](q, v, ctrl),
-                                 np.linalg.solve(T, data.qacc_smooth - drift)),
-                 "qfrc_actuator": (namespace["actuator_forces"](q, v, ctrl),
-                                   T.T @ data.qfrc_actuator),
-                 "qfrc_passive": (namespace["passive_forces"](q, v), T.T @ data.qfrc_passive)}
+        qacc = constrained(m, data) if model.couplings else data.qacc_smooth
+        pairs = {"qfrc_passive": (namespace["passive_forces"](q, v), T.T @ data.qfrc_passive)}
+        if act is None:
+            qdd = namespace["forward_dynamics_ctrl"](q, v, ctrl)
+            pairs["qfrc_actuator"] = (namespace["actuator_forces"](q, v, ctrl),
+                                      T.T @ data.qfrc_actuator)
+        else:
+            both = np.ravel(namespace["forward_dynamics_act"](q, v, ctrl, act))
+            qdd = both[:model.dof]
+            pairs["act_dot"] = (both[model.dof:], data.act_dot)
+        pairs[reference] = ((T @ np.ravel(qdd) + drift)[kept], qacc[kept])
         for name, (ours, theirs) in pairs.items():
+            ours = np.reshape(ours, np.shape(theirs))
             scale = max(np.abs(theirs).max(), 1e-300)
             worst[name] = max(worst[name], float(np.abs(ours - theirs).max() / scale))
     return worst
@@ -180,7 +228,7 @@ def main() -> int:
         print(f"{name:26s} nv {model.dof:2d} nu {m.nu:2d}  "
               + "  ".join(f"{k} {e:.1e}" for k, e in worst.items())
               + f"  left out: {len(left_out)}")
-        if not options.no_speed:
+        if not options.no_speed and not activated(model):  # the fast module of forward_dynamics_ctrl
             build, ours, theirs, ratios = speed(model, m, options.repeats)
             ratio = statistics.median(ratios)
             met &= ratio <= 0.5
