@@ -35,6 +35,12 @@ exact inside the range (up to rounding of order ``ulp(max(|lo|, |hi|))``), ``lo`
 ``hi`` above, and its derivative ``(sign(x − lo) − sign(x − hi)) / 2`` is 1 inside, 0 outside
 (½ on the bound itself). Every backend prints ``Abs`` and ``sign``.
 
+With coupled joints (:mod:`eomgen.symbolic.couplings`) ``tau_act`` is projected by ``Tᵀ`` and
+the other outputs are built in the independent coordinates: ``q̈ = M_a⁻¹ Tᵀ (τ_act + τ_p −
+h)``, ``M_a = Tᵀ (M + diag(a)) T``, from its LDLᵀ factors
+(:func:`~eomgen.symbolic.derivatives.applied_forward_dynamics`; the ABA solves the
+unconstrained tree), ``∂q̈/∂ctrl = M_a⁻¹ Tᵀ ∂τ_act/∂ctrl``.
+
 A control on a joint the model no longer moves (locked by a scene or an equality) gives no
 force; its ``ctrl`` entry stays (a tendon's held joints are in its length, :meth:`~eomgen.
 model.Control.locked`).

@@ -8,7 +8,8 @@ system built from MuJoCo's own arrays at eomgen's states (``mj_fullM`` with the 
 ``efc_J``: constant for joint and fixed-tendon equalities, so ``J q̈ = 0``), MuJoCo's
 ``act_dot``, and central differences of eomgen's own q̈ along q, q̇ and ctrl. The model: a joint
 equality (an actuated follower), a tendon equality, a servo on a fixed tendon across a leader
-and a follower, springs, damping and armature on followers and leaders.
+and a follower, springs, damping and armature on followers and leaders. (Slow) every code
+backend gives the NumPy module's.
 """
 
 from __future__ import annotations
@@ -134,3 +135,25 @@ def test_the_derivatives_are_central_differences(models):
                     relative(module.forward_dynamics_ctrl_derivative_ctrl(q, v, u),
                              differences(lambda w: f(q, v, w), u)))
     assert worst < 1e-6, worst
+
+
+@pytest.mark.slow
+def test_every_code_backend_gives_the_numpy_module(models, tmp_path):
+    from support.derivatives import results
+    from support.generated import generated
+
+    for name, functions in (("ctrl", ["forward_dynamics_ctrl", "forward_dynamics_ctrl_derivatives",
+                                      "forward_dynamics_ctrl_derivative_ctrl"]),
+                            ("act", ["forward_dynamics_act"])):
+        model, m, _ = models[name]
+        folder = tmp_path / name
+        folder.mkdir()
+        _, modules = generated(model, functions, folder)
+        q, v, u, act = next(samples(model, m, 7))
+        inputs = (q, v, u) if name == "ctrl" else (q, v, u, act)
+        for f in functions:
+            reference = results("numpy", modules["numpy"], f, *inputs)
+            for backend, module in modules.items():
+                for ours, theirs in zip(results(backend, module, f, *inputs), reference):
+                    assert np.allclose(np.reshape(ours, theirs.shape), theirs, rtol=1e-12,
+                                       atol=1e-12), (backend, f)
