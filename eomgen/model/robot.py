@@ -86,8 +86,11 @@ class RobotModel:
     controls: tuple[Control, ...] = ()
     #: Gravity compensation (MuJoCo's body ``gravcomp``): ``(link, factor)`` pairs, each link
     #: pushed up by ``factor`` times its weight at its centre of mass, a passive force
-    #: (``tau_p``, :func:`~eomgen.model.passive.compensated`); empty: none.
-    gravcomp: tuple[tuple[str, Scalar], ...] = ()
+    #: (``tau_p``, :func:`~eomgen.model.passive.compensated`); empty: none. A scene that merges
+    #: links of different factors into one body gives it ``(link, factor, inertial)``: the
+    #: weight held up is ``factor`` times that inertial's, not the link's
+    #: (:func:`eomgen.reduction.inertia.merged_gravcomp`).
+    gravcomp: tuple[tuple, ...] = ()
 
     @cached_property
     def link_by_name(self) -> dict[str, Link]:

@@ -36,7 +36,7 @@ from ..outputs import select
 from ..parsers import load
 from ..scene import Payload, Scene, did_you_mean, scene_error
 from ..model.bodies import frame_site
-from .inertia import (clean_transform, combined_inertial, inertial_scalars,
+from .inertia import (clean_transform, combined_inertial, inertial_scalars, merged_gravcomp,
                       substituted_inertial, tidy)
 from .planar import in_plane, planar_motion
 from .loops import with_loops
@@ -514,10 +514,15 @@ def _merge(model: RobotModel, payloads: Sequence[Payload]):
         merged.append(MergedBody(joint.child, joint.name, tuple(merged_links[k]),
                                  tuple(merged_payloads[k])))
     info = tuple((k, v) for k, v in model.info if not str(k).startswith("dh"))
+    # the tendons and controls name moving joints only (the locked ones were taken out of
+    # them by lock_joints), which keep their names; gravity compensation moves to the bodies
+    gravcomp = merged_gravcomp(model, site, parts,
+                               [(k, movers[k][0].child) for k in by_description])
     reduced = RobotModel(name=model.name, links=tuple(links), joints=tuple(joints),
                          root=model.root, gravity=model.gravity, parameters=model.parameters,
                          source=model.source, info=info,
-                         compound_joints=model.compound_joints, couplings=model.couplings)
+                         compound_joints=model.compound_joints, couplings=model.couplings,
+                         tendons=model.tendons, controls=model.controls, gravcomp=gravcomp)
     return reduced, tuple(merged), tuple(dropped), tuple(dropped_payloads)
 
 

@@ -94,3 +94,48 @@ def tidy(x, abs_terms) -> sp.Expr:
     if abs(v) <= ROUNDOFF * scale:
         return sp.Integer(0)
     return scalar(v)
+
+
+def scaled_inertial(inertial: Inertial, factor) -> Inertial:
+    """``inertial`` with its mass and inertia times ``factor`` (its centre of mass kept): the
+    weight a gravity compensation of that factor pushes back up."""
+    return Inertial(factor * inertial.mass, inertial.com,
+                    tuple(tuple(factor * x for x in row) for row in inertial.inertia))
+
+
+def merged_gravcomp(model, site, parts, bodies) -> tuple:
+    """:attr:`~eomgen.model.RobotModel.gravcomp` of the bodies a scene merges: per moving body
+    (``site``: each link's body and pose, :func:`eomgen.model.bodies.attach_fixed_links`;
+    ``parts``: each body's inertial parts, payloads included; ``bodies``: ``(body, link)`` in
+    the reduced model's order), its links' compensation added up. The compensation ``Σ γ_i m_i J_iᵀ (−g)`` is linear in each
+    part's ``γ_i m_i`` and ``γ_i m_i c_i``, so it is exact as:
+
+    * ``(link, γ)`` when every part with mass is compensated by one factor ``γ`` (the merged
+      body's own inertial times it);
+    * ``(link, 1, inertial)`` otherwise, ``inertial`` the parts' ``γ_i``-scaled inertials
+      combined (parts of different factors, a payload the compensation does not hold up).
+
+    Links fixed to the world (no joint force) are left out."""
+    if not model.gravcomp:
+        return ()
+    weighed: dict[int, list] = {}
+    for entry in model.gravcomp:
+        name, factor = entry[0], scalar(entry[1])
+        inertial = entry[2] if len(entry) > 2 else model.link_by_name[name].inertial
+        body, pose = site[name]
+        if body >= 0 and inertial is not None and factor != 0 and inertial.mass != 0:
+            weighed.setdefault(body, []).append((factor, inertial, pose, len(entry) > 2))
+    out = []
+    for body, link in bodies:
+        found = weighed.get(body)
+        if not found:
+            continue
+        massive = [p for p in parts[body] if p[0].mass != 0]
+        if (len({f for f, *_ in found}) == 1 and len(found) == len(massive)
+                and not any(own for *_, own in found)):
+            out.append((link, found[0][0]))
+        else:
+            out.append((link, sp.Integer(1),
+                        combined_inertial([(scaled_inertial(i, f), pose)
+                                           for f, i, pose, _ in found])))
+    return tuple(out)

@@ -75,16 +75,22 @@ def passive_forces(derivation) -> sp.Matrix:
 def gravity_compensation(derivation) -> list:
     """``τ_gc`` (NV) of the module docstring: Newton–Euler at ``q̇ = q̈ = 0`` on the
     derivation's tree with each link's inertial scaled by its ``gravcomp`` factor (the links
-    without one massless), so that fixed links merged into a body keep their own factors."""
+    without one massless), so that fixed links merged into a body keep their own factors; an
+    entry ``(link, factor, inertial)`` (a scene's merged body of several factors,
+    :func:`eomgen.reduction.inertia.merged_gravcomp`) scales its own inertial instead."""
     model = derivation.model
-    factors = dict(model.gravcomp)
-    links = tuple(replace(link, inertial=None) if link.name not in factors
-                  or link.inertial is None else
-                  replace(link, inertial=Inertial(factors[link.name] * link.inertial.mass,
-                                                  link.inertial.com,
-                                                  [[factors[link.name] * x for x in row]
-                                                   for row in link.inertial.inertia]))
-                  for link in model.links)
+    held = {entry[0]: (entry[1], entry[2] if len(entry) > 2 else None)
+            for entry in model.gravcomp}
+
+    def weight(link):  # what the compensation holds up of the link: None for nothing
+        factor, inertial = held.get(link.name, (0, None))
+        inertial = inertial or link.inertial
+        if factor == 0 or inertial is None:
+            return None
+        return Inertial(factor * inertial.mass, inertial.com,
+                        [[factor * x for x in row] for row in inertial.inertia])
+
+    links = tuple(replace(link, inertial=weight(link)) for link in model.links)
     scaled = body_tree(float_constants(replace(model, links=links)))
     tree = replace(derivation.tree, bodies=tuple(
         replace(body, inertial=light.inertial)
