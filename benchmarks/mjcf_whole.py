@@ -228,7 +228,7 @@ def main() -> int:
         print(f"{name:26s} nv {model.dof:2d} nu {m.nu:2d}  "
               + "  ".join(f"{k} {e:.1e}" for k, e in worst.items())
               + f"  left out: {len(left_out)}")
-        if not options.no_speed and not activated(model):  # the fast module of forward_dynamics_ctrl
+        if not options.no_speed and not activated(model):  # forward_dynamics_ctrl's speed
             build, ours, theirs, ratios = speed(model, m, options.repeats)
             ratio = statistics.median(ratios)
             met &= ratio <= 0.5

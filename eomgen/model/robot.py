@@ -90,7 +90,7 @@ class RobotModel:
     #: links of different factors into one body gives it ``(link, factor, inertial)``: the
     #: weight held up is ``factor`` times that inertial's, not the link's
     #: (:func:`eomgen.reduction.inertia.merged_gravcomp`).
-    gravcomp: tuple[tuple, ...] = ()
+    gravcomp: tuple[tuple[str, Scalar] | tuple[str, Scalar, Inertial], ...] = ()
 
     @cached_property
     def link_by_name(self) -> dict[str, Link]:

@@ -107,8 +107,9 @@ def merged_gravcomp(model, site, parts, bodies) -> tuple:
     """:attr:`~eomgen.model.RobotModel.gravcomp` of the bodies a scene merges: per moving body
     (``site``: each link's body and pose, :func:`eomgen.model.bodies.attach_fixed_links`;
     ``parts``: each body's inertial parts, payloads included; ``bodies``: ``(body, link)`` in
-    the reduced model's order), its links' compensation added up. The compensation ``Σ γ_i m_i J_iᵀ (−g)`` is linear in each
-    part's ``γ_i m_i`` and ``γ_i m_i c_i``, so it is exact as:
+    the reduced model's order), its links' compensation added up. The compensation
+    ``Σ γ_i m_i J_iᵀ (−g)`` is linear in each part's ``γ_i m_i`` and ``γ_i m_i c_i``, so it
+    is exact as:
 
     * ``(link, γ)`` when every part with mass is compensated by one factor ``γ`` (the merged
       body's own inertial times it);

@@ -23,7 +23,8 @@ from support.extras import need
 mujoco = need("mujoco", reason="MJCF is read by MuJoCo's compiler")
 
 from eomgen.parsers.mjcf import model_from_mujoco  # noqa: E402
-from eomgen.parsers.mjcf.convert import layout, mujoco_dynamics, to_mujoco, velocity_map  # noqa: E501  # noqa: E402
+from eomgen.parsers.mjcf.convert import (  # noqa: E402
+    layout, mujoco_dynamics, to_mujoco, velocity_map)
 
 BALL = """<mujoco model="ballarm"><option><flag contact="disable"/></option><worldbody>
 <body pos="0 0 1"><joint name="b1" type="ball" armature="0.05" damping="0.3" stiffness="2"/>

@@ -8,8 +8,9 @@ system built from MuJoCo's own arrays at eomgen's states (``mj_fullM`` with the 
 ``efc_J``: constant for joint and fixed-tendon equalities, so ``J q̈ = 0``), MuJoCo's
 ``act_dot``, and central differences of eomgen's own q̈ along q, q̇ and ctrl. The model: a joint
 equality (an actuated follower), a tendon equality, a servo on a fixed tendon across a leader
-and a follower, springs, damping and armature on followers and leaders. (Slow) every code
-backend gives the NumPy module's.
+and a follower, springs, damping and armature on followers and leaders. (Slow) a coupling
+below a free joint and a ball joint with armature, damping and a spring; every code backend
+gives the NumPy module's.
 """
 
 from __future__ import annotations
@@ -66,8 +67,9 @@ def models():
     return out
 
 
-def constrained(m, lay, q, v, ctrl, act):
-    """``(T, q̈ of MuJoCo's KKT system, act_dot)`` at eomgen's state (module docstring)."""
+def constrained(m, lay, q, v, ctrl, act, rows=2):
+    """``(T, q̈ of MuJoCo's KKT system, act_dot)`` at eomgen's state (module docstring), the
+    model's ``rows`` equality rows held."""
     data = mujoco.MjData(m)
     data.qpos[:], data.qvel[:] = to_mujoco(lay, q, v)
     data.ctrl[:], data.act[:] = ctrl, act
@@ -77,9 +79,9 @@ def constrained(m, lay, q, v, ctrl, act):
         mujoco.mj_fullM(m, full, data.qM)
     else:
         mujoco.mj_fullM(m, data, full)
-    rows = np.asarray(data.efc_type) == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
-    J = np.asarray(data.efc_J).reshape(data.nefc, m.nv)[rows]
-    assert len(J) == 2
+    held = np.asarray(data.efc_type) == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+    J = np.asarray(data.efc_J).reshape(data.nefc, m.nv)[held]
+    assert len(J) == rows
     K = np.block([[full, J.T], [J, np.zeros((len(J), len(J)))]])
     qdd = np.linalg.solve(K, np.r_[data.qfrc_smooth, np.zeros(len(J))])[:m.nv]
     return velocity_map(lay, data.qpos), qdd, data.act_dot.copy()
@@ -157,3 +159,53 @@ def test_every_code_backend_gives_the_numpy_module(models, tmp_path):
                 for ours, theirs in zip(results(backend, module, f, *inputs), reference):
                     assert np.allclose(np.reshape(ours, theirs.shape), theirs, rtol=1e-12,
                                        atol=1e-12), (backend, f)
+
+
+def floating_mjcf() -> str:
+    """tests/data/mjcf/coupled_floating.xml (a free joint, a ball hip, a knee–ankle equality)
+    with armature, damping and a spring on the ball and the hinges, a servo on the follower
+    and a motor."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parent.parent / "data" / "mjcf"
+            / "coupled_floating.xml").read_text(encoding="utf-8")
+    for old, new in (('pos="0 0 0.05"/>', 'pos="0 0 0.05" armature="0.05" damping="0.2" '
+                                          'stiffness="1"/>'),
+                     ('ref="0.2"/>', 'ref="0.2" armature="0.02"/>'),
+                     ('ref="-0.1"/>', 'ref="-0.1" armature="0.03" damping="0.1"/>'),
+                     ("</equality>", '</equality><actuator><position joint="ankle" kp="5" '
+                                     'kv="0.3"/><motor joint="shoulder"/></actuator>'),
+                     ('<option gravity="0.3 -0.2 -9.81"/>',
+                      '<option gravity="0.3 -0.2 -9.81"><flag contact="disable"/></option>')):
+        assert old in text
+        text = text.replace(old, new)
+    return text
+
+
+@pytest.mark.slow
+def test_a_coupling_below_a_free_joint_and_a_ball_with_armature():
+    """The constrained accelerations (the free joint's ``qacc = T v̇ + Ṫ v``) and the
+    derivatives along the tangent (eomgen's ``integrate``)."""
+    from eomgen.model.configuration import integrate
+
+    m = mujoco.MjModel.from_xml_string(floating_mjcf())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = model_from_mujoco(m, "floating.xml")
+    module = eomgen.derive(model, outputs=OUTPUTS["ctrl"][:3]).lambdify().module
+    lay, h, worst = layout(m, model), 1e-6, 0.0
+    for q, v, u, _ in samples(model, m, 5):
+        T, qdd, _ = constrained(m, lay, q, v, u, [], rows=1)
+        drift = np.zeros(m.nv)
+        drift[0:3] = T[0:3, 0:3] @ np.cross(v[3:6], v[0:3])
+        assert relative(T @ module.forward_dynamics_ctrl(q, v, u).ravel() + drift, qdd) < 1e-12
+
+        def f(x, y):
+            return module.forward_dynamics_ctrl(x, y, u).ravel()
+        along = np.column_stack([(f(integrate(q, h * e, model=model), v)
+                                  - f(integrate(q, -h * e, model=model), v)) / (2 * h)
+                                 for e in np.eye(model.dof)])
+        worst = max(worst, relative(module.forward_dynamics_ctrl_derivative_q(q, v, u), along),
+                    relative(module.forward_dynamics_ctrl_derivative_qd(q, v, u),
+                             differences(lambda y: f(q, y), v)))
+    assert worst < 1e-6, worst
