@@ -140,6 +140,9 @@ def main() -> None:
     parser.add_argument("--exact", action="store_true", help="also the exact Hessian (SX ways)")
     parser.add_argument("--repeats-limited", type=int, default=None,
                         help="repeats of the limited-memory runs (default: --repeats)")
+    parser.add_argument("--alternate", action="store_true",
+                        help="run the ways in turn within each repeat (fairer on a loaded "
+                             "machine) instead of each way's repeats in a row")
     parser.add_argument("--ways", default="sx-ad,sx-eomgen,external,external-ad,sx-eomgen2,"
                         "external2", help="comma-separated ways to run (see above)")
     parser.add_argument("--hessians", default=None,
@@ -182,16 +185,32 @@ def main() -> None:
         print("| way | Hessian | solve time [s] | iterations | optimum | load |")
         print("|---|---|---|---|---|---|")
         for hessian in hessians:
-            for label, f in ways.items():
-                if hessian == "exact" and label in ("external", "external-ad"):
-                    continue
-                repeats = (args.repeats_limited if hessian == "limited-memory"
-                           and args.repeats_limited is not None else args.repeats)
-                runs = [reach(f, n, args.steps, args.horizon, args.limit, hessian)
-                        for _ in range(repeats)]
-                elapsed = statistics.median(r[0] for r in runs)
-                print(f"| {label} | {hessian} | {elapsed:.3f} | {runs[0][1]} | "
-                      f"{runs[0][2]:.10g} | {os.getloadavg()[0]:.1f} |", flush=True)
+            labels = [label for label in ways if not (
+                hessian == "exact" and label in ("external", "external-ad"))]
+            repeats = (args.repeats_limited if hessian == "limited-memory"
+                       and args.repeats_limited is not None else args.repeats)
+            runs: dict = {label: [] for label in labels}
+            loads: dict = {label: [] for label in labels}
+            order = ([labels] * repeats if args.alternate
+                     else [[label] * repeats for label in labels])
+            for group in order:
+                for label in group:
+                    runs[label].append(reach(ways[label], n, args.steps, args.horizon,
+                                             args.limit, hessian))
+                    loads[label].append(os.getloadavg()[0])
+                    if not args.alternate and len(runs[label]) == repeats:
+                        report(label, hessian, runs[label], loads[label])
+            if args.alternate:
+                for label in labels:
+                    report(label, hessian, runs[label], loads[label])
+
+
+def report(label, hessian, runs, loads) -> None:
+    elapsed = statistics.median(r[0] for r in runs)
+    load = f"{min(loads):.1f}" + (f"-{max(loads):.1f}" if max(loads) - min(loads) >= 0.05
+                                  else "")
+    print(f"| {label} | {hessian} | {elapsed:.3f} | {runs[0][1]} | {runs[0][2]:.10g} | "
+          f"{load} |", flush=True)
 
 
 if __name__ == "__main__":
