@@ -148,7 +148,7 @@ def test_casadi_hessians_are_eomgens_and_equal_casadis_ad(planar):
     X, L = ca.MX.sym("x", 3 * n), ca.MX.sym("lam", n)
     Xs, Ls = ca.SX.sym("x", 3 * n), ca.SX.sym("lam", n)
 
-    def hessian(f, X, L, ca_type):
+    def hessian(f, X, L):
         qdd = f(X[:n], X[n:2 * n], X[2 * n:], *parameters)
         # a scalar function of qdd as a Lagrangian has it: lam^T qdd + |qdd|^2
         H = ca.hessian(ca.dot(L, qdd) + ca.sumsqr(qdd), X)[0]
@@ -157,13 +157,13 @@ def test_casadi_hessians_are_eomgens_and_equal_casadis_ad(planar):
     seen = {"module": fd}
     if library:
         seen["external"] = ca.external("forward_dynamics", library)
-    _, expected_f = hessian(reference, Xs, Ls, ca.SX)
+    _, expected_f = hessian(reference, Xs, Ls)
     for seed in (5, 6):
         q, qd, tau, lam = state(seed, n)
         x = np.concatenate([q, qd, tau])
         expected = expected_f(x, lam).full()
         for label, f in seen.items():
-            H, function = hessian(f, X, L, ca.MX)
+            H, function = hessian(f, X, L)
             assert "jac_jac_forward_dynamics" in str(H), label
             assert relative(function(x, lam).full(), expected) < 1e-10, label
         # the composed functions of the module against the same AD
