@@ -11,19 +11,28 @@ limits (multiple shooting, RK4, IPOPT) solved with
   ``jac_forward_dynamics`` written from the SX function's CasADi AD instead (what a library
   would export if eomgen differentiated nothing), for comparison.
 
-Each with IPOPT's limited-memory Hessian (an external function has no second derivatives) and,
-for the SX ways, the exact Hessian. The table gives the solve time (wall clock of
-``opti.solve()``, the median of ``--repeats``), IPOPT's iterations and the optimum, which must
-agree across ways.
+* ``sx-eomgen2``: the module generated with ``forward_dynamics_second_derivatives`` too, whose
+  Jacobian's Jacobian (``jac_jac_forward_dynamics``) is eomgen's second derivatives of the
+  forward dynamics, composed from those of the inverse dynamics;
+* ``external2``: that module's C library (``jac_forward_dynamics`` and
+  ``jac_jac_forward_dynamics``) loaded by ``casadi.external``.
+
+Each with IPOPT's limited-memory Hessian and, with ``--exact``, the exact Hessian (``external``
+and ``external-ad`` have no second derivatives: exact runs skip them). The table gives the
+solve time (wall clock of ``opti.solve()``, the median of ``--repeats``), IPOPT's iterations,
+the optimum, which must agree across ways, and the load average (``os.getloadavg()``, 1 min)
+when the row was measured: the machine is shared.
 
 Usage::
 
     python benchmarks/casadi_opti.py [--robot panda|puma560|planar_2link] [--steps 30] [--repeats 3]
+        [--exact] [--ways sx-ad,sx-eomgen2,...] [--hessians limited-memory,exact]
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import subprocess
 import sys
@@ -129,37 +138,79 @@ def main() -> None:
     parser.add_argument("--limit", type=float, default=60.0)
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--exact", action="store_true", help="also the exact Hessian (SX ways)")
+    parser.add_argument("--repeats-limited", type=int, default=None,
+                        help="repeats of the limited-memory runs (default: --repeats)")
+    parser.add_argument("--alternate", action="store_true",
+                        help="run the ways in turn within each repeat (fairer on a loaded "
+                             "machine) instead of each way's repeats in a row")
+    parser.add_argument("--ways", default="sx-ad,sx-eomgen,external,external-ad,sx-eomgen2,"
+                        "external2", help="comma-separated ways to run (see above)")
+    parser.add_argument("--hessians", default=None,
+                        help="comma-separated: limited-memory, exact (default: limited-memory, "
+                             "and exact with --exact)")
     args = parser.parse_args()
     model = model_of(args.robot)
     n = model.dof
+    chosen = args.ways.split(",")
+    second_order = {"sx-eomgen2", "external2"}
     with tempfile.TemporaryDirectory() as tmp:
-        plain_dir, derivative_dir = Path(tmp, "plain"), Path(tmp, "derivatives")
-        plain_dir.mkdir()
-        derivative_dir.mkdir()
-        plain = write(model, DEFAULT, plain_dir, ["casadi"])
-        with_derivatives = write(model, DEFAULT + ["forward_dynamics_derivatives"],
-                                 derivative_dir, ["casadi", "c"])
-        ways = {
-            "sx-ad": plain["forward_dynamics"],
-            "sx-eomgen": with_derivatives["forward_dynamics"],
-            "external": ca.external("forward_dynamics",
-                                    str(derivative_dir / library_name(module_name(model.name)))),
-            "external-ad": ad_library(plain["forward_dynamics"], plain_dir),
-        }
-        hessians = ["limited-memory"] + (["exact"] if args.exact else [])
+        folders = {name: Path(tmp, name) for name in ("plain", "derivatives", "second")}
+        for folder in folders.values():
+            folder.mkdir()
+        start = time.perf_counter()
+        plain = write(model, DEFAULT, folders["plain"], ["casadi"])
+        ways = {"sx-ad": lambda: plain["forward_dynamics"],
+                "external-ad": lambda: ad_library(plain["forward_dynamics"], folders["plain"])}
+        if {"sx-eomgen", "external"} & set(chosen):
+            first = write(model, DEFAULT + ["forward_dynamics_derivatives"],
+                          folders["derivatives"], ["casadi"] + (["c"] if "external" in chosen
+                                                                else []))
+            ways["sx-eomgen"] = lambda: first["forward_dynamics"]
+            ways["external"] = lambda: ca.external("forward_dynamics", str(
+                folders["derivatives"] / library_name(module_name(model.name))))
+        if second_order & set(chosen):
+            second = write(model, DEFAULT + ["forward_dynamics_second_derivatives"],
+                           folders["second"], ["casadi"] + (["c"] if "external2" in chosen
+                                                            else []))
+            ways["sx-eomgen2"] = lambda: second["forward_dynamics"]
+            ways["external2"] = lambda: ca.external("forward_dynamics", str(
+                folders["second"] / library_name(module_name(model.name))))
+        ways = {label: ways[label]() for label in chosen}
+        print(f"generation and compilation: {time.perf_counter() - start:.0f} s")
+        hessians = (args.hessians.split(",") if args.hessians else
+                    ["limited-memory"] + (["exact"] if args.exact else []))
         print(f"{args.robot} (n = {n}), N = {args.steps}, {args.horizon} s, |tau| <= "
-              f"{args.limit}, median of {args.repeats}")
-        print("| way | Hessian | solve time [s] | iterations | optimum |")
-        print("|---|---|---|---|---|")
+              f"{args.limit}, median of {args.repeats} (limited-memory: "
+              f"{args.repeats_limited or args.repeats})")
+        print("| way | Hessian | solve time [s] | iterations | optimum | load |")
+        print("|---|---|---|---|---|---|")
         for hessian in hessians:
-            for label, f in ways.items():
-                if hessian == "exact" and label.startswith("external"):
-                    continue
-                runs = [reach(f, n, args.steps, args.horizon, args.limit, hessian)
-                        for _ in range(args.repeats)]
-                elapsed = statistics.median(r[0] for r in runs)
-                print(f"| {label} | {hessian} | {elapsed:.3f} | {runs[0][1]} | "
-                      f"{runs[0][2]:.10g} |", flush=True)
+            labels = [label for label in ways if not (
+                hessian == "exact" and label in ("external", "external-ad"))]
+            repeats = (args.repeats_limited if hessian == "limited-memory"
+                       and args.repeats_limited is not None else args.repeats)
+            runs: dict = {label: [] for label in labels}
+            loads: dict = {label: [] for label in labels}
+            order = ([labels] * repeats if args.alternate
+                     else [[label] * repeats for label in labels])
+            for group in order:
+                for label in group:
+                    runs[label].append(reach(ways[label], n, args.steps, args.horizon,
+                                             args.limit, hessian))
+                    loads[label].append(os.getloadavg()[0])
+                    if not args.alternate and len(runs[label]) == repeats:
+                        report(label, hessian, runs[label], loads[label])
+            if args.alternate:
+                for label in labels:
+                    report(label, hessian, runs[label], loads[label])
+
+
+def report(label, hessian, runs, loads) -> None:
+    elapsed = statistics.median(r[0] for r in runs)
+    load = f"{min(loads):.1f}" + (f"-{max(loads):.1f}" if max(loads) - min(loads) >= 0.05
+                                  else "")
+    print(f"| {label} | {hessian} | {elapsed:.3f} | {runs[0][1]} | {runs[0][2]:.10g} | "
+          f"{load} |", flush=True)
 
 
 if __name__ == "__main__":

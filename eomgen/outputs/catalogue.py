@@ -393,6 +393,25 @@ SECOND_DERIVATIVES = _listed(Output(
     "ComputeRNEASecondOrderDerivatives.", ("q", "qd", "qdd"), False,
     "the units of the four tensors", ("d2tau",), default=False, on_charts=False,
     returns=("d2tau_dqdq", "d2tau_dvdv", "dtau_dqdv", "dtau_dadq")))
+# ... and of the forward dynamics, composed from them (no derivation of their own): with
+# x = (q, qd, tau) and a = qdd(x), M d2a/dx_j dx_k = -(d2tau/dx_j dx_k + dM/dx_j da/dx_k +
+# dM/dx_k da/dx_j) at qdd = a (docs/derivatives.md).
+_FORWARD_SECOND_FROM = (MASS.function, INVERSE.function, FORWARD.function,
+                        FORWARD_DERIVATIVES.function, SECOND_DERIVATIVES.function)
+_FORWARD_SECOND_BACKENDS = ("numpy", "casadi", "c")
+FORWARD_SECOND = _listed(Output(
+    "forward_dynamics_second_derivatives", None, "d2qdd/dx2 of qdd(q, qd, tau), x = (q, qd, "
+    "tau) stacked (3 nv): T[i, j, k] = d2qdd_i/dx_j dx_k returned as (nv, 9 nv*nv), entry "
+    "[i, j*3nv + k]: reshape(nv, 3 nv, 3 nv) gives T.", ("q", "qd", "tau"), False,
+    "1/s^2 per unit of x_j and x_k", ("M", "tau", "dqdd", "d2tau"),
+    composed_from=_FORWARD_SECOND_FROM, default=False, on_charts=False,
+    backends=_FORWARD_SECOND_BACKENDS))
+FORWARD_HESSIAN = _listed(Output(
+    "forward_dynamics_hessian", None, "Hessian (3 nv, 3 nv) of lam^T qdd(q, qd, tau) over x = "
+    "(q, qd, tau), for the multipliers lam (nv,) (an optimizer's Lagrangian term), without "
+    "the tensor.", ("q", "qd", "tau"), False, "1/s^2 per unit of x_j and x_k, times lam's",
+    ("M", "tau", "dqdd", "d2tau"), composed_from=_FORWARD_SECOND_FROM, default=False,
+    on_charts=False, backends=_FORWARD_SECOND_BACKENDS))
 
 CONSTRAINED_PARTIALS = _listed(Output(
     "constrained_dynamics_partials", "dKKT", "[[dr/dq, dr/dqd], [da/dq, da/dqd]] (nv + m, 2 nv) "

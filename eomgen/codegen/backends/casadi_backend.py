@@ -18,8 +18,8 @@ from pathlib import Path
 from sympy.printing.pycode import PythonCodePrinter
 
 from ...outputs import exported, function_names
-from ...outputs.catalogue import (FORWARD, FORWARD_DERIVATIVES, INVERSE, INVERSE_DERIVATIVES,
-                                  MASS)
+from ...outputs.catalogue import (FORWARD, FORWARD_DERIVATIVES, FORWARD_SECOND, INVERSE,
+                                  INVERSE_DERIVATIVES, MASS)
 from ...common.compiler import c_compiler, shared_library
 from ...common.output import GeneratedFile
 from ..job import Job
@@ -71,14 +71,24 @@ JACOBIAN_SOURCES: dict[str, tuple[str, ...]] = {
 }
 
 
-def jacobians(job: Job) -> list[tuple[str, tuple[str, ...]]]:
-    """The (function, sources) of :data:`JACOBIAN_SOURCES` a job's CasADi module builds: the
-    function and all its sources exported, and no quaternion joint (whose derivatives are
-    along the tangent, nv columns, not the NQ entries of q)."""
+#: The functions whose Jacobian's Jacobian (second order: IPOPT's exact Hessian through
+#: ``casadi.Opti``) is eomgen's too: {function: the function giving the tensor of its second
+#: derivatives over its vector inputs stacked, (n, (sum of their sizes)^2)}.
+SECOND_SOURCES: dict[str, str] = {FORWARD.function: FORWARD_SECOND.function}
+
+
+def jacobians(job: Job) -> list[tuple[str, tuple[str, ...], str | None]]:
+    """The (function, sources, second) of :data:`JACOBIAN_SOURCES` a job's CasADi module
+    builds: the function and all its sources exported, and no quaternion joint (whose
+    derivatives are along the tangent, nv columns, not the NQ entries of q); ``second``, the
+    function of :data:`SECOND_SOURCES` giving its second derivatives where it is exported,
+    else None."""
     if job.model.nq != job.model.dof:
         return []
     functions = exported(job.functions, "casadi")
-    return [(name, sources) for name, sources in JACOBIAN_SOURCES.items()
+    return [(name, sources, SECOND_SOURCES.get(name) if SECOND_SOURCES.get(name) in functions
+             else None)
+            for name, sources in JACOBIAN_SOURCES.items()
             if name in functions and all(s in functions for s in sources)]
 
 
@@ -157,6 +167,8 @@ def emit_c(job: Job, config: CasADiConfig = CasADiConfig()) -> list[GeneratedFil
         generator.add(namespace[name])
         if name in jacobians_of:  # casadi.external(name, library) finds jac_<name>
             generator.add(jacobians_of[name])
+            if "jac_" + name in jacobians_of:  # and, for the exact Hessian, jac_jac_<name>
+                generator.add(jacobians_of["jac_" + name])
     with tempfile.TemporaryDirectory() as tmp:
         generator.generate(tmp + os.sep)
         c_source = Path(tmp, prefix + ".c").read_text()

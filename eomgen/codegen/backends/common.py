@@ -17,6 +17,8 @@ from ...outputs import (CONSTRAINED_DERIVATIVES, CONSTRAINED_FORWARD, CONSTRAINE
                        TASK_SPACE, composition_names, constrained_names, exported,
                        parallel_names, task_space_names)
 from ..functions import FunctionSpec
+from ...outputs.catalogue import (FORWARD_DERIVATIVES, FORWARD_HESSIAN, FORWARD_SECOND,
+                                  SECOND_DERIVATIVES)
 from ...symbolic.printing import renamed
 
 
@@ -263,6 +265,11 @@ def python_module_context(job: Job, printer, template: str, extra_exports=(),
         constrained_derivatives=CONSTRAINED_DERIVATIVES.function in functions,
         cfdd={"name": CONSTRAINED_DERIVATIVES.function, "partials": CONSTRAINED_PARTIALS.function},
         parallel_inverse=PARALLEL_INVERSE.function in functions,
+        # issue 42: the second derivatives of the forward dynamics, composed from those of tau
+        forward_second=FORWARD_SECOND.function in functions,
+        forward_hessian=FORWARD_HESSIAN.function in functions,
+        fs={"second": FORWARD_SECOND.function, "hessian": FORWARD_HESSIAN.function,
+            "derivatives": FORWARD_DERIVATIVES.function, "tensors": SECOND_DERIVATIVES.function},
         pid=parallel_names(),
         **parallel_indices(job.model),
         # the task-space functions (composed from M, J_f, J_f-dot qd and tau) it exports
