@@ -149,7 +149,7 @@ LANES_OPERATIONS = 500
 #: for 0.31; ∂τ, 5,147: 10.5 s for 0.41; ∂q̈, 7,957: 18.8 s for 0.39 (at most 2.4 s per
 #: thousand operations, paid back after 5–17 million states). solo12's C (free flyer), 10,022:
 #: 56 s (5.6 s per thousand) for 0.48 (1.5 against 3.0 µs: 36 million states). Talos's C (free
-#: flyer, 38 DOF), 32,017: about 480 s (15 s per thousand; its one-state version 121 s) for 0.68
+#: flyer, 38 DOF), 32,017: about 500 s (16 s per thousand; its one-state version 121 s) for 0.68
 #: (6.3 against 9.4 µs: 160 million states), nearly all of Talos's build. The bound lies
 #: between the largest kernel measured to pay (the Panda's ∂q̈) and solo12's C. Without its FMA
 #: clone a lanes version compiles hardly faster (solo12's C 54 s, ∂τ 10.6 s), so the bound is
