@@ -235,10 +235,10 @@ def test_a_forked_child_runs_batches_on_threads_too(arm):
 
 
 def test_kernels_above_the_lanes_bound_get_no_lanes_version(monkeypatch):
-    """LANES_MAX_OPERATIONS (the compile-time bound of issue 42) set between the arm's kernel
-    sizes: the emitted source has a lanes version, FMA-cloned, for exactly the kernels at or
-    below it, each kernel's size read from the source's own comment on its one-state
-    version; the others' batches are declared without one (NULL)."""
+    """LANES_MAX_OPERATIONS (the compile-time bound of issues 42 and 43) set between the arm's
+    kernel sizes: the emitted source has a lanes version, FMA-cloned, for exactly the kernels
+    at or below it, each kernel's size read from the source's own comment on its one-state
+    version; the function table names none for the others."""
     import re
 
     from eomgen.codegen.functions import select_functions
