@@ -232,3 +232,40 @@ def test_a_forked_child_runs_batches_on_threads_too(arm):
         got = pool.apply(module.inverse_dynamics, inputs)
     module.set_threads(None)
     assert got.tobytes() == expected.tobytes()
+
+
+def test_kernels_above_the_lanes_bound_get_no_lanes_version(monkeypatch):
+    """LANES_MAX_OPERATIONS (the compile-time bound of issues 42 and 43) set between the arm's
+    kernel sizes: the emitted source has a lanes version, FMA-cloned, for exactly the kernels
+    at or below it, each kernel's size read from the source's own comment on its one-state
+    version; the function table names none for the others."""
+    import re
+
+    from eomgen.codegen.functions import select_functions
+
+    model = eomgen.load(eomgen.example_path("planar_2link"))
+    functions = ("mass_matrix", "inverse_dynamics", "forward_dynamics_aba", "gravity_vector")
+    monkeypatch.setattr(fast_backend, "LANES_OPERATIONS", 0)
+
+    def emitted(bound):
+        monkeypatch.setattr(fast_backend, "LANES_MAX_OPERATIONS", bound)
+        (source,) = [f.content for f in render_files(
+            model, ["fast"], functions=select_functions(functions), build=False)
+            if f.name.endswith(".c")]
+        return source
+
+    def sizes(source):  # kernel name -> operations, from "; N operations." above its _one
+        return {name: int(count) for count, name in re.findall(
+            r"; (\d+) operations\. \*/\n(?:FMA_CLONES )?static void (\w+)_one\(", source)}
+
+    operations = sizes(emitted(float("inf")))
+    assert set(operations) == set(functions)
+    bound = sorted(operations.values())[len(operations) // 2]
+    source = emitted(bound)
+    below = {name for name, count in operations.items() if count <= bound}
+    assert below and below != set(operations)  # the bound cuts the arm's kernels in two
+    for name in functions:
+        lanes = f"FMA_CLONES static void {name}_lanes(" in source
+        assert lanes == (name in below), name
+        assert (f"EOM_LANES_KERNEL({name}_lanes)" in source) == (name in below), name
+    assert set(re.findall(r"static void (\w+)_lanes\(", source)) == below

@@ -137,6 +137,32 @@ FMA_CLONE_OPERATIONS = 4000
 #: transposes, and the lanes version's compile time buys little.
 LANES_OPERATIONS = 500
 
+#: Kernels of more than this many operations get no lanes version: their batches go through the
+#: one-state kernel, state by state (issues 42 and 43). GCC's time on a lanes kernel grows
+#: faster than the kernel (about as its size squared above ten thousand operations), while what
+#: the lanes buy per state stays about half the one-state kernel's time.
+#:
+#: Measured (benchmarks/README.md, "The lanes bound"): GCC's CPU time on each kernel's lanes
+#: version (FMA-cloned, -O2) against what it buys per state in a batch of 1,000 on one thread
+#: (lanes / the one-state kernel looped in C), on a 2-core machine at load 4–7. The Panda's
+#: (fingers locked) τ, 598 operations: 0.8 s for 0.55; M, 613: 0.7 s for 0.55; ABA, 1,747: 1.9 s
+#: for 0.31; ∂τ, 5,147: 10.5 s for 0.41; ∂q̈, 7,957: 18.8 s for 0.39 (at most 2.4 s per
+#: thousand operations, paid back after 5–17 million states). solo12's C (free flyer), 10,022:
+#: 56 s (5.6 s per thousand) for 0.48 (1.5 against 3.0 µs: 36 million states). Talos's C (free
+#: flyer, 38 DOF), 32,017: about 500 s (16 s per thousand; its one-state version 121 s) for 0.68
+#: (6.3 against 9.4 µs: 160 million states), nearly all of Talos's build. The bound lies
+#: between the largest kernel measured to pay (the Panda's ∂q̈) and solo12's C. Without its FMA
+#: clone a lanes version compiles hardly faster (solo12's C 54 s, ∂τ 10.6 s), so the bound is
+#: on the lanes version itself.
+LANES_MAX_OPERATIONS = 9000
+
+
+def has_lanes(spec) -> bool:
+    """Whether ``spec``'s function gets a lanes kernel: between :data:`LANES_OPERATIONS` and
+    :data:`LANES_MAX_OPERATIONS` operations, and its arithmetic one a lanes kernel has
+    (:func:`in_lanes`)."""
+    return LANES_OPERATIONS <= spec.operation_count <= LANES_MAX_OPERATIONS and in_lanes(spec)
+
 
 @dataclass(frozen=True)
 class FastConfig:
@@ -214,7 +240,7 @@ def _render_source(job: Job, config: FastConfig, **extra) -> str:
         doprint = printers.setdefault(layout, printed_once(text))
 
         rows, cols = spec.output.shape
-        lanes = spec.operation_count >= LANES_OPERATIONS and in_lanes(spec)
+        lanes = has_lanes(spec)
         entries = [(r * cols + c, doprint(spec.output[r, c]))
                    for r in range(rows) for c in range(cols) if spec.output[r, c] != 0]
         functions.append(dict(
