@@ -55,10 +55,12 @@ from ..model import RobotModel, joint_actuators
 from .aba import forward_dynamics_program, true_accelerations
 from .builders import builds, provides, sizes
 from .charts import chart_offset
+from .couplings import independent
 from .derivatives import (applied_forward_dynamics, applied_forward_dynamics_jacobians,
-                          symmetric_inverse)
+                          input_jacobians, symmetric_inverse)
 from .passive import passive_forces
 from .program import name_expr
+from .tangent import velocity_transport
 
 
 @sizes("ctrl")
@@ -226,8 +228,31 @@ def _activated(derivation) -> sp.Matrix:
     return sp.Matrix(list(qdd) + activation_rates(derivation))
 
 
+def _activated_jacobians(derivation) -> dict:
+    """``dxd_act``, ``A_act`` and ``B_act``: the Jacobians of ``xd_act`` = (q̈, act_dot) by
+    :func:`~eomgen.symbolic.derivatives.applied_forward_dynamics_jacobians` (q̈, the implicit
+    function theorem) and :func:`~eomgen.symbolic.derivatives.input_jacobians` (act_dot), the
+    forces at the activations ``act`` (one step ahead with ``actearly``, so that ∂q̈/∂ctrl
+    takes α ∂act_dot/∂ctrl), and the state-space pair of x = (q, q̇, act), u = ctrl."""
+    armature = [a.armature for a in joint_actuators(derivation.model)]
+    tau = actuator_forces(derivation, control_forces(derivation, derivation.inputs["act"]))
+    _, _, *dqdd = applied_forward_dynamics_jacobians(
+        derivation, tau + passive_forces(derivation), armature, "xa", ("ctrl", "act"))
+    dq, dqd, dctrl, dact = dqdd
+    rates = activation_rates(derivation)
+    ddq, ddqd, ddctrl, ddact = input_jacobians(derivation, rates, ("ctrl", "act"))
+    n, na = dq.rows, len(rates)
+    jacobian = sp.Matrix.vstack(sp.Matrix.hstack(dq, dqd, dctrl, dact),
+                                sp.Matrix.hstack(ddq, ddqd, ddctrl, ddact))
+    transport = velocity_transport(independent(derivation))
+    A = sp.Matrix.vstack(sp.Matrix.hstack(transport, sp.eye(n), sp.zeros(n, na)),
+                         sp.Matrix.hstack(dq, dqd, dact), sp.Matrix.hstack(ddq, ddqd, ddact))
+    B = sp.Matrix.vstack(sp.zeros(n, dctrl.cols), dctrl, ddctrl)
+    return {"dxd_act": jacobian, "A_act": A, "B_act": B}
+
+
 @builds("tau_act", "qdd_ctrl", "dqdd_dctrl", "dqdd_ctrl_dq", "dqdd_ctrl_dqd", "dqdd_ctrl_dx",
-        "xd_act")
+        "xd_act", "dxd_act", "A_act", "B_act")
 def build_controls(derivation, wanted) -> dict:
     """The builder of ``tau_act``, ``qdd_ctrl``, ``dqdd_dctrl``, ``dqdd_ctrl_dq``,
     ``dqdd_ctrl_dqd`` and ``dqdd_ctrl_dx`` in :mod:`eomgen.outputs` (see the module
@@ -244,10 +269,13 @@ def build_controls(derivation, wanted) -> dict:
                               "(MJCF actuators on joints and fixed tendons, YAML controls:), "
                               "but the model has none (docs/formats.md)")
     out = {}
+    activated = {"xd_act", "dxd_act", "A_act", "B_act"}
     if "xd_act" in wanted:
         out["xd_act"] = _activated(derivation)
-        if not wanted - {"xd_act"}:
-            return out
+    if wanted & (activated - {"xd_act"}):
+        out.update((k, v) for k, v in _activated_jacobians(derivation).items() if k in wanted)
+    if not wanted - activated:
+        return out
     forces = control_forces(derivation)
     tau = out["tau_act"] = actuator_forces(derivation, forces)
     armature = [a.armature for a in joint_actuators(derivation.model)]
