@@ -209,3 +209,32 @@ def test_every_code_backend_gives_the_numpy_derivatives(arm, tmp_path):
             for ours, theirs in zip(results(backend, module, f, *x), reference[f]):
                 assert np.allclose(np.reshape(ours, theirs.shape), theirs, rtol=1e-12,
                                    atol=1e-12), (backend, f)
+
+
+COUPLED = """<mujoco model="coupledact"><option><flag contact="disable"/></option><worldbody>
+<body><joint name="j1" axis="0 0 1" damping="0.2" armature="0.03"/>
+ <geom type="capsule" size=".04" fromto="0 0 0 .4 0 0" mass="1"/>
+ <body pos=".4 0 0"><joint name="j2" axis="0 1 .3" armature="0.02" stiffness="2"/>
+  <geom type="capsule" size=".03" fromto="0 0 0 .3 0 .1" mass=".6"/>
+  <body pos=".3 0 .1"><joint name="j3" axis="1 0 0"/>
+   <geom type="capsule" size=".02" fromto="0 0 0 0 .2 0" mass=".2"/></body></body></body>
+</worldbody><equality><joint joint1="j2" joint2="j1" polycoef="0.1 -0.5 0 0 0"/></equality>
+<actuator><general joint="j2" dyntype="filter" dynprm="0.2" gainprm="3" biastype="affine"
+  biasprm="0 -1 -0.1" actearly="true"/><intvelocity joint="j3" kp="4" actrange="-1 1"/>
+ <motor joint="j1" gear="2"/></actuator></mujoco>"""
+
+
+def test_a_coupled_model_is_differentiated_in_its_independent_coordinates():
+    m, model, module = compiled(COUPLED, "coupledact")
+    assert model.joint_names == ("j1", "j3")
+    rng, worst = np.random.default_rng(6), 0.0
+    for _ in range(3):
+        x = (rng.uniform(-1, 1, 2), rng.uniform(-2, 2, 2), rng.uniform(-2, 2, 3),
+             rng.uniform(-1.5, 1.5, 2))
+        J = module.forward_dynamics_act_derivatives(*x)
+        assert J.shape == (2 + 2, 2 + 2 + 3 + 2)
+        numeric = differences(
+            lambda y: module.forward_dynamics_act(*split(y, (2, 2, 3, 2))).ravel(),
+            np.concatenate(x))
+        worst = max(worst, relative(J, numeric))
+    assert worst <= 1e-6, worst
