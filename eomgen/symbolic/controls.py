@@ -29,6 +29,17 @@ as generated functions of ``(q, q̇, ctrl)`` (:class:`~eomgen.model.Control`, do
   those controls follow their activations ``act`` (MuJoCo's ``act``, ``ACTIVATION_NAMES``
   order), ``q̈`` is ``qdd_ctrl``'s at those forces (MuJoCo's ``qacc_smooth``) and
   ``act_dot`` is MuJoCo's. The outputs above, without ``act``, refuse such a model.
+* ``dxd_act`` (``forward_dynamics_act_derivatives``): its Jacobian, ``(nv + na)`` rows
+  (q̈ then act_dot) and the columns ``∂/∂q`` (along the tangent, nv), ``∂/∂q̇`` (nv),
+  ``∂/∂ctrl`` (nu), ``∂/∂act`` (na) side by side: q̈'s by
+  :func:`~eomgen.symbolic.derivatives.applied_forward_dynamics_jacobians` (the implicit
+  function theorem, ``∂q̈/∂u = M_a⁻¹ Tᵀ ∂f/∂u`` for u = ctrl, act), act_dot's by forward
+  mode. With ``actearly`` the force follows ``clamp(act + α act_dot, actrange)``, so
+  ``∂q̈/∂ctrl`` takes ``α ∂act_dot/∂ctrl`` and ``∂q̈/∂q̇`` a DC motor's back-EMF through it;
+* ``A_act``, ``B_act`` (``state_matrix_act``, ``input_matrix_act``): ẋ = f(x, ctrl) of the
+  state ``x = (q, q̇, act)`` linearized, ``A = [[T, I, 0], [∂q̈/∂q, ∂q̈/∂q̇, ∂q̈/∂act],
+  [∂ȧ/∂q, ∂ȧ/∂q̇, ∂ȧ/∂act]]``, ``B = [[0], [∂q̈/∂ctrl], [∂ȧ/∂ctrl]]``, T the tangent
+  chart's velocity transport of :func:`~eomgen.symbolic.derivatives.linearization`.
 
 A clamp is the piecewise-linear ``clamp(x, lo, hi) = (lo + hi + |x − lo| − |x − hi|) / 2``:
 exact inside the range (up to rounding of order ``ulp(max(|lo|, |hi|))``), ``lo`` below and
@@ -255,8 +266,8 @@ def _activated_jacobians(derivation) -> dict:
         "xd_act", "dxd_act", "A_act", "B_act")
 def build_controls(derivation, wanted) -> dict:
     """The builder of ``tau_act``, ``qdd_ctrl``, ``dqdd_dctrl``, ``dqdd_ctrl_dq``,
-    ``dqdd_ctrl_dqd`` and ``dqdd_ctrl_dx`` in :mod:`eomgen.outputs` (see the module
-    docstring).
+    ``dqdd_ctrl_dqd``, ``dqdd_ctrl_dx``, ``xd_act``, ``dxd_act``, ``A_act`` and ``B_act`` in
+    :mod:`eomgen.outputs` (see the module docstring).
 
     Raises
     ------
