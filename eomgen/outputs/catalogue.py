@@ -500,6 +500,26 @@ FORWARD_ACT = _listed(Output(
     "qacc_smooth, act_dot).",
     ("q", "qd", "ctrl", "act"), True, "rad/s^2 or m/s^2 (qdd), activation units/s (act_dot)",
     ("xd_act",), default=False, constants=("ACTUATOR_NAMES", "ACTIVATION_NAMES")))
+# the derivatives of forward_dynamics_act, for MPC on the state x = (q, qd, act), u = ctrl
+# (eomgen.symbolic.controls; dq along the tangent of a quaternion joint)
+_ACTIVATION_NAMES = ("ACTUATOR_NAMES", "ACTIVATION_NAMES")
+FORWARD_ACT_DERIVATIVES = _listed(Output(
+    "forward_dynamics_act_derivatives", "dxd_act", "d(qdd, act_dot)/d(q, qd, ctrl, act) "
+    "(nv + na, 2 nv + nu + na) of forward_dynamics_act: rows qdd then act_dot, columns "
+    "dq (tangent), dqd, dctrl, dact side by side (zero where a clamp holds).",
+    ("q", "qd", "ctrl", "act"), False, "those of forward_dynamics_act per unit of each column",
+    ("dxd_act",), default=False, constants=_ACTIVATION_NAMES))
+STATE_MATRIX_ACT = _listed(Output(
+    "state_matrix_act", "A_act", "A = df/dx (2 nv + na, 2 nv + na) of xdot = f(x, ctrl), x = "
+    "(q, qd, act): [[T, I, 0], [dqdd/dq, dqdd/dqd, dqdd/dact], [dact_dot/dq, dact_dot/dqd, "
+    "dact_dot/dact]], T as in state_matrix.", ("q", "qd", "ctrl", "act"), False,
+    "1, 1/s, 1/s^2 and those of forward_dynamics_act_derivatives", ("A_act",), default=False,
+    constants=_ACTIVATION_NAMES))
+INPUT_MATRIX_ACT = _listed(Output(
+    "input_matrix_act", "B_act", "B = df/dctrl (2 nv + na, nu) of xdot = f(x, ctrl), x = "
+    "(q, qd, act): [[0], [dqdd/dctrl], [dact_dot/dctrl]].", ("q", "qd", "ctrl", "act"), False,
+    "those of forward_dynamics_act per unit of ctrl", ("B_act",), default=False,
+    constants=_ACTIVATION_NAMES))
 
 #: Every output, in module order (:mod:`eomgen.outputs` indexes them).
 CATALOGUE: tuple[Output, ...] = tuple(_ENTRIES)

@@ -29,6 +29,17 @@ as generated functions of ``(q, q̇, ctrl)`` (:class:`~eomgen.model.Control`, do
   those controls follow their activations ``act`` (MuJoCo's ``act``, ``ACTIVATION_NAMES``
   order), ``q̈`` is ``qdd_ctrl``'s at those forces (MuJoCo's ``qacc_smooth``) and
   ``act_dot`` is MuJoCo's. The outputs above, without ``act``, refuse such a model.
+* ``dxd_act`` (``forward_dynamics_act_derivatives``): its Jacobian, ``(nv + na)`` rows
+  (q̈ then act_dot) and the columns ``∂/∂q`` (along the tangent, nv), ``∂/∂q̇`` (nv),
+  ``∂/∂ctrl`` (nu), ``∂/∂act`` (na) side by side: q̈'s by
+  :func:`~eomgen.symbolic.derivatives.applied_forward_dynamics_jacobians` (the implicit
+  function theorem, ``∂q̈/∂u = M_a⁻¹ Tᵀ ∂f/∂u`` for u = ctrl, act), act_dot's by forward
+  mode. With ``actearly`` the force follows ``clamp(act + α act_dot, actrange)``, so
+  ``∂q̈/∂ctrl`` takes ``α ∂act_dot/∂ctrl`` and ``∂q̈/∂q̇`` a DC motor's back-EMF through it;
+* ``A_act``, ``B_act`` (``state_matrix_act``, ``input_matrix_act``): ẋ = f(x, ctrl) of the
+  state ``x = (q, q̇, act)`` linearized, ``A = [[T, I, 0], [∂q̈/∂q, ∂q̈/∂q̇, ∂q̈/∂act],
+  [∂ȧ/∂q, ∂ȧ/∂q̇, ∂ȧ/∂act]]``, ``B = [[0], [∂q̈/∂ctrl], [∂ȧ/∂ctrl]]``, T the tangent
+  chart's velocity transport of :func:`~eomgen.symbolic.derivatives.linearization`.
 
 A clamp is the piecewise-linear ``clamp(x, lo, hi) = (lo + hi + |x − lo| − |x − hi|) / 2``:
 exact inside the range (up to rounding of order ``ulp(max(|lo|, |hi|))``), ``lo`` below and
@@ -55,10 +66,12 @@ from ..model import RobotModel, joint_actuators
 from .aba import forward_dynamics_program, true_accelerations
 from .builders import builds, provides, sizes
 from .charts import chart_offset
+from .couplings import independent
 from .derivatives import (applied_forward_dynamics, applied_forward_dynamics_jacobians,
-                          symmetric_inverse)
+                          input_jacobians, symmetric_inverse)
 from .passive import passive_forces
 from .program import name_expr
+from .tangent import velocity_transport
 
 
 @sizes("ctrl")
@@ -226,12 +239,35 @@ def _activated(derivation) -> sp.Matrix:
     return sp.Matrix(list(qdd) + activation_rates(derivation))
 
 
+def _activated_jacobians(derivation) -> dict:
+    """``dxd_act``, ``A_act`` and ``B_act``: the Jacobians of ``xd_act`` = (q̈, act_dot) by
+    :func:`~eomgen.symbolic.derivatives.applied_forward_dynamics_jacobians` (q̈, the implicit
+    function theorem) and :func:`~eomgen.symbolic.derivatives.input_jacobians` (act_dot), the
+    forces at the activations ``act`` (one step ahead with ``actearly``, so that ∂q̈/∂ctrl
+    takes α ∂act_dot/∂ctrl), and the state-space pair of x = (q, q̇, act), u = ctrl."""
+    armature = [a.armature for a in joint_actuators(derivation.model)]
+    tau = actuator_forces(derivation, control_forces(derivation, derivation.inputs["act"]))
+    _, _, *dqdd = applied_forward_dynamics_jacobians(
+        derivation, tau + passive_forces(derivation), armature, "xa", ("ctrl", "act"))
+    dq, dqd, dctrl, dact = dqdd
+    rates = activation_rates(derivation)
+    ddq, ddqd, ddctrl, ddact = input_jacobians(derivation, rates, ("ctrl", "act"))
+    n, na = dq.rows, len(rates)
+    jacobian = sp.Matrix.vstack(sp.Matrix.hstack(dq, dqd, dctrl, dact),
+                                sp.Matrix.hstack(ddq, ddqd, ddctrl, ddact))
+    transport = velocity_transport(independent(derivation))
+    A = sp.Matrix.vstack(sp.Matrix.hstack(transport, sp.eye(n), sp.zeros(n, na)),
+                         sp.Matrix.hstack(dq, dqd, dact), sp.Matrix.hstack(ddq, ddqd, ddact))
+    B = sp.Matrix.vstack(sp.zeros(n, dctrl.cols), dctrl, ddctrl)
+    return {"dxd_act": jacobian, "A_act": A, "B_act": B}
+
+
 @builds("tau_act", "qdd_ctrl", "dqdd_dctrl", "dqdd_ctrl_dq", "dqdd_ctrl_dqd", "dqdd_ctrl_dx",
-        "xd_act")
+        "xd_act", "dxd_act", "A_act", "B_act")
 def build_controls(derivation, wanted) -> dict:
     """The builder of ``tau_act``, ``qdd_ctrl``, ``dqdd_dctrl``, ``dqdd_ctrl_dq``,
-    ``dqdd_ctrl_dqd`` and ``dqdd_ctrl_dx`` in :mod:`eomgen.outputs` (see the module
-    docstring).
+    ``dqdd_ctrl_dqd``, ``dqdd_ctrl_dx``, ``xd_act``, ``dxd_act``, ``A_act`` and ``B_act`` in
+    :mod:`eomgen.outputs` (see the module docstring).
 
     Raises
     ------
@@ -244,10 +280,13 @@ def build_controls(derivation, wanted) -> dict:
                               "(MJCF actuators on joints and fixed tendons, YAML controls:), "
                               "but the model has none (docs/formats.md)")
     out = {}
+    activated = {"xd_act", "dxd_act", "A_act", "B_act"}
     if "xd_act" in wanted:
         out["xd_act"] = _activated(derivation)
-        if not wanted - {"xd_act"}:
-            return out
+    if wanted & (activated - {"xd_act"}):
+        out.update((k, v) for k, v in _activated_jacobians(derivation).items() if k in wanted)
+    if not wanted - activated:
+        return out
     forces = control_forces(derivation)
     tau = out["tau_act"] = actuator_forces(derivation, forces)
     armature = [a.armature for a in joint_actuators(derivation.model)]

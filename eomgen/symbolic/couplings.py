@@ -58,7 +58,8 @@ PROJECTIONS: dict[str, tuple[bool, bool]] = {
     # the controls' forward dynamics, built in the independent coordinates too
     # (eomgen.symbolic.controls: M_a⁻¹ Tᵀ (τ_act + τ_p − h) from the LDLᵀ factors)
     "qdd_ctrl": (False, False), "dqdd_dctrl": (False, False), "dqdd_ctrl_dq": (False, False),
-    "dqdd_ctrl_dqd": (False, False), "xd_act": (False, False),
+    "dqdd_ctrl_dqd": (False, False), "xd_act": (False, False), "dxd_act": (False, False),
+    "A_act": (False, False), "B_act": (False, False),
 }
 
 #: Several-result outputs (:attr:`eomgen.outputs.Output.returns`) projected block by block.

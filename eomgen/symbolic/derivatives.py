@@ -406,28 +406,46 @@ def applied_forward_dynamics(derivation, forces, armature, hint: str):
     return work[hint]
 
 
-def applied_forward_dynamics_jacobians(derivation, forces, armature, hint: str):
-    """``(M_a⁻¹, q̈, ∂q̈/∂q, ∂q̈/∂q̇)`` of the forward dynamics under joint forces given as
-    expressions ``forces`` = f(q, q̇) (NV entries in the derivation's joints, e.g. the
-    actuators' and the springs' of :mod:`eomgen.symbolic.controls`) instead of the input τ::
+def input_jacobians(derivation, exprs, inputs=()) -> tuple[sp.Matrix, ...]:
+    """The Jacobians of the expressions ``exprs`` (of the builder's intermediates) by
+    :func:`forward_mode`: ∂/∂q along the tangent (the independent q with couplings), ∂/∂q̇,
+    then ∂/∂ each input named in ``inputs`` (e.g. ``"ctrl"``, ``"act"``), one matrix each
+    (``len(exprs)`` rows)."""
+    seeds = _tangent_seeds(derivation)
+    for name in inputs:
+        seeds.update(_seeds(derivation.inputs[name], name))
+    rows = forward_mode(derivation.builder, exprs, seeds)
+    sizes = [("q", _nv(derivation)), ("qd", _nv(derivation))]
+    sizes += [(name, len(derivation.inputs[name])) for name in inputs]
+    return tuple(_jacobian(rows, prefix, n) for prefix, n in sizes)
 
-        q̈ = M_a⁻¹ Tᵀ (f(q, q̇) − τ(q, q̇, 0)),     M_a = Tᵀ (M + diag(armature)) T
+
+def applied_forward_dynamics_jacobians(derivation, forces, armature, hint: str, inputs=()):
+    """``(M_a⁻¹, q̈, ∂q̈/∂q, ∂q̈/∂q̇, *∂q̈/∂inputs)`` of the forward dynamics under joint forces
+    given as expressions ``forces`` = f(q, q̇, u) (NV entries in the derivation's joints, e.g.
+    the actuators' and the springs' of :mod:`eomgen.symbolic.controls`) instead of the input
+    τ, ``u`` the further inputs named in ``inputs`` (``"ctrl"``, ``"act"``: one more Jacobian
+    each, in that order)::
+
+        q̈ = M_a⁻¹ Tᵀ (f(q, q̇, u) − τ(q, q̇, 0)),     M_a = Tᵀ (M + diag(armature)) T
         ∂q̈/∂x = −M_a⁻¹ Tᵀ (∂τ/∂x − ∂f/∂x)          (x = q along the tangent, or q̇)
+        ∂q̈/∂u = M_a⁻¹ Tᵀ ∂f/∂u
 
     with the Newton–Euler ∂τ taken at that q̈ held fixed (the implicit function theorem on
-    τ(q, q̇, q̈) + a q̈ = f(q, q̇), as :func:`drive_forward_dynamics_jacobians`) and ∂f by
-    :func:`forward_mode` through the builder's intermediates. Each n × n (n = NV, the
-    independent NV with couplings; T the identity without), the intermediates' names
-    starting with ``hint``."""
-    b, n = derivation.builder, _nv(derivation)
+    τ(q, q̇, q̈) + a q̈ = f(q, q̇, u), as :func:`drive_forward_dynamics_jacobians`) and ∂f by
+    :func:`forward_mode` through the builder's intermediates (:func:`input_jacobians`). The
+    state Jacobians n × n (n = NV, the independent NV with couplings; T the identity
+    without), ∂q̈/∂u n × len(u), the intermediates' names starting with ``hint``."""
+    b = derivation.builder
     f = _efforts(derivation, forces)
     Minv, qdd = applied_forward_dynamics(derivation, forces, armature, hint)
     dq, dqd = _efforts_at(derivation, qdd, f"tau_{hint}")
-    rows = forward_mode(b, f, _tangent_seeds(derivation))
-    dq = dq - _jacobian(rows, "q", n)
-    dqd = dqd - _jacobian(rows, "qd", n)
+    df = input_jacobians(derivation, f, inputs)
+    dq, dqd = dq - df[0], dqd - df[1]
     return (Minv, qdd, _product(b, Minv, dq, f"dqdd_{hint}_dq"),
-            _product(b, Minv, dqd, f"dqdd_{hint}_dqd"))
+            _product(b, Minv, dqd, f"dqdd_{hint}_dqd"),
+            *(_product(b, Minv, -du, f"dqdd_{hint}_d{name}")
+              for name, du in zip(inputs, df[2:])))
 
 
 def linearization(derivation) -> tuple[sp.Matrix, sp.Matrix]:
@@ -469,8 +487,8 @@ def build_derivatives(derivation, wanted) -> dict:
     return result
 
 
-__all__ = ["applied_forward_dynamics", "applied_forward_dynamics_jacobians", "build_derivatives", "drive_forward_dynamics_jacobians",
-           "drive_inverse_dynamics_jacobians", "forward_dynamics_jacobians", "forward_mode",
-           "forward_mode_map",
-           "gravity_jacobian", "inverse_dynamics_jacobians", "inverse_mass_matrix",
+__all__ = ["applied_forward_dynamics", "applied_forward_dynamics_jacobians", "build_derivatives",
+           "drive_forward_dynamics_jacobians", "drive_inverse_dynamics_jacobians",
+           "forward_dynamics_jacobians", "forward_mode", "forward_mode_map", "gravity_jacobian",
+           "input_jacobians", "inverse_dynamics_jacobians", "inverse_mass_matrix",
            "linearization", "symmetric_inverse"]
