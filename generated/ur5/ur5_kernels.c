@@ -733,8 +733,9 @@ static EOM_INLINE void eom_sincos_lanes(const eom_lanes *at, eom_lanes *sine, eo
 /* The lanes kernels of a batch (in_lanes): the one-state kernels' arithmetic on vectors of
  * EOM_LANES states, sin and cos by the vector routine above, sqrt lane by lane (a statement
  * expression: no vector crosses a function call); a constant is broadcast to every lane. Every
- * kernel of at least LANES_OPERATIONS operations (eomgen's fast backend) whose arithmetic is
- * +, -, *, / and those functions has one, compiled with and without FMA (FMA_CLONES). */
+ * kernel of LANES_OPERATIONS to LANES_MAX_OPERATIONS operations (eomgen's fast backend) whose
+ * arithmetic is +, -, *, / and those functions has one, compiled with and without FMA
+ * (FMA_CLONES). */
 #define EOM_BROADCAST(value) ((value) - (eom_lanes){0})
 #define EOM_LANES_KERNEL(kernel) kernel
 #define EOM_EACH_LANE(function, value) ({ \
