@@ -1105,7 +1105,6 @@ static void coriolis_matrix_lanes(const eom_lanes *const *x, const eom_lanes *p,
     out[34] = t_C6_5;
     out[35] = t_C6_6;
 }
-
 #undef sin
 #undef cos
 #undef sqrt
