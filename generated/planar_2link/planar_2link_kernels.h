@@ -50,8 +50,8 @@ void planar_2link_inverse_dynamics(const double *q, const double *qd, const doub
 /* Batches of every function above: planar_2link_<function>_batch(n, <inputs>, p, out) computes n
  * states, state k's inputs at q + k * PLANAR_2LINK_NQ and the other vectors at + k * their
  * length, its result at out + k * (rows x cols); with GCC or Clang, four states at a time on SIMD
- * vectors where the function has a lanes version (define PLANAR_2LINK_NO_LANES when
- * compiling the .c to turn them off). Equal to n one-state calls to about 1e-14 (the lanes' sin
+ * vectors where the function has a lanes version (eight when the .c is compiled with
+ * -DEOM_LANES=8, for AVX-512; define PLANAR_2LINK_NO_LANES to turn them off). Equal to n one-state calls to about 1e-14 (the lanes' sin
  * and cos are within 2 ulp of libm's: docs/numerics.md). */
 void planar_2link_mass_matrix_batch(long n, const double *q, const double *p, double *out);
 void planar_2link_coriolis_matrix_batch(long n, const double *q, const double *qd, const double *p, double *out);

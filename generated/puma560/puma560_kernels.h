@@ -50,8 +50,8 @@ void puma560_inverse_dynamics(const double *q, const double *qd, const double *q
 /* Batches of every function above: puma560_<function>_batch(n, <inputs>, p, out) computes n
  * states, state k's inputs at q + k * PUMA560_NQ and the other vectors at + k * their
  * length, its result at out + k * (rows x cols); with GCC or Clang, four states at a time on SIMD
- * vectors where the function has a lanes version (define PUMA560_NO_LANES when
- * compiling the .c to turn them off). Equal to n one-state calls to about 1e-14 (the lanes' sin
+ * vectors where the function has a lanes version (eight when the .c is compiled with
+ * -DEOM_LANES=8, for AVX-512; define PUMA560_NO_LANES to turn them off). Equal to n one-state calls to about 1e-14 (the lanes' sin
  * and cos are within 2 ulp of libm's: docs/numerics.md). */
 void puma560_mass_matrix_batch(long n, const double *q, const double *p, double *out);
 void puma560_coriolis_matrix_batch(long n, const double *q, const double *qd, const double *p, double *out);

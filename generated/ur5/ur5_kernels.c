@@ -651,12 +651,16 @@ void ur5_inverse_dynamics(const double *q, const double *qd, const double *qdd, 
 /* ---------------------------------------------------------------------------------------- */
 /* Batches: n states, state k's vectors at q + k * NQ, qd + k * NV, ... and its result at
  * out + k * (the one-state size). With GCC or Clang, a function with a lanes kernel takes the
- * states EOM_LANES at a time (one per lane of a SIMD vector, the inputs transposed once per
- * block), the rest one by one; elsewhere every state goes through the one-state function. */
+ * states EOM_LANES at a time (one per lane of a SIMD vector: 4 unless compiled with
+ * -DEOM_LANES=8, for AVX-512; the inputs transposed once per block), the rest one by one;
+ * elsewhere every state goes through the one-state function. */
 #if defined(__GNUC__) && !defined(UR5_NO_LANES)
-#define EOM_LANES 4
+#ifndef EOM_LANES
+#define EOM_LANES 4  /* states per vector: 4 doubles for AVX2; -DEOM_LANES=8 for AVX-512 */
+#endif
 typedef double eom_lanes __attribute__((vector_size(8 * EOM_LANES)));
 #else
+#undef EOM_LANES
 #define EOM_LANES 1
 #endif
 #if EOM_LANES > 1
