@@ -119,6 +119,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--states", type=int, default=10_000)
     parser.add_argument("--repeats", type=int, default=15)
+    parser.add_argument("--target", default="-march=native",
+                        help="the C program's target flag (default -march=native; e.g. -mfma "
+                        "or -mavx2 -mfma to compare with the fast module's FMA clones)")
     parser.add_argument("--markdown", type=Path, help="also write the table to this file")
     args = parser.parse_args()
     compiler = c_compiler()
@@ -148,7 +151,7 @@ def main() -> None:
         (folder / "driver.c").write_text(DRIVER % dict(largest=max(sizes.values()),
                                                        calls=calls), encoding="utf-8")
         flags = [f for f in FastConfig().flags if f not in ("-shared", "-fPIC")]
-        command = [compiler, *flags, "-march=native", "-I", str(folder),
+        command = [compiler, *flags, *args.target.split(), "-I", str(folder),
                    str(folder / "driver.c"), str(folder / "panda_kernels.c"),
                    "-o", str(folder / "driver"), "-lm"]
         subprocess.run(command, check=True)
@@ -176,7 +179,7 @@ def main() -> None:
                 sys.exit(f"batch_c_level: {name}: C and Python batches differ by {error:.1e}")
         uptime = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
         say(f"Panda, 7 joints (fingers locked); batch of {n:,} states, 1 thread; C: "
-            f"{' '.join(command[:1 + len(flags) + 1])} (the kernels backend); median of "
+            f"{' '.join(command[:1 + len(flags) + len(args.target.split())])} (the kernels backend); median of "
             f"{args.repeats} rounds.")
         say(f"uptime before: {uptime}")
         say()

@@ -844,9 +844,11 @@ typedef void (*kernel_t)(const double *const *, const double *, double *);
 #if defined(__GNUC__)
 #define EOM_LANES 4
 typedef double eom_lanes __attribute__((vector_size(8 * EOM_LANES)));
+#define EOM_LANE(vector, lane) ((vector)[lane])
 #else
 #define EOM_LANES 1
 typedef double eom_lanes;
+#define EOM_LANE(vector, lane) (vector)
 #endif
 typedef void (*lanes_kernel_t)(const eom_lanes *const *, const eom_lanes *, eom_lanes *);
 
@@ -878,7 +880,10 @@ typedef struct {
 /* The first states of a batch, EOM_LANES at a time, through f's lanes kernel: each input entry
  * gathered across the states into a vector, the parameters broadcast, the results scattered
  * back. Returns the number of states done (a multiple of EOM_LANES; 0 when the work arrays
- * cannot be allocated: the caller then does every state). */
+ * cannot be allocated: the caller then does every state). The lanes are written and read one
+ * double at a time in place (not through a small array copied whole: a vector load from
+ * scalar stores just made stalls the CPU's store forwarding, which cost as much as the τ
+ * kernel itself). */
 static npy_intp in_lanes(const function_t *f, const double *const *in, const double *p,
                          double *out, npy_intp states)
 {
@@ -887,7 +892,6 @@ static npy_intp in_lanes(const function_t *f, const double *const *in, const dou
     eom_lanes *work = aligned_alloc(sizeof(eom_lanes), slots * sizeof(eom_lanes));
     eom_lanes *x, *lanes_p, *result;
     const eom_lanes *at[MAX_IN] = {NULL};
-    double value[EOM_LANES];
     npy_intp k = 0, i;
     int j, l;
     if (work == NULL)
@@ -895,28 +899,24 @@ static npy_intp in_lanes(const function_t *f, const double *const *in, const dou
     x = work;
     lanes_p = work + MAX_IN * MAX_LEN;
     result = lanes_p + NP + 1;
-    for (i = 0; i < NP + 1; ++i) {
+    for (i = 0; i < NP + 1; ++i)
         for (l = 0; l < EOM_LANES; ++l)
-            value[l] = p[i];
-        memcpy(&lanes_p[i], value, sizeof(eom_lanes));
-    }
+            EOM_LANE(lanes_p[i], l) = p[i];
     for (j = 0; j < f->n_in; ++j)
         at[j] = x + j * MAX_LEN;
     for (; k + EOM_LANES <= states; k += EOM_LANES) {
         for (j = 0; j < f->n_in; ++j) {
             const npy_intp length = f->sizes[j] ? f->sizes[j] : NV;
-            for (i = 0; i < length; ++i) {
-                for (l = 0; l < EOM_LANES; ++l)
-                    value[l] = in[j][(k + l) * length + i];
-                memcpy(&x[j * MAX_LEN + i], value, sizeof(eom_lanes));
-            }
+            const double *from = in[j] + k * length;
+            eom_lanes *to = x + j * MAX_LEN;
+            for (l = 0; l < EOM_LANES; ++l)
+                for (i = 0; i < length; ++i)
+                    EOM_LANE(to[i], l) = from[l * length + i];
         }
         f->lanes(at, lanes_p, result);
-        for (i = 0; i < size; ++i) {
-            memcpy(value, &result[i], sizeof(eom_lanes));
-            for (l = 0; l < EOM_LANES; ++l)
-                out[(k + l) * size + i] = value[l];
-        }
+        for (l = 0; l < EOM_LANES; ++l)
+            for (i = 0; i < size; ++i)
+                out[(k + l) * size + i] = EOM_LANE(result[i], l);
     }
     free(work);
     return k;
@@ -1249,16 +1249,19 @@ static const char *not_finite(double value)
 }
 
 /* 0 when the `count` values (`size` a state) are finite, else -1 with a FloatingPointError
- * naming the input, its first bad entry and (batch) its state. One pass without a branch or a
- * chain of dependent additions: x - x is 0 for every finite x and nan for nan and +-inf. */
+ * naming the input, its first bad entry and (batch) its state. One pass of integer arithmetic
+ * the compiler makes SIMD, without a branch: a double is nan or +-inf when its exponent bits
+ * are all ones, and only then does adding one to the exponent field carry into bit 63. */
 static int check_finite(const function_t *f, const double *x, npy_intp count, int size,
                         int batch, const char *name)
 {
-    int finite = 1;
+    unsigned long long carried = 0, bits;
     npy_intp i;
-    for (i = 0; i < count; ++i)
-        finite &= (x[i] - x[i] == 0.0);
-    if (finite)
+    for (i = 0; i < count; ++i) {
+        memcpy(&bits, &x[i], sizeof bits);
+        carried |= (bits & 0x7ff0000000000000ULL) + 0x0010000000000000ULL;
+    }
+    if (!(carried >> 63))
         return 0;
     for (i = 0; isfinite(x[i]); ++i)
         ;
