@@ -155,10 +155,8 @@ class NumericModel:
     joint_places : tuple of QuaternionJoint
         Every joint of the tree in velocity order, with its kind and its first index in ``v``
         and in ``q`` (:attr:`eomgen.model.RobotModel.joint_places` of the uncoupled tree);
-        the algorithms ask a place's kind (``nq != nv``: a joint with a chart), never its name.
-    chart_places : tuple of QuaternionJoint
-        The places whose configuration is not their coordinates (``nq != nv``: a free flyer, a
-        ball joint, a planar joint), in velocity order; empty without them.
+        the algorithms ask a place's kind (``nq != nv``: a joint with a chart,
+        :attr:`chart_places`), never its name.
     quaternion_bodies : tuple of int
         For each of ``chart_places``, the body whose joint starts its chain (where its pose
         from ``q`` is placed).
