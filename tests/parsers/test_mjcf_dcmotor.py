@@ -22,23 +22,15 @@ import pytest
 import eomgen
 from eomgen.errors import UnsupportedFeatureWarning
 from support import relative
+from support.robots import MJCF_ARM_WITH_TENDON
 from support.extras import need
 
 mujoco = need("mujoco", reason="MJCF is read by MuJoCo's compiler")
 
 from eomgen.parsers.mjcf import model_from_mujoco  # noqa: E402
 
-BODIES = """<option timestep="0.004"><flag contact="disable"/></option><worldbody>
-<body><joint name="j1" axis="0 1 0" damping="0.01"/>
- <geom type="capsule" size=".05" fromto="0 0 0 .3 0 0"/>
- <body pos=".3 0 0"><joint name="j2" axis="0 1 0"/><geom type="capsule" size=".05"
-   fromto="0 0 0 .3 0 0"/>
-  <body pos=".3 0 0"><joint name="j3" type="slide" axis="1 0 0"/><geom size=".05"/></body>
- </body></body></worldbody>
-<tendon><fixed name="t"><joint joint="j2" coef="0.5"/><joint joint="j3" coef="-1"/></fixed>
-</tendon>"""
 
-STATELESS = f"""<mujoco model="stateless">{BODIES}<actuator>
+STATELESS = f"""<mujoco model="stateless">{MJCF_ARM_WITH_TENDON}<actuator>
  <dcmotor name="a" joint="j1" resistance="2" motorconst="0.05" gear="3" armature="0.003"
    damping="0.001"/>
  <dcmotor name="b" joint="j2" nominal="12 0.8 300" cogging="0.02 4 0.3" ctrlrange="-12 12"
@@ -46,7 +38,7 @@ STATELESS = f"""<mujoco model="stateless">{BODIES}<actuator>
  <dcmotor name="c" tendon="t" resistance="1.2" motorconst="0.04 0.06" gear="2" damping="0.02"/>
 </actuator></mujoco>"""
 
-CURRENT = f"""<mujoco model="current">{BODIES}<actuator>
+CURRENT = f"""<mujoco model="current">{MJCF_ARM_WITH_TENDON}<actuator>
  <dcmotor name="a" joint="j1" resistance="2" motorconst="0.05" gear="3" inductance="0 0.01"/>
  <dcmotor name="b" joint="j2" resistance="1.5" motorconst="0.04 0.06" inductance="0.003 0"
    saturation="0.5 0 30" cogging="0.02 4 0.3" ctrlrange="-12 12" ctrllimited="true"/>
@@ -57,7 +49,7 @@ CURRENT = f"""<mujoco model="current">{BODIES}<actuator>
  <general name="i" joint="j1" dyntype="integrator" gainprm="1" actearly="true"/>
 </actuator></mujoco>"""
 
-LEFT_OUT = f"""<mujoco model="left_out">{BODIES}<actuator>
+LEFT_OUT = f"""<mujoco model="left_out">{MJCF_ARM_WITH_TENDON}<actuator>
  <dcmotor name="hot" joint="j1" resistance="2" motorconst="0.05" thermal="1 2 0 0 0 0"/>
  <dcmotor name="sticky" joint="j2" resistance="2" motorconst="0.05" lugre="1 0 0.1 0.2 0.1"/>
  <dcmotor name="servo" joint="j3" resistance="2" motorconst="0.05" input="pos"

@@ -17,23 +17,15 @@ import pytest
 import eomgen
 from eomgen.errors import UnsupportedFeatureWarning
 from support import relative
+from support.robots import MJCF_ARM_WITH_TENDON
 from support.extras import need
 
 mujoco = need("mujoco", reason="MJCF is read by MuJoCo's compiler")
 
 from eomgen.parsers.mjcf import model_from_mujoco  # noqa: E402
 
-BODIES = """<option timestep="0.004"><flag contact="disable"/></option><worldbody>
-<body><joint name="j1" axis="0 1 0" damping="0.01"/>
- <geom type="capsule" size=".05" fromto="0 0 0 .3 0 0"/>
- <body pos=".3 0 0"><joint name="j2" axis="0 1 0"/><geom type="capsule" size=".05"
-   fromto="0 0 0 .3 0 0"/>
-  <body pos=".3 0 0"><joint name="j3" type="slide" axis="1 0 0"/><geom size=".05"/></body>
- </body></body></worldbody>
-<tendon><fixed name="t"><joint joint="j2" coef="0.5"/><joint joint="j3" coef="-1"/></fixed>
-</tendon>"""
 
-PIDS = f"""<mujoco model="pids">{BODIES}<actuator>
+PIDS = f"""<mujoco model="pids">{MJCF_ARM_WITH_TENDON}<actuator>
  <pid name="p1" joint="j1" kp="5" kv="0.5" input="pos" gear="2"/>
  <pid name="p2" joint="j2" kp="8" kv="0.3" ki="2" input="pos" ctrlrange="-1 1"
    ctrllimited="true" forcerange="-3 3" forcelimited="true"/>
@@ -43,7 +35,7 @@ PIDS = f"""<mujoco model="pids">{BODIES}<actuator>
  <motor name="m" joint="j3" gear="2"/>
 </actuator></mujoco>"""
 
-LEFT_OUT = f"""<mujoco model="pid_left_out">{BODIES}<actuator>
+LEFT_OUT = f"""<mujoco model="pid_left_out">{MJCF_ARM_WITH_TENDON}<actuator>
  <pid name="both" joint="j1" kp="5"/>
  <pid name="slewed" joint="j2" kp="5" input="pos" slewmax="2"/>
  <pid name="capped" joint="j3" kp="5" ki="1" imax="0.3" input="pos"/>

@@ -8,7 +8,10 @@
   literals, docstrings and comments they end up in;
 * the flexible 2-link arm with drives (:func:`drive_arm`);
 * the planar two-link arm whose second joint is turned about z (:func:`turned_arm_yaml`,
-  :func:`turned_arm_urdf`): exact and float rotation angles.
+  :func:`turned_arm_urdf`): exact and float rotation angles;
+* the MJCF bodies of the actuator tests (:data:`MJCF_ARM_WITH_TENDON`): two hinges and a
+  slide joint with a fixed tendon across the last two, contacts off, an ``<actuator>`` to
+  follow.
 
 Each function builds a fresh model (models are frozen data, but tests that cache a derivation
 do so in their own module).
@@ -31,6 +34,19 @@ from . import ROOT, erd_robots_or_skip, load_quietly
 # ----------------------------------------------------------------------------------------------
 # Hand-written URDFs
 # ----------------------------------------------------------------------------------------------
+
+
+#: Two hinges and a slide joint in a chain with a fixed tendon ``t`` across j2 and j3, contacts
+#: off: the MJCF body of the DC motor and PID tests, which append their ``<actuator>``.
+MJCF_ARM_WITH_TENDON = """<option timestep="0.004"><flag contact="disable"/></option><worldbody>
+<body><joint name="j1" axis="0 1 0" damping="0.01"/>
+ <geom type="capsule" size=".05" fromto="0 0 0 .3 0 0"/>
+ <body pos=".3 0 0"><joint name="j2" axis="0 1 0"/><geom type="capsule" size=".05"
+   fromto="0 0 0 .3 0 0"/>
+  <body pos=".3 0 0"><joint name="j3" type="slide" axis="1 0 0"/><geom size=".05"/></body>
+ </body></body></worldbody>
+<tendon><fixed name="t"><joint joint="j2" coef="0.5"/><joint joint="j3" coef="-1"/></fixed>
+</tendon>"""
 
 
 def robot(*parts: str, name: str = "r") -> str:
