@@ -30,7 +30,8 @@
           friction: 0.5            # Coulomb [N m], smoothed over friction_width [rad/s]
           stiffness: K1            # [N m/rad]: a flexible joint (Spong's model)
         spring: {stiffness: 2.0, reference: 0.1}   # optional: -k (q - q_ref) on the joint
-                                                   # (passive_forces; one-axis joints only)
+                                                   # (passive_forces; one-axis joints, and
+                                                   # spherical ones: reference [x, y, z, w])
     controls:                      # optional: MuJoCo's actuators, entries of ctrl
       - name: shoulder_servo
         joint: joint1              # a revolute, prismatic or helical joint, or instead
@@ -67,8 +68,8 @@ from pathlib import Path
 
 from ..errors import UnsupportedError
 from ..model import (
-    Control, Inertial, Joint, JointType, Link, RobotModel, Spring, Transform, build_model,
-    check_size, scalar, vec3,
+    BallSpring, Control, Inertial, Joint, JointType, Link, RobotModel, Spring, Transform,
+    build_model, check_size, scalar, vec3,
 )
 from .registry import register
 from ._yaml import Reader, read_document, top_level_key
@@ -297,17 +298,41 @@ def _inertial(r: Reader, entry: dict, where: str) -> Inertial | None:
     return Inertial(mass, com)
 
 
-def _spring(r: Reader, value, where: str, kind: JointType, source: str) -> Spring:
-    """A joint's ``spring: {stiffness, reference}`` (:class:`~eomgen.model.Spring`):
-    ``stiffness`` ``k ≥ 0`` [N m/rad or N/m], ``reference`` [rad or m] (default 0), on a
-    joint of one coordinate."""
+def _spring(r: Reader, value, where: str, kind: JointType, source: str) -> Spring | BallSpring:
+    """A joint's ``spring: {stiffness, reference}``: ``stiffness`` ``k ≥ 0``, and on a joint
+    of one coordinate (:class:`~eomgen.model.Spring`, ``−k (q − q_ref)``) ``reference`` [rad or
+    m] (default 0) with ``k`` in [N m/rad or N/m]; on a spherical joint
+    (:class:`~eomgen.model.BallSpring`, MuJoCo's ``−k · subQuat(q, q_ref)``) ``reference`` the
+    quaternion ``[x, y, z, w]`` where it rests (default the identity; normalised) with ``k`` in
+    [N m/rad]."""
     r.mapping(value, where, required=("stiffness",), optional=SPRING_KEYS)
-    if kind.kind.nv != 1 or not kind.is_movable:
+    ball = kind is JointType.SPHERICAL
+    if not ball and (kind.kind.nv != 1 or not kind.is_movable):
         raise UnsupportedError(source, where, f"a {kind.value} joint has no spring: only "
-                               "joints of one coordinate (revolute, prismatic, ...) have one")
+                               "joints of one coordinate (revolute, prismatic, ...) and "
+                               "spherical joints have one")
     stiffness = r.scalar(value["stiffness"], f"{where} stiffness")
     if stiffness.is_number and stiffness < 0:
         raise UnsupportedError(source, f"{where} stiffness", f"a negative stiffness "
                                f"({stiffness}): a spring pulls back, k >= 0")
+    if ball:
+        return BallSpring(stiffness, _rest_quaternion(r, value.get("reference"),
+                                                      f"{where} reference", source))
     return Spring(stiffness, r.scalar(value["reference"], f"{where} reference")
                   if "reference" in value else 0)
+
+
+def _rest_quaternion(r: Reader, value, where: str, source: str) -> tuple[float, ...]:
+    """A ball spring's ``reference``: four numbers ``[x, y, z, w]``, not all zero, normalised
+    (the identity when absent)."""
+    if value is None:
+        return (0.0, 0.0, 0.0, 1.0)
+    if not isinstance(value, list) or len(value) != 4:
+        shown = f"{len(value)} entries" if isinstance(value, list) else repr(value)
+        raise UnsupportedError(source, where, "a spherical joint's spring reference is a "
+                               f"quaternion [x, y, z, w], got {shown}")
+    numbers = [r.number(v, f"{where}[{i}]") for i, v in enumerate(value)]
+    norm = sum(v * v for v in numbers) ** 0.5
+    if norm == 0.0:
+        raise UnsupportedError(source, where, "a quaternion of norm 0 is no rotation")
+    return tuple(v / norm for v in numbers)
