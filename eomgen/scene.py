@@ -54,6 +54,11 @@ Version 1 of the format (every key but ``version`` is optional)::
                                   #   2 in-plane translations (+ the rotation of a weld)
     actuated: [crank_joint]       # the driven joints of a parallel robot (the others are
                                   #   passive), for the parallel inverse dynamics
+    springs:                      # joint: its spring, as in eomgen's YAML (docs/formats.md):
+      knee: {stiffness: 2.0, reference: 0.1}   # -k (q - q_ref); a spherical joint's
+      hip: {stiffness: 1.5, reference: [0, 0, 0, 1]}   # reference is a quaternion x, y, z, w
+    controls:                     # MuJoCo-style actuators, entries of ctrl, as YAML's
+      - {name: knee_servo, joint: knee, gain: [10, 0, 0], bias: [0, -10, -1]}
 
 The file is read like eomgen's robot YAML (:mod:`eomgen.parsers._yaml`): safe loading, no
 aliases, size and depth limits, and an unknown key is an error that lists the known ones. Keys
@@ -71,15 +76,16 @@ from __future__ import annotations
 
 import functools
 import warnings
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 from .model import HINGE, LOOP_KINDS, POINT, SURFACE, Contact, Loop, LoopFrame, Transform
 from .errors import DescriptionError, SceneError, did_you_mean  # noqa: F401  (re-export)
 from .model import Coupling, Inertial, Parameter, Vec3, check_inertial, make_coupling, mat3, vec3
-from .model import Link, check_model_numbers
+from .model import BallSpring, Control, Link, Spring, check_model_numbers
 from .outputs import select
 from .parsers._yaml import Reader, read_document
+from .parsers.yaml_format import read_controls, read_spring
 
 #: The scene format version this eomgen reads.
 SCENE_VERSION = 1
@@ -87,7 +93,7 @@ SCENE_VERSION = 1
 #: Top-level keys of a version-1 scene, in documentation order.
 SCENE_KEYS = ("version", "robot", "description", "fixed_base", "floating_base", "base", "tips",
               "locked", "payloads", "actuators", "gravity", "parameters", "symbolic", "outputs",
-              "contacts", "frames", "couplings", "loops", "actuated")
+              "contacts", "frames", "couplings", "loops", "actuated", "springs", "controls")
 
 #: Keys reserved for later versions of the format; refused with a message saying so (those of
 #: :data:`ACTUATOR_ALIASES` with a pointer to ``actuators``, which holds them per joint now).
@@ -173,6 +179,13 @@ class Scene:
         Loop closures (:class:`eomgen.model.Loop`), in file order.
     actuated:
         The driven joints (``actuated:``), in file order; empty: every joint.
+    springs:
+        ``(joint, spring)`` pairs, in file order: a :class:`~eomgen.model.Spring`, or a
+        :class:`~eomgen.model.BallSpring` when the reference is a quaternion; set over the
+        description's when the scene is applied (numbers only, no parameters).
+    controls:
+        Controls (:class:`~eomgen.model.Control`) added to the description's, in file order
+        (numbers only, no parameters); their joints are checked when the scene is applied.
     """
 
     source: str = "<scene>"
@@ -195,6 +208,8 @@ class Scene:
     couplings: tuple[Coupling, ...] = ()
     loops: tuple[Loop, ...] = ()
     actuated: tuple[str, ...] = ()
+    springs: tuple[tuple[str, Spring | BallSpring], ...] = ()
+    controls: tuple[Control, ...] = ()
 
     @property
     def locked_positions(self) -> dict[str, float]:
@@ -352,13 +367,56 @@ def _read(data: dict, source: str, strict: bool) -> Scene:
     loops = _loops(r, data["loops"]) if data.get("loops") is not None else ()
     actuated = (_names(r, data["actuated"], "actuated", "a joint name")
                 if data.get("actuated") is not None else ())
+    springs, controls = _springs_and_controls(r, data, source)
     declared = tuple(r.declared.values())
-    return Scene(frames=frames, loops=loops, actuated=actuated, source=source, version=version, robot=robot, description=description,
+    return Scene(springs=springs, controls=controls,
+                 frames=frames, loops=loops, actuated=actuated, source=source, version=version, robot=robot, description=description,
                  floating_base=floating_base, contacts=tuple(contacts),
                  fixed_base=fixed_base, base=base, tips=tuple(tips), locked=tuple(locked),
                  payloads=tuple(payloads), actuators=tuple(actuators),
                  gravity=gravity, parameters=declared, symbolic=symbolic, outputs=outputs,
                  couplings=couplings)
+
+
+def _springs_and_controls(r: _SceneReader, data: dict, source: str) -> tuple[tuple, tuple]:
+    """``springs:`` and ``controls:``, read as eomgen's YAML reads a joint's ``spring`` and
+    ``controls`` (:mod:`eomgen.parsers.yaml_format`): a spring whose ``reference`` is a list
+    is a ball joint's; numbers only (a scene's parameters do not reach them yet)."""
+    springs = []
+    try:
+        if data.get("springs") is not None:
+            if not isinstance(data["springs"], dict):
+                raise r.error("springs", "expected a mapping of joint: {stiffness, reference}")
+            for joint, entry in data["springs"].items():
+                name = r.name(joint, "springs")
+                ball = isinstance(entry, dict) and isinstance(entry.get("reference"), list)
+                springs.append((name, read_spring(r, entry, f"springs '{name}'", source, ball)))
+        controls = (read_controls(r, data["controls"], None)
+                    if data.get("controls") is not None else ())
+    except SceneError:
+        raise
+    except DescriptionError as exc:
+        raise _as_scene_error(exc) from None
+    for where, values in [*((f"springs '{name}'", (spring.stiffness, *(
+            spring.reference if isinstance(spring, BallSpring) else (spring.reference,))))
+            for name, spring in springs),
+            *((f"controls '{c.name}'", _values(c)) for c in controls)]:
+        if any(getattr(v, "free_symbols", ()) for v in values):
+            raise r.error(where, "a scene's springs and controls take numbers, not parameters "
+                          "(write the symbolic ones in the robot's description)")
+    return tuple(springs), controls
+
+
+def _values(item) -> list:
+    """Every value held in ``item``'s fields (a dataclass), tuples opened."""
+    out, todo = [], [getattr(item, f.name) for f in fields(item)]
+    while todo:
+        value = todo.pop()
+        if isinstance(value, tuple):
+            todo.extend(value)
+        else:
+            out.append(value)
+    return out
 
 
 def _payload(r: _SceneReader, entry, k: int, source: str, strict: bool) -> Payload:

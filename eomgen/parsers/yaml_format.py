@@ -175,23 +175,27 @@ def parse(data: dict, source: str, strict: bool = False, default_name: str = "ro
 
     info = {"description": r.text(data["description"], "description")} \
         if "description" in data else {}
-    controls = _controls(r, data["controls"], joints) if "controls" in data else ()
+    controls = read_controls(r, data["controls"], joints) if "controls" in data else ()
     model = build_model(source, name, links, joints, gravity, r.used_parameters(), strict, info,
                         defer_notices=defer_notices)
     return replace(model, controls=controls) if controls else model
 
 
-def _controls(r: Reader, value, joints: list[Joint]) -> tuple[Control, ...]:
+#: The joint types a control or a fixed tendon acts on (one coordinate).
+ONE_AXIS = (JointType.REVOLUTE, JointType.CONTINUOUS, JointType.PRISMATIC, JointType.HELICAL)
+
+
+def read_controls(r: Reader, value, joints: list[Joint] | None) -> tuple[Control, ...]:
     """The ``controls:`` entries (module docstring), each on a one-coordinate joint or on a
     fixed tendon of such joints (``tendon: {joint: coefficient, …}``, named after the
-    control)."""
-    kinds = {joint.name: joint.type for joint in joints}
-    one = (JointType.REVOLUTE, JointType.CONTINUOUS, JointType.PRISMATIC, JointType.HELICAL)
+    control). ``joints`` None (a scene, read before its robot): the joints are checked when
+    the scene is applied."""
+    kinds = None if joints is None else {joint.name: joint.type for joint in joints}
     out, seen = [], set()
 
     def one_axis(joint: str, where: str) -> str:
         joint = r.name(joint, where)
-        if kinds.get(joint) not in one:
+        if kinds is not None and kinds.get(joint) not in ONE_AXIS:
             raise r.error(where, f"'{joint}' is not a revolute, prismatic or helical joint of "
                           "the robot")
         return joint
@@ -299,18 +303,24 @@ def _inertial(r: Reader, entry: dict, where: str) -> Inertial | None:
 
 
 def _spring(r: Reader, value, where: str, kind: JointType, source: str) -> Spring | BallSpring:
-    """A joint's ``spring: {stiffness, reference}``: ``stiffness`` ``k ≥ 0``, and on a joint
-    of one coordinate (:class:`~eomgen.model.Spring`, ``−k (q − q_ref)``) ``reference`` [rad or
-    m] (default 0) with ``k`` in [N m/rad or N/m]; on a spherical joint
-    (:class:`~eomgen.model.BallSpring`, MuJoCo's ``−k · subQuat(q, q_ref)``) ``reference`` the
-    quaternion ``[x, y, z, w]`` where it rests (default the identity; normalised) with ``k`` in
-    [N m/rad]."""
-    r.mapping(value, where, required=("stiffness",), optional=SPRING_KEYS)
+    """A joint's ``spring: {stiffness, reference}`` (:func:`read_spring`), on a joint of one
+    coordinate or a spherical one."""
     ball = kind is JointType.SPHERICAL
     if not ball and (kind.kind.nv != 1 or not kind.is_movable):
         raise UnsupportedError(source, where, f"a {kind.value} joint has no spring: only "
                                "joints of one coordinate (revolute, prismatic, ...) and "
                                "spherical joints have one")
+    return read_spring(r, value, where, source, ball)
+
+
+def read_spring(r: Reader, value, where: str, source: str, ball: bool) -> Spring | BallSpring:
+    """``{stiffness, reference}``: ``stiffness`` ``k ≥ 0``, and for a joint of one coordinate
+    (:class:`~eomgen.model.Spring`, ``−k (q − q_ref)``) ``reference`` [rad or m] (default 0)
+    with ``k`` in [N m/rad or N/m]; for a spherical joint (``ball``;
+    :class:`~eomgen.model.BallSpring`, MuJoCo's ``−k · subQuat(q, q_ref)``) ``reference`` the
+    quaternion ``[x, y, z, w]`` where it rests (default the identity; normalised) with ``k`` in
+    [N m/rad]."""
+    r.mapping(value, where, required=("stiffness",), optional=SPRING_KEYS)
     stiffness = r.scalar(value["stiffness"], f"{where} stiffness")
     if stiffness.is_number and stiffness < 0:
         raise UnsupportedError(source, f"{where} stiffness", f"a negative stiffness "

@@ -38,6 +38,7 @@ from ..scene import Payload, Scene, did_you_mean, scene_error
 from ..model.bodies import frame_site
 from .inertia import (clean_transform, combined_inertial, inertial_scalars, merged_gravcomp,
                       substituted_inertial, tidy)
+from .passive import with_springs_and_controls
 from .planar import in_plane, planar_motion
 from .loops import with_loops
 from .report import LockedJoint, MergedBody, ModelSize, Reduction, ReductionReport
@@ -79,7 +80,7 @@ def apply_scene(model: RobotModel, scene: Scene | None = None) -> Reduction:
         raise scene.error("robot", f"the scene is for robot '{scene.robot}', not "
                           f"'{model.name}' ({model.source})")
     before = ModelSize.of(model)
-    model = _with_actuators(model, scene)
+    model = with_springs_and_controls(_with_actuators(model, scene), scene)
     model, payloads, scene_gravity, notes = _parameters(model, scene)
     if scene.floating_base == "quaternion":
         model = _float(model, scene, FLOATING_BASES["quaternion"])
