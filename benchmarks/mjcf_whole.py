@@ -62,7 +62,8 @@ from eomgen.codegen.backends.numpy_backend import NumPyConfig, numpy_source  # n
 from eomgen.codegen.generate import generate  # noqa: E402
 from eomgen.codegen.job import make_job  # noqa: E402
 from eomgen.model.configuration import integrate, neutral  # noqa: E402
-from eomgen.parsers.mjcf.convert import layout, to_mujoco, velocity_map  # noqa: E402
+from eomgen.parsers.mjcf.convert import (full_mass_matrix, layout, to_mujoco,  # noqa: E402
+                                         velocity_map)
 from eomgen.parsers.mjcf.tree import rotation_of_quaternion  # noqa: E402
 from eomgen.symbolic.printing import NumPyModulePrinter, exec_source  # noqa: E402
 
@@ -120,11 +121,7 @@ def constrained(m, data) -> np.ndarray:
     ``[[M, Jᵀ], [J, 0]] (q̈, λ) = (qfrc_smooth, 0)`` of MuJoCo's arrays (``mj_fullM`` with the
     armature, ``efc_J``; ``J̇ = 0`` for joint and fixed-tendon equalities), what eomgen's
     couplings give (MuJoCo's own equalities are soft: its ``qacc_smooth`` is without them)."""
-    full = np.zeros((m.nv, m.nv))
-    if hasattr(data, "qM"):  # MuJoCo before 3.3: mj_fullM(m, dst, qM)
-        mujoco.mj_fullM(m, full, data.qM)
-    else:
-        mujoco.mj_fullM(m, data, full)
+    full = full_mass_matrix(m, data)
     rows = np.asarray(data.efc_type) == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
     J = np.asarray(data.efc_J).reshape(data.nefc, m.nv)[rows]
     K = np.block([[full, J.T], [J, np.zeros((len(J), len(J)))]])

@@ -27,7 +27,8 @@ from support.extras import need
 mujoco = need("mujoco", reason="MJCF is read by MuJoCo's compiler")
 
 from eomgen.parsers.mjcf import model_from_mujoco  # noqa: E402
-from eomgen.parsers.mjcf.convert import layout, to_mujoco, velocity_map  # noqa: E402
+from eomgen.parsers.mjcf.convert import (full_mass_matrix, layout, to_mujoco,  # noqa: E402
+                                         velocity_map)
 
 COUPLED = """<mujoco model="coupledctrl"><option gravity="0.3 -0.2 -9.81">
 <flag contact="disable"/></option><worldbody>
@@ -74,11 +75,7 @@ def constrained(m, lay, q, v, ctrl, act, rows=2):
     data.qpos[:], data.qvel[:] = to_mujoco(lay, q, v)
     data.ctrl[:], data.act[:] = ctrl, act
     mujoco.mj_forward(m, data)
-    full = np.zeros((m.nv, m.nv))
-    if hasattr(data, "qM"):  # MuJoCo before 3.3: mj_fullM(m, dst, qM)
-        mujoco.mj_fullM(m, full, data.qM)
-    else:
-        mujoco.mj_fullM(m, data, full)
+    full = full_mass_matrix(m, data)
     held = np.asarray(data.efc_type) == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)
     J = np.asarray(data.efc_J).reshape(data.nefc, m.nv)[held]
     assert len(J) == rows

@@ -169,11 +169,7 @@ def mujoco_dynamics(m, lay: Layout, q, v) -> dict[str, np.ndarray]:
     qpos[_absent(m, lay)] = m.qpos0[_absent(m, lay)]
     data.qpos[:], data.qvel[:] = qpos, qvel
     mujoco.mj_forward(m, data)
-    full = np.zeros((m.nv, m.nv))
-    if hasattr(data, "qM"):  # MuJoCo before 3.3: mj_fullM(m, dst, qM)
-        mujoco.mj_fullM(m, full, data.qM)
-    else:
-        mujoco.mj_fullM(m, data, full)
+    full = full_mass_matrix(m, data)
     T = velocity_map(lay, qpos)
     drift = np.zeros(m.nv)  # Ṫ v
     if lay.free is not None:
@@ -186,6 +182,19 @@ def mujoco_dynamics(m, lay: Layout, q, v) -> dict[str, np.ndarray]:
             "passive": T.T @ data.qfrc_passive,
             **{part: T.T @ getattr(data, f"qfrc_{part}") for part in ("damper", "spring")
                if hasattr(data, f"qfrc_{part}")}}  # parts kept apart since MuJoCo 3.1
+
+
+def full_mass_matrix(m, data) -> np.ndarray:
+    """MuJoCo's dense mass matrix (nv × nv) of ``data`` after ``mj_forward``, by ``mj_fullM``
+    in the signature of the installed MuJoCo (before 3.3 it took ``qM``)."""
+    import mujoco  # an optional dependency, present whenever a compiled model is
+
+    full = np.zeros((m.nv, m.nv))
+    if hasattr(data, "qM"):  # MuJoCo before 3.3: mj_fullM(m, dst, qM)
+        mujoco.mj_fullM(m, full, data.qM)
+    else:
+        mujoco.mj_fullM(m, data, full)
+    return full
 
 
 def _absent(m, lay: Layout) -> np.ndarray:
